@@ -1,0 +1,121 @@
+//! Command-line arguments: parsers that turn text into the core's validated types, so every
+//! message about a bad value comes from the library's one registry.
+
+use clap::builder::{PossibleValue, TypedValueParser};
+use clap::{Arg, Command, ValueEnum};
+use specula::analysis::Precision;
+use specula::{Exponent, Geometry, LobeKind};
+
+/// Parses lobe ids against the registry and lists its ids as the possible values in `--help`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LobeParser;
+
+impl TypedValueParser for LobeParser {
+    type Value = LobeKind;
+
+    fn parse_ref(
+        &self,
+        cmd: &Command,
+        arg: Option<&Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<LobeKind, clap::Error> {
+        let text = value.to_string_lossy();
+        LobeKind::parse(&text).map_err(|error| invalid_value(cmd, arg, &error.to_string()))
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        Some(Box::new(LobeKind::ALL.into_iter().map(|kind| {
+            PossibleValue::new(kind.id()).help(kind.info().summary)
+        })))
+    }
+}
+
+/// Parses a specular exponent in `[1, 1000]`.
+pub fn parse_exponent(text: &str) -> Result<Exponent, String> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number; n must be a number in [1, 1000]"))?;
+    Exponent::try_new(value).map_err(|error| error.to_string())
+}
+
+/// Parses a cosine in `[-1, 1]`.
+pub fn parse_cosine(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number; a cosine must be in [-1, 1]"))?;
+    if (-1.0..=1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(specula::Error::CosineOutOfRange { value }.to_string())
+    }
+}
+
+/// Parses an angle in degrees (any finite value; the lobe is symmetric and 0 past 90).
+pub fn parse_degrees(text: &str) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|value| value.is_finite())
+        .ok_or_else(|| format!("'{text}' is not a finite angle in degrees"))
+}
+
+fn invalid_value(cmd: &Command, arg: Option<&Arg>, message: &str) -> clap::Error {
+    let name = arg.map_or_else(|| "value".to_owned(), |arg| arg.to_string());
+    clap::Error::raw(
+        clap::error::ErrorKind::ValueValidation,
+        format!("invalid {name}: {message}\n"),
+    )
+    .with_cmd(cmd)
+}
+
+/// Output formats of the table commands.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// Aligned columns for reading.
+    #[default]
+    Table,
+    /// Comma-separated values with a header row.
+    Csv,
+    /// JSON (an array of objects).
+    Json,
+}
+
+/// `phong` or `blinn`, as a clap value.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum GeometryArg {
+    /// t = R.V.
+    #[default]
+    Phong,
+    /// t = N.H.
+    Blinn,
+}
+
+impl From<GeometryArg> for Geometry {
+    fn from(arg: GeometryArg) -> Self {
+        match arg {
+            GeometryArg::Phong => Geometry::Phong,
+            GeometryArg::Blinn => Geometry::Blinn,
+        }
+    }
+}
+
+/// The arithmetic the analysis evaluates lobes in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum BackendArg {
+    /// The f64 reference path.
+    #[default]
+    F64,
+    /// The f32 fast path.
+    F32,
+}
+
+impl From<BackendArg> for Precision {
+    fn from(arg: BackendArg) -> Self {
+        match arg {
+            BackendArg::F64 => Precision::F64,
+            BackendArg::F32 => Precision::F32,
+        }
+    }
+}

@@ -1,0 +1,97 @@
+//! `specula analyze`: every figure of SPEC section 4 for lobes x exponents.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use specula::analysis::{analyze, LobeReport, DEFAULT_EXPONENTS};
+use specula::{Exponent, LobeKind};
+
+use super::{print_json, CommandResult};
+use crate::args::{parse_exponent, BackendArg, Format, LobeParser};
+use crate::output::{percent, sig, Table};
+
+/// Arguments of `specula analyze`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Lobes to analyse, comma separated (default: all).
+    #[arg(long, value_parser = LobeParser, value_delimiter = ',')]
+    lobe: Vec<LobeKind>,
+    /// Exponents, comma separated (default: 1,2,4,8,16,32,64,128,256,512,1000).
+    #[arg(long, value_parser = parse_exponent, value_delimiter = ',')]
+    n: Vec<Exponent>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t)]
+    format: Format,
+    /// Arithmetic for the error figures: the f64 reference or the f32 fast path.
+    #[arg(long, value_enum, default_value_t)]
+    backend: BackendArg,
+}
+
+/// Analyses and prints.
+pub fn run(args: &Args) -> CommandResult {
+    let lobes = if args.lobe.is_empty() {
+        LobeKind::ALL.to_vec()
+    } else {
+        args.lobe.clone()
+    };
+    let exponents: Vec<Exponent> = if args.n.is_empty() {
+        DEFAULT_EXPONENTS
+            .iter()
+            .map(|&n| Exponent::new(n))
+            .collect()
+    } else {
+        args.n.clone()
+    };
+    let jobs: Vec<(LobeKind, Exponent)> = lobes
+        .iter()
+        .flat_map(|&lobe| exponents.iter().map(move |&n| (lobe, n)))
+        .collect();
+    let progress = ProgressBar::new(jobs.len() as u64).with_style(
+        ProgressStyle::with_template("analyzing {bar:30} {pos}/{len} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let precision = args.backend.into();
+    let reports: Vec<LobeReport> = jobs
+        .par_iter()
+        .map(|&(lobe, n)| {
+            let report = analyze(lobe, n, precision);
+            progress.inc(1);
+            report
+        })
+        .collect();
+    progress.finish_and_clear();
+    if args.format == Format::Json {
+        return print_json(&reports);
+    }
+    let mut table = Table::new(&[
+        "lobe",
+        "n",
+        "epicentre max rel",
+        "epicentre max abs",
+        "bloom max abs",
+        "tail max abs",
+        "rms",
+        "energy ratio",
+        "max albedo",
+        "ops",
+    ]);
+    for r in &reports {
+        table.push(vec![
+            r.lobe.to_string(),
+            r.n.to_string(),
+            percent(r.errors.epicentre_max_rel),
+            sig(r.errors.epicentre_max_abs),
+            sig(r.errors.bloom_max_abs),
+            sig(r.errors.tail_max_abs),
+            sig(r.errors.rms),
+            sig(r.energy_ratio),
+            sig(r.max_albedo),
+            r.ops.to_string(),
+        ]);
+    }
+    if args.format == Format::Csv {
+        print!("{}", table.csv());
+    } else {
+        print!("{}", table.render());
+    }
+    Ok(())
+}

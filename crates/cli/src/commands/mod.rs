@@ -1,0 +1,16 @@
+//! One module per subcommand: its arguments and what it prints.
+
+pub mod analyze;
+pub mod claims;
+pub mod eval;
+pub mod models;
+
+/// What a command reports when it fails: a one-line message.
+pub type CommandResult = Result<(), String>;
+
+/// Serialises `value` as pretty JSON followed by a newline.
+pub fn print_json(value: &impl serde::Serialize) -> CommandResult {
+    let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
+    println!("{text}");
+    Ok(())
+}

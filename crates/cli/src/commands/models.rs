@@ -1,0 +1,92 @@
+//! `specula models`: the registry as a table.
+
+use serde::Serialize;
+use specula::lobe::{LobeInfo, LobeKind};
+use specula::ops::OpCounts;
+use specula::{Exponent, Lobe};
+
+use super::{print_json, CommandResult};
+use crate::args::{parse_exponent, Format};
+use crate::output::Table;
+
+/// Arguments of `specula models`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The exponent at which operations are counted (some lobes' cost depends on n).
+    #[arg(long, default_value = "100", value_parser = parse_exponent)]
+    n: Exponent,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t)]
+    format: Format,
+}
+
+#[derive(Serialize)]
+struct ModelRow {
+    #[serde(flatten)]
+    info: &'static LobeInfo,
+    ops_at_n: f64,
+    ops: OpCounts,
+    ops_total: u32,
+}
+
+/// Prints the registry.
+pub fn run(args: &Args) -> CommandResult {
+    let rows: Vec<ModelRow> = LobeKind::ALL
+        .into_iter()
+        .map(|kind| {
+            let ops = Lobe::new(kind, args.n).ops();
+            ModelRow {
+                info: kind.info(),
+                ops_at_n: args.n.get(),
+                ops,
+                ops_total: ops.total(),
+            }
+        })
+        .collect();
+    match args.format {
+        Format::Json => print_json(&rows),
+        Format::Table | Format::Csv => {
+            let ops_header = format!("ops at n = {}", args.n);
+            let mut table = Table::new(&[
+                "id",
+                "origin",
+                "input",
+                "params",
+                "formula",
+                &ops_header,
+                "total",
+            ]);
+            for row in &rows {
+                let params: Vec<String> = row
+                    .info
+                    .params
+                    .iter()
+                    .map(|p| format!("{}={} [{}..{}]", p.name, p.default, p.min, p.max))
+                    .collect();
+                table.push(vec![
+                    row.info.id.to_owned(),
+                    serde_json::to_value(row.info.origin)
+                        .ok()
+                        .and_then(|v| v.as_str().map(str::to_owned))
+                        .unwrap_or_default(),
+                    if row.info.takes_angle {
+                        "angle"
+                    } else {
+                        "cosine"
+                    }
+                    .to_owned(),
+                    params.join(" "),
+                    row.info.formula.to_owned(),
+                    row.ops.to_string(),
+                    row.ops_total.to_string(),
+                ]);
+            }
+            if args.format == Format::Csv {
+                print!("{}", table.csv());
+            } else {
+                print!("{}", table.render());
+            }
+            Ok(())
+        }
+    }
+}

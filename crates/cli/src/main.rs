@@ -1,0 +1,61 @@
+//! `specula`: the command-line face of the specula workbench.
+//!
+//! Each subcommand lives in `commands/`; argument parsing delegates to the core's registry
+//! (`args.rs`), so ids, ranges and their error messages have one source. Every failure is a
+//! one-line message on stderr and exit code 2.
+
+mod args;
+mod commands;
+mod output;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// specula: a workbench for specular reflectance models (Phong/Blinn lobes and their cheap
+/// approximations).
+#[derive(Debug, Parser)]
+#[command(name = "specula", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// List every lobe model: id, formula, parameters, operation counts.
+    #[command(after_help = "Examples:\n  specula models\n  specula models --n 512 --format json")]
+    Models(commands::models::Args),
+    /// Evaluate one lobe at one cosine or angle, next to the exact t^n.
+    #[command(
+        after_help = "Examples:\n  specula eval --lobe schlick --n 32 --cos 0.98\n  \
+                            specula eval --lobe cheb2 --n 100 --angle 5 --geometry blinn\n  \
+                            specula eval --lobe cosquad:v=5 --n 64 --cos 0.99"
+    )]
+    Eval(commands::eval::Args),
+    /// Measure lobes against t^n: error per zone, energy, albedo, cost.
+    #[command(after_help = "Examples:\n  specula analyze\n  \
+                            specula analyze --lobe schlick,schlick-mod --n 16,256\n  \
+                            specula analyze --format json --backend f32 > errors.json")]
+    Analyze(commands::analyze::Args),
+    /// Test the thesis's claims (SPEC section 9) with measured figures and verdicts.
+    #[command(after_help = "Examples:\n  specula claims\n  specula claims --format json")]
+    Claims(commands::claims::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Models(args) => commands::models::run(&args),
+        Command::Eval(args) => commands::eval::run(&args),
+        Command::Analyze(args) => commands::analyze::run(&args),
+        Command::Claims(args) => commands::claims::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,83 @@
+//! Measuring a lobe against `t^n`: errors per zone, energy, albedo, reciprocity, cost.
+//!
+//! [`analyze`] gathers every figure of SPEC section 4 and the white-furnace maximum of
+//! section 6 for one lobe at one `n`; the submodules expose each measurement on its own.
+
+pub mod albedo;
+pub mod error;
+pub mod reciprocity;
+
+use glam::DVec3;
+use serde::Serialize;
+
+pub use albedo::{directional_albedo, max_directional_albedo, specular_albedo_per_unit};
+pub use error::{error_figures, ErrorFigures, Precision, DEFAULT_SAMPLES_PER_ZONE};
+pub use reciprocity::max_reciprocity_error;
+
+use crate::normalisation::{lobe_constant, lobe_integral};
+use crate::ops::OpCounts;
+use crate::{Brdf, Exponent, Geometry, Lobe, LobeKind, Normalisation};
+
+/// Every figure for one lobe at one `n` (the rows of `specula analyze`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LobeReport {
+    /// The lobe (id with parameters).
+    pub lobe: LobeKind,
+    /// The exponent.
+    pub n: f64,
+    /// The arithmetic the lobe was evaluated in for the error figures.
+    pub precision: Precision,
+    /// Error figures, flattened into the report.
+    #[serde(flatten)]
+    pub errors: ErrorFigures,
+    /// `int_0^{pi/2} lobe(cos g) sin g dg / (1/(n+1))`: 1 means energy-matched to `t^n`.
+    pub energy_ratio: f64,
+    /// The constant that makes this lobe integrate to 1 (`lobe` normalisation, numeric).
+    pub lobe_norm_numeric: f64,
+    /// `(n+1)/(2 pi)`, the analytic constant of `t^n`, for comparison.
+    pub lobe_norm_analytic: f64,
+    /// The largest directional albedo of the `lobe`-normalised BRDF, `kd = 0`, `ks = 1`,
+    /// Phong geometry (at most 1 for an energy-conserving model).
+    pub max_albedo: f64,
+    /// The outgoing polar angle (degrees) of that maximum.
+    pub max_albedo_theta_deg: f64,
+    /// Operations of one evaluation from a cosine.
+    pub ops: OpCounts,
+}
+
+/// All figures for `kind` at `n`, with errors evaluated in `precision`.
+#[must_use]
+pub fn analyze(kind: LobeKind, n: Exponent, precision: Precision) -> LobeReport {
+    let lobe = Lobe::new(kind, n);
+    let brdf = Brdf::new(
+        DVec3::ZERO,
+        DVec3::ONE,
+        lobe,
+        Geometry::Phong,
+        Normalisation::Lobe,
+    );
+    let (theta, max_albedo) = max_directional_albedo(&brdf);
+    LobeReport {
+        lobe: kind,
+        n: n.get(),
+        precision,
+        errors: error_figures(&lobe, precision, DEFAULT_SAMPLES_PER_ZONE),
+        energy_ratio: energy_ratio(&lobe),
+        lobe_norm_numeric: lobe_constant(&lobe),
+        lobe_norm_analytic: Normalisation::Lobe.analytic(n),
+        max_albedo,
+        max_albedo_theta_deg: theta.to_degrees(),
+        ops: lobe.ops(),
+    }
+}
+
+/// The lobe's energy relative to `t^n`: `(n + 1) int_0^{pi/2} lobe(cos g) sin g dg`.
+#[must_use]
+pub fn energy_ratio(lobe: &Lobe) -> f64 {
+    lobe_integral(lobe) * (lobe.exponent().get() + 1.0)
+}
+
+/// The exponents `specula analyze` uses by default.
+pub const DEFAULT_EXPONENTS: [f64; 11] = [
+    1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0, 1000.0,
+];

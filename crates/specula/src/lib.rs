@@ -1,0 +1,51 @@
+//! # specula: specular lobes of the Phong/Blinn family
+//!
+//! The core of the specula workbench: every model of the thesis and SPEC (`pow`, `schlick`,
+//! `schlick-mod`, `cheb2-thesis`, `cheb2`, `logexp`, `cosquad`, and measured variants), the
+//! geometries and normalisations that turn a lobe into a BRDF, and the analysis that measures
+//! each model against `t^n`. No I/O: renderers, GPU code, hardware models and the CLI build on
+//! this crate.
+//!
+//! ## Design
+//! - **One formula, three arithmetics.** Each lobe is written once, generic over [`Real`]:
+//!   `f64` is the reference, `f32` the fast path, [`ops::Counted`] counts operations (so the
+//!   registry's cost column is measured, not typed).
+//! - **Closed set, static dispatch.** [`LobeKind`] enumerates the models; [`Lobe`] is one
+//!   prepared for an exponent, evaluated through a `match` (the shape of a WGSL `switch`).
+//! - **Validated once.** [`Exponent`] holds an `n` in `[1, 1000]`; nothing downstream
+//!   re-checks or clamps it.
+//! - **Vocabulary** (pbrt's): directions `wo` (towards the viewer) and `wi` (towards the light)
+//!   in a local frame whose `z` axis is the normal; angles in radians; `t` is the cosine the
+//!   lobe is a function of (`R.V` for Phong, `N.H` for Blinn).
+//!
+//! ```
+//! use specula::{Exponent, Lobe, LobeKind};
+//! let lobe = Lobe::new(LobeKind::CosQuad { v: 4 }, Exponent::new(64.0));
+//! let exact = Lobe::new(LobeKind::Pow, Exponent::new(64.0));
+//! let t = 0.995_f64;
+//! assert!((lobe.eval(t) - exact.eval(t)).abs() < 0.05);
+//! assert_eq!(lobe.eval(-0.3_f64), 0.0);
+//! ```
+
+pub mod analysis;
+pub mod brdf;
+pub mod claims;
+mod error;
+mod exponent;
+pub mod fit;
+pub mod geometry;
+pub mod lobe;
+pub mod normalisation;
+pub mod ops;
+pub mod quadrature;
+mod real;
+pub mod zones;
+
+pub use brdf::{Brdf, ClassicModel, Rgb};
+pub use error::{Error, Result};
+pub use exponent::Exponent;
+pub use geometry::Geometry;
+pub use lobe::{Lobe, LobeKind};
+pub use normalisation::Normalisation;
+pub use real::Real;
+pub use zones::Zone;

@@ -1,0 +1,62 @@
+//! # `cosquad`: the thesis's cosine-quadratic lobe `K_v`
+//!
+//! ```text
+//! cosquad(t) = max(0, a (t - 1) + 1)^(2^v),   a = (n + 1) / (2^v + 1)
+//! K_4(t)     = max(0, (n + 1)/17 (t - 1) + 1)^16
+//! ```
+//!
+//! A low-order polynomial in the cosine raised to a power of two, so it costs `v` squarings.
+//! `a` is chosen so that the lobe has the energy of `t^n`:
+//! `int_0^{acos((a-1)/a)} (a (cos g - 1) + 1)^(2^v) sin g dg = 1 / ((2^v + 1) a) = 1 / (n + 1)`.
+//! That holds exactly when the lobe's support ends inside the hemisphere, i.e. `a >= 1`, i.e.
+//! `n >= 2^v`; for smaller `n` the part beyond `g = pi/2` is cut off (SPEC: `t <= 0` gives 0)
+//! and the energy falls short.
+//!
+//! - **Parameters**: the exponent `n`; `v`, the number of squarings (default 4, `K_4`),
+//!   0 to 10.
+//! - **Domain**: `t in (0, 1]`; the base is at most 1, so the value lies in `[0, 1]`.
+//! - **Cost**: two adds, one multiply (by the per-material constant `a`), one comparison,
+//!   `v` squarings.
+//! - **Source**: the thesis, slide "A model based on a cosine-quadratic function".
+
+use crate::real::Real;
+use crate::Exponent;
+
+/// The prepared cosine-quadratic lobe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CosQuad {
+    a: f64,
+    v: u8,
+}
+
+impl CosQuad {
+    /// The default number of squarings (the thesis's `K_4`).
+    pub const DEFAULT_V: u8 = 4;
+    /// The largest supported number of squarings.
+    pub const MAX_V: u8 = 10;
+
+    pub(crate) fn new(n: Exponent, v: u8) -> Self {
+        let v = v.min(Self::MAX_V);
+        Self {
+            a: (n.get() + 1.0) / (f64::from(1u32 << v) + 1.0),
+            v,
+        }
+    }
+
+    /// The per-material slope `a = (n + 1) / (2^v + 1)`.
+    #[must_use]
+    pub fn slope(&self) -> f64 {
+        self.a
+    }
+
+    /// Evaluates at `t in (0, 1]`.
+    #[inline(always)]
+    pub(crate) fn eval<R: Real>(&self, t: R) -> R {
+        let one = R::from_f64(1.0);
+        let mut value = (R::from_f64(self.a) * (t - one) + one).max(R::from_f64(0.0));
+        for _ in 0..self.v {
+            value = value.square();
+        }
+        value
+    }
+}

@@ -1,0 +1,304 @@
+//! The registry: every lobe specula knows, its id, description and parameters.
+//!
+//! [`LobeKind`] is the closed set of models; [`LobeInfo`] is what the CLI's `models` table, its
+//! help text, the id parser and the documentation read. Adding a model means adding a variant
+//! here and an entry in [`LobeKind::info`]; the compiler then points at every `match` that
+//! must learn it.
+
+use serde::{Serialize, Serializer};
+
+use super::CosQuad;
+use crate::error::{Error, Result};
+
+/// Which lobe function, with its structural parameters (but not `n`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LobeKind {
+    /// `t^n`, the reference.
+    Pow,
+    /// Schlick's rational approximation.
+    Schlick,
+    /// The thesis's modified Schlick lobe.
+    SchlickMod,
+    /// The thesis's quadratic in the angle, with the slide's coefficient formulas.
+    Cheb2Thesis,
+    /// The thesis's Chebyshev method applied per `n` over the epicentre.
+    Cheb2,
+    /// The minimax relative-error quadratic in the angle over the epicentre.
+    Minimax2,
+    /// The thesis's log/exp lobe.
+    LogExp,
+    /// The log/exp lobe with range reduction.
+    LogExpRr,
+    /// The thesis's cosine-quadratic lobe with `v` squarings (`K_v`).
+    CosQuad {
+        /// Number of squarings, `0..=10`.
+        v: u8,
+    },
+}
+
+/// A lobe parameter other than `n`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ParamInfo {
+    /// Its name in ids such as `cosquad:v=5`.
+    pub name: &'static str,
+    /// What it does.
+    pub description: &'static str,
+    /// The default value.
+    pub default: u32,
+    /// The smallest valid value.
+    pub min: u32,
+    /// The largest valid value.
+    pub max: u32,
+}
+
+/// Where a lobe comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Origin {
+    /// The classic lobe every approximation is measured against.
+    Reference,
+    /// Published before the thesis.
+    Literature,
+    /// Proposed in the thesis.
+    Thesis,
+    /// A variant added by specula, measured the same way.
+    Specula,
+}
+
+/// A registry entry.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LobeInfo {
+    /// The id used on the command line and in scenes.
+    pub id: &'static str,
+    /// One line on what the lobe is.
+    pub summary: &'static str,
+    /// The formula, in plain text.
+    pub formula: &'static str,
+    /// Whether the lobe's native input is the angle `g` rather than the cosine `t`.
+    pub takes_angle: bool,
+    /// Parameters other than `n`.
+    pub params: &'static [ParamInfo],
+    /// Where it comes from.
+    pub origin: Origin,
+}
+
+const COSQUAD_V: ParamInfo = ParamInfo {
+    name: "v",
+    description: "number of squarings; the lobe is a polynomial of degree 2^v in the cosine",
+    default: CosQuad::DEFAULT_V as u32,
+    min: 0,
+    max: CosQuad::MAX_V as u32,
+};
+
+impl LobeKind {
+    /// Every lobe, with default parameters, in the order tables list them.
+    pub const ALL: [LobeKind; 9] = [
+        LobeKind::Pow,
+        LobeKind::Schlick,
+        LobeKind::SchlickMod,
+        LobeKind::Cheb2Thesis,
+        LobeKind::Cheb2,
+        LobeKind::Minimax2,
+        LobeKind::LogExp,
+        LobeKind::LogExpRr,
+        LobeKind::CosQuad {
+            v: CosQuad::DEFAULT_V,
+        },
+    ];
+
+    /// The registry entry.
+    #[must_use]
+    pub fn info(self) -> &'static LobeInfo {
+        match self {
+            LobeKind::Pow => &LobeInfo {
+                id: "pow",
+                summary: "the exact lobe t^n (Phong, Blinn): the reference",
+                formula: "t^n",
+                takes_angle: false,
+                params: &[],
+                origin: Origin::Reference,
+            },
+            LobeKind::Schlick => &LobeInfo {
+                id: "schlick",
+                summary: "Schlick's rational approximation",
+                formula: "t / (n (1 - t) + t)",
+                takes_angle: false,
+                params: &[],
+                origin: Origin::Literature,
+            },
+            LobeKind::SchlickMod => &LobeInfo {
+                id: "schlick-mod",
+                summary: "the thesis's modified Schlick: a power of two of t in the numerator",
+                formula: "t^a / (n (1 - t) + t), a = 2^max(0, floor(log2 n) - 2)",
+                takes_angle: false,
+                params: &[],
+                origin: Origin::Thesis,
+            },
+            LobeKind::Cheb2Thesis => &LobeInfo {
+                id: "cheb2-thesis",
+                summary: "quadratic in the angle, the thesis's slide coefficients fra(n), frb(n)",
+                formula: "max(0, 1 + frb(n) g + fra(n) g^2), g = acos t",
+                takes_angle: true,
+                params: &[],
+                origin: Origin::Thesis,
+            },
+            LobeKind::Cheb2 => &LobeInfo {
+                id: "cheb2",
+                summary: "quadratic in the angle, 3-node Chebyshev fit of cos^n over the epicentre",
+                formula: "max(0, C + B g + A g^2), g = acos t, fitted per n",
+                takes_angle: true,
+                params: &[],
+                origin: Origin::Thesis,
+            },
+            LobeKind::Minimax2 => &LobeInfo {
+                id: "minimax2",
+                summary: "quadratic in the angle, minimax relative error over the epicentre",
+                formula: "max(0, C + B g + A g^2), g = acos t, Remez per n",
+                takes_angle: true,
+                params: &[],
+                origin: Origin::Specula,
+            },
+            LobeKind::LogExp => &LobeInfo {
+                id: "logexp",
+                summary: "the thesis's log/exp lobe: 2^y replaced by a second log2",
+                formula: "max(0, 1 - log2(1 - y) / 2), y = n log2 t",
+                takes_angle: false,
+                params: &[],
+                origin: Origin::Thesis,
+            },
+            LobeKind::LogExpRr => &LobeInfo {
+                id: "logexp-rr",
+                summary: "log/exp with range reduction: exact shift for the integer part of y",
+                formula: "2^k (1 - log2(1 - (y - k)) / 2), y = n log2 t, k = ceil y",
+                takes_angle: false,
+                params: &[],
+                origin: Origin::Specula,
+            },
+            LobeKind::CosQuad { .. } => &LobeInfo {
+                id: "cosquad",
+                summary: "the thesis's cosine-quadratic K_v, energy-matched to t^n",
+                formula: "max(0, a (t - 1) + 1)^(2^v), a = (n + 1) / (2^v + 1)",
+                takes_angle: false,
+                params: &[COSQUAD_V],
+                origin: Origin::Thesis,
+            },
+        }
+    }
+
+    /// The id without parameters, e.g. `cosquad`.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        self.info().id
+    }
+
+    /// Every registered id, comma separated (for error messages and help).
+    #[must_use]
+    pub fn valid_ids() -> String {
+        Self::ALL.map(LobeKind::id).join(", ")
+    }
+
+    /// Parses `ID` or `ID:param=value`, e.g. `schlick`, `cosquad:v=5`.
+    pub fn parse(text: &str) -> Result<Self> {
+        let text = text.trim();
+        let (id, params) = match text.split_once(':') {
+            Some((id, params)) => (id, Some(params)),
+            None => (text, None),
+        };
+        let kind = Self::ALL
+            .into_iter()
+            .find(|kind| kind.id().eq_ignore_ascii_case(id))
+            .ok_or_else(|| Error::UnknownLobe {
+                id: id.to_owned(),
+                valid: Self::valid_ids(),
+            })?;
+        match (kind, params) {
+            (_, None) => Ok(kind),
+            (LobeKind::CosQuad { .. }, Some(params)) => {
+                let v = parse_param(kind.id(), &COSQUAD_V, params)?;
+                Ok(LobeKind::CosQuad { v: v as u8 })
+            }
+            (_, Some(params)) => Err(Error::InvalidLobeParameter {
+                lobe: kind.id(),
+                message: format!("'{params}' given, but this lobe takes no parameters besides n"),
+            }),
+        }
+    }
+}
+
+fn parse_param(lobe: &'static str, param: &ParamInfo, text: &str) -> Result<u32> {
+    let invalid = |message: String| Error::InvalidLobeParameter { lobe, message };
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| invalid(format!("expected '{}=VALUE', got '{text}'", param.name)))?;
+    if name.trim() != param.name {
+        return Err(invalid(format!(
+            "unknown parameter '{name}'; valid: {}",
+            param.name
+        )));
+    }
+    value
+        .trim()
+        .parse::<u32>()
+        .ok()
+        .filter(|v| (param.min..=param.max).contains(v))
+        .ok_or_else(|| {
+            invalid(format!(
+                "{} = '{value}' is not an integer in [{}, {}]",
+                param.name, param.min, param.max
+            ))
+        })
+}
+
+impl core::fmt::Display for LobeKind {
+    /// The id, with parameters only where they differ from the defaults.
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            LobeKind::CosQuad { v } if *v != CosQuad::DEFAULT_V => write!(f, "cosquad:v={v}"),
+            kind => f.write_str(kind.id()),
+        }
+    }
+}
+
+impl core::str::FromStr for LobeKind {
+    type Err = Error;
+    fn from_str(text: &str) -> Result<Self> {
+        Self::parse(text)
+    }
+}
+
+impl Serialize for LobeKind {
+    fn serialize<S: Serializer>(&self, serializer: S) -> core::result::Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_id_round_trips_and_is_unique() {
+        for kind in LobeKind::ALL {
+            assert_eq!(LobeKind::parse(&kind.to_string()), Ok(kind));
+            let same_id = LobeKind::ALL.iter().filter(|k| k.id() == kind.id()).count();
+            assert_eq!(same_id, 1, "{kind} registered twice");
+        }
+        assert_eq!(
+            LobeKind::parse("cosquad:v=6"),
+            Ok(LobeKind::CosQuad { v: 6 })
+        );
+        assert_eq!(LobeKind::CosQuad { v: 6 }.to_string(), "cosquad:v=6");
+    }
+
+    #[test]
+    fn bad_ids_and_parameters_name_the_valid_choices() {
+        let message = LobeKind::parse("phong").unwrap_err().to_string();
+        assert!(
+            message.contains("phong") && message.contains("schlick-mod"),
+            "{message}"
+        );
+        for bad in ["cosquad:v=11", "cosquad:w=3", "cosquad:v", "schlick:v=2"] {
+            assert!(LobeKind::parse(bad).is_err(), "{bad} accepted");
+        }
+    }
+}

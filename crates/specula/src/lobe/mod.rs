@@ -1,0 +1,145 @@
+//! The lobe functions: every approximation of `t^n` that specula knows (SPEC section 2).
+//!
+//! A [`Lobe`] is a model *prepared* for one exponent: everything that depends only on `n`
+//! (Schlick's power, the Chebyshev coefficients, the cosine-quadratic slope) is computed once
+//! in `f64` when it is built, the way a renderer would upload it per material. Evaluation is a
+//! `match` over a closed set of models (static dispatch, no trait objects), each written once
+//! over [`Real`] and thereby available in `f64` (reference), `f32` (fast path) and
+//! [`Counted`] (operation counts).
+//!
+//! Rules every lobe obeys (SPEC section 1), enforced here in one place: `t <= 0` (and NaN)
+//! gives 0; `t > 1` is treated as 1 (dot products of unit vectors overshoot by an ulp); the
+//! value is never NaN, negative, or above 1.
+
+mod cheb2;
+mod cheb2_thesis;
+mod cosquad;
+mod kind;
+mod logexp;
+mod logexp_rr;
+mod minimax2;
+mod pow;
+mod quadratic;
+mod schlick;
+mod schlick_mod;
+
+pub use cheb2_thesis::thesis_coefficients;
+pub use cosquad::CosQuad;
+pub use kind::{LobeInfo, LobeKind, Origin, ParamInfo};
+pub use quadratic::AngleQuadratic;
+
+use crate::ops::{count_ops, Counted, OpCounts};
+use crate::real::Real;
+use crate::Exponent;
+
+/// A lobe function prepared for one exponent `n`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lobe {
+    kind: LobeKind,
+    n: Exponent,
+    model: Model,
+}
+
+/// The prepared state, one variant per distinct evaluation routine.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Model {
+    Pow(pow::Pow),
+    Schlick(schlick::Schlick),
+    SchlickMod(schlick_mod::SchlickMod),
+    AngleQuadratic(AngleQuadratic),
+    LogExp(logexp::LogExp),
+    LogExpRr(logexp_rr::LogExpRr),
+    CosQuad(CosQuad),
+}
+
+impl Lobe {
+    /// Prepares `kind` for exponent `n`.
+    #[must_use]
+    pub fn new(kind: LobeKind, n: Exponent) -> Self {
+        let model = match kind {
+            LobeKind::Pow => Model::Pow(pow::Pow::new(n)),
+            LobeKind::Schlick => Model::Schlick(schlick::Schlick::new(n)),
+            LobeKind::SchlickMod => Model::SchlickMod(schlick_mod::SchlickMod::new(n)),
+            LobeKind::Cheb2Thesis => Model::AngleQuadratic(cheb2_thesis::new(n)),
+            LobeKind::Cheb2 => Model::AngleQuadratic(cheb2::new(n)),
+            LobeKind::Minimax2 => Model::AngleQuadratic(minimax2::new(n)),
+            LobeKind::LogExp => Model::LogExp(logexp::LogExp::new(n)),
+            LobeKind::LogExpRr => Model::LogExpRr(logexp_rr::LogExpRr::new(n)),
+            LobeKind::CosQuad { v } => Model::CosQuad(CosQuad::new(n, v)),
+        };
+        Self { kind, n, model }
+    }
+
+    /// Prepares `kind` for exponent `n`, validating `n` (see [`Exponent::try_new`]).
+    pub fn try_new(kind: LobeKind, n: f64) -> crate::Result<Self> {
+        Ok(Self::new(kind, Exponent::try_new(n)?))
+    }
+
+    /// Which model this is.
+    #[must_use]
+    pub fn kind(&self) -> LobeKind {
+        self.kind
+    }
+
+    /// The exponent it was prepared for.
+    #[must_use]
+    pub fn exponent(&self) -> Exponent {
+        self.n
+    }
+
+    /// The coefficients `[C, B, A]` of a quadratic-in-angle lobe, `None` for the others.
+    #[must_use]
+    pub fn angle_quadratic(&self) -> Option<AngleQuadratic> {
+        match self.model {
+            Model::AngleQuadratic(q) => Some(q),
+            _ => None,
+        }
+    }
+
+    /// The lobe at cosine `t` (any value; see the module docs for the rules).
+    #[inline]
+    #[must_use]
+    pub fn eval<R: Real>(&self, t: R) -> R {
+        let zero = R::from_f64(0.0);
+        if t > zero {
+            let t = t.min(R::from_f64(1.0));
+            match &self.model {
+                Model::Pow(m) => m.eval(t),
+                Model::Schlick(m) => m.eval(t),
+                Model::SchlickMod(m) => m.eval(t),
+                Model::AngleQuadratic(m) => m.eval_angle(t.acos()),
+                Model::LogExp(m) => m.eval(t),
+                Model::LogExpRr(m) => m.eval(t),
+                Model::CosQuad(m) => m.eval(t),
+            }
+        } else {
+            zero
+        }
+    }
+
+    /// The lobe at angle `g` (radians) from its axis. Lobes whose native input is the angle
+    /// (`cheb2`, `cheb2-thesis`, `minimax2`) skip the `acos`; the others take `cos g`.
+    #[inline]
+    #[must_use]
+    pub fn eval_angle<R: Real>(&self, g: R) -> R {
+        match &self.model {
+            Model::AngleQuadratic(m) => {
+                let g = g.max(-g);
+                if g < R::from_f64(core::f64::consts::FRAC_PI_2) {
+                    m.eval_angle(g)
+                } else {
+                    R::from_f64(0.0)
+                }
+            }
+            _ => self.eval(g.cos()),
+        }
+    }
+
+    /// The operations one evaluation from a cosine performs, counted by running
+    /// [`Lobe::eval`] on [`Counted`] at a cosine inside the epicentre.
+    #[must_use]
+    pub fn ops(&self) -> OpCounts {
+        let t = (0.5 * crate::zones::epicentre_angle(self.n)).cos();
+        count_ops(|| self.eval(Counted(t))).1
+    }
+}

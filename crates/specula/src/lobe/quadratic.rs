@@ -1,0 +1,105 @@
+//! A quadratic in the angle, `C + B g + A g^2`, as a lobe: the shared evaluator of
+//! `cheb2-thesis`, `cheb2` and `minimax2`, which differ only in their coefficients.
+//!
+//! A fitted quadratic is only meaningful up to its first zero past the peak; beyond that it
+//! would go negative (concave fit) or climb again (convex fit). The zero, `cutoff`, is solved
+//! once when the lobe is prepared; the evaluation returns 0 from there on and clamps to 1 in
+//! case a fit overshoots the peak, so the lobe obeys SPEC section 1's range rule.
+
+use crate::real::Real;
+
+/// A prepared quadratic-in-angle lobe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AngleQuadratic {
+    /// `[C, B, A]`.
+    coeffs: [f64; 3],
+    /// The first angle in `[0, pi/2]` at which the quadratic stops being positive.
+    cutoff: f64,
+}
+
+impl AngleQuadratic {
+    /// Prepares `C + B g + A g^2` (`coeffs = [C, B, A]`).
+    pub(crate) fn new(coeffs: [f64; 3]) -> Self {
+        Self {
+            coeffs,
+            cutoff: first_zero(coeffs),
+        }
+    }
+
+    /// `[C, B, A]`.
+    #[must_use]
+    pub fn coeffs(&self) -> [f64; 3] {
+        self.coeffs
+    }
+
+    /// The angle past which the lobe is 0.
+    #[must_use]
+    pub fn cutoff(&self) -> f64 {
+        self.cutoff
+    }
+
+    /// Evaluates at the angle `g in [0, pi/2)`, by Horner: `C + g (B + A g)`.
+    #[inline(always)]
+    pub(crate) fn eval_angle<R: Real>(&self, g: R) -> R {
+        let [c, b, a] = self.coeffs;
+        if g < R::from_f64(self.cutoff) {
+            (R::from_f64(c) + g * (R::from_f64(b) + R::from_f64(a) * g)).min(R::from_f64(1.0))
+        } else {
+            R::from_f64(0.0)
+        }
+    }
+}
+
+/// The smallest `g` in `[0, pi/2]` with `C + B g + A g^2 <= 0`, or `pi/2` if there is none.
+fn first_zero([c, b, a]: [f64; 3]) -> f64 {
+    let quarter = core::f64::consts::FRAC_PI_2;
+    if c <= 0.0 {
+        return 0.0;
+    }
+    let root = if a == 0.0 {
+        (b < 0.0).then(|| -c / b)
+    } else {
+        let discriminant = b * b - 4.0 * a * c;
+        (discriminant >= 0.0)
+            .then(|| {
+                // Stable roots: q = -(b + sign(b) sqrt(disc)) / 2; roots q/a and c/q.
+                let q = -0.5 * (b + b.signum() * discriminant.sqrt());
+                [q / a, c / q]
+                    .into_iter()
+                    .filter(|r| *r > 0.0)
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .filter(|r| r.is_finite())
+    };
+    root.map_or(quarter, |r| r.min(quarter))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cutoff_is_the_first_positive_root() {
+        // 1 - g^2: root at 1.
+        assert!((first_zero([1.0, 0.0, -1.0]) - 1.0).abs() < 1e-15);
+        // (g - 0.5)(g - 1.0) = 0.5 - 1.5 g + g^2: convex, first root 0.5.
+        assert!((first_zero([0.5, -1.5, 1.0]) - 0.5).abs() < 1e-15);
+        // 1 + g^2 never vanishes.
+        assert_eq!(first_zero([1.0, 0.0, 1.0]), core::f64::consts::FRAC_PI_2);
+        // Linear 1 - 2 g.
+        assert!((first_zero([1.0, -2.0, 0.0]) - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn is_zero_past_the_cutoff_and_never_above_one() {
+        let q = AngleQuadratic::new([0.5, -1.5, 1.0]);
+        assert_eq!(q.eval_angle(0.75f64), 0.0);
+        assert_eq!(
+            q.eval_angle(1.2f64),
+            0.0,
+            "a convex fit must not climb again"
+        );
+        let overshoot = AngleQuadratic::new([1.01, 0.5, -10.0]);
+        assert_eq!(overshoot.eval_angle(0.01f64), 1.0);
+    }
+}

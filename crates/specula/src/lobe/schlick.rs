@@ -1,0 +1,43 @@
+//! # `schlick`: Schlick's rational approximation
+//!
+//! ```text
+//! schlick(t) = t / (n - n t + t)  =  t / (n (1 - t) + t)
+//! ```
+//!
+//! Exact at `t = 1` (value 1) and for `n = 1` (value `t`); falls off like `1 / (n (1 - t))`,
+//! far more slowly than `t^n`, which is the "unnatural" wide highlight the thesis criticises.
+//! The denominator is evaluated as `n (1 - t) + t`: `1 - t` is exact for `t >= 1/2` and every
+//! term is non-negative, so there is no cancellation near the peak even in `f32`.
+//!
+//! - **Parameters**: the exponent `n`.
+//! - **Domain**: `t in (0, 1]`; the value lies in `(0, 1]` because the denominator is at
+//!   least `t`.
+//! - **Cost**: one multiply, two adds, one divide.
+//! - **Source**: C. Schlick, "A customizable reflectance model for everyday rendering" (1993).
+
+use crate::real::Real;
+use crate::Exponent;
+
+/// The prepared Schlick lobe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Schlick {
+    n: f64,
+}
+
+impl Schlick {
+    pub(crate) fn new(n: Exponent) -> Self {
+        Self { n: n.get() }
+    }
+
+    /// Evaluates at `t in (0, 1]`.
+    #[inline(always)]
+    pub(crate) fn eval<R: Real>(&self, t: R) -> R {
+        schlick_denominator_ratio(t, t, self.n)
+    }
+}
+
+/// `numerator / (n (1 - t) + t)`, the shared tail of `schlick` and `schlick-mod`.
+#[inline(always)]
+pub(crate) fn schlick_denominator_ratio<R: Real>(numerator: R, t: R, n: f64) -> R {
+    numerator / (R::from_f64(n) * (R::from_f64(1.0) - t) + t)
+}

@@ -1,0 +1,78 @@
+//! # `schlick-mod`: the thesis's modified Schlick lobe
+//!
+//! ```text
+//! schlick-mod(t) = t^a / (n (1 - t) + t),   a = 2^max(0, floor(log2 n) - 2)
+//! ```
+//!
+//! The thesis replaces Schlick's numerator `t` by a low power `t^a`, `a << n`, growing with
+//! `n`, to pull in the slowly decaying bloom. Because `a` is a power of two, `t^a` costs
+//! `log2(a)` squarings; for `n < 8`, `a = 1` and the lobe is plain Schlick.
+//! `floor(log2 n)` is read exactly from the binary exponent of `n`.
+//!
+//! | n        | a  | squarings |
+//! |----------|----|-----------|
+//! | 1 .. 7   | 1  | 0         |
+//! | 8 .. 15  | 2  | 1         |
+//! | 16 .. 31 | 4  | 2         |
+//! | 512 ..   | 128| 7         |
+//!
+//! - **Parameters**: the exponent `n` (which fixes `a`).
+//! - **Domain**: `t in (0, 1]`; the value lies in `(0, 1]` since `t^a <= t <= n (1 - t) + t`.
+//! - **Cost**: `log2(a)` squarings, one multiply, two adds, one divide.
+//! - **Source**: the thesis, slide "Modified Schlick BRDF".
+
+use super::schlick::schlick_denominator_ratio;
+use crate::real::Real;
+use crate::Exponent;
+
+/// The prepared modified Schlick lobe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SchlickMod {
+    n: f64,
+    squarings: u32,
+}
+
+impl SchlickMod {
+    pub(crate) fn new(n: Exponent) -> Self {
+        let floor_log2_n = floor_log2(n.get());
+        Self {
+            n: n.get(),
+            squarings: floor_log2_n.saturating_sub(2),
+        }
+    }
+
+    /// Evaluates at `t in (0, 1]`.
+    #[inline(always)]
+    pub(crate) fn eval<R: Real>(&self, t: R) -> R {
+        let mut numerator = t;
+        for _ in 0..self.squarings {
+            numerator = numerator.square();
+        }
+        schlick_denominator_ratio(numerator, t, self.n)
+    }
+}
+
+/// `floor(log2 x)` for a normal `x >= 1`, read from the IEEE exponent field (exact, unlike
+/// `x.log2().floor()` just below a power of two).
+fn floor_log2(x: f64) -> u32 {
+    let biased = (x.to_bits() >> 52) & 0x7ff;
+    (biased as i64 - 1023).max(0) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn power_follows_the_thesis_table() {
+        let power = |n: f64| 1u32 << SchlickMod::new(Exponent::new(n)).squarings;
+        assert_eq!(power(1.0), 1);
+        assert_eq!(power(7.999), 1);
+        assert_eq!(power(8.0), 2);
+        assert_eq!(power(15.9), 2);
+        assert_eq!(power(16.0), 4);
+        assert_eq!(power(100.0), 16);
+        assert_eq!(power(512.0), 128);
+        assert_eq!(power(1000.0), 128);
+    }
+}

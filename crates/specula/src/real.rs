@@ -1,0 +1,134 @@
+//! The scalar type every lobe is written against.
+//!
+//! Each model's formula exists once, generic over [`Real`]. Instantiated with `f64` it is the
+//! reference; with `f32` it is the fast path; with [`Counted`](crate::ops::Counted) it counts
+//! the operations of one evaluation, so the cost table is read off the implementation rather
+//! than typed by hand. Anything a formula needs (a squaring, a `log2`, a comparison) is a
+//! method here so that the counting type sees it.
+
+use core::ops::{Add, Div, Mul, Neg, Sub};
+
+/// A real number type a lobe can be evaluated in.
+///
+/// Constants enter through [`Real::from_f64`]: models keep their per-material constants in
+/// `f64` and convert at use, which a compiler hoists out of any loop.
+pub trait Real:
+    Copy
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// Converts an `f64` constant (rounding to nearest for narrower types).
+    fn from_f64(x: f64) -> Self;
+    /// Widens to `f64` (exact for `f32` and `f64`).
+    fn to_f64(self) -> f64;
+    /// `self * self`, counted as a squaring rather than a general multiply.
+    #[must_use]
+    fn square(self) -> Self;
+    /// Square root.
+    #[must_use]
+    fn sqrt(self) -> Self;
+    /// Base-2 logarithm.
+    #[must_use]
+    fn log2(self) -> Self;
+    /// Base-2 exponential.
+    #[must_use]
+    fn exp2(self) -> Self;
+    /// Arc cosine, in radians.
+    #[must_use]
+    fn acos(self) -> Self;
+    /// Cosine of an angle in radians.
+    #[must_use]
+    fn cos(self) -> Self;
+    /// `self` raised to a real power (the reference `t^n`).
+    #[must_use]
+    fn powf(self, exponent: Self) -> Self;
+    /// The larger of two values (a comparison and a select).
+    #[must_use]
+    fn max(self, other: Self) -> Self;
+    /// The smaller of two values (a comparison and a select).
+    #[must_use]
+    fn min(self, other: Self) -> Self;
+    /// The smallest integer not below `self` (in hardware, the integer field: free but for
+    /// the rounding).
+    #[must_use]
+    fn ceil(self) -> Self;
+    /// `self * 2^k` for an integer-valued `k <= 0` (in hardware, a shift); 0 once `2^k`
+    /// underflows the format.
+    #[must_use]
+    fn shift(self, k: Self) -> Self;
+}
+
+macro_rules! impl_real_for_float {
+    ($float:ty) => {
+        impl Real for $float {
+            #[inline(always)]
+            fn from_f64(x: f64) -> Self {
+                x as $float
+            }
+            #[inline(always)]
+            fn to_f64(self) -> f64 {
+                f64::from(self)
+            }
+            #[inline(always)]
+            fn square(self) -> Self {
+                self * self
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                <$float>::sqrt(self)
+            }
+            #[inline(always)]
+            fn log2(self) -> Self {
+                <$float>::log2(self)
+            }
+            #[inline(always)]
+            fn exp2(self) -> Self {
+                <$float>::exp2(self)
+            }
+            #[inline(always)]
+            fn acos(self) -> Self {
+                <$float>::acos(self)
+            }
+            #[inline(always)]
+            fn cos(self) -> Self {
+                <$float>::cos(self)
+            }
+            #[inline(always)]
+            fn powf(self, exponent: Self) -> Self {
+                <$float>::powf(self, exponent)
+            }
+            #[inline(always)]
+            fn max(self, other: Self) -> Self {
+                <$float>::max(self, other)
+            }
+            #[inline(always)]
+            fn min(self, other: Self) -> Self {
+                <$float>::min(self, other)
+            }
+            #[inline(always)]
+            fn ceil(self) -> Self {
+                <$float>::ceil(self)
+            }
+            #[inline(always)]
+            fn shift(self, k: Self) -> Self {
+                // Build 2^k from its exponent field; below the normal range the result is 0,
+                // which is also what a fixed-width shifter produces.
+                let biased = k as i64 + <$float>::MAX_EXP as i64 - 1;
+                if biased <= 0 {
+                    0.0
+                } else {
+                    self * <$float>::from_bits(
+                        ((biased as u64) << (<$float>::MANTISSA_DIGITS - 1)) as _,
+                    )
+                }
+            }
+        }
+    };
+}
+
+impl_real_for_float!(f32);
+impl_real_for_float!(f64);
