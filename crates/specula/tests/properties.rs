@@ -1,0 +1,98 @@
+//! Properties every lobe and BRDF must have, over random inputs (SPEC sections 1 and 6).
+//! The same suite runs on the `f64` reference and the `f32` fast path.
+
+use glam::DVec3;
+use proptest::prelude::*;
+use specula::analysis::max_directional_albedo;
+use specula::{Brdf, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
+
+/// The `f32` path's largest absolute deviation from `f64` at the same (`f32`) input.
+const F32_ABS_TOLERANCE: f64 = 4e-6;
+
+/// `cosquad` squares its base `v` times, and each squaring doubles the base's relative
+/// rounding error (the base sits near 1, where `f32` spacing is `6e-8`), so its bound scales
+/// with `2^v` beyond the default `v = 4`.
+fn f32_tolerance(kind: LobeKind) -> f64 {
+    match kind {
+        LobeKind::CosQuad { v } if v > 4 => F32_ABS_TOLERANCE * f64::from(1u32 << (v - 4)),
+        _ => F32_ABS_TOLERANCE,
+    }
+}
+
+fn any_lobe() -> impl Strategy<Value = LobeKind> {
+    prop_oneof![
+        proptest::sample::select(LobeKind::ALL.to_vec()),
+        (0u8..=10).prop_map(|v| LobeKind::CosQuad { v }),
+    ]
+}
+
+fn any_exponent() -> impl Strategy<Value = Exponent> {
+    prop_oneof![1.0f64..=1000.0, (0.0f64..=3.0).prop_map(|e| 10f64.powf(e))].prop_map(Exponent::new)
+}
+
+fn unit_upper(x: f64, y: f64, z: f64) -> Option<DVec3> {
+    let v = DVec3::new(x, y, z.abs());
+    (v.length() > 1e-3 && v.z > 1e-6).then(|| v.normalize())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    #[test]
+    fn lobe_is_finite_within_unit_range_and_zero_for_nonpositive_cosine(
+        kind in any_lobe(), n in any_exponent(), t in -1.0f64..=1.0,
+    ) {
+        let lobe = Lobe::new(kind, n);
+        let value = lobe.eval(t);
+        prop_assert!(value.is_finite() && (0.0..=1.0).contains(&value), "{kind} n={n} t={t}: {value}");
+        let value32 = lobe.eval(t as f32);
+        prop_assert!(value32.is_finite() && (0.0..=1.0).contains(&value32));
+        if t <= 0.0 {
+            prop_assert_eq!(value, 0.0);
+            prop_assert_eq!(value32, 0.0);
+        }
+    }
+
+    #[test]
+    fn f32_path_tracks_f64(kind in any_lobe(), n in any_exponent(), t in 0.0f32..=1.0) {
+        let lobe = Lobe::new(kind, n);
+        let (fast, reference) = (f64::from(lobe.eval(t)), lobe.eval(f64::from(t)));
+        prop_assert!((fast - reference).abs() <= f32_tolerance(kind),
+            "{kind} n={n} t={t}: f32 {fast} vs f64 {reference}");
+    }
+
+    #[test]
+    fn angle_and_cosine_inputs_agree(kind in any_lobe(), n in any_exponent(), g in 0.0f64..1.5707) {
+        let lobe = Lobe::new(kind, n);
+        prop_assert!((lobe.eval_angle(g) - lobe.eval(g.cos())).abs() < 1e-9);
+    }
+
+    #[test]
+    fn every_brdf_is_reciprocal(
+        kind in any_lobe(), n in any_exponent(),
+        geometry in proptest::sample::select(Geometry::ALL.to_vec()),
+        normalisation in proptest::sample::select(Normalisation::ALL.to_vec()),
+        a in (-1.0f64..1.0, -1.0f64..1.0, 0.0f64..1.0),
+        b in (-1.0f64..1.0, -1.0f64..1.0, 0.0f64..1.0),
+    ) {
+        let (Some(wo), Some(wi)) = (unit_upper(a.0, a.1, a.2), unit_upper(b.0, b.1, b.2)) else {
+            return Ok(());
+        };
+        let brdf = Brdf::new(Rgb::splat(0.3), Rgb::new(0.7, 0.5, 0.2), Lobe::new(kind, n), geometry, normalisation);
+        let (forward, backward) = (brdf.f(wo, wi), brdf.f(wi, wo));
+        prop_assert!((forward - backward).abs().max_element() <= 1e-12 * forward.max_element().max(1.0));
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// White furnace: the `lobe`-normalised BRDF (Phong geometry, kd = 0, ks = 1) reflects at
+    /// most what it receives, from every outgoing direction.
+    #[test]
+    fn lobe_normalised_brdf_passes_the_white_furnace(kind in any_lobe(), n in any_exponent()) {
+        let brdf = Brdf::new(Rgb::ZERO, Rgb::ONE, Lobe::new(kind, n), Geometry::Phong, Normalisation::Lobe);
+        let (theta, albedo) = max_directional_albedo(&brdf);
+        prop_assert!(albedo <= 1.0 + 1e-3, "{kind} n={n}: albedo {albedo} at {theta} rad");
+    }
+}
