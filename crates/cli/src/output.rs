@@ -87,6 +87,17 @@ impl Table {
     }
 }
 
+impl Table {
+    /// Prints as CSV for `Format::Csv`, aligned columns otherwise.
+    pub fn print(&self, format: crate::args::Format) {
+        if format == crate::args::Format::Csv {
+            print!("{}", self.csv());
+        } else {
+            print!("{}", self.render());
+        }
+    }
+}
+
 fn looks_numeric(cell: &str) -> bool {
     let trimmed = cell.trim_end_matches('%');
     trimmed.parse::<f64>().is_ok()
@@ -102,13 +113,21 @@ fn csv_field(cell: &str) -> String {
 
 /// A figure with 4 significant digits, in plain or scientific notation as fits.
 pub fn sig(value: f64) -> String {
-    if value == 0.0 {
-        "0".to_owned()
-    } else if (1e-3..1e5).contains(&value.abs()) {
-        let decimals = (3 - value.abs().log10().floor() as i32).max(0) as usize;
+    if value == 0.0 || !value.is_finite() {
+        return value.to_string();
+    }
+    // The decimal exponent after rounding to 4 digits (0.99996 rounds to 1.000e0, not 9.9996e-1).
+    let scientific = format!("{value:.3e}");
+    let exponent: i32 = scientific
+        .rsplit('e')
+        .next()
+        .and_then(|e| e.parse().ok())
+        .unwrap_or(0);
+    if (-3..5).contains(&exponent) {
+        let decimals = (3 - exponent).max(0) as usize;
         format!("{value:.decimals$}")
     } else {
-        format!("{value:.3e}")
+        scientific
     }
 }
 
@@ -133,5 +152,7 @@ mod tests {
         assert_eq!(sig(0.0123456), "0.01235");
         assert_eq!(sig(123.456), "123.5");
         assert_eq!(sig(1.5e-7), "1.500e-7");
+        assert_eq!(sig(0.99996), "1.000");
+        assert_eq!(sig(1.0), "1.000");
     }
 }

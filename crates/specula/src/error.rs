@@ -51,3 +51,26 @@ pub enum Error {
 
 /// Shorthand for results of this crate.
 pub type Result<T, E = Error> = core::result::Result<T, E>;
+
+/// Finds `text` (case-insensitively, trimmed) among `choices` by their names, or says which
+/// names are valid.
+pub(crate) fn parse_choice<T: Copy>(
+    what: &'static str,
+    text: &str,
+    choices: &[T],
+    name: fn(T) -> &'static str,
+) -> Result<T> {
+    choices
+        .iter()
+        .copied()
+        .find(|&c| name(c).eq_ignore_ascii_case(text.trim()))
+        .ok_or_else(|| Error::UnknownName {
+            what,
+            name: text.to_owned(),
+            valid: choices
+                .iter()
+                .map(|&c| name(c))
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+}

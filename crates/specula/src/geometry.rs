@@ -11,7 +11,7 @@
 use glam::{DVec3, Vec3};
 use serde::Serialize;
 
-use crate::error::{Error, Result};
+use crate::error::{parse_choice, Error, Result};
 
 /// Which cosine a lobe is evaluated at.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
@@ -70,14 +70,7 @@ impl Geometry {
 
     /// Parses `phong` or `blinn`.
     pub fn parse(text: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|g| g.id().eq_ignore_ascii_case(text.trim()))
-            .ok_or_else(|| Error::UnknownName {
-                what: "geometry",
-                name: text.to_owned(),
-                valid: Self::ALL.map(Geometry::id).join(", "),
-            })
+        parse_choice("geometry", text, &Self::ALL, Geometry::id)
     }
 
     cos_lobe_fn!(cos_lobe, DVec3, f64);

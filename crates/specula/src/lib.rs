@@ -19,12 +19,18 @@
 //!   lobe is a function of (`R.V` for Phong, `N.H` for Blinn).
 //!
 //! ```
-//! use specula::{Exponent, Lobe, LobeKind};
-//! let lobe = Lobe::new(LobeKind::CosQuad { v: 4 }, Exponent::new(64.0));
-//! let exact = Lobe::new(LobeKind::Pow, Exponent::new(64.0));
-//! let t = 0.995_f64;
-//! assert!((lobe.eval(t) - exact.eval(t)).abs() < 0.05);
+//! use specula::{Brdf, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
+//! # fn main() -> specula::Result<()> {
+//! let n = Exponent::try_new(64.0)?; // validated once: [1, 1000]
+//! let lobe = Lobe::new(LobeKind::CosQuad { v: 4 }, n); // prepared: `a` computed here
+//! let value: f32 = lobe.eval(0.99_f32); // fast path
+//! let reference: f64 = lobe.eval(0.99_f64); // reference path, same formula
+//! assert!((f64::from(value) - reference).abs() < 1e-6);
 //! assert_eq!(lobe.eval(-0.3_f64), 0.0);
+//! let brdf = Brdf::new(Rgb::splat(0.2), Rgb::splat(0.8), lobe, Geometry::Blinn, Normalisation::Lobe);
+//! assert!(brdf.f(Rgb::Z, Rgb::Z).x > 0.0);
+//! # Ok(())
+//! # }
 //! ```
 
 pub mod analysis;

@@ -14,11 +14,11 @@
 //! so a white furnace holds for it; the analytic `(n+1)/(2 pi)` of `t^n` applied to an
 //! approximation scales its energy by exactly its energy ratio, which the analysis reports.
 
-use core::f64::consts::{FRAC_PI_2, PI};
+use core::f64::consts::PI;
 
 use serde::Serialize;
 
-use crate::error::{Error, Result};
+use crate::error::{parse_choice, Error, Result};
 use crate::quadrature::integrate_pieces;
 use crate::{zones, Exponent, Lobe};
 
@@ -67,14 +67,7 @@ impl Normalisation {
 
     /// Parses a name from [`Normalisation::ALL`].
     pub fn parse(text: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|g| g.id().eq_ignore_ascii_case(text.trim()))
-            .ok_or_else(|| Error::UnknownName {
-                what: "normalisation",
-                name: text.to_owned(),
-                valid: Self::ALL.map(Normalisation::id).join(", "),
-            })
+        parse_choice("normalisation", text, &Self::ALL, Normalisation::id)
     }
 
     /// The analytic constant, a function of `n` alone (`lobe` gives that of `t^n`).
@@ -116,18 +109,12 @@ impl core::str::FromStr for Normalisation {
 /// the quadratic lobes' cut-off), to a relative accuracy of about `1e-12`.
 #[must_use]
 pub fn lobe_integral(lobe: &Lobe) -> f64 {
-    let n = lobe.exponent();
-    let mut points = vec![
-        0.0,
-        zones::epicentre_angle(n),
-        zones::bloom_angle(n),
-        FRAC_PI_2,
-    ];
-    if let Some(quadratic) = lobe.angle_quadratic() {
-        points.push(quadratic.cutoff());
-    }
-    let scale = 1.0 / (n.get() + 1.0);
-    integrate_pieces(|g| lobe.eval_angle(g) * g.sin(), &points, 1e-13 * scale)
+    let scale = 1.0 / (lobe.exponent().get() + 1.0);
+    integrate_pieces(
+        |g| lobe.eval_angle(g) * g.sin(),
+        &zones::breakpoints(lobe),
+        1e-13 * scale,
+    )
 }
 
 /// The constant that makes `lobe` integrate to 1 over the hemisphere around its axis:

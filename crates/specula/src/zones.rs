@@ -8,7 +8,7 @@
 
 use serde::Serialize;
 
-use crate::Exponent;
+use crate::{Exponent, Lobe};
 
 /// One of the three zones of a highlight.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -81,6 +81,24 @@ pub fn epicentre_angle(n: Exponent) -> f64 {
 #[must_use]
 pub fn bloom_angle(n: Exponent) -> f64 {
     bloom_cos(n).acos()
+}
+
+/// The angles in `[0, pi/2]` where an integrand built on `lobe` changes character: the zone
+/// edges, the quarter circle, and the lobe's own cut-off if it has one. Quadrature splits
+/// there first.
+#[must_use]
+pub fn breakpoints(lobe: &Lobe) -> Vec<f64> {
+    let n = lobe.exponent();
+    let mut points = vec![
+        0.0,
+        epicentre_angle(n),
+        bloom_angle(n),
+        core::f64::consts::FRAC_PI_2,
+    ];
+    if let Some(quadratic) = lobe.angle_quadratic() {
+        points.push(quadratic.cutoff());
+    }
+    points
 }
 
 #[cfg(test)]

@@ -16,7 +16,7 @@ pub struct Args {
     #[arg(long, value_parser = LobeParser, value_delimiter = ',')]
     lobe: Vec<LobeKind>,
     /// Exponents, comma separated (default: 1,2,4,8,16,32,64,128,256,512,1000).
-    #[arg(long, value_parser = parse_exponent, value_delimiter = ',')]
+    #[arg(long, value_parser = parse_exponent, value_delimiter = ',', allow_negative_numbers = true)]
     n: Vec<Exponent>,
     /// Output format.
     #[arg(long, value_enum, default_value_t)]
@@ -88,10 +88,6 @@ pub fn run(args: &Args) -> CommandResult {
             r.ops.to_string(),
         ]);
     }
-    if args.format == Format::Csv {
-        print!("{}", table.csv());
-    } else {
-        print!("{}", table.render());
-    }
+    table.print(args.format);
     Ok(())
 }

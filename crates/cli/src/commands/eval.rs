@@ -16,7 +16,7 @@ pub struct Args {
     #[arg(long, value_parser = LobeParser)]
     lobe: LobeKind,
     /// Specular exponent n, in [1, 1000].
-    #[arg(long, value_parser = parse_exponent)]
+    #[arg(long, value_parser = parse_exponent, allow_negative_numbers = true)]
     n: Exponent,
     /// The lobe's cosine t (R.V for Phong, N.H for Blinn), in [-1, 1].
     #[arg(long, value_parser = parse_cosine, allow_negative_numbers = true)]

@@ -81,11 +81,7 @@ pub fn run(args: &Args) -> CommandResult {
                     row.ops_total.to_string(),
                 ]);
             }
-            if args.format == Format::Csv {
-                print!("{}", table.csv());
-            } else {
-                print!("{}", table.render());
-            }
+            table.print(args.format);
             Ok(())
         }
     }

@@ -135,10 +135,12 @@ fn gaussian_elimination(system: &mut [Vec<f64>], size: usize) -> Option<Vec<f64>
             return None;
         }
         system.swap(column, pivot);
-        for row in column + 1..size {
-            let factor = system[row][column] / system[column][column];
-            for k in column..=size {
-                system[row][k] -= factor * system[column][k];
+        let (above, below) = system.split_at_mut(column + 1);
+        let pivot_row = &above[column];
+        for row in below.iter_mut().take(size - column - 1) {
+            let factor = row[column] / pivot_row[column];
+            for (target, &source) in row[column..=size].iter_mut().zip(&pivot_row[column..=size]) {
+                *target -= factor * source;
             }
         }
     }

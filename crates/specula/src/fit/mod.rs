@@ -30,7 +30,8 @@ pub enum AngleFit {
 /// computed once per `(fit, n)` and then served from a process-wide cache.
 #[must_use]
 pub fn cached_angle_quadratic(fit: AngleFit, n: crate::Exponent) -> [f64; 3] {
-    static CACHE: OnceLock<Mutex<HashMap<(AngleFit, u64), [f64; 3]>>> = OnceLock::new();
+    type Coefficients = HashMap<(AngleFit, u64), [f64; 3]>;
+    static CACHE: OnceLock<Mutex<Coefficients>> = OnceLock::new();
     let key = (fit, n.get().to_bits());
     let cache = CACHE.get_or_init(Default::default);
     if let Some(coeffs) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {

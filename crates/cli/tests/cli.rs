@@ -1,0 +1,189 @@
+//! The `specula` binary: documented JSON schemas, values from closed forms, and bad input
+//! answered with a one-line message and exit code 2, never a panic.
+
+use assert_cmd::Command;
+use serde_json::Value;
+
+fn specula(args: &[&str]) -> std::process::Output {
+    Command::cargo_bin("specula")
+        .expect("binary built")
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+fn json(args: &[&str]) -> Value {
+    let output = specula(args);
+    assert!(
+        output.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("valid JSON")
+}
+
+#[test]
+fn models_lists_every_registered_lobe() {
+    let output = specula(&["models"]);
+    assert!(output.status.success());
+    let text = String::from_utf8_lossy(&output.stdout);
+    for id in [
+        "pow",
+        "schlick",
+        "schlick-mod",
+        "cheb2-thesis",
+        "cheb2",
+        "logexp",
+        "cosquad",
+    ] {
+        assert!(
+            text.lines().any(|line| line.starts_with(&format!("{id} "))),
+            "{id} missing"
+        );
+    }
+    let rows = json(&["models", "--format", "json"]);
+    assert_eq!(
+        rows.as_array().map(Vec::len),
+        Some(specula::LobeKind::ALL.len())
+    );
+}
+
+#[test]
+fn analyze_json_has_the_documented_schema_and_closed_form_values() {
+    let rows = json(&[
+        "analyze",
+        "--lobe",
+        "pow,cosquad,schlick",
+        "--n",
+        "16",
+        "--format",
+        "json",
+    ]);
+    let rows = rows.as_array().expect("an array");
+    assert_eq!(rows.len(), 3);
+    for row in rows {
+        for key in [
+            "lobe",
+            "n",
+            "epicentre_max_rel",
+            "epicentre_max_abs",
+            "bloom_max_abs",
+            "tail_max_abs",
+            "rms",
+            "energy_ratio",
+            "max_albedo",
+            "ops",
+        ] {
+            assert!(row.get(key).is_some(), "missing {key} in {row}");
+        }
+        assert!(row["ops"].is_object());
+    }
+    // pow is the reference; K_4 at n = 2^4 is exactly t^16 (a = 1); the lobe-normalised pow's
+    // largest albedo is at normal incidence, (n+1)/(n+2).
+    let pow = &rows[0];
+    assert_eq!(pow["epicentre_max_rel"].as_f64(), Some(0.0));
+    assert!((pow["max_albedo"].as_f64().unwrap() - 17.0 / 18.0).abs() < 1e-9);
+    assert!(rows[1]["bloom_max_abs"].as_f64().unwrap() < 1e-12);
+    assert!(rows[2]["epicentre_max_rel"].as_f64().unwrap() > 0.01);
+}
+
+#[test]
+fn analyze_defaults_cover_every_lobe_and_exponent() {
+    let rows = json(&["analyze", "--format", "json"]);
+    assert_eq!(
+        rows.as_array().map(Vec::len),
+        Some(specula::LobeKind::ALL.len() * 11)
+    );
+    let csv = specula(&[
+        "analyze", "--lobe", "logexp", "--n", "2,3", "--format", "csv",
+    ]);
+    assert_eq!(String::from_utf8_lossy(&csv.stdout).lines().count(), 3);
+}
+
+#[test]
+fn claims_json_has_the_documented_schema() {
+    let claims = json(&["claims", "--format", "json"]);
+    let claims = claims.as_array().expect("an array");
+    assert_eq!(claims.len(), 7);
+    for claim in claims {
+        for key in ["claim", "measured", "verdict", "reading", "figures"] {
+            assert!(claim.get(key).is_some(), "missing {key} in {claim}");
+        }
+        let verdict = claim["verdict"].as_str().unwrap();
+        assert!(["holds", "does not hold", "holds with qualification"].contains(&verdict));
+    }
+}
+
+#[test]
+fn eval_matches_closed_forms() {
+    let schlick = json(&[
+        "eval", "--lobe", "schlick", "--n", "1", "--cos", "0.3", "--json",
+    ]);
+    assert!((schlick["value"].as_f64().unwrap() - 0.3).abs() < 1e-15);
+    let pow = json(&[
+        "eval", "--lobe", "pow", "--n", "4", "--angle", "60", "--json",
+    ]);
+    assert!((pow["value"].as_f64().unwrap() - 0.0625).abs() < 1e-12);
+    assert_eq!(pow["zone"], "bloom");
+    let below = json(&[
+        "eval", "--lobe", "logexp", "--n", "10", "--cos", "-0.5", "--json",
+    ]);
+    assert_eq!(below["value"].as_f64(), Some(0.0));
+}
+
+#[test]
+fn bad_input_is_a_one_line_error_with_exit_code_two() {
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["eval", "--lobe", "phong", "--n", "10", "--cos", "0.5"],
+            "schlick-mod",
+        ),
+        (
+            &["eval", "--lobe", "pow", "--n", "0", "--cos", "0.5"],
+            "[1, 1000]",
+        ),
+        (
+            &["eval", "--lobe", "pow", "--n", "-1", "--cos", "0.5"],
+            "[1, 1000]",
+        ),
+        (
+            &["eval", "--lobe", "pow", "--n", "NaN", "--cos", "0.5"],
+            "[1, 1000]",
+        ),
+        (
+            &["eval", "--lobe", "pow", "--n", "1e9", "--cos", "0.5"],
+            "[1, 1000]",
+        ),
+        (
+            &["eval", "--lobe", "pow", "--n", "10", "--cos", "1.5"],
+            "[-1, 1]",
+        ),
+        (&["eval", "--lobe", "pow", "--n", "10"], "--cos"),
+        (
+            &[
+                "eval",
+                "--lobe",
+                "cosquad:v=12",
+                "--n",
+                "10",
+                "--cos",
+                "0.5",
+            ],
+            "[0, 10]",
+        ),
+        (&["analyze", "--lobe", "pow,blinn"], "valid lobes"),
+        (&["analyze", "--n", "2000"], "[1, 1000]"),
+        (&["analyze", "--format", "xml"], "table"),
+    ];
+    for (args, expected) in cases {
+        let output = specula(args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains(expected),
+            "{args:?}: expected '{expected}' in: {stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+        assert!(output.stdout.is_empty(), "{args:?} wrote output");
+    }
+}
