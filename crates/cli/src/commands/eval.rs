@@ -1,7 +1,6 @@
 //! `specula eval`: one lobe at one point, next to the exact `t^n`.
 
 use serde::Serialize;
-use specula::normalisation::lobe_constant;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation, Zone};
 
 use super::{print_json, CommandResult};
@@ -81,11 +80,15 @@ pub fn run(args: &Args) -> CommandResult {
         .iter()
         .map(|norm| (norm.id(), norm.constant_for(&lobe)))
         .collect();
+    // Next to this lobe's own constant, the one of t^n: applying it to an approximation
+    // scales the energy by the approximation's energy ratio.
     normalisations.insert(
         1,
-        ("lobe (t^n analytic)", Normalisation::Lobe.analytic(args.n)),
+        (
+            "lobe, t^n's (n+1)/(2 pi)",
+            Normalisation::Lobe.analytic(args.n),
+        ),
     );
-    debug_assert_eq!(normalisations[0].1, lobe_constant(&lobe));
     let evaluation = Evaluation {
         lobe: args.lobe,
         n: args.n.get(),

@@ -65,10 +65,7 @@ pub fn run(args: &Args) -> CommandResult {
                     .collect();
                 table.push(vec![
                     row.info.id.to_owned(),
-                    serde_json::to_value(row.info.origin)
-                        .ok()
-                        .and_then(|v| v.as_str().map(str::to_owned))
-                        .unwrap_or_default(),
+                    row.info.origin.name().to_owned(),
                     if row.info.takes_angle {
                         "angle"
                     } else {

@@ -65,6 +65,19 @@ pub enum Origin {
     Specula,
 }
 
+impl Origin {
+    /// The origin in words, as tables show it.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Origin::Reference => "reference",
+            Origin::Literature => "literature",
+            Origin::Thesis => "thesis",
+            Origin::Specula => "specula",
+        }
+    }
+}
+
 /// A registry entry.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct LobeInfo {
