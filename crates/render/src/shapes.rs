@@ -8,7 +8,7 @@ use crate::Mesh;
 
 /// A grid of `(rows + 1) x (columns + 1)` vertices from `point(row, column) -> (position,
 /// normal)`, triangulated counter-clockwise when `d/drow x d/dcolumn` points outwards.
-fn grid(rows: u32, columns: u32, point: impl Fn(u32, u32) -> (Vec3, Vec3)) -> Mesh {
+pub(crate) fn grid(rows: u32, columns: u32, point: impl Fn(u32, u32) -> (Vec3, Vec3)) -> Mesh {
     let mut positions = Vec::with_capacity(((rows + 1) * (columns + 1)) as usize);
     let mut normals = Vec::with_capacity(positions.capacity());
     for row in 0..=rows {

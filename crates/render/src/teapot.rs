@@ -70,33 +70,10 @@ impl BezierPatch {
     pub fn tessellate(&self, level: u32) -> Mesh {
         let level = level.max(1);
         let steps = level as f32;
-        let mut positions = Vec::new();
-        let mut normals = Vec::new();
-        for i in 0..=level {
-            for j in 0..=level {
-                let (u, v) = (i as f32 / steps, j as f32 / steps);
-                positions.push(self.eval(u, v).0);
-                normals.push(self.normal(u, v));
-            }
-        }
-        let index = |i: u32, j: u32| i * (level + 1) + j;
-        let mut triangles = Vec::new();
-        for i in 0..level {
-            for j in 0..level {
-                let (a, b, c, d) = (
-                    index(i, j),
-                    index(i + 1, j),
-                    index(i + 1, j + 1),
-                    index(i, j + 1),
-                );
-                triangles.extend([[a, b, c], [a, c, d]]);
-            }
-        }
-        triangles.retain(|t| {
-            let [pa, pb, pc] = t.map(|k| positions[k as usize]);
-            (pb - pa).cross(pc - pa).length_squared() > 0.0
-        });
-        Mesh::try_new(positions, normals, triangles).unwrap_or_default()
+        crate::shapes::grid(level, level, |i, j| {
+            let (u, v) = (i as f32 / steps, j as f32 / steps);
+            (self.eval(u, v).0, self.normal(u, v))
+        })
     }
 }
 
