@@ -76,9 +76,7 @@ pub(super) fn chebyshev_epicentre(options: &ClaimOptions) -> Outcome {
             .map(|&n| (n.get(), errors(kind, n, options).epicentre_max_rel))
             .collect();
         let max = rels.iter().map(|r| r.1).fold(0.0, f64::max);
-        let (first, last, count) = where_true(options, |n| {
-            rels.iter().any(|&(m, rel)| m == n.get() && rel <= BOUND)
-        });
+        let (first, last, count) = where_true(&rels, |rel| rel <= BOUND);
         (max, first, last, count)
     };
     let thesis = worst(LobeKind::Cheb2Thesis);

@@ -56,8 +56,13 @@ pub(super) fn thesis_phong_coefficient(options: &ClaimOptions) -> Outcome {
         let exact = lobe_constant(&Lobe::new(LobeKind::Pow, n));
         Normalisation::ThesisPhong.analytic(n) / exact
     };
-    let (lo, hi) = range(options.exponents.iter().map(|&n| ratio(n)));
-    let (first, last, count) = where_true(options, |n| (ratio(n) - 1.0).abs() <= 0.05);
+    let ratios: Vec<(f64, f64)> = options
+        .exponents
+        .iter()
+        .map(|&n| (n.get(), ratio(n)))
+        .collect();
+    let (lo, hi) = range(ratios.iter().map(|&(_, r)| r));
+    let (first, last, count) = where_true(&ratios, |r| (r - 1.0).abs() <= 0.05);
     // coef1 = (n+1)/(2 pi) where 1.063 n = n + 1.
     let crossover =
         1.0 / (Normalisation::ThesisPhong.analytic(Exponent::new(1.0)) * 2.0 * PI - 1.0);

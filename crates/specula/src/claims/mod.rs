@@ -218,16 +218,16 @@ pub(crate) fn range(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
         })
 }
 
-/// The exponents (of `options`) at which `holds` is true, as `(first, last, count)`.
+/// Of measured `(n, value)` pairs, the exponents whose value satisfies `holds`, as
+/// `(first, last, count)`.
 pub(crate) fn where_true(
-    options: &ClaimOptions,
-    holds: impl Fn(Exponent) -> bool,
+    measured: &[(f64, f64)],
+    holds: impl Fn(f64) -> bool,
 ) -> (f64, f64, usize) {
-    let passing: Vec<f64> = options
-        .exponents
+    let passing: Vec<f64> = measured
         .iter()
-        .filter(|&&n| holds(n))
-        .map(|n| n.get())
+        .filter(|&&(_, value)| holds(value))
+        .map(|&(n, _)| n)
         .collect();
     let (lo, hi) = range(passing.iter().copied());
     (lo, hi, passing.len())
