@@ -119,3 +119,16 @@ impl From<BackendArg> for Precision {
         }
     }
 }
+
+/// A value parser for a closed set of choices named by `id`, listing them in `--help` and in
+/// the error for an unknown name (scenes and the command line share the ids).
+pub fn choice<T: Copy + Send + Sync + 'static>(
+    all: &'static [T],
+    id: fn(T) -> &'static str,
+) -> impl TypedValueParser<Value = T> {
+    clap::builder::PossibleValuesParser::new(all.iter().map(|&value| id(value))).map(move |name| {
+        *all.iter()
+            .find(|&&value| id(value) == name)
+            .expect("clap only passes listed names")
+    })
+}

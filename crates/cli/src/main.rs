@@ -41,6 +41,22 @@ enum Command {
     /// Test the thesis's claims (SPEC section 9) with measured figures and verdicts.
     #[command(after_help = "Examples:\n  specula claims\n  specula claims --format json")]
     Claims(commands::claims::Args),
+    /// Render a scene (TOML, or the embedded default) on the CPU to PNG or EXR.
+    #[command(after_help = "Examples:\n  specula render -o out.png\n  \
+                            specula render scene.toml --lobe schlick-mod --n 256 -o out.exr\n  \
+                            specula render --shading gouraud --width 640 --height 360\n  \
+                            specula render --grid lobes=pow,schlick,schlick-mod,cheb2,logexp -o grid.png\n  \
+                            specula render --dump-default-scene > my-scene.toml")]
+    Render(commands::render::Args),
+    /// Compare two images: PSNR, largest error, mean FLIP, and a FLIP heatmap.
+    #[command(after_help = "Examples:\n  specula diff reference.png test.png\n  \
+                            specula diff a.exr b.exr --heatmap flip.png --format json")]
+    Diff(commands::diff::Args),
+    /// Measure throughput (printed figures and ratios, not pass/fail).
+    #[command(
+        after_help = "Examples:\n  specula bench render\n  specula bench render --width 640 --height 360 --frames 3"
+    )]
+    Bench(commands::bench::Args),
 }
 
 fn main() -> ExitCode {
@@ -61,6 +77,9 @@ fn main() -> ExitCode {
         Command::Eval(args) => commands::eval::run(&args),
         Command::Analyze(args) => commands::analyze::run(&args),
         Command::Claims(args) => commands::claims::run(&args),
+        Command::Render(args) => commands::render::run(&args),
+        Command::Diff(args) => commands::diff::run(&args),
+        Command::Bench(args) => commands::bench::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,13 +1,49 @@
-//! # specula-render: geometry for the CPU renderer
+//! # specula-render: the CPU renderer
 //!
-//! Built on the core (`specula`): meshes with validated data, the built-in shapes (sphere,
-//! torus, plane) and Newell's teapot tessellated from its Bezier patches. Everything here is
-//! `f32`, the renderer's arithmetic; positions are in world units, normals unit length.
+//! Built on the core (`specula`): scenes (TOML, with an embedded default), meshes (built-in
+//! shapes, Newell's teapot, OBJ/STL/PLY files), a tiled parallel rasterizer, flat, Gouraud and
+//! Phong shading with any lobe, geometry and normalisation, images (PNG, OpenEXR) and image
+//! metrics (PSNR, FLIP).
+//!
+//! ## Design
+//! - **Exact coverage.** Vertices are snapped to 1/256 pixel and edge functions evaluated in
+//!   integers with the top-left rule: shared edges neither gap nor overlap (`raster.rs`).
+//! - **Deterministic parallelism.** Triangles are binned into 32x32 tiles; each tile resolves
+//!   visibility in submission order with a strict depth test, then shades each visible sample
+//!   once. Output is bit-identical for any thread count (`pipeline.rs`).
+//! - **Linear until written.** The renderer produces linear radiance; exposure, tone map and
+//!   the sRGB curve are applied only when a PNG is written (`image.rs`).
+//! - **`f32` throughout**, with the core's lobes on their fast path; each material's
+//!   normalisation constant is computed once, in `f64`.
+//! - Conventions: right-handed world, `z` up, counter-clockwise front faces, depth in
+//!   `[0, 1]` (wgpu's), `wo` towards the viewer and `wi` towards the light.
 
+mod camera;
+mod clip;
+mod description;
+mod grid;
+mod image;
+mod load;
+mod material;
 mod mesh;
+pub mod metrics;
+mod pipeline;
+mod raster;
+mod scene;
 mod shapes;
 mod teapot;
 
+pub use camera::{Camera, InvalidCamera, Projection};
+pub use description::{LoadedScene, SceneError};
+pub use grid::{render_grid, GridError, GridOptions};
+pub use image::{
+    check_output_path, read_image, srgb_decode, srgb_encode, write_image, write_png_srgb8, Display,
+    Image, ImageError, ToneMap,
+};
+pub use load::{load_mesh, LoadError, LoadedMesh, MESH_EXTENSIONS};
+pub use material::{IlluminationModel, Light, Material, Shading};
 pub use mesh::{Mesh, MeshError};
+pub use pipeline::{render, RenderError, MAX_SAMPLES};
+pub use scene::{Object, Overrides, Scene, Settings, DEFAULT_SCENE};
 pub use shapes::{plane, sphere, torus};
 pub use teapot::{teapot, BezierPatch, TEAPOT_PATCHES};

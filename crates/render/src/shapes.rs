@@ -28,10 +28,12 @@ pub(crate) fn grid(rows: u32, columns: u32, point: impl Fn(u32, u32) -> (Vec3, V
             triangles.push([a, c, d]);
         }
     }
-    // Degenerate triangles (at a sphere's poles) have no area and are dropped.
+    // Triangles at a pole (a sphere's, the teapot lid's) have no area, or only rounding
+    // noise's, and no meaningful orientation: they are dropped.
     triangles.retain(|t| {
         let [pa, pb, pc] = t.map(|i| positions[i as usize]);
-        (pb - pa).cross(pc - pa).length_squared() > 0.0
+        let longest = (pb - pa).length_squared().max((pc - pa).length_squared());
+        (pb - pa).cross(pc - pa).length() > 1e-5 * longest
     });
     Mesh::try_new(positions, normals, triangles).unwrap_or_default()
 }

@@ -52,26 +52,27 @@ impl BezierPatch {
         result
     }
 
-    /// The unit normal `dP/du x dP/dv` at `(u, v)`, stepping into the patch where the
-    /// surface is degenerate (a pole).
+    /// The outward unit normal `dP/dv x dP/du` at `(u, v)` (Newell's patches turn clockwise
+    /// seen from outside), stepping into the patch where the surface is degenerate (a pole).
     #[must_use]
     pub fn normal(&self, u: f32, v: f32) -> Vec3 {
         const STEP: f32 = 1e-3;
         let (_, du, dv) = self.eval(u, v);
-        du.cross(dv).try_normalize().unwrap_or_else(|| {
+        dv.cross(du).try_normalize().unwrap_or_else(|| {
             let inward = |x: f32| if x < 0.5 { x + STEP } else { x - STEP };
             let (_, du, dv) = self.eval(inward(u), inward(v));
-            du.cross(dv).normalize_or(Vec3::Z)
+            dv.cross(du).normalize_or(Vec3::Z)
         })
     }
 
-    /// The patch as a grid of `(level + 1)^2` vertices.
+    /// The patch as a grid of `(level + 1)^2` vertices, counter-clockwise seen from outside.
     #[must_use]
     pub fn tessellate(&self, level: u32) -> Mesh {
         let level = level.max(1);
         let steps = level as f32;
-        crate::shapes::grid(level, level, |i, j| {
-            let (u, v) = (i as f32 / steps, j as f32 / steps);
+        // Rows along v and columns along u, so that d/drow x d/dcolumn is the outward normal.
+        crate::shapes::grid(level, level, |row, column| {
+            let (u, v) = (column as f32 / steps, row as f32 / steps);
             (self.eval(u, v).0, self.normal(u, v))
         })
     }
@@ -143,5 +144,34 @@ mod tests {
         let fd_v = (patch.eval(u, v + h).0 - patch.eval(u, v - h).0) / (2.0 * h);
         assert!((du - fd_u).length() < 1e-2 * du.length().max(1.0));
         assert!((dv - fd_v).length() < 1e-2 * dv.length().max(1.0));
+    }
+
+    /// Outward faces: the body's normals point away from the axis, the lid's (not its knob's)
+    /// and the rim's upwards, the bottom's downwards; each triangle's winding agrees with its normals.
+    #[test]
+    fn faces_and_normals_point_outwards() {
+        let all = patches();
+        let away_from_axis = |patch: &BezierPatch| {
+            let p = patch.eval(0.5, 0.5).0;
+            patch
+                .normal(0.5, 0.5)
+                .dot(Vec3::new(p.x, p.y, 0.0).normalize())
+        };
+        for (range, expected) in [(0..4, Vec3::Z), (24..28, Vec3::Z), (28..32, -Vec3::Z)] {
+            for patch in &all[range] {
+                assert!(patch.normal(0.5, 0.5).dot(expected) > 0.5);
+            }
+        }
+        assert!(all[4..12].iter().all(|patch| away_from_axis(patch) > 0.5));
+        let mesh = teapot(6);
+        for t in mesh.triangles() {
+            let [a, b, c] = t.map(|i| mesh.positions()[i as usize]);
+            let mean_normal: Vec3 = t.iter().map(|&i| mesh.normals()[i as usize]).sum();
+            let face = (b - a).cross(c - a);
+            assert!(
+                face.dot(mean_normal) > 0.0,
+                "{t:?} {a} {b} {c} face {face} normals {mean_normal}"
+            );
+        }
     }
 }

@@ -1,9 +1,12 @@
 //! One module per subcommand: its arguments and what it prints.
 
 pub mod analyze;
+pub mod bench;
 pub mod claims;
+pub mod diff;
 pub mod eval;
 pub mod models;
+pub mod render;
 
 /// What a command reports when it fails: a one-line message.
 pub type CommandResult = Result<(), String>;

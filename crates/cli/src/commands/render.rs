@@ -1,0 +1,156 @@
+//! `specula render`: the CPU renderer on a scene file or the embedded default scene.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use specula::{Exponent, Geometry, LobeKind, Normalisation};
+use specula_render::{
+    check_output_path, render, render_grid, write_image, write_png_srgb8, GridOptions,
+    IlluminationModel, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE,
+};
+
+use super::CommandResult;
+use crate::args::{choice, parse_exponent, LobeParser};
+
+/// Arguments of `specula render`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// A scene file (TOML); the embedded default scene when omitted.
+    scene: Option<PathBuf>,
+    /// Output image: .png (8-bit sRGB) or .exr (linear f32 radiance).
+    #[arg(short, long, default_value = "render.png")]
+    output: PathBuf,
+    /// Every material's lobe.
+    #[arg(long, value_parser = LobeParser)]
+    lobe: Option<LobeKind>,
+    /// Every material's exponent, in [1, 1000].
+    #[arg(long, value_parser = parse_exponent, allow_negative_numbers = true)]
+    n: Option<Exponent>,
+    /// Every material's geometry.
+    #[arg(long, value_parser = choice(&Geometry::ALL, Geometry::id))]
+    geometry: Option<Geometry>,
+    /// Every material's normalisation.
+    #[arg(long, value_parser = choice(&Normalisation::ALL, Normalisation::id))]
+    normalisation: Option<Normalisation>,
+    /// The shading method.
+    #[arg(long, value_parser = choice(&Shading::ALL, Shading::id))]
+    shading: Option<Shading>,
+    /// The illumination model.
+    #[arg(long, value_parser = choice(&IlluminationModel::ALL, IlluminationModel::id))]
+    model: Option<IlluminationModel>,
+    /// Image width in pixels (per tile, with --grid).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    width: Option<u32>,
+    /// Image height in pixels (per tile, with --grid).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    height: Option<u32>,
+    /// Supersampling: S x S samples per pixel.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=specula_render::MAX_SAMPLES as i64))]
+    samples: Option<u32>,
+    /// One tile per lobe with its FLIP against pow, e.g. `lobes=pow,schlick,cheb2` (PNG only).
+    #[arg(long, value_parser = parse_grid, value_name = "lobes=ID,...")]
+    grid: Option<Vec<LobeKind>>,
+    /// Print the embedded default scene (a starting point for your own) and exit.
+    #[arg(long, exclusive = true)]
+    dump_default_scene: bool,
+}
+
+fn parse_grid(text: &str) -> Result<Vec<LobeKind>, String> {
+    let list = text.strip_prefix("lobes=").ok_or_else(|| {
+        format!("'{text}' must have the form lobes=ID,ID,... (e.g. lobes=pow,schlick)")
+    })?;
+    list.split(',')
+        .filter(|id| !id.is_empty())
+        .map(|id| LobeKind::parse(id.trim()).map_err(|e| e.to_string()))
+        .collect()
+}
+
+fn progress_bar(label: &str) -> ProgressBar {
+    ProgressBar::new(0).with_style(
+        ProgressStyle::with_template(&format!("{label} {{bar:30}} {{percent}}% {{elapsed}}"))
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    )
+}
+
+/// Loads the scene (or the default) and applies the command line's overrides.
+fn load(args: &Args) -> Result<Scene, String> {
+    let LoadedScene {
+        mut scene,
+        warnings,
+    } = match &args.scene {
+        Some(path) => Scene::from_file(path),
+        None => Scene::from_toml(DEFAULT_SCENE, "<default scene>", None),
+    }
+    .map_err(|e| e.to_string())?;
+    for warning in warnings {
+        eprintln!("warning: {warning}");
+    }
+    scene.apply(&Overrides {
+        lobe: args.lobe,
+        n: args.n,
+        geometry: args.geometry,
+        normalisation: args.normalisation,
+        shading: args.shading,
+        model: args.model,
+        width: args.width,
+        height: args.height,
+        samples: args.samples,
+    });
+    Ok(scene)
+}
+
+/// Renders and writes the image.
+pub fn run(args: &Args) -> CommandResult {
+    if args.dump_default_scene {
+        print!("{DEFAULT_SCENE}");
+        return Ok(());
+    }
+    check_output_path(&args.output).map_err(|e| e.to_string())?;
+    let scene = load(args)?;
+    let started = Instant::now();
+    let bar = progress_bar("rendering");
+    let progress = |done: usize, total: usize| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    };
+    let (width, height) = match &args.grid {
+        Some(lobes) => {
+            if !is_png(&args.output) {
+                return Err(format!(
+                    "{}: a grid is written as PNG; give an output ending in .png",
+                    args.output.display()
+                ));
+            }
+            let options = GridOptions {
+                lobes: lobes.clone(),
+                reference: LobeKind::Pow,
+            };
+            let grid = render_grid(&scene, &options, &progress).map_err(|e| e.to_string())?;
+            bar.finish_and_clear();
+            write_png_srgb8(&args.output, grid.width, grid.height, &grid.bytes)
+                .map_err(|e| e.to_string())?;
+            (grid.width, grid.height)
+        }
+        None => {
+            let image = render(&scene, &progress).map_err(|e| e.to_string())?;
+            bar.finish_and_clear();
+            write_image(&args.output, &image, scene.display).map_err(|e| e.to_string())?;
+            (image.width(), image.height())
+        }
+    };
+    eprintln!(
+        "wrote {} ({width}x{height}, {} shading, {} model, {:.2} s)",
+        args.output.display(),
+        scene.settings.shading.id(),
+        scene.settings.model.id(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn is_png(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+}

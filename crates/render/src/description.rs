@@ -1,0 +1,510 @@
+//! The TOML scene format, and its translation into a [`Scene`].
+//!
+//! Every key is optional except the camera's `eye` and `target`; unknown keys are refused. A
+//! problem is reported as `file:line:column: key: what is wrong (and the valid choices)`: syntax
+//! and type errors with the position `toml` gives, value errors (an unknown lobe id, `n` out of
+//! range, a key that does not apply to the shape) with the position of the offending value.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use glam::{EulerRot, Mat3, Vec3};
+use serde::Deserialize;
+use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+use thiserror::Error;
+use toml::Spanned;
+
+use crate::camera::Projection;
+use crate::load::load_mesh;
+use crate::material::{IlluminationModel, Light, Material, Shading};
+use crate::scene::{Object, Settings};
+use crate::{plane, sphere, teapot, torus, Camera, Display, Mesh, Scene, ToneMap};
+
+/// A scene file that cannot be used: where, and why.
+#[derive(Clone, Debug, Error, PartialEq)]
+#[error("{file}:{line}:{column}: {message}")]
+pub struct SceneError {
+    /// The file (or a label such as `<default scene>`).
+    pub file: String,
+    /// 1-based line of the offending text.
+    pub line: usize,
+    /// 1-based column.
+    pub column: usize,
+    /// What is wrong, naming the key and the valid choices.
+    pub message: String,
+}
+
+/// A parsed scene and the remarks made while building it (dropped degenerate triangles).
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    /// The scene.
+    pub scene: Scene,
+    /// Things the user should know, one line each.
+    pub warnings: Vec<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneDescription {
+    #[serde(default)]
+    ambient: Option<Spanned<[f32; 3]>>,
+    camera: Spanned<CameraDescription>,
+    #[serde(default)]
+    render: RenderDescription,
+    #[serde(default)]
+    lights: Vec<Spanned<LightDescription>>,
+    #[serde(default)]
+    objects: Vec<Spanned<ObjectDescription>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraDescription {
+    eye: [f32; 3],
+    target: [f32; 3],
+    #[serde(default = "z_up")]
+    up: [f32; 3],
+    fov: Option<f32>,
+    orthographic: Option<f32>,
+    #[serde(default = "default_near")]
+    near: f32,
+    #[serde(default = "default_far")]
+    far: f32,
+}
+
+fn z_up() -> [f32; 3] {
+    [0.0, 0.0, 1.0]
+}
+fn default_near() -> f32 {
+    0.1
+}
+fn default_far() -> f32 {
+    1000.0
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct RenderDescription {
+    width: u32,
+    height: u32,
+    samples: u32,
+    shading: Shading,
+    model: IlluminationModel,
+    cull_back_faces: bool,
+    background: Spanned<[f32; 3]>,
+    exposure: Spanned<f32>,
+    tonemap: ToneMap,
+}
+
+impl Default for RenderDescription {
+    fn default() -> Self {
+        let settings = Settings::default();
+        Self {
+            width: settings.width,
+            height: settings.height,
+            samples: settings.samples,
+            shading: settings.shading,
+            model: settings.model,
+            cull_back_faces: settings.cull_back_faces,
+            background: Spanned::new(0..0, settings.background.to_array()),
+            exposure: Spanned::new(0..0, Display::default().exposure),
+            tonemap: Display::default().tonemap,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum LightKind {
+    Directional,
+    Point,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightDescription {
+    kind: LightKind,
+    towards: Option<[f32; 3]>,
+    position: Option<[f32; 3]>,
+    #[serde(default = "white")]
+    intensity: [f32; 3],
+}
+
+fn white() -> [f32; 3] {
+    [1.0; 3]
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum ShapeKind {
+    Sphere,
+    Torus,
+    Plane,
+    Teapot,
+    Mesh,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObjectDescription {
+    shape: ShapeKind,
+    radius: Option<Spanned<f32>>,
+    segments: Option<Spanned<u32>>,
+    rings: Option<Spanned<u32>>,
+    major: Option<Spanned<f32>>,
+    minor: Option<Spanned<f32>>,
+    sides: Option<Spanned<u32>>,
+    size: Option<Spanned<f32>>,
+    level: Option<Spanned<u32>>,
+    path: Option<Spanned<String>>,
+    #[serde(default)]
+    translate: [f32; 3],
+    #[serde(default)]
+    rotate: [f32; 3],
+    #[serde(default = "one")]
+    scale: Spanned<f32>,
+    #[serde(default)]
+    material: MaterialDescription,
+}
+
+fn one() -> Spanned<f32> {
+    Spanned::new(0..0, 1.0)
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct MaterialDescription {
+    ka: Spanned<f32>,
+    kd: Spanned<f32>,
+    ks: Spanned<f32>,
+    colour: Spanned<[f32; 3]>,
+    specular_colour: Spanned<[f32; 3]>,
+    lobe: Spanned<String>,
+    n: Spanned<f64>,
+    geometry: Spanned<String>,
+    normalisation: Spanned<String>,
+}
+
+impl Default for MaterialDescription {
+    fn default() -> Self {
+        let unspanned = |v| Spanned::new(0..0, v);
+        Self {
+            ka: unspanned(0.1),
+            kd: unspanned(0.6),
+            ks: unspanned(0.4),
+            colour: Spanned::new(0..0, [0.8; 3]),
+            specular_colour: Spanned::new(0..0, [1.0; 3]),
+            lobe: Spanned::new(0..0, "pow".to_owned()),
+            n: Spanned::new(0..0, 32.0),
+            geometry: Spanned::new(0..0, "phong".to_owned()),
+            normalisation: Spanned::new(0..0, "none".to_owned()),
+        }
+    }
+}
+
+/// Turns byte spans into `file:line:column` errors.
+struct Locator<'a> {
+    source: &'a str,
+    file: &'a str,
+}
+
+impl Locator<'_> {
+    fn error(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
+        let before = &self.source[..span.start.min(self.source.len())];
+        let line = before.matches('\n').count() + 1;
+        let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+        SceneError {
+            file: self.file.to_owned(),
+            line,
+            column,
+            message: message.into(),
+        }
+    }
+
+    fn finite_non_negative(
+        &self,
+        key: &str,
+        value: &Spanned<[f32; 3]>,
+    ) -> Result<Vec3, SceneError> {
+        let v = *value.get_ref();
+        if v.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            Ok(Vec3::from_array(v))
+        } else {
+            Err(self.error(
+                value.span(),
+                format!("{key}: every component must be a finite number >= 0, got {v:?}"),
+            ))
+        }
+    }
+}
+
+impl Scene {
+    /// Reads a scene file; mesh paths in it are relative to the file's directory.
+    pub fn from_file(path: &Path) -> Result<LoadedScene, SceneError> {
+        let source = std::fs::read_to_string(path).map_err(|error| SceneError {
+            file: path.display().to_string(),
+            line: 0,
+            column: 0,
+            message: format!("cannot read the scene file: {error}"),
+        })?;
+        let base = path.parent().map(Path::to_path_buf);
+        Scene::from_toml(&source, &path.display().to_string(), base.as_deref())
+    }
+
+    /// Parses a scene from TOML text; `file` labels messages, `base` resolves mesh paths.
+    pub fn from_toml(
+        source: &str,
+        file: &str,
+        base: Option<&Path>,
+    ) -> Result<LoadedScene, SceneError> {
+        let locate = Locator { source, file };
+        let description: SceneDescription = toml::from_str(source).map_err(|error| {
+            locate.error(error.span().unwrap_or(0..0), error.message().trim_end())
+        })?;
+        let mut warnings = Vec::new();
+        let camera = build_camera(&locate, &description.camera)?;
+        let render = &description.render;
+        let settings = Settings {
+            width: render.width,
+            height: render.height,
+            samples: render.samples,
+            shading: render.shading,
+            model: render.model,
+            cull_back_faces: render.cull_back_faces,
+            background: locate.finite_non_negative("background", &render.background)?,
+        };
+        let exposure = *render.exposure.get_ref();
+        if !(exposure.is_finite() && exposure > 0.0) {
+            let message = format!("render.exposure: must be a positive number, got {exposure}");
+            return Err(locate.error(render.exposure.span(), message));
+        }
+        let lights = description
+            .lights
+            .iter()
+            .map(|light| build_light(&locate, light))
+            .collect::<Result<_, _>>()?;
+        let objects = description
+            .objects
+            .iter()
+            .map(|object| build_object(&locate, object, base, &mut warnings))
+            .collect::<Result<_, _>>()?;
+        let ambient = match &description.ambient {
+            Some(value) => locate.finite_non_negative("ambient", value)?,
+            None => Vec3::ZERO,
+        };
+        Ok(LoadedScene {
+            scene: Scene {
+                camera,
+                lights,
+                ambient,
+                objects,
+                settings,
+                display: Display {
+                    exposure,
+                    tonemap: render.tonemap,
+                },
+            },
+            warnings,
+        })
+    }
+}
+
+fn build_camera(
+    locate: &Locator,
+    camera: &Spanned<CameraDescription>,
+) -> Result<Camera, SceneError> {
+    let c = camera.get_ref();
+    let projection = match (c.fov, c.orthographic) {
+        (Some(_), Some(_)) => {
+            return Err(locate.error(
+                camera.span(),
+                "camera: give either fov (perspective) or orthographic (a view height), not both",
+            ));
+        }
+        (fov, None) => Projection::Perspective {
+            fov_y_degrees: fov.unwrap_or(40.0),
+        },
+        (None, Some(height)) => Projection::Orthographic { height },
+    };
+    let v = Vec3::from_array;
+    Camera::try_new(v(c.eye), v(c.target), v(c.up), projection, c.near, c.far)
+        .map_err(|error| locate.error(camera.span(), format!("camera: {error}")))
+}
+
+fn build_light(locate: &Locator, light: &Spanned<LightDescription>) -> Result<Light, SceneError> {
+    let l = light.get_ref();
+    let intensity =
+        locate.finite_non_negative("intensity", &Spanned::new(light.span(), l.intensity))?;
+    let fail = |message: &str| Err(locate.error(light.span(), message));
+    match (l.kind, l.towards, l.position) {
+        (LightKind::Directional, Some(towards), None) => match Vec3::from_array(towards).try_normalize() {
+            Some(towards) => Ok(Light::Directional { towards, intensity }),
+            None => fail("lights.towards: must be a finite, non-zero direction (towards the light)"),
+        },
+        (LightKind::Point, None, Some(position)) if Vec3::from_array(position).is_finite() => {
+            Ok(Light::Point { position: Vec3::from_array(position), intensity })
+        }
+        (LightKind::Directional, ..) => fail("lights: a directional light takes `towards` (the direction to the light) and no `position`"),
+        (LightKind::Point, ..) => fail("lights: a point light takes a finite `position` and no `towards`"),
+    }
+}
+
+/// The keys each shape accepts besides the common ones.
+fn shape_keys(shape: ShapeKind) -> &'static [&'static str] {
+    match shape {
+        ShapeKind::Sphere => &["radius", "segments", "rings"],
+        ShapeKind::Torus => &["major", "minor", "segments", "sides"],
+        ShapeKind::Plane => &["size"],
+        ShapeKind::Teapot => &["level"],
+        ShapeKind::Mesh => &["path"],
+    }
+}
+
+fn build_object(
+    locate: &Locator,
+    object: &Spanned<ObjectDescription>,
+    base: Option<&Path>,
+    warnings: &mut Vec<String>,
+) -> Result<Object, SceneError> {
+    let o = object.get_ref();
+    let given: [(&str, Option<Range<usize>>); 9] = [
+        ("radius", o.radius.as_ref().map(Spanned::span)),
+        ("segments", o.segments.as_ref().map(Spanned::span)),
+        ("rings", o.rings.as_ref().map(Spanned::span)),
+        ("major", o.major.as_ref().map(Spanned::span)),
+        ("minor", o.minor.as_ref().map(Spanned::span)),
+        ("sides", o.sides.as_ref().map(Spanned::span)),
+        ("size", o.size.as_ref().map(Spanned::span)),
+        ("level", o.level.as_ref().map(Spanned::span)),
+        ("path", o.path.as_ref().map(Spanned::span)),
+    ];
+    let allowed = shape_keys(o.shape);
+    for (key, span) in given {
+        if let Some(span) = span.filter(|_| !allowed.contains(&key)) {
+            return Err(locate.error(
+                span,
+                format!(
+                    "{key}: does not apply to this shape; its keys are {}",
+                    allowed.join(", ")
+                ),
+            ));
+        }
+    }
+    let length = |key: &str, value: &Option<Spanned<f32>>, default: f32| match value {
+        None => Ok(default),
+        Some(v) if v.get_ref().is_finite() && *v.get_ref() > 0.0 => Ok(*v.get_ref()),
+        Some(v) => Err(locate.error(
+            v.span(),
+            format!("{key}: must be a positive length, got {}", v.get_ref()),
+        )),
+    };
+    let count =
+        |key: &str, value: &Option<Spanned<u32>>, default: u32, range: Range<u32>| match value {
+            None => Ok(default),
+            Some(v) if range.contains(v.get_ref()) => Ok(*v.get_ref()),
+            Some(v) => Err(locate.error(
+                v.span(),
+                format!(
+                    "{key}: must be in [{}, {}], got {}",
+                    range.start,
+                    range.end - 1,
+                    v.get_ref()
+                ),
+            )),
+        };
+    let mesh = match o.shape {
+        ShapeKind::Sphere => sphere(
+            length("radius", &o.radius, 1.0)?,
+            count("segments", &o.segments, 96, 3..4097)?,
+            count("rings", &o.rings, 48, 2..4097)?,
+        ),
+        ShapeKind::Torus => torus(
+            length("major", &o.major, 1.0)?,
+            length("minor", &o.minor, 0.3)?,
+            count("segments", &o.segments, 96, 3..4097)?,
+            count("sides", &o.sides, 48, 3..4097)?,
+        ),
+        ShapeKind::Plane => plane(length("size", &o.size, 10.0)?),
+        ShapeKind::Teapot => teapot(count("level", &o.level, 12, 1..65)?),
+        ShapeKind::Mesh => {
+            let Some(path) = &o.path else {
+                return Err(locate.error(object.span(), "path: a mesh object needs `path`, a .obj, .stl or .ply file relative to the scene"));
+            };
+            let full: PathBuf =
+                base.map_or_else(|| PathBuf::from(path.get_ref()), |b| b.join(path.get_ref()));
+            let loaded = load_mesh(&full)
+                .map_err(|error| locate.error(path.span(), format!("path: {error}")))?;
+            if loaded.degenerate_triangles > 0 {
+                warnings.push(format!(
+                    "{}: skipped {} degenerate triangle(s)",
+                    full.display(),
+                    loaded.degenerate_triangles
+                ));
+            }
+            loaded.mesh
+        }
+    };
+    let scale = *o.scale.get_ref();
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(locate.error(
+            o.scale.span(),
+            format!("scale: must be a positive number, got {scale}"),
+        ));
+    }
+    let translate = Vec3::from_array(o.translate);
+    let r = o.rotate.map(f32::to_radians);
+    if !(translate.is_finite() && r.iter().all(|a| a.is_finite())) {
+        return Err(locate.error(object.span(), "translate and rotate must be finite"));
+    }
+    let rotation = Mat3::from_euler(EulerRot::ZYX, r[2], r[1], r[0]);
+    let mesh = transform(&mesh, rotation, scale, translate);
+    Ok(Object {
+        mesh,
+        material: build_material(locate, &o.material)?,
+    })
+}
+
+fn transform(mesh: &Mesh, rotation: Mat3, scale: f32, translate: Vec3) -> Mesh {
+    let positions = mesh
+        .positions()
+        .iter()
+        .map(|&p| rotation * (scale * p) + translate)
+        .collect();
+    let normals = mesh.normals().iter().map(|&n| rotation * n).collect();
+    // A rotation, uniform scale and translation of a valid mesh is valid.
+    Mesh::try_new(positions, normals, mesh.triangles().to_vec()).unwrap_or_default()
+}
+
+fn build_material(locate: &Locator, m: &MaterialDescription) -> Result<Material, SceneError> {
+    let coefficient = |key: &str, v: &Spanned<f32>| {
+        let value = *v.get_ref();
+        if value.is_finite() && value >= 0.0 {
+            Ok(value)
+        } else {
+            Err(locate.error(
+                v.span(),
+                format!("material.{key}: must be a finite number >= 0, got {value}"),
+            ))
+        }
+    };
+    let invalid = |key: &'static str, span: Range<usize>| {
+        move |error: specula::Error| locate.error(span, format!("material.{key}: {error}"))
+    };
+    let kind = LobeKind::parse(m.lobe.get_ref()).map_err(invalid("lobe", m.lobe.span()))?;
+    let n = Exponent::try_new(*m.n.get_ref()).map_err(invalid("n", m.n.span()))?;
+    let geometry =
+        Geometry::parse(m.geometry.get_ref()).map_err(invalid("geometry", m.geometry.span()))?;
+    let normalisation = Normalisation::parse(m.normalisation.get_ref())
+        .map_err(invalid("normalisation", m.normalisation.span()))?;
+    Ok(Material {
+        ka: coefficient("ka", &m.ka)?,
+        kd: coefficient("kd", &m.kd)?,
+        ks: coefficient("ks", &m.ks)?,
+        colour: locate.finite_non_negative("material.colour", &m.colour)?,
+        specular_colour: locate
+            .finite_non_negative("material.specular_colour", &m.specular_colour)?,
+        lobe: Lobe::new(kind, n),
+        geometry,
+        normalisation,
+    })
+}

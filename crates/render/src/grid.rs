@@ -1,0 +1,137 @@
+//! A comparison grid: the scene rendered once per lobe, side by side, each with its label, and
+//! below each its FLIP heatmap against the reference lobe (`pow`, the exact `t^n`) with the mean
+//! FLIP written on it.
+
+use font8x8::UnicodeFonts;
+use specula::LobeKind;
+use thiserror::Error;
+
+use crate::metrics::compare;
+use crate::{render, Overrides, RenderError, Scene};
+
+/// What a grid shows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridOptions {
+    /// One column per lobe, in this order.
+    pub lobes: Vec<LobeKind>,
+    /// What every column is compared with.
+    pub reference: LobeKind,
+}
+
+/// A grid that cannot be made.
+#[derive(Clone, Debug, Error, PartialEq)]
+#[non_exhaustive]
+pub enum GridError {
+    /// No lobe was named.
+    #[error("a grid needs at least one lobe, e.g. --grid lobes=pow,schlick,cheb2")]
+    Empty,
+    /// A render failed.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+}
+
+/// An 8-bit sRGB image (three bytes per pixel).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Srgb8Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major bytes.
+    pub bytes: Vec<u8>,
+}
+
+impl Srgb8Image {
+    fn blit(&mut self, x0: u32, y0: u32, width: u32, bytes: &[u8]) {
+        for (row, line) in bytes.chunks_exact(3 * width as usize).enumerate() {
+            let start = 3 * ((y0 + row as u32) * self.width + x0) as usize;
+            self.bytes[start..start + line.len()].copy_from_slice(line);
+        }
+    }
+
+    /// Writes `text` at `(x, y)` in white on a dark box, with 8x8 glyphs scaled twice.
+    fn label(&mut self, x: u32, y: u32, text: &str) {
+        const SCALE: u32 = 2;
+        let glyph_size = 8 * SCALE;
+        let box_width = (text.chars().count() as u32 * glyph_size + 8).min(self.width - x);
+        let box_height = (glyph_size + 8).min(self.height - y);
+        for yy in y..y + box_height {
+            for xx in x..x + box_width {
+                let k = 3 * (yy * self.width + xx) as usize;
+                self.bytes[k..k + 3].iter_mut().for_each(|b| *b /= 4);
+            }
+        }
+        for (index, c) in text.chars().enumerate() {
+            let glyph = font8x8::BASIC_FONTS.get(c).unwrap_or([0; 8]);
+            for (row, bits) in glyph.iter().enumerate() {
+                for column in 0..8 {
+                    if bits >> column & 1 == 0 {
+                        continue;
+                    }
+                    for (dy, dx) in (0..SCALE).flat_map(|dy| (0..SCALE).map(move |dx| (dy, dx))) {
+                        let px = x + 4 + index as u32 * glyph_size + column * SCALE + dx;
+                        let py = y + 4 + row as u32 * SCALE + dy;
+                        if px < self.width && py < self.height {
+                            let k = 3 * (py * self.width + px) as usize;
+                            self.bytes[k..k + 3].fill(255);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Renders the grid: row one the lobes, row two their FLIP against `options.reference`.
+/// `progress(done, total)` counts tiles over all renders.
+pub fn render_grid(
+    scene: &Scene,
+    options: &GridOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Srgb8Image, GridError> {
+    if options.lobes.is_empty() {
+        return Err(GridError::Empty);
+    }
+    let renders = 1 + options.lobes.len();
+    let with_lobe = |kind: LobeKind, index: usize| {
+        let mut variant = scene.clone();
+        variant.apply(&Overrides {
+            lobe: Some(kind),
+            ..Overrides::default()
+        });
+        render(&variant, &|done, total| {
+            progress(index * total + done, renders * total)
+        })
+    };
+    let reference = with_lobe(options.reference, 0)?;
+    let (width, height) = (reference.width(), reference.height());
+    let mut grid = Srgb8Image {
+        width: width * options.lobes.len() as u32,
+        height: 2 * height,
+        bytes: vec![0; 3 * (width * options.lobes.len() as u32 * 2 * height) as usize],
+    };
+    for (column, &kind) in options.lobes.iter().enumerate() {
+        let image = if kind == options.reference {
+            reference.clone()
+        } else {
+            with_lobe(kind, column + 1)?
+        };
+        let difference = compare(&reference, &image, scene.display)
+            .expect("every render of one scene has the scene's size");
+        let x0 = column as u32 * width;
+        grid.blit(x0, 0, width, &image.to_srgb8(scene.display));
+        grid.blit(x0, height, width, &difference.heatmap_srgb8());
+        grid.label(x0, 0, kind.id());
+        let caption = if kind == options.reference {
+            "reference".to_owned()
+        } else {
+            format!(
+                "FLIP {:.4} vs {}",
+                difference.mean_flip,
+                options.reference.id()
+            )
+        };
+        grid.label(x0, height, &caption);
+    }
+    Ok(grid)
+}

@@ -1,0 +1,398 @@
+//! Images: linear radiance in memory, tone mapping and sRGB encoding only at write time.
+//!
+//! PNG files hold 8-bit sRGB (exposure and tone map applied, then the sRGB curve); OpenEXR files
+//! hold the linear `f32` radiance untouched. Every file is written to a temporary file in the
+//! destination's directory and renamed into place, so a failed or interrupted write never
+//! leaves a partial image behind.
+
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// A linear RGB image, row-major from the top-left pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    width: u32,
+    height: u32,
+    pixels: Vec<Vec3>,
+}
+
+/// Why an image could not be read or written.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ImageError {
+    /// The extension is neither `.png` nor `.exr`.
+    #[error("{path}: unknown image format; use a file name ending in .png (8-bit sRGB) or .exr (linear f32)")]
+    UnknownFormat {
+        /// The path.
+        path: String,
+    },
+    /// The file system refused.
+    #[error("{path}: {source}")]
+    Io {
+        /// The path.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The codec refused.
+    #[error("{path}: {message}")]
+    Codec {
+        /// The path.
+        path: String,
+        /// The codec's message.
+        message: String,
+    },
+}
+
+/// How radiance above 1 is brought into the displayable range before sRGB encoding.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ToneMap {
+    /// Clip each channel to `[0, 1]` (the classic model's intensities are meant this way).
+    #[default]
+    Clamp,
+    /// `x / (1 + x)` per channel (keeps the peaks of normalised lobes visible).
+    Reinhard,
+}
+
+impl ToneMap {
+    /// Both tone maps.
+    pub const ALL: [ToneMap; 2] = [ToneMap::Clamp, ToneMap::Reinhard];
+
+    /// The name in scenes and on the command line.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            ToneMap::Clamp => "clamp",
+            ToneMap::Reinhard => "reinhard",
+        }
+    }
+
+    fn apply(self, value: f32) -> f32 {
+        match self {
+            ToneMap::Clamp => value.clamp(0.0, 1.0),
+            ToneMap::Reinhard => {
+                let v = value.max(0.0);
+                v / (1.0 + v)
+            }
+        }
+    }
+}
+
+/// What turns radiance into display values.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Display {
+    /// Radiance is multiplied by this before tone mapping.
+    pub exposure: f32,
+    /// The tone map.
+    pub tonemap: ToneMap,
+}
+
+impl Default for Display {
+    fn default() -> Self {
+        Self {
+            exposure: 1.0,
+            tonemap: ToneMap::Clamp,
+        }
+    }
+}
+
+/// The sRGB transfer function (IEC 61966-2-1) of a value in `[0, 1]`.
+#[must_use]
+pub fn srgb_encode(linear: f32) -> f32 {
+    if linear <= 0.003_130_8 {
+        12.92 * linear
+    } else {
+        1.055 * linear.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// The inverse of [`srgb_encode`].
+#[must_use]
+pub fn srgb_decode(encoded: f32) -> f32 {
+    if encoded <= 0.040_45 {
+        encoded / 12.92
+    } else {
+        ((encoded + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+impl Image {
+    /// A `width x height` image filled with `colour`.
+    #[must_use]
+    pub fn new(width: u32, height: u32, colour: Vec3) -> Self {
+        Self {
+            width,
+            height,
+            pixels: vec![colour; width as usize * height as usize],
+        }
+    }
+
+    /// An image from its pixels; `None` unless `pixels.len() == width * height`.
+    #[must_use]
+    pub fn from_pixels(width: u32, height: u32, pixels: Vec<Vec3>) -> Option<Self> {
+        (pixels.len() == width as usize * height as usize).then_some(Self {
+            width,
+            height,
+            pixels,
+        })
+    }
+
+    /// Width in pixels.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// The pixels, row-major.
+    #[must_use]
+    pub fn pixels(&self) -> &[Vec3] {
+        &self.pixels
+    }
+
+    /// The pixel at column `x`, row `y`.
+    #[must_use]
+    pub fn get(&self, x: u32, y: u32) -> Vec3 {
+        self.pixels[(y * self.width + x) as usize]
+    }
+
+    /// Sets the pixel at column `x`, row `y`.
+    pub fn set(&mut self, x: u32, y: u32, colour: Vec3) {
+        self.pixels[(y * self.width + x) as usize] = colour;
+    }
+
+    /// 8-bit sRGB values, three per pixel, after exposure and tone mapping.
+    #[must_use]
+    pub fn to_srgb8(&self, display: Display) -> Vec<u8> {
+        self.pixels
+            .iter()
+            .flat_map(|p| p.to_array())
+            .map(|c| {
+                let mapped = display.tonemap.apply(c * display.exposure);
+                // NaN cannot reach here (the renderer never writes one), but a NaN would
+                // saturate to 0 in the cast rather than poison the file.
+                (srgb_encode(mapped) * 255.0).round() as u8
+            })
+            .collect()
+    }
+
+    /// The image from 8-bit sRGB values, decoded to linear.
+    #[must_use]
+    pub fn from_srgb8(width: u32, height: u32, bytes: &[u8]) -> Option<Self> {
+        let decode = |b: u8| srgb_decode(f32::from(b) / 255.0);
+        let pixels = bytes
+            .chunks_exact(3)
+            .map(|c| Vec3::new(decode(c[0]), decode(c[1]), decode(c[2])))
+            .collect();
+        Self::from_pixels(width, height, pixels)
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Format {
+    Png,
+    Exr,
+}
+
+fn format_of(path: &Path) -> Result<Format, ImageError> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("png") => Ok(Format::Png),
+        Some("exr") => Ok(Format::Exr),
+        _ => Err(ImageError::UnknownFormat {
+            path: path.display().to_string(),
+        }),
+    }
+}
+
+/// Checks that `path` names a format this module writes (before any long work starts).
+pub fn check_output_path(path: &Path) -> Result<(), ImageError> {
+    format_of(path).map(|_| ())
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file beside it, renamed into place.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<(), String>,
+) -> Result<(), ImageError> {
+    let io = |source| ImageError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let directory = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let mut file = tempfile::Builder::new()
+        .prefix(".specula-")
+        .suffix(".tmp")
+        .tempfile_in(directory)
+        .map_err(io)?;
+    {
+        let mut writer = BufWriter::new(file.as_file_mut());
+        write(&mut writer).map_err(|message| ImageError::Codec {
+            path: path.display().to_string(),
+            message,
+        })?;
+        writer.flush().map_err(io)?;
+    }
+    file.as_file().sync_all().map_err(io)?;
+    file.persist(path).map_err(|error| io(error.error))?;
+    Ok(())
+}
+
+/// Writes 8-bit sRGB bytes (three per pixel) as a PNG, atomically.
+pub fn write_png_srgb8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+) -> Result<(), ImageError> {
+    use image::ImageEncoder;
+    write_atomically(path, |writer| {
+        image::codecs::png::PngEncoder::new(writer)
+            .write_image(bytes, width, height, image::ExtendedColorType::Rgb8)
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// Writes `image` to `path`: `.png` as 8-bit sRGB through `display`, `.exr` as linear `f32`.
+pub fn write_image(path: &Path, image: &Image, display: Display) -> Result<(), ImageError> {
+    use exr::prelude::{
+        Encoding, Image as ExrImage, Layer, LayerAttributes, SpecificChannels, WritableImage,
+    };
+    match format_of(path)? {
+        Format::Png => write_png_srgb8(path, image.width, image.height, &image.to_srgb8(display)),
+        Format::Exr => write_atomically(path, |writer| {
+            let layer = Layer::new(
+                (image.width as usize, image.height as usize),
+                LayerAttributes::named("radiance"),
+                Encoding::SMALL_LOSSLESS,
+                SpecificChannels::rgb(|position: exr::math::Vec2<usize>| {
+                    let p = image.get(position.x() as u32, position.y() as u32);
+                    (p.x, p.y, p.z)
+                }),
+            );
+            ExrImage::from_layer(layer)
+                .write()
+                .to_buffered(writer)
+                .map_err(|e| e.to_string())
+        }),
+    }
+}
+
+/// Reads a PNG (decoded from sRGB to linear) or an OpenEXR file (its first RGB(A) layer).
+pub fn read_image(path: &Path) -> Result<Image, ImageError> {
+    let codec = |message: String| ImageError::Codec {
+        path: path.display().to_string(),
+        message,
+    };
+    match format_of(path)? {
+        Format::Png => {
+            let decoded = image::open(path).map_err(|e| match e {
+                image::ImageError::IoError(source) => ImageError::Io {
+                    path: path.display().to_string(),
+                    source,
+                },
+                other => codec(other.to_string()),
+            })?;
+            let rgb = decoded.to_rgb8();
+            Image::from_srgb8(rgb.width(), rgb.height(), rgb.as_raw())
+                .ok_or_else(|| codec("inconsistent image size".into()))
+        }
+        Format::Exr => {
+            let read = exr::prelude::read_first_rgba_layer_from_file(
+                path,
+                |resolution, _| {
+                    Image::new(
+                        resolution.width() as u32,
+                        resolution.height() as u32,
+                        Vec3::ZERO,
+                    )
+                },
+                |image: &mut Image, position, (r, g, b, _a): (f32, f32, f32, f32)| {
+                    image.set(position.x() as u32, position.y() as u32, Vec3::new(r, g, b));
+                },
+            )
+            .map_err(|e| match e {
+                exr::error::Error::Io(source) => ImageError::Io {
+                    path: path.display().to_string(),
+                    source,
+                },
+                other => codec(other.to_string()),
+            })?;
+            Ok(read.layer_data.channel_data.pixels)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_curve_matches_its_definition_and_inverts() {
+        // IEC 61966-2-1 reference points: 0.5 linear encodes to 0.7353569830524495.
+        assert!((srgb_encode(0.5) - 0.735_357).abs() < 1e-6);
+        assert!((srgb_encode(0.002) - 0.025_84).abs() < 1e-6);
+        for k in 0..=255 {
+            let v = k as f32 / 255.0;
+            assert!((srgb_encode(srgb_decode(v)) - v).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn tone_maps_and_exposure_apply_before_encoding() {
+        let image =
+            Image::from_pixels(2, 1, vec![Vec3::new(3.0, 1.0, -1.0), Vec3::splat(0.25)]).unwrap();
+        let clamp = image.to_srgb8(Display::default());
+        assert_eq!(&clamp[..3], &[255, 255, 0]);
+        let reinhard = image.to_srgb8(Display {
+            exposure: 2.0,
+            tonemap: ToneMap::Reinhard,
+        });
+        // 0.25 * 2 = 0.5 -> 0.5 / 1.5 = 1/3 -> sRGB 0.6132 -> 156.
+        assert_eq!(reinhard[3], (srgb_encode(1.0 / 3.0) * 255.0).round() as u8);
+        assert_eq!(reinhard[3], 156);
+    }
+
+    #[test]
+    fn files_round_trip_and_unknown_extensions_are_refused() {
+        let directory = tempfile::tempdir().unwrap();
+        let pixels = (0..12)
+            .map(|k| Vec3::new(k as f32 * 0.7, 0.1, 1e-3 * k as f32))
+            .collect();
+        let image = Image::from_pixels(4, 3, pixels).unwrap();
+        let exr = directory.path().join("a.exr");
+        write_image(&exr, &image, Display::default()).unwrap();
+        assert_eq!(read_image(&exr).unwrap(), image);
+
+        let png = directory.path().join("a.png");
+        write_image(&png, &image, Display::default()).unwrap();
+        let back = read_image(&png).unwrap();
+        assert_eq!(
+            back.to_srgb8(Display::default()),
+            image.to_srgb8(Display::default())
+        );
+
+        let error = write_image(&directory.path().join("a.jpg"), &image, Display::default());
+        assert!(error.unwrap_err().to_string().contains(".png"));
+        // Only the two images: no temporary file left behind.
+        assert_eq!(std::fs::read_dir(directory.path()).unwrap().count(), 2);
+    }
+}

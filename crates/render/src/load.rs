@@ -1,0 +1,195 @@
+//! Mesh files: Wavefront OBJ (via `tobj`), STL binary and ASCII (via `stl_io`) and PLY ASCII
+//! and binary (via `ply-rs-bw`).
+//!
+//! Polygons are fan-triangulated. Missing normals (always, for STL) are left zero, which
+//! [`Mesh::try_new`] replaces with the area-weighted average of the faces around the vertex.
+//! Degenerate triangles (repeated corners, zero area) are dropped and counted, so a caller can
+//! say so; non-finite coordinates and out-of-range indices refuse the file with the reason.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+use glam::Vec3;
+use thiserror::Error;
+
+use crate::{Mesh, MeshError};
+
+/// A mesh file that could not be used, and why.
+#[derive(Debug, Error)]
+#[error("{path}: {message}")]
+pub struct LoadError {
+    /// The file.
+    pub path: String,
+    /// What is wrong with it.
+    pub message: String,
+}
+
+/// A loaded mesh and how many degenerate triangles were dropped from it.
+#[derive(Clone, Debug)]
+pub struct LoadedMesh {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// Triangles dropped for having no area.
+    pub degenerate_triangles: usize,
+}
+
+/// The file extensions [`load_mesh`] reads.
+pub const MESH_EXTENSIONS: [&str; 3] = ["obj", "stl", "ply"];
+
+/// Loads a mesh, choosing the format by the file's extension.
+pub fn load_mesh(path: &Path) -> Result<LoadedMesh, LoadError> {
+    let fail = |message: String| LoadError {
+        path: path.display().to_string(),
+        message,
+    };
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let (positions, normals, polygons) = match extension.as_str() {
+        "obj" => read_obj(path),
+        "stl" => read_stl(path),
+        "ply" => read_ply(path),
+        _ => Err(format!(
+            "unknown mesh format; the extension must be one of {}",
+            MESH_EXTENSIONS.join(", ")
+        )),
+    }
+    .map_err(fail)?;
+    build(positions, normals, &polygons).map_err(|error| fail(error.to_string()))
+}
+
+type Parts = (Vec<Vec3>, Vec<Vec3>, Vec<Vec<u32>>);
+
+/// Triangulates, drops degenerate triangles and validates.
+fn build(
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    polygons: &[Vec<u32>],
+) -> Result<LoadedMesh, MeshError> {
+    let mut triangles = Vec::new();
+    let mut degenerate_triangles = 0;
+    for polygon in polygons {
+        for k in 1..polygon.len().saturating_sub(1) {
+            let triangle = [polygon[0], polygon[k], polygon[k + 1]];
+            let corners = triangle.map(|i| positions.get(i as usize).copied());
+            let area = match corners {
+                [Some(a), Some(b), Some(c)] => (b - a).cross(c - a).length_squared(),
+                // Out of range: keep it so that validation names the index.
+                _ => f32::INFINITY,
+            };
+            if area > 0.0 || area.is_nan() {
+                triangles.push(triangle);
+            } else {
+                degenerate_triangles += 1;
+            }
+        }
+    }
+    let normals = if normals.len() == positions.len() {
+        normals
+    } else {
+        vec![Vec3::ZERO; positions.len()]
+    };
+    Ok(LoadedMesh {
+        mesh: Mesh::try_new(positions, normals, triangles)?,
+        degenerate_triangles,
+    })
+}
+
+fn read_obj(path: &Path) -> Result<Parts, String> {
+    let options = tobj::LoadOptions {
+        triangulate: false,
+        single_index: true,
+        ..tobj::LoadOptions::default()
+    };
+    let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| e.to_string())?;
+    let (mut positions, mut normals, mut polygons) = (Vec::new(), Vec::new(), Vec::new());
+    for model in models {
+        let mesh = model.mesh;
+        let offset = positions.len() as u32;
+        let vertex_count = mesh.positions.len() / 3;
+        positions.extend(mesh.positions.chunks_exact(3).map(Vec3::from_slice));
+        if mesh.normals.len() == mesh.positions.len() {
+            normals.extend(mesh.normals.chunks_exact(3).map(Vec3::from_slice));
+        } else {
+            normals.extend(core::iter::repeat_n(Vec3::ZERO, vertex_count));
+        }
+        let mut start = 0;
+        let arities: Vec<u32> = if mesh.face_arities.is_empty() {
+            vec![3; mesh.indices.len() / 3]
+        } else {
+            mesh.face_arities.clone()
+        };
+        for arity in arities {
+            let end = start + arity as usize;
+            polygons.push(
+                mesh.indices[start..end]
+                    .iter()
+                    .map(|i| i + offset)
+                    .collect(),
+            );
+            start = end;
+        }
+    }
+    Ok((positions, normals, polygons))
+}
+
+fn read_stl(path: &Path) -> Result<Parts, String> {
+    let mut file = File::open(path).map_err(|e| e.to_string())?;
+    let mesh = stl_io::read_stl(&mut file).map_err(|e| format!("not a valid STL file ({e})"))?;
+    let positions: Vec<Vec3> = mesh
+        .vertices
+        .iter()
+        .map(|v| Vec3::from_array(v.0))
+        .collect();
+    let polygons = mesh
+        .faces
+        .iter()
+        .map(|face| face.vertices.iter().map(|&i| i as u32).collect())
+        .collect();
+    Ok((positions, Vec::new(), polygons))
+}
+
+fn read_ply(path: &Path) -> Result<Parts, String> {
+    use ply_rs_bw::parser::Parser;
+    use ply_rs_bw::ply::{DefaultElement, Property};
+    let file = File::open(path).map_err(|e| e.to_string())?;
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut BufReader::new(file))
+        .map_err(|e| format!("not a valid PLY file ({e})"))?;
+    let empty = Vec::new();
+    let vertices = ply.payload.get("vertex").unwrap_or(&empty);
+    let scalar = |element: &DefaultElement, index: usize, key: &str| {
+        element
+            .get(key)
+            .and_then(Property::to_f32_lossy)
+            .ok_or_else(|| format!("vertex {index} has no numeric property '{key}'"))
+    };
+    let mut positions = Vec::with_capacity(vertices.len());
+    let mut normals = Vec::with_capacity(vertices.len());
+    for (index, vertex) in vertices.iter().enumerate() {
+        let read = |keys: [&str; 3]| -> Result<Vec3, String> {
+            Ok(Vec3::new(
+                scalar(vertex, index, keys[0])?,
+                scalar(vertex, index, keys[1])?,
+                scalar(vertex, index, keys[2])?,
+            ))
+        };
+        positions.push(read(["x", "y", "z"])?);
+        normals.push(read(["nx", "ny", "nz"]).unwrap_or(Vec3::ZERO));
+    }
+    let faces = ply.payload.get("face").unwrap_or(&empty);
+    let polygons = faces
+        .iter()
+        .enumerate()
+        .map(|(index, face)| {
+            face.get("vertex_indices")
+                .or_else(|| face.get("vertex_index"))
+                .and_then(Property::to_u32_list)
+                .ok_or_else(|| format!("face {index} has no integer list 'vertex_indices'"))
+        })
+        .collect::<Result<_, _>>()?;
+    Ok((positions, normals, polygons))
+}

@@ -1,0 +1,305 @@
+//! The rendering pipeline: vertex shading, clipping, triangle setup, binning into tiles, and
+//! per-tile visibility then shading, in parallel over tiles.
+//!
+//! Determinism: every tile draws its triangles in submission order with a strict depth test, so
+//! a tile's pixels depend only on the scene, never on which thread drew it or when. Within a
+//! tile, visibility is resolved first and each visible sample is shaded once (no overdraw
+//! shading), then the `samples x samples` block of each pixel is averaged (supersampling).
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use glam::{Vec3, Vec4};
+use rayon::prelude::*;
+use thiserror::Error;
+
+use crate::clip::{clip_triangle, ClipVertex, Varyings, MAX_SIDE};
+use crate::material::{Shader, Shading};
+use crate::raster::{Culling, PixelRect, ScreenVertex, Setup};
+use crate::{Image, Scene};
+
+/// Output pixels per tile side.
+const TILE: u32 = 32;
+
+/// The largest supersampling factor per axis.
+pub const MAX_SAMPLES: u32 = 8;
+
+/// A render that cannot be done, and why.
+#[derive(Clone, Debug, Error, PartialEq)]
+#[non_exhaustive]
+pub enum RenderError {
+    /// The image or sample count is out of range.
+    #[error("cannot render {width}x{height} pixels with {samples}x{samples} samples: width and height must be at least 1, samples in [1, {MAX_SAMPLES}], and width or height times samples at most {MAX_SIDE}")]
+    Size {
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+        /// Samples per pixel per axis.
+        samples: u32,
+    },
+}
+
+/// A triangle after clipping and setup, with what its fragments need.
+#[derive(Clone, Copy, Debug)]
+struct Primitive {
+    setup: Setup,
+    varyings: [Varyings; 3],
+    inverse_w: [f32; 3],
+    shader: usize,
+    face_normal: Vec3,
+    flat_colour: Vec3,
+}
+
+/// Renders `scene`; `progress(done, total)` is called as tiles finish (from any thread).
+pub fn render(
+    scene: &Scene,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Image, RenderError> {
+    let settings = &scene.settings;
+    let samples = settings.samples;
+    let (width, height) = (settings.width, settings.height);
+    let too_big = |side: u32| side.checked_mul(samples).is_none_or(|s| s > MAX_SIDE);
+    if width == 0
+        || height == 0
+        || !(1..=MAX_SAMPLES).contains(&samples)
+        || too_big(width)
+        || too_big(height)
+    {
+        return Err(RenderError::Size {
+            width,
+            height,
+            samples,
+        });
+    }
+    let shaders: Vec<Shader> = scene
+        .objects
+        .iter()
+        .map(|object| Shader::new(&object.material, settings.model))
+        .collect();
+    let primitives = setup_primitives(scene, &shaders);
+    let tiles_x = width.div_ceil(TILE);
+    let tiles_y = height.div_ceil(TILE);
+    let bins = bin(&primitives, tiles_x, tiles_y, TILE * samples);
+    let total = bins.len();
+    let done = AtomicUsize::new(0);
+    let tiles: Vec<Vec<Vec3>> = bins
+        .par_iter()
+        .enumerate()
+        .map(|(index, bin)| {
+            let (tx, ty) = (index as u32 % tiles_x, index as u32 / tiles_x);
+            let pixels = render_tile(scene, &shaders, &primitives, bin, tx, ty);
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+            pixels
+        })
+        .collect();
+    let mut image = Image::new(width, height, Vec3::ZERO);
+    for (index, pixels) in tiles.iter().enumerate() {
+        let (x0, y0) = (index as u32 % tiles_x * TILE, index as u32 / tiles_x * TILE);
+        let tile_width = TILE.min(width - x0);
+        for (k, &colour) in pixels.iter().enumerate() {
+            image.set(
+                x0 + k as u32 % tile_width,
+                y0 + k as u32 / tile_width,
+                colour,
+            );
+        }
+    }
+    Ok(image)
+}
+
+/// Vertex stage, clipping and triangle setup for every object, in submission order.
+fn setup_primitives(scene: &Scene, shaders: &[Shader]) -> Vec<Primitive> {
+    let settings = &scene.settings;
+    let (width, height) = (
+        settings.width * settings.samples,
+        settings.height * settings.samples,
+    );
+    let view_projection = scene.camera.view_projection(width as f32 / height as f32);
+    let culling = if settings.cull_back_faces {
+        Culling::Back
+    } else {
+        Culling::None
+    };
+    let shade = |shader: &Shader, position: Vec3, normal: Vec3| {
+        let wo = scene.camera.towards_viewer(position);
+        shader.shade(position, normal, wo, &scene.lights, scene.ambient)
+    };
+    let to_screen = |clip: Vec4| {
+        let ndc = clip.truncate() / clip.w;
+        ScreenVertex {
+            x: (ndc.x + 1.0) * 0.5 * width as f32,
+            y: (1.0 - ndc.y) * 0.5 * height as f32,
+            z: ndc.z,
+        }
+    };
+    let mut primitives = Vec::new();
+    for (object_index, object) in scene.objects.iter().enumerate() {
+        let shader = &shaders[object_index];
+        let mesh = &object.mesh;
+        let vertices: Vec<ClipVertex> = mesh
+            .positions()
+            .par_iter()
+            .zip(mesh.normals())
+            .map(|(&position, &normal)| ClipVertex {
+                clip: view_projection * position.extend(1.0),
+                varyings: Varyings {
+                    position,
+                    normal,
+                    colour: if settings.shading == Shading::Gouraud {
+                        shade(shader, position, normal)
+                    } else {
+                        Vec3::ZERO
+                    },
+                },
+            })
+            .collect();
+        let pieces: Vec<Vec<Primitive>> = mesh
+            .triangles()
+            .par_iter()
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |(polygon, scratch), triangle| {
+                    let corners = triangle.map(|i| vertices[i as usize]);
+                    let [a, b, c] = corners.map(|v| v.varyings.position);
+                    let Some(face_normal) = (b - a).cross(c - a).try_normalize() else {
+                        return Vec::new();
+                    };
+                    let flat_colour = if settings.shading == Shading::Flat {
+                        shade(shader, (a + b + c) / 3.0, face_normal)
+                    } else {
+                        Vec3::ZERO
+                    };
+                    clip_triangle(corners, polygon, scratch);
+                    (1..polygon.len().saturating_sub(1))
+                        .filter_map(|k| {
+                            let fan = [polygon[0], polygon[k], polygon[k + 1]];
+                            let setup =
+                                Setup::new(fan.map(|v| to_screen(v.clip)), culling, width, height)?;
+                            Some(Primitive {
+                                setup,
+                                varyings: fan.map(|v| v.varyings),
+                                inverse_w: fan.map(|v| 1.0 / v.clip.w),
+                                shader: object_index,
+                                face_normal,
+                                flat_colour,
+                            })
+                        })
+                        .collect()
+                },
+            )
+            .collect();
+        primitives.extend(pieces.into_iter().flatten());
+    }
+    primitives
+}
+
+/// For each tile (row-major), the primitives that may cover it, in submission order.
+fn bin(primitives: &[Primitive], tiles_x: u32, tiles_y: u32, tile_samples: u32) -> Vec<Vec<u32>> {
+    let mut bins = vec![Vec::new(); (tiles_x * tiles_y) as usize];
+    for (index, primitive) in primitives.iter().enumerate() {
+        let bounds = primitive.setup.bounds();
+        for ty in bounds.y0 / tile_samples..=(bounds.y1 / tile_samples).min(tiles_y - 1) {
+            for tx in bounds.x0 / tile_samples..=(bounds.x1 / tile_samples).min(tiles_x - 1) {
+                bins[(ty * tiles_x + tx) as usize].push(index as u32);
+            }
+        }
+    }
+    bins
+}
+
+/// Visibility, shading and the supersampling filter for one tile.
+fn render_tile(
+    scene: &Scene,
+    shaders: &[Shader],
+    primitives: &[Primitive],
+    bin: &[u32],
+    tx: u32,
+    ty: u32,
+) -> Vec<Vec3> {
+    let settings = &scene.settings;
+    let s = settings.samples;
+    let (x0, y0) = (tx * TILE, ty * TILE);
+    let (tile_width, tile_height) = (
+        TILE.min(settings.width - x0),
+        TILE.min(settings.height - y0),
+    );
+    let (sample_width, sample_height) = (tile_width * s, tile_height * s);
+    let rect = PixelRect {
+        x0: x0 * s,
+        y0: y0 * s,
+        x1: x0 * s + sample_width - 1,
+        y1: y0 * s + sample_height - 1,
+    };
+    let count = (sample_width * sample_height) as usize;
+    let mut depth = vec![f32::INFINITY; count];
+    let mut visible: Vec<Option<(u32, [f32; 3])>> = vec![None; count];
+    for &index in bin {
+        primitives[index as usize]
+            .setup
+            .for_each_covered(rect, |x, y, z, weights| {
+                let k = ((y - rect.y0) * sample_width + (x - rect.x0)) as usize;
+                if z < depth[k] {
+                    depth[k] = z;
+                    visible[k] = Some((index, weights));
+                }
+            });
+    }
+    let radiance: Vec<Vec3> = visible
+        .iter()
+        .map(|hit| match *hit {
+            None => settings.background,
+            Some((index, weights)) => {
+                shade_sample(scene, shaders, &primitives[index as usize], weights)
+            }
+        })
+        .collect();
+    let scale = 1.0 / (s * s) as f32;
+    (0..tile_height)
+        .flat_map(|py| (0..tile_width).map(move |px| (px, py)))
+        .map(|(px, py)| {
+            let mut sum = Vec3::ZERO;
+            for sy in 0..s {
+                let row = ((py * s + sy) * sample_width + px * s) as usize;
+                sum += radiance[row..row + s as usize]
+                    .iter()
+                    .copied()
+                    .sum::<Vec3>();
+            }
+            sum * scale
+        })
+        .collect()
+}
+
+fn shade_sample(
+    scene: &Scene,
+    shaders: &[Shader],
+    primitive: &Primitive,
+    screen_weights: [f32; 3],
+) -> Vec3 {
+    if scene.settings.shading == Shading::Flat {
+        return primitive.flat_colour;
+    }
+    // Perspective-correct weights: attributes are affine in world space, so their values over
+    // w are affine on screen.
+    let over_w: [f32; 3] = core::array::from_fn(|k| screen_weights[k] * primitive.inverse_w[k]);
+    let sum = over_w[0] + over_w[1] + over_w[2];
+    let weights = over_w.map(|w| w / sum);
+    let varyings = Varyings::blend(&primitive.varyings, weights);
+    match scene.settings.shading {
+        Shading::Gouraud => varyings.colour,
+        _ => {
+            let normal = varyings
+                .normal
+                .try_normalize()
+                .unwrap_or(primitive.face_normal);
+            let wo = scene.camera.towards_viewer(varyings.position);
+            shaders[primitive.shader].shade(
+                varyings.position,
+                normal,
+                wo,
+                &scene.lights,
+                scene.ambient,
+            )
+        }
+    }
+}
