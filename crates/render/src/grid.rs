@@ -121,7 +121,7 @@ pub fn render_grid(
         let x0 = column as u32 * width;
         grid.blit(x0, 0, width, &image.to_srgb8(scene.display));
         grid.blit(x0, height, width, &difference.heatmap_srgb8());
-        grid.label(x0, 0, kind.id());
+        grid.label(x0, 0, &kind.to_string());
         let caption = if kind == options.reference {
             "reference".to_owned()
         } else {

@@ -35,7 +35,7 @@ mod teapot;
 
 pub use camera::{Camera, InvalidCamera, Projection};
 pub use description::{LoadedScene, SceneError};
-pub use grid::{render_grid, GridError, GridOptions};
+pub use grid::{render_grid, GridError, GridOptions, Srgb8Image};
 pub use image::{
     check_output_path, read_image, srgb_decode, srgb_encode, write_image, write_png_srgb8, Display,
     Image, ImageError, ToneMap,
@@ -43,7 +43,7 @@ pub use image::{
 pub use load::{load_mesh, LoadError, LoadedMesh, MESH_EXTENSIONS};
 pub use material::{IlluminationModel, Light, Material, Shading};
 pub use mesh::{Mesh, MeshError};
-pub use pipeline::{render, RenderError, MAX_SAMPLES};
+pub use pipeline::{overdraw, render, RenderError, MAX_SAMPLES};
 pub use scene::{Object, Overrides, Scene, Settings, DEFAULT_SCENE};
 pub use shapes::{plane, sphere, torus};
 pub use teapot::{teapot, BezierPatch, TEAPOT_PATCHES};

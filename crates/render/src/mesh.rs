@@ -133,6 +133,17 @@ impl Mesh {
             .extend(other.triangles.iter().map(|t| t.map(|i| i + offset)));
     }
 
+    /// The same surface seen from the other side: winding reversed, normals negated (for a
+    /// dome or room the camera sits inside).
+    #[must_use]
+    pub fn flipped(&self) -> Mesh {
+        Mesh {
+            positions: self.positions.clone(),
+            normals: self.normals.iter().map(|&n| -n).collect(),
+            triangles: self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
+        }
+    }
+
     /// The axis-aligned bounds `(min, max)`; `None` for an empty mesh.
     #[must_use]
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {

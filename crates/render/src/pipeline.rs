@@ -15,7 +15,7 @@ use thiserror::Error;
 use crate::clip::{clip_triangle, ClipVertex, Varyings, MAX_SIDE};
 use crate::material::{Shader, Shading};
 use crate::raster::{Culling, PixelRect, ScreenVertex, Setup};
-use crate::{Image, Scene};
+use crate::{Image, Scene, Settings};
 
 /// Output pixels per tile side.
 const TILE: u32 = 32;
@@ -50,14 +50,8 @@ struct Primitive {
     flat_colour: Vec3,
 }
 
-/// Renders `scene`; `progress(done, total)` is called as tiles finish (from any thread).
-pub fn render(
-    scene: &Scene,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<Image, RenderError> {
-    let settings = &scene.settings;
-    let samples = settings.samples;
-    let (width, height) = (settings.width, settings.height);
+fn check_size(settings: &Settings) -> Result<(), RenderError> {
+    let (width, height, samples) = (settings.width, settings.height, settings.samples);
     let too_big = |side: u32| side.checked_mul(samples).is_none_or(|s| s > MAX_SIDE);
     if width == 0
         || height == 0
@@ -71,6 +65,17 @@ pub fn render(
             samples,
         });
     }
+    Ok(())
+}
+
+/// Renders `scene`; `progress(done, total)` is called as tiles finish (from any thread).
+pub fn render(
+    scene: &Scene,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Image, RenderError> {
+    let settings = &scene.settings;
+    check_size(settings)?;
+    let (width, height, samples) = (settings.width, settings.height, settings.samples);
     let shaders: Vec<Shader> = scene
         .objects
         .iter()
@@ -105,6 +110,37 @@ pub fn render(
         }
     }
     Ok(image)
+}
+
+/// How many fragments each sample position receives, before the depth test: an overdraw map
+/// of `width * samples` by `height * samples` counts, row-major. The same vertex stage,
+/// clipping, culling and rasterization as [`render`]; a closed convex surface seen from
+/// outside (or from inside, flipped) covers every sample it hides exactly once.
+pub fn overdraw(scene: &Scene) -> Result<Vec<u32>, RenderError> {
+    let settings = &scene.settings;
+    check_size(settings)?;
+    let shaders: Vec<Shader> = scene
+        .objects
+        .iter()
+        .map(|object| Shader::new(&object.material, settings.model))
+        .collect();
+    let (width, height) = (
+        settings.width * settings.samples,
+        settings.height * settings.samples,
+    );
+    let mut counts = vec![0; (width * height) as usize];
+    let all = PixelRect {
+        x0: 0,
+        y0: 0,
+        x1: width - 1,
+        y1: height - 1,
+    };
+    for primitive in setup_primitives(scene, &shaders) {
+        primitive.setup.for_each_covered(all, |x, y, _, _| {
+            counts[(y * width + x) as usize] += 1;
+        });
+    }
+    Ok(counts)
 }
 
 /// Vertex stage, clipping and triangle setup for every object, in submission order.

@@ -285,4 +285,62 @@ mod tests {
         let nan = [v(f32::NAN, 0.0), v(1.0, 1.0), v(0.0, 2.0)];
         assert!(Setup::new(nan, Culling::None, 4, 4).is_none());
     }
+
+    /// A jittered grid of vertices covering the target, each cell split along a random
+    /// diagonal, vertices on a 1/4-pixel lattice so that many edges pass exactly through pixel
+    /// centres: every pixel is covered exactly once.
+    #[test]
+    fn random_triangulations_cover_every_pixel_exactly_once() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        let (width, height, cells) = (37_u32, 23_u32, 9_usize);
+        for _ in 0..20 {
+            let point = |i: usize, j: usize, rng: &mut rand_pcg::Pcg64| {
+                let jitter = |k: usize, size: u32, rng: &mut rand_pcg::Pcg64| {
+                    let cell = size as f32 / cells as f32;
+                    let base = k as f32 * cell;
+                    if k == 0 || k == cells {
+                        base
+                    } else {
+                        // Less than half a cell, so that no cell folds over.
+                        ((base + 0.3 * cell * rng.random_range(-1.0..1.0)) * 4.0).round() / 4.0
+                    }
+                };
+                v(jitter(i, width, rng), jitter(j, height, rng))
+            };
+            let grid: Vec<Vec<ScreenVertex>> = (0..=cells)
+                .map(|i| (0..=cells).map(|j| point(i, j, &mut rng)).collect())
+                .collect();
+            let mut counts = vec![0_u32; (width * height) as usize];
+            let all = PixelRect {
+                x0: 0,
+                y0: 0,
+                x1: width - 1,
+                y1: height - 1,
+            };
+            for i in 0..cells {
+                for j in 0..cells {
+                    let [a, b, c, d] = [
+                        grid[i][j],
+                        grid[i + 1][j],
+                        grid[i + 1][j + 1],
+                        grid[i][j + 1],
+                    ];
+                    let halves = if rng.random_bool(0.5) {
+                        [[a, b, c], [a, c, d]]
+                    } else {
+                        [[a, b, d], [b, c, d]]
+                    };
+                    for triangle in halves {
+                        if let Some(setup) = Setup::new(triangle, Culling::None, width, height) {
+                            setup.for_each_covered(all, |x, y, _, _| {
+                                counts[(y * width + x) as usize] += 1;
+                            });
+                        }
+                    }
+                }
+            }
+            assert!(counts.iter().all(|&c| c == 1), "{counts:?}");
+        }
+    }
 }

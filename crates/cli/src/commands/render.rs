@@ -50,20 +50,25 @@ pub struct Args {
     samples: Option<u32>,
     /// One tile per lobe with its FLIP against pow, e.g. `lobes=pow,schlick,cheb2` (PNG only).
     #[arg(long, value_parser = parse_grid, value_name = "lobes=ID,...")]
-    grid: Option<Vec<LobeKind>>,
+    grid: Option<LobeList>,
     /// Print the embedded default scene (a starting point for your own) and exit.
     #[arg(long, exclusive = true)]
     dump_default_scene: bool,
 }
 
-fn parse_grid(text: &str) -> Result<Vec<LobeKind>, String> {
+/// The lobes of `--grid` (a newtype: clap reads a bare `Vec` as repeated values).
+#[derive(Clone, Debug)]
+struct LobeList(Vec<LobeKind>);
+
+fn parse_grid(text: &str) -> Result<LobeList, String> {
     let list = text.strip_prefix("lobes=").ok_or_else(|| {
         format!("'{text}' must have the form lobes=ID,ID,... (e.g. lobes=pow,schlick)")
     })?;
     list.split(',')
         .filter(|id| !id.is_empty())
         .map(|id| LobeKind::parse(id.trim()).map_err(|e| e.to_string()))
-        .collect()
+        .collect::<Result<_, _>>()
+        .map(LobeList)
 }
 
 fn progress_bar(label: &str) -> ProgressBar {
@@ -115,7 +120,7 @@ pub fn run(args: &Args) -> CommandResult {
         bar.set_position(done as u64);
     };
     let (width, height) = match &args.grid {
-        Some(lobes) => {
+        Some(LobeList(lobes)) => {
             if !is_png(&args.output) {
                 return Err(format!(
                     "{}: a grid is written as PNG; give an output ending in .png",
