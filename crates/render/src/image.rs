@@ -238,11 +238,13 @@ pub fn write_atomically(
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
-    let mut file = tempfile::Builder::new()
-        .prefix(".specula-")
-        .suffix(".tmp")
-        .tempfile_in(directory)
-        .map_err(io)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".specula-").suffix(".tmp");
+    // A temporary file is private (0600); the image should get the usual mode (0666 less the
+    // umask), as if created directly.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut file = builder.tempfile_in(directory).map_err(io)?;
     {
         let mut writer = BufWriter::new(file.as_file_mut());
         write(&mut writer).map_err(|message| ImageError::Codec {
