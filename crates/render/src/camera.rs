@@ -115,10 +115,17 @@ impl Camera {
         projection * view
     }
 
+    /// The unit direction from the target to the eye: every point's `wo` under an
+    /// orthographic projection.
+    #[must_use]
+    pub fn backwards(&self) -> Vec3 {
+        (self.eye - self.target).normalize()
+    }
+
     /// The unit direction from `point` towards the viewer (`wo`).
     #[must_use]
     pub fn towards_viewer(&self, point: Vec3) -> Vec3 {
-        let backwards = (self.eye - self.target).normalize();
+        let backwards = self.backwards();
         match self.projection {
             Projection::Perspective { .. } => (self.eye - point).normalize_or(backwards),
             Projection::Orthographic { .. } => backwards,

@@ -35,7 +35,7 @@ fn error_figures_agree_with_a_brute_force_scan() {
     for kind in LobeKind::ALL {
         for n in [3.0, 50.0, 600.0] {
             let lobe = Lobe::new(kind, Exponent::new(n));
-            let analysed = error_figures(&lobe, Precision::F64, DEFAULT_SAMPLES_PER_ZONE);
+            let analysed = error_figures(&lobe, &mut Precision::F64, DEFAULT_SAMPLES_PER_ZONE);
             // The narrowest epicentre (n = 600) is 0.048 rad: 4e6 samples put ~120k in it.
             let scanned = brute_force(&lobe, 4_000_000);
             let pairs = [

@@ -2,7 +2,7 @@
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use specula::analysis::{analyze, LobeReport, DEFAULT_EXPONENTS};
+use specula::analysis::{analyze, LobeReport, Precision, DEFAULT_EXPONENTS};
 use specula::{Exponent, LobeKind};
 
 use super::{print_json, CommandResult};
@@ -49,11 +49,11 @@ pub fn run(args: &Args) -> CommandResult {
         ProgressStyle::with_template("analyzing {bar:30} {pos}/{len} {elapsed}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let precision = args.backend.into();
+    let precision: Precision = args.backend.into();
     let reports: Vec<LobeReport> = jobs
         .par_iter()
         .map(|&(lobe, n)| {
-            let report = analyze(lobe, n, precision);
+            let report = analyze(lobe, n, &mut { precision });
             progress.inc(1);
             report
         })

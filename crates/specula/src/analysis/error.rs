@@ -2,8 +2,9 @@
 //!
 //! Each zone is sampled uniformly in the angle, endpoints included, with its boundaries from
 //! the closed forms of [`zones`](crate::zones). The reference is `cos(g)^n` in `f64`; the lobe
-//! is evaluated in the requested [`Precision`] from the same angle (for `f32`, the cosine is
-//! rounded to `f32` first, as an `f32` pipeline would see it).
+//! is evaluated by an [`Evaluator`] at the cosines of the same angles: [`Precision`] on the CPU
+//! (for `f32`, the cosine is rounded to `f32` first, as an `f32` pipeline would see it), or any
+//! other backend (the GPU crate's compute shader) that implements the trait.
 
 use serde::Serialize;
 
@@ -20,13 +21,30 @@ pub enum Precision {
     F32,
 }
 
-impl Precision {
-    /// The lobe at angle `g`, as the given arithmetic computes it, widened to `f64`.
-    #[must_use]
-    pub fn eval(self, lobe: &Lobe, g: f64) -> f64 {
+/// Evaluates a lobe at a batch of cosines: where, and in what arithmetic, error figures are
+/// measured. Batches let a backend such as a GPU amortise its dispatch.
+pub trait Evaluator {
+    /// The name reports give it (`f64`, `f32`, `gpu`).
+    fn name(&self) -> &'static str;
+    /// The lobe at each cosine, widened to `f64`; one value per input, in order.
+    fn eval_batch(&mut self, lobe: &Lobe, cosines: &[f64]) -> Vec<f64>;
+}
+
+impl Evaluator for Precision {
+    fn name(&self) -> &'static str {
         match self {
-            Precision::F64 => lobe.eval(g.cos()),
-            Precision::F32 => f64::from(lobe.eval(g.cos() as f32)),
+            Precision::F64 => "f64",
+            Precision::F32 => "f32",
+        }
+    }
+
+    fn eval_batch(&mut self, lobe: &Lobe, cosines: &[f64]) -> Vec<f64> {
+        match self {
+            Precision::F64 => cosines.iter().map(|&t| lobe.eval(t)).collect(),
+            Precision::F32 => cosines
+                .iter()
+                .map(|&t| f64::from(lobe.eval(t as f32)))
+                .collect(),
         }
     }
 }
@@ -58,16 +76,19 @@ struct ZoneScan {
     mean_square: f64,
 }
 
-fn scan_zone(lobe: &Lobe, precision: Precision, zone: Zone, samples: usize) -> ZoneScan {
+fn scan_zone(lobe: &Lobe, evaluator: &mut dyn Evaluator, zone: Zone, samples: usize) -> ZoneScan {
     let n = lobe.exponent().get();
     let (from, to) = zone.angles(lobe.exponent());
     let samples = samples.max(2);
+    let cosines: Vec<f64> = (0..samples)
+        .map(|i| (from + (to - from) * (i as f64 / (samples - 1) as f64)).cos())
+        .collect();
+    let values = evaluator.eval_batch(lobe, &cosines);
     let mut scan = ZoneScan::default();
     let mut sum_square = 0.0;
-    for i in 0..samples {
-        let g = from + (to - from) * (i as f64 / (samples - 1) as f64);
-        let reference = g.cos().powf(n);
-        let error = (precision.eval(lobe, g) - reference).abs();
+    for (&t, &value) in cosines.iter().zip(&values) {
+        let reference = t.powf(n);
+        let error = (value - reference).abs();
         scan.max_abs = scan.max_abs.max(error);
         if reference > 0.0 {
             scan.max_rel = scan.max_rel.max(error / reference);
@@ -80,9 +101,13 @@ fn scan_zone(lobe: &Lobe, precision: Precision, zone: Zone, samples: usize) -> Z
 
 /// The error figures of `lobe` with `samples_per_zone` samples in each zone.
 #[must_use]
-pub fn error_figures(lobe: &Lobe, precision: Precision, samples_per_zone: usize) -> ErrorFigures {
+pub fn error_figures(
+    lobe: &Lobe,
+    evaluator: &mut dyn Evaluator,
+    samples_per_zone: usize,
+) -> ErrorFigures {
     let [epicentre, bloom, tail] =
-        Zone::ALL.map(|zone| scan_zone(lobe, precision, zone, samples_per_zone));
+        Zone::ALL.map(|zone| scan_zone(lobe, evaluator, zone, samples_per_zone));
     let width = |zone: Zone| {
         let (from, to) = zone.angles(lobe.exponent());
         to - from

@@ -11,7 +11,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 pub use albedo::{directional_albedo, max_directional_albedo, specular_albedo_per_unit};
-pub use error::{error_figures, ErrorFigures, Precision, DEFAULT_SAMPLES_PER_ZONE};
+pub use error::{error_figures, ErrorFigures, Evaluator, Precision, DEFAULT_SAMPLES_PER_ZONE};
 pub use reciprocity::max_reciprocity_error;
 
 use crate::normalisation::{lobe_constant, lobe_integral};
@@ -25,8 +25,8 @@ pub struct LobeReport {
     pub lobe: LobeKind,
     /// The exponent.
     pub n: f64,
-    /// The arithmetic the lobe was evaluated in for the error figures.
-    pub precision: Precision,
+    /// The evaluator of the error figures (`f64`, `f32`, `gpu`).
+    pub precision: &'static str,
     /// Error figures, flattened into the report.
     #[serde(flatten)]
     pub errors: ErrorFigures,
@@ -45,9 +45,9 @@ pub struct LobeReport {
     pub ops: OpCounts,
 }
 
-/// All figures for `kind` at `n`, with errors evaluated in `precision`.
+/// All figures for `kind` at `n`, with the error figures evaluated by `evaluator`.
 #[must_use]
-pub fn analyze(kind: LobeKind, n: Exponent, precision: Precision) -> LobeReport {
+pub fn analyze(kind: LobeKind, n: Exponent, evaluator: &mut dyn Evaluator) -> LobeReport {
     let lobe = Lobe::new(kind, n);
     let brdf = Brdf::new(
         DVec3::ZERO,
@@ -60,8 +60,8 @@ pub fn analyze(kind: LobeKind, n: Exponent, precision: Precision) -> LobeReport 
     LobeReport {
         lobe: kind,
         n: n.get(),
-        precision,
-        errors: error_figures(&lobe, precision, DEFAULT_SAMPLES_PER_ZONE),
+        precision: evaluator.name(),
+        errors: error_figures(&lobe, evaluator, DEFAULT_SAMPLES_PER_ZONE),
         energy_ratio: energy_ratio(&lobe),
         lobe_norm_numeric: lobe_constant(&lobe),
         lobe_norm_analytic: Normalisation::Lobe.analytic(n),

@@ -204,7 +204,7 @@ pub(crate) fn figure(name: impl Into<String>, value: f64) -> Figure {
 pub(crate) fn errors(kind: LobeKind, n: Exponent, options: &ClaimOptions) -> ErrorFigures {
     error_figures(
         &Lobe::new(kind, n),
-        Precision::F64,
+        &mut Precision::F64,
         options.samples_per_zone,
     )
 }

@@ -49,6 +49,12 @@ impl CosQuad {
         self.a
     }
 
+    /// The number of squarings `v`.
+    #[must_use]
+    pub fn squarings(&self) -> u32 {
+        u32::from(self.v)
+    }
+
     /// Evaluates at `t in (0, 1]`.
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {

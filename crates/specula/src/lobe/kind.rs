@@ -210,6 +210,13 @@ impl LobeKind {
         Self::ALL.map(LobeKind::id).join(", ")
     }
 
+    /// The model's position in [`LobeKind::ALL`], parameters aside.
+    #[must_use]
+    pub fn index(self) -> u32 {
+        let same = |k: &LobeKind| core::mem::discriminant(k) == core::mem::discriminant(&self);
+        LobeKind::ALL.iter().position(same).unwrap_or_default() as u32
+    }
+
     /// Parses `ID` or `ID:param=value`, e.g. `schlick`, `cosquad:v=5`.
     pub fn parse(text: &str) -> Result<Self> {
         let text = text.trim();

@@ -32,6 +32,25 @@ use crate::ops::{count_ops, Counted, OpCounts};
 use crate::real::Real;
 use crate::Exponent;
 
+/// A prepared lobe as flat numbers, for backends outside Rust (WGSL uniforms, hardware
+/// registers): which formula, its integer parameter and its real constants, all computed by
+/// [`Lobe::new`] in `f64`. Fields a model does not use are 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PackedLobe {
+    /// The model's position in [`LobeKind::ALL`] (parameters aside): the shaders' `switch` case.
+    pub kind_index: u32,
+    /// Squarings: `log2 a` for `schlick-mod`, `v` for `cosquad`.
+    pub squarings: u32,
+    /// The exponent.
+    pub n: f64,
+    /// `cosquad`'s slope `a = (n + 1) / (2^v + 1)`.
+    pub slope: f64,
+    /// A quadratic-in-angle lobe's `[C, B, A]`.
+    pub quadratic: [f64; 3],
+    /// A quadratic-in-angle lobe's cut-off angle (radians).
+    pub cutoff: f64,
+}
+
 /// A lobe function prepared for one exponent `n`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lobe {
@@ -94,6 +113,29 @@ impl Lobe {
             Model::AngleQuadratic(q) => Some(q),
             _ => None,
         }
+    }
+
+    /// The prepared constants as flat numbers (see [`PackedLobe`]).
+    #[must_use]
+    pub fn packed(&self) -> PackedLobe {
+        let mut packed = PackedLobe {
+            kind_index: self.kind.index(),
+            n: self.n.get(),
+            ..PackedLobe::default()
+        };
+        match &self.model {
+            Model::SchlickMod(m) => packed.squarings = m.squarings(),
+            Model::CosQuad(m) => {
+                packed.squarings = m.squarings();
+                packed.slope = m.slope();
+            }
+            Model::AngleQuadratic(m) => {
+                packed.quadratic = m.coeffs();
+                packed.cutoff = m.cutoff();
+            }
+            Model::Pow(_) | Model::Schlick(_) | Model::LogExp(_) | Model::LogExpRr(_) => {}
+        }
+        packed
     }
 
     /// The lobe at cosine `t` (any value; see the module docs for the rules).

@@ -41,6 +41,11 @@ impl SchlickMod {
         }
     }
 
+    /// How many times `t` is squared: `log2` of the power `a`.
+    pub(crate) fn squarings(&self) -> u32 {
+        self.squarings
+    }
+
     /// Evaluates at `t in (0, 1]`.
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {

@@ -1,0 +1,28 @@
+//! # specula-gpu: the lobes on the GPU
+//!
+//! Every lobe, geometry, normalisation and shading method of the core and the CPU renderer,
+//! written in WGSL and driven by wgpu: a headless renderer that draws the same scenes as
+//! `specula-render`, a compute shader that evaluates any lobe over a batch of cosines, and
+//! shader export to WGSL, GLSL, HLSL, MSL and SPIR-V through naga.
+//!
+//! ## Design
+//! - **One transcription.** `shaders/lobes.wgsl` mirrors `crates/specula/src/lobe`: a function
+//!   per lobe named after its id, a `switch` on the kind's index where Rust has its `match`,
+//!   and the prepared constants uploaded from `Lobe::packed`, so the GPU never re-derives
+//!   anything the core computed in `f64`.
+//! - **Same images, measured.** The renderer uploads the materials exactly as the CPU's
+//!   shader prepares them, supersamples at the same sample positions and box-filters on read
+//!   back; parity tests compare the two images by FLIP and PSNR.
+//! - **No GPU is not a crash.** Without an adapter, [`Gpu::new`] returns a [`GpuError`] that
+//!   says how to get one (Mesa's lavapipe runs everything here on the CPU).
+
+mod context;
+mod evaluate;
+pub mod export;
+mod render;
+pub mod uniforms;
+pub mod wgsl;
+
+pub use context::{Gpu, GpuError};
+pub use evaluate::{GpuEvaluator, LobeEvaluator};
+pub use render::GpuRenderer;

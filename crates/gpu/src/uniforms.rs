@@ -1,0 +1,157 @@
+//! The uniform blocks of the WGSL code, laid out as WGSL lays them out (16-byte aligned
+//! `vec3`s with a 4-byte field in their padding).
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use specula::lobe::PackedLobe;
+use specula::{Geometry, Lobe};
+use specula_render::{IlluminationModel, Light, Material};
+
+/// `struct Lobe` of lobes.wgsl (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LobeBlock {
+    kind: u32,
+    squarings: u32,
+    n: f32,
+    slope: f32,
+    quadratic: [f32; 3],
+    cutoff: f32,
+}
+
+impl LobeBlock {
+    /// The prepared lobe's constants, rounded to `f32`.
+    #[must_use]
+    pub fn new(lobe: &Lobe) -> Self {
+        let PackedLobe {
+            kind_index,
+            squarings,
+            n,
+            slope,
+            quadratic,
+            cutoff,
+        } = lobe.packed();
+        Self {
+            kind: kind_index,
+            squarings,
+            n: n as f32,
+            slope: slope as f32,
+            quadratic: quadratic.map(|c| c as f32),
+            cutoff: cutoff as f32,
+        }
+    }
+}
+
+/// `struct Material` of brdf.wgsl (80 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct MaterialBlock {
+    ambient: [f32; 3],
+    geometry: u32,
+    diffuse: [f32; 3],
+    model: u32,
+    specular: [f32; 3],
+    padding: u32,
+    lobe: LobeBlock,
+}
+
+impl MaterialBlock {
+    /// The material prepared for `model`, with the same constants as the CPU's shader.
+    #[must_use]
+    pub fn new(material: &Material, model: IlluminationModel) -> Self {
+        let scale = material.normalisation.constant_for(&material.lobe) as f32;
+        let diffuse = material.kd * material.colour;
+        let (diffuse, model_index) = match model {
+            IlluminationModel::Classic => (diffuse, 0),
+            IlluminationModel::Physical => (diffuse * core::f32::consts::FRAC_1_PI, 1),
+        };
+        Self {
+            ambient: (material.ka * material.colour).to_array(),
+            geometry: match material.geometry {
+                Geometry::Phong => 0,
+                Geometry::Blinn => 1,
+            },
+            diffuse: diffuse.to_array(),
+            model: model_index,
+            specular: (material.ks * scale * material.specular_colour).to_array(),
+            padding: 0,
+            lobe: LobeBlock::new(&material.lobe),
+        }
+    }
+}
+
+/// `struct Light` of brdf.wgsl (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LightBlock {
+    position: [f32; 3],
+    kind: u32,
+    intensity: [f32; 3],
+    padding: u32,
+}
+
+impl LightBlock {
+    /// The light's block.
+    #[must_use]
+    pub fn new(light: &Light) -> Self {
+        let (position, kind, intensity): (Vec3, u32, Vec3) = match *light {
+            Light::Directional { towards, intensity } => (towards, 0, intensity),
+            Light::Point {
+                position,
+                intensity,
+            } => (position, 1, intensity),
+        };
+        Self {
+            position: position.to_array(),
+            kind,
+            intensity: intensity.to_array(),
+            padding: 0,
+        }
+    }
+}
+
+/// `struct Frame` of render.wgsl (112 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct FrameBlock {
+    /// World to clip space.
+    pub view_projection: [[f32; 4]; 4],
+    /// The eye.
+    pub eye: [f32; 3],
+    /// 1 for an orthographic camera.
+    pub orthographic: u32,
+    /// Unit direction from the target to the eye.
+    pub backwards: [f32; 3],
+    /// How many lights the light buffer holds.
+    pub light_count: u32,
+    /// Ambient intensity.
+    pub ambient: [f32; 3],
+    /// 0 flat, 1 Gouraud, 2 Phong.
+    pub shading: u32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sizes WGSL's layout rules give the structs (checked against naga's own layout).
+    #[test]
+    fn blocks_match_the_wgsl_layout() {
+        let source = crate::wgsl::render_module();
+        let (module, _) = crate::wgsl::validate(&source).unwrap();
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        let size_of = |name: &str| {
+            let (handle, _) = module
+                .types
+                .iter()
+                .find(|(_, ty)| ty.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("{name} not in the WGSL"));
+            layouter[handle].size as usize
+        };
+        assert_eq!(size_of("Lobe"), size_of_val(&LobeBlock::default()));
+        assert_eq!(size_of("Material"), size_of_val(&MaterialBlock::default()));
+        assert_eq!(size_of("Light"), size_of_val(&LightBlock::default()));
+        assert_eq!(size_of("Frame"), size_of_val(&FrameBlock::default()));
+    }
+}

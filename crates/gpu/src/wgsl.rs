@@ -1,0 +1,47 @@
+//! The WGSL sources, embedded, and how they are put together.
+//!
+//! `lobes.wgsl` is the library (one function per lobe, `lobe_eval` dispatching on the kind's
+//! index); `brdf.wgsl` adds geometry and the illumination models; `render.wgsl` and
+//! `evaluate.wgsl` are the entry points. A module is the concatenation of the files it needs
+//! (WGSL declarations may come in any order).
+
+use specula::LobeKind;
+
+/// The lobe library.
+pub const LOBES: &str = include_str!("../shaders/lobes.wgsl");
+/// Geometry, lights and the illumination models.
+pub const BRDF: &str = include_str!("../shaders/brdf.wgsl");
+/// The render pipeline's entry points.
+pub const RENDER: &str = include_str!("../shaders/render.wgsl");
+/// The lobe-evaluation compute shader.
+pub const EVALUATE: &str = include_str!("../shaders/evaluate.wgsl");
+
+/// The WGSL function that implements `kind`: `lobe_` and the id with `-` as `_`.
+#[must_use]
+pub fn lobe_function(kind: LobeKind) -> String {
+    format!("lobe_{}", kind.id().replace('-', "_"))
+}
+
+/// The render module's source.
+#[must_use]
+pub fn render_module() -> String {
+    [LOBES, BRDF, RENDER].concat()
+}
+
+/// The compute module's source.
+#[must_use]
+pub fn evaluate_module() -> String {
+    [LOBES, EVALUATE].concat()
+}
+
+/// Parses and validates WGSL with naga, as wgpu will; the error names the line.
+pub fn validate(source: &str) -> Result<(naga::Module, naga::valid::ModuleInfo), String> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+    let info = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .map_err(|e| e.emit_to_string(source))?;
+    Ok((module, info))
+}
