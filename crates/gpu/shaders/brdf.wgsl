@@ -1,5 +1,6 @@
 // Geometry, lights and the two illumination models: a transcription of crates/render's
-// `Shader::shade` (see crates/render/src/material.rs for the formulas). Needs lobes.wgsl.
+// `Shader::shade` (see crates/render/src/material.rs for the formulas). Needs lobes.wgsl and
+// geometry.wgsl, and a `lights` array declared by the entry points' module.
 
 struct Material {
     // ka colour.
@@ -23,20 +24,6 @@ struct Light {
     kind: u32,
     intensity: vec3<f32>,
     padding: u32,
-}
-
-// The lobe's cosine t from a unit normal and unit directions pointing away from the surface.
-fn cos_lobe(geometry: u32, normal: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    if geometry == 0u {
-        // 2 (N.wi)(N.wo) - wi.wo: symmetric in wi and wo by construction.
-        return 2.0 * dot(normal, wi) * dot(normal, wo) - dot(wi, wo);
-    }
-    let sum = wi + wo;
-    let length_squared = dot(sum, sum);
-    if length_squared > 0.0 {
-        return dot(normal, sum) / sqrt(length_squared);
-    }
-    return 0.0;
 }
 
 // Radiance leaving `position` towards `wo` for a unit `normal`, under `light_count` lights.

@@ -1,1 +1,256 @@
-//! placeholder
+//! Shader export: one lobe, prepared for one `n`, with its geometry and normalisation, as a
+//! self-contained function for other pipelines, through naga.
+//!
+//! The exported module defines
+//! - `specula_lobe(t)`: the lobe at cosine `t`, with the shared rules (`t <= 0` or NaN gives 0,
+//!   `t > 1` counts as 1) and the constants `Lobe::new` prepared in `f64` baked in;
+//! - `specula_cos_lobe(normal, wo, wi)`: `t` for the chosen geometry (unit vectors, pointing
+//!   away from the surface);
+//! - `specula_specular(normal, wo, wi)`: `N(n) lobe(t)`, the specular factor per unit `ks`;
+//! - an example fragment shader `fs_main` that shows the call.
+//!
+//! It is generated as WGSL from the same library the renderer uses, validated, compacted
+//! (unused lobes dropped), and written by naga's back ends.
+
+use core::fmt::Write as _;
+
+use specula::{Geometry, Lobe, Normalisation};
+use thiserror::Error;
+
+use crate::uniforms::LobeBlock;
+use crate::wgsl;
+
+/// A shading language naga writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Language {
+    /// WebGPU's WGSL.
+    Wgsl,
+    /// GLSL 4.50 (Vulkan/OpenGL).
+    Glsl,
+    /// HLSL shader model 5.1 (Direct3D).
+    Hlsl,
+    /// Metal Shading Language 2.0.
+    Msl,
+    /// SPIR-V 1.0 binary.
+    Spirv,
+}
+
+impl Language {
+    /// Every language.
+    pub const ALL: [Language; 5] = [
+        Language::Wgsl,
+        Language::Glsl,
+        Language::Hlsl,
+        Language::Msl,
+        Language::Spirv,
+    ];
+
+    /// The name on the command line.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            Language::Wgsl => "wgsl",
+            Language::Glsl => "glsl",
+            Language::Hlsl => "hlsl",
+            Language::Msl => "msl",
+            Language::Spirv => "spirv",
+        }
+    }
+}
+
+/// What an export produces: source text, or SPIR-V words.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ShaderCode {
+    /// Source code.
+    Text(String),
+    /// A SPIR-V module.
+    SpirV(Vec<u32>),
+}
+
+impl ShaderCode {
+    /// The bytes to write to a file (SPIR-V little-endian).
+    #[must_use]
+    pub fn to_bytes(&self) -> Vec<u8> {
+        match self {
+            ShaderCode::Text(text) => text.as_bytes().to_vec(),
+            ShaderCode::SpirV(words) => words.iter().flat_map(|w| w.to_le_bytes()).collect(),
+        }
+    }
+}
+
+/// An export naga could not complete (a bug in specula's WGSL if it ever happens).
+#[derive(Clone, Debug, Error, PartialEq)]
+#[error("shader export to {language} failed: {message}")]
+pub struct ExportError {
+    /// The target language.
+    pub language: &'static str,
+    /// naga's message.
+    pub message: String,
+}
+
+fn float(value: f32) -> String {
+    // `{:?}` prints the shortest representation that round-trips, always with a `.` or `e`.
+    format!("{value:?}")
+}
+
+/// The WGSL module an export starts from.
+#[must_use]
+pub fn export_wgsl_source(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> String {
+    let block = LobeBlock::new(lobe);
+    let fields = bytemuck::cast::<LobeBlock, [u32; 8]>(block);
+    let f = |k: usize| float(f32::from_bits(fields[k]));
+    let scale = normalisation.constant_for(lobe) as f32;
+    let kind = lobe.kind();
+    let mut source = String::new();
+    let _ = writeln!(
+        source,
+        "// specula: {kind}, n = {}, geometry {}, normalisation {} (N = {})",
+        lobe.exponent(),
+        geometry.id(),
+        normalisation.id(),
+        float(scale),
+    );
+    source.push_str(wgsl::LOBES);
+    source.push_str(wgsl::GEOMETRY);
+    let _ = write!(
+        source,
+        "
+// The prepared lobe: kind, squarings, n, slope, quadratic C B A, cut-off angle.
+const SPECULA_LOBE: Lobe = Lobe({}u, {}u, {}, {}, vec3<f32>({}, {}, {}), {});
+const SPECULA_NORMALISATION: f32 = {};
+const SPECULA_GEOMETRY: u32 = {}u;
+
+// {kind} at cosine t (n = {n}): 0 for t <= 0 or NaN, t above 1 counts as 1.
+fn specula_lobe(t: f32) -> f32 {{
+    if !(t > 0.0) {{
+        return 0.0;
+    }}
+    return {function}(SPECULA_LOBE, min(t, 1.0));
+}}
+
+// The lobe's cosine ({cosine}) from unit vectors pointing away from the surface.
+fn specula_cos_lobe(normal: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {{
+    return cos_lobe(SPECULA_GEOMETRY, normal, wo, wi);
+}}
+
+// N(n) lobe(t): the specular BRDF term per unit ks.
+fn specula_specular(normal: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {{
+    return SPECULA_NORMALISATION * specula_lobe(specula_cos_lobe(normal, wo, wi));
+}}
+
+// Example: white specular reflection of a unit light, as radiance f(wo, wi) cos(theta_i).
+@fragment
+fn fs_main(
+    @location(0) normal: vec3<f32>,
+    @location(1) wo: vec3<f32>,
+    @location(2) wi: vec3<f32>,
+) -> @location(0) vec4<f32> {{
+    let n = normalize(normal);
+    let l = normalize(wi);
+    let value = specula_specular(n, normalize(wo), l) * max(dot(n, l), 0.0);
+    return vec4<f32>(value, value, value, 1.0);
+}}
+",
+        fields[0],
+        fields[1],
+        f(2),
+        f(3),
+        f(4),
+        f(5),
+        f(6),
+        f(7),
+        float(scale),
+        match geometry {
+            Geometry::Phong => 0,
+            Geometry::Blinn => 1,
+        },
+        n = lobe.exponent(),
+        function = wgsl::lobe_function(kind),
+        cosine = geometry.cosine_name(),
+    );
+    source
+}
+
+/// Exports the lobe in `language`.
+pub fn export(
+    lobe: &Lobe,
+    geometry: Geometry,
+    normalisation: Normalisation,
+    language: Language,
+) -> Result<ShaderCode, ExportError> {
+    let fail = |message: String| ExportError {
+        language: language.id(),
+        message,
+    };
+    let source = export_wgsl_source(lobe, geometry, normalisation);
+    let (mut module, _) = wgsl::validate(&source).map_err(fail)?;
+    naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
+    let (module, info) = {
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .map_err(|e| fail(e.emit_to_string(&source)))?;
+        (module, info)
+    };
+    let header = source.lines().next().unwrap_or_default();
+    let commented = |comment: &str, body: String| format!("{comment} {}\n{body}", &header[3..]);
+    match language {
+        Language::Wgsl => {
+            naga::back::wgsl::write_string(&module, &info, naga::back::wgsl::WriterFlags::empty())
+                .map(|text| ShaderCode::Text(commented("//", text)))
+                .map_err(|e| fail(e.to_string()))
+        }
+        Language::Glsl => {
+            let mut text = String::new();
+            let options = naga::back::glsl::Options {
+                version: naga::back::glsl::Version::Desktop(450),
+                ..naga::back::glsl::Options::default()
+            };
+            let pipeline = naga::back::glsl::PipelineOptions {
+                shader_stage: naga::ShaderStage::Fragment,
+                entry_point: "fs_main".to_owned(),
+                multiview: None,
+            };
+            naga::back::glsl::Writer::new(
+                &mut text,
+                &module,
+                &info,
+                &options,
+                &pipeline,
+                naga::proc::BoundsCheckPolicies::default(),
+            )
+            .and_then(|mut writer| writer.write())
+            .map_err(|e| fail(e.to_string()))?;
+            // The `#version` line must stay first.
+            let (version, body) = text.split_once('\n').unwrap_or((&text, ""));
+            Ok(ShaderCode::Text(format!(
+                "{version}\n// {}\n{body}",
+                &header[3..]
+            )))
+        }
+        Language::Hlsl => {
+            let mut text = String::new();
+            let options = naga::back::hlsl::Options::default();
+            let pipeline = naga::back::hlsl::PipelineOptions { entry_point: None };
+            naga::back::hlsl::Writer::new(&mut text, &options, &pipeline)
+                .write(&module, &info, None)
+                .map_err(|e| fail(e.to_string()))?;
+            Ok(ShaderCode::Text(commented("//", text)))
+        }
+        Language::Msl => naga::back::msl::write_string(
+            &module,
+            &info,
+            &naga::back::msl::Options::default(),
+            &naga::back::msl::PipelineOptions::default(),
+        )
+        .map(|(text, _)| ShaderCode::Text(commented("//", text)))
+        .map_err(|e| fail(e.to_string())),
+        Language::Spirv => {
+            naga::back::spv::write_vec(&module, &info, &naga::back::spv::Options::default(), None)
+                .map(ShaderCode::SpirV)
+                .map_err(|e| fail(e.to_string()))
+        }
+    }
+}

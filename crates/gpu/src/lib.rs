@@ -24,5 +24,5 @@ pub mod uniforms;
 pub mod wgsl;
 
 pub use context::{Gpu, GpuError};
-pub use evaluate::{GpuEvaluator, LobeEvaluator};
+pub use evaluate::{evaluate_wgsl_function, GpuEvaluator, LobeEvaluator};
 pub use render::GpuRenderer;

@@ -36,49 +36,52 @@ impl<'gpu> GpuRenderer<'gpu> {
     /// Compiles the render module on `gpu`.
     pub fn new(gpu: &'gpu Gpu) -> Result<Self, GpuError> {
         gpu.checked(|| {
-            let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("specula render"),
-                source: wgpu::ShaderSource::Wgsl(wgsl::render_module().into()),
-            });
-            let pipeline = |cull_mode| {
-                gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            let module = gpu
+                .device
+                .create_shader_module(wgpu::ShaderModuleDescriptor {
                     label: Some("specula render"),
-                    layout: None,
-                    vertex: wgpu::VertexState {
-                        module: &module,
-                        entry_point: Some("vs_main"),
-                        compilation_options: wgpu::PipelineCompilationOptions::default(),
-                        buffers: &[Some(wgpu::VertexBufferLayout {
-                            array_stride: (VERTEX_FLOATS * 4) as u64,
-                            step_mode: wgpu::VertexStepMode::Vertex,
-                            attributes: &wgpu::vertex_attr_array![
-                                0 => Float32x3, 1 => Float32x3, 2 => Float32x3
-                            ],
-                        })],
-                    },
-                    primitive: wgpu::PrimitiveState {
-                        topology: wgpu::PrimitiveTopology::TriangleList,
-                        front_face: wgpu::FrontFace::Ccw,
-                        cull_mode,
-                        ..wgpu::PrimitiveState::default()
-                    },
-                    depth_stencil: Some(wgpu::DepthStencilState {
-                        format: DEPTH_FORMAT,
-                        depth_write_enabled: Some(true),
-                        depth_compare: Some(wgpu::CompareFunction::Less),
-                        stencil: wgpu::StencilState::default(),
-                        bias: wgpu::DepthBiasState::default(),
-                    }),
-                    multisample: wgpu::MultisampleState::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module: &module,
-                        entry_point: Some("fs_main"),
-                        compilation_options: wgpu::PipelineCompilationOptions::default(),
-                        targets: &[Some(COLOUR_FORMAT.into())],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
+                    source: wgpu::ShaderSource::Wgsl(wgsl::render_module().into()),
+                });
+            let pipeline = |cull_mode| {
+                gpu.device
+                    .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                        label: Some("specula render"),
+                        layout: None,
+                        vertex: wgpu::VertexState {
+                            module: &module,
+                            entry_point: Some("vs_main"),
+                            compilation_options: wgpu::PipelineCompilationOptions::default(),
+                            buffers: &[Some(wgpu::VertexBufferLayout {
+                                array_stride: (VERTEX_FLOATS * 4) as u64,
+                                step_mode: wgpu::VertexStepMode::Vertex,
+                                attributes: &wgpu::vertex_attr_array![
+                                    0 => Float32x3, 1 => Float32x3, 2 => Float32x3
+                                ],
+                            })],
+                        },
+                        primitive: wgpu::PrimitiveState {
+                            topology: wgpu::PrimitiveTopology::TriangleList,
+                            front_face: wgpu::FrontFace::Ccw,
+                            cull_mode,
+                            ..wgpu::PrimitiveState::default()
+                        },
+                        depth_stencil: Some(wgpu::DepthStencilState {
+                            format: DEPTH_FORMAT,
+                            depth_write_enabled: Some(true),
+                            depth_compare: Some(wgpu::CompareFunction::Less),
+                            stencil: wgpu::StencilState::default(),
+                            bias: wgpu::DepthBiasState::default(),
+                        }),
+                        multisample: wgpu::MultisampleState::default(),
+                        fragment: Some(wgpu::FragmentState {
+                            module: &module,
+                            entry_point: Some("fs_main"),
+                            compilation_options: wgpu::PipelineCompilationOptions::default(),
+                            targets: &[Some(COLOUR_FORMAT.into())],
+                        }),
+                        multiview_mask: None,
+                        cache: None,
+                    })
             };
             Self {
                 gpu,
@@ -106,9 +109,17 @@ impl<'gpu> GpuRenderer<'gpu> {
         }
         let (width, height) = (settings.width * s, settings.height * s);
         let row_bytes = (width * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let readback = self.gpu.checked(|| self.draw(scene, width, height, row_bytes))?;
+        let readback = self
+            .gpu
+            .checked(|| self.draw(scene, width, height, row_bytes))?;
         let bytes = self.gpu.read_buffer(&readback)?;
-        Ok(downsample(&bytes, row_bytes as usize, settings.width, settings.height, s))
+        Ok(downsample(
+            &bytes,
+            row_bytes as usize,
+            settings.width,
+            settings.height,
+            s,
+        ))
     }
 
     fn draw(&self, scene: &Scene, width: u32, height: u32, row_bytes: u32) -> wgpu::Buffer {
@@ -171,11 +182,12 @@ impl<'gpu> GpuRenderer<'gpu> {
             .iter()
             .map(|object| {
                 let material = MaterialBlock::new(&object.material, scene.settings.model);
-                let material_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("material"),
-                    contents: bytemuck::bytes_of(&material),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
+                let material_buffer =
+                    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("material"),
+                        contents: bytemuck::bytes_of(&material),
+                        usage: wgpu::BufferUsages::UNIFORM,
+                    });
                 let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("material"),
                     layout: &pipeline.get_bind_group_layout(1),
@@ -298,12 +310,22 @@ fn object_buffers(
             };
             let centroid = (a + b + c) / 3.0;
             for p in [a, b, c] {
-                vertices.extend(p.to_array().into_iter().chain(face.to_array()).chain(centroid.to_array()));
+                vertices.extend(
+                    p.to_array()
+                        .into_iter()
+                        .chain(face.to_array())
+                        .chain(centroid.to_array()),
+                );
             }
         }
     } else {
         for (p, n) in mesh.positions().iter().zip(mesh.normals()) {
-            vertices.extend(p.to_array().into_iter().chain(n.to_array()).chain(p.to_array()));
+            vertices.extend(
+                p.to_array()
+                    .into_iter()
+                    .chain(n.to_array())
+                    .chain(p.to_array()),
+            );
         }
         let flat: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
         if !flat.is_empty() {

@@ -1,7 +1,8 @@
 //! The WGSL sources, embedded, and how they are put together.
 //!
 //! `lobes.wgsl` is the library (one function per lobe, `lobe_eval` dispatching on the kind's
-//! index); `brdf.wgsl` adds geometry and the illumination models; `render.wgsl` and
+//! index); `geometry.wgsl` computes the lobe's cosine; `brdf.wgsl` adds the illumination
+//! models; `render.wgsl` and
 //! `evaluate.wgsl` are the entry points. A module is the concatenation of the files it needs
 //! (WGSL declarations may come in any order).
 
@@ -9,7 +10,9 @@ use specula::LobeKind;
 
 /// The lobe library.
 pub const LOBES: &str = include_str!("../shaders/lobes.wgsl");
-/// Geometry, lights and the illumination models.
+/// The lobe's cosine from the directions (Phong or Blinn).
+pub const GEOMETRY: &str = include_str!("../shaders/geometry.wgsl");
+/// Materials, lights and the illumination models.
 pub const BRDF: &str = include_str!("../shaders/brdf.wgsl");
 /// The render pipeline's entry points.
 pub const RENDER: &str = include_str!("../shaders/render.wgsl");
@@ -25,7 +28,7 @@ pub fn lobe_function(kind: LobeKind) -> String {
 /// The render module's source.
 #[must_use]
 pub fn render_module() -> String {
-    [LOBES, BRDF, RENDER].concat()
+    [LOBES, GEOMETRY, BRDF, RENDER].concat()
 }
 
 /// The compute module's source.
