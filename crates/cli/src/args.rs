@@ -101,23 +101,37 @@ impl From<GeometryArg> for Geometry {
     }
 }
 
-/// The arithmetic the analysis evaluates lobes in.
+/// Where (and in what arithmetic) the analysis evaluates lobes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum BackendArg {
     /// The f64 reference path.
     #[default]
     F64,
-    /// The f32 fast path.
+    /// The f32 fast path on the CPU.
     F32,
+    /// f32 in a GPU compute shader (WGSL on wgpu).
+    Gpu,
 }
 
-impl From<BackendArg> for Precision {
-    fn from(arg: BackendArg) -> Self {
-        match arg {
-            BackendArg::F64 => Precision::F64,
-            BackendArg::F32 => Precision::F32,
+impl BackendArg {
+    /// The CPU arithmetic, `None` for the GPU.
+    pub fn cpu_precision(self) -> Option<Precision> {
+        match self {
+            BackendArg::F64 => Some(Precision::F64),
+            BackendArg::F32 => Some(Precision::F32),
+            BackendArg::Gpu => None,
         }
     }
+}
+
+/// Which renderer draws.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum RendererArg {
+    /// The tiled CPU rasterizer.
+    #[default]
+    Cpu,
+    /// wgpu and WGSL (a GPU, or Mesa's lavapipe on the CPU).
+    Gpu,
 }
 
 /// A value parser for a closed set of choices named by `id`, listing them in `--help` and in

@@ -52,9 +52,16 @@ enum Command {
     #[command(after_help = "Examples:\n  specula diff reference.png test.png\n  \
                             specula diff a.exr b.exr --heatmap flip.png --format json")]
     Diff(commands::diff::Args),
+    /// Export one lobe as a shader function: WGSL, GLSL, HLSL, MSL or SPIR-V (through naga).
+    #[command(
+        after_help = "Examples:\n  specula shader --lobe schlick-mod --n 64 --lang glsl\n  \
+                            specula shader --lobe cosquad --n 100 --geometry blinn --normalisation lobe --lang hlsl -o lobe.hlsl\n  \
+                            specula shader --lobe cheb2 --n 32 --lang spirv -o lobe.spv"
+    )]
+    Shader(commands::shader::Args),
     /// Measure throughput (printed figures and ratios, not pass/fail).
     #[command(
-        after_help = "Examples:\n  specula bench render\n  specula bench render --width 640 --height 360 --frames 3"
+        after_help = "Examples:\n  specula bench render\n  specula bench gpu\n  specula bench render --width 640 --height 360 --frames 3"
     )]
     Bench(commands::bench::Args),
 }
@@ -79,6 +86,7 @@ fn main() -> ExitCode {
         Command::Claims(args) => commands::claims::run(&args),
         Command::Render(args) => commands::render::run(&args),
         Command::Diff(args) => commands::diff::run(&args),
+        Command::Shader(args) => commands::shader::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
     };
     match result {

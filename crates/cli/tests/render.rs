@@ -1,29 +1,12 @@
 //! `specula render`, `diff` and `bench`: files written whole or not at all, figures from
 //! closed forms, bad input answered with a message and exit code 2.
 
+mod common;
+
 use std::path::Path;
 
-use assert_cmd::Command;
+use common::{ok, specula};
 use serde_json::Value;
-
-fn specula(directory: &Path, args: &[&str]) -> std::process::Output {
-    Command::cargo_bin("specula")
-        .expect("binary built")
-        .current_dir(directory)
-        .args(args)
-        .output()
-        .expect("runs")
-}
-
-fn ok(directory: &Path, args: &[&str]) -> std::process::Output {
-    let output = specula(directory, args);
-    assert!(
-        output.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    output
-}
 
 fn png_size(path: &Path) -> (u32, u32) {
     let bytes = std::fs::read(path).unwrap();

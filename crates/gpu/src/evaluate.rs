@@ -175,15 +175,15 @@ fn evaluate(@builtin(global_invocation_id) id: vec3<u32>) {{
 /// pipeline sees them, values widened back. A GPU failure mid-analysis cannot be reported
 /// through the trait, so it is kept and the values are NaN; check [`GpuEvaluator::error`].
 #[derive(Debug)]
-pub struct GpuEvaluator<'gpu> {
-    evaluator: LobeEvaluator<'gpu>,
+pub struct GpuEvaluator<'a> {
+    evaluator: &'a LobeEvaluator<'a>,
     error: Option<GpuError>,
 }
 
-impl<'gpu> GpuEvaluator<'gpu> {
-    /// Wraps a compiled evaluator.
+impl<'a> GpuEvaluator<'a> {
+    /// Wraps a compiled evaluator (shareable between threads: one wrapper per thread).
     #[must_use]
-    pub fn new(evaluator: LobeEvaluator<'gpu>) -> Self {
+    pub fn new(evaluator: &'a LobeEvaluator<'a>) -> Self {
         Self {
             evaluator,
             error: None,

@@ -91,9 +91,8 @@ impl<'gpu> GpuRenderer<'gpu> {
         })
     }
 
-    /// Renders `scene` and reads the image back.
-    pub fn render(&self, scene: &Scene) -> Result<Image, GpuError> {
-        let settings = &scene.settings;
+    /// Refuses sizes the CPU renderer refuses or the adapter cannot hold.
+    fn check_size(&self, settings: &specula_render::Settings) -> Result<(), GpuError> {
         let s = settings.samples;
         let limit = self.gpu.device.limits().max_texture_dimension_2d;
         let fits = |side: u32| side > 0 && side.checked_mul(s).is_some_and(|v| v <= limit);
@@ -107,11 +106,20 @@ impl<'gpu> GpuRenderer<'gpu> {
                 }
             )));
         }
+        Ok(())
+    }
+
+    /// Renders `scene` and reads the image back.
+    pub fn render(&self, scene: &Scene) -> Result<Image, GpuError> {
+        let settings = &scene.settings;
+        self.check_size(settings)?;
+        let s = settings.samples;
         let (width, height) = (settings.width * s, settings.height * s);
         let row_bytes = (width * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
         let readback = self
             .gpu
-            .checked(|| self.draw(scene, width, height, row_bytes))?;
+            .checked(|| self.draw(scene, width, height, Some(row_bytes)))?
+            .ok_or_else(|| GpuError::Operation("no read-back buffer".into()))?;
         let bytes = self.gpu.read_buffer(&readback)?;
         Ok(downsample(
             &bytes,
@@ -122,7 +130,33 @@ impl<'gpu> GpuRenderer<'gpu> {
         ))
     }
 
-    fn draw(&self, scene: &Scene, width: u32, height: u32, row_bytes: u32) -> wgpu::Buffer {
+    /// Draws `scene` (uploading its buffers) and waits for the GPU, without reading the image
+    /// back: the time a frame takes, for benchmarks.
+    pub fn time_frame(&self, scene: &Scene) -> Result<std::time::Duration, GpuError> {
+        let settings = &scene.settings;
+        self.check_size(settings)?;
+        let started = std::time::Instant::now();
+        let (width, height) = (
+            settings.width * settings.samples,
+            settings.height * settings.samples,
+        );
+        self.gpu.checked(|| self.draw(scene, width, height, None))?;
+        self.gpu
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Operation(e.to_string()))?;
+        Ok(started.elapsed())
+    }
+
+    /// Records and submits the frame; with `row_bytes`, also copies the image to a read-back
+    /// buffer with rows of that many bytes.
+    fn draw(
+        &self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        row_bytes: Option<u32>,
+    ) -> Option<wgpu::Buffer> {
         let device = &self.gpu.device;
         let pipeline = if scene.settings.cull_back_faces {
             &self.culled
@@ -220,11 +254,14 @@ impl<'gpu> GpuRenderer<'gpu> {
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         );
         let depth = target(DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("image readback"),
-            size: u64::from(row_bytes) * u64::from(height),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
+        let readback = row_bytes.map(|row_bytes| {
+            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("image readback"),
+                size: u64::from(row_bytes) * u64::from(height),
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            (buffer, row_bytes)
         });
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
         {
@@ -271,24 +308,26 @@ impl<'gpu> GpuRenderer<'gpu> {
                 }
             }
         }
-        encoder.copy_texture_to_buffer(
-            colour.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &readback,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row_bytes),
-                    rows_per_image: Some(height),
+        if let Some((buffer, row_bytes)) = &readback {
+            encoder.copy_texture_to_buffer(
+                colour.as_image_copy(),
+                wgpu::TexelCopyBufferInfo {
+                    buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(*row_bytes),
+                        rows_per_image: Some(height),
+                    },
                 },
-            },
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-        );
+                wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
         self.gpu.queue.submit([encoder.finish()]);
-        readback
+        readback.map(|(buffer, _)| buffer)
     }
 }
 

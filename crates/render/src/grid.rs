@@ -26,8 +26,8 @@ pub enum GridError {
     #[error("a grid needs at least one lobe, e.g. --grid lobes=pow,schlick,cheb2")]
     Empty,
     /// A render failed.
-    #[error(transparent)]
-    Render(#[from] RenderError),
+    #[error("{0}")]
+    Render(String),
 }
 
 /// An 8-bit sRGB image (three bytes per pixel).
@@ -82,26 +82,39 @@ impl Srgb8Image {
     }
 }
 
-/// Renders the grid: row one the lobes, row two their FLIP against `options.reference`.
-/// `progress(done, total)` counts tiles over all renders.
+/// Renders the grid with the CPU renderer: row one the lobes, row two their FLIP against
+/// `options.reference`. `progress(done, total)` counts tiles over all renders.
 pub fn render_grid(
     scene: &Scene,
     options: &GridOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Srgb8Image, GridError> {
+    let renders = 1 + options.lobes.len();
+    render_grid_with(scene, options, &mut |variant, index| {
+        render(variant, &|done, total| {
+            progress(index * total + done, renders * total)
+        })
+        .map_err(|e: RenderError| e.to_string())
+    })
+}
+
+/// [`render_grid`] with any renderer: `render(scene, index)` draws the `index`-th of the
+/// `1 + lobes` renders (the reference first).
+pub fn render_grid_with(
+    scene: &Scene,
+    options: &GridOptions,
+    render: &mut dyn FnMut(&Scene, usize) -> Result<crate::Image, String>,
+) -> Result<Srgb8Image, GridError> {
     if options.lobes.is_empty() {
         return Err(GridError::Empty);
     }
-    let renders = 1 + options.lobes.len();
-    let with_lobe = |kind: LobeKind, index: usize| {
+    let mut with_lobe = |kind: LobeKind, index: usize| {
         let mut variant = scene.clone();
         variant.apply(&Overrides {
             lobe: Some(kind),
             ..Overrides::default()
         });
-        render(&variant, &|done, total| {
-            progress(index * total + done, renders * total)
-        })
+        render(&variant, index).map_err(GridError::Render)
     };
     let reference = with_lobe(options.reference, 0)?;
     let (width, height) = (reference.width(), reference.height());

@@ -2,8 +2,9 @@
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use specula::analysis::{analyze, LobeReport, Precision, DEFAULT_EXPONENTS};
+use specula::analysis::{analyze, LobeReport, DEFAULT_EXPONENTS};
 use specula::{Exponent, LobeKind};
+use specula_gpu::{Gpu, GpuEvaluator, LobeEvaluator};
 
 use super::{print_json, CommandResult};
 use crate::args::{parse_exponent, BackendArg, Format, LobeParser};
@@ -21,7 +22,8 @@ pub struct Args {
     /// Output format.
     #[arg(long, value_enum, default_value_t)]
     format: Format,
-    /// Arithmetic for the error figures: the f64 reference or the f32 fast path.
+    /// Arithmetic for the error figures: the f64 reference, the f32 fast path, or f32 in a GPU
+    /// compute shader.
     #[arg(long, value_enum, default_value_t)]
     backend: BackendArg,
 }
@@ -49,15 +51,28 @@ pub fn run(args: &Args) -> CommandResult {
         ProgressStyle::with_template("analyzing {bar:30} {pos}/{len} {elapsed}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let precision: Precision = args.backend.into();
-    let reports: Vec<LobeReport> = jobs
-        .par_iter()
-        .map(|&(lobe, n)| {
-            let report = analyze(lobe, n, &mut { precision });
-            progress.inc(1);
-            report
-        })
-        .collect();
+    let reports: Vec<LobeReport> = match args.backend.cpu_precision() {
+        Some(precision) => jobs
+            .par_iter()
+            .map(|&(lobe, n)| {
+                let report = analyze(lobe, n, &mut { precision });
+                progress.inc(1);
+                report
+            })
+            .collect(),
+        None => {
+            let gpu = Gpu::new().map_err(|e| e.to_string())?;
+            let evaluator = LobeEvaluator::new(&gpu).map_err(|e| e.to_string())?;
+            jobs.par_iter()
+                .map(|&(lobe, n)| {
+                    let mut on_gpu = GpuEvaluator::new(&evaluator);
+                    let report = analyze(lobe, n, &mut on_gpu);
+                    progress.inc(1);
+                    on_gpu.error().map_or(Ok(report), |e| Err(e.to_string()))
+                })
+                .collect::<Result<_, _>>()?
+        }
+    };
     progress.finish_and_clear();
     if args.format == Format::Json {
         return print_json(&reports);

@@ -3,6 +3,8 @@
 
 use std::time::Instant;
 
+use specula::LobeKind;
+use specula_gpu::{Gpu, GpuRenderer};
 use specula_render::{render, Overrides, Scene, Shading};
 
 use super::CommandResult;
@@ -13,6 +15,8 @@ use crate::output::Table;
 pub enum Target {
     /// The CPU renderer: ms per frame of the default scene for each shading method.
     Render,
+    /// The GPU renderer: ms per frame of the default scene (Phong shading) for each lobe.
+    Gpu,
 }
 
 /// Arguments of `specula bench`.
@@ -36,7 +40,70 @@ pub struct Args {
 pub fn run(args: &Args) -> CommandResult {
     match args.target {
         Target::Render => bench_render(args),
+        Target::Gpu => bench_gpu(args),
     }
+}
+
+/// The default scene at the requested size, one sample per pixel, with these overrides.
+fn bench_scene(args: &Args, overrides: Overrides) -> Scene {
+    let mut scene = Scene::default_scene();
+    scene.apply(&Overrides {
+        width: Some(args.width),
+        height: Some(args.height),
+        samples: Some(1),
+        ..overrides
+    });
+    scene
+}
+
+/// Best and mean of `frames` timed calls after one warm-up, in ms.
+fn time(frames: u32, mut frame: impl FnMut() -> Result<f64, String>) -> Result<(f64, f64), String> {
+    frame()?;
+    let times = (0..frames)
+        .map(|_| frame())
+        .collect::<Result<Vec<_>, _>>()?;
+    let best = times.iter().copied().fold(f64::INFINITY, f64::min);
+    Ok((best, times.iter().sum::<f64>() / times.len() as f64))
+}
+
+fn bench_gpu(args: &Args) -> CommandResult {
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    let renderer = GpuRenderer::new(&gpu).map_err(|e| e.to_string())?;
+    println!(
+        "{}\ndefault scene, {}x{}, Phong shading, 1 sample per pixel, {} frames per lobe \
+         (upload, draw, wait; no read-back)",
+        gpu.adapter_name(),
+        args.width,
+        args.height,
+        args.frames
+    );
+    let mut table = Table::new(&["lobe", "best ms/frame", "mean ms/frame", "vs pow"]);
+    let mut pow_best = None;
+    for kind in LobeKind::ALL {
+        let scene = bench_scene(
+            args,
+            Overrides {
+                lobe: Some(kind),
+                shading: Some(Shading::Phong),
+                ..Overrides::default()
+            },
+        );
+        let (best, mean) = time(args.frames, || {
+            renderer
+                .time_frame(&scene)
+                .map(|d| d.as_secs_f64() * 1e3)
+                .map_err(|e| e.to_string())
+        })?;
+        let pow = *pow_best.get_or_insert(best);
+        table.push(vec![
+            kind.to_string(),
+            format!("{best:.2}"),
+            format!("{mean:.2}"),
+            format!("{:.2}x", best / pow),
+        ]);
+    }
+    table.print(crate::args::Format::Table);
+    Ok(())
 }
 
 fn bench_render(args: &Args) -> CommandResult {

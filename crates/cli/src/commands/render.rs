@@ -5,13 +5,14 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use specula::{Exponent, Geometry, LobeKind, Normalisation};
+use specula_gpu::{Gpu, GpuRenderer};
 use specula_render::{
-    check_output_path, render, render_grid, write_image, write_png_srgb8, GridOptions,
-    IlluminationModel, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE,
+    check_output_path, render, render_grid_with, write_image, write_png_srgb8, GridOptions,
+    IlluminationModel, Image, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE,
 };
 
 use super::CommandResult;
-use crate::args::{choice, parse_exponent, LobeParser};
+use crate::args::{choice, parse_exponent, LobeParser, RendererArg};
 
 /// Arguments of `specula render`.
 #[derive(Debug, clap::Args)]
@@ -51,6 +52,9 @@ pub struct Args {
     /// One tile per lobe with its FLIP against pow, e.g. `lobes=pow,schlick,cheb2` (PNG only).
     #[arg(long, value_parser = parse_grid, value_name = "lobes=ID,...")]
     grid: Option<LobeList>,
+    /// The renderer: the CPU rasterizer, or wgpu (a GPU, or Mesa's lavapipe without one).
+    #[arg(long, value_enum, default_value_t)]
+    backend: RendererArg,
     /// Print the embedded default scene (a starting point for your own) and exit.
     #[arg(long, exclusive = true)]
     dump_default_scene: bool,
@@ -115,9 +119,30 @@ pub fn run(args: &Args) -> CommandResult {
     let scene = load(args)?;
     let started = Instant::now();
     let bar = progress_bar("rendering");
-    let progress = |done: usize, total: usize| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
+    let gpu = match args.backend {
+        RendererArg::Cpu => None,
+        RendererArg::Gpu => Some(Gpu::new().map_err(|e| e.to_string())?),
+    };
+    let gpu_renderer = match &gpu {
+        Some(gpu) => Some(GpuRenderer::new(gpu).map_err(|e| e.to_string())?),
+        None => None,
+    };
+    let renders = 1 + args.grid.as_ref().map_or(0, |LobeList(lobes)| lobes.len());
+    // Renders the `index`-th image of `renders`, on the chosen backend, with progress.
+    let mut draw = |scene: &Scene, index: usize| -> Result<Image, String> {
+        match &gpu_renderer {
+            Some(renderer) => {
+                let image = renderer.render(scene).map_err(|e| e.to_string());
+                bar.set_length(renders as u64);
+                bar.set_position(index as u64 + 1);
+                image
+            }
+            None => render(scene, &|done, total| {
+                bar.set_length((renders * total) as u64);
+                bar.set_position((index * total + done) as u64);
+            })
+            .map_err(|e| e.to_string()),
+        }
     };
     let (width, height) = match &args.grid {
         Some(LobeList(lobes)) => {
@@ -131,21 +156,22 @@ pub fn run(args: &Args) -> CommandResult {
                 lobes: lobes.clone(),
                 reference: LobeKind::Pow,
             };
-            let grid = render_grid(&scene, &options, &progress).map_err(|e| e.to_string())?;
+            let grid = render_grid_with(&scene, &options, &mut draw).map_err(|e| e.to_string())?;
             bar.finish_and_clear();
             write_png_srgb8(&args.output, grid.width, grid.height, &grid.bytes)
                 .map_err(|e| e.to_string())?;
             (grid.width, grid.height)
         }
         None => {
-            let image = render(&scene, &progress).map_err(|e| e.to_string())?;
+            let image = draw(&scene, 0)?;
             bar.finish_and_clear();
             write_image(&args.output, &image, scene.display).map_err(|e| e.to_string())?;
             (image.width(), image.height())
         }
     };
+    let device = gpu.map_or_else(|| "CPU".to_owned(), |gpu| gpu.adapter_name());
     eprintln!(
-        "wrote {} ({width}x{height}, {} shading, {} model, {:.2} s)",
+        "wrote {} ({width}x{height}, {} shading, {} model, {device}, {:.2} s)",
         args.output.display(),
         scene.settings.shading.id(),
         scene.settings.model.id(),

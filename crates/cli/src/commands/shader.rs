@@ -1,0 +1,57 @@
+//! `specula shader`: one lobe as a self-contained shader function for another pipeline.
+
+use std::io::Write as _;
+use std::path::PathBuf;
+
+use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+use specula_gpu::export::{export, Language, ShaderCode};
+
+use super::CommandResult;
+use crate::args::{choice, parse_exponent, LobeParser};
+
+/// Arguments of `specula shader`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The lobe.
+    #[arg(long, value_parser = LobeParser)]
+    lobe: LobeKind,
+    /// The exponent, in [1, 1000]; the lobe's constants are prepared for it.
+    #[arg(long, value_parser = parse_exponent, allow_negative_numbers = true)]
+    n: Exponent,
+    /// How the lobe's cosine is formed.
+    #[arg(long, value_parser = choice(&Geometry::ALL, Geometry::id), default_value = "phong")]
+    geometry: Geometry,
+    /// The normalisation baked into `specula_specular`.
+    #[arg(long, value_parser = choice(&Normalisation::ALL, Normalisation::id), default_value = "none")]
+    normalisation: Normalisation,
+    /// The shading language.
+    #[arg(long, value_parser = choice(&Language::ALL, Language::id))]
+    lang: Language,
+    /// Write to this file instead of standard output (required for SPIR-V, a binary).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+}
+
+/// Exports and writes.
+pub fn run(args: &Args) -> CommandResult {
+    if args.lang == Language::Spirv && args.output.is_none() {
+        return Err("SPIR-V is binary; give an output file with -o (e.g. -o lobe.spv)".into());
+    }
+    let lobe = Lobe::new(args.lobe, args.n);
+    let code =
+        export(&lobe, args.geometry, args.normalisation, args.lang).map_err(|e| e.to_string())?;
+    match &args.output {
+        Some(path) => specula_render::write_atomically(path, |writer| {
+            writer
+                .write_all(&code.to_bytes())
+                .map_err(|e| e.to_string())
+        })
+        .map_err(|e| e.to_string()),
+        None => {
+            if let ShaderCode::Text(text) = code {
+                print!("{text}");
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,189 @@
+//! The GPU commands: `render --backend gpu`, `analyze --backend gpu`, `shader`, `bench gpu`.
+//! Tests that need an adapter are skipped without one, except under CI (`CI=true`), where
+//! `.ci/run` installs Mesa's lavapipe and a missing adapter is a failure.
+
+mod common;
+
+use assert_cmd::Command;
+use common::{ok, specula};
+use serde_json::Value;
+
+fn have_gpu() -> bool {
+    match specula_gpu::Gpu::new() {
+        Ok(_) => true,
+        Err(error) if std::env::var("CI").as_deref() == Ok("true") => {
+            panic!("CI=true but no GPU: {error}")
+        }
+        Err(error) => {
+            eprintln!("skipped: {error}");
+            false
+        }
+    }
+}
+
+#[test]
+fn gpu_render_writes_the_image_the_cpu_writes() {
+    if !have_gpu() {
+        return;
+    }
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    let size = ["--width", "160", "--height", "90"];
+    ok(
+        d,
+        &[&["render", "--backend", "gpu", "-o", "gpu.png"][..], &size].concat(),
+    );
+    ok(d, &[&["render", "-o", "cpu.png"][..], &size].concat());
+    let output = ok(d, &["diff", "cpu.png", "gpu.png", "--format", "json"]);
+    let report: Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert!(report["mean_flip"].as_f64().unwrap() < 1e-3, "{report}");
+    ok(
+        d,
+        &[
+            "render",
+            "--backend",
+            "gpu",
+            "--grid",
+            "lobes=pow,logexp",
+            "--width",
+            "64",
+            "--height",
+            "40",
+            "-o",
+            "grid.png",
+        ],
+    );
+}
+
+#[test]
+fn no_adapter_is_a_clear_error_and_no_file() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = Command::cargo_bin("specula")
+        .unwrap()
+        .current_dir(directory.path())
+        .env("WGPU_BACKEND", "metal")
+        .args(["render", "--backend", "gpu", "-o", "x.png"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("no GPU adapter") && stderr.contains("mesa-vulkan-drivers"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"));
+    assert_eq!(std::fs::read_dir(directory.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn analyze_on_the_gpu_reports_figures_close_to_the_cpu_f32_path() {
+    if !have_gpu() {
+        return;
+    }
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    let figures = |backend: &str| -> Value {
+        let output = ok(
+            d,
+            &[
+                "analyze",
+                "--lobe",
+                "schlick-mod,cosquad",
+                "--n",
+                "64",
+                "--format",
+                "json",
+                "--backend",
+                backend,
+            ],
+        );
+        serde_json::from_slice(&output.stdout).unwrap()
+    };
+    let (gpu, f32) = (figures("gpu"), figures("f32"));
+    for (g, c) in gpu.as_array().unwrap().iter().zip(f32.as_array().unwrap()) {
+        assert_eq!(g["precision"], "gpu");
+        let (a, b) = (
+            g["epicentre_max_rel"].as_f64().unwrap(),
+            c["epicentre_max_rel"].as_f64().unwrap(),
+        );
+        assert!((a - b).abs() <= 1e-3 * b, "{a} {b}");
+    }
+}
+
+#[test]
+fn shader_exports_text_and_binary() {
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    let output = ok(
+        d,
+        &[
+            "shader",
+            "--lobe",
+            "cosquad:v=5",
+            "--n",
+            "100",
+            "--lang",
+            "glsl",
+        ],
+    );
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        text.starts_with("#version 450") && text.contains("float specula_lobe(float"),
+        "{text}"
+    );
+    assert!(text.contains("cosquad:v=5, n = 100"), "{text}");
+    ok(
+        d,
+        &[
+            "shader", "--lobe", "cheb2", "--n", "32", "--lang", "spirv", "-o", "lobe.spv",
+        ],
+    );
+    assert_eq!(
+        &std::fs::read(d.join("lobe.spv")).unwrap()[..4],
+        &[0x03, 0x02, 0x23, 0x07]
+    );
+    for (args, needle) in [
+        (
+            &["shader", "--lobe", "pow", "--n", "8", "--lang", "spirv"][..],
+            "-o",
+        ),
+        (
+            &["shader", "--lobe", "pow", "--n", "8", "--lang", "cg"][..],
+            "glsl",
+        ),
+        (
+            &["shader", "--lobe", "pow", "--n", "0", "--lang", "glsl"][..],
+            "[1, 1000]",
+        ),
+    ] {
+        let output = specula(d, args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn bench_gpu_lists_every_lobe_with_its_ratio_to_pow() {
+    if !have_gpu() {
+        return;
+    }
+    let directory = tempfile::tempdir().unwrap();
+    let output = ok(
+        directory.path(),
+        &[
+            "bench", "gpu", "--width", "64", "--height", "36", "--frames", "1",
+        ],
+    );
+    let text = String::from_utf8_lossy(&output.stdout);
+    for id in [
+        "pow ",
+        "schlick-mod",
+        "cheb2-thesis",
+        "logexp-rr",
+        "cosquad",
+    ] {
+        assert!(text.contains(id), "{text}");
+    }
+    assert!(text.contains("1.00x"), "{text}");
+}
