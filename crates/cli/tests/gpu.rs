@@ -187,3 +187,74 @@ fn bench_gpu_lists_every_lobe_with_its_ratio_to_pow() {
     }
     assert!(text.contains("1.00x"), "{text}");
 }
+
+/// The README's recipe: paste the exported declarations (from `struct Lobe` to before the
+/// example's `main`, without its `layout` lines) into a shader of one's own; glslang accepts it.
+#[test]
+fn the_readmes_glsl_paste_recipe_compiles() {
+    let found = std::process::Command::new("glslangValidator")
+        .arg("--version")
+        .output()
+        .is_ok();
+    if !found {
+        assert_ne!(
+            std::env::var("CI").as_deref(),
+            Ok("true"),
+            "CI=true but no glslangValidator"
+        );
+        return;
+    }
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    let output = ok(
+        d,
+        &[
+            "shader",
+            "--lobe",
+            "schlick-mod",
+            "--n",
+            "64",
+            "--geometry",
+            "blinn",
+            "--normalisation",
+            "blinn-approx",
+            "--lang",
+            "glsl",
+        ],
+    );
+    let exported = String::from_utf8(output.stdout).unwrap();
+    let start = exported.find("struct Lobe").unwrap();
+    let end = exported.find("void main()").unwrap();
+    let pasted: Vec<&str> = exported[start..end]
+        .lines()
+        .filter(|l| !l.starts_with("layout("))
+        .collect();
+    let shader = format!(
+        "#version 450\n{}\n{}",
+        pasted.join("\n"),
+        "layout(location = 0) in vec3 v_position;
+layout(location = 1) in vec3 v_normal;
+layout(location = 0) out vec4 colour;
+uniform vec3 u_eye, u_light, u_light_colour, u_kd, u_ks;
+
+void main() {
+    vec3 n = normalize(v_normal);
+    vec3 wo = normalize(u_eye - v_position);
+    vec3 wi = normalize(u_light - v_position);
+    float cos_in = max(dot(n, wi), 0.0);
+    vec3 brdf = u_kd / 3.14159265 + u_ks * specula_specular(n, wo, wi);
+    colour = vec4(u_light_colour * brdf * cos_in, 1.0);
+}
+"
+    );
+    std::fs::write(d.join("mine.frag"), shader).unwrap();
+    let check = std::process::Command::new("glslangValidator")
+        .arg(d.join("mine.frag"))
+        .output()
+        .unwrap();
+    assert!(
+        check.status.success(),
+        "{}",
+        String::from_utf8_lossy(&check.stdout)
+    );
+}
