@@ -41,6 +41,11 @@ enum Command {
     /// Test the thesis's claims (SPEC section 9) with measured figures and verdicts.
     #[command(after_help = "Examples:\n  specula claims\n  specula claims --format json")]
     Claims(commands::claims::Args),
+    /// Write the report: models, shapes, errors, energy, claims, renders, cost (HTML + images).
+    #[command(
+        after_help = "Examples:\n  specula report\n  specula report --quick --out /tmp/report\n  specula report --bench"
+    )]
+    Report(commands::report::Args),
     /// Render a scene (TOML, or the embedded default) on the CPU to PNG or EXR.
     #[command(after_help = "Examples:\n  specula render -o out.png\n  \
                             specula render scene.toml --lobe schlick-mod --n 256 -o out.exr\n  \
@@ -84,6 +89,7 @@ fn main() -> ExitCode {
         Command::Eval(args) => commands::eval::run(&args),
         Command::Analyze(args) => commands::analyze::run(&args),
         Command::Claims(args) => commands::claims::run(&args),
+        Command::Report(args) => commands::report::run(&args),
         Command::Render(args) => commands::render::run(&args),
         Command::Diff(args) => commands::diff::run(&args),
         Command::Shader(args) => commands::shader::run(&args),

@@ -7,6 +7,7 @@ pub mod diff;
 pub mod eval;
 pub mod models;
 pub mod render;
+pub mod report;
 pub mod shader;
 
 /// What a command reports when it fails: a one-line message.

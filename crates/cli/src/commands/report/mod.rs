@@ -1,0 +1,189 @@
+//! `specula report`: one page that answers, for each lobe, what it costs, how wrong it is
+//! where, what it does to energy, and whether the thesis's claims hold; every number computed
+//! during the run.
+//!
+//! The page (`index.html`) and its images (SVG plots, PNG renders) go to one folder. Each file
+//! is written atomically, and the page last, so an interrupted run never leaves a page that
+//! points at missing images.
+
+mod html;
+mod plot;
+mod renders;
+mod sections;
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use specula::claims::ClaimOptions;
+use specula_render::{write_atomically, write_png_srgb8, Display, Image, Scene};
+
+use super::CommandResult;
+
+/// Arguments of `specula report`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The folder to write `index.html` and its images to.
+    #[arg(long, default_value = "report")]
+    out: PathBuf,
+    /// Reduced sizes: fewer exponents and samples, smaller renders (under 20 s on 2 cores).
+    #[arg(long)]
+    quick: bool,
+    /// Also measure each lobe's throughput and plot error against speed.
+    #[arg(long)]
+    bench: bool,
+}
+
+/// How much each section computes.
+#[derive(Clone, Debug)]
+pub struct Sizes {
+    /// Log steps of `n` from 1 to 1000 in the plots against `n`.
+    pub n_steps: usize,
+    /// Samples per zone of the error figures.
+    pub samples_per_zone: usize,
+    /// Direction pairs of the reciprocity checks.
+    pub reciprocity_pairs: usize,
+    /// The claims' options.
+    pub claims: ClaimOptions,
+    /// Render width, height and samples per axis.
+    pub render: (u32, u32, u32),
+}
+
+/// What sections share: where files go and how much to compute.
+pub struct Context {
+    directory: PathBuf,
+    sizes: Sizes,
+    bench: bool,
+    files: Vec<String>,
+}
+
+impl Context {
+    fn write(&mut self, name: &str, bytes: &[u8]) -> Result<(), String> {
+        write_atomically(&self.directory.join(name), |w| {
+            std::io::Write::write_all(w, bytes).map_err(|e| e.to_string())
+        })
+        .map_err(|e| e.to_string())?;
+        self.files.push(name.to_owned());
+        Ok(())
+    }
+
+    /// Writes a chart and returns its figure.
+    fn svg(&mut self, name: &str, chart: &plot::Chart, caption: &str) -> Result<String, String> {
+        let svg = chart.to_svg(580, 360)?;
+        self.write(name, svg.as_bytes())?;
+        Ok(html::figure(name, caption))
+    }
+
+    /// Writes a render (through the scene's display settings) and returns its figure.
+    fn png(
+        &mut self,
+        name: &str,
+        image: &Image,
+        scene: &Scene,
+        caption: &str,
+    ) -> Result<String, String> {
+        let display: Display = scene.display;
+        self.png_srgb8(
+            name,
+            image.width(),
+            image.height(),
+            &image.to_srgb8(display),
+            caption,
+        )
+    }
+
+    fn png_srgb8(
+        &mut self,
+        name: &str,
+        width: u32,
+        height: u32,
+        bytes: &[u8],
+        caption: &str,
+    ) -> Result<String, String> {
+        write_png_srgb8(&self.directory.join(name), width, height, bytes)
+            .map_err(|e| e.to_string())?;
+        self.files.push(name.to_owned());
+        Ok(html::figure(name, caption))
+    }
+}
+
+type Section = (&'static str, fn(&mut Context) -> Result<String, String>);
+
+const SECTIONS: [Section; 9] = [
+    ("Models", sections::models),
+    ("Lobe shapes", sections::shapes),
+    ("Error against the angle and against n", sections::errors),
+    ("Energy and normalisation", sections::energy),
+    ("Reciprocity and white furnace", sections::reciprocity),
+    ("The thesis's claims", sections::claims),
+    ("Renders", renders::renders),
+    ("Cost", sections::cost),
+    ("Hardware", hardware),
+];
+
+fn hardware(_: &mut Context) -> Result<String, String> {
+    Ok(html::paragraph(
+        "The fixed-point models of the thesis's hardware datapaths are not part of this build yet; \
+         when they are, their error against word length and their resource tables appear here.",
+    ))
+}
+
+/// Writes the report.
+pub fn run(args: &Args) -> CommandResult {
+    let started = Instant::now();
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        format!(
+            "{}: cannot create the report folder: {e}",
+            args.out.display()
+        )
+    })?;
+    let mut context = Context {
+        directory: args.out.clone(),
+        sizes: sections::sizes(args.quick),
+        bench: args.bench,
+        files: Vec::new(),
+    };
+    let bar = ProgressBar::new(SECTIONS.len() as u64).with_style(
+        ProgressStyle::with_template("report {bar:30} {pos}/{len} {msg} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut bodies = Vec::new();
+    for (heading, section) in SECTIONS {
+        bar.set_message(heading);
+        bodies.push((heading.to_owned(), section(&mut context)?));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let page = html::page("specula report", &bodies, &footer(args, started));
+    context.write("index.html", page.as_bytes())?;
+    eprintln!(
+        "wrote {} and {} images ({:.1} s)",
+        args.out.join("index.html").display(),
+        context.files.len() - 1,
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn footer(args: &Args, started: Instant) -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|info| {
+            info.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_owned())
+        })
+        .unwrap_or_else(|| "unknown CPU".to_owned());
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    let command: Vec<String> = std::env::args().collect();
+    html::escape(&format!(
+        "specula {} on {cpu}, {threads} threads, {} {}; {} mode; computed in {:.1} s; command: {}",
+        env!("CARGO_PKG_VERSION"),
+        std::env::consts::OS,
+        std::env::consts::ARCH,
+        if args.quick { "quick" } else { "full" },
+        started.elapsed().as_secs_f64(),
+        command.join(" ")
+    ))
+}

@@ -1,0 +1,168 @@
+//! Line charts as SVG text (plotters' SVG back end: text stays text, no fonts needed).
+
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::prelude::*;
+
+/// One curve.
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+    pub colour: RGBColor,
+    pub width: u32,
+    /// Draw the points as dots instead of joining them.
+    pub markers: bool,
+}
+
+/// A chart: axes, curves and shaded bands along `x`.
+pub struct Chart {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub x: (f64, f64),
+    pub y: (f64, f64),
+    pub log_x: bool,
+    pub log_y: bool,
+    pub series: Vec<Series>,
+    /// `(from, to, colour, label)` bands over the whole height.
+    pub bands: Vec<(f64, f64, RGBColor, &'static str)>,
+    /// Put the legend in the lower right corner instead of the upper right.
+    pub legend_below: bool,
+}
+
+/// Tick labels: plain decimals in `[1e-3, 1e4)`, powers of ten outside.
+fn tick(value: &f64) -> String {
+    let v = *value;
+    if v == 0.0 {
+        "0".to_owned()
+    } else if (1e-3..1e4).contains(&v.abs()) {
+        let text = format!("{v:.3}");
+        text.trim_end_matches('0').trim_end_matches('.').to_owned()
+    } else {
+        format!("{v:.0e}")
+    }
+}
+
+/// The lobes' colours, in registry order (pow, the reference, is black).
+pub const PALETTE: [RGBColor; 10] = [
+    RGBColor(0, 0, 0),
+    RGBColor(230, 25, 75),
+    RGBColor(60, 140, 60),
+    RGBColor(245, 130, 48),
+    RGBColor(0, 130, 200),
+    RGBColor(145, 30, 180),
+    RGBColor(170, 110, 40),
+    RGBColor(240, 50, 230),
+    RGBColor(128, 128, 0),
+    RGBColor(0, 128, 128),
+];
+
+impl Chart {
+    /// The chart as an SVG document of `width x height` pixels.
+    pub fn to_svg(&self, width: u32, height: u32) -> Result<String, String> {
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            let mut low = self.y.0;
+            if self.log_y {
+                // Start the axis at the decade below the smallest value drawn.
+                let smallest = self
+                    .series
+                    .iter()
+                    .flat_map(|s| s.points.iter().map(|p| p.1))
+                    .filter(|&v| v > 0.0)
+                    .fold(f64::INFINITY, f64::min);
+                if smallest.is_finite() {
+                    low = low.max(10f64.powf(smallest.log10().floor()));
+                }
+            }
+            let (x, y) = (self.x.0..self.x.1, low..self.y.1);
+            match (self.log_x, self.log_y) {
+                (false, false) => self.draw(&root, x, y),
+                (true, false) => self.draw(&root, x.log_scale(), y),
+                (false, true) => self.draw(&root, x, y.log_scale()),
+                (true, true) => self.draw(&root, x.log_scale(), y.log_scale()),
+            }?;
+            root.present().map_err(|e| e.to_string())?;
+        }
+        Ok(svg)
+    }
+
+    fn draw<X, Y>(
+        &self,
+        root: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+        x: X,
+        y: Y,
+    ) -> Result<(), String>
+    where
+        X: AsRangedCoord<Value = f64>,
+        Y: AsRangedCoord<Value = f64>,
+        X::CoordDescType: ValueFormatter<f64>,
+        Y::CoordDescType: ValueFormatter<f64>,
+    {
+        let error = |e: DrawingAreaErrorKind<_>| e.to_string();
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(x, y)
+            .map_err(error)?;
+        chart
+            .configure_mesh()
+            .x_desc(&self.x_label)
+            .y_desc(&self.y_label)
+            .light_line_style(RGBColor(235, 235, 235))
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .draw()
+            .map_err(error)?;
+        for &(from, to, colour, label) in &self.bands {
+            chart
+                .draw_series([Rectangle::new(
+                    [(from, self.y.0), (to, self.y.1)],
+                    colour.mix(0.12).filled(),
+                )])
+                .map_err(error)?
+                .label(label)
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 16, y + 5)], colour.mix(0.3).filled())
+                });
+        }
+        for series in &self.series {
+            let style = series.colour.stroke_width(series.width);
+            let clipped = series
+                .points
+                .iter()
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .map(|&(x, y)| (x.clamp(self.x.0, self.x.1), y.clamp(self.y.0, self.y.1)));
+            let drawn = if series.markers {
+                let name = series.name.clone();
+                chart.draw_series(clipped.map(|p| {
+                    EmptyElement::at(p)
+                        + Circle::new((0, 0), 5, series.colour.filled())
+                        + Text::new(name.clone(), (8, -6), ("sans-serif", 12))
+                }))
+            } else {
+                chart.draw_series(LineSeries::new(clipped, style))
+            };
+            drawn
+                .map_err(error)?
+                .label(series.name.clone())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], style));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(200, 200, 200))
+            .label_font(("sans-serif", 12))
+            .position(if self.legend_below {
+                SeriesLabelPosition::LowerRight
+            } else {
+                SeriesLabelPosition::UpperRight
+            })
+            .draw()
+            .map_err(error)?;
+        Ok(())
+    }
+}

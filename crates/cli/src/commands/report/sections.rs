@@ -1,0 +1,577 @@
+//! The report's analysis sections: models, lobe shapes, errors, energy, reciprocity, claims
+//! and cost. Every figure is computed here, during the run.
+
+use rayon::prelude::*;
+use specula::analysis::{
+    error_figures, max_directional_albedo, max_reciprocity_error, ErrorFigures, Precision,
+};
+use specula::claims::{evaluate, ClaimId, ClaimOptions, Verdict};
+use specula::normalisation::lobe_constant;
+use specula::zones::{bloom_angle, epicentre_angle};
+use specula::{Brdf, ClassicModel, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
+
+use super::html::{escape, paragraph, table};
+use super::plot::{Chart, Series, PALETTE};
+use super::{Context, Sizes};
+use crate::output::sig;
+
+/// Chooses one figure.
+type Pick = fn(&ErrorFigures) -> f64;
+
+/// Exponents from 1 to 1000, log-spaced, `steps + 1` of them.
+fn exponents(steps: usize) -> Vec<Exponent> {
+    (0..=steps)
+        .map(|k| Exponent::new(1000f64.powf(k as f64 / steps as f64).clamp(1.0, 1000.0)))
+        .collect()
+}
+
+fn colour(kind: LobeKind) -> plotters::style::RGBColor {
+    PALETTE[kind.index() as usize % PALETTE.len()]
+}
+
+fn series(kind: LobeKind, points: Vec<(f64, f64)>) -> Series {
+    Series {
+        name: kind.to_string(),
+        points,
+        colour: colour(kind),
+        width: if kind == LobeKind::Pow { 3 } else { 1 },
+        markers: false,
+    }
+}
+
+pub fn models(_: &mut Context) -> Result<String, String> {
+    let n = Exponent::new(100.0);
+    let rows: Vec<Vec<String>> = LobeKind::ALL
+        .iter()
+        .map(|&kind| {
+            let info = kind.info();
+            let params = info
+                .params
+                .iter()
+                .map(|p| {
+                    format!(
+                        "{} (default {}, {}..{}): {}",
+                        p.name, p.default, p.min, p.max, p.description
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join("; ");
+            let ops = Lobe::new(kind, n).ops();
+            vec![
+                info.id.to_owned(),
+                info.origin.name().to_owned(),
+                info.formula.to_owned(),
+                if params.is_empty() {
+                    "n".to_owned()
+                } else {
+                    format!("n; {params}")
+                },
+                ops.to_string(),
+                ops.total().to_string(),
+            ]
+        })
+        .collect();
+    Ok(paragraph("Every lobe approximates t^n, t the cosine of the angle g to the lobe's axis (R.V for Phong, N.H for Blinn). Operation counts are measured by running each formula on a counting number type at n = 100.")
+        + &table(&["id", "origin", "formula", "parameters", "operations", "total"], &rows))
+}
+
+pub fn shapes(context: &mut Context) -> Result<String, String> {
+    let mut html = paragraph("Each lobe against cos^n over the angle; the epicentre (t^n >= 1/2) and bloom (t^n >= 1/256) zones are shaded. The log-scale variant shows the tail.");
+    for n in [2.0, 8.0, 32.0, 128.0, 512.0] {
+        let exponent = Exponent::new(n);
+        let (epicentre, bloom) = (
+            epicentre_angle(exponent).to_degrees(),
+            bloom_angle(exponent).to_degrees(),
+        );
+        let right = (2.0 * bloom).min(90.0);
+        let curves: Vec<Series> = LobeKind::ALL
+            .iter()
+            .map(|&kind| {
+                let lobe = Lobe::new(kind, exponent);
+                let points = (0..=400)
+                    .map(|i| {
+                        let g = right * f64::from(i) / 400.0;
+                        (g, lobe.eval(g.to_radians().cos()))
+                    })
+                    .collect();
+                series(kind, points)
+            })
+            .collect();
+        for log_y in [false, true] {
+            let chart = Chart {
+                title: format!(
+                    "lobes at n = {n}{}",
+                    if log_y { " (log scale)" } else { "" }
+                ),
+                x_label: "angle from the lobe's axis (degrees)".into(),
+                y_label: "lobe value".into(),
+                x: (0.0, right),
+                y: if log_y { (1e-4, 1.0) } else { (0.0, 1.05) },
+                log_x: false,
+                log_y,
+                series: curves
+                    .iter()
+                    .map(|s| Series {
+                        name: s.name.clone(),
+                        points: s.points.clone(),
+                        colour: s.colour,
+                        width: s.width,
+                        markers: false,
+                    })
+                    .collect(),
+                bands: vec![
+                    (
+                        0.0,
+                        epicentre,
+                        plotters::style::RGBColor(255, 80, 0),
+                        "epicentre",
+                    ),
+                    (
+                        epicentre,
+                        bloom,
+                        plotters::style::RGBColor(0, 90, 255),
+                        "bloom",
+                    ),
+                ],
+                legend_below: false,
+            };
+            let name = format!("shape-n{n}{}.svg", if log_y { "-log" } else { "" });
+            html += &context.svg(
+                &name,
+                &chart,
+                &format!("lobes at n = {n}{}", if log_y { ", log scale" } else { "" }),
+            )?;
+        }
+    }
+    Ok(html)
+}
+
+pub fn errors(context: &mut Context) -> Result<String, String> {
+    let mut html = paragraph("Signed error lobe - t^n against the angle, scaled by the bloom's edge so that every n fits one axis, for n = 8, 64 and 512.");
+    for kind in LobeKind::ALL.into_iter().filter(|&k| k != LobeKind::Pow) {
+        let mut low: f64 = -1e-3;
+        let mut high: f64 = 1e-3;
+        let curves: Vec<Series> = [8.0, 64.0, 512.0]
+            .iter()
+            .enumerate()
+            .map(|(k, &n)| {
+                let exponent = Exponent::new(n);
+                let (lobe, edge) = (Lobe::new(kind, exponent), bloom_angle(exponent));
+                let points: Vec<(f64, f64)> = (0..=400)
+                    .map(|i| {
+                        let x = 1.5 * f64::from(i) / 400.0;
+                        let t = (x * edge).min(core::f64::consts::FRAC_PI_2).cos();
+                        (x, lobe.eval(t) - t.powf(n))
+                    })
+                    .collect();
+                for &(_, e) in &points {
+                    low = low.min(e);
+                    high = high.max(e);
+                }
+                Series {
+                    name: format!("n = {n}"),
+                    points,
+                    colour: PALETTE[k + 1],
+                    width: 1,
+                    markers: false,
+                }
+            })
+            .collect();
+        let pad = 0.05 * (high - low);
+        let chart = Chart {
+            title: format!("{kind}: error against the angle"),
+            x_label: "angle / bloom edge".into(),
+            y_label: "lobe - t^n".into(),
+            x: (0.0, 1.5),
+            y: (low - pad, high + pad),
+            log_x: false,
+            log_y: false,
+            series: curves,
+            bands: Vec::new(),
+            legend_below: false,
+        };
+        html += &context.svg(
+            &format!("error-angle-{}.svg", kind.id()),
+            &chart,
+            &format!("{kind}: error against the angle"),
+        )?;
+    }
+    let sizes = context.sizes.clone();
+    let grid = exponents(sizes.n_steps);
+    let kinds: Vec<LobeKind> = LobeKind::ALL
+        .into_iter()
+        .filter(|&k| k != LobeKind::Pow)
+        .collect();
+    let figures: Vec<Vec<(f64, ErrorFigures)>> = kinds
+        .par_iter()
+        .map(|&kind| {
+            grid.iter()
+                .map(|&n| {
+                    (
+                        n.get(),
+                        error_figures(
+                            &Lobe::new(kind, n),
+                            &mut Precision::F64,
+                            sizes.samples_per_zone,
+                        ),
+                    )
+                })
+                .collect()
+        })
+        .collect();
+    html += &paragraph(&format!("The figures of SPEC section 4 against n (log axis, {} exponents from 1 to 1000, {} samples per zone).", grid.len(), sizes.samples_per_zone));
+    let zone_charts: [(&str, &str, Pick); 4] = [
+        (
+            "epicentre max relative error",
+            "error-n-epicentre.svg",
+            |f| f.epicentre_max_rel,
+        ),
+        ("bloom max absolute error", "error-n-bloom.svg", |f| {
+            f.bloom_max_abs
+        }),
+        ("tail max absolute error", "error-n-tail.svg", |f| {
+            f.tail_max_abs
+        }),
+        ("RMS error over the visible lobe", "error-n-rms.svg", |f| {
+            f.rms
+        }),
+    ];
+    for (title, file, pick) in zone_charts {
+        let curves = kinds
+            .iter()
+            .zip(&figures)
+            .map(|(&kind, rows)| {
+                series(
+                    kind,
+                    rows.iter().map(|(n, f)| (*n, pick(f).max(1e-9))).collect(),
+                )
+            })
+            .collect();
+        let chart = Chart {
+            title: title.to_owned(),
+            x_label: "n".into(),
+            y_label: title.to_owned(),
+            x: (1.0, 1000.0),
+            y: (1e-9, 2.0),
+            log_x: true,
+            log_y: true,
+            series: curves,
+            bands: Vec::new(),
+            legend_below: true,
+        };
+        html += &context.svg(file, &chart, title)?;
+    }
+    let rows: Vec<Vec<String>> = kinds
+        .iter()
+        .zip(&figures)
+        .map(|(kind, rows)| {
+            let max = |pick: fn(&ErrorFigures) -> f64| {
+                rows.iter().map(|(_, f)| pick(f)).fold(0.0, f64::max)
+            };
+            vec![
+                kind.to_string(),
+                format!("{:.3}%", 100.0 * max(|f| f.epicentre_max_rel)),
+                sig(max(|f| f.bloom_max_abs)),
+                sig(max(|f| f.tail_max_abs)),
+                sig(max(|f| f.rms)),
+            ]
+        })
+        .collect();
+    html += &paragraph("The worst over every exponent:");
+    html += &table(
+        &[
+            "lobe",
+            "epicentre max rel",
+            "bloom max abs",
+            "tail max abs",
+            "RMS",
+        ],
+        &rows,
+    );
+    Ok(html)
+}
+
+pub fn energy(context: &mut Context) -> Result<String, String> {
+    let grid = exponents(context.sizes.n_steps);
+    let kinds: Vec<LobeKind> = LobeKind::ALL.to_vec();
+    let ratios: Vec<Vec<(f64, f64)>> = kinds
+        .par_iter()
+        .map(|&kind| {
+            grid.iter()
+                .map(|&n| {
+                    (
+                        n.get(),
+                        specula::analysis::energy_ratio(&Lobe::new(kind, n)),
+                    )
+                })
+                .collect()
+        })
+        .collect();
+    let high = ratios.iter().flatten().map(|p| p.1).fold(1.2, f64::max);
+    let chart = Chart {
+        title: "energy relative to t^n".into(),
+        x_label: "n".into(),
+        y_label: "(n + 1) int lobe(cos g) sin g dg".into(),
+        x: (1.0, 1000.0),
+        y: (0.0, high * 1.05),
+        log_x: true,
+        log_y: false,
+        series: kinds
+            .iter()
+            .zip(ratios)
+            .map(|(&k, points)| series(k, points))
+            .collect(),
+        bands: Vec::new(),
+        legend_below: false,
+    };
+    let mut html = paragraph("Energy ratio 1 means the lobe reflects what t^n reflects; the analytic (n+1)/(2 pi) applied to an approximation scales its energy by exactly this ratio.");
+    html += &context.svg("energy-ratio.svg", &chart, "energy ratio against n")?;
+    let coef1 = Chart {
+        title: "the thesis's coef1 = 1.063 n / (2 pi) against the exact (n + 1) / (2 pi)".into(),
+        x_label: "n".into(),
+        y_label: "coef1 / exact".into(),
+        x: (1.0, 1000.0),
+        y: (0.4, 1.2),
+        log_x: true,
+        log_y: false,
+        series: vec![
+            Series {
+                name: "coef1 / exact".into(),
+                points: grid
+                    .iter()
+                    .map(|n| (n.get(), 1.063 * n.get() / (n.get() + 1.0)))
+                    .collect(),
+                colour: PALETTE[1],
+                width: 2,
+                markers: false,
+            },
+            Series {
+                name: "1".into(),
+                points: vec![(1.0, 1.0), (1000.0, 1.0)],
+                colour: PALETTE[0],
+                width: 1,
+                markers: false,
+            },
+        ],
+        bands: Vec::new(),
+        legend_below: false,
+    };
+    html += &context.svg("coef1.svg", &coef1, "coef1 against the exact normalisation")?;
+    let table_n = [1.0, 8.0, 64.0, 512.0, 1000.0].map(Exponent::new);
+    let rows: Vec<Vec<String>> = kinds
+        .iter()
+        .map(|&kind| {
+            let mut row = vec![kind.to_string()];
+            row.extend(table_n.iter().map(|&n| {
+                let numeric = lobe_constant(&Lobe::new(kind, n));
+                format!(
+                    "{} ({:+.2}%)",
+                    sig(numeric),
+                    100.0 * (numeric / Normalisation::Lobe.analytic(n) - 1.0)
+                )
+            }));
+            row
+        })
+        .collect();
+    html += &paragraph("Each lobe's own normalisation constant (computed numerically), and how far it is from the analytic (n+1)/(2 pi):");
+    html += &table(
+        &["lobe", "n = 1", "n = 8", "n = 64", "n = 512", "n = 1000"],
+        &rows,
+    );
+    Ok(html)
+}
+
+pub fn reciprocity(context: &mut Context) -> Result<String, String> {
+    use rand::SeedableRng;
+    let pairs = context.sizes.reciprocity_pairs;
+    let exponents = [8.0, 64.0, 512.0].map(Exponent::new);
+    let rows: Vec<Vec<String>> = LobeKind::ALL
+        .par_iter()
+        .map(|&kind| {
+            let mut row = vec![kind.to_string()];
+            for n in exponents {
+                let lobe = Lobe::new(kind, n);
+                let brdf = Brdf::new(
+                    Rgb::ZERO,
+                    Rgb::ONE,
+                    lobe,
+                    Geometry::Phong,
+                    Normalisation::Lobe,
+                );
+                row.push(format!("{:.5}", max_directional_albedo(&brdf).1));
+            }
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(0x5eed);
+            let worst = Geometry::ALL
+                .iter()
+                .map(|&geometry| {
+                    let brdf = Brdf::new(
+                        Rgb::splat(0.2),
+                        Rgb::splat(0.8),
+                        Lobe::new(kind, exponents[1]),
+                        geometry,
+                        Normalisation::Lobe,
+                    );
+                    max_reciprocity_error(|wo, wi| brdf.f(wo, wi), pairs, &mut rng)
+                })
+                .fold(0.0, f64::max);
+            let classic = ClassicModel {
+                ka: Rgb::ZERO,
+                kd: Rgb::splat(0.2),
+                ks: Rgb::splat(0.8),
+                lobe: Lobe::new(kind, exponents[1]),
+                geometry: Geometry::Phong,
+            };
+            let classic_error =
+                max_reciprocity_error(|wo, wi| classic.implied_brdf(wo, wi), pairs, &mut rng);
+            row.push(sig(worst));
+            row.push(sig(classic_error));
+            row
+        })
+        .collect();
+    Ok(paragraph(&format!("White furnace: the largest directional albedo of the lobe-normalised BRDF (kd = 0, ks = 1, Phong geometry) over all outgoing angles; at most 1 conserves energy. Reciprocity: the largest |f(wo, wi) - f(wi, wo)| over {pairs} random direction pairs at n = 64 (Phong and Blinn), and the same for the BRDF the classic model implies (kd + ks lobe / cos theta_i).")) + &table(
+        &["lobe", "max albedo n = 8", "n = 64", "n = 512", "reciprocity error", "classic model's implied BRDF"],
+        &rows,
+    ))
+}
+
+pub fn claims(context: &mut Context) -> Result<String, String> {
+    let options = context.sizes.claims.clone();
+    let results: Vec<_> = ClaimId::ALL
+        .par_iter()
+        .map(|&id| evaluate(id, &options))
+        .collect();
+    let mut html = format!(
+        "<p>Each claim of SPEC section 9, tested over {} exponents from 1 to 1000; thresholds come from the claims' own words.</p>\n<table><thead><tr><th>claim</th><th>verdict</th><th>measured</th><th>reading</th></tr></thead><tbody>",
+        options.exponents.len()
+    );
+    for result in &results {
+        let class = match result.verdict {
+            Verdict::Holds => "holds",
+            Verdict::HoldsWithQualification => "qualified",
+            Verdict::DoesNotHold => "fails",
+        };
+        html += &format!(
+            "<tr><td>{}</td><td class=\"{class}\">{}</td><td>{}</td><td>{}</td></tr>",
+            escape(result.claim),
+            escape(result.verdict.name()),
+            escape(&result.measured),
+            escape(&result.reading)
+        );
+    }
+    html += "</tbody></table>\n";
+    let figure_rows: Vec<Vec<String>> = results
+        .iter()
+        .flat_map(|r| {
+            r.figures.iter().map(move |f| {
+                vec![
+                    r.claim.split(' ').next().unwrap_or_default().to_owned(),
+                    f.name.clone(),
+                    sig(f.value),
+                ]
+            })
+        })
+        .collect();
+    html += &paragraph("The figures behind the verdicts:");
+    html += &table(&["claim", "figure", "value"], &figure_rows);
+    Ok(html)
+}
+
+pub fn cost(context: &mut Context) -> Result<String, String> {
+    let n = Exponent::new(64.0);
+    let mut rows = Vec::new();
+    let mut points = Vec::new();
+    for kind in LobeKind::ALL {
+        let lobe = Lobe::new(kind, n);
+        let error = error_figures(&lobe, &mut Precision::F64, context.sizes.samples_per_zone)
+            .epicentre_max_rel;
+        let mut row = vec![
+            kind.to_string(),
+            lobe.ops().to_string(),
+            lobe.ops().total().to_string(),
+            format!("{:.3}%", 100.0 * error),
+        ];
+        if context.bench {
+            let ns = measure_ns_per_eval(&lobe);
+            row.push(format!("{ns:.2}"));
+            points.push((kind, ns, error.max(1e-7)));
+        }
+        rows.push(row);
+    }
+    let mut header = vec![
+        "lobe",
+        "operations (n = 64)",
+        "total",
+        "epicentre max rel error (n = 64)",
+    ];
+    let mut html = String::new();
+    if context.bench {
+        header.push("ns per evaluation (f32, scalar)");
+        let right = points.iter().map(|p| p.1).fold(0.0, f64::max) * 1.1;
+        let chart = Chart {
+            title: "error against speed (n = 64): lower left is better".into(),
+            x_label: "ns per evaluation (f32, one core)".into(),
+            y_label: "epicentre max relative error".into(),
+            x: (0.0, right),
+            y: (1e-7, 1.0),
+            log_x: false,
+            log_y: true,
+            series: points
+                .iter()
+                .map(|&(kind, ns, error)| Series {
+                    markers: true,
+                    ..series(kind, vec![(ns, error)])
+                })
+                .collect(),
+            bands: Vec::new(),
+            legend_below: true,
+        };
+        html += &context.svg("pareto.svg", &chart, "error against speed")?;
+    } else {
+        html += &paragraph("Run `specula report --bench` to add measured throughput and the error-against-speed plot.");
+    }
+    Ok(table(&header, &rows) + &html)
+}
+
+/// Scalar `f32` nanoseconds per evaluation, the best of five passes over a million cosines.
+fn measure_ns_per_eval(lobe: &Lobe) -> f64 {
+    let cosines: Vec<f32> = (0..1_000_000)
+        .map(|i| 1.0 - (i as f32 / 1e6).powi(2) * 0.2)
+        .collect();
+    (0..5)
+        .map(|_| {
+            let started = std::time::Instant::now();
+            let sum: f32 = cosines
+                .iter()
+                .map(|&t| lobe.eval(std::hint::black_box(t)))
+                .sum();
+            std::hint::black_box(sum);
+            started.elapsed().as_secs_f64() * 1e9 / cosines.len() as f64
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Sizes for `--quick` and the default.
+pub fn sizes(quick: bool) -> Sizes {
+    if quick {
+        Sizes {
+            n_steps: 12,
+            samples_per_zone: 2_001,
+            reciprocity_pairs: 2_000,
+            claims: ClaimOptions {
+                exponents: specula::claims::claim_exponents(12),
+                samples_per_zone: 5_001,
+                reciprocity_pairs: 10_000,
+                ..ClaimOptions::default()
+            },
+            render: (240, 135, 1),
+        }
+    } else {
+        Sizes {
+            n_steps: 40,
+            samples_per_zone: 20_001,
+            reciprocity_pairs: 20_000,
+            claims: ClaimOptions::default(),
+            render: (480, 270, 2),
+        }
+    }
+}

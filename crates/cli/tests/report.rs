@@ -1,0 +1,65 @@
+//! `specula report --quick`: a well-formed page whose every image exists, every SVG parses,
+//! and no number is NaN or infinite.
+
+mod common;
+
+use common::ok;
+
+#[test]
+fn the_quick_report_is_complete_and_well_formed() {
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    ok(d, &["report", "--quick", "--out", "out"]);
+    let out = d.join("out");
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let document = roxmltree::Document::parse_with_options(
+        &page,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..roxmltree::ParsingOptions::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("index.html is not well formed: {e}"));
+    let sections = document
+        .descendants()
+        .filter(|n| n.has_tag_name("section"))
+        .count();
+    assert_eq!(sections, 9);
+    let sources: Vec<&str> = document
+        .descendants()
+        .filter(|n| n.has_tag_name("img"))
+        .filter_map(|n| n.attribute("src"))
+        .collect();
+    assert!(sources.len() >= 25, "{} images", sources.len());
+    for source in &sources {
+        let bytes = std::fs::read(out.join(source)).unwrap_or_else(|e| panic!("{source}: {e}"));
+        assert!(!bytes.is_empty(), "{source} is empty");
+        if source.ends_with(".svg") {
+            let text = String::from_utf8(bytes).unwrap();
+            roxmltree::Document::parse(&text).unwrap_or_else(|e| panic!("{source}: {e}"));
+            assert!(!text.contains("NaN"), "{source} has a NaN");
+        } else {
+            assert_eq!(&bytes[1..4], b"PNG", "{source}");
+        }
+    }
+    let text: String = document.descendants().filter_map(|n| n.text()).collect();
+    for bad in ["NaN", " inf", "-inf"] {
+        assert!(!text.contains(bad), "the page shows '{bad}'");
+    }
+    // The claims table carries the verdicts.
+    for verdict in ["holds", "does not hold"] {
+        assert!(text.contains(verdict), "no '{verdict}' verdict");
+    }
+    // Nothing but the report was written: no temporary files left.
+    let stray = std::fs::read_dir(&out)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .ends_with(".tmp")
+        })
+        .count();
+    assert_eq!(stray, 0);
+}
