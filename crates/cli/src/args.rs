@@ -109,6 +109,8 @@ pub enum BackendArg {
     F64,
     /// The f32 fast path on the CPU.
     F32,
+    /// The f32 batch path on the CPU (SIMD).
+    Simd,
     /// f32 in a GPU compute shader (WGSL on wgpu).
     Gpu,
 }
@@ -119,6 +121,7 @@ impl BackendArg {
         match self {
             BackendArg::F64 => Some(Precision::F64),
             BackendArg::F32 => Some(Precision::F32),
+            BackendArg::Simd => Some(Precision::F32Simd),
             BackendArg::Gpu => None,
         }
     }

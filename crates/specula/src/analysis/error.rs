@@ -19,6 +19,8 @@ pub enum Precision {
     F64,
     /// The `f32` fast path.
     F32,
+    /// The `f32` batch path (SIMD, `Lobe::eval_batch`).
+    F32Simd,
 }
 
 /// Evaluates a lobe at a batch of cosines: where, and in what arithmetic, error figures are
@@ -35,6 +37,7 @@ impl Evaluator for Precision {
         match self {
             Precision::F64 => "f64",
             Precision::F32 => "f32",
+            Precision::F32Simd => "f32-simd",
         }
     }
 
@@ -45,6 +48,12 @@ impl Evaluator for Precision {
                 .iter()
                 .map(|&t| f64::from(lobe.eval(t as f32)))
                 .collect(),
+            Precision::F32Simd => {
+                let narrow: Vec<f32> = cosines.iter().map(|&t| t as f32).collect();
+                let mut values = vec![0.0; narrow.len()];
+                lobe.eval_batch(&narrow, &mut values);
+                values.into_iter().map(f64::from).collect()
+            }
         }
     }
 }

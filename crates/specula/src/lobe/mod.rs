@@ -11,9 +11,11 @@
 //! gives 0; `t > 1` is treated as 1 (dot products of unit vectors overshoot by an ulp); the
 //! value is never NaN, negative, or above 1.
 
+mod batch;
 mod cheb2;
 mod cheb2_thesis;
 mod cosquad;
+mod fast_math;
 mod kind;
 mod logexp;
 mod logexp_rr;

@@ -505,11 +505,11 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
     ];
     let mut html = String::new();
     if context.bench {
-        header.push("ns per evaluation (f32, scalar)");
+        header.push("ns per evaluation (f32 SIMD batch, one thread)");
         let right = points.iter().map(|p| p.1).fold(0.0, f64::max) * 1.1;
         let chart = Chart {
             title: "error against speed (n = 64): lower left is better".into(),
-            x_label: "ns per evaluation (f32, one core)".into(),
+            x_label: "ns per evaluation (f32 SIMD batch, one thread)".into(),
             y_label: "epicentre max relative error".into(),
             x: (0.0, right),
             y: (1e-7, 1.0),

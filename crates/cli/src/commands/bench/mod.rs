@@ -10,9 +10,15 @@ use specula_render::{render, Overrides, Scene, Shading};
 use super::CommandResult;
 use crate::output::Table;
 
+mod lobes;
+
 /// What to measure.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Target {
+    /// Every lobe's batch (SIMD) throughput against powf, a copy and the FMA limit.
+    Lobes,
+    /// A whole frame: the CPU rasterizer against the GPU pipeline, per shading method.
+    Frame,
     /// The CPU renderer: ms per frame of the default scene for each shading method.
     Render,
     /// The GPU renderer: ms per frame of the default scene (Phong shading) for each lobe.
@@ -34,11 +40,16 @@ pub struct Args {
     /// Timed frames per method (after one untimed warm-up frame).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     frames: u32,
+    /// The exponent the lobes are prepared for (`bench lobes`).
+    #[arg(long, default_value = "64", value_parser = crate::args::parse_exponent)]
+    n: specula::Exponent,
 }
 
 /// Measures and prints.
 pub fn run(args: &Args) -> CommandResult {
     match args.target {
+        Target::Lobes => lobes::run(args.n),
+        Target::Frame => bench_frame(args),
         Target::Render => bench_render(args),
         Target::Gpu => bench_gpu(args),
     }
@@ -64,6 +75,48 @@ fn time(frames: u32, mut frame: impl FnMut() -> Result<f64, String>) -> Result<(
         .collect::<Result<Vec<_>, _>>()?;
     let best = times.iter().copied().fold(f64::INFINITY, f64::min);
     Ok((best, times.iter().sum::<f64>() / times.len() as f64))
+}
+
+fn bench_frame(args: &Args) -> CommandResult {
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    let renderer = GpuRenderer::new(&gpu).map_err(|e| e.to_string())?;
+    println!(
+        "default scene, {}x{}, 1 sample per pixel, {} frames per method; CPU: {} threads; GPU: {}",
+        args.width,
+        args.height,
+        args.frames,
+        rayon::current_num_threads(),
+        gpu.adapter_name()
+    );
+    let mut table = Table::new(&["shading", "CPU ms/frame", "GPU ms/frame", "CPU / GPU"]);
+    for shading in Shading::ALL {
+        let scene = bench_scene(
+            args,
+            Overrides {
+                shading: Some(shading),
+                ..Overrides::default()
+            },
+        );
+        let (cpu, _) = time(args.frames, || {
+            let started = Instant::now();
+            render(&scene, &|_, _| {}).map_err(|e| e.to_string())?;
+            Ok(started.elapsed().as_secs_f64() * 1e3)
+        })?;
+        let (gpu_ms, _) = time(args.frames, || {
+            renderer
+                .time_frame(&scene)
+                .map(|d| d.as_secs_f64() * 1e3)
+                .map_err(|e| e.to_string())
+        })?;
+        table.push(vec![
+            shading.id().to_owned(),
+            format!("{cpu:.1}"),
+            format!("{gpu_ms:.1}"),
+            format!("{:.2}", cpu / gpu_ms),
+        ]);
+    }
+    table.print(crate::args::Format::Table);
+    Ok(())
 }
 
 fn bench_gpu(args: &Args) -> CommandResult {
