@@ -136,7 +136,7 @@ pub fn overdraw(scene: &Scene) -> Result<Vec<u32>, RenderError> {
         y1: height - 1,
     };
     for primitive in setup_primitives(scene, &shaders) {
-        primitive.setup.for_each_covered(all, |x, y, _, _| {
+        primitive.setup.for_each_covered(all, |x, y, _| {
             counts[(y * width + x) as usize] += 1;
         });
     }
@@ -268,25 +268,31 @@ fn render_tile(
     };
     let count = (sample_width * sample_height) as usize;
     let mut depth = vec![f32::INFINITY; count];
-    let mut visible: Vec<Option<(u32, [f32; 3])>> = vec![None; count];
+    let mut visible = vec![u32::MAX; count];
     for &index in bin {
         primitives[index as usize]
             .setup
-            .for_each_covered(rect, |x, y, z, weights| {
+            .for_each_covered(rect, |x, y, z| {
                 let k = ((y - rect.y0) * sample_width + (x - rect.x0)) as usize;
                 if z < depth[k] {
                     depth[k] = z;
-                    visible[k] = Some((index, weights));
+                    visible[k] = index;
                 }
             });
     }
     let radiance: Vec<Vec3> = visible
         .iter()
-        .map(|hit| match *hit {
-            None => settings.background,
-            Some((index, weights)) => {
-                shade_sample(scene, shaders, &primitives[index as usize], weights)
+        .enumerate()
+        .map(|(k, &index)| {
+            if index == u32::MAX {
+                return settings.background;
             }
+            let primitive = &primitives[index as usize];
+            let (x, y) = (
+                rect.x0 + k as u32 % sample_width,
+                rect.y0 + k as u32 / sample_width,
+            );
+            shade_sample(scene, shaders, primitive, primitive.setup.weights_at(x, y))
         })
         .collect();
     let scale = 1.0 / (s * s) as f32;

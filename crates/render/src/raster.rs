@@ -173,42 +173,46 @@ impl Setup {
         self.bounds
     }
 
-    /// Calls `visit(x, y, depth, weights)` for every pixel of `rect` whose centre the triangle
-    /// covers; `weights` are the screen-space barycentric weights of the caller's vertices.
-    pub fn for_each_covered(
-        &self,
-        rect: PixelRect,
-        mut visit: impl FnMut(u32, u32, f32, [f32; 3]),
-    ) {
+    /// Calls `visit(x, y, depth)` for every pixel of `rect` whose centre the triangle covers.
+    /// Depth is the plane through the vertices' depths, stepped along the row; barycentric
+    /// weights are left to [`Setup::weights_at`], for the samples that survive the depth test.
+    pub fn for_each_covered(&self, rect: PixelRect, mut visit: impl FnMut(u32, u32, f32)) {
         let Some(rect) = self.bounds.intersect(rect) else {
             return;
         };
         let inverse_area = 1.0 / self.area as f64;
         let centre = |i: u32| i64::from(i) * ONE + HALF;
+        let steps = self.edges.map(|e| -e.dy * ONE);
+        let depth_step = (0..3)
+            .map(|k| f64::from(self.depth[k]) * steps[k] as f64 * inverse_area)
+            .sum::<f64>();
         for y in rect.y0..=rect.y1 {
-            let mut values = self
-                .edges
-                .map(|e| e.at(centre(rect.x0), centre(y)) - e.bias);
-            let steps = self.edges.map(|e| -e.dy * ONE);
+            let exact = self.edges.map(|e| e.at(centre(rect.x0), centre(y)));
+            let mut depth = (0..3)
+                .map(|k| f64::from(self.depth[k]) * exact[k] as f64 * inverse_area)
+                .sum::<f64>();
+            let mut values = [0, 1, 2].map(|k| exact[k] - self.edges[k].bias);
             for x in rect.x0..=rect.x1 {
-                if values.iter().all(|&v| v >= 0) {
-                    let oriented = core::array::from_fn::<f32, 3, _>(|k| {
-                        ((values[k] + self.edges[k].bias) as f64 * inverse_area) as f32
-                    });
-                    let depth = oriented[0] * self.depth[0]
-                        + oriented[1] * self.depth[1]
-                        + oriented[2] * self.depth[2];
-                    let mut weights = [0.0; 3];
-                    for (k, &w) in oriented.iter().enumerate() {
-                        weights[self.order[k]] = w;
-                    }
-                    visit(x, y, depth, weights);
+                if (values[0] | values[1] | values[2]) >= 0 {
+                    visit(x, y, depth as f32);
                 }
                 for (value, step) in values.iter_mut().zip(steps) {
                     *value += step;
                 }
+                depth += depth_step;
             }
         }
+    }
+
+    /// The screen-space barycentric weights of the caller's vertices at pixel `(x, y)`'s centre.
+    pub fn weights_at(&self, x: u32, y: u32) -> [f32; 3] {
+        let centre = |i: u32| i64::from(i) * ONE + HALF;
+        let inverse_area = 1.0 / self.area as f64;
+        let mut weights = [0.0; 3];
+        for (k, edge) in self.edges.iter().enumerate() {
+            weights[self.order[k]] = (edge.at(centre(x), centre(y)) as f64 * inverse_area) as f32;
+        }
+        weights
     }
 }
 
@@ -228,7 +232,7 @@ mod tests {
             x1: width - 1,
             y1: height - 1,
         };
-        setup.for_each_covered(all, |x, y, _, _| pixels.push((x, y)));
+        setup.for_each_covered(all, |x, y, _| pixels.push((x, y)));
         pixels
     }
 
@@ -270,7 +274,9 @@ mod tests {
     fn weights_are_barycentric_in_the_callers_order() {
         let setup = Setup::new([v(0.0, 0.0), v(0.0, 8.0), v(8.0, 8.0)], Culling::None, 8, 8)
             .expect("front");
-        setup.for_each_covered(setup.bounds(), |x, y, _, w| {
+        setup.for_each_covered(setup.bounds(), |x, y, depth| {
+            let w = setup.weights_at(x, y);
+            assert!((depth - 0.5).abs() < 1e-6, "constant depth plane");
             let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
             let interpolated = (w[1] * 8.0 + w[2] * 8.0, w[2] * 8.0);
             assert!((interpolated.0 - py).abs() < 1e-5 && (interpolated.1 - px).abs() < 1e-5);
@@ -333,7 +339,7 @@ mod tests {
                     };
                     for triangle in halves {
                         if let Some(setup) = Setup::new(triangle, Culling::None, width, height) {
-                            setup.for_each_covered(all, |x, y, _, _| {
+                            setup.for_each_covered(all, |x, y, _| {
                                 counts[(y * width + x) as usize] += 1;
                             });
                         }

@@ -63,7 +63,9 @@ fn schlick_mod<const K: u32>(ts: &[f32], out: &mut [f32], n: f32) {
 
 #[inline(always)]
 fn cosquad<const K: u32>(ts: &[f32], out: &mut [f32], slope: f32) {
-    each!(ts, out, |c| squarings::<K>((slope * (c - 1.0) + 1.0).max(0.0)));
+    each!(ts, out, |c| squarings::<K>(
+        (slope * (c - 1.0) + 1.0).max(0.0)
+    ));
 }
 
 /// One batch evaluation, as `pulp` runs it: `with_simd` is `#[inline(always)]`, so the whole
