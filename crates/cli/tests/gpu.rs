@@ -258,3 +258,22 @@ void main() {
         String::from_utf8_lossy(&check.stdout)
     );
 }
+
+#[test]
+fn bench_frame_compares_cpu_and_gpu_per_shading_method() {
+    if !have_gpu() {
+        return;
+    }
+    let directory = tempfile::tempdir().unwrap();
+    let output = ok(
+        directory.path(),
+        &[
+            "bench", "frame", "--width", "64", "--height", "36", "--frames", "1",
+        ],
+    );
+    let text = String::from_utf8_lossy(&output.stdout);
+    for method in ["flat", "gouraud", "phong"] {
+        assert!(text.lines().any(|l| l.starts_with(method)), "{text}");
+    }
+    assert!(text.contains("CPU / GPU"), "{text}");
+}
