@@ -5,7 +5,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use specula::lobe::PackedLobe;
 use specula::{Geometry, Lobe};
-use specula_render::{IlluminationModel, Light, Material};
+use specula_render::{IlluminationModel, Light, Material, Shader};
 
 /// `struct Lobe` of lobes.wgsl (32 bytes).
 #[repr(C)]
@@ -56,26 +56,27 @@ pub struct MaterialBlock {
 }
 
 impl MaterialBlock {
-    /// The material prepared for `model`, with the same constants as the CPU's shader.
+    /// The material prepared for `model` by the CPU renderer's [`Shader`], so both renderers
+    /// upload the same coefficients.
     #[must_use]
     pub fn new(material: &Material, model: IlluminationModel) -> Self {
-        let scale = material.normalisation.constant_for(&material.lobe) as f32;
-        let diffuse = material.kd * material.colour;
-        let (diffuse, model_index) = match model {
-            IlluminationModel::Classic => (diffuse, 0),
-            IlluminationModel::Physical => (diffuse * core::f32::consts::FRAC_1_PI, 1),
-        };
+        let shader = Shader::new(material, model);
+        let (ambient, diffuse, specular) = shader.coefficients();
+        let (geometry, model) = shader.geometry_and_model();
         Self {
-            ambient: (material.ka * material.colour).to_array(),
-            geometry: match material.geometry {
+            ambient: ambient.to_array(),
+            geometry: match geometry {
                 Geometry::Phong => 0,
                 Geometry::Blinn => 1,
             },
             diffuse: diffuse.to_array(),
-            model: model_index,
-            specular: (material.ks * scale * material.specular_colour).to_array(),
+            model: match model {
+                IlluminationModel::Classic => 0,
+                IlluminationModel::Physical => 1,
+            },
+            specular: specular.to_array(),
             padding: 0,
-            lobe: LobeBlock::new(&material.lobe),
+            lobe: LobeBlock::new(shader.lobe()),
         }
     }
 }

@@ -41,7 +41,7 @@ pub use image::{
     write_png_srgb8, Display, Image, ImageError, ToneMap,
 };
 pub use load::{load_mesh, LoadError, LoadedMesh, MESH_EXTENSIONS};
-pub use material::{IlluminationModel, Light, Material, Shading};
+pub use material::{IlluminationModel, Light, Material, Shader, Shading};
 pub use mesh::{Mesh, MeshError};
 pub use pipeline::{overdraw, render, RenderError, MAX_SAMPLES};
 pub use scene::{Object, Overrides, Scene, Settings, DEFAULT_SCENE};

@@ -109,9 +109,10 @@ pub struct Material {
     pub normalisation: Normalisation,
 }
 
-/// A material prepared for one illumination model.
+/// A material prepared for one illumination model: the coefficients both renderers (this
+/// crate's and the GPU's) upload, computed in one place.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Shader {
+pub struct Shader {
     ambient: Vec3,
     diffuse: Vec3,
     specular: Vec3,
@@ -121,6 +122,8 @@ pub(crate) struct Shader {
 }
 
 impl Shader {
+    /// Prepares `material` for `model` (the normalisation constant is computed here, once).
+    #[must_use]
     pub fn new(material: &Material, model: IlluminationModel) -> Self {
         let scale = material.normalisation.constant_for(&material.lobe) as f32;
         let diffuse = material.kd * material.colour;
@@ -138,17 +141,33 @@ impl Shader {
     }
 
     /// The ambient term for ambient intensity `ambient`.
+    #[must_use]
     pub fn ambient(&self, ambient: Vec3) -> Vec3 {
         self.ambient * ambient
     }
 
+    /// The prepared reflectances `(ambient, diffuse, specular)`: `ka C`, `kd C` (over `pi` in
+    /// the physical model) and `ks S N(n)`.
+    #[must_use]
+    pub fn coefficients(&self) -> (Vec3, Vec3, Vec3) {
+        (self.ambient, self.diffuse, self.specular)
+    }
+
+    /// The geometry and the illumination model.
+    #[must_use]
+    pub fn geometry_and_model(&self) -> (Geometry, IlluminationModel) {
+        (self.geometry, self.model)
+    }
+
     /// Whether the lobe matters: a material without a specular term (a matte floor) skips it,
     /// exactly, since the lobe is finite.
+    #[must_use]
     pub fn has_specular(&self) -> bool {
         self.specular != Vec3::ZERO
     }
 
     /// The lobe.
+    #[must_use]
     pub fn lobe(&self) -> &specula::Lobe {
         &self.lobe
     }
