@@ -5,7 +5,7 @@
 //! the two backends differ only in rasterization and arithmetic details.
 
 use glam::Vec3;
-use specula_render::{Image, RenderError, Scene, Shading, MAX_SAMPLES};
+use specula_render::{Image, Scene, Shading};
 use wgpu::util::DeviceExt;
 
 use crate::uniforms::{FrameBlock, LightBlock, MaterialBlock};
@@ -93,17 +93,14 @@ impl<'gpu> GpuRenderer<'gpu> {
 
     /// Refuses sizes the CPU renderer refuses or the adapter cannot hold.
     fn check_size(&self, settings: &specula_render::Settings) -> Result<(), GpuError> {
-        let s = settings.samples;
+        settings
+            .validate()
+            .map_err(|e| GpuError::Unsupported(e.to_string()))?;
         let limit = self.gpu.device.limits().max_texture_dimension_2d;
-        let fits = |side: u32| side > 0 && side.checked_mul(s).is_some_and(|v| v <= limit);
-        if !(1..=MAX_SAMPLES).contains(&s) || !fits(settings.width) || !fits(settings.height) {
+        let largest = settings.width.max(settings.height) * settings.samples;
+        if largest > limit {
             return Err(GpuError::Unsupported(format!(
-                "{} (this adapter's largest texture side is {limit})",
-                RenderError::Size {
-                    width: settings.width,
-                    height: settings.height,
-                    samples: s,
-                }
+                "{largest} samples per side exceed this adapter's largest texture side, {limit}"
             )));
         }
         Ok(())

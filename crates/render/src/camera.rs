@@ -125,10 +125,12 @@ impl Camera {
     /// The unit direction from `point` towards the viewer (`wo`).
     #[must_use]
     pub fn towards_viewer(&self, point: Vec3) -> Vec3 {
-        let backwards = self.backwards();
+        // Called per sample: the fallback's normalisation is paid only where it is needed.
         match self.projection {
-            Projection::Perspective { .. } => (self.eye - point).normalize_or(backwards),
-            Projection::Orthographic { .. } => backwards,
+            Projection::Perspective { .. } => (self.eye - point)
+                .try_normalize()
+                .unwrap_or_else(|| self.backwards()),
+            Projection::Orthographic { .. } => self.backwards(),
         }
     }
 }

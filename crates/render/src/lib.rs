@@ -13,7 +13,8 @@
 //!   once. Output is bit-identical for any thread count (`pipeline.rs`).
 //! - **Linear until written.** The renderer produces linear radiance; exposure, tone map and
 //!   the sRGB curve are applied only when a PNG is written (`image.rs`).
-//! - **`f32` throughout**, with the core's lobes on their fast path; each material's
+//! - **`f32` throughout**, with the core's lobes on their fast paths (Phong shading: the batch,
+//!   SIMD path, a tile's samples at a time); each material's
 //!   normalisation constant is computed once, in `f64`.
 //! - Conventions: right-handed world, `z` up, counter-clockwise front faces, depth in
 //!   `[0, 1]` (wgpu's), `wo` towards the viewer and `wi` towards the light.

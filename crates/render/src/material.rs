@@ -8,7 +8,8 @@
 //! - **physical**: `D = kd colour / pi`, `S = ks specular_colour N(n)`, both terms times the
 //!   cosine, and a point light's intensity falls off as `1 / d^2`.
 //!
-//! Arithmetic is `f32` and the lobe is evaluated by the core's fast path; the normalisation
+//! Arithmetic is `f32`; [`Shader::shade`] evaluates the lobe on the core's scalar fast path, and
+//! the pipeline's Phong path feeds [`Shader::cosines`] to the batch path instead; the normalisation
 //! constant is computed once per material in `f64`.
 
 use glam::Vec3;

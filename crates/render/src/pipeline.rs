@@ -50,22 +50,27 @@ struct Primitive {
     flat_colour: Vec3,
 }
 
-fn check_size(settings: &Settings) -> Result<(), RenderError> {
-    let (width, height, samples) = (settings.width, settings.height, settings.samples);
-    let too_big = |side: u32| side.checked_mul(samples).is_none_or(|s| s > MAX_SIDE);
-    if width == 0
-        || height == 0
-        || !(1..=MAX_SAMPLES).contains(&samples)
-        || too_big(width)
-        || too_big(height)
-    {
-        return Err(RenderError::Size {
-            width,
-            height,
-            samples,
-        });
+impl Settings {
+    /// Refuses an image or sample count outside what the renderers draw: width and height at
+    /// least 1, samples in `[1, MAX_SAMPLES]`, each side times samples at most the rasterizer's
+    /// exact range.
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let (width, height, samples) = (self.width, self.height, self.samples);
+        let too_big = |side: u32| side.checked_mul(samples).is_none_or(|s| s > MAX_SIDE);
+        if width == 0
+            || height == 0
+            || !(1..=MAX_SAMPLES).contains(&samples)
+            || too_big(width)
+            || too_big(height)
+        {
+            return Err(RenderError::Size {
+                width,
+                height,
+                samples,
+            });
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 /// Renders `scene`; `progress(done, total)` is called as tiles finish (from any thread).
@@ -74,7 +79,7 @@ pub fn render(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Image, RenderError> {
     let settings = &scene.settings;
-    check_size(settings)?;
+    settings.validate()?;
     let (width, height, samples) = (settings.width, settings.height, settings.samples);
     let shaders: Vec<Shader> = scene
         .objects
@@ -118,7 +123,7 @@ pub fn render(
 /// outside (or from inside, flipped) covers every sample it hides exactly once.
 pub fn overdraw(scene: &Scene) -> Result<Vec<u32>, RenderError> {
     let settings = &scene.settings;
-    check_size(settings)?;
+    settings.validate()?;
     let shaders: Vec<Shader> = scene
         .objects
         .iter()

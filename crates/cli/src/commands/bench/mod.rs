@@ -97,11 +97,7 @@ fn bench_frame(args: &Args) -> CommandResult {
                 ..Overrides::default()
             },
         );
-        let (cpu, _) = time(args.frames, || {
-            let started = Instant::now();
-            render(&scene, &|_, _| {}).map_err(|e| e.to_string())?;
-            Ok(started.elapsed().as_secs_f64() * 1e3)
-        })?;
+        let (cpu, _) = time(args.frames, || cpu_frame_ms(&scene))?;
         let (gpu_ms, _) = time(args.frames, || {
             renderer
                 .time_frame(&scene)
@@ -159,6 +155,13 @@ fn bench_gpu(args: &Args) -> CommandResult {
     Ok(())
 }
 
+/// One CPU frame of `scene`, in ms.
+fn cpu_frame_ms(scene: &Scene) -> Result<f64, String> {
+    let started = Instant::now();
+    render(scene, &|_, _| {}).map_err(|e| e.to_string())?;
+    Ok(started.elapsed().as_secs_f64() * 1e3)
+}
+
 fn bench_render(args: &Args) -> CommandResult {
     let cores = rayon::current_num_threads();
     println!(
@@ -168,25 +171,12 @@ fn bench_render(args: &Args) -> CommandResult {
     let mut table = Table::new(&["shading", "best ms/frame", "mean ms/frame", "vs flat"]);
     let mut flat_best = None;
     for shading in Shading::ALL {
-        let mut scene = Scene::default_scene();
-        scene.apply(&Overrides {
+        let overrides = Overrides {
             shading: Some(shading),
-            width: Some(args.width),
-            height: Some(args.height),
-            samples: Some(1),
             ..Overrides::default()
-        });
-        let frame = || -> Result<f64, String> {
-            let started = Instant::now();
-            render(&scene, &|_, _| {}).map_err(|e| e.to_string())?;
-            Ok(started.elapsed().as_secs_f64() * 1e3)
         };
-        frame()?;
-        let times = (0..args.frames)
-            .map(|_| frame())
-            .collect::<Result<Vec<_>, _>>()?;
-        let best = times.iter().copied().fold(f64::INFINITY, f64::min);
-        let mean = times.iter().sum::<f64>() / times.len() as f64;
+        let scene = bench_scene(args, overrides);
+        let (best, mean) = time(args.frames, || cpu_frame_ms(&scene))?;
         let flat = *flat_best.get_or_insert(best);
         table.push(vec![
             shading.id().to_owned(),

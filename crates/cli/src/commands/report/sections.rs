@@ -109,16 +109,7 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
                 y: if log_y { (1e-4, 1.0) } else { (0.0, 1.05) },
                 log_x: false,
                 log_y,
-                series: curves
-                    .iter()
-                    .map(|s| Series {
-                        name: s.name.clone(),
-                        points: s.points.clone(),
-                        colour: s.colour,
-                        width: s.width,
-                        markers: false,
-                    })
-                    .collect(),
+                series: curves.clone(),
                 bands: vec![
                     (
                         0.0,
