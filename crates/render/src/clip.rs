@@ -29,20 +29,6 @@ impl Varyings {
             colour: self.colour.lerp(other.colour, t),
         }
     }
-
-    /// The weighted sum `sum w_k v_k`.
-    pub fn blend(vertices: &[Varyings; 3], weights: [f32; 3]) -> Varyings {
-        let sum = |field: fn(&Varyings) -> Vec3| {
-            weights[0] * field(&vertices[0])
-                + weights[1] * field(&vertices[1])
-                + weights[2] * field(&vertices[2])
-        };
-        Varyings {
-            position: sum(|v| v.position),
-            normal: sum(|v| v.normal),
-            colour: sum(|v| v.colour),
-        }
-    }
 }
 
 /// A vertex in clip space with its varyings.

@@ -161,6 +161,11 @@ impl Image {
         &self.pixels
     }
 
+    /// The pixels, row-major, to write.
+    pub fn pixels_mut(&mut self) -> &mut [Vec3] {
+        &mut self.pixels
+    }
+
     /// The pixel at column `x`, row `y`.
     #[must_use]
     pub fn get(&self, x: u32, y: u32) -> Vec3 {

@@ -28,6 +28,7 @@ mod load;
 mod material;
 mod mesh;
 pub mod metrics;
+mod phong;
 mod pipeline;
 mod raster;
 mod scene;

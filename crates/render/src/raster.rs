@@ -179,7 +179,7 @@ impl Setup {
 
     /// Calls `visit(x, y, depth)` for every pixel of `rect` whose centre the triangle covers.
     /// Depth is the plane through the vertices' depths, stepped along the row; barycentric
-    /// weights are left to [`Setup::weights_at`], for the samples that survive the depth test.
+    /// weights are left to [`Setup::edge_weights_near`], for the samples that survive the depth test.
     pub fn for_each_covered(&self, rect: PixelRect, mut visit: impl FnMut(u32, u32, f32)) {
         let Some(rect) = self.bounds.intersect(rect) else {
             return;
@@ -208,15 +208,42 @@ impl Setup {
         }
     }
 
-    /// The screen-space barycentric weights of the caller's vertices at pixel `(x, y)`'s centre.
-    pub fn weights_at(&self, x: u32, y: u32) -> [f32; 3] {
+    /// The edge functions around pixel `(x0, y0)`, for the caller's vertices (the one opposite
+    /// each): the screen-space barycentric weights times twice the area, a scale the
+    /// perspective divide's own normalisation cancels. Exact at `(x0, y0)`'s centre; elsewhere
+    /// a plane in `f32`, accurate while the offset from `(x0, y0)` stays small (a tile).
+    pub fn edge_weights_near(&self, x0: u32, y0: u32) -> EdgeWeights {
         let centre = |i: u32| i64::from(i) * ONE + HALF;
-        let inverse_area = 1.0 / self.area as f64;
-        let mut weights = [0.0; 3];
+        let mut weights = EdgeWeights::default();
         for (k, edge) in self.edges.iter().enumerate() {
-            weights[self.order[k]] = (edge.at(centre(x), centre(y)) as f64 * inverse_area) as f32;
+            let caller = self.order[k];
+            weights.at_origin[caller] = edge.at(centre(x0), centre(y0)) as f32;
+            weights.step_x[caller] = (-edge.dy * ONE) as f32;
+            weights.step_y[caller] = (edge.dx * ONE) as f32;
         }
+        weights.origin = (x0, y0);
         weights
+    }
+}
+
+/// A triangle's edge functions as planes around a pixel: see [`Setup::edge_weights_near`].
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct EdgeWeights {
+    origin: (u32, u32),
+    at_origin: [f32; 3],
+    step_x: [f32; 3],
+    step_y: [f32; 3],
+}
+
+impl EdgeWeights {
+    /// The three edge functions at pixel `(x, y)`'s centre.
+    #[inline]
+    pub fn at(&self, x: u32, y: u32) -> [f32; 3] {
+        let (dx, dy) = (
+            x as f32 - self.origin.0 as f32,
+            y as f32 - self.origin.1 as f32,
+        );
+        core::array::from_fn(|k| self.at_origin[k] + self.step_x[k] * dx + self.step_y[k] * dy)
     }
 }
 
@@ -279,7 +306,11 @@ mod tests {
         let setup = Setup::new([v(0.0, 0.0), v(0.0, 8.0), v(8.0, 8.0)], Culling::None, 8, 8)
             .expect("front");
         setup.for_each_covered(setup.bounds(), |x, y, depth| {
-            let w = setup.weights_at(x, y);
+            let edges = setup.edge_weights_near(1, 2).at(x, y);
+            let sum: f32 = edges.iter().sum();
+            // Twice the area of the 8 x 8 right triangle, in 1/256-pixel units squared.
+            assert!((sum / (64.0 * 256.0 * 256.0) - 1.0).abs() < 1e-6);
+            let w = edges.map(|e| e / sum);
             assert!((depth - 0.5).abs() < 1e-6, "constant depth plane");
             let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
             let interpolated = (w[1] * 8.0 + w[2] * 8.0, w[2] * 8.0);
