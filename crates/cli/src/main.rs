@@ -69,6 +69,13 @@ enum Command {
         after_help = "Examples:\n  specula bench render\n  specula bench gpu\n  specula bench render --width 640 --height 360 --frames 3"
     )]
     Bench(commands::bench::Args),
+    /// Hardware datapaths: error against word length and resources, Verilog, block diagrams.
+    #[command(
+        after_help = "Examples:\n  specula hw table --lobe cosquad,logexp --bits 8..24 --n 64\n  \
+                            specula hw verilog --lobe cosquad --bits 16 -o cosquad.v --testbench cosquad_tb.v\n  \
+                            specula hw diagram --lobe logexp -o logexp.svg"
+    )]
+    Hw(commands::hw::Args),
 }
 
 fn main() -> ExitCode {
@@ -94,6 +101,7 @@ fn main() -> ExitCode {
         Command::Diff(args) => commands::diff::run(&args),
         Command::Shader(args) => commands::shader::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
+        Command::Hw(args) => commands::hw::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod claims;
 pub mod diff;
 pub mod eval;
+pub mod hw;
 pub mod models;
 pub mod render;
 pub mod report;

@@ -1,0 +1,263 @@
+//! `specula hw`: the hardware datapaths: error against word length and resources, Verilog with
+//! a self-checking testbench, and the block diagram, all from one description per lobe.
+
+use std::io::Write as _;
+use std::path::PathBuf;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use specula_hw::analysis::{sweep, WidthSweep, MEETS_TOLERANCE};
+use specula_hw::{diagram, integer_exponent, verilog, HwLobe, Resources, BITS};
+
+use super::{print_json, CommandResult};
+use crate::args::Format;
+use crate::output::{percent, sig, Table};
+
+/// Arguments of `specula hw`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    action: Action,
+}
+
+#[derive(Debug, clap::Subcommand)]
+enum Action {
+    /// Error against t^n per word length, and the resources, for each datapath.
+    Table(TableArgs),
+    /// A pipelined Verilog module, and optionally a self-checking testbench.
+    Verilog(VerilogArgs),
+    /// The structural scheme as an SVG block diagram.
+    Diagram(DiagramArgs),
+}
+
+/// A datapath id, parsed with the valid ids in the message.
+fn parse_lobe(text: &str) -> Result<HwLobe, String> {
+    HwLobe::parse(text).map_err(|e| e.to_string())
+}
+
+/// A word length in [8, 24].
+fn parse_bits(text: &str) -> Result<u32, String> {
+    let bits: u32 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a word length; valid: an integer from 8 to 24"))?;
+    if BITS.contains(&bits) {
+        Ok(bits)
+    } else {
+        Err(format!(
+            "word length {bits} is out of range; valid: 8 to 24"
+        ))
+    }
+}
+
+/// `A..B`, `A-B` or `A`, each within [8, 24].
+fn parse_bits_range(text: &str) -> Result<(u32, u32), String> {
+    let (low, high) = text
+        .split_once("..")
+        .or_else(|| text.split_once('-'))
+        .unwrap_or((text, text));
+    let (low, high) = (parse_bits(low)?, parse_bits(high)?);
+    if low <= high {
+        Ok((low, high))
+    } else {
+        Err(format!(
+            "`{text}` is an empty range; write LOW..HIGH with LOW <= HIGH"
+        ))
+    }
+}
+
+/// An integer exponent in [1, 1000].
+fn parse_integer_exponent(text: &str) -> Result<u32, String> {
+    let n: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number; n must be an integer in [1, 1000]"))?;
+    integer_exponent(n).map_err(|e| e.to_string())
+}
+
+#[derive(Debug, clap::Args)]
+struct TableArgs {
+    /// Datapaths, comma separated (default: all).
+    #[arg(long, value_parser = parse_lobe, value_delimiter = ',')]
+    lobe: Vec<HwLobe>,
+    /// Word lengths: LOW..HIGH or one width.
+    #[arg(long, value_parser = parse_bits_range, default_value = "8..24")]
+    bits: (u32, u32),
+    /// The integer exponent.
+    #[arg(long, value_parser = parse_integer_exponent, default_value = "64")]
+    n: u32,
+    /// Angles sampled per zone.
+    #[arg(long, default_value_t = 20_000, value_parser = clap::value_parser!(u32).range(100..=1_000_000))]
+    samples: u32,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t)]
+    format: Format,
+}
+
+#[derive(Debug, clap::Args)]
+struct VerilogArgs {
+    /// The datapath.
+    #[arg(long, value_parser = parse_lobe)]
+    lobe: HwLobe,
+    /// The word length.
+    #[arg(long, value_parser = parse_bits)]
+    bits: u32,
+    /// The module's file (.v).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also write a self-checking testbench here, with vectors from the Rust model.
+    #[arg(long)]
+    testbench: Option<PathBuf>,
+    /// Test vectors in the testbench.
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(2..=100_000))]
+    vectors: u32,
+}
+
+#[derive(Debug, clap::Args)]
+struct DiagramArgs {
+    /// The datapath.
+    #[arg(long, value_parser = parse_lobe)]
+    lobe: HwLobe,
+    /// The word length the formats are shown for.
+    #[arg(long, value_parser = parse_bits, default_value = "16")]
+    bits: u32,
+    /// The SVG file.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+/// Runs the action.
+pub fn run(args: &Args) -> CommandResult {
+    match &args.action {
+        Action::Table(args) => table(args),
+        Action::Verilog(args) => write_verilog(args),
+        Action::Diagram(args) => {
+            let datapath = args.lobe.build(args.bits).map_err(|e| e.to_string())?;
+            let title = format!("{}: structural scheme at W = {}", args.lobe.id(), args.bits);
+            write_text(&args.output, &diagram::svg(&datapath, &title))
+        }
+    }
+}
+
+fn write_text(path: &std::path::Path, text: &str) -> CommandResult {
+    specula_render::write_atomically(path, |writer| {
+        writer.write_all(text.as_bytes()).map_err(|e| e.to_string())
+    })
+    .map_err(|e| e.to_string())
+}
+
+fn write_verilog(args: &VerilogArgs) -> CommandResult {
+    let datapath = args.lobe.build(args.bits).map_err(|e| e.to_string())?;
+    if let Some(path) = &args.testbench {
+        let vectors = verilog::test_vectors(args.lobe, &datapath, args.bits, args.vectors as usize);
+        write_text(path, &verilog::testbench(&datapath, &vectors))?;
+    }
+    write_text(
+        &args.output,
+        &verilog::module(&datapath, args.lobe, args.bits),
+    )
+}
+
+/// The resources in one cell each: `count x widths`.
+fn resource_cells(r: &Resources) -> [String; 7] {
+    let list = |items: Vec<String>| {
+        if items.is_empty() {
+            "-".to_owned()
+        } else {
+            items.join(" ")
+        }
+    };
+    [
+        list(
+            r.multipliers
+                .iter()
+                .map(|(a, b)| format!("{a}x{b}"))
+                .collect(),
+        ),
+        list(r.squarers.iter().map(u32::to_string).collect()),
+        list(r.adders.iter().map(u32::to_string).collect()),
+        list(r.dividers.iter().map(|(a, b)| format!("{a}/{b}")).collect()),
+        r.rom_bits.to_string(),
+        r.register_bits.to_string(),
+        r.latency.to_string(),
+    ]
+}
+
+/// Sweeps every chosen datapath in parallel, with a progress bar over the widths.
+pub fn sweeps(
+    lobes: &[HwLobe],
+    n: u32,
+    (low, high): (u32, u32),
+    samples: usize,
+) -> Result<Vec<WidthSweep>, String> {
+    let progress = ProgressBar::new((lobes.len() as u32 * (high - low + 1)).into()).with_style(
+        ProgressStyle::with_template("datapaths {bar:30} {pos}/{len} widths {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let result = lobes
+        .par_iter()
+        .map(|&lobe| sweep(lobe, n, low..=high, samples, &mut |_| progress.inc(1)))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string());
+    progress.finish_and_clear();
+    result
+}
+
+fn table(args: &TableArgs) -> CommandResult {
+    let lobes = if args.lobe.is_empty() {
+        HwLobe::ALL.to_vec()
+    } else {
+        args.lobe.clone()
+    };
+    let results = sweeps(&lobes, args.n, args.bits, args.samples as usize)?;
+    if args.format == Format::Json {
+        return print_json(&results);
+    }
+    let mut table = Table::new(&[
+        "datapath",
+        "bits",
+        "epicentre max rel",
+        "bloom max abs",
+        "multipliers",
+        "squarers",
+        "adders",
+        "dividers",
+        "ROM bits",
+        "register bits",
+        "latency",
+    ]);
+    for result in &results {
+        for row in &result.rows {
+            let mut cells = vec![
+                result.lobe.id().to_owned(),
+                row.bits.to_string(),
+                percent(row.errors.epicentre_max_rel),
+                sig(row.errors.bloom_max_abs),
+            ];
+            cells.extend(resource_cells(&row.resources));
+            table.push(cells);
+        }
+    }
+    table.print(args.format);
+    if args.format == Format::Table {
+        println!("\nn = {}; widths are in bits; \"meets\" = epicentre max rel within {MEETS_TOLERANCE}x the f64 model's.", args.n);
+        for result in &results {
+            let meets = result.minimum_width().map_or_else(
+                || {
+                    format!(
+                        "does not meet it within {}..{} bits",
+                        args.bits.0, args.bits.1
+                    )
+                },
+                |w| format!("meets it from {w} bits"),
+            );
+            println!(
+                "{:16} f64 model: epicentre {}, bloom {}; {meets}",
+                result.lobe.id(),
+                percent(result.float.epicentre_max_rel),
+                sig(result.float.bloom_max_abs)
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,129 @@
+//! Error against `t^n` as a function of word length, measured with the core's zone scan.
+//!
+//! A datapath is an [`Evaluator`]: the core's [`error_figures`] samples each zone densely in
+//! the angle (closed-form boundaries, at least `samples_per_zone` points), hands the cosines
+//! here, and compares with `cos(g)^n` in `f64`. The datapath sees its inputs as hardware
+//! would: `t` (or `g = acos t`) rounded to `UQ1.(W-1)`, so input quantisation is part of the
+//! error, as it is on silicon. At `W <= 16` the scan's points outnumber the representable
+//! inputs of each zone, so every representable input is visited (exhaustive in effect).
+
+use serde::Serialize;
+use specula::analysis::{error_figures, ErrorFigures, Evaluator, Precision};
+use specula::{Exponent, Lobe};
+
+use crate::datapath::{Datapath, Resources};
+use crate::lobes::{HwError, HwLobe};
+
+/// A datapath at one word length as an [`Evaluator`].
+pub struct HwEvaluator {
+    lobe: HwLobe,
+    bits: u32,
+    n: u32,
+    datapath: Datapath,
+}
+
+impl HwEvaluator {
+    /// The datapath for `lobe` at `bits`, evaluating with integer exponent `n`.
+    pub fn new(lobe: HwLobe, bits: u32, n: u32) -> Result<Self, HwError> {
+        Ok(Self {
+            lobe,
+            bits,
+            n,
+            datapath: lobe.build(bits)?,
+        })
+    }
+}
+
+impl Evaluator for HwEvaluator {
+    fn name(&self) -> &'static str {
+        "fixed-point"
+    }
+
+    fn eval_batch(&mut self, _lobe: &Lobe, cosines: &[f64]) -> Vec<f64> {
+        cosines
+            .iter()
+            .map(|&t| {
+                let input = if self.lobe.takes_angle() {
+                    t.clamp(-1.0, 1.0).acos()
+                } else {
+                    t
+                };
+                let raw = self
+                    .datapath
+                    .eval(&self.lobe.inputs(self.bits, input, self.n));
+                HwLobe::value(self.bits, raw)
+            })
+            .collect()
+    }
+}
+
+/// One row of the error-against-width table.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct WidthRow {
+    /// The word length.
+    pub bits: u32,
+    /// The datapath's error figures.
+    pub errors: ErrorFigures,
+    /// What it costs.
+    pub resources: Resources,
+}
+
+/// A datapath's errors and resources over a range of word lengths, beside its float model.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct WidthSweep {
+    /// The datapath.
+    pub lobe: HwLobe,
+    /// The exponent.
+    pub n: u32,
+    /// The float model's figures (`f64`): what the hardware is held to.
+    pub float: ErrorFigures,
+    /// One row per word length.
+    pub rows: Vec<WidthRow>,
+}
+
+/// How far above the float model's epicentre error a datapath may be and still "meet" it.
+pub const MEETS_TOLERANCE: f64 = 1.1;
+
+impl WidthSweep {
+    /// The smallest word length whose epicentre max relative error is within
+    /// [`MEETS_TOLERANCE`] times the float model's, if any in the sweep.
+    #[must_use]
+    pub fn minimum_width(&self) -> Option<u32> {
+        let bound = self.float.epicentre_max_rel * MEETS_TOLERANCE;
+        self.rows
+            .iter()
+            .find(|row| row.errors.epicentre_max_rel <= bound)
+            .map(|row| row.bits)
+    }
+}
+
+/// Errors and resources of `lobe` for every word length in `bits`, at integer exponent `n`,
+/// sampling each zone at `samples_per_zone` angles; `progress` is called after each width.
+pub fn sweep(
+    lobe: HwLobe,
+    n: u32,
+    bits: impl IntoIterator<Item = u32>,
+    samples_per_zone: usize,
+    progress: &mut dyn FnMut(u32),
+) -> Result<WidthSweep, HwError> {
+    let exponent = Exponent::try_new(f64::from(n)).map_err(|_| HwError::Exponent(f64::from(n)))?;
+    let float_lobe = Lobe::new(lobe.float_kind(), exponent);
+    let float = error_figures(&float_lobe, &mut Precision::F64, samples_per_zone);
+    let mut rows = Vec::new();
+    for bits in bits {
+        let mut evaluator = HwEvaluator::new(lobe, bits, n)?;
+        let errors = error_figures(&float_lobe, &mut evaluator, samples_per_zone);
+        rows.push(WidthRow {
+            bits,
+            errors,
+            resources: evaluator.datapath.resources(),
+        });
+        progress(bits);
+    }
+    Ok(WidthSweep {
+        lobe,
+        n,
+        float,
+        rows,
+    })
+}

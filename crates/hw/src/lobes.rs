@@ -1,0 +1,302 @@
+//! The datapaths, one per lobe (SPEC section 8), built for a word length `W`.
+//!
+//! **What `W` means.** Every signal in `[0, 1]` (the input `t` or angle `g`, the lobe's value
+//! and the intermediate values of that range) is `UQ1.(W-1)`: one integer bit, so that `t = 1`
+//! is exact, and `W - 1` fraction bits. Signals of a wider range (`n (1 - t)`, the `cheb2`
+//! coefficients, the first logarithm) keep the same least significant bit, `2^-(W-1)`, and as
+//! many integer bits as their range needs. The exponent `n` is an integer `UQ10.0` in
+//! `[1, 1000]`: hardware takes the thesis's integer exponents. Per-material constants are
+//! prepared on the host, as [`specula::Lobe`] prepares them: `cosquad`'s `a = (n + 1) / 17`
+//! (`v = 4`, the thesis's `K_4`), `schlick-mod`'s squaring count, `cheb2`'s ROM address.
+//!
+//! Every node rounds half to even and saturates.
+
+use serde::Serialize;
+use specula::{Exponent, Lobe, LobeKind};
+
+use crate::datapath::{Builder, Datapath, Op};
+use crate::fixed::{Format, Rounding};
+use crate::log2::Log2Unit;
+
+/// The word lengths the models are built for.
+pub const BITS: core::ops::RangeInclusive<u32> = 8..=24;
+
+/// `cosquad`'s squaring count in hardware: the thesis's `K_4`.
+pub const COSQUAD_V: u32 = 4;
+
+/// `logexp`'s log2 unit: 64 segments. The first logarithm's error is multiplied by `n`, so
+/// the table must be fine: 16 segments (error 3.5e-4) cost 25 % in the epicentre at `n = 512`.
+pub const LOGEXP_TABLE: Log2Unit = Log2Unit::Table { segments_log2: 6 };
+
+/// The squarings `schlick-mod` can select: `a = 2^k` with `k <= 7` covers `n <= 1000`.
+const SCHLICK_MOD_MAX_SQUARINGS: u32 = 7;
+
+/// A hardware datapath: the lobe it implements and, for `logexp`, its log2 unit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum HwLobe {
+    /// `t / (n (1 - t) + t)`: one multiply, two adds, a divider.
+    Schlick,
+    /// `t^a / (n (1 - t) + t)`: adds seven squarers and a multiplexer choosing `t^(2^k)`.
+    SchlickMod,
+    /// `C + g (B + A g)` with `[A, B, C]` from a ROM indexed by `n`: two multiplies, two adds.
+    Cheb2,
+    /// `1 - log2(1 - n log2 t) / 2` with the log2 unit's table ([`LOGEXP_TABLE`]).
+    LogExp,
+    /// The same with Mitchell's log2 (no table, no multiplier in the unit).
+    LogExpMitchell,
+    /// `max(0, a (t - 1) + 1)^16`: one multiply, two adds, four squarers.
+    CosQuad,
+}
+
+/// An unknown datapath id.
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
+pub enum HwError {
+    /// Not a datapath id.
+    #[error("unknown hardware datapath `{0}`; valid: {valid}", valid = HwLobe::valid_ids())]
+    UnknownLobe(String),
+    /// A word length outside [`BITS`].
+    #[error("word length {0} is out of range; valid: 8 to 24 bits")]
+    Bits(u32),
+    /// An exponent the hardware cannot take.
+    #[error("n = {0} is not an integer in [1, 1000], which the hardware datapaths take")]
+    Exponent(f64),
+}
+
+impl HwLobe {
+    /// Every datapath.
+    pub const ALL: [HwLobe; 6] = [
+        HwLobe::Schlick,
+        HwLobe::SchlickMod,
+        HwLobe::Cheb2,
+        HwLobe::LogExp,
+        HwLobe::LogExpMitchell,
+        HwLobe::CosQuad,
+    ];
+
+    /// The id on the command line.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            HwLobe::Schlick => "schlick",
+            HwLobe::SchlickMod => "schlick-mod",
+            HwLobe::Cheb2 => "cheb2",
+            HwLobe::LogExp => "logexp",
+            HwLobe::LogExpMitchell => "logexp-mitchell",
+            HwLobe::CosQuad => "cosquad",
+        }
+    }
+
+    /// Every id, comma-separated.
+    #[must_use]
+    pub fn valid_ids() -> String {
+        Self::ALL.map(HwLobe::id).join(", ")
+    }
+
+    /// The datapath with id `text`.
+    pub fn parse(text: &str) -> Result<Self, HwError> {
+        Self::ALL
+            .into_iter()
+            .find(|lobe| lobe.id() == text)
+            .ok_or_else(|| HwError::UnknownLobe(text.to_owned()))
+    }
+
+    /// The float model it implements.
+    #[must_use]
+    pub fn float_kind(self) -> LobeKind {
+        match self {
+            HwLobe::Schlick => LobeKind::Schlick,
+            HwLobe::SchlickMod => LobeKind::SchlickMod,
+            HwLobe::Cheb2 => LobeKind::Cheb2,
+            HwLobe::LogExp | HwLobe::LogExpMitchell => LobeKind::LogExp,
+            HwLobe::CosQuad => LobeKind::CosQuad { v: COSQUAD_V as u8 },
+        }
+    }
+
+    /// Whether the input is the angle `g` rather than the cosine `t`.
+    #[must_use]
+    pub fn takes_angle(self) -> bool {
+        self == HwLobe::Cheb2
+    }
+
+    /// The input format of `t` (or `g`) and of the output.
+    #[must_use]
+    pub fn unit_format(bits: u32) -> Format {
+        Format::unsigned(1, bits - 1)
+    }
+
+    /// The datapath at word length `bits`.
+    pub fn build(self, bits: u32) -> Result<Datapath, HwError> {
+        if !BITS.contains(&bits) {
+            return Err(HwError::Bits(bits));
+        }
+        let frac = bits - 1;
+        let unit = Self::unit_format(bits);
+        let mut b = Builder::new(Rounding::HalfEven);
+        let name = format!("specula_{}_w{bits}", self.id().replace('-', "_"));
+        let output = match self {
+            HwLobe::Schlick | HwLobe::SchlickMod => {
+                let t = b.input("t", unit);
+                let n = b.input("n", Format::unsigned(10, 0));
+                let numerator = if self == HwLobe::SchlickMod {
+                    let k = b.input("k", Format::unsigned(3, 0));
+                    let mut powers = vec![t];
+                    for i in 1..=SCHLICK_MOD_MAX_SQUARINGS {
+                        let previous = powers[powers.len() - 1];
+                        powers.push(b.node(&format!("t_{}", 1 << i), Op::Square(previous), unit));
+                    }
+                    b.node(
+                        "t_a",
+                        Op::Select {
+                            index: k,
+                            options: powers,
+                        },
+                        unit,
+                    )
+                } else {
+                    t
+                };
+                let one = b.node("one", Op::Const(1 << frac), unit);
+                let u = b.node("u", Op::Sub(one, t), unit);
+                let n_u = b.node("n_u", Op::Mul(n, u), Format::unsigned(10, frac));
+                let denominator = b.node("d", Op::Add(n_u, t), Format::unsigned(10, frac));
+                b.node("value", Op::Div(numerator, denominator), unit)
+            }
+            HwLobe::Cheb2 => {
+                let g = b.input("g", unit);
+                let n = b.input("n", Format::unsigned(10, 0));
+                let [c, b_coef, a] = cheb2_roms(frac);
+                let rom = |b: &mut Builder, name: &str, (table, format): (Vec<i64>, Format)| {
+                    b.node(name, Op::Rom { index: n, table }, format)
+                };
+                let (fa, fb, fc) = (a.1, b_coef.1, c.1);
+                let a = rom(&mut b, "rom_a", a);
+                let b_node = rom(&mut b, "rom_b", b_coef);
+                let c = rom(&mut b, "rom_c", c);
+                let a_g = b.node("a_g", Op::Mul(a, g), Format::signed(fa.int_bits + 1, frac));
+                let inner_int = fa.int_bits.max(fb.int_bits) + 2;
+                let inner = b.node(
+                    "inner",
+                    Op::Add(a_g, b_node),
+                    Format::signed(inner_int, frac),
+                );
+                // The result is clamped to [0, 1] and C is near 1, so these two may saturate
+                // at +-8 and +-4: any value beyond clamps to the same 0 or 1.
+                let times_g = b.node("inner_g", Op::Mul(inner, g), Format::signed(3, frac));
+                let sum = b.node(
+                    "sum",
+                    Op::Add(times_g, c),
+                    Format::signed(fc.int_bits.max(2), frac),
+                );
+                let one = b.node("one", Op::Const(1 << frac), unit);
+                // min(sum, 1), and negatives saturate to 0 in the unsigned output.
+                b.node("value", Op::Min(sum, one), unit)
+            }
+            HwLobe::LogExp | HwLobe::LogExpMitchell => {
+                let log2_unit = if self == HwLobe::LogExp {
+                    LOGEXP_TABLE
+                } else {
+                    Log2Unit::Mitchell
+                };
+                let t = b.input("t", unit);
+                let n = b.input("n", Format::unsigned(10, 0));
+                let log_t = b.node("log2_t", Op::Log2(t, log2_unit), Format::signed(5, frac));
+                let zero = b.node("zero", Op::Const(0), Format::unsigned(1, frac));
+                let minus_log = b.node(
+                    "minus_log2_t",
+                    Op::Sub(zero, log_t),
+                    Format::unsigned(5, frac),
+                );
+                // -y = -n log2 t; at 3 and above the lobe is 0, so 2 integer bits suffice.
+                let minus_y = b.node("minus_y", Op::Mul(n, minus_log), Format::unsigned(2, frac));
+                let one = b.node("one", Op::Const(1 << frac), unit);
+                let s = b.node(
+                    "one_minus_y",
+                    Op::Add(one, minus_y),
+                    Format::unsigned(3, frac),
+                );
+                let log_s = b.node("log2_s", Op::Log2(s, log2_unit), Format::unsigned(2, frac));
+                let half = b.node(
+                    "half_log2_s",
+                    Op::Shift(log_s, -1),
+                    Format::unsigned(1, frac + 1),
+                );
+                b.node("value", Op::Sub(one, half), unit)
+            }
+            HwLobe::CosQuad => {
+                let t = b.input("t", unit);
+                let a = b.input("a", Format::unsigned(6, frac));
+                let one = b.node("one", Op::Const(1 << frac), unit);
+                let u = b.node("u", Op::Sub(one, t), unit);
+                let a_u = b.node("a_u", Op::Mul(a, u), Format::unsigned(6, frac));
+                let mut value = b.node("base", Op::Sub(one, a_u), unit);
+                for i in 1..=COSQUAD_V {
+                    value = b.node(&format!("power_{}", 1 << i), Op::Square(value), unit);
+                }
+                value
+            }
+        };
+        Ok(b.finish(&name, output))
+    }
+
+    /// The raw inputs for cosine `t` (or angle `g`, for [`HwLobe::takes_angle`]) and integer
+    /// exponent `n`, with the per-material constants prepared on the host.
+    #[must_use]
+    pub fn inputs(self, bits: u32, t_or_g: f64, n: u32) -> Vec<i64> {
+        let unit = Self::unit_format(bits);
+        let x = unit.quantize(t_or_g, Rounding::HalfEven);
+        let n_raw = i64::from(n);
+        match self {
+            HwLobe::Schlick | HwLobe::LogExp | HwLobe::LogExpMitchell | HwLobe::Cheb2 => {
+                vec![x, n_raw]
+            }
+            HwLobe::SchlickMod => {
+                let squarings = (f64::from(n).log2().floor() as i64 - 2).clamp(0, 7);
+                vec![x, n_raw, squarings]
+            }
+            HwLobe::CosQuad => {
+                let a = f64::from(n + 1) / f64::from((1 << COSQUAD_V) + 1);
+                vec![
+                    x,
+                    Format::unsigned(6, bits - 1).quantize(a, Rounding::HalfEven),
+                ]
+            }
+        }
+    }
+
+    /// The lobe's value from the datapath's raw output.
+    #[must_use]
+    pub fn value(bits: u32, raw: i64) -> f64 {
+        Self::unit_format(bits).to_f64(raw)
+    }
+}
+
+/// The integer exponent the hardware takes, or why `n` is not one.
+pub fn integer_exponent(n: f64) -> Result<u32, HwError> {
+    if n.fract() == 0.0 && (1.0..=1000.0).contains(&n) {
+        Ok(n as u32)
+    } else {
+        Err(HwError::Exponent(n))
+    }
+}
+
+/// The `cheb2` ROMs `[C, B, A]` for `n = 0..=1000` (address 0 repeats `n = 1`), each with the
+/// signed format its largest magnitude needs and `frac` fraction bits.
+fn cheb2_roms(frac: u32) -> [(Vec<i64>, Format); 3] {
+    let coefficients: Vec<[f64; 3]> = (0..=1000)
+        .map(|n: u32| {
+            let lobe = Lobe::new(LobeKind::Cheb2, Exponent::new(f64::from(n.max(1))));
+            lobe.packed().quadratic
+        })
+        .collect();
+    core::array::from_fn(|k| {
+        let largest = coefficients.iter().map(|c| c[k].abs()).fold(0.0, f64::max);
+        let int_bits = (largest + 1.0).log2().ceil() as u32;
+        let format = Format::signed(int_bits, frac);
+        let table = coefficients
+            .iter()
+            .map(|c| format.quantize(c[k], Rounding::HalfEven))
+            .collect();
+        (table, format)
+    })
+}

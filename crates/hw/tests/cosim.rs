@@ -1,0 +1,115 @@
+//! Co-simulation: every datapath's Verilog, at two word lengths, run by Icarus Verilog against
+//! vectors from the Rust model; every output must be bit-identical.
+//!
+//! Needs `iverilog` and `vvp` (Debian package `iverilog`, which `.ci/run` installs). Without
+//! them the test fails when `CI=true` and is skipped, with a message, otherwise.
+
+use std::path::Path;
+use std::process::Command;
+
+use specula_hw::{verilog, HwLobe};
+
+const WIDTHS: [u32; 2] = [10, 20];
+const VECTORS: usize = 1500;
+
+fn have_iverilog() -> bool {
+    let found = Command::new("iverilog")
+        .arg("-V")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !found {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "iverilog is not installed, and CI=true requires the co-simulation: apt-get install iverilog"
+        );
+        eprintln!("skipping co-simulation: iverilog is not installed (apt-get install iverilog)");
+    }
+    found
+}
+
+fn simulate(directory: &Path, lobe: HwLobe, bits: u32) -> String {
+    let datapath = lobe.build(bits).expect("valid width");
+    let vectors = verilog::test_vectors(lobe, &datapath, bits, VECTORS);
+    let module = directory.join(format!("{}.v", datapath.name));
+    let bench = directory.join(format!("{}_tb.v", datapath.name));
+    std::fs::write(&module, verilog::module(&datapath, lobe, bits)).expect("write module");
+    std::fs::write(&bench, verilog::testbench(&datapath, &vectors)).expect("write testbench");
+    let program = directory.join(format!("{}.vvp", datapath.name));
+    let compiled = Command::new("iverilog")
+        .args(["-g2005", "-Wall", "-o"])
+        .arg(&program)
+        .arg(&module)
+        .arg(&bench)
+        .output()
+        .expect("run iverilog");
+    let compiler_text = String::from_utf8_lossy(&compiled.stderr).into_owned();
+    assert!(
+        compiled.status.success(),
+        "{}: iverilog failed:\n{compiler_text}",
+        datapath.name
+    );
+    let run = Command::new("vvp")
+        .arg("-n")
+        .arg(&program)
+        .output()
+        .expect("run vvp");
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    )
+}
+
+#[test]
+fn every_datapath_simulates_bit_exactly_at_two_widths() {
+    if !have_iverilog() {
+        return;
+    }
+    let directory = tempfile::tempdir().expect("temporary directory");
+    for lobe in HwLobe::ALL {
+        for bits in WIDTHS {
+            let output = simulate(directory.path(), lobe, bits);
+            assert!(
+                output.contains(&format!("PASS {VECTORS} vectors")),
+                "{} at {bits} bits:\n{output}",
+                lobe.id()
+            );
+        }
+    }
+}
+
+/// The check can fail: a testbench whose expected values are off by one bit reports it.
+#[test]
+fn a_wrong_expected_value_is_caught() {
+    if !have_iverilog() {
+        return;
+    }
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let (lobe, bits) = (HwLobe::CosQuad, 12);
+    let datapath = lobe.build(bits).expect("valid width");
+    let mut vectors = verilog::test_vectors(lobe, &datapath, bits, 50);
+    vectors[7].1 ^= 1;
+    let module = directory.path().join("m.v");
+    let bench = directory.path().join("tb.v");
+    std::fs::write(&module, verilog::module(&datapath, lobe, bits)).expect("write");
+    std::fs::write(&bench, verilog::testbench(&datapath, &vectors)).expect("write");
+    let program = directory.path().join("sim.vvp");
+    let compiled = Command::new("iverilog")
+        .arg("-o")
+        .arg(&program)
+        .arg(&module)
+        .arg(&bench)
+        .status()
+        .expect("iverilog");
+    assert!(compiled.success());
+    let run = Command::new("vvp")
+        .arg("-n")
+        .arg(&program)
+        .output()
+        .expect("vvp");
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        text.contains("FAIL 1 of 50 vectors") && text.contains("MISMATCH vector 7"),
+        "{text}"
+    );
+}
