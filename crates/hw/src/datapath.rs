@@ -42,6 +42,8 @@ pub enum Op {
     Log2(NodeId, Log2Unit),
     /// `min(a, b)`: a comparator and a multiplexer.
     Min(NodeId, NodeId),
+    /// 1 if `a` is not zero, else 0: an OR of its bits.
+    NonZero(NodeId),
     /// `table[index]`, the index clamped to the table.
     Rom {
         /// The address.
@@ -154,7 +156,7 @@ pub fn operands(op: &Op) -> Vec<NodeId> {
         Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Min(a, b) => {
             vec![*a, *b]
         }
-        Op::Square(a) | Op::Shift(a, _) | Op::Log2(a, _) => vec![*a],
+        Op::Square(a) | Op::Shift(a, _) | Op::Log2(a, _) | Op::NonZero(a) => vec![*a],
         Op::Rom { index, .. } => vec![*index],
         Op::Select { index, options } => core::iter::once(*index)
             .chain(options.iter().copied())
@@ -278,6 +280,7 @@ impl Datapath {
                     let (b_exact, frac) = exact_add(b, fb, 0, fa);
                     resize((a_exact.min(b_exact), frac))
                 }
+                Op::NonZero(a) => resize((i128::from(at(*a).0 != 0), 0)),
                 Op::Rom { index, table } => {
                     let (index, _) = at(*index);
                     table[(index.max(0) as usize).min(table.len() - 1)]
@@ -368,7 +371,7 @@ impl Datapath {
         for (k, node) in self.nodes.iter().enumerate() {
             let bits = node.format.width();
             match &node.op {
-                Op::Input | Op::Const(_) | Op::Shift(..) => {}
+                Op::Input | Op::Const(_) | Op::Shift(..) | Op::NonZero(_) => {}
                 Op::Add(..) | Op::Sub(..) => r.adders.push(bits),
                 Op::Min(a, b) => r.adders.push(width(a).max(width(b))),
                 Op::Mul(a, b) => r.multipliers.push((width(a), width(b))),

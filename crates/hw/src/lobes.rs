@@ -37,7 +37,8 @@ const SCHLICK_MOD_MAX_SQUARINGS: u32 = 7;
 pub enum HwLobe {
     /// `t / (n (1 - t) + t)`: one multiply, two adds, a divider.
     Schlick,
-    /// `t^a / (n (1 - t) + t)`: adds seven squarers and a multiplexer choosing `t^(2^k)`.
+    /// `t^a / (n (1 - t) + t)`: adds seven squarers, a multiplexer choosing `t^(2^k)` and a
+    /// clamp to 1 (for `t > 1`).
     SchlickMod,
     /// `C + g (B + A g)` with `[A, B, C]` from a ROM indexed by `n`: two multiplies, two adds.
     Cheb2,
@@ -45,7 +46,7 @@ pub enum HwLobe {
     LogExp,
     /// The same with Mitchell's log2 (no table, no multiplier in the unit).
     LogExpMitchell,
-    /// `max(0, a (t - 1) + 1)^16`: one multiply, two adds, four squarers.
+    /// `max(0, a (t - 1) + 1)^16`: one multiply, two adds, four squarers (and 0 at `t = 0`).
     CosQuad,
 }
 
@@ -160,7 +161,13 @@ impl HwLobe {
                 let u = b.node("u", Op::Sub(one, t), unit);
                 let n_u = b.node("n_u", Op::Mul(n, u), Format::unsigned(10, frac));
                 let denominator = b.node("d", Op::Add(n_u, t), Format::unsigned(10, frac));
-                b.node("value", Op::Div(numerator, denominator), unit)
+                if self == HwLobe::SchlickMod {
+                    // Above t = 1 the quotient is t^(a-1) > 1; the float model clamps t to 1.
+                    let quotient = b.node("quotient", Op::Div(numerator, denominator), unit);
+                    b.node("value", Op::Min(quotient, one), unit)
+                } else {
+                    b.node("value", Op::Div(numerator, denominator), unit)
+                }
             }
             HwLobe::Cheb2 => {
                 let g = b.input("g", unit);
@@ -233,7 +240,11 @@ impl HwLobe {
                 for i in 1..=COSQUAD_V {
                     value = b.node(&format!("power_{}", 1 << i), Op::Square(value), unit);
                 }
-                value
+                // The lobe is 0 at t = 0 (SPEC section 1), where the formula gives (1 - a)^16
+                // for n < 16.
+                let lit = b.node("t_nonzero", Op::NonZero(t), Format::unsigned(1, 0));
+                let zero = b.node("zero", Op::Const(0), unit);
+                b.node("value", Op::Select { index: lit, options: vec![zero, value] }, unit)
             }
         };
         Ok(b.finish(&name, output))

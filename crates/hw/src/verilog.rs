@@ -166,6 +166,10 @@ impl Emitter<'_> {
                 );
                 (expr, out.frac_bits, bits)
             }
+            Op::NonZero(a) => {
+                let (a, _) = self.operand(id, *a);
+                (format!("(({a} != 64'sd0) ? 64'sd1 : 64'sd0)"), 0, 2)
+            }
             Op::Log2(a, unit) => {
                 let input = self.datapath.node(*a).format;
                 let frac = unit.frac_bits(input, out.frac_bits);
@@ -459,6 +463,7 @@ pub fn describe(datapath: &Datapath, op: &Op) -> String {
         Op::Shift(a, s) => format!("{} * 2^{s}", name(a)),
         Op::Log2(a, unit) => format!("log2 {} ({})", name(a), unit.name()),
         Op::Min(a, b) => format!("min({}, {})", name(a), name(b)),
+        Op::NonZero(a) => format!("{} != 0", name(a)),
         Op::Rom { index, table } => format!("ROM[{}] ({} words)", name(index), table.len()),
         Op::Select { index, options } => format!(
             "select by {} of {}",
