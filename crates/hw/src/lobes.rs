@@ -32,8 +32,7 @@ pub const LOGEXP_TABLE: Log2Unit = Log2Unit::Table { segments_log2: 6 };
 const SCHLICK_MOD_MAX_SQUARINGS: u32 = 7;
 
 /// A hardware datapath: the lobe it implements and, for `logexp`, its log2 unit.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum HwLobe {
     /// `t / (n (1 - t) + t)`: one multiply, two adds, a divider.
     Schlick,
@@ -48,6 +47,12 @@ pub enum HwLobe {
     LogExpMitchell,
     /// `max(0, a (t - 1) + 1)^16`: one multiply, two adds, four squarers (and 0 at `t = 0`).
     CosQuad,
+}
+
+impl Serialize for HwLobe {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.id())
+    }
 }
 
 /// An unknown datapath id.
@@ -244,7 +249,14 @@ impl HwLobe {
                 // for n < 16.
                 let lit = b.node("t_nonzero", Op::NonZero(t), Format::unsigned(1, 0));
                 let zero = b.node("zero", Op::Const(0), unit);
-                b.node("value", Op::Select { index: lit, options: vec![zero, value] }, unit)
+                b.node(
+                    "value",
+                    Op::Select {
+                        index: lit,
+                        options: vec![zero, value],
+                    },
+                    unit,
+                )
             }
         };
         Ok(b.finish(&name, output))

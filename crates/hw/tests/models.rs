@@ -20,7 +20,11 @@ fn float_at(lobe: HwLobe, bits: u32, x: f64, n: u32) -> f64 {
 /// The largest difference from the float model over inputs spread across the range.
 fn worst_difference(lobe: HwLobe, bits: u32, n: u32) -> f64 {
     let datapath = lobe.build(bits).expect("valid width");
-    let top = if lobe.takes_angle() { core::f64::consts::FRAC_PI_2 } else { 1.0 };
+    let top = if lobe.takes_angle() {
+        core::f64::consts::FRAC_PI_2
+    } else {
+        1.0
+    };
     (0..=4000)
         .map(|i| {
             // Dense near the peak (t = 1, g = 0), where the lobes are steep.
@@ -66,7 +70,11 @@ fn full_width_datapaths_follow_their_float_models() {
                 HwLobe::LogExpMitchell => (0.722 * f64::from(n) + 0.5) * 0.0861 + 4.0 * ulp(bits),
             };
             let worst = worst_difference(lobe, bits, n);
-            assert!(worst <= bound, "{} at n = {n}: {worst:e} > {bound:e}", lobe.id());
+            assert!(
+                worst <= bound,
+                "{} at n = {n}: {worst:e} > {bound:e}",
+                lobe.id()
+            );
         }
         assert!(
             worst_difference(HwLobe::LogExpMitchell, bits, n)
@@ -89,13 +97,22 @@ fn every_input_at_small_widths_gives_a_lobe_value() {
                 for raw in 0..=unit.max_raw() {
                     let x = unit.to_f64(raw);
                     let value = datapath.eval(&lobe.inputs(bits, x, n));
-                    assert!((0..=one).contains(&value), "{} {bits} bits n={n} x={x}: {value}", lobe.id());
+                    assert!(
+                        (0..=one).contains(&value),
+                        "{} {bits} bits n={n} x={x}: {value}",
+                        lobe.id()
+                    );
                 }
                 let at = |x: f64| datapath.eval(&lobe.inputs(bits, x, n));
                 if lobe.takes_angle() {
                     assert_eq!(at(core::f64::consts::FRAC_PI_2), 0, "{} n={n}", lobe.id());
                 } else {
-                    assert_eq!((at(1.0), at(0.0)), (one, 0), "{} {bits} bits n={n}", lobe.id());
+                    assert_eq!(
+                        (at(1.0), at(0.0)),
+                        (one, 0),
+                        "{} {bits} bits n={n}",
+                        lobe.id()
+                    );
                 }
             }
         }
@@ -108,31 +125,81 @@ fn resources_are_the_structural_schemes_of_spec_section_8() {
     let count = |lobe: HwLobe| lobe.build(16).expect("valid width").resources();
     // cosquad: subtract, one multiply by a, add (1 - a u), then v = 4 squarings.
     let r = count(HwLobe::CosQuad);
-    assert_eq!((r.multipliers.len(), r.adders.len(), r.squarers.len(), r.dividers.len()), (1, 2, 4, 0));
+    assert_eq!(
+        (
+            r.multipliers.len(),
+            r.adders.len(),
+            r.squarers.len(),
+            r.dividers.len()
+        ),
+        (1, 2, 4, 0)
+    );
     // schlick: one multiply, two adds (1 - t, n u + t), one divide.
     let r = count(HwLobe::Schlick);
-    assert_eq!((r.multipliers.len(), r.adders.len(), r.squarers.len(), r.dividers.len()), (1, 2, 0, 1));
+    assert_eq!(
+        (
+            r.multipliers.len(),
+            r.adders.len(),
+            r.squarers.len(),
+            r.dividers.len()
+        ),
+        (1, 2, 0, 1)
+    );
     // schlick-mod: log2(a) <= 7 squarings more (and the clamp's comparator).
     let r = count(HwLobe::SchlickMod);
-    assert_eq!((r.multipliers.len(), r.adders.len(), r.squarers.len(), r.dividers.len()), (1, 3, 7, 1));
+    assert_eq!(
+        (
+            r.multipliers.len(),
+            r.adders.len(),
+            r.squarers.len(),
+            r.dividers.len()
+        ),
+        (1, 3, 7, 1)
+    );
     // cheb2: ROM, two multiplies, two adds (and the clamp's comparator).
     let cheb2 = HwLobe::Cheb2.build(16).expect("valid width");
     let r = cheb2.resources();
-    assert_eq!((r.multipliers.len(), r.adders.len(), r.squarers.len()), (2, 3, 0));
+    assert_eq!(
+        (r.multipliers.len(), r.adders.len(), r.squarers.len()),
+        (2, 3, 0)
+    );
     let word_bits: u64 = cheb2
         .nodes()
         .iter()
         .filter(|node| matches!(node.op, specula_hw::Op::Rom { .. }))
         .map(|node| u64::from(node.format.width()))
         .sum();
-    assert_eq!(r.rom_bits, 1001 * word_bits, "three coefficient words for each n in 0..=1000");
+    assert_eq!(
+        r.rom_bits,
+        1001 * word_bits,
+        "three coefficient words for each n in 0..=1000"
+    );
     // logexp: two log2 units, one multiply by n, 1 - y, a shift, a subtract (plus the
     // negation of log2 t); the table adds an interpolation multiplier and adder per unit.
     let r = count(HwLobe::LogExpMitchell);
-    assert_eq!((r.leading_one_detectors.len(), r.multipliers.len(), r.adders.len(), r.rom_bits), (2, 1, 3, 0));
+    assert_eq!(
+        (
+            r.leading_one_detectors.len(),
+            r.multipliers.len(),
+            r.adders.len(),
+            r.rom_bits
+        ),
+        (2, 1, 3, 0)
+    );
     let r = count(HwLobe::LogExp);
-    assert_eq!((r.leading_one_detectors.len(), r.multipliers.len(), r.adders.len()), (2, 3, 5));
-    assert_eq!(r.rom_bits, 2 * 65 * (15 + 2 + 1), "two 65-entry tables with two guard bits");
+    assert_eq!(
+        (
+            r.leading_one_detectors.len(),
+            r.multipliers.len(),
+            r.adders.len()
+        ),
+        (2, 3, 5)
+    );
+    assert_eq!(
+        r.rom_bits,
+        2 * 65 * (15 + 2 + 1),
+        "two 65-entry tables with two guard bits"
+    );
     // Latency: the input registers plus the longest chain of stages.
     assert_eq!(count(HwLobe::CosQuad).latency, 1 + 3 + 4 + 1);
     assert_eq!(count(HwLobe::Schlick).latency, 1 + 4);
@@ -145,7 +212,11 @@ fn error_falls_as_words_widen() {
         let sweep = specula_hw::analysis::sweep(lobe, 64, [8, 12, 16, 24], 2000, &mut |_| {})
             .expect("valid sweep");
         let rms: Vec<f64> = sweep.rows.iter().map(|row| row.errors.rms).collect();
-        assert!(rms.windows(2).all(|w| w[1] <= w[0] * 1.05), "{}: {rms:?}", lobe.id());
+        assert!(
+            rms.windows(2).all(|w| w[1] <= w[0] * 1.05),
+            "{}: {rms:?}",
+            lobe.id()
+        );
         assert!(rms[3] < rms[0], "{}: {rms:?}", lobe.id());
     }
 }
@@ -166,8 +237,13 @@ fn verilog_is_emitted_for_every_lobe_and_width() {
 
 #[test]
 fn bad_requests_are_refused_with_the_valid_choices() {
-    let unknown = HwLobe::parse("pow").expect_err("pow has no datapath").to_string();
-    assert!(unknown.contains("valid: schlick, schlick-mod, cheb2, logexp, logexp-mitchell, cosquad"), "{unknown}");
+    let unknown = HwLobe::parse("pow")
+        .expect_err("pow has no datapath")
+        .to_string();
+    assert!(
+        unknown.contains("valid: schlick, schlick-mod, cheb2, logexp, logexp-mitchell, cosquad"),
+        "{unknown}"
+    );
     assert!(HwLobe::CosQuad.build(7).is_err() && HwLobe::CosQuad.build(25).is_err());
     assert!(specula_hw::integer_exponent(64.5).is_err());
     assert!(specula_hw::integer_exponent(0.0).is_err());

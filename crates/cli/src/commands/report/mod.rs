@@ -6,6 +6,7 @@
 //! is written atomically, and the page last, so an interrupted run never leaves a page that
 //! points at missing images.
 
+mod hardware;
 mod html;
 mod plot;
 mod renders;
@@ -118,15 +119,8 @@ const SECTIONS: [Section; 9] = [
     ("The thesis's claims", sections::claims),
     ("Renders", renders::renders),
     ("Cost", sections::cost),
-    ("Hardware", hardware),
+    ("Hardware", hardware::hardware),
 ];
-
-fn hardware(_: &mut Context) -> Result<String, String> {
-    Ok(html::paragraph(
-        "The fixed-point models of the thesis's hardware datapaths are not part of this build yet; \
-         when they are, their error against word length and their resource tables appear here.",
-    ))
-}
 
 /// Writes the report.
 pub fn run(args: &Args) -> CommandResult {

@@ -1,0 +1,137 @@
+//! The report's hardware section: each datapath's error against word length beside its float
+//! model, the smallest width that matches it, the resources there, and the block diagrams.
+
+use rayon::prelude::*;
+use specula_hw::analysis::{sweep, WidthSweep, MEETS_TOLERANCE};
+use specula_hw::{diagram, HwLobe, Resources, BITS};
+
+use super::html::{figure, paragraph, table};
+use super::plot::{Chart, Series, PALETTE};
+use super::Context;
+use crate::output::{percent, sig};
+
+/// The word length the diagrams show.
+const DIAGRAM_BITS: u32 = 16;
+
+fn sweeps(n: u32, samples: usize) -> Result<Vec<WidthSweep>, String> {
+    HwLobe::ALL
+        .par_iter()
+        .map(|&lobe| sweep(lobe, n, BITS, samples, &mut |_| {}))
+        .collect::<Result<_, _>>()
+        .map_err(|e| e.to_string())
+}
+
+fn resources_summary(r: &Resources) -> String {
+    let widths = |items: Vec<String>| {
+        if items.is_empty() {
+            "-".to_owned()
+        } else {
+            items.join(", ")
+        }
+    };
+    format!(
+        "mul {}; sq {}; add {}; div {}",
+        widths(
+            r.multipliers
+                .iter()
+                .map(|(a, b)| format!("{a}x{b}"))
+                .collect()
+        ),
+        widths(r.squarers.iter().map(u32::to_string).collect()),
+        r.adders.len(),
+        widths(r.dividers.iter().map(|(a, b)| format!("{a}/{b}")).collect()),
+    )
+}
+
+pub fn hardware(context: &mut Context) -> Result<String, String> {
+    let samples = context.sizes.samples_per_zone.min(20_001);
+    let exponents: &[u32] = if context.sizes.n_steps < 20 {
+        &[64]
+    } else {
+        &[8, 64, 512]
+    };
+    let mut html = paragraph(&format!(
+        "Each approximation as a bit-accurate fixed-point datapath (SPEC section 8; crates/hw). \
+         W is the word length of signals in [0, 1] (UQ1.(W-1)); wider signals keep the same \
+         least significant bit. Every stage rounds half to even and saturates. The error \
+         includes the input's quantisation, as on silicon. A datapath meets its float model \
+         when its epicentre max relative error is within {MEETS_TOLERANCE}x the f64 model's. \
+         The Verilog of every datapath is co-simulated with Icarus Verilog, bit-exact, in the tests."
+    ));
+    let mut rows = Vec::new();
+    for &n in exponents {
+        let results = sweeps(n, samples)?;
+        let series: Vec<Series> = results
+            .iter()
+            .enumerate()
+            .map(|(k, result)| Series {
+                name: result.lobe.id().to_owned(),
+                points: result
+                    .rows
+                    .iter()
+                    .map(|row| (f64::from(row.bits), row.errors.epicentre_max_rel.max(1e-6)))
+                    .collect(),
+                colour: PALETTE[k + 1],
+                width: 2,
+                markers: false,
+            })
+            .collect();
+        let chart = Chart {
+            title: format!("epicentre max relative error against word length, n = {n}"),
+            x_label: "word length W (bits)".into(),
+            y_label: "epicentre max rel error".into(),
+            x: (f64::from(*BITS.start()), f64::from(*BITS.end())),
+            y: (1e-4, 1.0),
+            log_x: false,
+            log_y: true,
+            series,
+            bands: Vec::new(),
+            legend_below: false,
+        };
+        html += &context.svg(
+            &format!("hardware-error-n{n}.svg"),
+            &chart,
+            &format!("every datapath's epicentre error against its word length, n = {n}"),
+        )?;
+        for result in &results {
+            let width = result.minimum_width();
+            let at = width.and_then(|w| result.rows.iter().find(|row| row.bits == w));
+            rows.push(vec![
+                result.lobe.id().to_owned(),
+                n.to_string(),
+                percent(result.float.epicentre_max_rel),
+                width.map_or("not by 24".to_owned(), |w| w.to_string()),
+                at.map_or("-".to_owned(), |row| percent(row.errors.epicentre_max_rel)),
+                at.map_or("-".to_owned(), |row| sig(row.errors.bloom_max_abs)),
+                at.map_or("-".to_owned(), |row| resources_summary(&row.resources)),
+                at.map_or("-".to_owned(), |row| row.resources.rom_bits.to_string()),
+                at.map_or("-".to_owned(), |row| row.resources.latency.to_string()),
+            ]);
+        }
+    }
+    html += &table(
+        &[
+            "datapath",
+            "n",
+            "f64 epicentre max rel",
+            "smallest W meeting it",
+            "epicentre max rel at W",
+            "bloom max abs at W",
+            "arithmetic at W",
+            "ROM bits",
+            "latency (cycles)",
+        ],
+        &rows,
+    );
+    html += &paragraph(&format!(
+        "The structural schemes, drawn from the same descriptions as the models and the Verilog, at W = {DIAGRAM_BITS}: one column per pipeline stage."
+    ));
+    for lobe in HwLobe::ALL {
+        let datapath = lobe.build(DIAGRAM_BITS).map_err(|e| e.to_string())?;
+        let name = format!("hardware-{}.svg", lobe.id());
+        let title = format!("{}: structural scheme at W = {DIAGRAM_BITS}", lobe.id());
+        context.write(&name, diagram::svg(&datapath, &title).as_bytes())?;
+        html += &figure(&name, &title);
+    }
+    Ok(html)
+}
