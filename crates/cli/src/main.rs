@@ -76,6 +76,11 @@ enum Command {
                             specula hw diagram --lobe logexp -o logexp.svg"
     )]
     Hw(commands::hw::Args),
+    /// Serve the interactive BRDF explorer (page and JSON API) on 127.0.0.1.
+    #[command(
+        after_help = "Examples:\n  specula serve --open\n  specula serve --port 9000\n  specula serve --port 0   # a free port, printed"
+    )]
+    Serve(commands::serve::Args),
 }
 
 fn main() -> ExitCode {
@@ -102,6 +107,7 @@ fn main() -> ExitCode {
         Command::Shader(args) => commands::shader::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
         Command::Hw(args) => commands::hw::run(&args),
+        Command::Serve(args) => commands::serve::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

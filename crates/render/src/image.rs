@@ -270,12 +270,26 @@ pub fn write_png_srgb8(
     height: u32,
     bytes: &[u8],
 ) -> Result<(), ImageError> {
+    write_atomically(path, |writer| png_into(writer, width, height, bytes))
+}
+
+/// 8-bit sRGB bytes (three per pixel) as PNG file contents in memory.
+pub fn encode_png_srgb8(width: u32, height: u32, bytes: &[u8]) -> Result<Vec<u8>, String> {
+    let mut png = Vec::new();
+    png_into(&mut png, width, height, bytes)?;
+    Ok(png)
+}
+
+fn png_into(
+    writer: impl std::io::Write,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+) -> Result<(), String> {
     use image::ImageEncoder;
-    write_atomically(path, |writer| {
-        image::codecs::png::PngEncoder::new(writer)
-            .write_image(bytes, width, height, image::ExtendedColorType::Rgb8)
-            .map_err(|e| e.to_string())
-    })
+    image::codecs::png::PngEncoder::new(writer)
+        .write_image(bytes, width, height, image::ExtendedColorType::Rgb8)
+        .map_err(|e| e.to_string())
 }
 
 /// Writes `image` to `path`: `.png` as 8-bit sRGB through `display`, `.exr` as linear `f32`.

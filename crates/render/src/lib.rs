@@ -39,8 +39,8 @@ pub use camera::{Camera, InvalidCamera, Projection};
 pub use description::{LoadedScene, SceneError};
 pub use grid::{render_grid, render_grid_with, GridError, GridOptions, Srgb8Image};
 pub use image::{
-    check_output_path, read_image, srgb_decode, srgb_encode, write_atomically, write_image,
-    write_png_srgb8, Display, Image, ImageError, ToneMap,
+    check_output_path, encode_png_srgb8, read_image, srgb_decode, srgb_encode, write_atomically,
+    write_image, write_png_srgb8, Display, Image, ImageError, ToneMap,
 };
 pub use load::{load_mesh, LoadError, LoadedMesh, MESH_EXTENSIONS};
 pub use material::{IlluminationModel, Light, Material, Shader, Shading};

@@ -9,6 +9,7 @@ pub mod hw;
 pub mod models;
 pub mod render;
 pub mod report;
+pub mod serve;
 pub mod shader;
 
 /// What a command reports when it fails: a one-line message.

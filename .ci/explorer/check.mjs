@@ -1,0 +1,74 @@
+// Drives `specula serve` in Debian's Chromium: loads the explorer, moves the n slider, changes
+// the lobes, and requires that the plots and the renders change and that the console stays
+// silent. Saves a screenshot. Usage: node check.mjs SPECULA_BINARY SCREENSHOT.png
+import { spawn } from "node:child_process";
+import { chromium } from "playwright-core";
+
+const [binary, screenshot] = process.argv.slice(2);
+const server = spawn(binary, ["serve", "--port", "0"], { stdio: ["ignore", "pipe", "inherit"] });
+const url = await new Promise((resolve, reject) => {
+  server.stdout.on("data", (chunk) => {
+    const match = /on (http:\/\/\S+)/.exec(String(chunk));
+    if (match) resolve(match[1]);
+  });
+  server.on("exit", (code) => reject(new Error(`specula serve exited with ${code}`)));
+  setTimeout(() => reject(new Error("specula serve printed no address")), 20000);
+});
+
+const browser = await chromium.launch({ executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium", args: ["--no-sandbox", "--disable-gpu"] });
+const failures = [];
+try {
+  const page = await browser.newPage({ viewport: { width: 1500, height: 1200 } });
+  const messages = [];
+  page.on("console", (message) => messages.push(`${message.type()}: ${message.text()}`));
+  page.on("pageerror", (error) => messages.push(`pageerror: ${error.message}`));
+  const updates = () => page.evaluate(() => Number(document.body.dataset.updates));
+  const settled = async (before) => page.waitForFunction((n) => Number(document.body.dataset.updates) > n, before, { timeout: 30000 });
+  const snapshot = () => page.evaluate(() => ({
+    plots: ["cartesian", "error", "polar", "albedo", "slice"].map((id) => document.getElementById(id).toDataURL()),
+    sphere: document.getElementById("sphere").src,
+    teapot: document.getElementById("teapot").src,
+    address: location.search,
+  }));
+  const changed = (a, b, what) => {
+    a.plots.forEach((plot, k) => { if (plot === b.plots[k]) failures.push(`${what}: plot ${k} did not change`); });
+    if (a.sphere === b.sphere) failures.push(`${what}: the sphere was not re-rendered`);
+  };
+
+  await page.goto(url + "?lobes=schlick,cosquad&n=16");
+  await settled(0);
+  const first = await snapshot();
+  if (!first.address.includes("lobes=schlick%2Ccosquad")) failures.push(`the address does not hold the state: ${first.address}`);
+
+  let before = await updates();
+  await page.locator("#n").evaluate((slider) => { slider.value = "250"; slider.dispatchEvent(new Event("input", { bubbles: true })); });
+  await settled(before);
+  const moved = await snapshot();
+  changed(first, moved, "moving n");
+  if (!moved.address.includes("n=316")) failures.push(`n is not in the address: ${moved.address}`);
+
+  before = await updates();
+  await page.locator('#lobes input[value="schlick"]').uncheck();
+  await page.locator('#lobes input[value="logexp"]').check();
+  await settled(before);
+  changed(moved, await snapshot(), "changing the lobes");
+
+  // The shared address restores the view.
+  const shared = page.url();
+  const other = await browser.newPage();
+  await other.goto(shared);
+  await other.waitForFunction(() => Number(document.body.dataset.updates) > 0, null, { timeout: 30000 });
+  const restored = await other.evaluate(() => [...document.querySelectorAll("#lobes input:checked")].map((c) => c.value).join(","));
+  if (restored !== "logexp,cosquad" && restored !== "cosquad,logexp") failures.push(`the shared address restored ${restored}`);
+
+  await page.screenshot({ path: screenshot, fullPage: true });
+  if (messages.length) failures.push(...messages.map((m) => `console: ${m}`));
+} finally {
+  await browser.close();
+  server.kill("SIGINT");
+}
+if (failures.length) {
+  console.error("explorer check failed:\n  " + failures.join("\n  "));
+  process.exit(1);
+}
+console.log(`explorer check: loaded, moved n, changed lobes, restored from the address; no console message; screenshot ${screenshot}`);

@@ -1,0 +1,321 @@
+//! The JSON API: parameters parsed with the library's registries, every refusal a 400 with a
+//! JSON body naming the parameter and its valid range or choices.
+//!
+//! - `GET /api/models`: the lobes, geometries, normalisations, shadings, objects and limits;
+//! - `GET /api/evaluate?lobe&n&geometry&normalisation&theta_in`: every plot's data;
+//! - `GET /api/analyze?lobe&n`: the error, energy and albedo figures (`specula analyze`'s);
+//! - `GET /api/render?object&lobe&n&geometry&normalisation&shading&model&light_theta&light_phi&size`:
+//!   a PNG from the CPU renderer.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use axum::extract::rejection::QueryRejection;
+use axum::extract::{Query, State};
+use axum::http::{header, StatusCode};
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+use serde::Serialize;
+use serde_json::json;
+use specula::analysis::{analyze, Precision};
+use specula::{Exponent, Geometry, LobeKind, Normalisation};
+use specula_render::{IlluminationModel, Shading};
+use tokio::sync::Semaphore;
+
+use super::explorer::{curves, render_png, Object, RenderRequest};
+
+/// The largest render side, in pixels.
+pub const MAX_RENDER_SIZE: u32 = 1024;
+/// Renders computed at once; more wait their turn.
+pub const CONCURRENT_RENDERS: usize = 2;
+
+/// What the handlers share.
+#[derive(Clone)]
+pub struct AppState {
+    pub renders: Arc<Semaphore>,
+}
+
+impl Default for AppState {
+    fn default() -> Self {
+        Self {
+            renders: Arc::new(Semaphore::new(CONCURRENT_RENDERS)),
+        }
+    }
+}
+
+/// A request the server cannot serve, and why.
+#[derive(Debug, Serialize)]
+pub struct ApiError {
+    #[serde(skip)]
+    status: StatusCode,
+    /// What went wrong, in a sentence.
+    error: String,
+    /// The offending parameter, if one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    parameter: Option<String>,
+    /// Its valid values or range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    valid: Option<String>,
+}
+
+impl ApiError {
+    fn bad(parameter: &str, error: String, valid: String) -> Self {
+        Self {
+            status: StatusCode::BAD_REQUEST,
+            error,
+            parameter: Some(parameter.to_owned()),
+            valid: Some(valid),
+        }
+    }
+
+    fn internal(error: String) -> Self {
+        Self {
+            status: StatusCode::INTERNAL_SERVER_ERROR,
+            error,
+            parameter: None,
+            valid: None,
+        }
+    }
+}
+
+impl IntoResponse for ApiError {
+    fn into_response(self) -> Response {
+        (self.status, Json(&self)).into_response()
+    }
+}
+
+/// The query string as key-value pairs, or a JSON 400 when it is not well-formed.
+type QueryPairs = Result<Query<Vec<(String, String)>>, QueryRejection>;
+
+fn pairs(query: QueryPairs) -> Result<Vec<(String, String)>, ApiError> {
+    query.map(|Query(pairs)| pairs).map_err(|e| ApiError {
+        status: StatusCode::BAD_REQUEST,
+        error: format!("the query string is malformed: {e}"),
+        parameter: None,
+        valid: Some("key=value pairs joined by &, percent-encoded".into()),
+    })
+}
+
+/// A request's query parameters, each read at most once.
+struct Params {
+    values: HashMap<String, String>,
+}
+
+impl Params {
+    /// The query, refusing any parameter outside `known`.
+    fn new(query: Vec<(String, String)>, known: &[&str]) -> Result<Self, ApiError> {
+        let mut values = HashMap::new();
+        for (key, value) in query {
+            if !known.contains(&key.as_str()) {
+                return Err(ApiError::bad(
+                    &key,
+                    format!("unknown parameter `{key}`"),
+                    known.join(", "),
+                ));
+            }
+            if values.insert(key.clone(), value).is_some() {
+                return Err(ApiError::bad(
+                    &key,
+                    format!("`{key}` is given twice"),
+                    "one value".into(),
+                ));
+            }
+        }
+        Ok(Self { values })
+    }
+
+    fn text(&self, name: &str) -> Option<&str> {
+        self.values.get(name).map(String::as_str)
+    }
+
+    /// A choice from `all` by id, or `default`.
+    fn choice<T: Copy>(
+        &self,
+        name: &str,
+        all: &[T],
+        id: fn(T) -> &'static str,
+        default: T,
+    ) -> Result<T, ApiError> {
+        let Some(text) = self.text(name) else {
+            return Ok(default);
+        };
+        all.iter().copied().find(|&v| id(v) == text).ok_or_else(|| {
+            let valid = all.iter().map(|&v| id(v)).collect::<Vec<_>>().join(", ");
+            ApiError::bad(name, format!("unknown {name} `{text}`"), valid)
+        })
+    }
+
+    /// A finite number in `range`, or `default`.
+    fn number(
+        &self,
+        name: &str,
+        range: core::ops::RangeInclusive<f64>,
+        default: f64,
+    ) -> Result<f64, ApiError> {
+        let Some(text) = self.text(name) else {
+            return Ok(default);
+        };
+        let valid = format!("a number in [{}, {}]", range.start(), range.end());
+        match text.trim().parse::<f64>() {
+            Ok(value) if value.is_finite() && range.contains(&value) => Ok(value),
+            Ok(value) => Err(ApiError::bad(
+                name,
+                format!("{name} = {value} is out of range"),
+                valid,
+            )),
+            Err(_) => Err(ApiError::bad(
+                name,
+                format!("{name} = `{text}` is not a number"),
+                valid,
+            )),
+        }
+    }
+
+    fn lobe(&self) -> Result<LobeKind, ApiError> {
+        let text = self.text("lobe").unwrap_or("pow");
+        LobeKind::parse(text).map_err(|_| {
+            ApiError::bad(
+                "lobe",
+                format!("unknown lobe `{text}`"),
+                LobeKind::valid_ids(),
+            )
+        })
+    }
+
+    fn exponent(&self) -> Result<Exponent, ApiError> {
+        let n = self.number("n", 1.0..=1000.0, 64.0)?;
+        Exponent::try_new(n)
+            .map_err(|e| ApiError::bad("n", e.to_string(), "a number in [1, 1000]".into()))
+    }
+
+    fn geometry(&self) -> Result<Geometry, ApiError> {
+        self.choice("geometry", &Geometry::ALL, Geometry::id, Geometry::Blinn)
+    }
+
+    fn normalisation(&self) -> Result<Normalisation, ApiError> {
+        self.choice(
+            "normalisation",
+            &Normalisation::ALL,
+            Normalisation::id,
+            Normalisation::Lobe,
+        )
+    }
+}
+
+/// Runs `work` on the blocking pool; a panic inside becomes a 500, never a dropped server.
+async fn blocking<T: Send + 'static>(
+    work: impl FnOnce() -> T + Send + 'static,
+) -> Result<T, ApiError> {
+    tokio::task::spawn_blocking(work)
+        .await
+        .map_err(|e| ApiError::internal(format!("the computation failed: {e}")))
+}
+
+/// Any other path.
+pub async fn not_found() -> ApiError {
+    ApiError {
+        status: StatusCode::NOT_FOUND,
+        error: "no such page or endpoint".into(),
+        parameter: None,
+        valid: Some("/, /api/models, /api/evaluate, /api/analyze, /api/render".into()),
+    }
+}
+
+pub async fn models() -> impl IntoResponse {
+    let lobes: Vec<_> = LobeKind::ALL
+        .iter()
+        .map(|kind| {
+            let info = kind.info();
+            json!({ "id": kind.id(), "summary": info.summary, "formula": info.formula })
+        })
+        .collect();
+    Json(json!({
+        "lobes": lobes,
+        "geometries": Geometry::ALL.map(Geometry::id),
+        "normalisations": Normalisation::ALL.map(Normalisation::id),
+        "shadings": Shading::ALL.map(Shading::id),
+        "models": IlluminationModel::ALL.map(IlluminationModel::id),
+        "objects": Object::ALL.map(Object::id),
+        "n": [1.0, 1000.0],
+        "max_render_size": MAX_RENDER_SIZE,
+    }))
+}
+
+pub async fn evaluate(query: QueryPairs) -> Result<impl IntoResponse, ApiError> {
+    let params = Params::new(
+        pairs(query)?,
+        &["lobe", "n", "geometry", "normalisation", "theta_in"],
+    )?;
+    let (kind, n) = (params.lobe()?, params.exponent()?);
+    let (geometry, normalisation) = (params.geometry()?, params.normalisation()?);
+    let theta_in = params.number("theta_in", 0.0..=89.0, 30.0)?.to_radians();
+    let data = blocking(move || curves(kind, n, geometry, normalisation, theta_in)).await?;
+    Ok(Json(data))
+}
+
+pub async fn analyze_lobe(query: QueryPairs) -> Result<impl IntoResponse, ApiError> {
+    let params = Params::new(pairs(query)?, &["lobe", "n"])?;
+    let (kind, n) = (params.lobe()?, params.exponent()?);
+    let report = blocking(move || analyze(kind, n, &mut Precision::F64)).await?;
+    Ok(Json(report))
+}
+
+pub async fn render(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<impl IntoResponse, ApiError> {
+    let params = Params::new(
+        pairs(query)?,
+        &[
+            "object",
+            "lobe",
+            "n",
+            "geometry",
+            "normalisation",
+            "shading",
+            "model",
+            "light_theta",
+            "light_phi",
+            "size",
+        ],
+    )?;
+    let request = RenderRequest {
+        object: params.choice("object", &Object::ALL, Object::id, Object::Sphere)?,
+        kind: params.lobe()?,
+        n: params.exponent()?,
+        geometry: params.geometry()?,
+        normalisation: params.choice(
+            "normalisation",
+            &Normalisation::ALL,
+            Normalisation::id,
+            Normalisation::None,
+        )?,
+        shading: params.choice("shading", &Shading::ALL, Shading::id, Shading::Phong)?,
+        model: params.choice(
+            "model",
+            &IlluminationModel::ALL,
+            IlluminationModel::id,
+            IlluminationModel::Classic,
+        )?,
+        light_theta: params.number("light_theta", 0.0..=89.0, 30.0)?.to_radians(),
+        light_phi: params
+            .number("light_phi", -180.0..=180.0, 45.0)?
+            .to_radians(),
+        size: params.number("size", 16.0..=f64::from(MAX_RENDER_SIZE), 512.0)? as u32,
+    };
+    let _permit = state
+        .renders
+        .acquire()
+        .await
+        .map_err(|e| ApiError::internal(e.to_string()))?;
+    let png = blocking(move || render_png(&request))
+        .await?
+        .map_err(ApiError::internal)?;
+    Ok((
+        [
+            (header::CONTENT_TYPE, "image/png"),
+            (header::CACHE_CONTROL, "no-store"),
+        ],
+        png,
+    ))
+}

@@ -1,0 +1,222 @@
+// specula explorer: controls -> URL -> API -> plots. No dependencies; everything drawn on
+// canvases. The state lives in the address (history.replaceState), so a view can be shared.
+"use strict";
+
+const PALETTE = ["#000000", "#e6194b", "#3c8c3c", "#f58230", "#0082c8", "#911eb4", "#aa6e28", "#f032e6", "#808000", "#008080"];
+const DEFAULTS = { lobes: "pow,schlick,schlick-mod", n: "64", geometry: "blinn", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0" };
+const $ = (id) => document.getElementById(id);
+let registry = null;
+let generation = 0;
+
+function readState() {
+  const query = new URLSearchParams(location.search);
+  const state = {};
+  for (const key of Object.keys(DEFAULTS)) state[key] = query.get(key) ?? DEFAULTS[key];
+  return state;
+}
+
+function nFromSlider(v) { return Math.round(Math.pow(10, v / 100) * 100) / 100; }
+function sliderFromN(n) { return Math.round(100 * Math.log10(n)); }
+
+function currentState() {
+  const lobes = [...document.querySelectorAll("#lobes input:checked")].map((c) => c.value);
+  return {
+    lobes: lobes.join(","),
+    n: String(nFromSlider(Number($("n").value))),
+    geometry: $("geometry").value,
+    normalisation: $("normalisation").value,
+    shading: $("shading").value,
+    model: $("model").value,
+    theta_in: $("theta_in").value,
+    light_theta: $("light_theta").value,
+    light_phi: $("light_phi").value,
+    log: $("log").checked ? "1" : "0",
+  };
+}
+
+function fillSelect(id, values, chosen) {
+  const select = $(id);
+  select.replaceChildren(...values.map((v) => new Option(v, v, false, v === chosen)));
+}
+
+function buildControls(state) {
+  const chosen = new Set(state.lobes.split(","));
+  $("lobes").replaceChildren(...registry.lobes.map((lobe, k) => {
+    const label = document.createElement("label");
+    const box = Object.assign(document.createElement("input"), { type: "checkbox", value: lobe.id, checked: chosen.has(lobe.id) });
+    const swatch = Object.assign(document.createElement("span"), { className: "swatch", title: lobe.formula });
+    swatch.style.background = PALETTE[k % PALETTE.length];
+    label.append(box, swatch, lobe.id);
+    label.title = lobe.summary;
+    return label;
+  }));
+  fillSelect("geometry", registry.geometries, state.geometry);
+  fillSelect("normalisation", registry.normalisations, state.normalisation);
+  fillSelect("shading", registry.shadings, state.shading);
+  fillSelect("model", registry.models, state.model);
+  $("n").value = sliderFromN(Number(state.n) || 64);
+  for (const id of ["theta_in", "light_theta", "light_phi"]) $(id).value = state[id];
+  $("log").checked = state.log === "1";
+}
+
+function showValues(state) {
+  $("n-value").textContent = state.n;
+  $("theta_in-value").textContent = state.theta_in + "°";
+  $("light_theta-value").textContent = state.light_theta + "°";
+  $("light_phi-value").textContent = state.light_phi + "°";
+}
+
+function colourOf(id) { return PALETTE[registry.lobes.findIndex((l) => l.id === id) % PALETTE.length]; }
+
+async function getJson(url) {
+  const response = await fetch(url);
+  const body = await response.json();
+  if (!response.ok) throw new Error(body.error + (body.valid ? " (valid: " + body.valid + ")" : ""));
+  return body;
+}
+
+// A line plot: axes with ticks, optional shaded bands, one polyline per series.
+function plot(canvas, { series, x, y, logY = false, bands = [], xLabel = "", yLabel = "" }) {
+  const g = canvas.getContext("2d");
+  const [w, h] = [canvas.width, canvas.height];
+  const m = { l: 66, r: 12, t: 10, b: 36 };
+  g.clearRect(0, 0, w, h);
+  const ty = (v) => (logY ? Math.log10(Math.max(v, y[0])) : v);
+  const [y0, y1] = logY ? [Math.log10(y[0]), Math.log10(y[1])] : y;
+  const px = (v) => m.l + ((v - x[0]) / (x[1] - x[0])) * (w - m.l - m.r);
+  const py = (v) => h - m.b - ((ty(v) - y0) / (y1 - y0)) * (h - m.t - m.b);
+  for (const [from, to, colour] of bands) {
+    g.fillStyle = colour;
+    g.fillRect(px(from), m.t, px(Math.min(to, x[1])) - px(from), h - m.t - m.b);
+  }
+  g.strokeStyle = "#999"; g.fillStyle = "#444"; g.font = "11px sans-serif"; g.lineWidth = 1;
+  g.strokeRect(m.l, m.t, w - m.l - m.r, h - m.t - m.b);
+  for (let i = 0; i <= 5; i++) {
+    const vx = x[0] + ((x[1] - x[0]) * i) / 5;
+    g.fillText(Number(vx.toPrecision(3)).toString(), px(vx) - 10, h - m.b + 14);
+    const vy = logY ? Math.pow(10, y0 + ((y1 - y0) * i) / 5) : y0 + ((y1 - y0) * i) / 5;
+    g.fillText(logY ? vy.toExponential(0) : Number(vy.toPrecision(3)).toString(), 20, py(vy) + 4);
+  }
+  g.fillText(xLabel, w / 2 - 40, h - 6);
+  g.save(); g.translate(12, h / 2 + 30); g.rotate(-Math.PI / 2); g.fillText(yLabel, 0, 0); g.restore();
+  g.save(); g.beginPath(); g.rect(m.l, m.t, w - m.l - m.r, h - m.t - m.b); g.clip();
+  for (const s of series) {
+    g.strokeStyle = s.colour; g.lineWidth = s.width ?? 2; g.setLineDash(s.dash ?? []);
+    g.beginPath();
+    s.points.forEach(([a, b], i) => (i ? g.lineTo(px(a), py(b)) : g.moveTo(px(a), py(b))));
+    g.stroke();
+  }
+  g.restore();
+}
+
+function zip(xs, ys) { return xs.map((v, i) => [v, ys[i]]); }
+
+function drawPolar(canvas, data, thetaIn) {
+  const g = canvas.getContext("2d");
+  const [w, h] = [canvas.width, canvas.height];
+  const [cx, cy, radius] = [w / 2, h - 20, Math.min(w / 2, h) - 30];
+  g.clearRect(0, 0, w, h);
+  g.strokeStyle = "#ccc"; g.lineWidth = 1;
+  for (const r of [0.25, 0.5, 0.75, 1]) { g.beginPath(); g.arc(cx, cy, r * radius, Math.PI, 2 * Math.PI); g.stroke(); }
+  g.beginPath(); g.moveTo(cx - radius, cy); g.lineTo(cx + radius, cy); g.stroke();
+  const peak = Math.max(1e-12, ...data.flatMap((d) => d.polar));
+  const at = (theta, r) => [cx + r * radius * Math.sin(theta), cy - r * radius * Math.cos(theta)];
+  g.strokeStyle = "#e0a000"; g.setLineDash([4, 3]);
+  g.beginPath(); g.moveTo(cx, cy); g.lineTo(...at((thetaIn * Math.PI) / 180, 1)); g.stroke(); g.setLineDash([]);
+  for (const d of data) {
+    g.strokeStyle = colourOf(d.lobe); g.lineWidth = 2; g.beginPath();
+    d.polar_deg.forEach((deg, i) => { const p = at((deg * Math.PI) / 180, d.polar[i] / peak); i ? g.lineTo(...p) : g.moveTo(...p); });
+    g.stroke();
+  }
+  g.fillStyle = "#444"; g.font = "11px sans-serif";
+  g.fillText("light (dashed) at " + thetaIn + "°; radius: f / " + peak.toPrecision(3), 8, 14);
+}
+
+function drawSlice(canvas, d) {
+  const g = canvas.getContext("2d");
+  const size = d.slice_size;
+  const image = g.createImageData(size, size);
+  const logs = d.slice.map((v) => (v > 0 ? Math.log10(v) : -Infinity));
+  const top = Math.max(...logs.filter(Number.isFinite));
+  const bottom = top - 6;
+  logs.forEach((v, k) => {
+    const s = Number.isFinite(v) ? Math.min(1, Math.max(0, (v - bottom) / (top - bottom))) : 0;
+    image.data.set([255 * Math.min(1, 1.6 * s), 255 * Math.max(0, 2 * s - 1) * 0.9, 255 * (0.3 + 0.7 * Math.max(0, s - 0.5)), 255], 4 * k);
+  });
+  const scratch = Object.assign(document.createElement("canvas"), { width: size, height: size });
+  scratch.getContext("2d").putImageData(image, 0, 0);
+  g.imageSmoothingEnabled = false;
+  g.clearRect(0, 0, canvas.width, canvas.height);
+  g.drawImage(scratch, 0, 0, canvas.width, canvas.height);
+}
+
+function analysisTable(reports) {
+  const pct = (v) => (100 * v).toPrecision(3) + " %";
+  const rows = reports.map((r) => `<tr><td>${r.lobe}</td><td>${pct(r.epicentre_max_rel)}</td><td>${r.bloom_max_abs.toPrecision(3)}</td><td>${r.rms.toPrecision(3)}</td><td>${r.energy_ratio.toPrecision(4)}</td><td>${r.max_albedo.toPrecision(4)}</td></tr>`);
+  return `<table><thead><tr><th>lobe</th><th>epicentre max rel</th><th>bloom max abs</th><th>rms</th><th>energy ratio</th><th>max albedo (lobe-normalised)</th></tr></thead><tbody>${rows.join("")}</tbody></table>`;
+}
+
+function loadImage(img, url) {
+  return new Promise((resolve, reject) => {
+    img.onload = () => resolve();
+    img.onerror = () => reject(new Error("render failed: " + url));
+    img.src = url;
+  });
+}
+
+async function update() {
+  const state = currentState();
+  showValues(state);
+  history.replaceState(null, "", "?" + new URLSearchParams(state).toString());
+  const mine = ++generation;
+  const lobes = state.lobes ? state.lobes.split(",") : [];
+  const common = { n: state.n, geometry: state.geometry, normalisation: state.normalisation };
+  try {
+    const data = await Promise.all(lobes.map((lobe) => getJson("/api/evaluate?" + new URLSearchParams({ lobe, ...common, theta_in: state.theta_in }))));
+    const reports = await Promise.all(lobes.map((lobe) => getJson("/api/analyze?" + new URLSearchParams({ lobe, n: state.n }))));
+    if (mine !== generation) return;
+    draw(data, state);
+    $("analysis").innerHTML = lobes.length ? analysisTable(reports) : "<p>Choose a lobe.</p>";
+    if (lobes.length) {
+      const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: lobes[0], ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
+      await Promise.all([loadImage($("sphere"), render("sphere")), loadImage($("teapot"), render("teapot"))]);
+    }
+    if (mine !== generation) return;
+    $("status").textContent = "";
+    document.body.dataset.updates = String(Number(document.body.dataset.updates) + 1);
+  } catch (error) {
+    $("status").textContent = error.message;
+  }
+}
+
+function draw(data, state) {
+  const right = Math.max(1e-3, ...data.map((d) => d.angles_deg[d.angles_deg.length - 1]));
+  const first = data[0];
+  const bands = first ? [[0, first.epicentre_deg, "rgba(255,200,0,0.18)"], [first.epicentre_deg, first.bloom_deg, "rgba(0,120,255,0.08)"]] : [];
+  const logY = state.log === "1";
+  plot($("cartesian"), {
+    series: data.map((d) => ({ points: zip(d.angles_deg, d.values), colour: colourOf(d.lobe) })).concat(first ? [{ points: zip(first.angles_deg, first.reference), colour: "#888", width: 1, dash: [5, 4] }] : []),
+    x: [0, right], y: logY ? [1e-4, 1] : [0, 1.05], logY, bands,
+    xLabel: "angle from the lobe's axis (degrees); dashed: t^n", yLabel: "lobe",
+  });
+  const errors = data.flatMap((d) => d.error);
+  const spread = Math.max(1e-6, ...errors.map(Math.abs));
+  plot($("error"), { series: data.map((d) => ({ points: zip(d.angles_deg, d.error), colour: colourOf(d.lobe) })), x: [0, right], y: [-spread * 1.05, spread * 1.05], bands, xLabel: "angle (degrees)", yLabel: "lobe - t^n" });
+  drawPolar($("polar"), data, Number(state.theta_in));
+  const albedoTop = Math.max(1.05, ...data.flatMap((d) => d.albedo));
+  plot($("albedo"), { series: data.map((d) => ({ points: zip(d.albedo_deg, d.albedo), colour: colourOf(d.lobe) })), x: [0, 90], y: [0, albedoTop], xLabel: "angle of incidence (degrees)", yLabel: "albedo" });
+  if (first) drawSlice($("slice"), first);
+}
+
+let pending = null;
+function schedule() { clearTimeout(pending); pending = setTimeout(update, 60); }
+
+async function start() {
+  registry = await getJson("/api/models");
+  buildControls(readState());
+  document.querySelectorAll("#controls input, #controls select").forEach((el) => el.addEventListener("input", schedule));
+  $("lobes").addEventListener("change", schedule);
+  await update();
+}
+
+start().catch((error) => { $("status").textContent = error.message; });

@@ -1,0 +1,115 @@
+//! `specula serve`: the BRDF explorer, a page and a JSON API served by the binary itself.
+//!
+//! The page, its script and its styles are compiled in (`assets/`); nothing is fetched from
+//! the network. The server binds to 127.0.0.1 unless `--bind` says otherwise. Computations run
+//! on the blocking pool, renders at most [`api::CONCURRENT_RENDERS`] at a time, and request
+//! bodies are capped (the API takes none).
+
+mod api;
+mod explorer;
+#[cfg(test)]
+mod tests;
+
+use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+
+use axum::extract::DefaultBodyLimit;
+use axum::http::header;
+use axum::response::IntoResponse;
+use axum::routing::get;
+use axum::Router;
+
+use super::CommandResult;
+
+/// Arguments of `specula serve`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The port to listen on (0 picks a free one).
+    #[arg(long, default_value_t = 8080)]
+    port: u16,
+    /// The address to listen on; anything but loopback exposes the explorer to the network.
+    #[arg(long, default_value_t = IpAddr::V4(Ipv4Addr::LOCALHOST))]
+    bind: IpAddr,
+    /// Open the explorer in the default browser.
+    #[arg(long)]
+    open: bool,
+}
+
+/// The largest request body accepted.
+const MAX_BODY_BYTES: usize = 16 * 1024;
+
+/// The explorer's routes.
+pub fn router() -> Router {
+    let asset = |content_type: &'static str, body: &'static str| {
+        get(move || async move { ([(header::CONTENT_TYPE, content_type)], body).into_response() })
+    };
+    Router::new()
+        .route(
+            "/",
+            asset(
+                "text/html; charset=utf-8",
+                include_str!("assets/index.html"),
+            ),
+        )
+        .route(
+            "/app.js",
+            asset(
+                "text/javascript; charset=utf-8",
+                include_str!("assets/app.js"),
+            ),
+        )
+        .route(
+            "/style.css",
+            asset("text/css; charset=utf-8", include_str!("assets/style.css")),
+        )
+        .route("/api/models", get(api::models))
+        .route("/api/evaluate", get(api::evaluate))
+        .route("/api/analyze", get(api::analyze_lobe))
+        .route("/api/render", get(api::render))
+        .fallback(api::not_found)
+        .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
+        .with_state(api::AppState::default())
+}
+
+/// Serves until Ctrl-C.
+pub fn run(args: &Args) -> CommandResult {
+    if !args.bind.is_loopback() {
+        eprintln!(
+            "warning: listening on {}, reachable from other machines; the explorer has no authentication",
+            args.bind
+        );
+    }
+    let runtime =
+        tokio::runtime::Runtime::new().map_err(|e| format!("cannot start the server: {e}"))?;
+    runtime.block_on(async {
+        let address = SocketAddr::new(args.bind, args.port);
+        let listener = tokio::net::TcpListener::bind(address).await.map_err(|e| {
+            format!("cannot listen on {address}: {e}; choose another --port (0 picks a free one)")
+        })?;
+        let local = listener.local_addr().map_err(|e| e.to_string())?;
+        let url = format!("http://{local}/");
+        println!("specula explorer on {url} (Ctrl-C stops it)");
+        if args.open {
+            open_browser(&url);
+        }
+        axum::serve(listener, router())
+            .with_graceful_shutdown(async {
+                let _ = tokio::signal::ctrl_c().await;
+            })
+            .await
+            .map_err(|e| format!("the server stopped: {e}"))
+    })
+}
+
+/// Asks the desktop to open `url`; failing that, says so (the URL is already printed).
+fn open_browser(url: &str) {
+    let program = if cfg!(target_os = "macos") {
+        "open"
+    } else if cfg!(windows) {
+        "explorer"
+    } else {
+        "xdg-open"
+    };
+    if let Err(error) = std::process::Command::new(program).arg(url).spawn() {
+        eprintln!("could not open a browser ({program}: {error}); open {url} by hand");
+    }
+}

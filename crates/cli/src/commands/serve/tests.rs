@@ -1,0 +1,175 @@
+//! The API through the router itself: valid, invalid, oversized and concurrent requests.
+
+use axum::body::{to_bytes, Body};
+use axum::http::{Request, StatusCode};
+use serde_json::Value;
+use tower::ServiceExt as _;
+
+use super::router;
+
+async fn get(uri: &str) -> (StatusCode, Vec<u8>) {
+    let response = router()
+        .oneshot(Request::get(uri).body(Body::empty()).expect("request"))
+        .await
+        .expect("infallible");
+    let status = response.status();
+    let body = to_bytes(response.into_body(), usize::MAX)
+        .await
+        .expect("body");
+    (status, body.to_vec())
+}
+
+async fn json(uri: &str) -> (StatusCode, Value) {
+    let (status, body) = get(uri).await;
+    (status, serde_json::from_slice(&body).expect("JSON body"))
+}
+
+#[tokio::test]
+async fn evaluate_returns_the_lobe_and_its_closed_form_reference() {
+    let (status, data) =
+        json("/api/evaluate?lobe=pow&n=40&geometry=phong&normalisation=lobe&theta_in=20").await;
+    assert_eq!(status, StatusCode::OK);
+    let angles = data["angles_deg"].as_array().expect("angles");
+    let values = data["values"].as_array().expect("values");
+    for (angle, value) in angles.iter().zip(values).step_by(37) {
+        let g = angle.as_f64().expect("number").to_radians();
+        assert!((value.as_f64().expect("number") - g.cos().powi(40)).abs() < 1e-12);
+    }
+    // The epicentre ends where cos^n = 1/2.
+    let epicentre = data["epicentre_deg"].as_f64().expect("number").to_radians();
+    assert!((epicentre.cos().powi(40) - 0.5).abs() < 1e-9);
+    assert_eq!(data["slice"].as_array().expect("slice").len(), 64 * 64);
+}
+
+#[tokio::test]
+async fn analyze_matches_the_library() {
+    let (status, report) = json("/api/analyze?lobe=schlick&n=64").await;
+    assert_eq!(status, StatusCode::OK);
+    let expected = specula::analysis::analyze(
+        specula::LobeKind::Schlick,
+        specula::Exponent::new(64.0),
+        &mut specula::analysis::Precision::F64,
+    );
+    assert_eq!(
+        report["epicentre_max_rel"].as_f64(),
+        Some(expected.errors.epicentre_max_rel)
+    );
+}
+
+#[tokio::test]
+async fn render_returns_a_png_that_depends_on_the_lobe() {
+    let uri = |n: u32| format!("/api/render?object=sphere&lobe=pow&n={n}&size=64");
+    let (status, narrow) = get(&uri(500)).await;
+    assert_eq!(status, StatusCode::OK);
+    assert_eq!(&narrow[..8], b"\x89PNG\r\n\x1a\n");
+    let (_, broad) = get(&uri(4)).await;
+    assert_ne!(
+        narrow, broad,
+        "a different exponent gives a different image"
+    );
+    let (status, teapot) = get("/api/render?object=teapot&size=32").await;
+    assert_eq!((status, &teapot[1..4]), (StatusCode::OK, &b"PNG"[..]));
+}
+
+#[tokio::test]
+async fn bad_parameters_get_400_naming_the_parameter_and_the_valid_values() {
+    let cases = [
+        ("/api/evaluate?lobe=phong", "lobe", "schlick-mod"),
+        ("/api/evaluate?n=0", "n", "[1, 1000]"),
+        ("/api/evaluate?n=NaN", "n", "[1, 1000]"),
+        ("/api/evaluate?n=1e9", "n", "[1, 1000]"),
+        ("/api/evaluate?geometry=ward", "geometry", "phong, blinn"),
+        ("/api/evaluate?theta_in=90", "theta_in", "[0, 89]"),
+        ("/api/evaluate?colour=red", "colour", "lobe, n, geometry"),
+        ("/api/evaluate?n=3&n=4", "n", "one value"),
+        (
+            "/api/analyze?normalisation=lobe",
+            "normalisation",
+            "lobe, n",
+        ),
+        ("/api/render?size=4096", "size", "[16, 1024]"),
+        ("/api/render?size=-5", "size", "[16, 1024]"),
+        ("/api/render?object=cube", "object", "sphere, teapot"),
+        (
+            "/api/render?shading=toon",
+            "shading",
+            "flat, gouraud, phong",
+        ),
+        ("/api/render?light_phi=720", "light_phi", "[-180, 180]"),
+    ];
+    for (uri, parameter, valid) in cases {
+        let (status, body) = json(uri).await;
+        assert_eq!(status, StatusCode::BAD_REQUEST, "{uri}");
+        assert_eq!(body["parameter"], parameter, "{uri}: {body}");
+        assert!(
+            body["valid"].as_str().expect("valid").contains(valid),
+            "{uri}: {body}"
+        );
+    }
+    // Broken percent-encoding is kept as text, which is then not a number.
+    let (status, body) = json("/api/evaluate?n=%ZZ%").await;
+    assert_eq!(
+        (status, &body["parameter"]),
+        (StatusCode::BAD_REQUEST, &Value::from("n")),
+        "{body}"
+    );
+    let (status, body) = json("/no/such/thing").await;
+    assert_eq!(status, StatusCode::NOT_FOUND);
+    assert!(body["valid"]
+        .as_str()
+        .expect("routes")
+        .contains("/api/render"));
+}
+
+#[tokio::test]
+async fn bodies_are_refused_and_the_page_is_self_contained() {
+    let big = vec![b'x'; 1 << 20];
+    let response = router()
+        .oneshot(
+            Request::post("/api/evaluate")
+                .body(Body::from(big))
+                .expect("request"),
+        )
+        .await
+        .expect("infallible");
+    assert_eq!(response.status(), StatusCode::METHOD_NOT_ALLOWED);
+    for asset in ["/", "/app.js", "/style.css"] {
+        let (status, body) = get(asset).await;
+        let text = String::from_utf8(body).expect("text");
+        assert_eq!(status, StatusCode::OK);
+        assert!(
+            !text.contains("http://") && !text.contains("https://"),
+            "{asset} fetches from the network"
+        );
+    }
+}
+
+/// 200 requests at once, renders among them: every one answered, none an error.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn two_hundred_parallel_requests_all_succeed() {
+    let app = router();
+    let requests = (0..200).map(|k| {
+        let app = app.clone();
+        let uri = match k % 4 {
+            0 => format!("/api/render?object=sphere&size=48&n={}", 1 + k),
+            1 => format!("/api/evaluate?lobe=cosquad&n={}", 1 + k),
+            2 => "/api/models".to_owned(),
+            _ => format!("/api/analyze?lobe=schlick-mod&n={}", 1 + k),
+        };
+        tokio::spawn(async move {
+            let response = app
+                .oneshot(Request::get(&uri).body(Body::empty()).expect("request"))
+                .await
+                .expect("infallible");
+            (uri, response.status())
+        })
+    });
+    let mut failures = Vec::new();
+    for handle in requests.collect::<Vec<_>>() {
+        let (uri, status) = handle.await.expect("task");
+        if status != StatusCode::OK {
+            failures.push((uri, status));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:?}");
+}
