@@ -34,7 +34,7 @@ pub enum Op {
     /// `a * a`, on a squarer (about half a multiplier).
     Square(NodeId),
     /// `a / b` for unsigned operands, the quotient truncated (a restoring divider); a zero
-    /// divisor saturates.
+    /// divisor gives 0 (in the lobes it only meets `t = 0`, whose lobe value is 0).
     Div(NodeId, NodeId),
     /// `a * 2^shift`: wiring only, no register.
     Shift(NodeId, i32),
@@ -398,10 +398,10 @@ impl Datapath {
     }
 }
 
-/// `a / b` for unsigned operands, truncated, into `out` (saturated; `b = 0` gives the maximum).
+/// `a / b` for unsigned operands, truncated, into `out` (saturated; `b = 0` gives 0).
 fn divide(a: i64, fa: Format, b: i64, fb: Format, out: Format) -> i64 {
     if b <= 0 {
-        return out.max_raw();
+        return 0;
     }
     // a / b = (a_raw / b_raw) 2^(fb - fa); with `out.frac` bits: (a_raw 2^s) / b_raw.
     let shift = i64::from(out.frac_bits) + i64::from(fb.frac_bits) - i64::from(fa.frac_bits);

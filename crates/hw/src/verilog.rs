@@ -160,9 +160,8 @@ impl Emitter<'_> {
                     )
                 };
                 let expr = format!(
-                    "(({} == 64'sd0) ? {} : {numerator} / {denominator})",
-                    b.0,
-                    literal(i128::from(out.max_raw()))
+                    "(({} == 64'sd0) ? 64'sd0 : {numerator} / {denominator})",
+                    b.0
                 );
                 (expr, out.frac_bits, bits)
             }

@@ -250,3 +250,34 @@ fn bad_requests_are_refused_with_the_valid_choices() {
     assert!(specula_hw::integer_exponent(f64::NAN).is_err());
     assert_eq!(specula_hw::integer_exponent(1000.0), Ok(1000));
 }
+
+/// Any raw inputs, in range or not (inputs saturate into their formats), give a lobe value in
+/// [0, 1] at every width: the fixed-point models have no NaN to produce, and no overflow.
+#[test]
+fn any_raw_inputs_give_a_lobe_value() {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(9);
+    for lobe in HwLobe::ALL {
+        for bits in BITS.step_by(4) {
+            let datapath = lobe.build(bits).expect("valid width");
+            let one = 1_i64 << (bits - 1);
+            for _ in 0..2000 {
+                let inputs: Vec<i64> = datapath
+                    .inputs()
+                    .iter()
+                    .map(|_| match rng.random_range(0..4) {
+                        0 => rng.random_range(i64::MIN..=i64::MAX),
+                        1 => -rng.random_range(0..1_i64 << 40),
+                        _ => rng.random_range(0..1_i64 << 32),
+                    })
+                    .collect();
+                let value = datapath.eval(&inputs);
+                assert!(
+                    (0..=one).contains(&value),
+                    "{} {bits} bits {inputs:?}: {value}",
+                    lobe.id()
+                );
+            }
+        }
+    }
+}

@@ -202,6 +202,42 @@ impl Default for MaterialDescription {
     }
 }
 
+/// serde's "unknown field `x`, expected one of `a`, `b`" (or "unknown variant") with the
+/// nearest valid choice named, when one is close: a typo gets its correction.
+fn with_nearest_choice(message: &str) -> String {
+    let unknown = ["unknown field `", "unknown variant `"]
+        .iter()
+        .find_map(|prefix| message.strip_prefix(prefix));
+    let Some((typed, rest)) = unknown.and_then(|rest| rest.split_once('`')) else {
+        return message.to_owned();
+    };
+    // The choices are the back-quoted words after "expected".
+    let choices = rest.split('`').skip(1).step_by(2);
+    let nearest = choices
+        .map(|choice| (edit_distance(typed, choice), choice))
+        .min()
+        .filter(|&(distance, choice)| distance <= (choice.len() / 3).max(2));
+    match nearest {
+        Some((_, choice)) => format!("{message}; did you mean `{choice}`?"),
+        None => message.to_owned(),
+    }
+}
+
+/// Levenshtein distance between `a` and `b` (characters inserted, deleted or replaced).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut previous: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut current = vec![i + 1];
+        for (j, &cb) in b.iter().enumerate() {
+            let replace = previous[j] + usize::from(ca != cb);
+            current.push(replace.min(previous[j + 1] + 1).min(current[j] + 1));
+        }
+        previous = current;
+    }
+    previous[b.len()]
+}
+
 /// Turns byte spans into `file:line:column` errors.
 struct Locator<'a> {
     source: &'a str,
@@ -259,7 +295,10 @@ impl Scene {
     ) -> Result<LoadedScene, SceneError> {
         let locate = Locator { source, file };
         let description: SceneDescription = toml::from_str(source).map_err(|error| {
-            locate.error(error.span().unwrap_or(0..0), error.message().trim_end())
+            locate.error(
+                error.span().unwrap_or(0..0),
+                with_nearest_choice(error.message().trim_end()),
+            )
         })?;
         let mut warnings = Vec::new();
         let camera = build_camera(&locate, &description.camera)?;

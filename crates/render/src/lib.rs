@@ -42,10 +42,10 @@ pub use image::{
     check_output_path, encode_png_srgb8, read_image, srgb_decode, srgb_encode, write_atomically,
     write_image, write_png_srgb8, Display, Image, ImageError, ToneMap,
 };
-pub use load::{load_mesh, LoadError, LoadedMesh, MESH_EXTENSIONS};
+pub use load::{load_mesh, parse_mesh, LoadError, LoadedMesh, MeshFormat, MESH_EXTENSIONS};
 pub use material::{IlluminationModel, Light, Material, Shader, Shading};
 pub use mesh::{Mesh, MeshError};
-pub use pipeline::{overdraw, render, RenderError, MAX_SAMPLES};
+pub use pipeline::{overdraw, render, RenderError, MAX_PIXELS, MAX_SAMPLES};
 pub use scene::{Object, Overrides, Scene, Settings, DEFAULT_SCENE};
 pub use shapes::{plane, sphere, torus};
 pub use teapot::{teapot, BezierPatch, TEAPOT_PATCHES};

@@ -7,7 +7,7 @@
 //! say so; non-finite coordinates and out-of-range indices refuse the file with the reason.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufRead, BufReader, Seek};
 use std::path::Path;
 
 use glam::Vec3;
@@ -37,28 +37,59 @@ pub struct LoadedMesh {
 /// The file extensions [`load_mesh`] reads.
 pub const MESH_EXTENSIONS: [&str; 3] = ["obj", "stl", "ply"];
 
+/// A mesh file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ.
+    Obj,
+    /// STL, binary or ASCII.
+    Stl,
+    /// PLY, ASCII or binary.
+    Ply,
+}
+
+impl MeshFormat {
+    /// The format named by `path`'s extension.
+    pub fn of_path(path: &Path) -> Result<Self, String> {
+        let extension = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default();
+        match extension.as_str() {
+            "obj" => Ok(Self::Obj),
+            "stl" => Ok(Self::Stl),
+            "ply" => Ok(Self::Ply),
+            _ => Err(format!(
+                "unknown mesh format; the extension must be one of {}",
+                MESH_EXTENSIONS.join(", ")
+            )),
+        }
+    }
+}
+
 /// Loads a mesh, choosing the format by the file's extension.
 pub fn load_mesh(path: &Path) -> Result<LoadedMesh, LoadError> {
     let fail = |message: String| LoadError {
         path: path.display().to_string(),
         message,
     };
-    let extension = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
-    let (positions, normals, polygons) = match extension.as_str() {
-        "obj" => read_obj(path),
-        "stl" => read_stl(path),
-        "ply" => read_ply(path),
-        _ => Err(format!(
-            "unknown mesh format; the extension must be one of {}",
-            MESH_EXTENSIONS.join(", ")
-        )),
-    }
-    .map_err(fail)?;
-    build(positions, normals, &polygons).map_err(|error| fail(error.to_string()))
+    let format = MeshFormat::of_path(path).map_err(fail)?;
+    let file = File::open(path).map_err(|e| fail(e.to_string()))?;
+    parse_mesh(BufReader::new(file), format).map_err(fail)
+}
+
+/// Reads a mesh in `format` from `reader`: what [`load_mesh`] does after opening the file.
+pub fn parse_mesh(
+    mut reader: impl BufRead + Seek,
+    format: MeshFormat,
+) -> Result<LoadedMesh, String> {
+    let (positions, normals, polygons) = match format {
+        MeshFormat::Obj => read_obj(&mut reader),
+        MeshFormat::Stl => read_stl(&mut reader),
+        MeshFormat::Ply => read_ply(&mut reader),
+    }?;
+    build(positions, normals, &polygons).map_err(|error| error.to_string())
 }
 
 type Parts = (Vec<Vec3>, Vec<Vec3>, Vec<Vec<u32>>);
@@ -98,13 +129,16 @@ fn build(
     })
 }
 
-fn read_obj(path: &Path) -> Result<Parts, String> {
+fn read_obj(reader: &mut impl BufRead) -> Result<Parts, String> {
     let options = tobj::LoadOptions {
         triangulate: false,
         single_index: true,
         ..tobj::LoadOptions::default()
     };
-    let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| e.to_string())?;
+    // Materials are not used: a referenced .mtl file is not read.
+    let (models, _materials) =
+        tobj::load_obj_buf(reader, &options, |_| Err(tobj::LoadError::OpenFileFailed))
+            .map_err(|e| e.to_string())?;
     let (mut positions, mut normals, mut polygons) = (Vec::new(), Vec::new(), Vec::new());
     for model in models {
         let mesh = model.mesh;
@@ -136,9 +170,8 @@ fn read_obj(path: &Path) -> Result<Parts, String> {
     Ok((positions, normals, polygons))
 }
 
-fn read_stl(path: &Path) -> Result<Parts, String> {
-    let mut file = File::open(path).map_err(|e| e.to_string())?;
-    let mesh = stl_io::read_stl(&mut file).map_err(|e| format!("not a valid STL file ({e})"))?;
+fn read_stl(reader: &mut (impl BufRead + Seek)) -> Result<Parts, String> {
+    let mesh = stl_io::read_stl(reader).map_err(|e| format!("not a valid STL file ({e})"))?;
     let positions: Vec<Vec3> = mesh
         .vertices
         .iter()
@@ -152,12 +185,11 @@ fn read_stl(path: &Path) -> Result<Parts, String> {
     Ok((positions, Vec::new(), polygons))
 }
 
-fn read_ply(path: &Path) -> Result<Parts, String> {
+fn read_ply(reader: &mut impl BufRead) -> Result<Parts, String> {
     use ply_rs_bw::parser::Parser;
     use ply_rs_bw::ply::{DefaultElement, Property};
-    let file = File::open(path).map_err(|e| e.to_string())?;
     let ply = Parser::<DefaultElement>::new()
-        .read_ply(&mut BufReader::new(file))
+        .read_ply(reader)
         .map_err(|e| format!("not a valid PLY file ({e})"))?;
     let empty = Vec::new();
     let vertices = ply.payload.get("vertex").unwrap_or(&empty);

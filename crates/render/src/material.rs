@@ -174,10 +174,13 @@ impl Shader {
     }
 
     /// What `light` sends to `position`: the unit direction towards it and the intensity that
-    /// arrives, or `None` for a point light at the point itself.
+    /// arrives, or `None` for a point light at the point itself (or a directional light with
+    /// no direction).
     pub fn incoming(&self, light: &Light, position: Vec3) -> Option<(Vec3, Vec3)> {
         match *light {
-            Light::Directional { towards, intensity } => Some((towards, intensity)),
+            Light::Directional { towards, intensity } => {
+                towards.try_normalize().map(|wi| (wi, intensity))
+            }
             Light::Point {
                 position: at,
                 intensity,
@@ -212,7 +215,9 @@ impl Shader {
             }
     }
 
-    /// Radiance leaving `position` towards `wo` (unit), for a unit `normal`.
+    /// Radiance leaving `position` towards `wo`, for the surface `normal`. Both directions
+    /// are normalised here; where one has no direction (zero, or too long for `f32`), only
+    /// the ambient term remains.
     pub fn shade(
         &self,
         position: Vec3,
@@ -222,6 +227,9 @@ impl Shader {
         ambient: Vec3,
     ) -> Vec3 {
         let mut radiance = self.ambient(ambient);
+        let (Some(normal), Some(wo)) = (normal.try_normalize(), wo.try_normalize()) else {
+            return radiance;
+        };
         for light in lights {
             let Some((wi, intensity)) = self.incoming(light, position) else {
                 continue;

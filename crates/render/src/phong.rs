@@ -338,9 +338,11 @@ impl Cosines<'_> {
     /// The loop for one light kind, geometry and model, with each choice a constant.
     #[inline(always)]
     fn run<const POINT: bool, const BLINN: bool, const PHYSICAL: bool>(self) {
+        // As `Shader::incoming`: a directional light without a direction lights nothing
+        // (a zero `wi` makes every cosine 0).
         let (at, towards) = match *self.light {
             Light::Point { position, .. } => (position, Vec3::ZERO),
-            Light::Directional { towards, .. } => (Vec3::ZERO, towards),
+            Light::Directional { towards, .. } => (Vec3::ZERO, towards.normalize_or_zero()),
         };
         let len = self.t.len();
         let [px, py, pz] = self.position.map(|s| &s[..len]);

@@ -24,12 +24,16 @@ const TILE: u32 = 32;
 /// The largest supersampling factor per axis.
 pub const MAX_SAMPLES: u32 = 8;
 
+/// The most output pixels a render may have: 64 Mi (8192 x 8192), 768 MiB of linear RGB.
+/// Larger requests are refused before anything is allocated.
+pub const MAX_PIXELS: u64 = 1 << 26;
+
 /// A render that cannot be done, and why.
 #[derive(Clone, Debug, Error, PartialEq)]
 #[non_exhaustive]
 pub enum RenderError {
     /// The image or sample count is out of range.
-    #[error("cannot render {width}x{height} pixels with {samples}x{samples} samples: width and height must be at least 1, samples in [1, {MAX_SAMPLES}], and width or height times samples at most {MAX_SIDE}")]
+    #[error("cannot render {width}x{height} pixels with {samples}x{samples} samples: width and height must be at least 1, width x height at most {MAX_PIXELS} pixels, samples in [1, {MAX_SAMPLES}], and width or height times samples at most {MAX_SIDE}")]
     Size {
         /// Width in pixels.
         width: u32,
@@ -53,13 +57,14 @@ struct Primitive {
 
 impl Settings {
     /// Refuses an image or sample count outside what the renderers draw: width and height at
-    /// least 1, samples in `[1, MAX_SAMPLES]`, each side times samples at most the rasterizer's
-    /// exact range.
+    /// least 1, at most [`MAX_PIXELS`] pixels, samples in `[1, MAX_SAMPLES]`, each side times
+    /// samples at most the rasterizer's exact range.
     pub fn validate(&self) -> Result<(), RenderError> {
         let (width, height, samples) = (self.width, self.height, self.samples);
         let too_big = |side: u32| side.checked_mul(samples).is_none_or(|s| s > MAX_SIDE);
         if width == 0
             || height == 0
+            || u64::from(width) * u64::from(height) > MAX_PIXELS
             || !(1..=MAX_SAMPLES).contains(&samples)
             || too_big(width)
             || too_big(height)

@@ -173,3 +173,110 @@ async fn two_hundred_parallel_requests_all_succeed() {
     }
     assert!(failures.is_empty(), "{failures:?}");
 }
+
+/// The API fuzzer's seeds and crash inputs (`fuzz/regressions/api`), through the same check:
+/// 200 or a JSON 400, never a 500 or a panic.
+#[tokio::test]
+async fn fuzz_inputs_get_200_or_a_json_400() {
+    let fuzz = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
+    let mut count = 0;
+    for kind in ["seeds", "regressions"] {
+        for entry in std::fs::read_dir(fuzz.join(kind).join("api"))
+            .into_iter()
+            .flatten()
+        {
+            let path = entry.expect("entry").path();
+            let bytes = std::fs::read(&path).expect("read");
+            let Some((&which, rest)) = bytes.split_first() else {
+                continue;
+            };
+            let query = String::from_utf8_lossy(rest);
+            let uri = match which % 3 {
+                0 => format!("/api/evaluate?{query}"),
+                1 => format!("/api/analyze?{query}"),
+                _ => format!("/api/render?size=16&{query}"),
+            };
+            let Ok(request) = Request::get(uri.as_str()).body(Body::empty()) else {
+                continue;
+            };
+            let response = router().oneshot(request).await.expect("infallible");
+            let status = response.status();
+            let body = to_bytes(response.into_body(), usize::MAX)
+                .await
+                .expect("body");
+            assert!(
+                status == StatusCode::OK || status == StatusCode::BAD_REQUEST,
+                "{uri}: {status}"
+            );
+            if status == StatusCode::BAD_REQUEST {
+                let error: Value = serde_json::from_slice(&body).expect("JSON error");
+                assert!(error["error"].is_string());
+            }
+            count += 1;
+        }
+    }
+    assert!(count >= 2, "the API seeds are missing");
+}
+
+/// The resident set size of this process, in KiB (Linux), if it can be read.
+fn resident_kib() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|line| line.starts_with("VmRSS:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
+/// A bounded load test over loopback: the real server, 400 requests 40 at a time on fresh
+/// connections (renders among them), within a fixed time; no error, and memory that stays
+/// bounded (renders are capped at two at a time, so requests queue instead of piling up).
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn loopback_load_test_has_no_error_and_bounded_memory() {
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
+        .await
+        .expect("bind");
+    let address = listener.local_addr().expect("address");
+    tokio::spawn(async move { axum::serve(listener, router()).await });
+    let before = resident_kib();
+    let request = |k: usize| async move {
+        let path = match k % 4 {
+            0 => format!("/api/render?object=teapot&size=128&n={}", 1 + k % 997),
+            1 => format!("/api/evaluate?lobe=logexp&n={}", 1 + k % 997),
+            2 => format!("/api/analyze?lobe=cheb2&n={}", 1 + k % 997),
+            _ => "/".to_owned(),
+        };
+        let mut stream = tokio::net::TcpStream::connect(address)
+            .await
+            .expect("connect");
+        let head = format!("GET {path} HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n\r\n");
+        stream.write_all(head.as_bytes()).await.expect("send");
+        let mut response = Vec::new();
+        stream.read_to_end(&mut response).await.expect("receive");
+        let status_line = String::from_utf8_lossy(&response[..response.len().min(12)]).into_owned();
+        (path, status_line)
+    };
+    let load = async {
+        let mut failures = Vec::new();
+        for batch in 0..10 {
+            let handles: Vec<_> = (0..40)
+                .map(|k| tokio::spawn(request(batch * 40 + k)))
+                .collect();
+            for handle in handles {
+                let (path, status) = handle.await.expect("task");
+                if status != "HTTP/1.1 200" {
+                    failures.push((path, status));
+                }
+            }
+        }
+        failures
+    };
+    let failures = tokio::time::timeout(std::time::Duration::from_secs(300), load)
+        .await
+        .expect("400 requests within the time bound");
+    assert!(failures.is_empty(), "{failures:?}");
+    if let (Some(before), Some(after)) = (before, resident_kib()) {
+        assert!(
+            after < before + 512 * 1024,
+            "resident memory grew from {before} KiB to {after} KiB"
+        );
+    }
+}

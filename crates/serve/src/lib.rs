@@ -1,8 +1,10 @@
-//! `specula serve`: the BRDF explorer, a page and a JSON API served by the binary itself.
+//! # specula-serve: the BRDF explorer
+//!
+//! A page and a JSON API over the library and the CPU renderer; `specula serve` runs it.
 //!
 //! The page, its script and its styles are compiled in (`assets/`); nothing is fetched from
 //! the network. The server binds to 127.0.0.1 unless `--bind` says otherwise. Computations run
-//! on the blocking pool, renders at most [`api::CONCURRENT_RENDERS`] at a time, and request
+//! on the blocking pool, renders at most [`CONCURRENT_RENDERS`] at a time, and request
 //! bodies are capped (the API takes none).
 
 mod api;
@@ -10,7 +12,9 @@ mod explorer;
 #[cfg(test)]
 mod tests;
 
-use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+use std::net::SocketAddr;
+
+pub use api::{CONCURRENT_RENDERS, MAX_RENDER_SIZE};
 
 use axum::extract::DefaultBodyLimit;
 use axum::http::header;
@@ -18,26 +22,10 @@ use axum::response::IntoResponse;
 use axum::routing::get;
 use axum::Router;
 
-use super::CommandResult;
-
-/// Arguments of `specula serve`.
-#[derive(Debug, clap::Args)]
-pub struct Args {
-    /// The port to listen on (0 picks a free one).
-    #[arg(long, default_value_t = 8080)]
-    port: u16,
-    /// The address to listen on; anything but loopback exposes the explorer to the network.
-    #[arg(long, default_value_t = IpAddr::V4(Ipv4Addr::LOCALHOST))]
-    bind: IpAddr,
-    /// Open the explorer in the default browser.
-    #[arg(long)]
-    open: bool,
-}
-
 /// The largest request body accepted.
 const MAX_BODY_BYTES: usize = 16 * 1024;
 
-/// The explorer's routes.
+/// The explorer's routes: the page, its assets and the API.
 pub fn router() -> Router {
     let asset = |content_type: &'static str, body: &'static str| {
         get(move || async move { ([(header::CONTENT_TYPE, content_type)], body).into_response() })
@@ -70,25 +58,25 @@ pub fn router() -> Router {
         .with_state(api::AppState::default())
 }
 
-/// Serves until Ctrl-C.
-pub fn run(args: &Args) -> CommandResult {
-    if !args.bind.is_loopback() {
+/// Serves on `address` until Ctrl-C, printing the URL; `open` also opens it in a browser.
+/// Anything but a loopback address is warned about: the explorer has no authentication.
+pub fn serve(address: SocketAddr, open: bool) -> Result<(), String> {
+    if !address.ip().is_loopback() {
         eprintln!(
             "warning: listening on {}, reachable from other machines; the explorer has no authentication",
-            args.bind
+            address.ip()
         );
     }
     let runtime =
         tokio::runtime::Runtime::new().map_err(|e| format!("cannot start the server: {e}"))?;
     runtime.block_on(async {
-        let address = SocketAddr::new(args.bind, args.port);
         let listener = tokio::net::TcpListener::bind(address).await.map_err(|e| {
             format!("cannot listen on {address}: {e}; choose another --port (0 picks a free one)")
         })?;
         let local = listener.local_addr().map_err(|e| e.to_string())?;
         let url = format!("http://{local}/");
         println!("specula explorer on {url} (Ctrl-C stops it)");
-        if args.open {
+        if open {
             open_browser(&url);
         }
         axum::serve(listener, router())
