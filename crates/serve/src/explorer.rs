@@ -39,8 +39,9 @@ pub struct Curves {
     /// Directional albedo of the specular term against the angle of incidence, degrees.
     pub albedo_deg: Vec<f64>,
     pub albedo: Vec<f64>,
-    /// The specular term over `theta_h` (columns) by `theta_d` (rows), `phi_d = 90` degrees,
-    /// both from 0 to 90 degrees, row-major.
+    /// The specular term over `theta_h` (columns, on a square-root scale: column `i` is at
+    /// `90 (i / (size - 1))^2` degrees) by `theta_d` (rows, linear), `phi_d = 90` degrees,
+    /// row-major.
     pub slice: Vec<f64>,
     pub slice_size: usize,
 }
@@ -103,13 +104,13 @@ pub fn curves(
         .iter()
         .map(|&theta| constant * specular_albedo_per_unit(&lobe, geometry, theta))
         .collect();
-    let step = FRAC_PI_2 / (SLICE_SIZE - 1) as f64;
+    let fraction = |i: usize| i as f64 / (SLICE_SIZE - 1) as f64;
     let slice = (0..SLICE_SIZE * SLICE_SIZE)
         .map(|k| {
-            let (theta_h, theta_d) = (
-                (k % SLICE_SIZE) as f64 * step,
-                (k / SLICE_SIZE) as f64 * step,
-            );
+            // theta_h on a square-root scale (BRDF Explorer's), so that a narrow lobe's few
+            // degrees get columns; theta_d linear.
+            let theta_h = fraction(k % SLICE_SIZE).powi(2) * FRAC_PI_2;
+            let theta_d = fraction(k / SLICE_SIZE) * FRAC_PI_2;
             let (wi, wo) = from_half_difference(theta_h, theta_d, FRAC_PI_2);
             if wi.z > 0.0 && wo.z > 0.0 {
                 brdf.specular(wo, wi)
