@@ -1,8 +1,9 @@
-//! The ply loader: see `common::check_mesh`.
+//! The ply loader: see `checks/mesh.rs`.
 #![no_main]
 
-mod common;
+#[path = "checks/mesh.rs"]
+mod checks;
 
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(|data: &[u8]| common::check_mesh(data, specula_render::MeshFormat::Ply));
+fuzz_target!(|data: &[u8]| checks::check_mesh(data, specula_render::MeshFormat::Ply));

@@ -12,14 +12,16 @@ use specula::analysis::{error_figures, ErrorFigures, Evaluator, Precision};
 use specula::{Exponent, Lobe};
 
 use crate::datapath::{Datapath, Resources};
+use crate::fixed::Rounding;
 use crate::lobes::{HwError, HwLobe};
 
 /// A datapath at one word length as an [`Evaluator`].
 pub struct HwEvaluator {
     lobe: HwLobe,
     bits: u32,
-    n: u32,
     datapath: Datapath,
+    /// The input slot for `t` (or `g`) followed by the material's inputs, prepared once.
+    inputs: Vec<i64>,
 }
 
 impl HwEvaluator {
@@ -28,8 +30,10 @@ impl HwEvaluator {
         Ok(Self {
             lobe,
             bits,
-            n,
             datapath: lobe.build(bits)?,
+            inputs: core::iter::once(0)
+                .chain(lobe.material_inputs(bits, n))
+                .collect(),
         })
     }
 }
@@ -40,6 +44,7 @@ impl Evaluator for HwEvaluator {
     }
 
     fn eval_batch(&mut self, _lobe: &Lobe, cosines: &[f64]) -> Vec<f64> {
+        let unit = HwLobe::unit_format(self.bits);
         cosines
             .iter()
             .map(|&t| {
@@ -48,10 +53,8 @@ impl Evaluator for HwEvaluator {
                 } else {
                     t
                 };
-                let raw = self
-                    .datapath
-                    .eval(&self.lobe.inputs(self.bits, input, self.n));
-                HwLobe::value(self.bits, raw)
+                self.inputs[0] = unit.quantize(input, Rounding::HalfEven);
+                HwLobe::value(self.bits, self.datapath.eval(&self.inputs))
             })
             .collect()
     }

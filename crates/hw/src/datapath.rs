@@ -345,14 +345,6 @@ impl Datapath {
         delay
     }
 
-    /// The delay, in cycles, of operand `operand` as read by the registered node `reader`.
-    #[must_use]
-    pub fn operand_delay(&self, reader: NodeId, operand: NodeId) -> u32 {
-        let stage = self.stages();
-        let source = self.wired_source(operand);
-        stage[reader.0] - 1 - stage[source.0]
-    }
-
     /// The registered node a wiring-only node reads through (itself if registered).
     #[must_use]
     pub fn wired_source(&self, mut id: NodeId) -> NodeId {

@@ -202,15 +202,20 @@ impl<const SIGNED: bool, const INT: u32, const FRAC: u32> Q<SIGNED, INT, FRAC> {
         Self::FORMAT.to_f64(self.raw)
     }
 
+    /// The exact value `raw / 2^frac` rounded and saturated into this format.
+    fn from_exact((raw, frac): (i128, u32), rounding: Rounding) -> Self {
+        Self {
+            raw: Self::FORMAT.resize(raw, frac, rounding),
+        }
+    }
+
     /// This number in another format.
     #[must_use]
     pub fn resize<const S: bool, const I: u32, const F: u32>(
         self,
         rounding: Rounding,
     ) -> Q<S, I, F> {
-        Q {
-            raw: Q::<S, I, F>::FORMAT.resize(i128::from(self.raw), FRAC, rounding),
-        }
+        Q::from_exact((i128::from(self.raw), FRAC), rounding)
     }
 
     /// `self + rhs` in the result's format.
@@ -227,10 +232,10 @@ impl<const SIGNED: bool, const INT: u32, const FRAC: u32> Q<SIGNED, INT, FRAC> {
         rhs: Q<S2, I2, F2>,
         rounding: Rounding,
     ) -> Q<S, I, F> {
-        let (raw, frac) = exact_add(self.raw, Self::FORMAT, rhs.raw, Q::<S2, I2, F2>::FORMAT);
-        Q {
-            raw: Q::<S, I, F>::FORMAT.resize(raw, frac, rounding),
-        }
+        Q::from_exact(
+            exact_add(self.raw, Self::FORMAT, rhs.raw, Q::<S2, I2, F2>::FORMAT),
+            rounding,
+        )
     }
 
     /// `self - rhs` in the result's format.
@@ -247,10 +252,10 @@ impl<const SIGNED: bool, const INT: u32, const FRAC: u32> Q<SIGNED, INT, FRAC> {
         rhs: Q<S2, I2, F2>,
         rounding: Rounding,
     ) -> Q<S, I, F> {
-        let (raw, frac) = exact_add(self.raw, Self::FORMAT, -rhs.raw, Q::<S2, I2, F2>::FORMAT);
-        Q {
-            raw: Q::<S, I, F>::FORMAT.resize(raw, frac, rounding),
-        }
+        Q::from_exact(
+            exact_add(self.raw, Self::FORMAT, -rhs.raw, Q::<S2, I2, F2>::FORMAT),
+            rounding,
+        )
     }
 
     /// `self * rhs` in the result's format.
@@ -267,10 +272,10 @@ impl<const SIGNED: bool, const INT: u32, const FRAC: u32> Q<SIGNED, INT, FRAC> {
         rhs: Q<S2, I2, F2>,
         rounding: Rounding,
     ) -> Q<S, I, F> {
-        let (raw, frac) = exact_mul(self.raw, Self::FORMAT, rhs.raw, Q::<S2, I2, F2>::FORMAT);
-        Q {
-            raw: Q::<S, I, F>::FORMAT.resize(raw, frac, rounding),
-        }
+        Q::from_exact(
+            exact_mul(self.raw, Self::FORMAT, rhs.raw, Q::<S2, I2, F2>::FORMAT),
+            rounding,
+        )
     }
 }
 

@@ -262,29 +262,35 @@ impl HwLobe {
         Ok(b.finish(&name, output))
     }
 
-    /// The raw inputs for cosine `t` (or angle `g`, for [`HwLobe::takes_angle`]) and integer
-    /// exponent `n`, with the per-material constants prepared on the host.
+    /// The per-material inputs for integer exponent `n`: `n` itself and the constants the
+    /// library prepares for it (`Lobe::packed`), in the datapath's formats. What a renderer
+    /// uploads once per material.
     #[must_use]
-    pub fn inputs(self, bits: u32, t_or_g: f64, n: u32) -> Vec<i64> {
-        let unit = Self::unit_format(bits);
-        let x = unit.quantize(t_or_g, Rounding::HalfEven);
+    pub fn material_inputs(self, bits: u32, n: u32) -> Vec<i64> {
         let n_raw = i64::from(n);
+        let packed = || Lobe::new(self.float_kind(), Exponent::new(f64::from(n))).packed();
         match self {
             HwLobe::Schlick | HwLobe::LogExp | HwLobe::LogExpMitchell | HwLobe::Cheb2 => {
-                vec![x, n_raw]
+                vec![n_raw]
             }
             HwLobe::SchlickMod => {
-                let squarings = (f64::from(n).log2().floor() as i64 - 2).clamp(0, 7);
-                vec![x, n_raw, squarings]
+                let squarings = i64::from(packed().squarings).min(SCHLICK_MOD_MAX_SQUARINGS.into());
+                vec![n_raw, squarings]
             }
             HwLobe::CosQuad => {
-                let a = f64::from(n + 1) / f64::from((1 << COSQUAD_V) + 1);
-                vec![
-                    x,
-                    Format::unsigned(6, bits - 1).quantize(a, Rounding::HalfEven),
-                ]
+                vec![Format::unsigned(6, bits - 1).quantize(packed().slope, Rounding::HalfEven)]
             }
         }
+    }
+
+    /// The raw inputs for cosine `t` (or angle `g`, for [`HwLobe::takes_angle`]) and integer
+    /// exponent `n`: the quantised input followed by [`HwLobe::material_inputs`].
+    #[must_use]
+    pub fn inputs(self, bits: u32, t_or_g: f64, n: u32) -> Vec<i64> {
+        let x = Self::unit_format(bits).quantize(t_or_g, Rounding::HalfEven);
+        core::iter::once(x)
+            .chain(self.material_inputs(bits, n))
+            .collect()
     }
 
     /// The lobe's value from the datapath's raw output.

@@ -5,7 +5,11 @@
 
 use std::path::{Path, PathBuf};
 
-use specula_render::{parse_mesh, MeshFormat, Scene};
+use specula_render::{MeshFormat, Scene};
+
+/// The fuzz targets' own check.
+#[path = "../../../fuzz/fuzz_targets/checks/mesh.rs"]
+mod checks;
 
 fn inputs(target: &str) -> Vec<PathBuf> {
     let fuzz = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
@@ -43,23 +47,7 @@ fn mesh_inputs_load_valid_meshes_or_fail_cleanly() {
         let files = inputs(target);
         assert!(!files.is_empty(), "the {target} seeds are missing");
         for path in files {
-            let bytes = std::fs::read(&path).expect("read");
-            if let Ok(loaded) = parse_mesh(std::io::Cursor::new(bytes), format) {
-                let mesh = loaded.mesh;
-                assert!(
-                    mesh.positions().iter().all(|p| p.is_finite()),
-                    "{}",
-                    path.display()
-                );
-                assert!(
-                    mesh.triangles()
-                        .iter()
-                        .flatten()
-                        .all(|&i| (i as usize) < mesh.positions().len()),
-                    "{}",
-                    path.display()
-                );
-            }
+            checks::check_mesh(&std::fs::read(&path).expect("read"), format);
         }
     }
 }

@@ -144,11 +144,10 @@ proptest! {
 
     #[test]
     fn random_valid_scenes_render_without_a_nan_pixel(text in any_scene()) {
-        // Some random cameras are invalid (eye at the target, looking along `up`): the parser
-        // refuses those, which another test covers.
-        let Ok(loaded) = Scene::from_toml(&text, "random.toml", None) else {
-            return Ok(());
-        };
+        // The generator writes only valid scenes: a refusal is a failure, so that no case
+        // passes without rendering.
+        let loaded = Scene::from_toml(&text, "random.toml", None)
+            .map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
         let image = specula_render::render(&loaded.scene, &|_, _| {}).expect("valid size");
         prop_assert!(image.pixels().iter().all(|p| p.is_finite() && p.min_element() >= 0.0), "{text}");
     }

@@ -174,50 +174,6 @@ async fn two_hundred_parallel_requests_all_succeed() {
     assert!(failures.is_empty(), "{failures:?}");
 }
 
-/// The API fuzzer's seeds and crash inputs (`fuzz/regressions/api`), through the same check:
-/// 200 or a JSON 400, never a 500 or a panic.
-#[tokio::test]
-async fn fuzz_inputs_get_200_or_a_json_400() {
-    let fuzz = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
-    let mut count = 0;
-    for kind in ["seeds", "regressions"] {
-        for entry in std::fs::read_dir(fuzz.join(kind).join("api"))
-            .into_iter()
-            .flatten()
-        {
-            let path = entry.expect("entry").path();
-            let bytes = std::fs::read(&path).expect("read");
-            let Some((&which, rest)) = bytes.split_first() else {
-                continue;
-            };
-            let query = String::from_utf8_lossy(rest);
-            let uri = match which % 3 {
-                0 => format!("/api/evaluate?{query}"),
-                1 => format!("/api/analyze?{query}"),
-                _ => format!("/api/render?size=16&{query}"),
-            };
-            let Ok(request) = Request::get(uri.as_str()).body(Body::empty()) else {
-                continue;
-            };
-            let response = router().oneshot(request).await.expect("infallible");
-            let status = response.status();
-            let body = to_bytes(response.into_body(), usize::MAX)
-                .await
-                .expect("body");
-            assert!(
-                status == StatusCode::OK || status == StatusCode::BAD_REQUEST,
-                "{uri}: {status}"
-            );
-            if status == StatusCode::BAD_REQUEST {
-                let error: Value = serde_json::from_slice(&body).expect("JSON error");
-                assert!(error["error"].is_string());
-            }
-            count += 1;
-        }
-    }
-    assert!(count >= 2, "the API seeds are missing");
-}
-
 /// The resident set size of this process, in KiB (Linux), if it can be read.
 fn resident_kib() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;

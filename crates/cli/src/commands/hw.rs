@@ -158,8 +158,9 @@ fn write_verilog(args: &VerilogArgs) -> CommandResult {
     )
 }
 
-/// The resources in one cell each: `count x widths`.
-fn resource_cells(r: &Resources) -> [String; 7] {
+/// The resources, a cell each: multipliers, squarers, adders, dividers (their widths), ROM
+/// bits, register bits, latency.
+pub fn resource_cells(r: &Resources) -> [String; 7] {
     let list = |items: Vec<String>| {
         if items.is_empty() {
             "-".to_owned()
@@ -183,17 +184,23 @@ fn resource_cells(r: &Resources) -> [String; 7] {
     ]
 }
 
-/// Sweeps every chosen datapath in parallel, with a progress bar over the widths.
+/// Sweeps every chosen datapath in parallel; with `show_progress`, a bar counts the widths.
 pub fn sweeps(
     lobes: &[HwLobe],
     n: u32,
     (low, high): (u32, u32),
     samples: usize,
+    show_progress: bool,
 ) -> Result<Vec<WidthSweep>, String> {
-    let progress = ProgressBar::new((lobes.len() as u32 * (high - low + 1)).into()).with_style(
-        ProgressStyle::with_template("datapaths {bar:30} {pos}/{len} widths {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let total = (lobes.len() as u32 * (high - low + 1)).into();
+    let progress = if show_progress {
+        ProgressBar::new(total).with_style(
+            ProgressStyle::with_template("datapaths {bar:30} {pos}/{len} widths {elapsed}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        )
+    } else {
+        ProgressBar::hidden()
+    };
     let result = lobes
         .par_iter()
         .map(|&lobe| sweep(lobe, n, low..=high, samples, &mut |_| progress.inc(1)))
@@ -209,7 +216,7 @@ fn table(args: &TableArgs) -> CommandResult {
     } else {
         args.lobe.clone()
     };
-    let results = sweeps(&lobes, args.n, args.bits, args.samples as usize)?;
+    let results = sweeps(&lobes, args.n, args.bits, args.samples as usize, true)?;
     if args.format == Format::Json {
         return print_json(&results);
     }

@@ -1,55 +1,27 @@
 //! The report's hardware section: each datapath's error against word length beside its float
 //! model, the smallest width that matches it, the resources there, and the block diagrams.
 
-use rayon::prelude::*;
-use specula_hw::analysis::{sweep, WidthSweep, MEETS_TOLERANCE};
+use specula_hw::analysis::MEETS_TOLERANCE;
 use specula_hw::{diagram, HwLobe, Resources, BITS};
 
 use super::html::{figure, paragraph, table};
 use super::plot::{Chart, Series, PALETTE};
 use super::Context;
+use crate::commands::hw::{resource_cells, sweeps};
 use crate::output::{percent, sig};
 
 /// The word length the diagrams show.
 const DIAGRAM_BITS: u32 = 16;
 
-fn sweeps(n: u32, samples: usize) -> Result<Vec<WidthSweep>, String> {
-    HwLobe::ALL
-        .par_iter()
-        .map(|&lobe| sweep(lobe, n, BITS, samples, &mut |_| {}))
-        .collect::<Result<_, _>>()
-        .map_err(|e| e.to_string())
-}
-
-fn resources_summary(r: &Resources) -> String {
-    let widths = |items: Vec<String>| {
-        if items.is_empty() {
-            "-".to_owned()
-        } else {
-            items.join(", ")
-        }
-    };
-    format!(
-        "mul {}; sq {}; add {}; div {}",
-        widths(
-            r.multipliers
-                .iter()
-                .map(|(a, b)| format!("{a}x{b}"))
-                .collect()
-        ),
-        widths(r.squarers.iter().map(u32::to_string).collect()),
-        r.adders.len(),
-        widths(r.dividers.iter().map(|(a, b)| format!("{a}/{b}")).collect()),
-    )
+/// The arithmetic at one width, in one cell.
+fn arithmetic(r: &Resources) -> String {
+    let [multipliers, squarers, adders, dividers, ..] = resource_cells(r);
+    format!("mul {multipliers}; sq {squarers}; add {adders}; div {dividers}")
 }
 
 pub fn hardware(context: &mut Context) -> Result<String, String> {
     let samples = context.sizes.samples_per_zone.min(20_001);
-    let exponents: &[u32] = if context.sizes.n_steps < 20 {
-        &[64]
-    } else {
-        &[8, 64, 512]
-    };
+    let exponents = context.sizes.hardware_exponents;
     let mut html = paragraph(&format!(
         "Each approximation as a bit-accurate fixed-point datapath (SPEC section 8; crates/hw). \
          W is the word length of signals in [0, 1] (UQ1.(W-1)); wider signals keep the same \
@@ -60,7 +32,13 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
     ));
     let mut rows = Vec::new();
     for &n in exponents {
-        let results = sweeps(n, samples)?;
+        let results = sweeps(
+            &HwLobe::ALL,
+            n,
+            (*BITS.start(), *BITS.end()),
+            samples,
+            false,
+        )?;
         let series: Vec<Series> = results
             .iter()
             .enumerate()
@@ -103,7 +81,7 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
                 width.map_or("not by 24".to_owned(), |w| w.to_string()),
                 at.map_or("-".to_owned(), |row| percent(row.errors.epicentre_max_rel)),
                 at.map_or("-".to_owned(), |row| sig(row.errors.bloom_max_abs)),
-                at.map_or("-".to_owned(), |row| resources_summary(&row.resources)),
+                at.map_or("-".to_owned(), |row| arithmetic(&row.resources)),
                 at.map_or("-".to_owned(), |row| row.resources.rom_bits.to_string()),
                 at.map_or("-".to_owned(), |row| row.resources.latency.to_string()),
             ]);

@@ -48,6 +48,8 @@ pub struct Sizes {
     pub claims: ClaimOptions,
     /// Render width, height and samples per axis.
     pub render: (u32, u32, u32),
+    /// The (integer) exponents the hardware section sweeps word lengths at.
+    pub hardware_exponents: &'static [u32],
 }
 
 /// What sections share: where files go and how much to compute.

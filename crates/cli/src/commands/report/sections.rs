@@ -555,6 +555,7 @@ pub fn sizes(quick: bool) -> Sizes {
                 ..ClaimOptions::default()
             },
             render: (240, 135, 1),
+            hardware_exponents: &[64],
         }
     } else {
         Sizes {
@@ -563,6 +564,7 @@ pub fn sizes(quick: bool) -> Sizes {
             reciprocity_pairs: 20_000,
             claims: ClaimOptions::default(),
             render: (480, 270, 2),
+            hardware_exponents: &[8, 64, 512],
         }
     }
 }

@@ -1,4 +1,5 @@
-//! The mesh targets' shared check.
+//! The mesh targets' check, also run by `crates/render/tests/fuzz_regressions.rs` on the seeds
+//! and every crash input kept in `fuzz/regressions/`.
 
 use specula_render::{parse_mesh, MeshFormat};
 
