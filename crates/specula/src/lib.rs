@@ -45,6 +45,7 @@ pub mod normalisation;
 pub mod ops;
 pub mod quadrature;
 mod real;
+pub mod simd;
 pub mod zones;
 
 pub use brdf::{Brdf, ClassicModel, Rgb};

@@ -1,133 +1,163 @@
-//! Batch evaluation: a lobe over a slice of cosines, compiled for the widest SIMD the CPU has.
+//! Batch evaluation: a lobe over a slice of cosines, with the explicit SIMD kernels of
+//! [`simd`](crate::simd) at the best level the CPU has.
 //!
-//! [`Lobe::eval_batch`] dispatches at run time (through `pulp`) to a copy of the loop compiled
-//! for AVX-512, AVX2+FMA or the baseline, and each model's loop is written branch-free over
-//! plain `f32` so that the compiler vectorises it: the rules every lobe obeys become selects,
-//! the squarings of `schlick-mod` and `cosquad` are unrolled per count, and `log2`, `exp2` and
-//! `acos` are the polynomials of [`fast_math`](super::fast_math).
+//! Each model's kernel lives in its own file beside the scalar formula (`PowKernel` in
+//! `pow.rs`, and so on) and states the instructions it executes per vector
+//! ([`Lobe::batch_instructions`]); a test holds every statement to what the kernel runs.
+//! Unrolled squarings (`schlick-mod`, `cosquad`) are const generics picked here.
 //!
-//! Against the scalar `f32` path ([`Lobe::eval`]): `schlick`, `schlick-mod` and `cosquad` are
-//! bit-identical (the same IEEE operations in the same order); the others differ by the
-//! polynomials' rounding, bounded by [`Lobe::batch_ulp_bound`] (tested).
+//! Against the scalar `f32` path ([`Lobe::eval`]) the kernels differ by fused multiply-adds
+//! and by the polynomials standing in for `log2`, `exp2` and `acos`, within
+//! [`Lobe::batch_ulp_bound`] (tested at every level and for the plain loop).
 
-use super::fast_math::{acos, exp2, log2};
 use super::{Lobe, Model};
+use crate::simd::tally::{Class, Instructions};
+use crate::simd::{dispatch, Drive, Kernel, Lanes, Level};
 
-/// `t^(2^K)` by `K` squarings, unrolled.
-#[inline(always)]
-fn squarings<const K: u32>(mut x: f32) -> f32 {
-    for _ in 0..K {
-        x *= x;
-    }
-    x
+/// Which loop a batch runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BatchLoop {
+    /// The explicit kernel ([`Lobe::eval_batch`]).
+    Explicit,
+    /// The same formula as a plain per-element loop, unfused, left to the auto-vectoriser:
+    /// the peer the explicit kernels are measured against.
+    Plain,
 }
 
-/// Runs `kernel` with the squaring count as a constant, so that the loop is straight-line.
+/// A lobe's kernel, with the instructions it states it executes per vector.
+pub(crate) trait LobeKernel: Kernel {
+    /// Counted by hand from the kernel; a test compares it with [`crate::simd::tally`].
+    fn instructions(self) -> Instructions;
+}
+
+/// `t` clamped to `[0, 1]`, NaN to 0 (`min` keeps a NaN, `max` then replaces it).
+#[inline(always)]
+pub(crate) fn clamp_unit<V: Lanes>(t: V) -> V {
+    t.splat(1.0).min(t).max(t.splat(0.0))
+}
+
+/// [`clamp_unit`]'s instructions.
+pub(crate) const CLAMP: Instructions = Instructions::of(&[(Class::MinMax, 2)]);
+
+/// Runs `$body` with `$k` bound to the squaring count as a constant, so that the kernel is
+/// straight-line.
 macro_rules! with_squarings {
-    ($count:expr, $kernel:ident, $($arg:expr),*) => {
+    ($count:expr, $k:ident => $body:expr) => {
         match $count {
-            0 => $kernel::<0>($($arg),*),
-            1 => $kernel::<1>($($arg),*),
-            2 => $kernel::<2>($($arg),*),
-            3 => $kernel::<3>($($arg),*),
-            4 => $kernel::<4>($($arg),*),
-            5 => $kernel::<5>($($arg),*),
-            6 => $kernel::<6>($($arg),*),
-            7 => $kernel::<7>($($arg),*),
-            8 => $kernel::<8>($($arg),*),
-            9 => $kernel::<9>($($arg),*),
-            _ => $kernel::<10>($($arg),*),
+            0 => {
+                const $k: u32 = 0;
+                $body
+            }
+            1 => {
+                const $k: u32 = 1;
+                $body
+            }
+            2 => {
+                const $k: u32 = 2;
+                $body
+            }
+            3 => {
+                const $k: u32 = 3;
+                $body
+            }
+            4 => {
+                const $k: u32 = 4;
+                $body
+            }
+            5 => {
+                const $k: u32 = 5;
+                $body
+            }
+            6 => {
+                const $k: u32 = 6;
+                $body
+            }
+            7 => {
+                const $k: u32 = 7;
+                $body
+            }
+            8 => {
+                const $k: u32 = 8;
+                $body
+            }
+            9 => {
+                const $k: u32 = 9;
+                $body
+            }
+            _ => {
+                const $k: u32 = 10;
+                $body
+            }
         }
     };
 }
 
-/// Applies `$body` (an expression in the cosine `$c`, clamped into `(0, 1]`) to every cosine,
-/// giving 0 where `t <= 0` or NaN. A macro rather than a function taking a closure: the body
-/// must be inlined into the SIMD-enabled copy of the loop for it to vectorise, and a closure
-/// is not always inlined.
-macro_rules! each {
-    ($ts:expr, $out:expr, |$c:ident| $body:expr) => {{
-        let (ts, out): (&[f32], &mut [f32]) = ($ts, $out);
-        for (value, &t) in out.iter_mut().zip(ts) {
-            let $c = t.min(1.0).max(f32::MIN_POSITIVE);
-            let v = $body;
-            *value = if t > 0.0 { v } else { 0.0 };
-        }
-    }};
+/// What to do with a lobe's kernel, once its type is known.
+pub(crate) trait WithKernel {
+    type Output;
+    fn call<K: LobeKernel>(self, kernel: K) -> Self::Output;
 }
 
-#[inline(always)]
-fn schlick_mod<const K: u32>(ts: &[f32], out: &mut [f32], n: f32) {
-    each!(ts, out, |c| squarings::<K>(c) / (n * (1.0 - c) + c));
-}
-
-#[inline(always)]
-fn cosquad<const K: u32>(ts: &[f32], out: &mut [f32], slope: f32) {
-    each!(ts, out, |c| squarings::<K>(
-        (slope * (c - 1.0) + 1.0).max(0.0)
-    ));
-}
-
-/// One batch evaluation, as `pulp` runs it: `with_simd` is `#[inline(always)]`, so the whole
-/// body lands in the copy compiled for the CPU's SIMD level. (A closure passed to `dispatch`
-/// is only inlined when it is small; the log/exp and angle loops were not, and ran at scalar
-/// speed: measured.)
-struct Job<'a> {
-    lobe: &'a Lobe,
-    ts: &'a [f32],
-    out: &'a mut [f32],
-}
-
-impl pulp::WithSimd for Job<'_> {
-    type Output = ();
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        let Job { lobe, ts, out } = self;
-        let n = lobe.n.get() as f32;
-        match &lobe.model {
-            Model::Pow(_) => each!(ts, out, |c| exp2(n * log2(c))),
-            Model::Schlick(_) => each!(ts, out, |c| c / (n * (1.0 - c) + c)),
-            Model::SchlickMod(m) => with_squarings!(m.squarings(), schlick_mod, ts, out, n),
-            Model::AngleQuadratic(q) => {
-                let [c0, b, a] = q.coeffs().map(|v| v as f32);
-                let cutoff = q.cutoff() as f32;
-                each!(ts, out, |c| {
-                    let g = acos(c);
-                    let value = (c0 + g * (b + a * g)).min(1.0);
-                    if g < cutoff {
-                        value
-                    } else {
-                        0.0
-                    }
-                });
-            }
-            Model::LogExp(_) => each!(ts, out, |c| {
-                let y = n * log2(c);
-                (1.0 - 0.5 * log2(1.0 - y)).max(0.0)
-            }),
-            Model::LogExpRr(_) => each!(ts, out, |c| {
-                let y = n * log2(c);
-                let k = y.ceil();
-                let r = 1.0 - 0.5 * log2(1.0 - (y - k));
-                // 2^k from its exponent field (k is integral, at most 0); 0 below the normals.
-                let scale = f32::from_bits(((k.max(-127.0) + 127.0) as u32) << 23);
-                if k > -127.0 {
-                    r * scale
+impl Lobe {
+    /// Calls `f` with this lobe's kernel (one monomorphised path per model and constant).
+    pub(crate) fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        match &self.model {
+            Model::Pow(m) => f.call(m.kernel()),
+            Model::Schlick(m) => f.call(m.kernel()),
+            Model::SchlickMod(m) => with_squarings!(m.squarings(), K => f.call(m.kernel::<K>())),
+            Model::AngleQuadratic(m) => f.call(m.kernel()),
+            Model::LogExp(m) => f.call(m.kernel()),
+            Model::LogExpRr(m) => f.call(m.kernel()),
+            Model::CosQuad(m) => with_squarings!(m.squarings(), K => {
+                if m.needs_mask() {
+                    f.call(m.kernel::<K, true>())
                 } else {
-                    0.0
+                    f.call(m.kernel::<K, false>())
                 }
             }),
-            Model::CosQuad(m) => {
-                let slope = m.slope() as f32;
-                with_squarings!(m.squarings(), cosquad, ts, out, slope);
-            }
         }
     }
 }
 
-fn kernel(arch: pulp::Arch, lobe: &Lobe, ts: &[f32], out: &mut [f32]) {
-    arch.dispatch(Job { lobe, ts, out });
+struct Run<'a> {
+    level: Level,
+    batch_loop: BatchLoop,
+    ts: &'a [f32],
+    out: &'a mut [f32],
+}
+
+impl WithKernel for Run<'_> {
+    type Output = ();
+    fn call<K: LobeKernel>(self, kernel: K) {
+        let job = Drive {
+            kernel,
+            ts: self.ts,
+            out: self.out,
+            plain: self.batch_loop == BatchLoop::Plain,
+        };
+        dispatch(self.level, job);
+    }
+}
+
+struct Stated;
+
+impl WithKernel for Stated {
+    type Output = Instructions;
+    fn call<K: LobeKernel>(self, kernel: K) -> Instructions {
+        kernel.instructions()
+    }
+}
+
+#[cfg(test)]
+struct Tallied(f32);
+
+#[cfg(test)]
+impl WithKernel for Tallied {
+    type Output = Instructions;
+    fn call<K: LobeKernel>(self, kernel: K) -> Instructions {
+        crate::simd::tally::count(kernel, self.0)
+    }
 }
 
 impl Lobe {
@@ -137,8 +167,34 @@ impl Lobe {
     /// # Panics
     /// If `ts` and `out` differ in length.
     pub fn eval_batch(&self, ts: &[f32], out: &mut [f32]) {
+        self.eval_batch_with(Level::detect(), BatchLoop::Explicit, ts, out);
+    }
+
+    /// [`Lobe::eval_batch`] at a chosen level and loop (for benchmarks and tests).
+    ///
+    /// # Panics
+    /// If `ts` and `out` differ in length, or `level` is not available on this CPU.
+    pub fn eval_batch_with(
+        &self,
+        level: Level,
+        batch_loop: BatchLoop,
+        ts: &[f32],
+        out: &mut [f32],
+    ) {
         assert_eq!(ts.len(), out.len(), "eval_batch: one output per cosine");
-        kernel(pulp::Arch::new(), self, ts, out);
+        self.with_kernel(Run {
+            level,
+            batch_loop,
+            ts,
+            out,
+        });
+    }
+
+    /// The instructions the explicit kernel executes per vector (a statement counted by hand
+    /// from the kernel and tested against what it runs).
+    #[must_use]
+    pub fn batch_instructions(&self) -> Instructions {
+        self.with_kernel(Stated)
     }
 
     /// The specular lobe for structure-of-arrays shading data: element `i` has the unit normal
@@ -161,7 +217,7 @@ impl Lobe {
             "eval_directions: every component slice needs one entry per output"
         );
         const CHUNK: usize = 256;
-        let arch = pulp::Arch::new();
+        let level = Level::detect();
         {
             let mut ts = [0.0_f32; CHUNK];
             for (start, chunk) in (0..len).step_by(CHUNK).zip(out.chunks_mut(CHUNK)) {
@@ -187,7 +243,7 @@ impl Lobe {
                         }
                     };
                 }
-                kernel(arch, self, &ts[..chunk.len()], chunk);
+                self.eval_batch_with(level, BatchLoop::Explicit, &ts[..chunk.len()], chunk);
             }
         }
     }
@@ -198,7 +254,10 @@ impl Lobe {
     pub fn batch_ulp_bound(&self) -> f64 {
         let n = self.n.get();
         match self.model {
-            Model::Schlick(_) | Model::SchlickMod(_) | Model::CosQuad(_) => 0.0,
+            // One fused rounding in the denominator: a few ULP of the value.
+            Model::Schlick(_) | Model::SchlickMod(_) => 4.0,
+            // The fused base differs by half an ULP; each squaring doubles its effect.
+            Model::CosQuad(m) => 4.0 + f64::from(1u32 << m.squarings()) / 2.0,
             // exp2(n log2 t): log2's error is multiplied by n.
             Model::Pow(_) | Model::LogExp(_) | Model::LogExpRr(_) => 8.0 + 2.0 * n,
             // acos within 2.5e-7 rad, times the quadratic's slope (at most ~2n^(1/2) per rad).
@@ -250,25 +309,64 @@ mod tests {
         [s[0].as_slice(), s[1].as_slice(), s[2].as_slice()]
     }
 
-    /// The dispatched (SIMD) loop and the same loop compiled without SIMD agree bit for bit:
-    /// vectorisation changes speed, not results.
+    /// Every level, explicit and plain, agrees with the scalar path within the stated bound.
     #[test]
-    fn simd_and_scalar_compilations_agree_bitwise() {
+    fn every_level_and_loop_matches_the_scalar_path() {
         let ts: Vec<f32> = (0..4099)
             .map(|i| 1.0 - (i as f32 / 4099.0).powi(2))
+            .chain([
+                0.0,
+                -0.0,
+                -1.0,
+                f32::NAN,
+                1.5,
+                f32::INFINITY,
+                f32::MIN_POSITIVE,
+                1e-30,
+            ])
             .collect();
-        for kind in LobeKind::ALL {
+        let kinds = LobeKind::ALL
+            .into_iter()
+            .chain((0..=10).map(|v| LobeKind::CosQuad { v }));
+        for kind in kinds {
             for n in [1.0, 9.5, 100.0, 1000.0] {
                 let lobe = Lobe::new(kind, Exponent::new(n));
-                let mut simd = vec![0.0; ts.len()];
-                let mut scalar = vec![0.0; ts.len()];
-                lobe.eval_batch(&ts, &mut simd);
-                kernel(pulp::Arch::Scalar, &lobe, &ts, &mut scalar);
-                let same = simd
-                    .iter()
-                    .zip(&scalar)
-                    .all(|(a, b)| a.to_bits() == b.to_bits());
-                assert!(same, "{kind} n = {n}");
+                let bound = lobe.batch_ulp_bound() * f64::from(f32::EPSILON);
+                for level in Level::available() {
+                    for batch_loop in [BatchLoop::Explicit, BatchLoop::Plain] {
+                        let mut out = vec![0.0; ts.len()];
+                        lobe.eval_batch_with(level, batch_loop, &ts, &mut out);
+                        for (&t, &value) in ts.iter().zip(&out) {
+                            let scalar = lobe.eval(t);
+                            assert!(
+                                f64::from((value - scalar).abs()) <= bound
+                                    && (0.0..=1.0).contains(&value),
+                                "{kind} n = {n} {level:?} {batch_loop:?} t = {t}: {value} vs {scalar}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// What each kernel states it executes is what it executes, for every model and every
+    /// unrolled constant.
+    #[test]
+    fn stated_instructions_are_what_each_kernel_executes() {
+        let kinds = LobeKind::ALL
+            .into_iter()
+            .chain((0..=10).map(|v| LobeKind::CosQuad { v }));
+        for kind in kinds {
+            for n in [1.0, 3.0, 9.5, 64.0, 1000.0] {
+                let lobe = Lobe::new(kind, Exponent::new(n));
+                for t in [0.9, 0.3, -0.5] {
+                    assert_eq!(
+                        lobe.with_kernel(Tallied(t)),
+                        lobe.batch_instructions(),
+                        "{kind} n = {n} t = {t}"
+                    );
+                }
             }
         }
     }

@@ -19,7 +19,10 @@
 //!   `v` squarings.
 //! - **Source**: the thesis, slide "A model based on a cosine-quadratic function".
 
+use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use crate::real::Real;
+use crate::simd::tally::{Class, Instructions};
+use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
 
 /// The prepared cosine-quadratic lobe.
@@ -64,5 +67,64 @@ impl CosQuad {
             value = value.square();
         }
         value
+    }
+}
+
+/// The batch kernel: `max(0, a (t - 1) + 1)` fused, squared `SQUARINGS` times, unrolled.
+/// With `t` clamped to `[0, 1]`, NaN and `t <= 0` give a base of at most `1 - a`, which the
+/// `max` zeroes when `a >= 1` (`n >= 2^v`); below that (`MASKED`) a compare zeroes them.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CosQuadKernel<const SQUARINGS: u32, const MASKED: bool> {
+    slope: f32,
+}
+
+impl CosQuad {
+    /// Whether `t <= 0` needs an explicit zero (the slope is below 1).
+    pub(crate) fn needs_mask(&self) -> bool {
+        self.a < 1.0
+    }
+
+    /// The batch kernel (the caller picks `SQUARINGS = v` and `MASKED = needs_mask()`).
+    pub(crate) fn kernel<const SQUARINGS: u32, const MASKED: bool>(
+        &self,
+    ) -> CosQuadKernel<SQUARINGS, MASKED> {
+        debug_assert_eq!((SQUARINGS, MASKED), (self.squarings(), self.needs_mask()));
+        CosQuadKernel {
+            slope: self.a as f32,
+        }
+    }
+}
+
+impl<const SQUARINGS: u32, const MASKED: bool> Kernel for CosQuadKernel<SQUARINGS, MASKED> {
+    #[inline(always)]
+    fn apply<V: Lanes>(self, t: V) -> V {
+        let one = t.splat(1.0);
+        let c = clamp_unit(t);
+        let mut value = (c - one)
+            .mul_add(t.splat(self.slope), one)
+            .max(t.splat(0.0));
+        for _ in 0..SQUARINGS {
+            value = value * value;
+        }
+        if MASKED {
+            value.keep(t.gt(t.splat(0.0)))
+        } else {
+            value
+        }
+    }
+}
+
+impl<const SQUARINGS: u32, const MASKED: bool> LobeKernel for CosQuadKernel<SQUARINGS, MASKED> {
+    fn instructions(self) -> Instructions {
+        let base = CLAMP
+            .plus(Class::Add, 1)
+            .plus(Class::Fma, 1)
+            .plus(Class::MinMax, 1)
+            .plus(Class::Mul, SQUARINGS);
+        if MASKED {
+            base.plus(Class::Compare, 1).plus(Class::Logic, 1)
+        } else {
+            base
+        }
     }
 }

@@ -15,7 +15,11 @@
 //! - **Cost**: two log2, two multiplies, two adds, one comparison.
 //! - **Source**: the thesis, slide "Models based on the logarithmic and exponential functions".
 
+use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use crate::real::Real;
+use crate::simd::math::{log2, LOG2};
+use crate::simd::tally::{Class, Instructions};
+use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
 
 /// The prepared log/exp lobe.
@@ -41,4 +45,41 @@ impl LogExp {
 #[inline(always)]
 pub(crate) fn exp2_by_log2<R: Real>(y: R) -> R {
     R::from_f64(1.0) - R::from_f64(0.5) * (R::from_f64(1.0) - y).log2()
+}
+
+/// The batch kernel: `max(0, 1 - log2(1 - y) / 2)`, `y = n log2 t`, with the vector `log2`.
+/// `t` clamped to `[0, 1]` makes `t <= 0` and NaN give `y <= -127`, where the value is
+/// below 0 and the `max` zeroes it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LogExpKernel {
+    n: f32,
+}
+
+impl LogExp {
+    pub(crate) fn kernel(&self) -> LogExpKernel {
+        LogExpKernel { n: self.n as f32 }
+    }
+}
+
+impl Kernel for LogExpKernel {
+    #[inline(always)]
+    fn apply<V: Lanes>(self, t: V) -> V {
+        let one = t.splat(1.0);
+        let y = t.splat(self.n) * log2(clamp_unit(t));
+        log2(one - y)
+            .neg_mul_add(t.splat(0.5), one)
+            .max(t.splat(0.0))
+    }
+}
+
+impl LobeKernel for LogExpKernel {
+    fn instructions(self) -> Instructions {
+        CLAMP
+            .and(LOG2)
+            .and(LOG2)
+            .plus(Class::Mul, 1)
+            .plus(Class::Add, 1)
+            .plus(Class::Fma, 1)
+            .plus(Class::MinMax, 1)
+    }
 }

@@ -16,8 +16,12 @@
 //! - **Cost**: two log2, two multiplies, three adds, one rounding, one shift.
 //! - **Source**: specula.
 
+use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use super::logexp::exp2_by_log2;
 use crate::real::Real;
+use crate::simd::math::{log2, LOG2};
+use crate::simd::tally::{Class, Instructions};
+use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
 
 /// The prepared range-reduced log/exp lobe.
@@ -37,5 +41,47 @@ impl LogExpRr {
         let y = R::from_f64(self.n) * t.log2();
         let k = y.ceil();
         exp2_by_log2(y - k).shift(k)
+    }
+}
+
+/// The batch kernel. `k = ceil y` is `y` truncated (`y <= 0`), in an integer register:
+/// converted back it gives the reduced argument, shifted into an exponent field it gives
+/// `2^k`. `y` is first clamped to `-127`, whose scale has a zero exponent field: the value is 0
+/// below the normals, and for `t <= 0` and NaN (clamped to `t = 0`, `log2 0 = -127`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LogExpRrKernel {
+    n: f32,
+}
+
+impl LogExpRr {
+    pub(crate) fn kernel(&self) -> LogExpRrKernel {
+        LogExpRrKernel { n: self.n as f32 }
+    }
+}
+
+impl Kernel for LogExpRrKernel {
+    #[inline(always)]
+    fn apply<V: Lanes>(self, t: V) -> V {
+        let one = t.splat(1.0);
+        let y = (t.splat(self.n) * log2(clamp_unit(t))).max(t.splat(-127.0));
+        let k = y.float_to_int();
+        let reduced = one - (y - k.int_to_float());
+        let value = log2(reduced).neg_mul_add(t.splat(0.5), one);
+        value * k.bits_add(127).bits_shl::<23>()
+    }
+}
+
+impl LobeKernel for LogExpRrKernel {
+    fn instructions(self) -> Instructions {
+        CLAMP
+            .and(LOG2)
+            .and(LOG2)
+            .plus(Class::Mul, 2)
+            .plus(Class::MinMax, 1)
+            .plus(Class::Convert, 2)
+            .plus(Class::Add, 2)
+            .plus(Class::Fma, 1)
+            .plus(Class::IntAdd, 1)
+            .plus(Class::Shift, 1)
     }
 }

@@ -15,7 +15,6 @@ mod batch;
 mod cheb2;
 mod cheb2_thesis;
 mod cosquad;
-mod fast_math;
 mod kind;
 mod logexp;
 mod logexp_rr;
@@ -25,6 +24,7 @@ mod quadratic;
 mod schlick;
 mod schlick_mod;
 
+pub use batch::BatchLoop;
 pub use cheb2_thesis::thesis_coefficients;
 pub use cosquad::CosQuad;
 pub use kind::{LobeInfo, LobeKind, Origin, ParamInfo};

@@ -12,7 +12,11 @@
 //! - **Cost**: one general power, i.e. `exp2(n * log2 t)` in a math library.
 //! - **Source**: B. T. Phong (1975); J. F. Blinn (1977); the thesis's reference function.
 
+use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use crate::real::Real;
+use crate::simd::math::{exp2, log2, EXP2, LOG2};
+use crate::simd::tally::{Class, Instructions};
+use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
 
 /// The prepared reference lobe `t^n`.
@@ -30,5 +34,31 @@ impl Pow {
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {
         t.powf(R::from_f64(self.n))
+    }
+}
+
+/// The batch kernel: `exp2(n log2 t)` with the vector `log2` and `exp2`. The clamp to
+/// `[0, 1]` sends `t <= 0` and NaN to `log2 0 = -127`, whose `exp2` is 0: no mask needed.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PowKernel {
+    n: f32,
+}
+
+impl Pow {
+    pub(crate) fn kernel(&self) -> PowKernel {
+        PowKernel { n: self.n as f32 }
+    }
+}
+
+impl Kernel for PowKernel {
+    #[inline(always)]
+    fn apply<V: Lanes>(self, t: V) -> V {
+        exp2(t.splat(self.n) * log2(clamp_unit(t)))
+    }
+}
+
+impl LobeKernel for PowKernel {
+    fn instructions(self) -> Instructions {
+        CLAMP.and(LOG2).and(EXP2).plus(Class::Mul, 1)
     }
 }

@@ -6,7 +6,11 @@
 //! once when the lobe is prepared; the evaluation returns 0 from there on and clamps to 1 in
 //! case a fit overshoots the peak, so the lobe obeys SPEC section 1's range rule.
 
+use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use crate::real::Real;
+use crate::simd::math::{acos, ACOS};
+use crate::simd::tally::{Class, Instructions};
+use crate::simd::{Kernel, Lanes};
 
 /// A prepared quadratic-in-angle lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,6 +76,45 @@ fn first_zero([c, b, a]: [f64; 3]) -> f64 {
             .filter(|r| r.is_finite())
     };
     root.map_or(quarter, |r| r.min(quarter))
+}
+
+/// The batch kernel: `min(1, C + g (B + A g))` with `g = acos t` by the vector `acos`, zero
+/// from the cut-off on. `t` clamped to `[0, 1]` makes `t <= 0` and NaN give `g = pi/2`, which
+/// is never below the cut-off.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct AngleQuadraticKernel {
+    coeffs: [f32; 3],
+    cutoff: f32,
+}
+
+impl AngleQuadratic {
+    pub(crate) fn kernel(&self) -> AngleQuadraticKernel {
+        AngleQuadraticKernel {
+            coeffs: self.coeffs.map(|c| c as f32),
+            cutoff: self.cutoff as f32,
+        }
+    }
+}
+
+impl Kernel for AngleQuadraticKernel {
+    #[inline(always)]
+    fn apply<V: Lanes>(self, t: V) -> V {
+        let [c, b, a] = self.coeffs.map(|value| t.splat(value));
+        let g = acos(clamp_unit(t));
+        let value = a.mul_add(g, b).mul_add(g, c).min(t.splat(1.0));
+        value.keep(g.lt(t.splat(self.cutoff)))
+    }
+}
+
+impl LobeKernel for AngleQuadraticKernel {
+    fn instructions(self) -> Instructions {
+        CLAMP
+            .and(ACOS)
+            .plus(Class::Fma, 2)
+            .plus(Class::MinMax, 1)
+            .plus(Class::Compare, 1)
+            .plus(Class::Logic, 1)
+    }
 }
 
 #[cfg(test)]

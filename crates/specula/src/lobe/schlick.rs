@@ -15,7 +15,10 @@
 //! - **Cost**: one multiply, two adds, one divide.
 //! - **Source**: C. Schlick, "A customizable reflectance model for everyday rendering" (1993).
 
+use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use crate::real::Real;
+use crate::simd::tally::{Class, Instructions};
+use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
 
 /// The prepared Schlick lobe.
@@ -40,4 +43,39 @@ impl Schlick {
 #[inline(always)]
 pub(crate) fn schlick_denominator_ratio<R: Real>(numerator: R, t: R, n: f64) -> R {
     numerator / (R::from_f64(n) * (R::from_f64(1.0) - t) + t)
+}
+
+/// The batch kernel: `t / (n (1 - t) + t)` with the denominator fused; `t` clamped to
+/// `[0, 1]` makes `t <= 0` and NaN give `0 / n = 0`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SchlickKernel<const SQUARINGS: u32> {
+    pub(crate) n: f32,
+}
+
+impl Schlick {
+    pub(crate) fn kernel(&self) -> SchlickKernel<0> {
+        SchlickKernel { n: self.n as f32 }
+    }
+}
+
+impl<const SQUARINGS: u32> Kernel for SchlickKernel<SQUARINGS> {
+    #[inline(always)]
+    fn apply<V: Lanes>(self, t: V) -> V {
+        let c = clamp_unit(t);
+        let mut numerator = c;
+        for _ in 0..SQUARINGS {
+            numerator = numerator * numerator;
+        }
+        numerator / t.splat(self.n).mul_add(t.splat(1.0) - c, c)
+    }
+}
+
+impl<const SQUARINGS: u32> LobeKernel for SchlickKernel<SQUARINGS> {
+    fn instructions(self) -> Instructions {
+        CLAMP
+            .plus(Class::Mul, SQUARINGS)
+            .plus(Class::Add, 1)
+            .plus(Class::Fma, 1)
+            .plus(Class::Div, 1)
+    }
 }

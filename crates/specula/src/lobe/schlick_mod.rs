@@ -22,6 +22,7 @@
 //! - **Source**: the thesis, slide "Modified Schlick BRDF".
 
 use super::schlick::schlick_denominator_ratio;
+use super::schlick::SchlickKernel;
 use crate::real::Real;
 use crate::Exponent;
 
@@ -62,6 +63,15 @@ impl SchlickMod {
 fn floor_log2(x: f64) -> u32 {
     let biased = (x.to_bits() >> 52) & 0x7ff;
     (biased as i64 - 1023).max(0) as u32
+}
+
+impl SchlickMod {
+    /// The batch kernel: Schlick's with the numerator squared `SQUARINGS` times, unrolled
+    /// (the caller picks `SQUARINGS = self.squarings()`).
+    pub(crate) fn kernel<const SQUARINGS: u32>(&self) -> SchlickKernel<SQUARINGS> {
+        debug_assert_eq!(SQUARINGS, self.squarings);
+        SchlickKernel { n: self.n as f32 }
+    }
 }
 
 #[cfg(test)]

@@ -1,15 +1,22 @@
-//! `specula bench lobes`: batch (SIMD) lobe throughput against `powf`, a plain copy and the
-//! machine's measured FMA limit, with each lobe's error, all from one run.
+//! `specula bench lobes`: every lobe's explicit SIMD kernel against its bound (the machine's
+//! measured peaks and the instructions the kernel executes), its plain loop, `powf` and the
+//! fast pow, with its error, all from one run. The report's cost section reuses [`measure`].
 
 use std::hint::black_box;
 use std::time::Instant;
 
+use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
+use serde::Serialize;
 use specula::analysis::{error_figures, Precision};
-use specula::ops::OpCounts;
+use specula::lobe::BatchLoop;
+use specula::simd::cost::{Bound, Peaks};
+use specula::simd::tally::{Class, Instructions};
+use specula::simd::{peak, Level};
 use specula::{Exponent, Lobe, LobeKind};
 
-use crate::output::{sig, Table};
+use crate::args::Format;
+use crate::output::{percent, sig, Table};
 
 /// Elements of the L1-resident buffers (8 KiB in, 8 KiB out).
 const L1_SIZE: usize = 2048;
@@ -18,13 +25,70 @@ const STREAM_SIZE: usize = 32 << 20;
 /// Each L1 measurement runs at least this long.
 const MIN_SECONDS: f64 = 0.05;
 
+/// One lobe's figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct LobeRate {
+    /// The lobe's id.
+    pub lobe: String,
+    /// What its kernel executes per vector.
+    pub instructions: Instructions,
+    /// Evaluations per second of the explicit kernel, L1, one thread.
+    pub explicit: f64,
+    /// The same for the plain loop of the same formula.
+    pub plain: f64,
+    /// The kernel's bound.
+    pub bound: Bound,
+    /// Streaming evaluations per second, one thread and all threads (when measured).
+    pub stream: Option<[f64; 2]>,
+    /// Epicentre max relative error of the batch path.
+    pub epicentre_max_rel: f64,
+}
+
+impl LobeRate {
+    /// The measured rate as a fraction of the bound.
+    #[must_use]
+    pub fn of_bound(&self) -> f64 {
+        self.explicit / self.bound.evals_per_second
+    }
+}
+
+/// A whole run.
+#[derive(Clone, Debug, Serialize)]
+pub struct Measured {
+    /// The exponent.
+    pub n: f64,
+    /// Where the kernels ran.
+    pub level: Level,
+    /// Threads of the all-thread figures.
+    pub threads: usize,
+    /// The measured peaks.
+    pub peaks: Peaks,
+    /// `f32::powf` per element (libm), L1, one thread.
+    pub powf: f64,
+    /// Copy rate streaming, one thread and all (floats per second, when measured).
+    pub copy_stream: Option<[f64; 2]>,
+    /// Every lobe.
+    pub lobes: Vec<LobeRate>,
+}
+
+impl Measured {
+    /// The fast pow's explicit rate (the `pow` lobe's kernel).
+    #[must_use]
+    pub fn fast_pow(&self) -> f64 {
+        self.lobes
+            .iter()
+            .find(|r| r.lobe == LobeKind::Pow.id())
+            .map_or(f64::NAN, |r| r.explicit)
+    }
+}
+
 fn cosines(len: usize) -> Vec<f32> {
     (0..len)
         .map(|i| 1.0 - 0.2 * ((i % 4093) as f32 / 4093.0).powi(2))
         .collect()
 }
 
-/// Evaluations per second of `work` over an L1-sized buffer, on one thread.
+/// Evaluations per second of `work` over an L1-sized buffer, on one thread (best of 3).
 fn l1_rate(work: &(dyn Fn(&[f32], &mut [f32]) + Sync)) -> f64 {
     let ts = cosines(L1_SIZE);
     let mut out = vec![0.0; L1_SIZE];
@@ -41,198 +105,168 @@ fn l1_rate(work: &(dyn Fn(&[f32], &mut [f32]) + Sync)) -> f64 {
     best
 }
 
-/// The same on every thread at once, each with its own buffers.
-fn l1_rate_all(work: &(dyn Fn(&[f32], &mut [f32]) + Sync)) -> f64 {
-    let threads = rayon::current_num_threads();
-    let started = Instant::now();
-    let rounds: u64 = (0..threads)
-        .into_par_iter()
-        .map(|_| {
-            let ts = cosines(L1_SIZE);
-            let mut out = vec![0.0; L1_SIZE];
-            let begun = Instant::now();
-            let mut rounds = 0_u64;
-            while begun.elapsed().as_secs_f64() < 2.0 * MIN_SECONDS {
-                work(black_box(&ts), black_box(&mut out));
-                rounds += 1;
-            }
-            rounds
-        })
-        .sum();
-    rounds as f64 * L1_SIZE as f64 / started.elapsed().as_secs_f64()
-}
-
-/// Evaluations per second streaming `ts` into `out` (best of two), on one or all threads.
-fn stream_rate(
+/// Evaluations per second streaming `ts` into `out`, one thread and all (best of 2 each).
+fn stream_rates(
     ts: &[f32],
     out: &mut [f32],
-    all: bool,
     work: &(dyn Fn(&[f32], &mut [f32]) + Sync),
-) -> f64 {
-    let chunk = if all {
-        ts.len().div_ceil(rayon::current_num_threads())
-    } else {
-        ts.len()
-    };
-    (0..2)
-        .map(|_| {
-            let started = Instant::now();
-            ts.par_chunks(chunk)
-                .zip(out.par_chunks_mut(chunk))
-                .for_each(|(t, o)| work(t, o));
-            ts.len() as f64 / started.elapsed().as_secs_f64()
-        })
-        .fold(0.0, f64::max)
+) -> [f64; 2] {
+    [ts.len(), ts.len().div_ceil(rayon::current_num_threads())].map(|chunk| {
+        (0..2)
+            .map(|_| {
+                let started = Instant::now();
+                ts.par_chunks(chunk)
+                    .zip(out.par_chunks_mut(chunk))
+                    .for_each(|(t, o)| work(t, o));
+                ts.len() as f64 / started.elapsed().as_secs_f64()
+            })
+            .fold(0.0, f64::max)
+    })
 }
 
-/// The machine's measured peak of independent `f32` fused multiply-adds per second on one
-/// thread (8 chains per SIMD register file's worth of lanes: enough to cover FMA latency).
-fn fma_peak() -> f64 {
-    const LANES: usize = 256;
-    const STEPS: usize = 200_000;
-    let run = || {
-        let mut acc = [1.0_f32; LANES];
-        let (a, b) = (black_box(0.999_999_f32), black_box(1e-7_f32));
-        for _ in 0..STEPS {
-            for x in &mut acc {
-                *x = x.mul_add(a, b);
-            }
-        }
-        black_box(acc);
-    };
-    (0..3)
-        .map(|_| {
-            let started = Instant::now();
-            pulp::Arch::new().dispatch(run);
-            (LANES * STEPS) as f64 / started.elapsed().as_secs_f64()
-        })
-        .fold(0.0, f64::max)
-}
-
-/// An estimate of a lobe's vector-instruction cost per evaluation, in FMA slots: simple
-/// operations 1; division 4 and square root 6 (their throughput on current x86 is a quarter to
-/// a sixth of an FMA's); the batch path's `log2` 16, `exp2` 12 and `acos` 16 (the operations of
-/// their polynomials, both `acos` branches included); `pow` is a `log2` and an `exp2`.
-fn fma_slots(ops: &OpCounts) -> f64 {
-    ops.entries()
+/// Measures every lobe at `n`; with `stream`, also streaming through 128 MiB buffers.
+#[must_use]
+pub fn measure(n: Exponent, stream: bool, progress: &ProgressBar) -> Measured {
+    let level = Level::detect();
+    progress.set_length(LobeKind::ALL.len() as u64 + 2);
+    progress.set_message("peaks");
+    let peaks = peak::measure(level);
+    progress.inc(1);
+    let pow_n = n.get() as f32;
+    let powf = l1_rate(&|t, o| o.iter_mut().zip(t).for_each(|(o, &t)| *o = t.powf(pow_n)));
+    let mut buffers = stream.then(|| (cosines(STREAM_SIZE), vec![0.0_f32; STREAM_SIZE]));
+    let copy_stream = buffers
+        .as_mut()
+        .map(|(ts, out)| stream_rates(ts, out, &|t, o| o.copy_from_slice(t)));
+    progress.inc(1);
+    let lobes = LobeKind::ALL
         .iter()
-        .map(|&(name, count)| {
-            let weight = match name {
-                "div" => 4.0,
-                "sqrt" => 6.0,
-                "log2" | "acos" => 16.0,
-                "exp2" => 12.0,
-                "pow" => 29.0,
-                _ => 1.0,
+        .map(|&kind| {
+            progress.set_message(kind.to_string());
+            let lobe = Lobe::new(kind, n);
+            let run = |batch_loop| {
+                move |t: &[f32], o: &mut [f32]| lobe.eval_batch_with(level, batch_loop, t, o)
             };
-            weight * f64::from(count)
+            let rate = LobeRate {
+                lobe: kind.to_string(),
+                instructions: lobe.batch_instructions(),
+                explicit: l1_rate(&run(BatchLoop::Explicit)),
+                plain: l1_rate(&run(BatchLoop::Plain)),
+                bound: peaks.bound(&lobe.batch_instructions()),
+                stream: buffers
+                    .as_mut()
+                    .map(|(ts, out)| stream_rates(ts, out, &run(BatchLoop::Explicit))),
+                epicentre_max_rel: error_figures(&lobe, &mut Precision::F32Simd, 20_001)
+                    .epicentre_max_rel,
+            };
+            progress.inc(1);
+            rate
         })
-        .sum()
-}
-
-struct Row {
-    name: String,
-    scalar: Option<f64>,
-    l1: f64,
-    l1_all: f64,
-    stream: f64,
-    stream_all: f64,
-    slots: Option<f64>,
-    errors: Option<(f64, f64)>,
+        .collect();
+    progress.finish_and_clear();
+    Measured {
+        n: n.get(),
+        level,
+        threads: rayon::current_num_threads(),
+        peaks,
+        powf,
+        copy_stream,
+        lobes,
+    }
 }
 
 /// Measures and prints.
-pub fn run(n: Exponent) -> Result<(), String> {
-    let threads = rayon::current_num_threads();
-    let peak = fma_peak();
-    println!(
-        "lobes at n = {n}: {L1_SIZE} cosines in L1, {} Mi streaming; {threads} threads; measured FMA peak {:.1} G lane-ops/s per thread",
-        STREAM_SIZE >> 20,
-        peak / 1e9
+pub fn run(n: Exponent, format: Format) -> Result<(), String> {
+    let progress = ProgressBar::new(1).with_style(
+        ProgressStyle::with_template("measuring {bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let ts = cosines(STREAM_SIZE);
-    let mut out = vec![0.0; STREAM_SIZE];
-    let mut rows = Vec::new();
-    let mut measure = |name: String,
-                       scalar: Option<f64>,
-                       slots,
-                       errors,
-                       work: &(dyn Fn(&[f32], &mut [f32]) + Sync)| {
-        rows.push(Row {
-            name,
-            scalar,
-            l1: l1_rate(work),
-            l1_all: l1_rate_all(work),
-            stream: stream_rate(&ts, &mut out, false, work),
-            stream_all: stream_rate(&ts, &mut out, true, work),
-            slots,
-            errors,
-        });
-    };
-    let pow_n = n.get() as f32;
-    measure("copy (memory limit)".into(), None, None, None, &|t, o| {
-        o.copy_from_slice(t)
-    });
-    let powf_errors = error_figures(&Lobe::new(LobeKind::Pow, n), &mut Precision::F32, 20_001);
-    measure(
-        "powf (libm, scalar)".into(),
-        None,
-        None,
-        Some((powf_errors.epicentre_max_rel, powf_errors.bloom_max_abs)),
-        &|t, o| o.iter_mut().zip(t).for_each(|(o, &t)| *o = t.powf(pow_n)),
-    );
-    for kind in LobeKind::ALL {
-        let lobe = Lobe::new(kind, n);
-        let scalar = l1_rate(&|t, o| o.iter_mut().zip(t).for_each(|(o, &t)| *o = lobe.eval(t)));
-        let errors = error_figures(&lobe, &mut Precision::F32Simd, 20_001);
-        let name = if kind == LobeKind::Pow {
-            "pow (fast pow: exp2(n log2 t))".to_owned()
-        } else {
-            kind.to_string()
-        };
-        measure(
-            name,
-            Some(scalar),
-            Some(fma_slots(&lobe.ops())),
-            Some((errors.epicentre_max_rel, errors.bloom_max_abs)),
-            &|t, o| lobe.eval_batch(t, o),
+    let measured = measure(n, true, &progress);
+    let over: Vec<&LobeRate> = measured
+        .lobes
+        .iter()
+        .filter(|r| r.of_bound() > 1.0)
+        .collect();
+    for rate in &over {
+        eprintln!(
+            "MODEL ERROR: {} runs at {} of its bound ({}): a peak was measured too low or a \
+             resource is missing from the model (crates/specula/src/simd/cost.rs)",
+            rate.lobe,
+            percent(rate.of_bound()),
+            rate.bound.limit
         );
     }
-    let (copy, powf) = (rows[0].stream, rows[1].l1);
+    if format == Format::Json {
+        return super::super::print_json(&measured);
+    }
+    print_peaks(&measured);
+    let g = |rate: f64| format!("{:.2}", rate / 1e9);
+    let ratio = |a: f64, b: f64| format!("{:.2}x", a / b);
     let mut table = Table::new(&[
         "lobe",
-        "scalar 1T",
-        "SIMD 1T L1",
-        "SIMD all L1",
-        "SIMD 1T stream",
-        "SIMD all stream",
-        "vs powf (L1)",
-        "vs copy (stream)",
-        "FMA limit",
-        "of limit",
+        "G/s",
+        "bound G/s",
+        "of bound",
+        "limited by",
+        "instructions per vector",
+        "plain loop G/s",
+        "vs plain",
+        "vs powf",
+        "vs fast pow",
+        "stream 1T / all G/s",
+        "of copy (all)",
         "epicentre max rel",
-        "bloom max abs",
     ]);
-    let rate = |r: f64| format!("{:.2}", r / 1e9);
-    for row in &rows {
-        let limit = row.slots.map(|slots| peak / slots);
+    let copy_all = measured.copy_stream.map_or(f64::NAN, |c| c[1]);
+    for rate in &measured.lobes {
+        let stream = rate.stream.unwrap_or([f64::NAN; 2]);
         table.push(vec![
-            row.name.clone(),
-            row.scalar.map_or("-".into(), rate),
-            rate(row.l1),
-            rate(row.l1_all),
-            rate(row.stream),
-            rate(row.stream_all),
-            format!("{:.1}x", row.l1 / powf),
-            format!("{:.0}%", 100.0 * row.stream / copy),
-            limit.map_or("-".into(), rate),
-            limit.map_or("-".into(), |l| format!("{:.0}%", 100.0 * row.l1 / l)),
-            row.errors
-                .map_or("-".into(), |e| format!("{:.4}%", 100.0 * e.0)),
-            row.errors.map_or("-".into(), |e| sig(e.1)),
+            rate.lobe.clone(),
+            g(rate.explicit),
+            g(rate.bound.evals_per_second),
+            percent(rate.of_bound()),
+            rate.bound.limit.to_string(),
+            format!("{} ({})", rate.instructions.total(), rate.instructions),
+            g(rate.plain),
+            ratio(rate.explicit, rate.plain),
+            ratio(rate.explicit, measured.powf),
+            ratio(rate.explicit, measured.fast_pow()),
+            format!("{} / {}", g(stream[0]), g(stream[1])),
+            percent(stream[1] / copy_all),
+            format!("{:.4}%", 100.0 * rate.epicentre_max_rel),
         ]);
     }
-    println!("rates in G evaluations/s (copy: G floats/s); FMA limit = measured peak / estimated FMA slots per evaluation");
-    table.print(crate::args::Format::Table);
+    println!(
+        "lobes at n = {}: {L1_SIZE} cosines in L1 on one thread unless stated; streaming {} Mi \
+         cosines; level {}; powf (libm) {} G/s; copy streaming 1T / all {} G floats/s",
+        measured.n,
+        STREAM_SIZE >> 20,
+        measured.level.name(),
+        g(measured.powf),
+        measured
+            .copy_stream
+            .map_or("-".into(), |c| format!("{} / {}", g(c[0]), g(c[1]))),
+    );
+    table.print(format);
     Ok(())
+}
+
+fn print_peaks(measured: &Measured) {
+    let lanes = measured.level.lanes() as f64;
+    let peaks = &measured.peaks;
+    let mut parts: Vec<String> = Class::ALL
+        .iter()
+        .filter_map(|&class| {
+            peaks
+                .of(class)
+                .map(|p| format!("{} {}", class.name(), sig(p / 1e9)))
+        })
+        .collect();
+    parts.push(format!("issue {}", sig(peaks.issue / 1e9)));
+    parts.push(format!("L1 copy {}", sig(peaks.copy / 1e9)));
+    println!(
+        "measured peaks, G vector instructions/s on one thread ({} lanes each; mul counts against fma, cmp against issue): {}",
+        lanes,
+        parts.join(", ")
+    );
 }

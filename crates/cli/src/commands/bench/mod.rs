@@ -10,7 +10,7 @@ use specula_render::{render, Overrides, Scene, Shading};
 use super::CommandResult;
 use crate::output::Table;
 
-mod lobes;
+pub mod lobes;
 
 /// What to measure.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -43,12 +43,15 @@ pub struct Args {
     /// The exponent the lobes are prepared for (`bench lobes`).
     #[arg(long, default_value = "64", value_parser = crate::args::parse_exponent)]
     n: specula::Exponent,
+    /// Output format (`bench lobes`).
+    #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
+    format: crate::args::Format,
 }
 
 /// Measures and prints.
 pub fn run(args: &Args) -> CommandResult {
     match args.target {
-        Target::Lobes => lobes::run(args.n),
+        Target::Lobes => lobes::run(args.n, args.format),
         Target::Frame => bench_frame(args),
         Target::Render => bench_render(args),
         Target::Gpu => bench_gpu(args),

@@ -1,0 +1,156 @@
+//! The throughput bound of a kernel: from its [`Instructions`] per vector and the machine's
+//! measured [`Peaks`], the fastest it could possibly run on one thread.
+//!
+//! Each resource gives a lower bound on the time per vector, and the largest wins:
+//! - each instruction class alone, at its measured peak (`count / peak`);
+//! - the FMA pipes, shared by `fma` and `mul` (multiplies run on the FMA units on every x86
+//!   core since Haswell and Zen): `(fma + mul) / peak(fma)`;
+//! - the divider, shared by `div` and `sqrt`: `div / peak(div) + sqrt / peak(sqrt)`;
+//! - issue: every vector instruction at the measured peak of an independent mix;
+//! - memory: one load and one store per vector, at the driver's measured L1 copy rate.
+//!
+//! The peaks are measured, never typed, so a kernel measured above 100 % of its bound means a
+//! peak was measured too low or a resource is missing here: the model is wrong, not the kernel
+//! fast. `specula bench lobes` says so when it happens.
+
+use serde::Serialize;
+
+use super::tally::{Class, Instructions};
+use super::Level;
+
+/// Measured single-thread throughputs at one [`Level`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Peaks {
+    /// Where they were measured.
+    pub level: Level,
+    /// Vector instructions per second of each class alone, `None` where not measured.
+    pub per_class: [Option<f64>; 12],
+    /// Vector instructions per second of an independent mix of `fma`, `add` and `and`.
+    pub issue: f64,
+    /// Vectors per second the driver loads and stores with nothing in between (L1).
+    pub copy: f64,
+}
+
+/// The resource that bounds a kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Limit {
+    /// One instruction class.
+    Class(Class),
+    /// The FMA pipes (`fma` + `mul`).
+    FmaPipes,
+    /// The divider (`div` + `sqrt`).
+    Divider,
+    /// Instruction issue.
+    Issue,
+    /// Loads and stores.
+    Memory,
+}
+
+impl core::fmt::Display for Limit {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Limit::Class(class) => f.write_str(class.name()),
+            Limit::FmaPipes => f.write_str("fma pipes"),
+            Limit::Divider => f.write_str("divider"),
+            Limit::Issue => f.write_str("issue"),
+            Limit::Memory => f.write_str("load/store"),
+        }
+    }
+}
+
+/// A kernel's throughput bound.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Bound {
+    /// Evaluations (lanes) per second, at most.
+    pub evals_per_second: f64,
+    /// What sets it.
+    pub limit: Limit,
+}
+
+impl Peaks {
+    /// The peak of `class`, if measured.
+    #[must_use]
+    pub fn of(&self, class: Class) -> Option<f64> {
+        self.per_class[class as usize]
+    }
+
+    /// The bound of a kernel executing `instructions` per vector of `level.lanes()` lanes.
+    #[must_use]
+    pub fn bound(&self, instructions: &Instructions) -> Bound {
+        let count = |class: Class| f64::from(instructions.get(class));
+        let time = |class: Class| self.of(class).map_or(0.0, |peak| count(class) / peak);
+        let fma_peak = self.of(Class::Fma).unwrap_or(f64::INFINITY);
+        let mut candidates: Vec<(f64, Limit)> = Class::ALL
+            .iter()
+            .map(|&class| (time(class), Limit::Class(class)))
+            .collect();
+        candidates.extend([
+            (
+                (count(Class::Fma) + count(Class::Mul)) / fma_peak,
+                Limit::FmaPipes,
+            ),
+            (time(Class::Div) + time(Class::Sqrt), Limit::Divider),
+            (f64::from(instructions.total()) / self.issue, Limit::Issue),
+            (1.0 / self.copy, Limit::Memory),
+        ]);
+        // Strictly greater: on a tie, the simplest explanation (listed first) is kept.
+        let (seconds, limit) =
+            candidates.into_iter().fold(
+                (0.0, Limit::Memory),
+                |best, c| if c.0 > best.0 { c } else { best },
+            );
+        Bound {
+            evals_per_second: self.level.lanes() as f64 / seconds,
+            limit,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Round numbers for a hypothetical 8-lane machine at 1 GHz: 2 FMAs, 2 adds, 1 shift per
+    /// cycle, a divide every 4 cycles, 4 instructions issued and 1 vector copied per cycle.
+    fn peaks() -> Peaks {
+        let mut per_class = [None; 12];
+        per_class[Class::Fma as usize] = Some(2e9);
+        per_class[Class::Add as usize] = Some(2e9);
+        per_class[Class::Shift as usize] = Some(1e9);
+        per_class[Class::Div as usize] = Some(0.25e9);
+        per_class[Class::Sqrt as usize] = Some(0.25e9);
+        Peaks {
+            level: Level::Avx2,
+            per_class,
+            issue: 4e9,
+            copy: 1e9,
+        }
+    }
+
+    #[test]
+    fn a_known_loop_is_bounded_by_the_resource_it_saturates() {
+        // 8 FMAs + 2 multiplies: 10 on 2 pipes, 5 cycles per vector of 8 -> 1.6 G/s.
+        let horner = Instructions::of(&[(Class::Fma, 8), (Class::Mul, 2)]);
+        let bound = peaks().bound(&horner);
+        assert_eq!(bound.limit, Limit::FmaPipes);
+        assert!((bound.evals_per_second - 1.6e9).abs() < 1.0);
+        // One divide and one square root share the divider: 8 cycles -> 1 G/s.
+        let root = Instructions::of(&[(Class::Div, 1), (Class::Sqrt, 1), (Class::Add, 1)]);
+        let bound = peaks().bound(&root);
+        assert_eq!(bound.limit, Limit::Divider);
+        assert!((bound.evals_per_second - 1e9).abs() < 1.0);
+        // 3 fma + 3 add + 6 logic: no pipe full, 12 issued at 4 a cycle -> 3 cycles.
+        let mix = Instructions::of(&[(Class::Fma, 3), (Class::Add, 3), (Class::Logic, 6)]);
+        let bound = peaks().bound(&mix);
+        assert_eq!(bound.limit, Limit::Issue);
+        assert!((bound.evals_per_second - 8e9 / 3.0).abs() < 1.0);
+        // Nothing to compute: the copy.
+        let bound = peaks().bound(&Instructions::NONE);
+        assert_eq!(bound.limit, Limit::Memory);
+        assert!((bound.evals_per_second - 8e9).abs() < 1.0);
+        // Three shifts at one a cycle.
+        let shifts = Instructions::of(&[(Class::Shift, 3)]);
+        assert_eq!(peaks().bound(&shifts).limit, Limit::Class(Class::Shift));
+    }
+}
