@@ -1,6 +1,6 @@
 //! Error against `t^n` as a function of word length, measured with the core's zone scan.
 //!
-//! A datapath is an [`Evaluator`]: the core's [`error_figures`] samples each zone densely in
+//! A datapath is an [`Evaluator`]: the core's [`error_figures_on`] samples each zone densely in
 //! the angle (closed-form boundaries, at least `samples_per_zone` points), hands the cosines
 //! here, and compares with `cos(g)^n` in `f64`. The datapath sees its inputs as hardware
 //! would: `t` (or `g = acos t`) rounded to `UQ1.(W-1)`, so input quantisation is part of the
@@ -8,7 +8,7 @@
 //! inputs of each zone, so every representable input is visited (exhaustive in effect).
 
 use serde::Serialize;
-use specula::analysis::{error_figures, ErrorFigures, Evaluator, Precision};
+use specula::analysis::{error_figures_on, ErrorFigures, Evaluator, Precision, ZoneSamples};
 use specula::{Exponent, Lobe};
 
 use crate::datapath::{Datapath, Resources};
@@ -111,11 +111,12 @@ pub fn sweep(
 ) -> Result<WidthSweep, HwError> {
     let exponent = Exponent::try_new(f64::from(n)).map_err(|_| HwError::Exponent(f64::from(n)))?;
     let float_lobe = Lobe::new(lobe.float_kind(), exponent);
-    let float = error_figures(&float_lobe, &mut Precision::F64, samples_per_zone);
+    let samples = ZoneSamples::new(exponent, samples_per_zone);
+    let float = error_figures_on(&float_lobe, &mut Precision::F64, &samples);
     let mut rows = Vec::new();
     for bits in bits {
         let mut evaluator = HwEvaluator::new(lobe, bits, n)?;
-        let errors = error_figures(&float_lobe, &mut evaluator, samples_per_zone);
+        let errors = error_figures_on(&float_lobe, &mut evaluator, &samples);
         rows.push(WidthRow {
             bits,
             errors,

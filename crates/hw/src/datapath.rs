@@ -81,6 +81,10 @@ pub struct Datapath {
     nodes: Vec<Node>,
     inputs: Vec<NodeId>,
     output: NodeId,
+    /// Each node's log2 table (empty for other nodes), built once here rather than per
+    /// evaluation: the sweeps evaluate a datapath millions of times.
+    #[serde(skip)]
+    log2_tables: Vec<Vec<i64>>,
 }
 
 /// The datapath builder: nodes are added in order, each naming its operands.
@@ -139,11 +143,20 @@ impl Builder {
     /// The finished datapath, with `output` as its result.
     #[must_use]
     pub fn finish(self, name: &str, output: NodeId) -> Datapath {
+        let log2_tables = self
+            .nodes
+            .iter()
+            .map(|node| match node.op {
+                Op::Log2(_, unit) => unit.table(Log2Unit::table_frac_bits(node.format.frac_bits)),
+                _ => Vec::new(),
+            })
+            .collect();
         Datapath {
             name: name.to_owned(),
             nodes: self.nodes,
             inputs: self.inputs,
             output,
+            log2_tables,
         }
     }
 }
@@ -272,7 +285,8 @@ impl Datapath {
                 }
                 Op::Log2(a, unit) => {
                     let (a, fa) = at(*a);
-                    resize(unit.eval(a, fa, out.frac_bits, out))
+                    let table = &self.log2_tables[k];
+                    resize(unit.eval_with_table(table, a, fa, out.frac_bits, out))
                 }
                 Op::Min(a, b) => {
                     let ((a, fa), (b, fb)) = (at(*a), at(*b));

@@ -80,6 +80,21 @@ impl Log2Unit {
     /// `(raw, frac_bits)` of the result before its final resize.
     #[must_use]
     pub fn eval(self, raw: i64, input: Format, out_frac: u32, out: Format) -> (i128, u32) {
+        let table = self.table(Self::table_frac_bits(out_frac));
+        self.eval_with_table(&table, raw, input, out_frac, out)
+    }
+
+    /// [`Log2Unit::eval`] with the unit's [`Log2Unit::table`] for `out_frac` built once by the
+    /// caller.
+    #[must_use]
+    pub fn eval_with_table(
+        self,
+        table: &[i64],
+        raw: i64,
+        input: Format,
+        out_frac: u32,
+        out: Format,
+    ) -> (i128, u32) {
         debug_assert!(!input.signed);
         let width = input.width();
         let mantissa_bits = width - 1;
@@ -104,7 +119,6 @@ impl Log2Unit {
             ),
             Log2Unit::Table { segments_log2 } => {
                 let frac = Self::table_frac_bits(out_frac);
-                let table = self.table(frac);
                 let (index, within, within_bits) = split(normalised, mantissa_bits, segments_log2);
                 let (low, high) = (table[index], table[index + 1]);
                 let interpolated = low + (((high - low) * within) >> within_bits);

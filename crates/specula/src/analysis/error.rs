@@ -77,6 +77,45 @@ pub struct ErrorFigures {
 /// Samples per zone used by [`error_figures`] by default (SPEC asks for at least `10^5`).
 pub const DEFAULT_SAMPLES_PER_ZONE: usize = 100_001;
 
+/// The sample cosines of every zone at one `n`, with the reference `cos^n` at each: computed
+/// once and shared by every lobe and backend measured at that `n` (the hardware sweeps measure
+/// dozens of word lengths against the same samples).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ZoneSamples {
+    n: crate::Exponent,
+    /// Per zone: `(cosines, references, angular width)`.
+    zones: [(Vec<f64>, Vec<f64>, f64); 3],
+}
+
+impl ZoneSamples {
+    /// `samples_per_zone` angles per zone (at least 2), uniform, endpoints included.
+    #[must_use]
+    pub fn new(n: crate::Exponent, samples_per_zone: usize) -> Self {
+        let samples = samples_per_zone.max(2);
+        let zones = Zone::ALL.map(|zone| {
+            let (from, to) = zone.angles(n);
+            let cosines: Vec<f64> = (0..samples)
+                .map(|i| (from + (to - from) * (i as f64 / (samples - 1) as f64)).cos())
+                .collect();
+            let references = cosines.iter().map(|t| t.powf(n.get())).collect();
+            (cosines, references, to - from)
+        });
+        Self { n, zones }
+    }
+
+    /// The exponent they were taken at.
+    #[must_use]
+    pub fn exponent(&self) -> crate::Exponent {
+        self.n
+    }
+
+    /// Samples in each zone.
+    #[must_use]
+    pub fn samples_per_zone(&self) -> usize {
+        self.zones[0].0.len()
+    }
+}
+
 /// Per-zone statistics of a scan.
 #[derive(Clone, Copy, Debug, Default)]
 struct ZoneScan {
@@ -85,18 +124,15 @@ struct ZoneScan {
     mean_square: f64,
 }
 
-fn scan_zone(lobe: &Lobe, evaluator: &mut dyn Evaluator, zone: Zone, samples: usize) -> ZoneScan {
-    let n = lobe.exponent().get();
-    let (from, to) = zone.angles(lobe.exponent());
-    let samples = samples.max(2);
-    let cosines: Vec<f64> = (0..samples)
-        .map(|i| (from + (to - from) * (i as f64 / (samples - 1) as f64)).cos())
-        .collect();
-    let values = evaluator.eval_batch(lobe, &cosines);
+fn scan_zone(
+    lobe: &Lobe,
+    evaluator: &mut dyn Evaluator,
+    (cosines, references, _): &(Vec<f64>, Vec<f64>, f64),
+) -> ZoneScan {
+    let values = evaluator.eval_batch(lobe, cosines);
     let mut scan = ZoneScan::default();
     let mut sum_square = 0.0;
-    for (&t, &value) in cosines.iter().zip(&values) {
-        let reference = t.powf(n);
+    for (&reference, &value) in references.iter().zip(&values) {
         let error = (value - reference).abs();
         scan.max_abs = scan.max_abs.max(error);
         if reference > 0.0 {
@@ -104,7 +140,7 @@ fn scan_zone(lobe: &Lobe, evaluator: &mut dyn Evaluator, zone: Zone, samples: us
         }
         sum_square += error * error;
     }
-    scan.mean_square = sum_square / samples as f64;
+    scan.mean_square = sum_square / cosines.len() as f64;
     scan
 }
 
@@ -115,13 +151,30 @@ pub fn error_figures(
     evaluator: &mut dyn Evaluator,
     samples_per_zone: usize,
 ) -> ErrorFigures {
-    let [epicentre, bloom, tail] =
-        Zone::ALL.map(|zone| scan_zone(lobe, evaluator, zone, samples_per_zone));
-    let width = |zone: Zone| {
-        let (from, to) = zone.angles(lobe.exponent());
-        to - from
-    };
-    let (epicentre_width, bloom_width) = (width(Zone::Epicentre), width(Zone::Bloom));
+    error_figures_on(
+        lobe,
+        evaluator,
+        &ZoneSamples::new(lobe.exponent(), samples_per_zone),
+    )
+}
+
+/// The error figures of `lobe` on precomputed `samples` (taken at the lobe's exponent).
+///
+/// # Panics
+/// If `samples` were taken at another exponent.
+#[must_use]
+pub fn error_figures_on(
+    lobe: &Lobe,
+    evaluator: &mut dyn Evaluator,
+    samples: &ZoneSamples,
+) -> ErrorFigures {
+    assert_eq!(
+        samples.n,
+        lobe.exponent(),
+        "zone samples taken at another n"
+    );
+    let [epicentre, bloom, tail] = [0, 1, 2].map(|k| scan_zone(lobe, evaluator, &samples.zones[k]));
+    let (epicentre_width, bloom_width) = (samples.zones[0].2, samples.zones[1].2);
     let rms = ((epicentre.mean_square * epicentre_width + bloom.mean_square * bloom_width)
         / (epicentre_width + bloom_width))
         .sqrt();

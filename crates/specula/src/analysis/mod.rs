@@ -11,7 +11,10 @@ use glam::DVec3;
 use serde::Serialize;
 
 pub use albedo::{directional_albedo, max_directional_albedo, specular_albedo_per_unit};
-pub use error::{error_figures, ErrorFigures, Evaluator, Precision, DEFAULT_SAMPLES_PER_ZONE};
+pub use error::{
+    error_figures, error_figures_on, ErrorFigures, Evaluator, Precision, ZoneSamples,
+    DEFAULT_SAMPLES_PER_ZONE,
+};
 pub use reciprocity::max_reciprocity_error;
 
 use crate::normalisation::{lobe_constant, lobe_integral};

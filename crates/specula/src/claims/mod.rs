@@ -7,7 +7,7 @@
 
 use serde::Serialize;
 
-use crate::analysis::{error_figures, ErrorFigures, Precision};
+use crate::analysis::{error_figures_on, ErrorFigures, Precision, ZoneSamples};
 use crate::{Exponent, Lobe, LobeKind};
 
 mod accuracy;
@@ -202,11 +202,31 @@ pub(crate) fn figure(name: impl Into<String>, value: f64) -> Figure {
 }
 
 pub(crate) fn errors(kind: LobeKind, n: Exponent, options: &ClaimOptions) -> ErrorFigures {
-    error_figures(
-        &Lobe::new(kind, n),
-        &mut Precision::F64,
-        options.samples_per_zone,
-    )
+    let samples = zone_samples(n, options.samples_per_zone);
+    error_figures_on(&Lobe::new(kind, n), &mut Precision::F64, &samples)
+}
+
+/// The zone samples at `n`, shared by the lobes a claim compares at the same `n`: the claims
+/// loop over `n` and compare several lobes at each, so the few most recent are kept (at
+/// `10^5` samples per zone each holds 4.8 MB; keeping every `n` would hold 280 MB).
+fn zone_samples(n: Exponent, samples_per_zone: usize) -> std::sync::Arc<ZoneSamples> {
+    use std::sync::{Arc, Mutex, PoisonError};
+    const KEPT: usize = 8;
+    static RECENT: Mutex<Vec<Arc<ZoneSamples>>> = Mutex::new(Vec::new());
+    let find = |recent: &[Arc<ZoneSamples>]| {
+        recent
+            .iter()
+            .find(|s| s.exponent() == n && s.samples_per_zone() == samples_per_zone.max(2))
+            .cloned()
+    };
+    if let Some(found) = find(&RECENT.lock().unwrap_or_else(PoisonError::into_inner)) {
+        return found;
+    }
+    let made = Arc::new(ZoneSamples::new(n, samples_per_zone));
+    let mut recent = RECENT.lock().unwrap_or_else(PoisonError::into_inner);
+    recent.insert(0, Arc::clone(&made));
+    recent.truncate(KEPT);
+    made
 }
 
 /// The smallest and largest of `values`.

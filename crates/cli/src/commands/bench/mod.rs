@@ -15,7 +15,7 @@ pub mod lobes;
 /// What to measure.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Target {
-    /// Every lobe's batch (SIMD) throughput against powf, a copy and the FMA limit.
+    /// Every lobe's SIMD kernel against its bound, its plain loop, powf and the fast pow.
     Lobes,
     /// A whole frame: the CPU rasterizer against the GPU pipeline, per shading method.
     Frame,

@@ -144,16 +144,20 @@ pub fn run(args: &Args) -> CommandResult {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut bodies = Vec::new();
+    let mut timings = Vec::new();
     for (heading, section) in SECTIONS {
         bar.set_message(heading);
+        let begun = Instant::now();
         bodies.push((heading.to_owned(), section(&mut context)?));
+        timings.push(format!("{heading} {:.1} s", begun.elapsed().as_secs_f64()));
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let page = html::page("specula report", &bodies, &footer(args, started));
+    let timings = timings.join(", ");
+    let page = html::page("specula report", &bodies, &footer(args, started, &timings));
     context.write("index.html", page.as_bytes())?;
     eprintln!(
-        "wrote {} and {} images ({:.1} s)",
+        "wrote {} and {} images ({:.1} s: {timings})",
         args.out.join("index.html").display(),
         context.files.len() - 1,
         started.elapsed().as_secs_f64()
@@ -161,7 +165,7 @@ pub fn run(args: &Args) -> CommandResult {
     Ok(())
 }
 
-fn footer(args: &Args, started: Instant) -> String {
+fn footer(args: &Args, started: Instant, timings: &str) -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|info| {
@@ -174,7 +178,7 @@ fn footer(args: &Args, started: Instant) -> String {
     let threads = std::thread::available_parallelism().map_or(1, usize::from);
     let command: Vec<String> = std::env::args().collect();
     html::escape(&format!(
-        "specula {} on {cpu}, {threads} threads, {} {}; {} mode; computed in {:.1} s; command: {}",
+        "specula {} on {cpu}, {threads} threads, {} {}; {} mode; computed in {:.1} s ({timings}); command: {}",
         env!("CARGO_PKG_VERSION"),
         std::env::consts::OS,
         std::env::consts::ARCH,

@@ -469,38 +469,58 @@ pub fn claims(context: &mut Context) -> Result<String, String> {
 
 pub fn cost(context: &mut Context) -> Result<String, String> {
     let n = Exponent::new(64.0);
+    let measured = context.bench.then(|| {
+        crate::commands::bench::lobes::measure(n, false, &indicatif::ProgressBar::hidden())
+    });
     let mut rows = Vec::new();
     let mut points = Vec::new();
-    for kind in LobeKind::ALL {
+    for (k, kind) in LobeKind::ALL.into_iter().enumerate() {
         let lobe = Lobe::new(kind, n);
         let error = error_figures(&lobe, &mut Precision::F64, context.sizes.samples_per_zone)
             .epicentre_max_rel;
+        let instructions = lobe.batch_instructions();
         let mut row = vec![
             kind.to_string(),
-            lobe.ops().to_string(),
-            lobe.ops().total().to_string(),
+            format!("{} ({instructions})", instructions.total()),
             format!("{:.3}%", 100.0 * error),
         ];
-        if context.bench {
-            let ns = measure_ns_per_eval(&lobe);
-            row.push(format!("{ns:.2}"));
-            points.push((kind, ns, error.max(1e-7)));
+        if let Some(measured) = &measured {
+            let rate = &measured.lobes[k];
+            row.extend([
+                format!("{:.2}", rate.explicit / 1e9),
+                format!("{:.0}% ({})", 100.0 * rate.of_bound(), rate.bound.limit),
+                format!("{:.1}x", rate.explicit / measured.powf),
+            ]);
+            points.push((kind, 1e9 / rate.explicit, error.max(1e-7)));
         }
         rows.push(row);
     }
     let mut header = vec![
         "lobe",
-        "operations (n = 64)",
-        "total",
+        "SIMD instructions per 8 lanes (counted from the kernel)",
         "epicentre max rel error (n = 64)",
     ];
-    let mut html = String::new();
-    if context.bench {
-        header.push("ns per evaluation (f32 SIMD batch, one thread)");
+    let mut html = paragraph(
+        "What each lobe's explicit SIMD kernel executes per vector, read off the kernel (a test \
+         holds the count to what it runs); not a guess of operation weights.",
+    );
+    if let Some(measured) = &measured {
+        header.extend([
+            "G evaluations/s (one thread, L1)",
+            "of its bound",
+            "vs powf",
+        ]);
+        html += &paragraph(&format!(
+            "Measured on this machine ({}; the bound is the fastest the kernel's instructions \
+             could run at the machine's measured per-instruction peaks, see `specula bench \
+             lobes`); powf (libm) runs at {:.2} G/s.",
+            measured.level.name(),
+            measured.powf / 1e9
+        ));
         let right = points.iter().map(|p| p.1).fold(0.0, f64::max) * 1.1;
         let chart = Chart {
             title: "error against speed (n = 64): lower left is better".into(),
-            x_label: "ns per evaluation (f32 SIMD batch, one thread)".into(),
+            x_label: "ns per evaluation (explicit SIMD kernel, one thread)".into(),
             y_label: "epicentre max relative error".into(),
             x: (0.0, right),
             y: (1e-7, 1.0),
@@ -518,27 +538,9 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
         };
         html += &context.svg("pareto.svg", &chart, "error against speed")?;
     } else {
-        html += &paragraph("Run `specula report --bench` to add measured throughput and the error-against-speed plot.");
+        html += &paragraph("Run `specula report --bench` to add measured throughput, each kernel's share of its bound and the error-against-speed plot.");
     }
     Ok(table(&header, &rows) + &html)
-}
-
-/// Scalar `f32` nanoseconds per evaluation, the best of five passes over a million cosines.
-fn measure_ns_per_eval(lobe: &Lobe) -> f64 {
-    let cosines: Vec<f32> = (0..1_000_000)
-        .map(|i| 1.0 - (i as f32 / 1e6).powi(2) * 0.2)
-        .collect();
-    (0..5)
-        .map(|_| {
-            let started = std::time::Instant::now();
-            let sum: f32 = cosines
-                .iter()
-                .map(|&t| lobe.eval(std::hint::black_box(t)))
-                .sum();
-            std::hint::black_box(sum);
-            started.elapsed().as_secs_f64() * 1e9 / cosines.len() as f64
-        })
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// Sizes for `--quick` and the default.
