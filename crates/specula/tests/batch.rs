@@ -1,5 +1,5 @@
 //! The batch (SIMD) path against the scalar `f32` path, lobe by lobe, within
-//! `Lobe::batch_ulp_bound` (0: bit-identical), over random and edge-case cosines.
+//! `Lobe::batch_ulp_bound`, over random and edge-case cosines.
 
 use proptest::prelude::*;
 use specula::{Exponent, Lobe, LobeKind};

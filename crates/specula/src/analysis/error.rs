@@ -83,8 +83,17 @@ pub const DEFAULT_SAMPLES_PER_ZONE: usize = 100_001;
 #[derive(Clone, Debug, PartialEq)]
 pub struct ZoneSamples {
     n: crate::Exponent,
-    /// Per zone: `(cosines, references, angular width)`.
-    zones: [(Vec<f64>, Vec<f64>, f64); 3],
+    zones: [ZoneSample; 3],
+}
+
+/// One zone's samples.
+#[derive(Clone, Debug, PartialEq)]
+struct ZoneSample {
+    cosines: Vec<f64>,
+    /// `cos^n` at each cosine, in `f64`.
+    references: Vec<f64>,
+    /// The zone's width in angle (radians), for the RMS weighting.
+    width: f64,
 }
 
 impl ZoneSamples {
@@ -98,7 +107,11 @@ impl ZoneSamples {
                 .map(|i| (from + (to - from) * (i as f64 / (samples - 1) as f64)).cos())
                 .collect();
             let references = cosines.iter().map(|t| t.powf(n.get())).collect();
-            (cosines, references, to - from)
+            ZoneSample {
+                cosines,
+                references,
+                width: to - from,
+            }
         });
         Self { n, zones }
     }
@@ -112,7 +125,7 @@ impl ZoneSamples {
     /// Samples in each zone.
     #[must_use]
     pub fn samples_per_zone(&self) -> usize {
-        self.zones[0].0.len()
+        self.zones[0].cosines.len()
     }
 }
 
@@ -124,15 +137,11 @@ struct ZoneScan {
     mean_square: f64,
 }
 
-fn scan_zone(
-    lobe: &Lobe,
-    evaluator: &mut dyn Evaluator,
-    (cosines, references, _): &(Vec<f64>, Vec<f64>, f64),
-) -> ZoneScan {
-    let values = evaluator.eval_batch(lobe, cosines);
+fn scan_zone(lobe: &Lobe, evaluator: &mut dyn Evaluator, zone: &ZoneSample) -> ZoneScan {
+    let values = evaluator.eval_batch(lobe, &zone.cosines);
     let mut scan = ZoneScan::default();
     let mut sum_square = 0.0;
-    for (&reference, &value) in references.iter().zip(&values) {
+    for (&reference, &value) in zone.references.iter().zip(&values) {
         let error = (value - reference).abs();
         scan.max_abs = scan.max_abs.max(error);
         if reference > 0.0 {
@@ -140,7 +149,7 @@ fn scan_zone(
         }
         sum_square += error * error;
     }
-    scan.mean_square = sum_square / cosines.len() as f64;
+    scan.mean_square = sum_square / zone.cosines.len() as f64;
     scan
 }
 
@@ -173,8 +182,11 @@ pub fn error_figures_on(
         lobe.exponent(),
         "zone samples taken at another n"
     );
-    let [epicentre, bloom, tail] = [0, 1, 2].map(|k| scan_zone(lobe, evaluator, &samples.zones[k]));
-    let (epicentre_width, bloom_width) = (samples.zones[0].2, samples.zones[1].2);
+    let [epicentre, bloom, tail] = samples
+        .zones
+        .each_ref()
+        .map(|zone| scan_zone(lobe, evaluator, zone));
+    let (epicentre_width, bloom_width) = (samples.zones[0].width, samples.zones[1].width);
     let rms = ((epicentre.mean_square * epicentre_width + bloom.mean_square * bloom_width)
         / (epicentre_width + bloom_width))
         .sqrt();

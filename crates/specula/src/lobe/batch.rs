@@ -12,18 +12,7 @@
 
 use super::{Lobe, Model};
 use crate::simd::tally::{Class, Instructions};
-use crate::simd::{dispatch, Drive, Kernel, Lanes, Level};
-
-/// Which loop a batch runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum BatchLoop {
-    /// The explicit kernel ([`Lobe::eval_batch`]).
-    Explicit,
-    /// The same formula as a plain per-element loop, unfused, left to the auto-vectoriser:
-    /// the peer the explicit kernels are measured against.
-    Plain,
-}
+use crate::simd::{dispatch, BatchLoop, Drive, Kernel, Lanes, Level};
 
 /// A lobe's kernel, with the instructions it states it executes per vector.
 pub(crate) trait LobeKernel: Kernel {
@@ -40,55 +29,17 @@ pub(crate) fn clamp_unit<V: Lanes>(t: V) -> V {
 /// [`clamp_unit`]'s instructions.
 pub(crate) const CLAMP: Instructions = Instructions::of(&[(Class::MinMax, 2)]);
 
-/// Runs `$body` with `$k` bound to the squaring count as a constant, so that the kernel is
-/// straight-line.
+/// Runs `$body` with `$k` bound to the squaring count as a constant (0 to 10), so that the
+/// kernel is straight-line.
+#[rustfmt::skip]
 macro_rules! with_squarings {
     ($count:expr, $k:ident => $body:expr) => {
+        with_squarings!(@arms $count, $k, $body, 0 1 2 3 4 5 6 7 8 9)
+    };
+    (@arms $count:expr, $k:ident, $body:expr, $($value:literal)*) => {
         match $count {
-            0 => {
-                const $k: u32 = 0;
-                $body
-            }
-            1 => {
-                const $k: u32 = 1;
-                $body
-            }
-            2 => {
-                const $k: u32 = 2;
-                $body
-            }
-            3 => {
-                const $k: u32 = 3;
-                $body
-            }
-            4 => {
-                const $k: u32 = 4;
-                $body
-            }
-            5 => {
-                const $k: u32 = 5;
-                $body
-            }
-            6 => {
-                const $k: u32 = 6;
-                $body
-            }
-            7 => {
-                const $k: u32 = 7;
-                $body
-            }
-            8 => {
-                const $k: u32 = 8;
-                $body
-            }
-            9 => {
-                const $k: u32 = 9;
-                $body
-            }
-            _ => {
-                const $k: u32 = 10;
-                $body
-            }
+            $($value => { const $k: u32 = $value; $body })*
+            _ => { const $k: u32 = 10; $body }
         }
     };
 }
@@ -134,7 +85,7 @@ impl WithKernel for Run<'_> {
             kernel,
             ts: self.ts,
             out: self.out,
-            plain: self.batch_loop == BatchLoop::Plain,
+            batch_loop: self.batch_loop,
         };
         dispatch(self.level, job);
     }

@@ -24,7 +24,6 @@ mod quadratic;
 mod schlick;
 mod schlick_mod;
 
-pub use batch::BatchLoop;
 pub use cheb2_thesis::thesis_coefficients;
 pub use cosquad::CosQuad;
 pub use kind::{LobeInfo, LobeKind, Origin, ParamInfo};

@@ -4,9 +4,9 @@
 //! Each resource gives a lower bound on the time per vector, and the largest wins:
 //! - each instruction class alone, at its measured peak (`count / peak`);
 //! - the FMA pipes, shared by `fma` and `mul` (multiplies run on the FMA units on every x86
-//!   core since Haswell and Zen): `(fma + mul) / peak(fma)`;
+//!   core since Haswell and Zen): `fma / peak(fma) + mul / peak(mul)`;
 //! - the divider, shared by `div` and `sqrt`: `div / peak(div) + sqrt / peak(sqrt)`;
-//! - issue: every vector instruction at the measured peak of an independent mix;
+//! - dispatch: every vector instruction at the measured peak of an independent mix;
 //! - memory: one load and one store per vector, at the driver's measured L1 copy rate.
 //!
 //! The peaks are measured, never typed, so a kernel measured above 100 % of its bound means a
@@ -24,9 +24,9 @@ pub struct Peaks {
     /// Where they were measured.
     pub level: Level,
     /// Vector instructions per second of each class alone, `None` where not measured.
-    pub per_class: [Option<f64>; 12],
+    pub per_class: [Option<f64>; Class::ALL.len()],
     /// Vector instructions per second of an independent mix of `fma`, `add` and `and`.
-    pub issue: f64,
+    pub dispatch: f64,
     /// Vectors per second the driver loads and stores with nothing in between (L1).
     pub copy: f64,
 }
@@ -41,8 +41,8 @@ pub enum Limit {
     FmaPipes,
     /// The divider (`div` + `sqrt`).
     Divider,
-    /// Instruction issue.
-    Issue,
+    /// Instruction dispatch.
+    Dispatch,
     /// Loads and stores.
     Memory,
 }
@@ -53,7 +53,7 @@ impl core::fmt::Display for Limit {
             Limit::Class(class) => f.write_str(class.name()),
             Limit::FmaPipes => f.write_str("fma pipes"),
             Limit::Divider => f.write_str("divider"),
-            Limit::Issue => f.write_str("issue"),
+            Limit::Dispatch => f.write_str("dispatch"),
             Limit::Memory => f.write_str("load/store"),
         }
     }
@@ -80,18 +80,17 @@ impl Peaks {
     pub fn bound(&self, instructions: &Instructions) -> Bound {
         let count = |class: Class| f64::from(instructions.get(class));
         let time = |class: Class| self.of(class).map_or(0.0, |peak| count(class) / peak);
-        let fma_peak = self.of(Class::Fma).unwrap_or(f64::INFINITY);
         let mut candidates: Vec<(f64, Limit)> = Class::ALL
             .iter()
             .map(|&class| (time(class), Limit::Class(class)))
             .collect();
         candidates.extend([
-            (
-                (count(Class::Fma) + count(Class::Mul)) / fma_peak,
-                Limit::FmaPipes,
-            ),
+            (time(Class::Fma) + time(Class::Mul), Limit::FmaPipes),
             (time(Class::Div) + time(Class::Sqrt), Limit::Divider),
-            (f64::from(instructions.total()) / self.issue, Limit::Issue),
+            (
+                f64::from(instructions.total()) / self.dispatch,
+                Limit::Dispatch,
+            ),
             (1.0 / self.copy, Limit::Memory),
         ]);
         // Strictly greater: on a tie, the simplest explanation (listed first) is kept.
@@ -111,11 +110,12 @@ impl Peaks {
 mod tests {
     use super::*;
 
-    /// Round numbers for a hypothetical 8-lane machine at 1 GHz: 2 FMAs, 2 adds, 1 shift per
-    /// cycle, a divide every 4 cycles, 4 instructions issued and 1 vector copied per cycle.
+    /// Round numbers for a hypothetical 8-lane machine at 1 GHz: 2 FMAs or multiplies, 2 adds, 1 shift per
+    /// cycle, a divide every 4 cycles, 4 instructions dispatched and 1 vector copied per cycle.
     fn peaks() -> Peaks {
-        let mut per_class = [None; 12];
+        let mut per_class = [None; Class::ALL.len()];
         per_class[Class::Fma as usize] = Some(2e9);
+        per_class[Class::Mul as usize] = Some(2e9);
         per_class[Class::Add as usize] = Some(2e9);
         per_class[Class::Shift as usize] = Some(1e9);
         per_class[Class::Div as usize] = Some(0.25e9);
@@ -123,7 +123,7 @@ mod tests {
         Peaks {
             level: Level::Avx2,
             per_class,
-            issue: 4e9,
+            dispatch: 4e9,
             copy: 1e9,
         }
     }
@@ -140,10 +140,10 @@ mod tests {
         let bound = peaks().bound(&root);
         assert_eq!(bound.limit, Limit::Divider);
         assert!((bound.evals_per_second - 1e9).abs() < 1.0);
-        // 3 fma + 3 add + 6 logic: no pipe full, 12 issued at 4 a cycle -> 3 cycles.
+        // 3 fma + 3 add + 6 logic: no pipe full, 12 dispatched at 4 a cycle -> 3 cycles.
         let mix = Instructions::of(&[(Class::Fma, 3), (Class::Add, 3), (Class::Logic, 6)]);
         let bound = peaks().bound(&mix);
-        assert_eq!(bound.limit, Limit::Issue);
+        assert_eq!(bound.limit, Limit::Dispatch);
         assert!((bound.evals_per_second - 8e9 / 3.0).abs() < 1.0);
         // Nothing to compute: the copy.
         let bound = peaks().bound(&Instructions::NONE);

@@ -122,21 +122,23 @@ pub enum Level {
 }
 
 impl Level {
-    /// The best level this CPU supports.
+    /// The best level this CPU supports (cheap: feature detection is cached by `std`).
     #[must_use]
     pub fn detect() -> Self {
-        Self::available()[0]
+        #[cfg(target_arch = "x86_64")]
+        if pulp::x86::V3::try_new().is_some() {
+            return Level::Avx2;
+        }
+        Level::Baseline
     }
 
     /// Every level this CPU supports, best first.
     #[must_use]
     pub fn available() -> Vec<Level> {
-        let mut levels = Vec::with_capacity(2);
-        #[cfg(target_arch = "x86_64")]
-        if pulp::x86::V3::try_new().is_some() {
-            levels.push(Level::Avx2);
+        let mut levels = vec![Self::detect()];
+        if levels[0] != Level::Baseline {
+            levels.push(Level::Baseline);
         }
-        levels.push(Level::Baseline);
         levels
     }
 
@@ -235,13 +237,23 @@ pub(crate) fn plain_loop<K: Kernel>(kernel: K, ts: &[f32], out: &mut [f32]) {
     }
 }
 
-/// [`drive`] as a [`Job`].
+/// Which loop a batch runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BatchLoop {
+    /// The explicit kernel ([`drive`]; what `Lobe::eval_batch` runs).
+    Explicit,
+    /// The same formula as a plain per-element loop ([`plain_loop`]): the peer the explicit
+    /// kernels are measured against.
+    Plain,
+}
+
+/// [`drive`] or [`plain_loop`] as a [`Job`].
 pub(crate) struct Drive<'a, K> {
     pub kernel: K,
     pub ts: &'a [f32],
     pub out: &'a mut [f32],
-    /// Run [`plain_loop`] instead of the explicit kernel.
-    pub plain: bool,
+    pub batch_loop: BatchLoop,
 }
 
 impl<K: Kernel> Job for Drive<'_, K> {
@@ -249,10 +261,9 @@ impl<K: Kernel> Job for Drive<'_, K> {
 
     #[inline(always)]
     fn run<V: Lanes>(self, lanes: V) {
-        if self.plain {
-            plain_loop(self.kernel, self.ts, self.out);
-        } else {
-            drive(lanes, self.kernel, self.ts, self.out);
+        match self.batch_loop {
+            BatchLoop::Explicit => drive(lanes, self.kernel, self.ts, self.out),
+            BatchLoop::Plain => plain_loop(self.kernel, self.ts, self.out),
         }
     }
 }

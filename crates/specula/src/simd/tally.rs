@@ -42,7 +42,7 @@ pub enum Class {
 
 impl Class {
     /// Every class, in table order.
-    pub const ALL: [Class; 12] = [
+    pub const ALL: [Class; CLASSES] = [
         Class::Fma,
         Class::Mul,
         Class::Add,
@@ -77,18 +77,21 @@ impl Class {
     }
 }
 
+/// How many classes there are.
+const CLASSES: usize = 12;
+
 /// Instructions per vector, by class.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct Instructions([u32; 12]);
+pub struct Instructions([u32; CLASSES]);
 
 impl Instructions {
     /// No instructions.
-    pub const NONE: Instructions = Instructions([0; 12]);
+    pub const NONE: Instructions = Instructions([0; CLASSES]);
 
     /// These counts, as `(class, count)` pairs.
     #[must_use]
     pub const fn of(pairs: &[(Class, u32)]) -> Self {
-        let mut counts = [0; 12];
+        let mut counts = [0; CLASSES];
         let mut i = 0;
         while i < pairs.len() {
             counts[pairs[i].0 as usize] += pairs[i].1;
@@ -120,7 +123,7 @@ impl Instructions {
     #[must_use]
     pub const fn and(mut self, other: Instructions) -> Self {
         let mut i = 0;
-        while i < 12 {
+        while i < CLASSES {
             self.0[i] += other.0[i];
             i += 1;
         }

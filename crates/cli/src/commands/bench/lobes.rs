@@ -9,10 +9,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 use specula::analysis::{error_figures, Precision};
-use specula::lobe::BatchLoop;
 use specula::simd::cost::{Bound, Peaks};
 use specula::simd::tally::{Class, Instructions};
-use specula::simd::{peak, Level};
+use specula::simd::{peak, BatchLoop, Level};
 use specula::{Exponent, Lobe, LobeKind};
 
 use crate::args::Format;
@@ -262,10 +261,10 @@ fn print_peaks(measured: &Measured) {
                 .map(|p| format!("{} {}", class.name(), sig(p / 1e9)))
         })
         .collect();
-    parts.push(format!("issue {}", sig(peaks.issue / 1e9)));
+    parts.push(format!("dispatch {}", sig(peaks.dispatch / 1e9)));
     parts.push(format!("L1 copy {}", sig(peaks.copy / 1e9)));
     println!(
-        "measured peaks, G vector instructions/s on one thread ({} lanes each; mul counts against fma, cmp against issue): {}",
+        "measured peaks, G vector instructions/s on one thread ({} lanes each; compares count against dispatch): {}",
         lanes,
         parts.join(", ")
     );
