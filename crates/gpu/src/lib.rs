@@ -19,10 +19,12 @@
 mod context;
 mod evaluate;
 pub mod export;
+mod frame;
 mod render;
 pub mod uniforms;
 pub mod wgsl;
 
 pub use context::{Gpu, GpuError};
 pub use evaluate::{evaluate_wgsl_function, GpuEvaluator, LobeEvaluator};
+pub use frame::{FrameTime, GpuFrame};
 pub use render::GpuRenderer;

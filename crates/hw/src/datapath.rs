@@ -231,7 +231,7 @@ impl Datapath {
     /// If `inputs` does not have one value per input.
     #[must_use]
     pub fn eval(&self, inputs: &[i64]) -> i64 {
-        self.eval_all(inputs)[self.output.0]
+        self.eval_in(inputs, &mut Vec::new())
     }
 
     /// Every node's value for raw `inputs`.
@@ -240,8 +240,21 @@ impl Datapath {
     /// If `inputs` does not have one value per input.
     #[must_use]
     pub fn eval_all(&self, inputs: &[i64]) -> Vec<i64> {
+        let mut values = Vec::new();
+        self.eval_in(inputs, &mut values);
+        values
+    }
+
+    /// The output for raw `inputs`, with every node's value left in `values`: a caller that
+    /// evaluates many inputs passes the same buffer and allocates once (sweeps evaluate
+    /// millions).
+    ///
+    /// # Panics
+    /// If `inputs` does not have one value per input.
+    pub fn eval_in(&self, inputs: &[i64], values: &mut Vec<i64>) -> i64 {
         assert_eq!(inputs.len(), self.inputs.len(), "one value per input");
-        let mut values = vec![0_i64; self.nodes.len()];
+        values.clear();
+        values.resize(self.nodes.len(), 0);
         let mut next_input = inputs.iter();
         for (k, node) in self.nodes.iter().enumerate() {
             let out = node.format;
@@ -307,7 +320,7 @@ impl Datapath {
                 }
             };
         }
-        values
+        values[self.output.0]
     }
 
     /// Each node's pipeline stage: inputs and constants at 0, wiring-only shifts at their

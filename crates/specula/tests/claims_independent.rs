@@ -1,6 +1,6 @@
 //! The claims' figures against values derived here from closed forms.
 
-use specula::claims::{claim_exponents, evaluate, ClaimId, ClaimOptions, Verdict};
+use specula::claims::{claim_exponents, evaluate, evaluate_all, ClaimId, ClaimOptions, Verdict};
 
 fn options() -> ClaimOptions {
     ClaimOptions {
@@ -75,4 +75,21 @@ fn cosquad_energy_claim_is_qualified_at_small_n() {
     assert_eq!(result.verdict, Verdict::HoldsWithQualification);
     assert!(result.figures[0].value < 1e-9);
     assert!(result.figures[1].value < 1.0);
+}
+
+/// The shared error table changes nothing: all claims at once are each claim alone.
+#[test]
+fn evaluating_every_claim_at_once_gives_each_claims_own_result() {
+    let options = ClaimOptions {
+        exponents: claim_exponents(4),
+        samples_per_zone: 2_001,
+        reciprocity_pairs: 1_000,
+        seed: 7,
+    };
+    let all = evaluate_all(&options);
+    assert_eq!(all.len(), ClaimId::ALL.len());
+    for (id, result) in ClaimId::ALL.into_iter().zip(&all) {
+        assert_eq!(result.id, id);
+        assert_eq!(*result, evaluate(id, &options), "{id:?}");
+    }
 }

@@ -1,8 +1,7 @@
 //! `specula claims`: the thesis's claims with measured figures and verdicts.
 
 use indicatif::{ProgressBar, ProgressStyle};
-use rayon::prelude::*;
-use specula::claims::{evaluate, ClaimId, ClaimOptions, ClaimResult};
+use specula::claims::{evaluate_all, ClaimId, ClaimOptions, ClaimResult};
 
 use super::{print_json, CommandResult};
 use crate::output::Table;
@@ -28,18 +27,13 @@ pub enum ClaimsFormat {
 /// Tests every claim (in parallel) and prints the results in the thesis's order.
 pub fn run(args: &Args) -> CommandResult {
     let options = ClaimOptions::default();
-    let progress = ProgressBar::new(ClaimId::ALL.len() as u64).with_style(
-        ProgressStyle::with_template("testing claims {bar:30} {pos}/{len} {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    let progress = ProgressBar::new_spinner().with_style(
+        ProgressStyle::with_template("{spinner} testing {msg} claims {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
     );
-    let results: Vec<ClaimResult> = ClaimId::ALL
-        .par_iter()
-        .map(|&id| {
-            let result = evaluate(id, &options);
-            progress.inc(1);
-            result
-        })
-        .collect();
+    progress.set_message(ClaimId::ALL.len().to_string());
+    progress.enable_steady_tick(std::time::Duration::from_millis(100));
+    let results: Vec<ClaimResult> = evaluate_all(&options);
     progress.finish_and_clear();
     match args.format {
         ClaimsFormat::Json => print_json(&results),

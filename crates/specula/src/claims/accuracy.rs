@@ -1,10 +1,10 @@
 //! Claims 1-3: how close the thesis's approximations come to `cos^n`.
 
-use super::{errors, figure, range, where_true, ClaimOptions, Outcome, Verdict};
+use super::{figure, range, where_true, ClaimOptions, Errors, Outcome, Verdict};
 use crate::analysis::ErrorFigures;
 use crate::{Exponent, LobeKind};
 
-pub(super) fn schlick_mod_bloom(options: &ClaimOptions) -> Outcome {
+pub(super) fn schlick_mod_bloom(options: &ClaimOptions, errors: &Errors) -> Outcome {
     let tested: Vec<Exponent> = options
         .exponents
         .iter()
@@ -15,8 +15,8 @@ pub(super) fn schlick_mod_bloom(options: &ClaimOptions) -> Outcome {
         .iter()
         .map(|&n| {
             (
-                errors(LobeKind::Schlick, n, options),
-                errors(LobeKind::SchlickMod, n, options),
+                errors(LobeKind::Schlick, n),
+                errors(LobeKind::SchlickMod, n),
             )
         })
         .collect();
@@ -67,13 +67,13 @@ pub(super) fn schlick_mod_bloom(options: &ClaimOptions) -> Outcome {
     )
 }
 
-pub(super) fn chebyshev_epicentre(options: &ClaimOptions) -> Outcome {
+pub(super) fn chebyshev_epicentre(options: &ClaimOptions, errors: &Errors) -> Outcome {
     const BOUND: f64 = 0.005;
     let worst = |kind: LobeKind| {
         let rels: Vec<(f64, f64)> = options
             .exponents
             .iter()
-            .map(|&n| (n.get(), errors(kind, n, options).epicentre_max_rel))
+            .map(|&n| (n.get(), errors(kind, n).epicentre_max_rel))
             .collect();
         let max = rels.iter().map(|r| r.1).fold(0.0, f64::max);
         let (first, last, count) = where_true(&rels, |rel| rel <= BOUND);
@@ -123,11 +123,11 @@ pub(super) fn chebyshev_epicentre(options: &ClaimOptions) -> Outcome {
     )
 }
 
-pub(super) fn logexp_delta(options: &ClaimOptions) -> Outcome {
+pub(super) fn logexp_delta(options: &ClaimOptions, errors: &Errors) -> Outcome {
     let rows: Vec<ErrorFigures> = options
         .exponents
         .iter()
-        .map(|&n| errors(LobeKind::LogExp, n, options))
+        .map(|&n| errors(LobeKind::LogExp, n))
         .collect();
     let (rel_min, rel_max) = range(rows.iter().map(|e| e.epicentre_max_rel));
     let bloom = rows.iter().map(|e| e.bloom_max_abs).fold(0.0, f64::max);

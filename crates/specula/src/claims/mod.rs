@@ -3,11 +3,12 @@
 //! Each claim is evaluated under stated readings; the verdict follows from the measured
 //! figures and fixed thresholds that come from the claim's own wording (0.5 %, 0.29 %,
 //! "equals", "conserves"), never from the figures themselves. Claim 7 (speed) belongs to the
-//! benchmarks. Every figure is computed when [`evaluate`] runs.
+//! benchmarks. Every figure is computed when [`evaluate`] or [`evaluate_all`] runs.
 
+use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::analysis::{error_figures_on, ErrorFigures, Precision, ZoneSamples};
+use crate::analysis::{error_figures, error_figures_on, ErrorFigures, Precision, ZoneSamples};
 use crate::{Exponent, Lobe, LobeKind};
 
 mod accuracy;
@@ -70,6 +71,22 @@ impl ClaimId {
             ClaimId::EnergyCorrectModel => {
                 "6: the energy-correct model conserves energy and is Helmholtz-reciprocal"
             }
+        }
+    }
+
+    /// The lobes whose error figures against `cos^n` the claim compares, at every exponent.
+    #[must_use]
+    pub fn compared_lobes(self) -> &'static [LobeKind] {
+        match self {
+            ClaimId::SchlickModBloom => &[LobeKind::Schlick, LobeKind::SchlickMod],
+            ClaimId::ChebyshevEpicentre => {
+                &[LobeKind::Cheb2Thesis, LobeKind::Cheb2, LobeKind::Minimax2]
+            }
+            ClaimId::LogExpDelta => &[LobeKind::LogExp],
+            ClaimId::CosQuadEnergy
+            | ClaimId::ThesisPhongCoefficient
+            | ClaimId::CosQuadCoefficient
+            | ClaimId::EnergyCorrectModel => &[],
         }
     }
 }
@@ -173,10 +190,36 @@ pub fn claim_exponents(steps: usize) -> Vec<Exponent> {
 /// Tests one claim.
 #[must_use]
 pub fn evaluate(id: ClaimId, options: &ClaimOptions) -> ClaimResult {
+    evaluate_with(
+        id,
+        options,
+        &ErrorTable::measure(id.compared_lobes(), options),
+    )
+}
+
+/// Tests every claim, in the thesis's order, in parallel, measuring the error figures they
+/// share once.
+#[must_use]
+pub fn evaluate_all(options: &ClaimOptions) -> Vec<ClaimResult> {
+    let mut kinds: Vec<LobeKind> = Vec::new();
+    for kind in ClaimId::ALL.iter().flat_map(|id| id.compared_lobes()) {
+        if !kinds.contains(kind) {
+            kinds.push(*kind);
+        }
+    }
+    let table = ErrorTable::measure(&kinds, options);
+    ClaimId::ALL
+        .par_iter()
+        .map(|&id| evaluate_with(id, options, &table))
+        .collect()
+}
+
+fn evaluate_with(id: ClaimId, options: &ClaimOptions, table: &ErrorTable) -> ClaimResult {
+    let errors = |kind, n| table.get(kind, n, options);
     let (reading, measured, verdict, figures) = match id {
-        ClaimId::SchlickModBloom => schlick_mod_bloom(options),
-        ClaimId::ChebyshevEpicentre => chebyshev_epicentre(options),
-        ClaimId::LogExpDelta => logexp_delta(options),
+        ClaimId::SchlickModBloom => schlick_mod_bloom(options, &errors),
+        ClaimId::ChebyshevEpicentre => chebyshev_epicentre(options, &errors),
+        ClaimId::LogExpDelta => logexp_delta(options, &errors),
         ClaimId::CosQuadEnergy => cosquad_energy(options),
         ClaimId::ThesisPhongCoefficient => thesis_phong_coefficient(options),
         ClaimId::CosQuadCoefficient => cosquad_coefficient(options),
@@ -192,6 +235,61 @@ pub fn evaluate(id: ClaimId, options: &ClaimOptions) -> ClaimResult {
     }
 }
 
+/// Error figures against `cos^n` of some lobes at every claim exponent. Each exponent's zone
+/// samples (`cos` and `powf` in `f64` at three zones of `samples_per_zone` angles, the larger
+/// part of the work) are computed once and shared by every lobe compared there, whichever
+/// claim compares it.
+struct ErrorTable {
+    figures: Vec<(Exponent, LobeKind, ErrorFigures)>,
+}
+
+impl ErrorTable {
+    /// Measures `kinds` at every exponent of `options`, one exponent per task.
+    fn measure(kinds: &[LobeKind], options: &ClaimOptions) -> Self {
+        if kinds.is_empty() {
+            return Self {
+                figures: Vec::new(),
+            };
+        }
+        let figures = options
+            .exponents
+            .par_iter()
+            .flat_map_iter(|&n| {
+                let samples = ZoneSamples::new(n, options.samples_per_zone);
+                kinds
+                    .iter()
+                    .map(|&kind| {
+                        let lobe = Lobe::new(kind, n);
+                        (
+                            n,
+                            kind,
+                            error_figures_on(&lobe, &mut Precision::F64, &samples),
+                        )
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        Self { figures }
+    }
+
+    /// The figures of `kind` at `n`: from the table, or measured now if it lacks them.
+    fn get(&self, kind: LobeKind, n: Exponent, options: &ClaimOptions) -> ErrorFigures {
+        self.figures
+            .iter()
+            .find(|(at, measured, _)| *at == n && *measured == kind)
+            .map_or_else(
+                || {
+                    error_figures(
+                        &Lobe::new(kind, n),
+                        &mut Precision::F64,
+                        options.samples_per_zone,
+                    )
+                },
+                |(.., figures)| *figures,
+            )
+    }
+}
+
 pub(crate) type Outcome = (String, String, Verdict, Vec<Figure>);
 
 pub(crate) fn figure(name: impl Into<String>, value: f64) -> Figure {
@@ -201,33 +299,8 @@ pub(crate) fn figure(name: impl Into<String>, value: f64) -> Figure {
     }
 }
 
-pub(crate) fn errors(kind: LobeKind, n: Exponent, options: &ClaimOptions) -> ErrorFigures {
-    let samples = zone_samples(n, options.samples_per_zone);
-    error_figures_on(&Lobe::new(kind, n), &mut Precision::F64, &samples)
-}
-
-/// The zone samples at `n`, shared by the lobes a claim compares at the same `n`: the claims
-/// loop over `n` and compare several lobes at each, so the few most recent are kept (at
-/// `10^5` samples per zone each holds 4.8 MB; keeping every `n` would hold 280 MB).
-fn zone_samples(n: Exponent, samples_per_zone: usize) -> std::sync::Arc<ZoneSamples> {
-    use std::sync::{Arc, Mutex, PoisonError};
-    const KEPT: usize = 8;
-    static RECENT: Mutex<Vec<Arc<ZoneSamples>>> = Mutex::new(Vec::new());
-    let find = |recent: &[Arc<ZoneSamples>]| {
-        recent
-            .iter()
-            .find(|s| s.exponent() == n && s.samples_per_zone() == samples_per_zone.max(2))
-            .cloned()
-    };
-    if let Some(found) = find(&RECENT.lock().unwrap_or_else(PoisonError::into_inner)) {
-        return found;
-    }
-    let made = Arc::new(ZoneSamples::new(n, samples_per_zone));
-    let mut recent = RECENT.lock().unwrap_or_else(PoisonError::into_inner);
-    recent.insert(0, Arc::clone(&made));
-    recent.truncate(KEPT);
-    made
-}
+/// The error figures of a lobe at an exponent, as a claim asks for them.
+pub(crate) type Errors<'a> = dyn Fn(LobeKind, Exponent) -> ErrorFigures + 'a;
 
 /// The smallest and largest of `values`.
 pub(crate) fn range(values: impl IntoIterator<Item = f64>) -> (f64, f64) {

@@ -69,6 +69,26 @@ pub struct Bound {
 }
 
 impl Peaks {
+    /// The larger of two measurements of every peak: a clock that drifts between measuring
+    /// the peaks and the kernels (turbo, a neighbour on a shared host) only ever makes a
+    /// measured peak too low, so the best seen is the closest to the machine's.
+    #[must_use]
+    pub fn best_of(&self, other: &Peaks) -> Peaks {
+        let mut per_class = self.per_class;
+        for (mine, theirs) in per_class.iter_mut().zip(other.per_class) {
+            *mine = match (*mine, theirs) {
+                (Some(a), Some(b)) => Some(a.max(b)),
+                (a, b) => a.or(b),
+            };
+        }
+        Peaks {
+            level: self.level,
+            per_class,
+            dispatch: self.dispatch.max(other.dispatch),
+            copy: self.copy.max(other.copy),
+        }
+    }
+
     /// The peak of `class`, if measured.
     #[must_use]
     pub fn of(&self, class: Class) -> Option<f64> {
@@ -126,6 +146,22 @@ mod tests {
             dispatch: 4e9,
             copy: 1e9,
         }
+    }
+
+    #[test]
+    fn the_best_of_two_measurements_keeps_every_higher_peak() {
+        let low = peaks();
+        let mut high = peaks();
+        high.per_class[Class::Div as usize] = Some(0.5e9);
+        high.per_class[Class::Fma as usize] = Some(1e9);
+        high.per_class[Class::Convert as usize] = Some(3e9);
+        high.dispatch = 5e9;
+        let best = low.best_of(&high);
+        assert_eq!(best.of(Class::Div), Some(0.5e9));
+        assert_eq!(best.of(Class::Fma), Some(2e9));
+        assert_eq!(best.of(Class::Convert), Some(3e9));
+        assert_eq!(best.of(Class::Compare), None);
+        assert_eq!((best.dispatch, best.copy), (5e9, 1e9));
     }
 
     #[test]

@@ -47,13 +47,6 @@ pub fn measure(level: Level) -> Peaks {
 /// Floats per second the driver moves through L1 with an identity kernel, best of 3.
 #[must_use]
 pub fn copy_rate(level: Level) -> f64 {
-    #[derive(Clone, Copy)]
-    struct Identity;
-    impl Kernel for Identity {
-        fn apply<V: Lanes>(self, t: V) -> V {
-            t
-        }
-    }
     const LEN: usize = 2048;
     const ROUNDS: usize = 20_000;
     let ts = vec![0.5_f32; LEN];
@@ -62,17 +55,32 @@ pub fn copy_rate(level: Level) -> f64 {
         .map(|_| {
             let started = Instant::now();
             for _ in 0..ROUNDS {
-                let job = Drive {
-                    kernel: Identity,
-                    ts: black_box(&ts),
-                    out: black_box(&mut out),
-                    batch_loop: BatchLoop::Explicit,
-                };
-                dispatch(level, job);
+                copy(level, black_box(&ts), black_box(&mut out));
             }
             (LEN * ROUNDS) as f64 / started.elapsed().as_secs_f64()
         })
         .fold(0.0, f64::max)
+}
+
+/// Copies `ts` to `out` through the kernels' driver (an identity kernel: the same loads and
+/// stores a lobe kernel makes, and nothing else), the peer of a streaming kernel.
+pub fn copy(level: Level, ts: &[f32], out: &mut [f32]) {
+    #[derive(Clone, Copy)]
+    struct Identity;
+    impl Kernel for Identity {
+        fn apply<V: Lanes>(self, t: V) -> V {
+            t
+        }
+    }
+    dispatch(
+        level,
+        Drive {
+            kernel: Identity,
+            ts,
+            out,
+            batch_loop: BatchLoop::Explicit,
+        },
+    );
 }
 
 /// `CHAINS` chains of one instruction.

@@ -104,14 +104,14 @@ fn l1_rate(work: &(dyn Fn(&[f32], &mut [f32]) + Sync)) -> f64 {
     best
 }
 
-/// Evaluations per second streaming `ts` into `out`, one thread and all (best of 2 each).
+/// Evaluations per second streaming `ts` into `out`, one thread and all (best of 3 each).
 fn stream_rates(
     ts: &[f32],
     out: &mut [f32],
     work: &(dyn Fn(&[f32], &mut [f32]) + Sync),
 ) -> [f64; 2] {
     [ts.len(), ts.len().div_ceil(rayon::current_num_threads())].map(|chunk| {
-        (0..2)
+        (0..3)
             .map(|_| {
                 let started = Instant::now();
                 ts.par_chunks(chunk)
@@ -127,16 +127,22 @@ fn stream_rates(
 #[must_use]
 pub fn measure(n: Exponent, stream: bool, progress: &ProgressBar) -> Measured {
     let level = Level::detect();
-    progress.set_length(LobeKind::ALL.len() as u64 + 2);
+    progress.set_length(LobeKind::ALL.len() as u64 + 3);
     progress.set_message("peaks");
-    let peaks = peak::measure(level);
+    let peaks_before = peak::measure(level);
     progress.inc(1);
     let pow_n = n.get() as f32;
     let powf = l1_rate(&|t, o| o.iter_mut().zip(t).for_each(|(o, &t)| *o = t.powf(pow_n)));
     let mut buffers = stream.then(|| (cosines(STREAM_SIZE), vec![0.0_f32; STREAM_SIZE]));
-    let copy_stream = buffers
-        .as_mut()
-        .map(|(ts, out)| stream_rates(ts, out, &|t, o| o.copy_from_slice(t)));
+    // The copy peer: the faster of memcpy and the driver's own loads and stores.
+    let copy_rates = |buffers: &mut Option<(Vec<f32>, Vec<f32>)>| {
+        buffers.as_mut().map(|(ts, out)| {
+            let memcpy = stream_rates(ts, out, &|t, o| o.copy_from_slice(t));
+            let driver = stream_rates(ts, out, &|t, o| peak::copy(level, t, o));
+            [0, 1].map(|k| memcpy[k].max(driver[k]))
+        })
+    };
+    let copy_before = copy_rates(&mut buffers);
     progress.inc(1);
     let lobes = LobeKind::ALL
         .iter()
@@ -151,7 +157,7 @@ pub fn measure(n: Exponent, stream: bool, progress: &ProgressBar) -> Measured {
                 instructions: lobe.batch_instructions(),
                 explicit: l1_rate(&run(BatchLoop::Explicit)),
                 plain: l1_rate(&run(BatchLoop::Plain)),
-                bound: peaks.bound(&lobe.batch_instructions()),
+                bound: peaks_before.bound(&lobe.batch_instructions()),
                 stream: buffers
                     .as_mut()
                     .map(|(ts, out)| stream_rates(ts, out, &run(BatchLoop::Explicit))),
@@ -160,6 +166,20 @@ pub fn measure(n: Exponent, stream: bool, progress: &ProgressBar) -> Measured {
             };
             progress.inc(1);
             rate
+        })
+        .collect::<Vec<_>>();
+    // Peaks measured on both sides of the kernels, so that a clock change in between
+    // cannot put a kernel above its bound.
+    progress.set_message("peaks");
+    let peaks = peaks_before.best_of(&peak::measure(level));
+    let copy_stream = copy_before
+        .zip(copy_rates(&mut buffers))
+        .map(|(before, after)| [0, 1].map(|k| before[k].max(after[k])));
+    let lobes = lobes
+        .into_iter()
+        .map(|rate| LobeRate {
+            bound: peaks.bound(&rate.instructions),
+            ..rate
         })
         .collect();
     progress.finish_and_clear();
@@ -194,6 +214,19 @@ pub fn run(n: Exponent, format: Format) -> Result<(), String> {
             percent(rate.of_bound()),
             rate.bound.limit
         );
+    }
+    if let Some(copy) = measured.copy_stream {
+        for rate in &measured.lobes {
+            let Some(stream) = rate.stream else { continue };
+            if stream[1] > copy[1] {
+                eprintln!(
+                    "MODEL ERROR: {} streams at {} of copy: the copy peer measured low (memory \
+                     bandwidth varies on a shared host; rerun on a quiet machine)",
+                    rate.lobe,
+                    percent(stream[1] / copy[1])
+                );
+            }
+        }
     }
     if format == Format::Json {
         return super::super::print_json(&measured);

@@ -16,6 +16,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
 use specula::claims::ClaimOptions;
 use specula_render::{write_atomically, write_png_srgb8, Display, Image, Scene};
 
@@ -52,7 +53,7 @@ pub struct Sizes {
     pub hardware_exponents: &'static [u32],
 }
 
-/// What sections share: where files go and how much to compute.
+/// What a section works with: where files go, how much to compute, and what it wrote.
 pub struct Context {
     directory: PathBuf,
     sizes: Sizes,
@@ -120,11 +121,14 @@ const SECTIONS: [Section; 9] = [
     ("Reciprocity and white furnace", sections::reciprocity),
     ("The thesis's claims", sections::claims),
     ("Renders", renders::renders),
-    ("Cost", sections::cost),
+    (sections::COST, sections::cost),
     ("Hardware", hardware::hardware),
 ];
 
 /// Writes the report.
+///
+/// The sections are independent, so they run concurrently, each writing its own files; the
+/// cost section's throughput measurement (`--bench`) runs alone afterwards, on a quiet machine.
 pub fn run(args: &Args) -> CommandResult {
     let started = Instant::now();
     std::fs::create_dir_all(&args.out).map_err(|e| {
@@ -133,33 +137,50 @@ pub fn run(args: &Args) -> CommandResult {
             args.out.display()
         )
     })?;
-    let mut context = Context {
+    let context = || Context {
         directory: args.out.clone(),
         sizes: sections::sizes(args.quick),
         bench: args.bench,
         files: Vec::new(),
     };
     let bar = ProgressBar::new(SECTIONS.len() as u64).with_style(
-        ProgressStyle::with_template("report {bar:30} {pos}/{len} {msg} {elapsed}")
+        ProgressStyle::with_template("report {bar:30} {pos}/{len} sections {elapsed}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let mut bodies = Vec::new();
-    let mut timings = Vec::new();
-    for (heading, section) in SECTIONS {
-        bar.set_message(heading);
+    let run_section = |&(heading, section): &Section| {
+        let mut own = context();
         let begun = Instant::now();
-        bodies.push((heading.to_owned(), section(&mut context)?));
-        timings.push(format!("{heading} {:.1} s", begun.elapsed().as_secs_f64()));
+        let body = section(&mut own);
         bar.inc(1);
+        body.map(|body| (heading, body, begun.elapsed(), own.files))
+    };
+    let alone = |(heading, _): &&Section| args.bench && *heading == sections::COST;
+    let mut done: Vec<_> = SECTIONS
+        .par_iter()
+        .filter(|section| !alone(section))
+        .map(run_section)
+        .collect::<Result<_, String>>()?;
+    for section in SECTIONS.iter().filter(alone) {
+        done.push(run_section(section)?);
     }
     bar.finish_and_clear();
-    let timings = timings.join(", ");
+    done.sort_by_key(|(heading, ..)| SECTIONS.iter().position(|(h, _)| h == heading));
+    let mut files = Vec::new();
+    let mut bodies = Vec::new();
+    let mut timings = Vec::new();
+    for (heading, body, took, written) in done {
+        timings.push(format!("{heading} {:.1} s", took.as_secs_f64()));
+        bodies.push((heading.to_owned(), body));
+        files.extend(written);
+    }
+    let timings = format!("sections concurrently: {}", timings.join(", "));
     let page = html::page("specula report", &bodies, &footer(args, started, &timings));
-    context.write("index.html", page.as_bytes())?;
+    let mut page_context = context();
+    page_context.write("index.html", page.as_bytes())?;
     eprintln!(
-        "wrote {} and {} images ({:.1} s: {timings})",
+        "wrote {} and {} images ({:.1} s; {timings})",
         args.out.join("index.html").display(),
-        context.files.len() - 1,
+        files.len(),
         started.elapsed().as_secs_f64()
     );
     Ok(())

@@ -5,7 +5,7 @@ use rayon::prelude::*;
 use specula::analysis::{
     error_figures, max_directional_albedo, max_reciprocity_error, ErrorFigures, Precision,
 };
-use specula::claims::{evaluate, ClaimId, ClaimOptions, Verdict};
+use specula::claims::{evaluate_all, ClaimOptions, Verdict};
 use specula::normalisation::lobe_constant;
 use specula::zones::{bloom_angle, epicentre_angle};
 use specula::{Brdf, ClassicModel, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
@@ -427,10 +427,7 @@ pub fn reciprocity(context: &mut Context) -> Result<String, String> {
 
 pub fn claims(context: &mut Context) -> Result<String, String> {
     let options = context.sizes.claims.clone();
-    let results: Vec<_> = ClaimId::ALL
-        .par_iter()
-        .map(|&id| evaluate(id, &options))
-        .collect();
+    let results = evaluate_all(&options);
     let mut html = format!(
         "<p>Each claim of SPEC section 9, tested over {} exponents from 1 to 1000; thresholds come from the claims' own words.</p>\n<table><thead><tr><th>claim</th><th>verdict</th><th>measured</th><th>reading</th></tr></thead><tbody>",
         options.exponents.len()
@@ -466,6 +463,9 @@ pub fn claims(context: &mut Context) -> Result<String, String> {
     html += &table(&["claim", "figure", "value"], &figure_rows);
     Ok(html)
 }
+
+/// The cost section's heading.
+pub const COST: &str = "Cost";
 
 pub fn cost(context: &mut Context) -> Result<String, String> {
     let n = Exponent::new(64.0);
