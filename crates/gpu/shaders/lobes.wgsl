@@ -9,7 +9,7 @@ struct Lobe {
     // log2 of schlick-mod's power, or cosquad's v.
     squarings: u32,
     n: f32,
-    // cosquad's slope a = (n + 1) / (2^v + 1).
+    // cosquad's slope a = (n + 1) / (2^v + 1); a spherical Gaussian's rate log2(e) (n + offset).
     slope: f32,
     // A quadratic-in-angle lobe's C, B, A.
     quadratic: vec3<f32>,
@@ -93,6 +93,48 @@ fn lobe_cosquad(lobe: Lobe, t: f32) -> f32 {
     return value;
 }
 
+fn lobe_sg(lobe: Lobe, t: f32) -> f32 {
+    return exp2(lobe.slope * (t - 1.0));
+}
+
+fn lobe_sg_karis(lobe: Lobe, t: f32) -> f32 {
+    return exp2(lobe.slope * (t - 1.0));
+}
+
+// t = m 2^e with m in [1/2, 1), read off the bits (Rust's `Real::frexp`).
+struct Split {
+    mantissa: f32,
+    exponent: f32,
+}
+
+fn split(t: f32) -> Split {
+    let bits = bitcast<u32>(t);
+    let mantissa = bitcast<f32>((bits & 0x007fffffu) | 0x3f000000u);
+    return Split(mantissa, f32((bits >> 23u) & 0xffu) - 126.0);
+}
+
+// The float whose bits, read with 23 fraction bits, are x + 127 (Rust's `Real::bits_exp2`).
+fn bits_exp2(x: f32) -> f32 {
+    return bitcast<f32>(u32(max(x, -127.0) * 8388608.0 + 1065353216.0));
+}
+
+fn lobe_fastpow(lobe: Lobe, t: f32) -> f32 {
+    let s = split(t);
+    // fastapprox's correction as one fraction expanded around m = 1 (see fastpow.rs).
+    let u = s.mantissa - 1.0;
+    let numerator = u * (u * 0.501969698 + 1.9551622678) + 5.428491878e-9;
+    let p = lobe.n * (numerator / (u + 1.3520887068) + s.exponent);
+    let z = p - floor(p);
+    let correction = 27.7280233 / (4.84252568 - z);
+    return min(bits_exp2((p + correction - 5.7259425) - 1.49012907 * z), 1.0);
+}
+
+fn lobe_fasterpow(lobe: Lobe, t: f32) -> f32 {
+    let s = split(t);
+    let log = (s.mantissa - 1.0) * 2.0 + (s.exponent + 0.05730496);
+    return min(bits_exp2(log * lobe.n - 0.05730496), 1.0);
+}
+
 fn lobe_eval(lobe: Lobe, t: f32) -> f32 {
     // `!(t > 0)` is also true for NaN.
     if !(t > 0.0) {
@@ -109,6 +151,10 @@ fn lobe_eval(lobe: Lobe, t: f32) -> f32 {
         case 6u: { return lobe_logexp(lobe, c); }
         case 7u: { return lobe_logexp_rr(lobe, c); }
         case 8u: { return lobe_cosquad(lobe, c); }
+        case 9u: { return lobe_sg(lobe, c); }
+        case 10u: { return lobe_sg_karis(lobe, c); }
+        case 11u: { return lobe_fastpow(lobe, c); }
+        case 12u: { return lobe_fasterpow(lobe, c); }
         default: { return 0.0; }
     }
 }

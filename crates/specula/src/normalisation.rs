@@ -106,15 +106,25 @@ impl core::str::FromStr for Normalisation {
 /// divided by `2 pi` (`1/(n+1)` for `t^n`).
 ///
 /// Integrated in the angle, where every lobe is smooth between its known kinks (zone edges,
-/// the quadratic lobes' cut-off), to a relative accuracy of about `1e-12`.
+/// the quadratic lobes' cut-off), to a relative accuracy of about `1e-12`. Lobes with kinks
+/// of their own ([`Lobe::kinks`], the bit tricks) are integrated in the cosine instead, as
+/// `int_0^1 lobe(t) dt`: their kinks are cosines, and `acos` of a cosine near 1 places them
+/// only to `1e-12` rad, which leaves a jump straddling a panel that no refinement resolves.
 #[must_use]
 pub fn lobe_integral(lobe: &Lobe) -> f64 {
     let scale = 1.0 / (lobe.exponent().get() + 1.0);
-    integrate_pieces(
-        |g| lobe.eval_angle(g) * g.sin(),
-        &zones::breakpoints(lobe),
-        1e-13 * scale,
-    )
+    let kinks = lobe.kinks();
+    if kinks.is_empty() {
+        return integrate_pieces(
+            |g| lobe.eval_angle(g) * g.sin(),
+            &zones::breakpoints(lobe),
+            1e-13 * scale,
+        );
+    }
+    let n = lobe.exponent();
+    let mut cuts = vec![0.0, zones::bloom_cos(n), zones::epicentre_cos(n), 1.0];
+    cuts.extend(kinks);
+    integrate_pieces(|t| lobe.eval(t), &cuts, 1e-13 * scale)
 }
 
 /// The constant that makes `lobe` integrate to 1 over the hemisphere around its axis:

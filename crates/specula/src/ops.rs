@@ -201,6 +201,21 @@ impl Real for Counted {
         tally(|c| c.shift += 1);
         Counted(self.0.shift(k.0))
     }
+    /// Field extraction: counted as one shift (the exponent field moved into place).
+    fn frexp(self) -> (Self, Self) {
+        tally(|c| c.shift += 1);
+        let (m, e) = self.0.frexp();
+        (Counted(m), Counted(e))
+    }
+    /// A multiply-add into the bit pattern and its conversion to an integer.
+    fn bits_exp2(self) -> Self {
+        tally(|c| {
+            c.mul += 1;
+            c.add += 1;
+            c.round += 1;
+        });
+        Counted(self.0.bits_exp2())
+    }
 }
 
 #[cfg(test)]

@@ -60,6 +60,17 @@ pub trait Real:
     /// underflows the format.
     #[must_use]
     fn shift(self, k: Self) -> Self;
+    /// `(m, e)` with `self = m 2^e`, `m` in `[1/2, 1)`, for `self > 0` (C's `frexp`): read
+    /// off the float's exponent and mantissa fields, no arithmetic (in hardware, wiring).
+    #[must_use]
+    fn frexp(self) -> (Self, Self);
+    /// The float whose bit pattern, read as a number with 23 fraction bits, is `self + 127`:
+    /// `2^floor(x) (1 + x - floor(x))`, the piecewise-linear `2^x` of the IEEE bit trick
+    /// (Schraudolph 1999); 0 at or below -127. In `f32` it is what the trick computes (one
+    /// multiply-add and a float-to-int conversion, so the result lies on a grid of `2^-17`
+    /// relative steps); in `f64` it is the exact piecewise-linear function.
+    #[must_use]
+    fn bits_exp2(self) -> Self;
 }
 
 macro_rules! impl_real_for_float {
@@ -126,9 +137,55 @@ macro_rules! impl_real_for_float {
                     )
                 }
             }
+            #[inline(always)]
+            fn frexp(self) -> (Self, Self) {
+                BitTricks::frexp_fields(self)
+            }
+            #[inline(always)]
+            fn bits_exp2(self) -> Self {
+                BitTricks::bits_exp2_fields(self)
+            }
         }
     };
 }
 
 impl_real_for_float!(f32);
 impl_real_for_float!(f64);
+
+impl BitTricks for f32 {
+    #[inline(always)]
+    fn frexp_fields(self) -> (Self, Self) {
+        let bits = self.to_bits();
+        let mantissa = f32::from_bits((bits & 0x007f_ffff) | 0x3f00_0000);
+        (mantissa, ((bits >> 23) & 0xff) as f32 - 126.0)
+    }
+    #[inline(always)]
+    fn bits_exp2_fields(self) -> Self {
+        // As fastapprox writes it: (x + 127) 2^23, truncated, is the bit pattern.
+        f32::from_bits((self.max(-127.0) * 8_388_608.0 + 1_065_353_216.0) as u32)
+    }
+}
+
+impl BitTricks for f64 {
+    #[inline(always)]
+    fn frexp_fields(self) -> (Self, Self) {
+        let bits = self.to_bits();
+        let mantissa = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3fe0_0000_0000_0000);
+        (mantissa, ((bits >> 52) & 0x7ff) as f64 - 1022.0)
+    }
+    #[inline(always)]
+    fn bits_exp2_fields(self) -> Self {
+        if self <= -127.0 {
+            return 0.0;
+        }
+        let whole = self.floor();
+        (1.0 + self - whole) * 2f64.powi(whole as i32)
+    }
+}
+
+/// The bit-pattern operations behind [`Real::frexp`] and [`Real::bits_exp2`] for the float
+/// types.
+trait BitTricks: Sized {
+    fn frexp_fields(self) -> (Self, Self);
+    fn bits_exp2_fields(self) -> Self;
+}

@@ -2,7 +2,7 @@
 // canvases. The state lives in the address (history.replaceState), so a view can be shared.
 "use strict";
 
-const PALETTE = ["#000000", "#e6194b", "#3c8c3c", "#f58230", "#0082c8", "#911eb4", "#aa6e28", "#f032e6", "#808000", "#008080"];
+const PALETTE = ["#000000", "#e6194b", "#3c8c3c", "#f58230", "#0082c8", "#911eb4", "#aa6e28", "#f032e6", "#808000", "#008080", "#000080", "#800000", "#d29600"];
 const DEFAULTS = { lobes: "pow,schlick,schlick-mod", n: "64", geometry: "blinn", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0" };
 const $ = (id) => document.getElementById(id);
 let registry = null;

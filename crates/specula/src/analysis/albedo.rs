@@ -37,6 +37,8 @@ pub fn specular_albedo_per_unit(lobe: &Lobe, geometry: Geometry, theta_o: f64) -
     if let Some(quadratic) = lobe.angle_quadratic() {
         points.push(quadratic.cutoff());
     }
+    // The bit tricks' kinks: placed to 1e-12 rad, well inside this tolerance's reach.
+    points.extend(lobe.kinks().into_iter().map(f64::acos));
     let tolerance = 1e-11;
     match geometry {
         Geometry::Phong => {

@@ -67,6 +67,9 @@ impl Lobe {
                     f.call(m.kernel::<K, false>())
                 }
             }),
+            Model::Sg(m) => f.call(m.kernel()),
+            Model::FastPow(m) => f.call(m.kernel()),
+            Model::FasterPow(m) => f.call(m.kernel()),
         }
     }
 }
@@ -213,6 +216,12 @@ impl Lobe {
             Model::Pow(_) | Model::LogExp(_) | Model::LogExpRr(_) => 8.0 + 2.0 * n,
             // acos within 2.5e-7 rad, times the quadratic's slope (at most ~2n^(1/2) per rad).
             Model::AngleQuadratic(_) => 16.0 + 8.0 * n.sqrt(),
+            // One fused multiply-add against a rounded product, scaled by the value times its
+            // argument (at most 0.53), plus exp2's 2 ULP.
+            Model::Sg(_) => 8.0,
+            // The corrected log's rounding times n, plus one step of the bit-pattern grid
+            // (2^-17 relative, 64 ULP) where the two paths round it apart.
+            Model::FastPow(_) | Model::FasterPow(_) => 72.0 + 2.0 * n,
         }
     }
 }

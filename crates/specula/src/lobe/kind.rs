@@ -34,6 +34,14 @@ pub enum LobeKind {
         /// Number of squarings, `0..=10`.
         v: u8,
     },
+    /// The spherical Gaussian `exp(n (t - 1))`.
+    Sg,
+    /// The spherical Gaussian with the rate `n + 0.775`.
+    SgKaris,
+    /// The IEEE bit-trick power with fastapprox's rational corrections.
+    FastPow,
+    /// The IEEE bit-trick power without corrections (Schraudolph).
+    FasterPow,
 }
 
 /// A lobe parameter other than `n`.
@@ -105,7 +113,7 @@ const COSQUAD_V: ParamInfo = ParamInfo {
 
 impl LobeKind {
     /// Every lobe, with default parameters, in the order tables list them.
-    pub const ALL: [LobeKind; 9] = [
+    pub const ALL: [LobeKind; 13] = [
         LobeKind::Pow,
         LobeKind::Schlick,
         LobeKind::SchlickMod,
@@ -117,6 +125,10 @@ impl LobeKind {
         LobeKind::CosQuad {
             v: CosQuad::DEFAULT_V,
         },
+        LobeKind::Sg,
+        LobeKind::SgKaris,
+        LobeKind::FastPow,
+        LobeKind::FasterPow,
     ];
 
     /// The registry entry.
@@ -194,6 +206,38 @@ impl LobeKind {
                 takes_angle: false,
                 params: &[COSQUAD_V],
                 origin: Origin::Thesis,
+            },
+            LobeKind::Sg => &LobeInfo {
+                id: "sg",
+                summary: "the spherical Gaussian engines use for cos^n: one exp2",
+                formula: "exp(n (t - 1)) = exp2(n log2(e) (t - 1))",
+                takes_angle: false,
+                params: &[],
+                origin: Origin::Literature,
+            },
+            LobeKind::SgKaris => &LobeInfo {
+                id: "sg-karis",
+                summary: "the spherical Gaussian with the fitted rate n + 0.775 (UE4)",
+                formula: "exp((n + 0.775) (t - 1))",
+                takes_angle: false,
+                params: &[],
+                origin: Origin::Literature,
+            },
+            LobeKind::FastPow => &LobeInfo {
+                id: "fastpow",
+                summary: "the IEEE bit-trick power with fastapprox's rational corrections",
+                formula: "fastpow2(n fastlog2(t)), log and exp read off the float's bits",
+                takes_angle: false,
+                params: &[],
+                origin: Origin::Literature,
+            },
+            LobeKind::FasterPow => &LobeInfo {
+                id: "fasterpow",
+                summary: "the IEEE bit-trick power, uncorrected (Schraudolph; fastapprox)",
+                formula: "bits_exp2(n (bits_log2(t) + 0.0573) - 0.0573), clamped to 1",
+                takes_angle: false,
+                params: &[],
+                origin: Origin::Literature,
             },
         }
     }

@@ -15,6 +15,8 @@ mod batch;
 mod cheb2;
 mod cheb2_thesis;
 mod cosquad;
+mod fasterpow;
+mod fastpow;
 mod kind;
 mod logexp;
 mod logexp_rr;
@@ -23,11 +25,14 @@ mod pow;
 mod quadratic;
 mod schlick;
 mod schlick_mod;
+mod sg;
+mod sg_karis;
 
 pub use cheb2_thesis::thesis_coefficients;
 pub use cosquad::CosQuad;
 pub use kind::{LobeInfo, LobeKind, Origin, ParamInfo};
 pub use quadratic::AngleQuadratic;
+pub use sg_karis::KARIS_OFFSET;
 
 use crate::ops::{count_ops, Counted, OpCounts};
 use crate::real::Real;
@@ -44,7 +49,8 @@ pub struct PackedLobe {
     pub squarings: u32,
     /// The exponent.
     pub n: f64,
-    /// `cosquad`'s slope `a = (n + 1) / (2^v + 1)`.
+    /// `cosquad`'s slope `a = (n + 1) / (2^v + 1)`; a spherical Gaussian's rate
+    /// `log2(e) (n + offset)`.
     pub slope: f64,
     /// A quadratic-in-angle lobe's `[C, B, A]`.
     pub quadratic: [f64; 3],
@@ -70,6 +76,9 @@ enum Model {
     LogExp(logexp::LogExp),
     LogExpRr(logexp_rr::LogExpRr),
     CosQuad(CosQuad),
+    Sg(sg::Sg),
+    FastPow(fastpow::FastPow),
+    FasterPow(fasterpow::FasterPow),
 }
 
 impl Lobe {
@@ -86,6 +95,10 @@ impl Lobe {
             LobeKind::LogExp => Model::LogExp(logexp::LogExp::new(n)),
             LobeKind::LogExpRr => Model::LogExpRr(logexp_rr::LogExpRr::new(n)),
             LobeKind::CosQuad { v } => Model::CosQuad(CosQuad::new(n, v)),
+            LobeKind::Sg => Model::Sg(sg::Sg::new(n, 0.0)),
+            LobeKind::SgKaris => Model::Sg(sg_karis::new(n)),
+            LobeKind::FastPow => Model::FastPow(fastpow::FastPow::new(n)),
+            LobeKind::FasterPow => Model::FasterPow(fasterpow::FasterPow::new(n)),
         };
         Self { kind, n, model }
     }
@@ -134,9 +147,27 @@ impl Lobe {
                 packed.quadratic = m.coeffs();
                 packed.cutoff = m.cutoff();
             }
-            Model::Pow(_) | Model::Schlick(_) | Model::LogExp(_) | Model::LogExpRr(_) => {}
+            Model::Sg(m) => packed.slope = m.rate(),
+            Model::Pow(_)
+            | Model::Schlick(_)
+            | Model::LogExp(_)
+            | Model::LogExpRr(_)
+            | Model::FastPow(_)
+            | Model::FasterPow(_) => {}
         }
         packed
+    }
+
+    /// Cosines in `(0, 1)` where the lobe's value is not smooth beyond what
+    /// [`zones::breakpoints`](crate::zones::breakpoints) lists: the bit-trick lobes' binade
+    /// boundaries and integer crossings. Empty for the others.
+    #[must_use]
+    pub fn kinks(&self) -> Vec<f64> {
+        match &self.model {
+            Model::FastPow(m) => m.kinks(),
+            Model::FasterPow(m) => m.kinks(),
+            _ => Vec::new(),
+        }
     }
 
     /// The lobe at cosine `t` (any value; see the module docs for the rules).
@@ -154,6 +185,9 @@ impl Lobe {
                 Model::LogExp(m) => m.eval(t),
                 Model::LogExpRr(m) => m.eval(t),
                 Model::CosQuad(m) => m.eval(t),
+                Model::Sg(m) => m.eval(t),
+                Model::FastPow(m) => m.eval(t),
+                Model::FasterPow(m) => m.eval(t),
             }
         } else {
             zero

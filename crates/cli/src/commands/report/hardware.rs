@@ -5,7 +5,8 @@ use specula_hw::analysis::MEETS_TOLERANCE;
 use specula_hw::{diagram, HwLobe, Resources, BITS};
 
 use super::html::{figure, paragraph, table};
-use super::plot::{Chart, Series, PALETTE};
+use super::plot::{Chart, Series};
+use super::sections::colour;
 use super::Context;
 use crate::commands::hw::{resource_cells, sweeps};
 use crate::output::{percent, sig};
@@ -41,15 +42,14 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
         )?;
         let series: Vec<Series> = results
             .iter()
-            .enumerate()
-            .map(|(k, result)| Series {
+            .map(|result| Series {
                 name: result.lobe.id().to_owned(),
                 points: result
                     .rows
                     .iter()
                     .map(|row| (f64::from(row.bits), row.errors.epicentre_max_rel.max(1e-6)))
                     .collect(),
-                colour: PALETTE[k + 1],
+                colour: colour(result.lobe.float_kind()),
                 width: 2,
                 markers: false,
             })

@@ -44,7 +44,7 @@ fn tick(value: &f64) -> String {
 }
 
 /// The lobes' colours, in registry order (pow, the reference, is black).
-pub const PALETTE: [RGBColor; 10] = [
+pub const PALETTE: [RGBColor; specula::LobeKind::ALL.len()] = [
     RGBColor(0, 0, 0),
     RGBColor(230, 25, 75),
     RGBColor(60, 140, 60),
@@ -55,6 +55,9 @@ pub const PALETTE: [RGBColor; 10] = [
     RGBColor(240, 50, 230),
     RGBColor(128, 128, 0),
     RGBColor(0, 128, 128),
+    RGBColor(0, 0, 128),
+    RGBColor(128, 0, 0),
+    RGBColor(210, 150, 0),
 ];
 
 impl Chart {

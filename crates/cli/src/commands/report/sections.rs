@@ -25,8 +25,9 @@ fn exponents(steps: usize) -> Vec<Exponent> {
         .collect()
 }
 
-fn colour(kind: LobeKind) -> plotters::style::RGBColor {
-    PALETTE[kind.index() as usize % PALETTE.len()]
+/// The lobe's colour, the same in every plot.
+pub(super) fn colour(kind: LobeKind) -> plotters::style::RGBColor {
+    PALETTE[kind.index() as usize]
 }
 
 fn series(kind: LobeKind, points: Vec<(f64, f64)>) -> Series {
