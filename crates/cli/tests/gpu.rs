@@ -277,3 +277,19 @@ fn bench_frame_compares_cpu_and_gpu_per_shading_method() {
     }
     assert!(text.contains("CPU / GPU"), "{text}");
 }
+
+#[test]
+fn bench_gpu_lobes_lists_every_lobe_against_pow() {
+    if !have_gpu() {
+        return;
+    }
+    let directory = tempfile::tempdir().unwrap();
+    let output = ok(directory.path(), &["bench", "gpu-lobes", "--format", "csv"]);
+    let text = String::from_utf8_lossy(&output.stdout);
+    let rows: Vec<&str> = text.lines().filter(|l| l.contains("x,")).collect();
+    assert_eq!(rows.len(), specula::LobeKind::ALL.len(), "{text}");
+    assert!(
+        rows[0].starts_with("pow,") && rows[0].contains(",1.00x,"),
+        "{text}"
+    );
+}

@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use specula::LobeKind;
-use specula_gpu::{Gpu, GpuRenderer};
+use specula_gpu::{throughput, Gpu, GpuRenderer};
 use specula_render::{render, Overrides, Scene, Shading};
 
 use super::CommandResult;
@@ -23,6 +23,8 @@ pub enum Target {
     Render,
     /// The GPU renderer: ms per frame of the default scene (Phong shading) for each lobe.
     Gpu,
+    /// Every lobe in a GPU compute shader: G evaluations/s and the ratio to pow.
+    GpuLobes,
 }
 
 /// Arguments of `specula bench`.
@@ -43,7 +45,7 @@ pub struct Args {
     /// The exponent the lobes are prepared for (`bench lobes`).
     #[arg(long, default_value = "64", value_parser = crate::args::parse_exponent)]
     n: specula::Exponent,
-    /// Output format (`bench lobes`).
+    /// Output format (`bench lobes`, `bench gpu-lobes`).
     #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
     format: crate::args::Format,
 }
@@ -55,6 +57,7 @@ pub fn run(args: &Args) -> CommandResult {
         Target::Frame => bench_frame(args),
         Target::Render => bench_render(args),
         Target::Gpu => bench_gpu(args),
+        Target::GpuLobes => bench_gpu_lobes(args),
     }
 }
 
@@ -207,6 +210,33 @@ fn bench_gpu(args: &Args) -> CommandResult {
         ]);
     }
     table.print(crate::args::Format::Table);
+    Ok(())
+}
+
+fn bench_gpu_lobes(args: &Args) -> CommandResult {
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    println!(
+        "{}\nevery lobe at n = {}, its constants baked into a compute shader; each invocation \
+         sums the lobe at {} cosines; dispatches grow until one takes 20 ms, best of 5",
+        gpu.adapter_name(),
+        args.n,
+        throughput::CHAIN
+    );
+    let mut table = Table::new(&["lobe", "G evals/s", "vs pow", "evaluations timed", "ms"]);
+    let mut pow = None;
+    for kind in LobeKind::ALL {
+        let lobe = specula::Lobe::new(kind, args.n);
+        let (rate, _) = throughput::measure(&gpu, &lobe).map_err(|e| e.to_string())?;
+        let pow = *pow.get_or_insert(rate.evals_per_second);
+        table.push(vec![
+            kind.to_string(),
+            format!("{:.1}", rate.evals_per_second / 1e9),
+            format!("{:.2}x", rate.evals_per_second / pow),
+            rate.evaluations.to_string(),
+            format!("{:.2}", rate.time.as_secs_f64() * 1e3),
+        ]);
+    }
+    table.print(args.format);
     Ok(())
 }
 
