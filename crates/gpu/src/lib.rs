@@ -21,6 +21,7 @@ mod evaluate;
 pub mod export;
 mod frame;
 mod render;
+pub mod shader_ops;
 pub mod throughput;
 pub mod uniforms;
 pub mod wgsl;

@@ -40,6 +40,7 @@ mod error;
 mod exponent;
 pub mod fit;
 pub mod geometry;
+pub mod gpu_cost;
 pub mod lobe;
 pub mod normalisation;
 pub mod ops;

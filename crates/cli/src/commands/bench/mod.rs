@@ -222,20 +222,54 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
         args.n,
         throughput::CHAIN
     );
-    let mut table = Table::new(&["lobe", "G evals/s", "vs pow", "evaluations timed", "ms"]);
-    let mut pow = None;
+    let families = specula::gpu_cost::GpuFamily::ALL;
+    let mut headers = vec![
+        "lobe".to_owned(),
+        "G evals/s".to_owned(),
+        "vs pow".to_owned(),
+        "evaluations timed".to_owned(),
+        "ms".to_owned(),
+        "shader ops".to_owned(),
+    ];
+    headers.extend(
+        families
+            .iter()
+            .map(|f| format!("modelled vs pow, {}", f.id)),
+    );
+    let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
+    let mut table = Table::new(&headers);
+    let mut pow: Option<(f64, Vec<f64>)> = None;
     for kind in LobeKind::ALL {
         let lobe = specula::Lobe::new(kind, args.n);
         let (rate, _) = throughput::measure(&gpu, &lobe).map_err(|e| e.to_string())?;
-        let pow = *pow.get_or_insert(rate.evals_per_second);
-        table.push(vec![
+        let ops = specula_gpu::shader_ops::lobe_shader_ops(&lobe)?;
+        let modelled: Vec<f64> = families
+            .iter()
+            .map(|family| family.cost(&ops).evals_per_clock)
+            .collect();
+        let (pow_rate, pow_modelled) = pow
+            .get_or_insert_with(|| (rate.evals_per_second, modelled.clone()))
+            .clone();
+        let mut row = vec![
             kind.to_string(),
             format!("{:.1}", rate.evals_per_second / 1e9),
-            format!("{:.2}x", rate.evals_per_second / pow),
+            format!("{:.2}x", rate.evals_per_second / pow_rate),
             rate.evaluations.to_string(),
             format!("{:.2}", rate.time.as_secs_f64() * 1e3),
-        ]);
+            ops.expanded().total().to_string(),
+        ];
+        row.extend(
+            modelled
+                .iter()
+                .zip(&pow_modelled)
+                .map(|(m, p)| format!("{:.2}x", m / p)),
+        );
+        table.push(row);
     }
+    println!(
+        "modelled: the shader's instructions (naga IR, acos expanded) at published per-clock \
+         rates (crates/specula/src/gpu_cost.rs names the sources)"
+    );
     table.print(args.format);
     Ok(())
 }
