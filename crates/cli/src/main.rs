@@ -26,6 +26,13 @@ enum Command {
     /// List every lobe model: id, formula, parameters, operation counts.
     #[command(after_help = "Examples:\n  specula models\n  specula models --n 512 --format json")]
     Models(commands::models::Args),
+    /// Which lobe to ship on a target at an accuracy: ranked by cost, with the Pareto front.
+    #[command(
+        after_help = "Examples:\n  specula recommend --target gpu-nvidia --n 64 --max-error 1%\n  \
+                            specula recommend --target cpu --n 8..512 --max-error 0.5% --zone epicentre\n  \
+                            specula recommend --target gpu-amd --n 64 --max-error 2% --zone whole --energy-conserving --format json"
+    )]
+    Recommend(commands::recommend::Args),
     /// Evaluate one lobe at one cosine or angle, next to the exact t^n.
     #[command(
         after_help = "Examples:\n  specula eval --lobe schlick --n 32 --cos 0.98\n  \
@@ -98,6 +105,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Models(args) => commands::models::run(&args),
+        Command::Recommend(args) => commands::recommend::run(&args),
         Command::Eval(args) => commands::eval::run(&args),
         Command::Analyze(args) => commands::analyze::run(&args),
         Command::Claims(args) => commands::claims::run(&args),

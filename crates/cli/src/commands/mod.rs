@@ -7,6 +7,7 @@ pub mod diff;
 pub mod eval;
 pub mod hw;
 pub mod models;
+pub mod recommend;
 pub mod render;
 pub mod report;
 pub mod serve;

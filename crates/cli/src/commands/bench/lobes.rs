@@ -87,6 +87,15 @@ fn cosines(len: usize) -> Vec<f32> {
         .collect()
 }
 
+/// Evaluations per second of `lobe`'s SIMD kernel, L1-resident, one thread (best of 3).
+#[must_use]
+pub fn kernel_rate(lobe: &Lobe) -> f64 {
+    let level = Level::detect();
+    l1_rate(&|t: &[f32], o: &mut [f32]| {
+        lobe.eval_batch_with(level, BatchLoop::Explicit, t, o);
+    })
+}
+
 /// Evaluations per second of `work` over an L1-sized buffer, on one thread (best of 3).
 fn l1_rate(work: &(dyn Fn(&[f32], &mut [f32]) + Sync)) -> f64 {
     let ts = cosines(L1_SIZE);

@@ -1,0 +1,335 @@
+//! `specula recommend`: which lobe to ship on a target at an accuracy.
+//!
+//! Every lobe is measured against `t^n` at each exponent asked for (a range is sampled at
+//! log-spaced points, its ends and the powers of two inside, where `schlick-mod` and
+//! `cosquad` change shape); a lobe's error is its worst over them. Those within the allowed
+//! error are ranked by cost on the target: on `cpu`, the measured throughput of its SIMD
+//! kernel on this machine (one thread, L1, the slowest over the exponents); on a GPU family,
+//! the modelled evaluations per clock per multiprocessor of its exported shader
+//! (`specula::gpu_cost`). The Pareto front is taken over every lobe, met or not.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use specula::analysis::{energy_ratio, error_figures, ErrorFigures, Precision};
+use specula::gpu_cost::GpuFamily;
+use specula::{Exponent, Lobe, LobeKind};
+
+use super::CommandResult;
+use crate::output::Table;
+
+/// Where the lobe will run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Target {
+    /// This machine's CPU: measured SIMD throughput.
+    Cpu,
+    /// NVIDIA GPUs (compute capability 8.6-9.0): modelled from the shader's instructions.
+    GpuNvidia,
+    /// AMD RDNA GPUs: modelled from the shader's instructions.
+    GpuAmd,
+    /// FPGA: refused until the datapaths are synthesized (see the README).
+    Fpga,
+}
+
+/// Where the error is measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ZoneChoice {
+    /// The epicentre's largest relative error (where `t^n >= 1/2`).
+    Epicentre,
+    /// The bloom's largest absolute error, as a fraction of the peak.
+    Bloom,
+    /// The largest absolute error anywhere, as a fraction of the peak.
+    Whole,
+}
+
+/// Arguments of `specula recommend`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Where the lobe will run.
+    #[arg(long, value_enum)]
+    target: Target,
+    /// The exponent, or a range `LOW..HIGH` over which the answer must hold.
+    #[arg(long, default_value = "64", value_parser = parse_exponents)]
+    n: Exponents,
+    /// The largest error allowed, as a percentage (`1%` or `1`).
+    #[arg(long, value_parser = parse_percent)]
+    max_error: f64,
+    /// Which error.
+    #[arg(long, value_enum, default_value_t = ZoneChoice::Epicentre)]
+    zone: ZoneChoice,
+    /// Only lobes whose energy stays within 0.1 % of t^n's (so the n + 1 normalisation keeps
+    /// the BRDF energy-conserving).
+    #[arg(long)]
+    energy_conserving: bool,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
+    format: crate::args::Format,
+}
+
+/// One exponent or a sampled range.
+#[derive(Clone, Debug)]
+pub struct Exponents(Vec<Exponent>);
+
+fn parse_exponents(text: &str) -> Result<Exponents, String> {
+    let Some((low, high)) = text.split_once("..") else {
+        return Ok(Exponents(vec![crate::args::parse_exponent(text)?]));
+    };
+    let (low, high) = (
+        crate::args::parse_exponent(low)?.get(),
+        crate::args::parse_exponent(high)?.get(),
+    );
+    if low >= high {
+        return Err(format!(
+            "'{text}': a range needs LOW < HIGH, both in [1, 1000]"
+        ));
+    }
+    let mut values: Vec<f64> = (0..=8)
+        .map(|k| low * (high / low).powf(f64::from(k) / 8.0))
+        .chain(
+            (0..10)
+                .map(|p| f64::from(1u32 << p))
+                .filter(|&v| v > low && v < high),
+        )
+        .collect();
+    values.sort_by(f64::total_cmp);
+    values.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    Ok(Exponents(values.into_iter().map(Exponent::new).collect()))
+}
+
+fn parse_percent(text: &str) -> Result<f64, String> {
+    let number = text.trim().trim_end_matches('%');
+    match number.parse::<f64>() {
+        Ok(value) if value > 0.0 && value <= 100.0 => Ok(value / 100.0),
+        _ => Err(format!(
+            "'{text}' is not an error in (0, 100] %; write it as 1% or 0.5"
+        )),
+    }
+}
+
+/// One lobe's figures.
+#[derive(Clone, Debug, Serialize)]
+struct Candidate {
+    lobe: String,
+    /// The worst error over the exponents, as a fraction.
+    error: f64,
+    /// The cost figure: evaluations per second (cpu) or per clock per multiprocessor (gpu),
+    /// the smallest over the exponents. Higher is cheaper.
+    rate: f64,
+    /// Its unit.
+    unit: &'static str,
+    /// The worst energy ratio against `t^n` over the exponents.
+    energy_ratio: f64,
+    /// Whether it meets the error (and the energy condition, if asked).
+    meets: bool,
+    /// No other lobe is at least as accurate and at least as cheap, and better in one.
+    pareto: bool,
+    /// Why it stands where it does.
+    why: String,
+}
+
+fn zone_error(figures: &ErrorFigures, zone: ZoneChoice) -> f64 {
+    match zone {
+        ZoneChoice::Epicentre => figures.epicentre_max_rel,
+        ZoneChoice::Bloom => figures.bloom_max_abs,
+        ZoneChoice::Whole => figures
+            .epicentre_max_abs
+            .max(figures.bloom_max_abs)
+            .max(figures.tail_max_abs),
+    }
+}
+
+/// The cost figure of `lobe` on `target` (higher is cheaper), and its unit.
+fn rate(lobe: &Lobe, target: Target) -> Result<(f64, &'static str), String> {
+    let family =
+        |id| GpuFamily::find(id).ok_or_else(|| format!("no GPU family '{id}' in the cost model"));
+    match target {
+        Target::Cpu => Ok((super::bench::lobes::kernel_rate(lobe), "evals/s, 1 thread")),
+        Target::GpuNvidia | Target::GpuAmd => {
+            let id = if target == Target::GpuNvidia {
+                "gpu-nvidia"
+            } else {
+                "gpu-amd"
+            };
+            let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
+            Ok((
+                family(id)?.cost(&ops).evals_per_clock,
+                "evals/clock/multiprocessor (modelled)",
+            ))
+        }
+        Target::Fpga => Err(refuse_fpga()),
+    }
+}
+
+fn refuse_fpga() -> String {
+    "target fpga is not available yet: its costs need the datapaths' synthesized resources \
+     (LUTs, DSPs, Fmax), which specula does not produce yet; valid targets: cpu, gpu-nvidia, \
+     gpu-amd"
+        .to_owned()
+}
+
+/// Which of `points` (error, rate) no other point dominates.
+fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
+    points
+        .iter()
+        .map(|&(error, rate)| {
+            !points
+                .iter()
+                .any(|&(e, r)| e <= error && r >= rate && (e < error || r > rate))
+        })
+        .collect()
+}
+
+/// Measures, ranks and prints.
+pub fn run(args: &Args) -> CommandResult {
+    if args.target == Target::Fpga {
+        return Err(refuse_fpga());
+    }
+    let exponents = &args.n.0;
+    let progress = ProgressBar::new(LobeKind::ALL.len() as u64).with_style(
+        ProgressStyle::with_template("measuring {bar:30} {pos}/{len} lobes {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut candidates = Vec::new();
+    for kind in LobeKind::ALL {
+        progress.set_message(kind.to_string());
+        let mut error = 0.0_f64;
+        let mut energy = 0.0_f64;
+        let mut cheapest = f64::INFINITY;
+        let mut unit = "";
+        for &n in exponents {
+            let lobe = Lobe::new(kind, n);
+            let figures = error_figures(&lobe, &mut Precision::F64, 20_001);
+            error = error.max(zone_error(&figures, args.zone));
+            energy = energy.max(energy_ratio(&lobe));
+            let (value, its_unit) = rate(&lobe, args.target)?;
+            cheapest = cheapest.min(value);
+            unit = its_unit;
+        }
+        let meets = error <= args.max_error && (!args.energy_conserving || energy <= 1.001);
+        candidates.push(Candidate {
+            lobe: kind.to_string(),
+            error,
+            rate: cheapest,
+            unit,
+            energy_ratio: energy,
+            meets,
+            pareto: false,
+            why: String::new(),
+        });
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    let front = pareto_front(
+        &candidates
+            .iter()
+            .map(|c| (c.error, c.rate))
+            .collect::<Vec<_>>(),
+    );
+    let pow_rate = candidates
+        .iter()
+        .find(|c| c.lobe == LobeKind::Pow.id())
+        .map_or(f64::NAN, |c| c.rate);
+    for (candidate, on_front) in candidates.iter_mut().zip(front) {
+        candidate.pareto = on_front;
+    }
+    candidates.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
+    let best = candidates.iter().find(|c| c.meets).map(|c| c.lobe.clone());
+    for candidate in &mut candidates {
+        candidate.why = why(candidate, best.as_deref(), pow_rate, args);
+    }
+    if args.format == crate::args::Format::Json {
+        return super::print_json(&candidates);
+    }
+    let span = match exponents.as_slice() {
+        [only] => format!("n = {only}"),
+        all => format!(
+            "n from {} to {} ({} exponents sampled)",
+            all[0],
+            all[all.len() - 1],
+            all.len()
+        ),
+    };
+    let name = |value: &dyn Fn() -> Option<clap::builder::PossibleValue>| {
+        value().map_or_else(String::new, |v| v.get_name().to_owned())
+    };
+    let zone = name(&|| clap::ValueEnum::to_possible_value(&args.zone));
+    let target = name(&|| clap::ValueEnum::to_possible_value(&args.target));
+    // pow is exact and keeps t^n's energy, so some lobe always meets the request.
+    let lobe = best.as_deref().unwrap_or(LobeKind::Pow.id());
+    println!(
+        "{lobe}: the cheapest lobe within {} % ({zone} error) at {span} on {target}",
+        100.0 * args.max_error
+    );
+    let mut table = Table::new(&[
+        "lobe",
+        "meets",
+        "error",
+        "cost",
+        "vs pow",
+        "energy ratio",
+        "pareto",
+        "why",
+    ]);
+    for c in &candidates {
+        table.push(vec![
+            c.lobe.clone(),
+            if c.meets { "yes" } else { "no" }.to_owned(),
+            format!("{:.4} %", 100.0 * c.error),
+            format!("{:.3e} {}", c.rate, c.unit),
+            format!("{:.2}x", c.rate / pow_rate),
+            format!("{:.4}", c.energy_ratio),
+            if c.pareto { "front" } else { "" }.to_owned(),
+            c.why.clone(),
+        ]);
+    }
+    table.print(args.format);
+    Ok(())
+}
+
+fn why(c: &Candidate, best: Option<&str>, pow_rate: f64, args: &Args) -> String {
+    let speed = c.rate / pow_rate;
+    if !c.meets {
+        if c.error > args.max_error {
+            return format!(
+                "error {:.3} % exceeds {:.3} %",
+                100.0 * c.error,
+                100.0 * args.max_error
+            );
+        }
+        return format!("energy {:.2} % above t^n's", 100.0 * (c.energy_ratio - 1.0));
+    }
+    if Some(c.lobe.as_str()) == best {
+        return format!("cheapest that meets it ({speed:.2}x pow's rate)");
+    }
+    if c.lobe == LobeKind::Pow.id() {
+        return "exact, the reference".to_owned();
+    }
+    format!("meets it at {speed:.2}x pow's rate")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_front_keeps_exactly_the_undominated() {
+        // (error, rate): b dominates c; a and b trade off; d is dominated by a.
+        let points = [(0.0, 1.0), (0.01, 3.0), (0.02, 2.0), (0.001, 0.5)];
+        assert_eq!(pareto_front(&points), [true, true, false, false]);
+    }
+
+    #[test]
+    fn ranges_are_sampled_between_their_ends_with_powers_of_two() {
+        let Exponents(values) = parse_exponents("8..512").unwrap();
+        let values: Vec<f64> = values.iter().map(|n| n.get()).collect();
+        assert_eq!((values[0], values[values.len() - 1]), (8.0, 512.0));
+        for p in [16.0, 32.0, 64.0, 128.0, 256.0] {
+            assert!(values.contains(&p), "{p} missing from {values:?}");
+        }
+        assert!(parse_exponents("512..8").is_err());
+        assert!(parse_percent("0").is_err() && parse_percent("-1%").is_err());
+        assert!(parse_percent("NaN").is_err());
+        assert_eq!(parse_percent("1%"), Ok(0.01));
+    }
+}

@@ -1,0 +1,133 @@
+//! `specula recommend`: its answer is confirmed by `specula analyze`, its front is a front,
+//! and bad requests are refused in one line.
+
+mod common;
+
+use common::{ok, specula};
+use serde_json::Value;
+
+fn json(args: &[&str]) -> Vec<Value> {
+    let directory = tempfile::tempdir().unwrap();
+    let output = ok(directory.path(), args);
+    serde_json::from_slice::<Value>(&output.stdout)
+        .unwrap()
+        .as_array()
+        .unwrap()
+        .clone()
+}
+
+#[test]
+fn the_recommendation_is_what_analyze_measures() {
+    let rows = json(&[
+        "recommend",
+        "--target",
+        "gpu-nvidia",
+        "--n",
+        "64",
+        "--max-error",
+        "1%",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(rows.len(), specula::LobeKind::ALL.len());
+    let analyzed = json(&["analyze", "--n", "64", "--format", "json"]);
+    for row in &rows {
+        let lobe = row["lobe"].as_str().unwrap();
+        let figures = analyzed
+            .iter()
+            .find(|a| a["lobe"] == lobe)
+            .unwrap_or_else(|| panic!("{lobe} not analyzed"));
+        let error = figures["epicentre_max_rel"].as_f64().unwrap();
+        // analyze samples 10^5 angles per zone, recommend 2 x 10^4: the same maximum to 1e-4.
+        let reported = row["error"].as_f64().unwrap();
+        assert!(
+            (reported - error).abs() <= 1e-4 * error.max(1e-12) + 1e-12,
+            "{lobe}: recommend {reported}, analyze {error}"
+        );
+        assert_eq!(row["meets"].as_bool().unwrap(), error <= 0.01, "{lobe}");
+    }
+    // The met lobes come first, cheapest first.
+    let met: Vec<f64> = rows
+        .iter()
+        .take_while(|r| r["meets"].as_bool().unwrap())
+        .map(|r| r["rate"].as_f64().unwrap())
+        .collect();
+    assert!(met.windows(2).all(|w| w[0] >= w[1]), "{met:?}");
+    assert!(rows
+        .iter()
+        .any(|r| r["lobe"] == "pow" && r["meets"] == true));
+}
+
+#[test]
+fn the_front_is_undominated_and_everything_else_is_dominated() {
+    let rows = json(&[
+        "recommend",
+        "--target",
+        "gpu-amd",
+        "--n",
+        "8..512",
+        "--max-error",
+        "2",
+        "--zone",
+        "whole",
+        "--format",
+        "json",
+    ]);
+    let point = |r: &Value| (r["error"].as_f64().unwrap(), r["rate"].as_f64().unwrap());
+    for row in &rows {
+        let (error, rate) = point(row);
+        let dominated = rows.iter().any(|other| {
+            let (e, r) = point(other);
+            e <= error && r >= rate && (e < error || r > rate)
+        });
+        assert_eq!(row["pareto"].as_bool().unwrap(), !dominated, "{row}");
+    }
+}
+
+#[test]
+fn an_impossible_accuracy_leaves_the_exact_lobe_and_bad_requests_are_refused() {
+    let directory = tempfile::tempdir().unwrap();
+    let output = ok(
+        directory.path(),
+        &[
+            "recommend",
+            "--target",
+            "gpu-amd",
+            "--max-error",
+            "1e-9",
+            "--zone",
+            "whole",
+        ],
+    );
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(text.starts_with("pow: the cheapest lobe within"), "{text}");
+    for bad in [
+        &["recommend", "--target", "tpu", "--max-error", "1%"][..],
+        &["recommend", "--target", "cpu", "--max-error", "0"],
+        &["recommend", "--target", "cpu", "--max-error", "nan"],
+        &[
+            "recommend",
+            "--target",
+            "cpu",
+            "--max-error",
+            "1",
+            "--n",
+            "0..5",
+        ],
+        &[
+            "recommend",
+            "--target",
+            "cpu",
+            "--max-error",
+            "1",
+            "--n",
+            "64..8",
+        ],
+        &["recommend", "--target", "fpga", "--max-error", "1"],
+    ] {
+        let output = specula(directory.path(), bad);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{bad:?}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{bad:?}: {stderr}");
+    }
+}
