@@ -24,7 +24,10 @@ fn the_quick_report_is_complete_and_well_formed() {
         .descendants()
         .filter(|n| n.has_tag_name("section"))
         .count();
-    assert_eq!(sections, 9);
+    assert_eq!(sections, 10);
+    // The verdict opens the page.
+    let verdict = page.find("Which lobe when").expect("a verdict section");
+    assert!(verdict < page.find("Models").expect("a models section"));
     let sources: Vec<&str> = document
         .descendants()
         .filter(|n| n.has_tag_name("img"))

@@ -141,24 +141,21 @@ fn zone_error(figures: &ErrorFigures, zone: ZoneChoice) -> f64 {
 
 /// The cost figure of `lobe` on `target` (higher is cheaper), and its unit.
 fn rate(lobe: &Lobe, target: Target) -> Result<(f64, &'static str), String> {
-    let family =
-        |id| GpuFamily::find(id).ok_or_else(|| format!("no GPU family '{id}' in the cost model"));
+    const MODELLED: &str = "evals/clock/multiprocessor (modelled)";
     match target {
         Target::Cpu => Ok((super::bench::lobes::kernel_rate(lobe), "evals/s, 1 thread")),
-        Target::GpuNvidia | Target::GpuAmd => {
-            let id = if target == Target::GpuNvidia {
-                "gpu-nvidia"
-            } else {
-                "gpu-amd"
-            };
-            let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
-            Ok((
-                family(id)?.cost(&ops).evals_per_clock,
-                "evals/clock/multiprocessor (modelled)",
-            ))
-        }
+        Target::GpuNvidia => Ok((gpu_rate(lobe, "gpu-nvidia")?, MODELLED)),
+        Target::GpuAmd => Ok((gpu_rate(lobe, "gpu-amd")?, MODELLED)),
         Target::Fpga => Err(refuse_fpga()),
     }
+}
+
+/// The modelled evaluations per clock per multiprocessor of `lobe`'s shader on a GPU family.
+fn gpu_rate(lobe: &Lobe, family: &str) -> Result<f64, String> {
+    let family =
+        GpuFamily::find(family).ok_or_else(|| format!("no GPU family '{family}' in the model"))?;
+    let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
+    Ok(family.cost(&ops).evals_per_clock)
 }
 
 fn refuse_fpga() -> String {
@@ -169,7 +166,7 @@ fn refuse_fpga() -> String {
 }
 
 /// Which of `points` (error, rate) no other point dominates.
-fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
+pub(crate) fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
     points
         .iter()
         .map(|&(error, rate)| {

@@ -11,6 +11,7 @@ mod html;
 mod plot;
 mod renders;
 mod sections;
+mod verdict;
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -113,7 +114,8 @@ impl Context {
 
 type Section = (&'static str, fn(&mut Context) -> Result<String, String>);
 
-const SECTIONS: [Section; 9] = [
+const SECTIONS: [Section; 10] = [
+    ("Which lobe when", verdict::verdict),
     ("Models", sections::models),
     ("Lobe shapes", sections::shapes),
     ("Error against the angle and against n", sections::errors),

@@ -30,7 +30,7 @@ pub(super) fn colour(kind: LobeKind) -> plotters::style::RGBColor {
     PALETTE[kind.index() as usize]
 }
 
-fn series(kind: LobeKind, points: Vec<(f64, f64)>) -> Series {
+pub(super) fn series(kind: LobeKind, points: Vec<(f64, f64)>) -> Series {
     Series {
         name: kind.to_string(),
         points,
