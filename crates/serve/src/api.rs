@@ -3,7 +3,8 @@
 //!
 //! - `GET /api/models`: the lobes, geometries, normalisations, shadings, objects and limits;
 //! - `GET /api/evaluate?lobe&n&geometry&normalisation&theta_in`: every plot's data;
-//! - `GET /api/analyze?lobe&n`: the error, energy and albedo figures (`specula analyze`'s);
+//! - `GET /api/analyze?lobe&n`: the error, energy and albedo figures (`specula analyze`'s),
+//!   and `costs`, the lobe's cost on every target the server's cost model knows;
 //! - `GET /api/render?object&lobe&n&geometry&normalisation&shading&model&light_theta&light_phi&size`:
 //!   a PNG from the CPU renderer.
 
@@ -18,7 +19,7 @@ use axum::Json;
 use serde::Serialize;
 use serde_json::json;
 use specula::analysis::{analyze, Precision};
-use specula::{Exponent, Geometry, LobeKind, Normalisation};
+use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use specula_render::{IlluminationModel, Shading};
 use tokio::sync::Semaphore;
 
@@ -29,17 +30,53 @@ pub const MAX_RENDER_SIZE: u32 = 1024;
 /// Renders computed at once; more wait their turn.
 pub const CONCURRENT_RENDERS: usize = 2;
 
+/// A lobe's cost on one target, as the explorer shows it beside its errors.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TargetCost {
+    /// The target's id (`cpu`, `gpu-nvidia`, ...).
+    pub target: String,
+    /// The figure.
+    pub value: f64,
+    /// What it counts.
+    pub unit: String,
+}
+
+/// The costs of a prepared lobe on every target the server knows. The binary supplies the
+/// GPU models (they need the shader compiler, which this crate does not depend on); the
+/// default knows the CPU's counted SIMD instructions only.
+pub type CostModel = Arc<dyn Fn(&Lobe) -> Result<Vec<TargetCost>, String> + Send + Sync>;
+
+/// The CPU's cost: the instructions the lobe's SIMD kernel executes per vector of 8.
+#[must_use]
+pub fn cpu_cost(lobe: &Lobe) -> TargetCost {
+    TargetCost {
+        target: "cpu".into(),
+        value: f64::from(lobe.batch_instructions().total()),
+        unit: "SIMD instructions per 8 evaluations (counted; fewer is cheaper)".into(),
+    }
+}
+
 /// What the handlers share.
 #[derive(Clone)]
 pub struct AppState {
-    pub renders: Arc<Semaphore>,
+    renders: Arc<Semaphore>,
+    costs: CostModel,
+}
+
+impl AppState {
+    /// The state with `costs` as the cost model.
+    #[must_use]
+    pub fn with_costs(costs: CostModel) -> Self {
+        Self {
+            renders: Arc::new(Semaphore::new(CONCURRENT_RENDERS)),
+            costs,
+        }
+    }
 }
 
 impl Default for AppState {
     fn default() -> Self {
-        Self {
-            renders: Arc::new(Semaphore::new(CONCURRENT_RENDERS)),
-        }
+        Self::with_costs(Arc::new(|lobe: &Lobe| Ok(vec![cpu_cost(lobe)])))
     }
 }
 
@@ -253,11 +290,22 @@ pub async fn evaluate(query: QueryPairs) -> Result<impl IntoResponse, ApiError> 
     Ok(Json(data))
 }
 
-pub async fn analyze_lobe(query: QueryPairs) -> Result<impl IntoResponse, ApiError> {
+pub async fn analyze_lobe(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<impl IntoResponse, ApiError> {
     let params = Params::new(pairs(query)?, &["lobe", "n"])?;
     let (kind, n) = (params.lobe()?, params.exponent()?);
-    let report = blocking(move || analyze(kind, n, &mut Precision::F64)).await?;
-    Ok(Json(report))
+    let costs = state.costs.clone();
+    let (report, costs) = blocking(move || {
+        let report = analyze(kind, n, &mut Precision::F64);
+        (report, costs(&Lobe::new(kind, n)))
+    })
+    .await?;
+    let costs = costs.map_err(ApiError::internal)?;
+    let mut body = serde_json::to_value(report).map_err(|e| ApiError::internal(e.to_string()))?;
+    body["costs"] = json!(costs);
+    Ok(Json(body))
 }
 
 pub async fn render(

@@ -14,7 +14,7 @@ mod tests;
 
 use std::net::SocketAddr;
 
-pub use api::{CONCURRENT_RENDERS, MAX_RENDER_SIZE};
+pub use api::{cpu_cost, AppState, CostModel, TargetCost, CONCURRENT_RENDERS, MAX_RENDER_SIZE};
 
 use axum::extract::DefaultBodyLimit;
 use axum::http::header;
@@ -25,8 +25,13 @@ use axum::Router;
 /// The largest request body accepted.
 const MAX_BODY_BYTES: usize = 16 * 1024;
 
-/// The explorer's routes: the page, its assets and the API.
+/// The explorer's routes with the default cost model (the CPU's counted instructions).
 pub fn router() -> Router {
+    router_with(api::AppState::default())
+}
+
+/// The explorer's routes: the page, its assets and the API.
+pub fn router_with(state: api::AppState) -> Router {
     let asset = |content_type: &'static str, body: &'static str| {
         get(move || async move { ([(header::CONTENT_TYPE, content_type)], body).into_response() })
     };
@@ -55,12 +60,13 @@ pub fn router() -> Router {
         .route("/api/render", get(api::render))
         .fallback(api::not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
-        .with_state(api::AppState::default())
+        .with_state(state)
 }
 
-/// Serves on `address` until Ctrl-C, printing the URL; `open` also opens it in a browser.
+/// Serves on `address` until Ctrl-C, printing the URL; `open` also opens it in a browser;
+/// `costs` prices each lobe on each target.
 /// Anything but a loopback address is warned about: the explorer has no authentication.
-pub fn serve(address: SocketAddr, open: bool) -> Result<(), String> {
+pub fn serve(address: SocketAddr, open: bool, costs: api::CostModel) -> Result<(), String> {
     if !address.ip().is_loopback() {
         eprintln!(
             "warning: listening on {}, reachable from other machines; the explorer has no authentication",
@@ -79,7 +85,7 @@ pub fn serve(address: SocketAddr, open: bool) -> Result<(), String> {
         if open {
             open_browser(&url);
         }
-        axum::serve(listener, router())
+        axum::serve(listener, router_with(api::AppState::with_costs(costs)))
             .with_graceful_shutdown(async {
                 let _ = tokio::signal::ctrl_c().await;
             })

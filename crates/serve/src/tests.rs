@@ -236,3 +236,40 @@ async fn loopback_load_test_has_no_error_and_bounded_memory() {
         );
     }
 }
+
+/// The analysis carries each lobe's costs from the server's cost model: by default the CPU's
+/// counted SIMD instructions; a supplied model's figures verbatim.
+#[tokio::test]
+async fn analyze_carries_the_cost_model() {
+    let (status, report) = json("/api/analyze?lobe=cosquad&n=64").await;
+    assert_eq!(status, StatusCode::OK);
+    let lobe = specula::Lobe::new(
+        specula::LobeKind::CosQuad { v: 4 },
+        specula::Exponent::new(64.0),
+    );
+    assert_eq!(report["costs"][0]["target"], "cpu");
+    assert_eq!(
+        report["costs"][0]["value"].as_f64(),
+        Some(f64::from(lobe.batch_instructions().total()))
+    );
+    let model: crate::CostModel = std::sync::Arc::new(|lobe: &specula::Lobe| {
+        Ok(vec![crate::TargetCost {
+            target: "test".into(),
+            value: lobe.exponent().get() * 2.0,
+            unit: "twice n".into(),
+        }])
+    });
+    let response = crate::router_with(crate::AppState::with_costs(model))
+        .oneshot(
+            Request::get("/api/analyze?lobe=pow&n=10")
+                .body(Body::empty())
+                .expect("request"),
+        )
+        .await
+        .expect("infallible");
+    let body = axum::body::to_bytes(response.into_body(), 1 << 20)
+        .await
+        .expect("body");
+    let value: serde_json::Value = serde_json::from_slice(&body).expect("json");
+    assert_eq!(value["costs"][0]["value"].as_f64(), Some(20.0));
+}

@@ -1,6 +1,11 @@
 //! `specula serve`: the BRDF explorer (`crates/serve`), served by the binary itself.
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+use std::sync::Arc;
+
+use specula::gpu_cost::GpuFamily;
+use specula::Lobe;
+use specula_serve::{cpu_cost, TargetCost};
 
 use super::CommandResult;
 
@@ -20,5 +25,21 @@ pub struct Args {
 
 /// Serves until Ctrl-C.
 pub fn run(args: &Args) -> CommandResult {
-    specula_serve::serve(SocketAddr::new(args.bind, args.port), args.open)
+    specula_serve::serve(
+        SocketAddr::new(args.bind, args.port),
+        args.open,
+        Arc::new(costs),
+    )
+}
+
+/// A lobe's costs: the CPU's counted SIMD instructions and the GPU families' modelled rates.
+pub fn costs(lobe: &Lobe) -> Result<Vec<TargetCost>, String> {
+    let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
+    Ok(std::iter::once(cpu_cost(lobe))
+        .chain(GpuFamily::ALL.iter().map(|family| TargetCost {
+            target: family.id.to_owned(),
+            value: family.cost(&ops).evals_per_clock,
+            unit: "evaluations per clock per multiprocessor (modelled; more is cheaper)".to_owned(),
+        }))
+        .collect())
 }
