@@ -480,11 +480,17 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
         let error = error_figures(&lobe, &mut Precision::F64, context.sizes.samples_per_zone)
             .epicentre_max_rel;
         let instructions = lobe.batch_instructions();
+        let shader = specula_gpu::shader_ops::lobe_shader_ops(&lobe)?;
         let mut row = vec![
             kind.to_string(),
             format!("{} ({instructions})", instructions.total()),
             format!("{:.3}%", 100.0 * error),
         ];
+        row.extend(
+            specula::gpu_cost::GpuFamily::ALL
+                .iter()
+                .map(|family| format!("{:.2}", family.cost(&shader).evals_per_clock)),
+        );
         if let Some(measured) = &measured {
             let rate = &measured.lobes[k];
             row.extend([
@@ -500,10 +506,14 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
         "lobe",
         "SIMD instructions per 8 lanes (counted from the kernel)",
         "epicentre max rel error (n = 64)",
+        "NVIDIA: evals/clock/SM (modelled)",
+        "AMD RDNA: evals/clock/CU (modelled)",
     ];
     let mut html = paragraph(
         "What each lobe's explicit SIMD kernel executes per vector, read off the kernel (a test \
-         holds the count to what it runs); not a guess of operation weights.",
+         holds the count to what it runs); not a guess of operation weights. The GPU columns \
+         are the cost model's bound for the lobe's exported shader (more is cheaper; see \
+         Which lobe when).",
     );
     if let Some(measured) = &measured {
         header.extend([
