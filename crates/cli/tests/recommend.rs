@@ -123,11 +123,58 @@ fn an_impossible_accuracy_leaves_the_exact_lobe_and_bad_requests_are_refused() {
             "--n",
             "64..8",
         ],
-        &["recommend", "--target", "fpga", "--max-error", "1"],
     ] {
         let output = specula(directory.path(), bad);
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(2), "{bad:?}: {stderr}");
         assert_eq!(stderr.trim().lines().count(), 1, "{bad:?}: {stderr}");
+    }
+}
+
+/// The FPGA estimate: only lobes with a fixed-point datapath can meet, each named with the
+/// word length costed, and the datapath's error is what `specula hw table` measures there.
+#[test]
+fn fpga_answers_come_from_the_datapaths() {
+    let rows = json(&[
+        "recommend",
+        "--target",
+        "fpga",
+        "--n",
+        "64",
+        "--max-error",
+        "1%",
+        "--format",
+        "json",
+    ]);
+    let best = &rows[0];
+    assert_eq!(best["meets"], true, "{best}");
+    let datapath = best["datapath"].as_str().expect("a datapath is named");
+    let (name, bits) = datapath.split_once(" at ").unwrap();
+    let bits = bits.trim_end_matches(" bits");
+    let table = json(&[
+        "hw",
+        "table",
+        "--lobe",
+        name,
+        "--n",
+        "64",
+        "--samples",
+        "20001",
+        "--bits",
+        &format!("{bits}..{bits}"),
+        "--format",
+        "json",
+    ]);
+    let measured = table[0]["rows"][0]["errors"]["epicentre_max_rel"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (best["error"].as_f64().unwrap() - measured).abs() <= 1e-3 * measured,
+        "{best} vs {measured}"
+    );
+    for row in &rows {
+        if row["datapath"].is_null() {
+            assert_eq!(row["meets"], false, "{row}");
+        }
     }
 }

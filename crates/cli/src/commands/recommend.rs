@@ -13,7 +13,10 @@ use serde::Serialize;
 use specula::analysis::{energy_ratio, error_figures, ErrorFigures, Precision};
 use specula::gpu_cost::GpuFamily;
 use specula::{Exponent, Lobe, LobeKind};
+use specula_hw::analysis::WidthSweep;
+use specula_hw::{HwLobe, BITS};
 
+use super::fpga_estimate::logic_cells;
 use super::CommandResult;
 use crate::output::Table;
 
@@ -27,7 +30,7 @@ pub enum Target {
     GpuNvidia,
     /// AMD RDNA GPUs: modelled from the shader's instructions.
     GpuAmd,
-    /// FPGA: refused until the datapaths are synthesized (see the README).
+    /// FPGA: estimated from the fixed-point datapaths' operators (see the README).
     Fpga,
 }
 
@@ -111,6 +114,10 @@ fn parse_percent(text: &str) -> Result<f64, String> {
 #[derive(Clone, Debug, Serialize)]
 struct Candidate {
     lobe: String,
+    /// On `fpga`, the datapath and word length costed (at the last exponent); `None` where
+    /// the lobe has no datapath that meets its float model.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    datapath: Option<String>,
     /// The worst error over the exponents, as a fraction.
     error: f64,
     /// The cost figure: evaluations per second (cpu) or per clock per multiprocessor (gpu),
@@ -146,7 +153,7 @@ fn rate(lobe: &Lobe, target: Target) -> Result<(f64, &'static str), String> {
         Target::Cpu => Ok((super::bench::lobes::kernel_rate(lobe), "evals/s, 1 thread")),
         Target::GpuNvidia => Ok((gpu_rate(lobe, "gpu-nvidia")?, MODELLED)),
         Target::GpuAmd => Ok((gpu_rate(lobe, "gpu-amd")?, MODELLED)),
-        Target::Fpga => Err(refuse_fpga()),
+        Target::Fpga => Err("fpga costs come from the hardware sweeps".to_owned()),
     }
 }
 
@@ -158,11 +165,47 @@ fn gpu_rate(lobe: &Lobe, family: &str) -> Result<f64, String> {
     Ok(family.cost(&ops).evals_per_clock)
 }
 
-fn refuse_fpga() -> String {
-    "target fpga is not available yet: its costs need the datapaths' synthesized resources \
-     (LUTs, DSPs, Fmax), which specula does not produce yet; valid targets: cpu, gpu-nvidia, \
-     gpu-amd"
-        .to_owned()
+/// Every datapath's sweep over word lengths at each exponent, rounded to an integer (the
+/// datapaths take integer `n`).
+fn hardware_sweeps(exponents: &[Exponent]) -> Result<Vec<(Exponent, Vec<WidthSweep>)>, String> {
+    exponents
+        .iter()
+        .map(|&n| {
+            let whole = n.get().round().clamp(1.0, 1000.0) as u32;
+            let sweeps = super::hw::sweeps(
+                &HwLobe::ALL,
+                whole,
+                (*BITS.start(), *BITS.end()),
+                20_001,
+                false,
+            )?;
+            Ok((n, sweeps))
+        })
+        .collect()
+}
+
+/// Of `kind`'s datapaths at `n`, the one with the fewest estimated logic cells at the
+/// smallest word length that meets its float model: `(its error, cells, "name at W bits")`.
+fn cheapest_datapath(
+    hardware: &[(Exponent, Vec<WidthSweep>)],
+    n: Exponent,
+    kind: LobeKind,
+    zone: ZoneChoice,
+) -> Option<(f64, u64, String)> {
+    let (_, sweeps) = hardware.iter().find(|(at, _)| *at == n)?;
+    sweeps
+        .iter()
+        .filter(|sweep| sweep.lobe.float_kind() == kind)
+        .filter_map(|sweep| {
+            let width = sweep.minimum_width()?;
+            let row = sweep.rows.iter().find(|row| row.bits == width)?;
+            Some((
+                zone_error(&row.errors, zone),
+                logic_cells(&row.resources),
+                format!("{} at {width} bits", sweep.lobe.id()),
+            ))
+        })
+        .min_by_key(|(_, cells, _)| *cells)
 }
 
 /// Which of `points` (error, rate) no other point dominates.
@@ -179,10 +222,12 @@ pub(crate) fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
 
 /// Measures, ranks and prints.
 pub fn run(args: &Args) -> CommandResult {
-    if args.target == Target::Fpga {
-        return Err(refuse_fpga());
-    }
     let exponents = &args.n.0;
+    let hardware = if args.target == Target::Fpga {
+        Some(hardware_sweeps(exponents)?)
+    } else {
+        None
+    };
     let progress = ProgressBar::new(LobeKind::ALL.len() as u64).with_style(
         ProgressStyle::with_template("measuring {bar:30} {pos}/{len} lobes {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -194,18 +239,40 @@ pub fn run(args: &Args) -> CommandResult {
         let mut energy = 0.0_f64;
         let mut cheapest = f64::INFINITY;
         let mut unit = "";
+        let mut datapath = None;
+        let mut unavailable = false;
         for &n in exponents {
             let lobe = Lobe::new(kind, n);
+            energy = energy.max(energy_ratio(&lobe));
+            if let Some(hardware) = &hardware {
+                match cheapest_datapath(hardware, n, kind, args.zone) {
+                    Some((hw_error, cells, name)) => {
+                        error = error.max(hw_error);
+                        cheapest = cheapest.min(1e3 / cells as f64);
+                        datapath = datapath.or(Some(name));
+                    }
+                    None => {
+                        error = f64::INFINITY;
+                        cheapest = 0.0;
+                        unavailable = true;
+                    }
+                }
+                unit = "evals/clock per 1000 logic cells (estimated)";
+                continue;
+            }
             let figures = error_figures(&lobe, &mut Precision::F64, 20_001);
             error = error.max(zone_error(&figures, args.zone));
-            energy = energy.max(energy_ratio(&lobe));
             let (value, its_unit) = rate(&lobe, args.target)?;
             cheapest = cheapest.min(value);
             unit = its_unit;
         }
+        if unavailable {
+            datapath = None;
+        }
         let meets = error <= args.max_error && (!args.energy_conserving || energy <= 1.001);
         candidates.push(Candidate {
             lobe: kind.to_string(),
+            datapath,
             error,
             rate: cheapest,
             unit,
@@ -252,12 +319,19 @@ pub fn run(args: &Args) -> CommandResult {
     };
     let zone = name(&|| clap::ValueEnum::to_possible_value(&args.zone));
     let target = name(&|| clap::ValueEnum::to_possible_value(&args.target));
-    // pow is exact and keeps t^n's energy, so some lobe always meets the request.
-    let lobe = best.as_deref().unwrap_or(LobeKind::Pow.id());
-    println!(
-        "{lobe}: the cheapest lobe within {} % ({zone} error) at {span} on {target}",
-        100.0 * args.max_error
-    );
+    // Off the FPGA, pow is exact, keeps t^n's energy and so always meets the request; the
+    // FPGA has no datapath for it, so there nothing may meet it.
+    match &best {
+        Some(lobe) => println!(
+            "{lobe}: the cheapest lobe within {} % ({zone} error) at {span} on {target}",
+            100.0 * args.max_error
+        ),
+        None => println!(
+            "no lobe is within {} % ({zone} error) at {span} on {target}; every lobe is listed, \
+             with the Pareto front marked",
+            100.0 * args.max_error
+        ),
+    }
     let mut table = Table::new(&[
         "lobe",
         "meets",
@@ -272,9 +346,13 @@ pub fn run(args: &Args) -> CommandResult {
         table.push(vec![
             c.lobe.clone(),
             if c.meets { "yes" } else { "no" }.to_owned(),
-            format!("{:.4} %", 100.0 * c.error),
+            if c.error.is_finite() {
+                format!("{:.4} %", 100.0 * c.error)
+            } else {
+                "-".to_owned()
+            },
             format!("{:.3e} {}", c.rate, c.unit),
-            format!("{:.2}x", c.rate / pow_rate),
+            versus_pow(c.rate, pow_rate),
             format!("{:.4}", c.energy_ratio),
             if c.pareto { "front" } else { "" }.to_owned(),
             c.why.clone(),
@@ -284,9 +362,26 @@ pub fn run(args: &Args) -> CommandResult {
     Ok(())
 }
 
+/// `rate` as a multiple of pow's, or `-` where pow has no cost on the target (no datapath).
+fn versus_pow(rate: f64, pow_rate: f64) -> String {
+    if pow_rate > 0.0 && pow_rate.is_finite() {
+        format!("{:.2}x", rate / pow_rate)
+    } else {
+        "-".to_owned()
+    }
+}
+
 fn why(c: &Candidate, best: Option<&str>, pow_rate: f64, args: &Args) -> String {
-    let speed = c.rate / pow_rate;
+    let speed = versus_pow(c.rate, pow_rate);
+    let relative = if speed == "-" {
+        String::new()
+    } else {
+        format!(" at {speed} pow's rate")
+    };
     if !c.meets {
+        if args.target == Target::Fpga && c.datapath.is_none() {
+            return "no fixed-point datapath meets its float model at every n".to_owned();
+        }
         if c.error > args.max_error {
             return format!(
                 "error {:.3} % exceeds {:.3} %",
@@ -297,12 +392,12 @@ fn why(c: &Candidate, best: Option<&str>, pow_rate: f64, args: &Args) -> String 
         return format!("energy {:.2} % above t^n's", 100.0 * (c.energy_ratio - 1.0));
     }
     if Some(c.lobe.as_str()) == best {
-        return format!("cheapest that meets it ({speed:.2}x pow's rate)");
+        return format!("cheapest that meets it{relative}");
     }
     if c.lobe == LobeKind::Pow.id() {
         return "exact, the reference".to_owned();
     }
-    format!("meets it at {speed:.2}x pow's rate")
+    format!("meets it{relative}")
 }
 
 #[cfg(test)]

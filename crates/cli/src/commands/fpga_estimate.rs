@@ -1,0 +1,64 @@
+//! An FPGA cost estimate from a datapath's operators, until the datapaths are synthesized:
+//! logic cells of a LUT4 fabric without DSP blocks (an iCE40-class part, where each cell is
+//! one 4-input LUT, one flip-flop and a carry link). Per operator, the textbook mapping:
+//! a `b`-bit adder or comparator takes `b` cells (one per bit on the carry chain); an `a x b`
+//! array multiplier `a b` cells (a partial-product AND and a full adder per bit); a `b`-bit
+//! squarer half that (the product's symmetric half); an `a / b` divider `a b` cells (`a`
+//! stages of a `b`-bit subtract-and-select); a leading-one detector `b` cells; a ROM 1 cell per
+//! 16 bits (a LUT4 is a 16 x 1 ROM). Flip-flops pack into the cells the logic uses, so the
+//! estimate is the larger of the logic cells and the register bits. `specula recommend
+//! --target fpga` labels every figure from here "estimated".
+
+use specula_hw::Resources;
+
+/// Estimated logic cells of `resources` on a LUT4 fabric without DSPs.
+#[must_use]
+pub fn logic_cells(resources: &Resources) -> u64 {
+    let sum = |values: &mut dyn Iterator<Item = u64>| values.sum::<u64>();
+    let logic = sum(&mut resources.adders.iter().map(|&b| u64::from(b)))
+        + sum(&mut resources
+            .multipliers
+            .iter()
+            .map(|&(a, b)| u64::from(a) * u64::from(b)))
+        + sum(&mut resources
+            .squarers
+            .iter()
+            .map(|&b| u64::from(b) * u64::from(b) / 2))
+        + sum(&mut resources
+            .dividers
+            .iter()
+            .map(|&(a, b)| u64::from(a) * u64::from(b)))
+        + sum(&mut resources
+            .leading_one_detectors
+            .iter()
+            .map(|&b| u64::from(b)))
+        + resources.rom_bits.div_ceil(16);
+    logic.max(resources.register_bits)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_operator_costs_its_textbook_mapping() {
+        let resources = Resources {
+            multipliers: vec![(16, 12)],
+            squarers: vec![10],
+            adders: vec![16, 8],
+            dividers: vec![(16, 16)],
+            leading_one_detectors: vec![16],
+            rom_bits: 1000,
+            register_bits: 100,
+            latency: 4,
+        };
+        // 192 + 50 + 24 + 256 + 16 + 63.
+        assert_eq!(logic_cells(&resources), 601);
+        // Registers bound it when they outnumber the logic.
+        let registers = Resources {
+            register_bits: 5000,
+            ..resources
+        };
+        assert_eq!(logic_cells(&registers), 5000);
+    }
+}
