@@ -186,13 +186,11 @@ fn hardware_sweeps(exponents: &[Exponent]) -> Result<Vec<(Exponent, Vec<WidthSwe
 
 /// Of `kind`'s datapaths at `n`, the one with the fewest estimated logic cells at the
 /// smallest word length that meets its float model: `(its error, cells, "name at W bits")`.
-fn cheapest_datapath(
-    hardware: &[(Exponent, Vec<WidthSweep>)],
-    n: Exponent,
+pub(crate) fn cheapest_datapath(
+    sweeps: &[WidthSweep],
     kind: LobeKind,
     zone: ZoneChoice,
 ) -> Option<(f64, u64, String)> {
-    let (_, sweeps) = hardware.iter().find(|(at, _)| *at == n)?;
     sweeps
         .iter()
         .filter(|sweep| sweep.lobe.float_kind() == kind)
@@ -245,7 +243,11 @@ pub fn run(args: &Args) -> CommandResult {
             let lobe = Lobe::new(kind, n);
             energy = energy.max(energy_ratio(&lobe));
             if let Some(hardware) = &hardware {
-                match cheapest_datapath(hardware, n, kind, args.zone) {
+                let at_n = hardware
+                    .iter()
+                    .find(|(at, _)| *at == n)
+                    .map_or(&[][..], |(_, sweeps)| sweeps.as_slice());
+                match cheapest_datapath(at_n, kind, args.zone) {
                     Some((hw_error, cells, name)) => {
                         error = error.max(hw_error);
                         cheapest = cheapest.min(1e3 / cells as f64);

@@ -8,7 +8,7 @@ use super::html::{figure, paragraph, table};
 use super::plot::{Chart, Series};
 use super::sections::colour;
 use super::Context;
-use crate::commands::hw::{resource_cells, sweeps};
+use crate::commands::hw::resource_cells;
 use crate::output::{percent, sig};
 
 /// The word length the diagrams show.
@@ -21,8 +21,7 @@ fn arithmetic(r: &Resources) -> String {
 }
 
 pub fn hardware(context: &mut Context) -> Result<String, String> {
-    let samples = context.sizes.samples_per_zone.min(20_001);
-    let exponents = context.sizes.hardware_exponents;
+    let all = context.hardware_sweeps()?.to_vec();
     let mut html = paragraph(&format!(
         "Each approximation as a bit-accurate fixed-point datapath (SPEC section 8; crates/hw). \
          W is the word length of signals in [0, 1] (UQ1.(W-1)); wider signals keep the same \
@@ -32,14 +31,7 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
          The Verilog of every datapath is co-simulated with Icarus Verilog, bit-exact, in the tests."
     ));
     let mut rows = Vec::new();
-    for &n in exponents {
-        let results = sweeps(
-            &HwLobe::ALL,
-            n,
-            (*BITS.start(), *BITS.end()),
-            samples,
-            false,
-        )?;
+    for (n, results) in all {
         let series: Vec<Series> = results
             .iter()
             .map(|result| Series {

@@ -14,11 +14,14 @@ mod sections;
 mod verdict;
 
 use std::path::PathBuf;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use specula::claims::ClaimOptions;
+use specula_hw::analysis::WidthSweep;
+use specula_hw::{HwLobe, BITS};
 use specula_render::{write_atomically, write_png_srgb8, Display, Image, Scene};
 
 use super::CommandResult;
@@ -60,6 +63,45 @@ pub struct Context {
     sizes: Sizes,
     bench: bool,
     files: Vec<String>,
+    shared: Arc<Shared>,
+}
+
+/// Every datapath's sweeps over word lengths, per hardware exponent.
+type HardwareSweeps = Vec<(u32, Vec<WidthSweep>)>;
+
+/// Work more than one section needs, done once by whichever asks first (the others wait).
+#[derive(Default)]
+pub struct Shared {
+    /// Every datapath's sweep over word lengths at each of the hardware exponents.
+    hardware: OnceLock<Result<HardwareSweeps, String>>,
+}
+
+impl Context {
+    /// The hardware sweeps (the hardware section's, which the verdict's FPGA rows reuse).
+    fn hardware_sweeps(&self) -> Result<&[(u32, Vec<WidthSweep>)], String> {
+        let samples = self.sizes.samples_per_zone.min(20_001);
+        let exponents = self.sizes.hardware_exponents;
+        self.shared
+            .hardware
+            .get_or_init(|| {
+                exponents
+                    .iter()
+                    .map(|&n| {
+                        let sweeps = crate::commands::hw::sweeps(
+                            &HwLobe::ALL,
+                            n,
+                            (*BITS.start(), *BITS.end()),
+                            samples,
+                            false,
+                        )?;
+                        Ok((n, sweeps))
+                    })
+                    .collect()
+            })
+            .as_ref()
+            .map(Vec::as_slice)
+            .map_err(Clone::clone)
+    }
 }
 
 impl Context {
@@ -114,8 +156,13 @@ impl Context {
 
 type Section = (&'static str, fn(&mut Context) -> Result<String, String>);
 
+/// The sections that read the hardware sweeps.
+const HARDWARE_SECTIONS: [&str; 2] = [VERDICT, HARDWARE];
+const VERDICT: &str = "Which lobe when";
+const HARDWARE: &str = "Hardware";
+
 const SECTIONS: [Section; 10] = [
-    ("Which lobe when", verdict::verdict),
+    (VERDICT, verdict::verdict),
     ("Models", sections::models),
     ("Lobe shapes", sections::shapes),
     ("Error against the angle and against n", sections::errors),
@@ -124,7 +171,7 @@ const SECTIONS: [Section; 10] = [
     ("The thesis's claims", sections::claims),
     ("Renders", renders::renders),
     (sections::COST, sections::cost),
-    ("Hardware", hardware::hardware),
+    (HARDWARE, hardware::hardware),
 ];
 
 /// Writes the report.
@@ -139,11 +186,13 @@ pub fn run(args: &Args) -> CommandResult {
             args.out.display()
         )
     })?;
+    let shared = Arc::new(Shared::default());
     let context = || Context {
         directory: args.out.clone(),
         sizes: sections::sizes(args.quick),
         bench: args.bench,
         files: Vec::new(),
+        shared: Arc::clone(&shared),
     };
     let bar = ProgressBar::new(SECTIONS.len() as u64).with_style(
         ProgressStyle::with_template("report {bar:30} {pos}/{len} sections {elapsed}")
@@ -157,11 +206,31 @@ pub fn run(args: &Args) -> CommandResult {
         body.map(|body| (heading, body, begun.elapsed(), own.files))
     };
     let alone = |(heading, _): &&Section| args.bench && *heading == sections::COST;
-    let mut done: Vec<_> = SECTIONS
-        .par_iter()
-        .filter(|section| !alone(section))
-        .map(run_section)
-        .collect::<Result<_, String>>()?;
+    // The hardware sweeps run beside the sections that do not need them (waiting for them
+    // inside a section would hold one of the two worker threads idle); then the two that do.
+    let needs_sweeps = |(heading, _): &&Section| HARDWARE_SECTIONS.contains(heading);
+    let (sweeps, first) = rayon::join(
+        || {
+            let begun = Instant::now();
+            context().hardware_sweeps().map(|_| begun.elapsed())
+        },
+        || {
+            SECTIONS
+                .par_iter()
+                .filter(|section| !alone(section) && !needs_sweeps(section))
+                .map(run_section)
+                .collect::<Result<Vec<_>, String>>()
+        },
+    );
+    let sweeps_took = sweeps?;
+    let mut done = first?;
+    done.extend(
+        SECTIONS
+            .par_iter()
+            .filter(|section| !alone(section) && needs_sweeps(section))
+            .map(run_section)
+            .collect::<Result<Vec<_>, String>>()?,
+    );
     for section in SECTIONS.iter().filter(alone) {
         done.push(run_section(section)?);
     }
@@ -175,6 +244,10 @@ pub fn run(args: &Args) -> CommandResult {
         bodies.push((heading.to_owned(), body));
         files.extend(written);
     }
+    timings.push(format!(
+        "hardware sweeps (shared by two sections) {:.1} s",
+        sweeps_took.as_secs_f64()
+    ));
     let timings = format!("sections concurrently: {}", timings.join(", "));
     let page = html::page("specula report", &bodies, &footer(args, started, &timings));
     let mut page_context = context();

@@ -1,6 +1,6 @@
-//! The report's first section, "Which lobe when": for each GPU family of the cost model, the
-//! cheapest lobe within a few epicentre accuracies at a few exponents, and the Pareto plot of
-//! error against modelled cost. The CPU's answer needs timing on a quiet machine, so it is
+//! The report's first section, "Which lobe when": for each GPU family of the cost model and the
+//! FPGA estimate, the cheapest lobe within a few epicentre accuracies at a few exponents, and
+//! for the GPUs the Pareto plot of error against modelled cost. The CPU's answer needs timing on a quiet machine, so it is
 //! `specula recommend --target cpu` (and the cost section with `--bench`).
 
 use specula::analysis::{error_figures, Precision};
@@ -13,7 +13,7 @@ use super::Context;
 use specula::gpu_cost::{GpuFamily, ShaderOps};
 use specula_gpu::shader_ops::lobe_shader_ops;
 
-use crate::commands::recommend::pareto_front;
+use crate::commands::recommend::{cheapest_datapath, pareto_front, ZoneChoice};
 
 const FAMILIES: [(&str, &str); 2] = [("gpu-nvidia", "NVIDIA"), ("gpu-amd", "AMD RDNA")];
 const EXPONENTS: [f64; 3] = [8.0, 64.0, 512.0];
@@ -85,9 +85,29 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
             rows.push(row);
         }
     }
+    for (n, sweeps) in context.hardware_sweeps()? {
+        let mut row = vec!["FPGA (estimated)".to_owned(), n.to_string()];
+        for bound in ACCURACIES {
+            let best = LobeKind::ALL
+                .into_iter()
+                .filter_map(|kind| cheapest_datapath(sweeps, kind, ZoneChoice::Epicentre))
+                .filter(|(error, ..)| *error <= bound)
+                .min_by_key(|(_, cells, _)| *cells);
+            row.push(best.map_or("-".to_owned(), |(_, cells, name)| {
+                format!("{name} ({cells} cells)")
+            }));
+        }
+        rows.push(row);
+    }
     html += &table(
-        &["GPU", "n", "within 0.5 %", "within 2 %", "within 10 %"],
+        &["target", "n", "within 0.5 %", "within 2 %", "within 10 %"],
         &rows,
+    );
+    html += &paragraph(
+        "FPGA rows: the fixed-point datapath with the fewest estimated logic cells (a LUT4 \
+         fabric without DSPs, from its operators) at the smallest word length that meets its \
+         float model, whose epicentre error there is within the bound; an estimate until the \
+         datapaths are synthesized. '-': no datapath meets it.",
     );
     let plotted_n = &by_n
         .iter()
