@@ -50,7 +50,8 @@ fn shade(
                 continue;
             }
             if material.model == 1u {
-                intensity = intensity / distance_squared;
+                // The inverse square stops growing inside 1e-4 units (Rust's MIN_DISTANCE_SQUARED).
+                intensity = intensity / max(distance_squared, 1e-8);
             }
             wi = offset / sqrt(distance_squared);
         }

@@ -16,6 +16,11 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use specula::{Geometry, Lobe, Normalisation};
 
+/// The physical model's inverse square stops growing inside this squared distance (1e-4
+/// scene units): a point light on the surface would otherwise send infinite radiance (a
+/// subnormal distance squared in `f32`); renderers clamp it likewise.
+pub const MIN_DISTANCE_SQUARED: f32 = 1e-8;
+
 /// Where lighting is computed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -192,7 +197,9 @@ impl Shader {
                 }
                 let arriving = match self.model {
                     IlluminationModel::Classic => intensity,
-                    IlluminationModel::Physical => intensity / distance_squared,
+                    IlluminationModel::Physical => {
+                        intensity / distance_squared.max(MIN_DISTANCE_SQUARED)
+                    }
                 };
                 Some((offset / distance_squared.sqrt(), arriving))
             }

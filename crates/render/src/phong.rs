@@ -359,7 +359,7 @@ impl Cosines<'_> {
                 let offset = at - Vec3::new(px[i], py[i], pz[i]);
                 let distance_squared = offset.length_squared();
                 let attenuation = if PHYSICAL {
-                    1.0 / distance_squared
+                    1.0 / distance_squared.max(crate::material::MIN_DISTANCE_SQUARED)
                 } else {
                     1.0
                 };

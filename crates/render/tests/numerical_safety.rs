@@ -152,3 +152,37 @@ proptest! {
         prop_assert!(image.pixels().iter().all(|p| p.is_finite() && p.min_element() >= 0.0), "{text}");
     }
 }
+
+/// Found by the property above: a point light a subnormal distance from the shaded point (its
+/// distance squared underflows in `f32`) sent infinite radiance in the physical model.
+#[test]
+fn a_point_light_on_the_surface_sends_finite_radiance() {
+    for kind in LobeKind::ALL {
+        let material = Material {
+            ka: 0.1,
+            kd: 0.5,
+            ks: 0.4,
+            colour: Vec3::new(0.8, 0.4, 0.2),
+            specular_colour: Vec3::ONE,
+            lobe: Lobe::new(kind, Exponent::new(1000.0)),
+            geometry: Geometry::Blinn,
+            normalisation: Normalisation::Lobe,
+        };
+        let light = [Light::Point {
+            position: Vec3::ZERO,
+            intensity: Vec3::ONE,
+        }];
+        let normal = Vec3::new(0.890_045_2, -0.455_872_3, 1e-9);
+        let radiance = Shader::new(&material, IlluminationModel::Physical).shade(
+            Vec3::new(0.0, 8.664e-23, 0.0),
+            normal,
+            Vec3::new(1.0, 0.0, 1e-9),
+            &light,
+            Vec3::splat(0.1),
+        );
+        assert!(
+            radiance.is_finite() && radiance.min_element() >= 0.0,
+            "{kind}: {radiance}"
+        );
+    }
+}
