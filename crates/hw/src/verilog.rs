@@ -266,7 +266,7 @@ fn log2_module(datapath: &Datapath, id: NodeId, unit: Log2Unit, input: Format) -
         let table = unit.table(frac);
         let _ = writeln!(
             v,
-            "    reg [{k}:0] index;\n    reg signed [63:0] low, high, within;"
+            "    reg [{k}:0] index;\n    reg signed [63:0] low, high, fraction;"
         );
         let _ = writeln!(
             v,
@@ -318,16 +318,16 @@ fn log2_module(datapath: &Datapath, id: NodeId, unit: Log2Unit, input: Format) -
             if rest > 0 {
                 let _ = writeln!(
                     v,
-                    "            within = $signed({{{}'d0, f[{}:0]}});",
+                    "            fraction = $signed({{{}'d0, f[{}:0]}});",
                     EXACT_BITS - rest,
                     rest - 1
                 );
             } else {
-                let _ = writeln!(v, "            within = 64'sd0;");
+                let _ = writeln!(v, "            fraction = 64'sd0;");
             }
             let _ = writeln!(
                 v,
-                "            y = (e <<< {frac}) + low + (((high - low) * within) >>> {rest});"
+                "            y = (e <<< {frac}) + low + (((high - low) * fraction) >>> {rest});"
             );
         }
     }
