@@ -1,8 +1,11 @@
 //! Co-simulation: every datapath's Verilog, at two word lengths, run by Icarus Verilog against
 //! vectors from the Rust model; every output must be bit-identical.
 //!
-//! Needs `iverilog` and `vvp` (Debian package `iverilog`, which `.ci/run` installs). Without
-//! them the test fails when `CI=true` and is skipped, with a message, otherwise.
+//! Also: every module passes Verilator's `--lint-only -Wall` with no warning.
+//!
+//! Needs `iverilog` and `vvp` (Debian package `iverilog`) and `verilator` (Debian package
+//! `verilator`), which `.ci/run` installs. Without them the tests fail when `CI=true` and are
+//! skipped, with a message, otherwise.
 
 use std::path::Path;
 use std::process::Command;
@@ -12,19 +15,49 @@ use specula_hw::{verilog, HwLobe};
 const WIDTHS: [u32; 2] = [10, 20];
 const VECTORS: usize = 1500;
 
-fn have_iverilog() -> bool {
-    let found = Command::new("iverilog")
-        .arg("-V")
+fn have(tool: &str, version_flag: &str) -> bool {
+    let found = Command::new(tool)
+        .arg(version_flag)
         .output()
         .is_ok_and(|o| o.status.success());
     if !found {
         assert!(
             std::env::var("CI").as_deref() != Ok("true"),
-            "iverilog is not installed, and CI=true requires the co-simulation: apt-get install iverilog"
+            "{tool} is not installed, and CI=true requires it: apt-get install {tool}"
         );
-        eprintln!("skipping co-simulation: iverilog is not installed (apt-get install iverilog)");
+        eprintln!("skipped: {tool} is not installed (apt-get install {tool})");
     }
     found
+}
+
+fn have_iverilog() -> bool {
+    have("iverilog", "-V")
+}
+
+#[test]
+fn every_module_is_lint_clean_under_verilator() {
+    if !have("verilator", "--version") {
+        return;
+    }
+    let directory = tempfile::tempdir().expect("temporary directory");
+    for lobe in HwLobe::ALL {
+        for bits in [8, 10, 16, 20, 24] {
+            let datapath = lobe.build(bits).expect("valid width");
+            let module = directory.path().join(format!("{}.v", datapath.name));
+            std::fs::write(&module, verilog::module(&datapath, lobe, bits)).expect("write");
+            let lint = Command::new("verilator")
+                .args(["--lint-only", "-Wall"])
+                .arg(&module)
+                .output()
+                .expect("run verilator");
+            let text = String::from_utf8_lossy(&lint.stderr);
+            assert!(
+                lint.status.success() && !text.contains("%Warning"),
+                "{} at {bits} bits:\n{text}",
+                lobe.id()
+            );
+        }
+    }
 }
 
 fn simulate(directory: &Path, lobe: HwLobe, bits: u32) -> String {
