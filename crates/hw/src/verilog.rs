@@ -487,9 +487,14 @@ pub fn describe(datapath: &Datapath, op: &Op) -> String {
     }
 }
 
-/// Input vectors and the model's outputs for them: `count` points spread over the input
-/// range (a low-discrepancy sequence, so that the set is the same on every run) and the ends
-/// `t = 0` and `t = 1`, each with an exponent cycling through `[1, 1000]`.
+/// `count` test vectors `(inputs, expected output)` for `lobe` at `bits`, from the model.
+///
+/// Each vector draws its own integer `n` in `[1, 1000]` and a cosine where the lobe lives: `y =
+/// n log2 t` over `[-1.8, 0]` for three vectors in four (the epicentre is `y >= -1`), over
+/// `[-12, -1.8]` (the outer bloom, `y >= -8`, and the tail) for the fourth, so few vectors
+/// expect the 0 that the lobes' cut-offs and the tail give. The first
+/// vectors are the edge cases: `t = 0`, `t = 1`, the largest input word, and each zone's
+/// boundary.
 #[must_use]
 pub fn test_vectors(
     lobe: HwLobe,
@@ -497,30 +502,40 @@ pub fn test_vectors(
     bits: u32,
     count: usize,
 ) -> Vec<(Vec<i64>, i64)> {
-    let top = if lobe.takes_angle() {
-        core::f64::consts::FRAC_PI_2
-    } else {
-        1.0
+    let to_input = |t: f64| {
+        if lobe.takes_angle() {
+            t.clamp(0.0, 1.0).acos()
+        } else {
+            t
+        }
     };
-    (0..count)
-        .map(|i| {
-            let position = match i {
-                0 => 0.0,
-                1 => 1.0,
-                // Weyl sequence, squared towards 1 so the epicentre (t near 1) is well covered.
-                _ => 1.0 - (i as f64 * 0.618_033_988_749_895).fract().powi(3),
-            };
-            let x = if lobe.takes_angle() {
-                (1.0 - position) * top
-            } else {
-                position
-            };
-            let n = 1 + (i as u32 * 7919) % 1000;
-            let inputs = lobe.inputs(bits, x, n);
-            let expected = datapath.eval(&inputs);
-            (inputs, expected)
-        })
-        .collect()
+    let vector = |x: f64, n: u32| {
+        let inputs = lobe.inputs(bits, x, n);
+        let expected = datapath.eval(&inputs);
+        (inputs, expected)
+    };
+    let mut vectors = vec![
+        vector(to_input(0.0), 64),
+        vector(to_input(1.0), 64),
+        // The largest input word: 2 saturates into the input's UQ1.(W-1) format.
+        vector(2.0, 64),
+        vector(to_input((-1.0_f64 / 64.0).exp2()), 64),
+        vector(to_input((-8.0_f64 / 64.0).exp2()), 64),
+    ];
+    vectors.truncate(count);
+    vectors.extend((vectors.len()..count).map(|i| {
+        let n = 1 + (i as u32 * 7919) % 1000;
+        // Weyl sequence: three vectors in four over y in [-1.8, 0] (the epicentre and the
+        // inner bloom, where every lobe is alive), the fourth over [-12, -1.8].
+        let u = (i as f64 * 0.618_033_988_749_895).fract();
+        let y = if i % 4 == 3 {
+            -1.8 - 10.2 * u
+        } else {
+            -1.8 * u
+        };
+        vector(to_input((y / f64::from(n)).exp2()), n)
+    }));
+    vectors
 }
 
 /// A self-checking testbench for the module of `datapath` over `vectors`.

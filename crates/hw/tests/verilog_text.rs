@@ -180,3 +180,30 @@ fn no_systemverilog_keyword_is_an_identifier() {
         }
     }
 }
+
+/// The testbench's vectors cover the lobe, not its tail: at most 30 % expect 0, and the edge
+/// cases (t = 0, the peak, the largest input word) come first.
+#[test]
+fn test_vectors_cover_the_lobe() {
+    for lobe in HwLobe::ALL {
+        for bits in [12, 16, 20] {
+            let datapath = lobe.build(bits).expect("valid width");
+            let vectors = verilog::test_vectors(lobe, &datapath, bits, 2000);
+            assert_eq!(vectors.len(), 2000);
+            let zeros = vectors.iter().filter(|(_, out)| *out == 0).count();
+            assert!(
+                zeros * 10 <= vectors.len() * 3,
+                "{} at {bits} bits: {zeros} of {} vectors expect 0",
+                lobe.id(),
+                vectors.len()
+            );
+            let first_inputs: Vec<i64> = vectors[..3].iter().map(|(i, _)| i[0]).collect();
+            let top = (1_i64 << bits) - 1;
+            assert!(
+                first_inputs.contains(&top),
+                "{}: no largest input",
+                lobe.id()
+            );
+        }
+    }
+}
