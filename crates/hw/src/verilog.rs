@@ -591,7 +591,7 @@ pub fn testbench(datapath: &Datapath, vectors: &[(Vec<i64>, i64)]) -> String {
         .collect();
     let _ = writeln!(
         v,
-        "        errors = 0;\n        for (i = 0; i < COUNT + LATENCY - 1; i = i + 1) begin\n            if (i < COUNT) begin {} end\n            #5 clk = 1'b1;\n            #1;\n            j = i + 1 - LATENCY;\n            if (j >= 0 && value !== expected[j]) begin\n                errors = errors + 1;\n                if (errors <= 10) $display(\"MISMATCH vector %0d: got %0d, expected %0d\", j, value, expected[j]);\n            end\n            #4 clk = 1'b0;\n        end\n        if (errors == 0) $display(\"PASS %0d vectors\", COUNT);\n        else $display(\"FAIL %0d of %0d vectors\", errors, COUNT);\n        $finish;\n    end\nendmodule",
+        "        errors = 0;\n        for (i = 0; i < COUNT + LATENCY - 1; i = i + 1) begin\n            if (i < COUNT) begin {} end\n            #5 clk = 1'b1;\n            #1;\n            j = i + 1 - LATENCY;\n            if (j >= 0 && value !== expected[j]) begin\n                errors = errors + 1;\n                if (errors <= 10) $display(\"MISMATCH vector %0d: got %0d, expected %0d\", j, value, expected[j]);\n            end\n            #4 clk = 1'b0;\n        end\n        if (errors != 0) $fatal(1, \"FAIL %0d of %0d vectors\", errors, COUNT);\n        $display(\"PASS %0d vectors\", COUNT);\n        $finish;\n    end\nendmodule",
         assign.join(" ")
     );
     v

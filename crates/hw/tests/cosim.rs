@@ -143,9 +143,15 @@ fn a_wrong_expected_value_is_caught() {
         .arg(&program)
         .output()
         .expect("vvp");
-    let text = String::from_utf8_lossy(&run.stdout);
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    );
     assert!(
         text.contains("FAIL 1 of 50 vectors") && text.contains("MISMATCH vector 7"),
         "{text}"
     );
+    // `$fatal`: the simulator's exit status says so too, for scripts and make.
+    assert!(!run.status.success(), "a failing testbench exited 0");
 }
