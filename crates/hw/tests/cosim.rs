@@ -10,7 +10,8 @@
 use std::path::Path;
 use std::process::Command;
 
-use specula_hw::{verilog, HwLobe};
+use specula_hw::verilog::{self, Form};
+use specula_hw::HwLobe;
 
 const WIDTHS: [u32; 2] = [10, 20];
 const VECTORS: usize = 1500;
@@ -43,31 +44,37 @@ fn every_module_is_lint_clean_under_verilator() {
     for lobe in HwLobe::ALL {
         for bits in [8, 10, 16, 20, 24] {
             let datapath = lobe.build(bits).expect("valid width");
-            let module = directory.path().join(format!("{}.v", datapath.name));
-            std::fs::write(&module, verilog::module(&datapath, lobe, bits)).expect("write");
-            let lint = Command::new("verilator")
-                .args(["--lint-only", "-Wall"])
-                .arg(&module)
-                .output()
-                .expect("run verilator");
-            let text = String::from_utf8_lossy(&lint.stderr);
-            assert!(
-                lint.status.success() && !text.contains("%Warning"),
-                "{} at {bits} bits:\n{text}",
-                lobe.id()
-            );
+            for form in [Form::Pipelined, Form::Combinational] {
+                let module = directory
+                    .path()
+                    .join(format!("{}.v", form.module_name(&datapath)));
+                let text = verilog::module_in(&datapath, lobe, bits, form);
+                std::fs::write(&module, text).expect("write");
+                let lint = Command::new("verilator")
+                    .args(["--lint-only", "-Wall"])
+                    .arg(&module)
+                    .output()
+                    .expect("run verilator");
+                let text = String::from_utf8_lossy(&lint.stderr);
+                assert!(
+                    lint.status.success() && !text.contains("%Warning"),
+                    "{} at {bits} bits, {form:?}:\n{text}",
+                    lobe.id()
+                );
+            }
         }
     }
 }
 
-fn simulate(directory: &Path, lobe: HwLobe, bits: u32) -> String {
+fn simulate(directory: &Path, lobe: HwLobe, bits: u32, form: Form) -> String {
     let datapath = lobe.build(bits).expect("valid width");
     let vectors = verilog::test_vectors(lobe, &datapath, bits, VECTORS);
-    let module = directory.join(format!("{}.v", datapath.name));
-    let bench = directory.join(format!("{}_tb.v", datapath.name));
-    std::fs::write(&module, verilog::module(&datapath, lobe, bits)).expect("write module");
-    std::fs::write(&bench, verilog::testbench(&datapath, &vectors)).expect("write testbench");
-    let program = directory.join(format!("{}.vvp", datapath.name));
+    let name = form.module_name(&datapath);
+    let module = directory.join(format!("{name}.v"));
+    let bench = directory.join(format!("{name}_tb.v"));
+    std::fs::write(&module, verilog::module_in(&datapath, lobe, bits, form)).expect("write");
+    std::fs::write(&bench, verilog::testbench_in(&datapath, &vectors, form)).expect("write");
+    let program = directory.join(format!("{name}.vvp"));
     // Verilog-2005 and SystemVerilog-2012 both: an identifier that is a keyword in one fails.
     for generation in ["-g2012", "-g2005"] {
         let compiled = Command::new("iverilog")
@@ -104,12 +111,14 @@ fn every_datapath_simulates_bit_exactly_at_two_widths() {
     let directory = tempfile::tempdir().expect("temporary directory");
     for lobe in HwLobe::ALL {
         for bits in WIDTHS {
-            let output = simulate(directory.path(), lobe, bits);
-            assert!(
-                output.contains(&format!("PASS {VECTORS} vectors")),
-                "{} at {bits} bits:\n{output}",
-                lobe.id()
-            );
+            for form in [Form::Pipelined, Form::Combinational] {
+                let output = simulate(directory.path(), lobe, bits, form);
+                assert!(
+                    output.contains(&format!("PASS {VECTORS} vectors")),
+                    "{} at {bits} bits, {form:?}:\n{output}",
+                    lobe.id()
+                );
+            }
         }
     }
 }

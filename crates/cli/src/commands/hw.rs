@@ -111,6 +111,10 @@ struct VerilogArgs {
     /// Test vectors in the testbench.
     #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(2..=100_000))]
     vectors: u32,
+    /// The combinational form (module `<name>_comb`, no clock, no register) instead of the
+    /// pipeline.
+    #[arg(long)]
+    combinational: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -148,13 +152,18 @@ fn write_text(path: &std::path::Path, text: &str) -> CommandResult {
 
 fn write_verilog(args: &VerilogArgs) -> CommandResult {
     let datapath = args.lobe.build(args.bits).map_err(|e| e.to_string())?;
+    let form = if args.combinational {
+        verilog::Form::Combinational
+    } else {
+        verilog::Form::Pipelined
+    };
     if let Some(path) = &args.testbench {
         let vectors = verilog::test_vectors(args.lobe, &datapath, args.bits, args.vectors as usize);
-        write_text(path, &verilog::testbench(&datapath, &vectors))?;
+        write_text(path, &verilog::testbench_in(&datapath, &vectors, form))?;
     }
     write_text(
         &args.output,
-        &verilog::module(&datapath, args.lobe, args.bits),
+        &verilog::module_in(&datapath, args.lobe, args.bits, form),
     )
 }
 
