@@ -14,7 +14,6 @@ use specula_hw::verilog::{self, Form};
 use specula_hw::HwLobe;
 
 const WIDTHS: [u32; 2] = [10, 20];
-const VECTORS: usize = 1500;
 
 fn have(tool: &str, version_flag: &str) -> bool {
     let found = Command::new(tool)
@@ -68,7 +67,7 @@ fn every_module_is_lint_clean_under_verilator() {
 
 fn simulate(directory: &Path, lobe: HwLobe, bits: u32, form: Form) -> String {
     let datapath = lobe.build(bits).expect("valid width");
-    let vectors = verilog::test_vectors(lobe, &datapath, bits, VECTORS);
+    let vectors = verilog::default_vectors(lobe, &datapath, bits, 64);
     let name = form.module_name(&datapath);
     let module = directory.join(format!("{name}.v"));
     let bench = directory.join(format!("{name}_tb.v"));
@@ -113,8 +112,14 @@ fn every_datapath_simulates_bit_exactly_at_two_widths() {
         for bits in WIDTHS {
             for form in [Form::Pipelined, Form::Combinational] {
                 let output = simulate(directory.path(), lobe, bits, form);
+                // Exhaustive at 10 bits (every input word), sampled at 20.
+                let count = if bits <= verilog::EXHAUSTIVE_BITS {
+                    1 << bits
+                } else {
+                    verilog::SAMPLED_VECTORS
+                };
                 assert!(
-                    output.contains(&format!("PASS {VECTORS} vectors")),
+                    output.contains(&format!("PASS {count} vectors")),
                     "{} at {bits} bits, {form:?}:\n{output}",
                     lobe.id()
                 );

@@ -207,3 +207,20 @@ fn test_vectors_cover_the_lobe() {
         }
     }
 }
+
+/// Up to 16 bits the default testbench visits every input word once; above, 10,000 vectors.
+#[test]
+fn default_testbenches_are_exhaustive_up_to_sixteen_bits() {
+    for lobe in HwLobe::ALL {
+        let datapath = lobe.build(12).expect("valid width");
+        let vectors = verilog::default_vectors(lobe, &datapath, 12, 64);
+        let mut words: Vec<i64> = vectors.iter().map(|(inputs, _)| inputs[0]).collect();
+        words.sort_unstable();
+        assert_eq!(words, (0..1 << 12).collect::<Vec<i64>>(), "{}", lobe.id());
+        let wide = lobe.build(20).expect("valid width");
+        assert_eq!(
+            verilog::default_vectors(lobe, &wide, 20, 64).len(),
+            verilog::SAMPLED_VECTORS
+        );
+    }
+}

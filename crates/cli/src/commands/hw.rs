@@ -108,9 +108,10 @@ struct VerilogArgs {
     /// Also write a self-checking testbench here, with vectors from the Rust model.
     #[arg(long)]
     testbench: Option<PathBuf>,
-    /// Test vectors in the testbench.
-    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(2..=100_000))]
-    vectors: u32,
+    /// Test vectors in the testbench (default: every input word, at n = 64, up to 16 bits;
+    /// 10,000 spread over the lobe above).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=100_000))]
+    vectors: Option<u32>,
     /// The combinational form (module `<name>_comb`, no clock, no register) instead of the
     /// pipeline.
     #[arg(long)]
@@ -158,7 +159,10 @@ fn write_verilog(args: &VerilogArgs) -> CommandResult {
         verilog::Form::Pipelined
     };
     if let Some(path) = &args.testbench {
-        let vectors = verilog::test_vectors(args.lobe, &datapath, args.bits, args.vectors as usize);
+        let vectors = match args.vectors {
+            Some(count) => verilog::test_vectors(args.lobe, &datapath, args.bits, count as usize),
+            None => verilog::default_vectors(args.lobe, &datapath, args.bits, 64),
+        };
         write_text(path, &verilog::testbench_in(&datapath, &vectors, form))?;
     }
     write_text(

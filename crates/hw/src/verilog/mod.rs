@@ -21,7 +21,10 @@ use crate::log2::Log2Unit;
 
 mod testbench;
 
-pub use testbench::{test_vectors, testbench, testbench_in};
+pub use testbench::{
+    default_vectors, exhaustive_vectors, test_vectors, testbench, testbench_in, EXHAUSTIVE_BITS,
+    SAMPLED_VECTORS,
+};
 
 /// Bits of the intermediates the Verilog computes exact results in (signed).
 const EXACT_BITS: u32 = 64;

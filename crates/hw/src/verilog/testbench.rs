@@ -7,6 +7,47 @@ use super::Form;
 use crate::datapath::Datapath;
 use crate::lobes::HwLobe;
 
+/// Word lengths up to this get exhaustive testbenches by default.
+pub const EXHAUSTIVE_BITS: u32 = 16;
+/// Vectors of a wider datapath's default testbench.
+pub const SAMPLED_VECTORS: usize = 10_000;
+
+/// The default testbench vectors: every input word at exponent `n` when `bits` is at most
+/// [`EXHAUSTIVE_BITS`], else [`SAMPLED_VECTORS`] of [`test_vectors`].
+#[must_use]
+pub fn default_vectors(
+    lobe: HwLobe,
+    datapath: &Datapath,
+    bits: u32,
+    n: u32,
+) -> Vec<(Vec<i64>, i64)> {
+    if bits <= EXHAUSTIVE_BITS {
+        exhaustive_vectors(lobe, datapath, bits, n)
+    } else {
+        test_vectors(lobe, datapath, bits, SAMPLED_VECTORS)
+    }
+}
+
+/// Every value of the input word (`t`, or `g` for the angle datapaths) at exponent `n`.
+#[must_use]
+pub fn exhaustive_vectors(
+    lobe: HwLobe,
+    datapath: &Datapath,
+    bits: u32,
+    n: u32,
+) -> Vec<(Vec<i64>, i64)> {
+    let material = lobe.material_inputs(bits, n);
+    (0..1_i64 << bits)
+        .map(|raw| {
+            let inputs: Vec<i64> = core::iter::once(raw)
+                .chain(material.iter().copied())
+                .collect();
+            let expected = datapath.eval(&inputs);
+            (inputs, expected)
+        })
+        .collect()
+}
+
 /// `count` test vectors `(inputs, expected output)` for `lobe` at `bits`, from the model.
 ///
 /// Each vector draws its own integer `n` in `[1, 1000]` and a cosine where the lobe lives: `y =
