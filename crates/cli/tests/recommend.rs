@@ -6,9 +6,11 @@ mod common;
 use common::{ok, specula};
 use serde_json::Value;
 
-fn json(args: &[&str]) -> Vec<Value> {
+/// A command line's JSON answer (`line` split at spaces).
+fn json(line: &str) -> Vec<Value> {
     let directory = tempfile::tempdir().unwrap();
-    let output = ok(directory.path(), args);
+    let args: Vec<&str> = line.split_whitespace().collect();
+    let output = ok(directory.path(), &args);
     serde_json::from_slice::<Value>(&output.stdout)
         .unwrap()
         .as_array()
@@ -18,19 +20,9 @@ fn json(args: &[&str]) -> Vec<Value> {
 
 #[test]
 fn the_recommendation_is_what_analyze_measures() {
-    let rows = json(&[
-        "recommend",
-        "--target",
-        "gpu-nvidia",
-        "--n",
-        "64",
-        "--max-error",
-        "1%",
-        "--format",
-        "json",
-    ]);
+    let rows = json("recommend --target gpu-nvidia --n 64 --max-error 1% --format json");
     assert_eq!(rows.len(), specula::LobeKind::ALL.len());
-    let analyzed = json(&["analyze", "--n", "64", "--format", "json"]);
+    let analyzed = json("analyze --n 64 --format json");
     for row in &rows {
         let lobe = row["lobe"].as_str().unwrap();
         let figures = analyzed
@@ -60,19 +52,8 @@ fn the_recommendation_is_what_analyze_measures() {
 
 #[test]
 fn the_front_is_undominated_and_everything_else_is_dominated() {
-    let rows = json(&[
-        "recommend",
-        "--target",
-        "gpu-amd",
-        "--n",
-        "8..512",
-        "--max-error",
-        "2",
-        "--zone",
-        "whole",
-        "--format",
-        "json",
-    ]);
+    let rows =
+        json("recommend --target gpu-amd --n 8..512 --max-error 2 --zone whole --format json");
     let point = |r: &Value| (r["error"].as_f64().unwrap(), r["rate"].as_f64().unwrap());
     for row in &rows {
         let (error, rate) = point(row);
@@ -87,44 +68,21 @@ fn the_front_is_undominated_and_everything_else_is_dominated() {
 #[test]
 fn an_impossible_accuracy_leaves_the_exact_lobe_and_bad_requests_are_refused() {
     let directory = tempfile::tempdir().unwrap();
-    let output = ok(
-        directory.path(),
-        &[
-            "recommend",
-            "--target",
-            "gpu-amd",
-            "--max-error",
-            "1e-9",
-            "--zone",
-            "whole",
-        ],
-    );
+    let args: Vec<&str> = "recommend --target gpu-amd --max-error 1e-9 --zone whole"
+        .split_whitespace()
+        .collect();
+    let output = ok(directory.path(), &args);
     let text = String::from_utf8_lossy(&output.stdout);
     assert!(text.starts_with("pow: the cheapest lobe within"), "{text}");
     for bad in [
-        &["recommend", "--target", "tpu", "--max-error", "1%"][..],
-        &["recommend", "--target", "cpu", "--max-error", "0"],
-        &["recommend", "--target", "cpu", "--max-error", "nan"],
-        &[
-            "recommend",
-            "--target",
-            "cpu",
-            "--max-error",
-            "1",
-            "--n",
-            "0..5",
-        ],
-        &[
-            "recommend",
-            "--target",
-            "cpu",
-            "--max-error",
-            "1",
-            "--n",
-            "64..8",
-        ],
+        "recommend --target tpu --max-error 1%",
+        "recommend --target cpu --max-error 0",
+        "recommend --target cpu --max-error nan",
+        "recommend --target cpu --max-error 1 --n 0..5",
+        "recommend --target cpu --max-error 1 --n 64..8",
     ] {
-        let output = specula(directory.path(), bad);
+        let bad: Vec<&str> = bad.split_whitespace().collect();
+        let output = specula(directory.path(), &bad);
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(2), "{bad:?}: {stderr}");
         assert_eq!(stderr.trim().lines().count(), 1, "{bad:?}: {stderr}");
@@ -135,36 +93,15 @@ fn an_impossible_accuracy_leaves_the_exact_lobe_and_bad_requests_are_refused() {
 /// word length costed, and the datapath's error is what `specula hw table` measures there.
 #[test]
 fn fpga_answers_come_from_the_datapaths() {
-    let rows = json(&[
-        "recommend",
-        "--target",
-        "fpga",
-        "--n",
-        "64",
-        "--max-error",
-        "1%",
-        "--format",
-        "json",
-    ]);
+    let rows = json("recommend --target fpga --n 64 --max-error 1% --format json");
     let best = &rows[0];
     assert_eq!(best["meets"], true, "{best}");
     let datapath = best["datapath"].as_str().expect("a datapath is named");
     let (name, bits) = datapath.split_once(" at ").unwrap();
     let bits = bits.trim_end_matches(" bits");
-    let table = json(&[
-        "hw",
-        "table",
-        "--lobe",
-        name,
-        "--n",
-        "64",
-        "--samples",
-        "20001",
-        "--bits",
-        &format!("{bits}..{bits}"),
-        "--format",
-        "json",
-    ]);
+    let table = json(&format!(
+        "hw table --lobe {name} --n 64 --samples 20001 --bits {bits}..{bits} --format json"
+    ));
     let measured = table[0]["rows"][0]["errors"]["epicentre_max_rel"]
         .as_f64()
         .unwrap();

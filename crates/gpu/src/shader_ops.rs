@@ -51,14 +51,14 @@ impl Counter<'_> {
 
     fn block(&self, function: Handle<naga::Function>, block: &Block) -> ShaderOps {
         block.iter().fold(ShaderOps::default(), |sum, statement| {
-            add(sum, self.statement(function, statement))
+            sum + self.statement(function, statement)
         })
     }
 
     fn statement(&self, function: Handle<naga::Function>, statement: &Statement) -> ShaderOps {
         match statement {
             Statement::Emit(range) => range.clone().fold(ShaderOps::default(), |sum, e| {
-                add(sum, self.expression(function, e))
+                sum + self.expression(function, e)
             }),
             Statement::Block(block) => self.block(function, block),
             Statement::If { accept, reject, .. } => {
@@ -72,10 +72,10 @@ impl Counter<'_> {
             Statement::Loop {
                 body, continuing, ..
             } => {
-                let trip = add(self.block(function, body), self.block(function, continuing));
+                let trip = self.block(function, body) + self.block(function, continuing);
                 // The trip count is a baked constant: compilers unroll the loop, and its
                 // counter's increment and exit test (its only integer work) vanish.
-                scale(ShaderOps { integer: 0, ..trip }, self.trips)
+                ShaderOps { integer: 0, ..trip } * self.trips
             }
             Statement::Call {
                 function: callee, ..
@@ -157,27 +157,5 @@ impl Counter<'_> {
             _ => {}
         }
         ops
-    }
-}
-
-fn add(a: ShaderOps, b: ShaderOps) -> ShaderOps {
-    ShaderOps {
-        arithmetic: a.arithmetic + b.arithmetic,
-        compare: a.compare + b.compare,
-        transcendental: a.transcendental + b.transcendental,
-        conversion: a.conversion + b.conversion,
-        integer: a.integer + b.integer,
-        acos: a.acos + b.acos,
-    }
-}
-
-fn scale(a: ShaderOps, k: u32) -> ShaderOps {
-    ShaderOps {
-        arithmetic: a.arithmetic * k,
-        compare: a.compare * k,
-        transcendental: a.transcendental * k,
-        conversion: a.conversion * k,
-        integer: a.integer * k,
-        acos: a.acos * k,
     }
 }

@@ -28,19 +28,40 @@ pub struct ShaderOps {
     pub acos: u32,
 }
 
+impl core::ops::Add for ShaderOps {
+    type Output = ShaderOps;
+    fn add(self, other: ShaderOps) -> ShaderOps {
+        ShaderOps {
+            arithmetic: self.arithmetic + other.arithmetic,
+            compare: self.compare + other.compare,
+            transcendental: self.transcendental + other.transcendental,
+            conversion: self.conversion + other.conversion,
+            integer: self.integer + other.integer,
+            acos: self.acos + other.acos,
+        }
+    }
+}
+
+impl core::ops::Mul<u32> for ShaderOps {
+    type Output = ShaderOps;
+    /// The counts of `k` executions.
+    fn mul(self, k: u32) -> ShaderOps {
+        ShaderOps {
+            arithmetic: self.arithmetic * k,
+            compare: self.compare * k,
+            transcendental: self.transcendental * k,
+            conversion: self.conversion * k,
+            integer: self.integer * k,
+            acos: self.acos * k,
+        }
+    }
+}
+
 impl ShaderOps {
     /// Every count, `acos` expanded as drivers expand it.
     #[must_use]
     pub fn expanded(&self) -> ShaderOps {
-        let acos = GpuFamily::ACOS;
-        ShaderOps {
-            arithmetic: self.arithmetic + self.acos * acos.arithmetic,
-            compare: self.compare + self.acos * acos.compare,
-            transcendental: self.transcendental + self.acos * acos.transcendental,
-            conversion: self.conversion,
-            integer: self.integer,
-            acos: 0,
-        }
+        ShaderOps { acos: 0, ..*self } + GpuFamily::ACOS * self.acos
     }
 
     /// Instructions in all.

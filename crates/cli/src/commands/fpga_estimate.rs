@@ -14,25 +14,30 @@ use specula_hw::Resources;
 /// Estimated logic cells of `resources` on a LUT4 fabric without DSPs.
 #[must_use]
 pub fn logic_cells(resources: &Resources) -> u64 {
-    let sum = |values: &mut dyn Iterator<Item = u64>| values.sum::<u64>();
-    let logic = sum(&mut resources.adders.iter().map(|&b| u64::from(b)))
-        + sum(&mut resources
-            .multipliers
-            .iter()
-            .map(|&(a, b)| u64::from(a) * u64::from(b)))
-        + sum(&mut resources
-            .squarers
-            .iter()
-            .map(|&b| u64::from(b) * u64::from(b) / 2))
-        + sum(&mut resources
-            .dividers
-            .iter()
-            .map(|&(a, b)| u64::from(a) * u64::from(b)))
-        + sum(&mut resources
-            .leading_one_detectors
-            .iter()
-            .map(|&b| u64::from(b)))
-        + resources.rom_bits.div_ceil(16);
+    let bits = |b: u32| u64::from(b);
+    let adders: u64 = resources.adders.iter().map(|&b| bits(b)).sum();
+    let multipliers: u64 = resources
+        .multipliers
+        .iter()
+        .map(|&(a, b)| bits(a) * bits(b))
+        .sum();
+    let squarers: u64 = resources
+        .squarers
+        .iter()
+        .map(|&b| bits(b) * bits(b) / 2)
+        .sum();
+    let dividers: u64 = resources
+        .dividers
+        .iter()
+        .map(|&(a, b)| bits(a) * bits(b))
+        .sum();
+    let detectors: u64 = resources
+        .leading_one_detectors
+        .iter()
+        .map(|&b| bits(b))
+        .sum();
+    let logic =
+        adders + multipliers + squarers + dividers + detectors + resources.rom_bits.div_ceil(16);
     logic.max(resources.register_bits)
 }
 

@@ -114,7 +114,7 @@ fn parse_percent(text: &str) -> Result<f64, String> {
 #[derive(Clone, Debug, Serialize)]
 struct Candidate {
     lobe: String,
-    /// On `fpga`, the datapath and word length costed (at the last exponent); `None` where
+    /// On `fpga`, the datapath and word length costed (at the first exponent); `None` where
     /// the lobe has no datapath that meets its float model.
     #[serde(skip_serializing_if = "Option::is_none")]
     datapath: Option<String>,

@@ -22,8 +22,9 @@
 //!   N. N. Schraudolph, "A fast, compact approximation of the exponential function" (1999).
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
-use super::fastpow::{bits_exp2, frexp, kinks, BITS_EXP2, FREXP};
+use super::fastpow::kinks;
 use crate::real::Real;
+use crate::simd::math::{bits_exp2, frexp, BITS_EXP2, FREXP};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;

@@ -29,6 +29,7 @@
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use crate::real::Real;
+use crate::simd::math::{bits_exp2, frexp, BITS_EXP2, FREXP};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
@@ -49,35 +50,6 @@ const EXP_NUMERATOR: f64 = 27.728_023_3;
 const EXP_POLE: f64 = 4.842_525_68;
 const EXP_SLOPE: f64 = 1.490_129_07;
 const EXP_OFFSET: f64 = 127.0 - 121.274_057_5;
-
-/// `(t's mantissa in [1/2, 1), t's exponent)` as vector lanes, from the bits: the
-/// [`Real::frexp`] of the kernels, for `t >= 0`.
-#[inline(always)]
-pub(crate) fn frexp<V: Lanes>(t: V) -> (V, V) {
-    let mantissa = t.bits_and(0x007f_ffff).bits_add(0x3f00_0000);
-    let exponent = t.bits_shr_signed::<23>().bits_add(126_u32.wrapping_neg());
-    (mantissa, exponent.int_to_float())
-}
-
-/// [`frexp`]'s instructions.
-pub(crate) const FREXP: Instructions = Instructions::of(&[
-    (Class::Logic, 1),
-    (Class::IntAdd, 2),
-    (Class::Shift, 1),
-    (Class::Convert, 1),
-]);
-
-/// [`Real::bits_exp2`] on vector lanes: `(x + 127) 2^23` truncated is the bit pattern.
-#[inline(always)]
-pub(crate) fn bits_exp2<V: Lanes>(x: V) -> V {
-    x.max(x.splat(-127.0))
-        .mul_add(x.splat(8_388_608.0), x.splat(1_065_353_216.0))
-        .float_to_int()
-}
-
-/// [`bits_exp2`]'s instructions.
-pub(crate) const BITS_EXP2: Instructions =
-    Instructions::of(&[(Class::MinMax, 1), (Class::Fma, 1), (Class::Convert, 1)]);
 
 /// Cosines in `(0, 1]` where a bit-trick lobe is not smooth while it is above `2^-64`: the
 /// binade boundaries `2^-k`, and where each of `crossings` (increasing functions of `t` that

@@ -6,6 +6,9 @@
 //! inputs); [`exp2`] within 2 ULP on `[-126, 0]` and 0 at or below `-127`; [`acos`] within
 //! `2.5e-7` radians on `[0, 1]`.
 //!
+//! Also the IEEE bit tricks' two halves, [`frexp`] and [`bits_exp2`] (the bit-trick lobes'
+//! `log2` and `exp2`, exact by construction: field moves and one multiply-add).
+//!
 //! Instruction counts per vector are stated beside each function and checked by the tests.
 
 use super::tally::{Class, Instructions};
@@ -114,6 +117,35 @@ pub(crate) const ACOS: Instructions = Instructions::of(&[
     (Class::Blend, 4),
     (Class::Sqrt, 1),
 ]);
+
+/// `(t's mantissa in [1/2, 1), t's exponent)` as vector lanes, from the bits: the
+/// [`Real::frexp`](crate::Real::frexp) of the kernels, for `t >= 0`.
+#[inline(always)]
+pub(crate) fn frexp<V: Lanes>(t: V) -> (V, V) {
+    let mantissa = t.bits_and(0x007f_ffff).bits_add(0x3f00_0000);
+    let exponent = t.bits_shr_signed::<23>().bits_add(126_u32.wrapping_neg());
+    (mantissa, exponent.int_to_float())
+}
+
+/// [`frexp`]'s instructions.
+pub(crate) const FREXP: Instructions = Instructions::of(&[
+    (Class::Logic, 1),
+    (Class::IntAdd, 2),
+    (Class::Shift, 1),
+    (Class::Convert, 1),
+]);
+
+/// [`Real::bits_exp2`](crate::Real::bits_exp2) on vector lanes: `(x + 127) 2^23` truncated is the bit pattern.
+#[inline(always)]
+pub(crate) fn bits_exp2<V: Lanes>(x: V) -> V {
+    x.max(x.splat(-127.0))
+        .mul_add(x.splat(8_388_608.0), x.splat(1_065_353_216.0))
+        .float_to_int()
+}
+
+/// [`bits_exp2`]'s instructions.
+pub(crate) const BITS_EXP2: Instructions =
+    Instructions::of(&[(Class::MinMax, 1), (Class::Fma, 1), (Class::Convert, 1)]);
 
 #[cfg(test)]
 mod tests {
