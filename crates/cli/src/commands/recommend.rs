@@ -146,23 +146,73 @@ fn zone_error(figures: &ErrorFigures, zone: ZoneChoice) -> f64 {
     }
 }
 
-/// The cost figure of `lobe` on `target` (higher is cheaper), and its unit.
-fn rate(lobe: &Lobe, target: Target) -> Result<(f64, &'static str), String> {
-    const MODELLED: &str = "evals/clock/multiprocessor (modelled)";
-    match target {
-        Target::Cpu => Ok((super::bench::lobes::kernel_rate(lobe), "evals/s, 1 thread")),
-        Target::GpuNvidia => Ok((gpu_rate(lobe, "gpu-nvidia")?, MODELLED)),
-        Target::GpuAmd => Ok((gpu_rate(lobe, "gpu-amd")?, MODELLED)),
-        Target::Fpga => Err("fpga costs come from the hardware sweeps".to_owned()),
-    }
+/// How a target's costs are obtained.
+enum Costing {
+    /// Timed on this machine's CPU.
+    Measured,
+    /// The GPU cost model of one family.
+    Modelled(GpuFamily),
+    /// Estimated from the fixed-point datapaths' sweeps, per exponent.
+    Estimated(Vec<(Exponent, Vec<WidthSweep>)>),
 }
 
-/// The modelled evaluations per clock per multiprocessor of `lobe`'s shader on a GPU family.
-fn gpu_rate(lobe: &Lobe, family: &str) -> Result<f64, String> {
-    let family =
-        GpuFamily::find(family).ok_or_else(|| format!("no GPU family '{family}' in the model"))?;
-    let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
-    Ok(family.cost(&ops).evals_per_clock)
+/// One lobe at one exponent: its error, its cost figure (higher is cheaper), and on the FPGA
+/// the datapath costed.
+struct Point {
+    error: f64,
+    rate: f64,
+    datapath: Option<String>,
+}
+
+impl Costing {
+    fn new(target: Target, exponents: &[Exponent]) -> Result<Self, String> {
+        let family = |id: &str| {
+            GpuFamily::find(id).ok_or_else(|| format!("no GPU family '{id}' in the model"))
+        };
+        Ok(match target {
+            Target::Cpu => Costing::Measured,
+            Target::GpuNvidia => Costing::Modelled(family("gpu-nvidia")?),
+            Target::GpuAmd => Costing::Modelled(family("gpu-amd")?),
+            Target::Fpga => Costing::Estimated(hardware_sweeps(exponents)?),
+        })
+    }
+
+    fn unit(&self) -> &'static str {
+        match self {
+            Costing::Measured => "evals/s, 1 thread",
+            Costing::Modelled(_) => "evals/clock/multiprocessor (modelled)",
+            Costing::Estimated(_) => "evals/clock per 1000 logic cells (estimated)",
+        }
+    }
+
+    /// `lobe` at its exponent, or `None` where the target cannot run it (no datapath).
+    fn point(&self, lobe: &Lobe, zone: ZoneChoice) -> Result<Option<Point>, String> {
+        let float_error = || zone_error(&error_figures(lobe, &mut Precision::F64, 20_001), zone);
+        Ok(match self {
+            Costing::Measured => Some(Point {
+                error: float_error(),
+                rate: super::bench::lobes::kernel_rate(lobe),
+                datapath: None,
+            }),
+            Costing::Modelled(family) => {
+                let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
+                Some(Point {
+                    error: float_error(),
+                    rate: family.cost(&ops).evals_per_clock,
+                    datapath: None,
+                })
+            }
+            Costing::Estimated(hardware) => hardware
+                .iter()
+                .find(|(at, _)| *at == lobe.exponent())
+                .and_then(|(_, sweeps)| cheapest_datapath(sweeps, lobe.kind(), zone))
+                .map(|(error, cells, name)| Point {
+                    error,
+                    rate: 1e3 / cells as f64,
+                    datapath: Some(name),
+                }),
+        })
+    }
 }
 
 /// Every datapath's sweep over word lengths at each exponent, rounded to an integer (the
@@ -221,11 +271,7 @@ pub(crate) fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
 /// Measures, ranks and prints.
 pub fn run(args: &Args) -> CommandResult {
     let exponents = &args.n.0;
-    let hardware = if args.target == Target::Fpga {
-        Some(hardware_sweeps(exponents)?)
-    } else {
-        None
-    };
+    let costing = Costing::new(args.target, exponents)?;
     let progress = ProgressBar::new(LobeKind::ALL.len() as u64).with_style(
         ProgressStyle::with_template("measuring {bar:30} {pos}/{len} lobes {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -236,41 +282,25 @@ pub fn run(args: &Args) -> CommandResult {
         let mut error = 0.0_f64;
         let mut energy = 0.0_f64;
         let mut cheapest = f64::INFINITY;
-        let mut unit = "";
+        // The datapath named at the first exponent; none if any exponent has none.
         let mut datapath = None;
         let mut unavailable = false;
         for &n in exponents {
             let lobe = Lobe::new(kind, n);
             energy = energy.max(energy_ratio(&lobe));
-            if let Some(hardware) = &hardware {
-                let at_n = hardware
-                    .iter()
-                    .find(|(at, _)| *at == n)
-                    .map_or(&[][..], |(_, sweeps)| sweeps.as_slice());
-                match cheapest_datapath(at_n, kind, args.zone) {
-                    Some((hw_error, cells, name)) => {
-                        error = error.max(hw_error);
-                        cheapest = cheapest.min(1e3 / cells as f64);
-                        datapath = datapath.or(Some(name));
-                    }
-                    None => {
-                        error = f64::INFINITY;
-                        cheapest = 0.0;
-                        unavailable = true;
-                    }
+            match costing.point(&lobe, args.zone)? {
+                Some(point) => {
+                    error = error.max(point.error);
+                    cheapest = cheapest.min(point.rate);
+                    datapath = datapath.or(point.datapath);
                 }
-                unit = "evals/clock per 1000 logic cells (estimated)";
-                continue;
+                None => unavailable = true,
             }
-            let figures = error_figures(&lobe, &mut Precision::F64, 20_001);
-            error = error.max(zone_error(&figures, args.zone));
-            let (value, its_unit) = rate(&lobe, args.target)?;
-            cheapest = cheapest.min(value);
-            unit = its_unit;
         }
         if unavailable {
-            datapath = None;
+            (error, cheapest, datapath) = (f64::INFINITY, 0.0, None);
         }
+        let unit = costing.unit();
         let meets = error <= args.max_error && (!args.energy_conserving || energy <= 1.001);
         candidates.push(Candidate {
             lobe: kind.to_string(),
