@@ -85,9 +85,9 @@ fn bad_requests_name_the_problem_and_write_nothing() {
     let cases: [(&[&str], &str); 5] = [
         (
             &[
-                "hw", "verilog", "--lobe", "pow", "--bits", "16", "-o", "x.v",
+                "hw", "verilog", "--lobe", "sg-karis", "--bits", "16", "-o", "x.v",
             ],
-            "valid: schlick, schlick-mod, cheb2, logexp",
+            "valid: schlick, schlick-mod, cheb2, logexp, logexp-mitchell, cosquad, pow, sg",
         ),
         (
             &[

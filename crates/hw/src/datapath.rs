@@ -10,6 +10,7 @@
 
 use serde::Serialize;
 
+use crate::exp2::Exp2Unit;
 use crate::fixed::{exact_add, exact_mul, Format, Rounding, MAX_WIDTH};
 use crate::log2::Log2Unit;
 
@@ -40,6 +41,8 @@ pub enum Op {
     Shift(NodeId, i32),
     /// `log2 a` for an unsigned `a`.
     Log2(NodeId, Log2Unit),
+    /// `2^-a` for an unsigned `a`.
+    Exp2Neg(NodeId, Exp2Unit),
     /// `min(a, b)`: a comparator and a multiplexer.
     Min(NodeId, NodeId),
     /// 1 if `a` is not zero, else 0: an OR of its bits.
@@ -81,10 +84,10 @@ pub struct Datapath {
     nodes: Vec<Node>,
     inputs: Vec<NodeId>,
     output: NodeId,
-    /// Each node's log2 table (empty for other nodes), built once here rather than per
-    /// evaluation: the sweeps evaluate a datapath millions of times.
+    /// Each node's log2 or exp2 table (empty for other nodes), built once here rather than
+    /// per evaluation: the sweeps evaluate a datapath millions of times.
     #[serde(skip)]
-    log2_tables: Vec<Vec<i64>>,
+    tables: Vec<Vec<i64>>,
 }
 
 /// The datapath builder: nodes are added in order, each naming its operands.
@@ -143,11 +146,12 @@ impl Builder {
     /// The finished datapath, with `output` as its result.
     #[must_use]
     pub fn finish(self, name: &str, output: NodeId) -> Datapath {
-        let log2_tables = self
+        let tables = self
             .nodes
             .iter()
             .map(|node| match node.op {
                 Op::Log2(_, unit) => unit.table(Log2Unit::table_frac_bits(node.format.frac_bits)),
+                Op::Exp2Neg(_, unit) => unit.table(Exp2Unit::frac_bits(node.format.frac_bits)),
                 _ => Vec::new(),
             })
             .collect();
@@ -156,7 +160,7 @@ impl Builder {
             nodes: self.nodes,
             inputs: self.inputs,
             output,
-            log2_tables,
+            tables,
         }
     }
 }
@@ -169,7 +173,9 @@ pub fn operands(op: &Op) -> Vec<NodeId> {
         Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Min(a, b) => {
             vec![*a, *b]
         }
-        Op::Square(a) | Op::Shift(a, _) | Op::Log2(a, _) | Op::NonZero(a) => vec![*a],
+        Op::Square(a) | Op::Shift(a, _) | Op::Log2(a, _) | Op::Exp2Neg(a, _) | Op::NonZero(a) => {
+            vec![*a]
+        }
         Op::Rom { index, .. } => vec![*index],
         Op::Select { index, options } => core::iter::once(*index)
             .chain(options.iter().copied())
@@ -190,6 +196,8 @@ pub struct Resources {
     pub dividers: Vec<(u32, u32)>,
     /// Leading-one detectors (one per log2 unit) by input bits.
     pub leading_one_detectors: Vec<u32>,
+    /// Barrel shifters (a log2 unit's normalisation, an exp2 unit's scaling) by data bits.
+    pub shifters: Vec<u32>,
     /// ROM bits: coefficient tables and log2 tables.
     pub rom_bits: u64,
     /// Pipeline registers' bits, delay registers included.
@@ -298,8 +306,12 @@ impl Datapath {
                 }
                 Op::Log2(a, unit) => {
                     let (a, fa) = at(*a);
-                    let table = &self.log2_tables[k];
+                    let table = &self.tables[k];
                     resize(unit.eval_with_table(table, a, fa, out.frac_bits, out))
+                }
+                Op::Exp2Neg(a, unit) => {
+                    let (a, fa) = at(*a);
+                    resize(unit.eval_with_table(&self.tables[k], a, fa, out.frac_bits))
                 }
                 Op::Min(a, b) => {
                     let ((a, fa), (b, fb)) = (at(*a), at(*b));
@@ -398,6 +410,7 @@ impl Datapath {
                 Op::Div(a, b) => r.dividers.push((width(a), width(b))),
                 Op::Log2(a, unit) => {
                     r.leading_one_detectors.push(width(a));
+                    r.shifters.push(width(a));
                     if let Log2Unit::Table { segments_log2 } = unit {
                         let frac = Log2Unit::table_frac_bits(node.format.frac_bits);
                         r.rom_bits += ((1_u64 << segments_log2) + 1) * u64::from(frac + 1);
@@ -405,6 +418,15 @@ impl Datapath {
                         r.multipliers.push((frac + 1, within));
                         r.adders.push(frac + 1);
                     }
+                }
+                Op::Exp2Neg(a, unit) => {
+                    let frac = Exp2Unit::frac_bits(node.format.frac_bits);
+                    r.rom_bits += ((1_u64 << unit.segments_log2) + 1) * u64::from(frac + 1);
+                    let fraction = self.nodes[a.0].format.frac_bits;
+                    r.multipliers
+                        .push((frac + 1, fraction.saturating_sub(unit.segments_log2)));
+                    r.adders.push(frac + 1);
+                    r.shifters.push(frac + 1);
                 }
                 Op::Rom { table, .. } => r.rom_bits += table.len() as u64 * u64::from(bits),
                 Op::Select { .. } => {}

@@ -112,7 +112,7 @@ pub fn svg(datapath: &Datapath, title: &str) -> String {
         let fill = match node.op {
             Op::Input => "#e8f0fe",
             Op::Rom { .. } => "#fdf2e0",
-            Op::Log2(..) => "#e9f7ec",
+            Op::Log2(..) | Op::Exp2Neg(..) => "#e9f7ec",
             _ => "#f4f4f4",
         };
         let output =

@@ -18,11 +18,16 @@
 pub mod analysis;
 mod datapath;
 pub mod diagram;
+mod exp2;
 pub mod fixed;
 mod lobes;
 mod log2;
 pub mod verilog;
 
 pub use datapath::{operands, Builder, Datapath, Node, NodeId, Op, Resources};
-pub use lobes::{integer_exponent, HwError, HwLobe, BITS, COSQUAD_V, LOGEXP_TABLE};
+pub use exp2::{Exp2Unit, EXP2_GUARD_BITS};
+pub use lobes::{
+    integer_exponent, HwError, HwLobe, BITS, COSQUAD_V, LOGEXP_TABLE, POW_EXP2_TABLE,
+    POW_LOG2_TABLE,
+};
 pub use log2::{Log2Unit, TABLE_GUARD_BITS};

@@ -15,6 +15,7 @@ use serde::Serialize;
 use specula::{Exponent, Lobe, LobeKind};
 
 use crate::datapath::{Builder, Datapath, Op};
+use crate::exp2::Exp2Unit;
 use crate::fixed::{Format, Rounding};
 use crate::log2::Log2Unit;
 
@@ -27,6 +28,17 @@ pub const COSQUAD_V: u32 = 4;
 /// `logexp`'s log2 unit: 64 segments. The first logarithm's error is multiplied by `n`, so
 /// the table must be fine: 16 segments (error 3.5e-4) cost 25 % in the epicentre at `n = 512`.
 pub const LOGEXP_TABLE: Log2Unit = Log2Unit::Table { segments_log2: 6 };
+
+/// `pow`'s log2 unit: as fine as `logexp`'s, for the same reason (its error is multiplied by
+/// `n`).
+pub const POW_LOG2_TABLE: Log2Unit = LOGEXP_TABLE;
+
+/// The exp2 unit of `pow` and `sg`: 64 segments, relative interpolation error `1.8e-5`, below
+/// a 16-bit result's rounding.
+pub const POW_EXP2_TABLE: Exp2Unit = Exp2Unit { segments_log2: 6 };
+
+/// Integer bits of `sg`'s rate `log2(e) n`: up to 1443 at `n = 1000`.
+const SG_RATE_INT_BITS: u32 = 11;
 
 /// The squarings `schlick-mod` can select: `a = 2^k` with `k <= 7` covers `n <= 1000`.
 const SCHLICK_MOD_MAX_SQUARINGS: u32 = 7;
@@ -47,6 +59,12 @@ pub enum HwLobe {
     LogExpMitchell,
     /// `max(0, a (t - 1) + 1)^16`: one multiply, two adds, four squarers (and 0 at `t = 0`).
     CosQuad,
+    /// The baseline: `t^n = 2^-(n (-log2 t))`, a log2 unit, a multiply by `n` and an exp2
+    /// unit, both units table-interpolated ([`POW_LOG2_TABLE`], [`POW_EXP2_TABLE`]).
+    Pow,
+    /// The engines' spherical Gaussian `2^-(r (1 - t))`, `r = log2(e) n` per material: a
+    /// subtract, a multiply and an exp2 unit (and 0 at `t = 0`).
+    Sg,
 }
 
 impl Serialize for HwLobe {
@@ -71,13 +89,15 @@ pub enum HwError {
 
 impl HwLobe {
     /// Every datapath.
-    pub const ALL: [HwLobe; 6] = [
+    pub const ALL: [HwLobe; 8] = [
         HwLobe::Schlick,
         HwLobe::SchlickMod,
         HwLobe::Cheb2,
         HwLobe::LogExp,
         HwLobe::LogExpMitchell,
         HwLobe::CosQuad,
+        HwLobe::Pow,
+        HwLobe::Sg,
     ];
 
     /// The id on the command line.
@@ -90,6 +110,8 @@ impl HwLobe {
             HwLobe::LogExp => "logexp",
             HwLobe::LogExpMitchell => "logexp-mitchell",
             HwLobe::CosQuad => "cosquad",
+            HwLobe::Pow => "pow",
+            HwLobe::Sg => "sg",
         }
     }
 
@@ -116,6 +138,8 @@ impl HwLobe {
             HwLobe::Cheb2 => LobeKind::Cheb2,
             HwLobe::LogExp | HwLobe::LogExpMitchell => LobeKind::LogExp,
             HwLobe::CosQuad => LobeKind::CosQuad { v: COSQUAD_V as u8 },
+            HwLobe::Pow => LobeKind::Pow,
+            HwLobe::Sg => LobeKind::Sg,
         }
     }
 
@@ -245,18 +269,37 @@ impl HwLobe {
                 for i in 1..=COSQUAD_V {
                     value = b.node(&format!("power_{}", 1 << i), Op::Square(value), unit);
                 }
-                // The lobe is 0 at t = 0 (SPEC section 1), where the formula gives (1 - a)^16
-                // for n < 16.
-                let lit = b.node("t_nonzero", Op::NonZero(t), Format::unsigned(1, 0));
-                let zero = b.node("zero", Op::Const(0), unit);
-                b.node(
-                    "value",
-                    Op::Select {
-                        index: lit,
-                        options: vec![zero, value],
-                    },
-                    unit,
-                )
+                // The formula gives (1 - a)^16 at t = 0 for n < 16.
+                zero_at_t_zero(&mut b, t, value, unit)
+            }
+            HwLobe::Pow => {
+                let t = b.input("t", unit);
+                let n = b.input("n", Format::unsigned(10, 0));
+                // Six integer bits: log2 0 saturates to -32, and 2^-32 is 0 at every width.
+                let log_t = b.node(
+                    "log2_t",
+                    Op::Log2(t, POW_LOG2_TABLE),
+                    Format::signed(6, frac),
+                );
+                let zero = b.node("zero", Op::Const(0), Format::unsigned(1, frac));
+                // Above t = 1 the logarithm is positive and this saturates to 0: t^n = 1.
+                let minus_log = b.node(
+                    "minus_log2_t",
+                    Op::Sub(zero, log_t),
+                    Format::unsigned(6, frac),
+                );
+                let minus_y = b.node("minus_y", Op::Mul(n, minus_log), Format::unsigned(6, frac));
+                b.node("value", Op::Exp2Neg(minus_y, POW_EXP2_TABLE), unit)
+            }
+            HwLobe::Sg => {
+                let t = b.input("t", unit);
+                let rate = b.input("rate", Format::unsigned(SG_RATE_INT_BITS, frac));
+                let one = b.node("one", Op::Const(1 << frac), unit);
+                let u = b.node("u", Op::Sub(one, t), unit);
+                let minus_y = b.node("minus_y", Op::Mul(rate, u), Format::unsigned(6, frac));
+                let value = b.node("gaussian", Op::Exp2Neg(minus_y, POW_EXP2_TABLE), unit);
+                // The Gaussian is exp(-n) at t = 0.
+                zero_at_t_zero(&mut b, t, value, unit)
             }
         };
         Ok(b.finish(&name, output))
@@ -270,9 +313,13 @@ impl HwLobe {
         let n_raw = i64::from(n);
         let packed = || Lobe::new(self.float_kind(), Exponent::new(f64::from(n))).packed();
         match self {
-            HwLobe::Schlick | HwLobe::LogExp | HwLobe::LogExpMitchell | HwLobe::Cheb2 => {
-                vec![n_raw]
-            }
+            HwLobe::Schlick
+            | HwLobe::LogExp
+            | HwLobe::LogExpMitchell
+            | HwLobe::Cheb2
+            | HwLobe::Pow => vec![n_raw],
+            HwLobe::Sg => vec![Format::unsigned(SG_RATE_INT_BITS, bits - 1)
+                .quantize(packed().slope, Rounding::HalfEven)],
             HwLobe::SchlickMod => {
                 let squarings = i64::from(packed().squarings).min(SCHLICK_MOD_MAX_SQUARINGS.into());
                 vec![n_raw, squarings]
@@ -298,6 +345,26 @@ impl HwLobe {
     pub fn value(bits: u32, raw: i64) -> f64 {
         Self::unit_format(bits).to_f64(raw)
     }
+}
+
+/// The output node: `value`, or 0 where `t = 0`, since every lobe is 0 there (SPEC section 1)
+/// and some formulas are not.
+fn zero_at_t_zero(
+    b: &mut Builder,
+    t: crate::NodeId,
+    value: crate::NodeId,
+    unit: Format,
+) -> crate::NodeId {
+    let lit = b.node("t_nonzero", Op::NonZero(t), Format::unsigned(1, 0));
+    let zero = b.node("zero", Op::Const(0), unit);
+    b.node(
+        "value",
+        Op::Select {
+            index: lit,
+            options: vec![zero, value],
+        },
+        unit,
+    )
 }
 
 /// The integer exponent the hardware takes, or why `n` is not one.

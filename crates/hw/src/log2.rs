@@ -128,9 +128,9 @@ impl Log2Unit {
     }
 }
 
-/// The mantissa fraction split into a table index (its top `k` bits) and the position within
-/// the segment (the remaining bits, and how many there are).
-fn split(fraction: i64, bits: u32, k: u32) -> (usize, i64, u32) {
+/// A fraction of `bits` bits split into a table index (its top `k` bits) and the position
+/// within the segment (the remaining bits, and how many there are): both table units' address.
+pub(crate) fn split(fraction: i64, bits: u32, k: u32) -> (usize, i64, u32) {
     if bits >= k {
         let rest = bits - k;
         (

@@ -65,6 +65,42 @@ fn every_module_is_lint_clean_under_verilator() {
     }
 }
 
+/// The testbenches too (delays and `$fatal` need `--timing`), exhaustive and sampled.
+#[test]
+fn every_testbench_is_lint_clean_under_verilator() {
+    if !have("verilator", "--version") {
+        return;
+    }
+    let directory = tempfile::tempdir().expect("temporary directory");
+    for lobe in HwLobe::ALL {
+        for bits in [8, 20] {
+            let datapath = lobe.build(bits).expect("valid width");
+            for form in [Form::Pipelined, Form::Combinational] {
+                let name = form.module_name(&datapath);
+                let module = directory.path().join(format!("{name}.v"));
+                let bench = directory.path().join(format!("{name}_tb.v"));
+                let vectors = verilog::default_vectors(lobe, &datapath, bits, 64);
+                std::fs::write(&module, verilog::module_in(&datapath, lobe, bits, form))
+                    .expect("write");
+                std::fs::write(&bench, verilog::testbench_in(&datapath, &vectors, form))
+                    .expect("write");
+                let lint = Command::new("verilator")
+                    .args(["--lint-only", "-Wall", "--timing", "--top-module"])
+                    .arg(format!("{name}_tb"))
+                    .args([&bench, &module])
+                    .output()
+                    .expect("run verilator");
+                let text = String::from_utf8_lossy(&lint.stderr);
+                assert!(
+                    lint.status.success() && !text.contains("%Warning"),
+                    "{} testbench at {bits} bits, {form:?}:\n{text}",
+                    lobe.id()
+                );
+            }
+        }
+    }
+}
+
 fn simulate(directory: &Path, lobe: HwLobe, bits: u32, form: Form) -> String {
     let datapath = lobe.build(bits).expect("valid width");
     let vectors = verilog::default_vectors(lobe, &datapath, bits, 64);

@@ -51,6 +51,8 @@ fn full_width_datapaths_follow_their_float_models() {
         let h = 1.0 / 64.0;
         h * h / (8.0 * core::f64::consts::LN_2)
     };
+    // Linear interpolation of 2^-f over the same segments: h^2 (ln 2)^2 / 8.
+    let exp2_table_error = core::f64::consts::LN_2.powi(2) / 8.0 / 64.0_f64.powi(2);
     for n in [1, 8, 64, 512, 1000] {
         let squarings = (f64::from(n).log2().floor() - 2.0).clamp(0.0, 7.0);
         for lobe in HwLobe::ALL {
@@ -68,6 +70,17 @@ fn full_width_datapaths_follow_their_float_models() {
                 }
                 // Mitchell's 0.0861 the same way: a bound only at small n.
                 HwLobe::LogExpMitchell => (0.722 * f64::from(n) + 0.5) * 0.0861 + 4.0 * ulp(bits),
+                // 2^y moves by ln 2 per unit of y <= 0: the log2 unit's error times n, the
+                // product's rounding, then the exp2 table's own error and the roundings.
+                HwLobe::Pow => {
+                    core::f64::consts::LN_2 * (f64::from(n) * (table_error + ulp(bits)) + ulp(bits))
+                        + exp2_table_error
+                        + 4.0 * ulp(bits)
+                }
+                // The rate's and the product's roundings move y by one ulp.
+                HwLobe::Sg => {
+                    core::f64::consts::LN_2 * ulp(bits) + exp2_table_error + 4.0 * ulp(bits)
+                }
             };
             let worst = worst_difference(lobe, bits, n);
             assert!(
@@ -200,6 +213,30 @@ fn resources_are_the_structural_schemes_of_spec_section_8() {
         2 * 65 * (15 + 2 + 1),
         "two 65-entry tables with two guard bits"
     );
+    // pow: a log2 unit, the multiply by n, an exp2 unit; each unit interpolates its table
+    // with a multiplier and an adder, and shifts.
+    let r = count(HwLobe::Pow);
+    assert_eq!(
+        (
+            r.leading_one_detectors.len(),
+            r.shifters.len(),
+            r.multipliers.len(),
+            r.rom_bits
+        ),
+        (1, 2, 3, 2 * 65 * (15 + 2 + 1))
+    );
+    // sg: 1 - t, the multiply by the rate, an exp2 unit.
+    let r = count(HwLobe::Sg);
+    assert_eq!(
+        (
+            r.leading_one_detectors.len(),
+            r.shifters.len(),
+            r.multipliers.len(),
+            r.adders.len(),
+            r.rom_bits
+        ),
+        (0, 1, 2, 2, 65 * (15 + 2 + 1))
+    );
     // Latency: the input registers plus the longest chain of stages.
     assert_eq!(count(HwLobe::CosQuad).latency, 1 + 3 + 4 + 1);
     assert_eq!(count(HwLobe::Schlick).latency, 1 + 4);
@@ -237,7 +274,7 @@ fn verilog_is_emitted_for_every_lobe_and_width() {
 
 #[test]
 fn bad_requests_are_refused_with_the_valid_choices() {
-    let unknown = HwLobe::parse("pow")
+    let unknown = HwLobe::parse("sg-karis")
         .expect_err("pow has no datapath")
         .to_string();
     assert!(

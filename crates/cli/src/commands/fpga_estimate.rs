@@ -4,8 +4,8 @@
 //! a `b`-bit adder or comparator takes `b` cells (one per bit on the carry chain); an `a x b`
 //! array multiplier `a b` cells (a partial-product AND and a full adder per bit); a `b`-bit
 //! squarer half that (the product's symmetric half); an `a / b` divider `a b` cells (`a`
-//! stages of a `b`-bit subtract-and-select); a leading-one detector `b` cells; a ROM 1 cell per
-//! 16 bits (a LUT4 is a 16 x 1 ROM). Flip-flops pack into the cells the logic uses, so the
+//! stages of a `b`-bit subtract-and-select); a leading-one detector `b` cells; a `b`-bit barrel
+//! shifter `b ceil(log2 b)` cells (a 2:1 multiplexer per bit and stage); a ROM 1 cell per 16 bits (a LUT4 is a 16 x 1 ROM). Flip-flops pack into the cells the logic uses, so the
 //! estimate is the larger of the logic cells and the register bits. `specula recommend
 //! --target fpga` labels every figure from here "estimated".
 
@@ -36,8 +36,18 @@ pub fn logic_cells(resources: &Resources) -> u64 {
         .iter()
         .map(|&b| bits(b))
         .sum();
-    let logic =
-        adders + multipliers + squarers + dividers + detectors + resources.rom_bits.div_ceil(16);
+    let shifters: u64 = resources
+        .shifters
+        .iter()
+        .map(|&b| bits(b) * u64::from(b.next_power_of_two().trailing_zeros()))
+        .sum();
+    let logic = adders
+        + multipliers
+        + squarers
+        + dividers
+        + detectors
+        + shifters
+        + resources.rom_bits.div_ceil(16);
     logic.max(resources.register_bits)
 }
 
@@ -53,12 +63,13 @@ mod tests {
             adders: vec![16, 8],
             dividers: vec![(16, 16)],
             leading_one_detectors: vec![16],
+            shifters: vec![18],
             rom_bits: 1000,
             register_bits: 100,
             latency: 4,
         };
-        // 192 + 50 + 24 + 256 + 16 + 63.
-        assert_eq!(logic_cells(&resources), 601);
+        // 192 + 50 + 24 + 256 + 16 + 18 * 5 + 63.
+        assert_eq!(logic_cells(&resources), 691);
         // Registers bound it when they outnumber the logic.
         let registers = Resources {
             register_bits: 5000,

@@ -171,9 +171,9 @@ fn write_verilog(args: &VerilogArgs) -> CommandResult {
     )
 }
 
-/// The resources, a cell each: multipliers, squarers, adders, dividers (their widths), ROM
-/// bits, register bits, latency.
-pub fn resource_cells(r: &Resources) -> [String; 7] {
+/// The resources, a cell each: multipliers, squarers, adders, dividers, shifters (their
+/// widths), ROM bits, register bits, latency.
+pub fn resource_cells(r: &Resources) -> [String; 8] {
     let list = |items: Vec<String>| {
         if items.is_empty() {
             "-".to_owned()
@@ -191,6 +191,7 @@ pub fn resource_cells(r: &Resources) -> [String; 7] {
         list(r.squarers.iter().map(u32::to_string).collect()),
         list(r.adders.iter().map(u32::to_string).collect()),
         list(r.dividers.iter().map(|(a, b)| format!("{a}/{b}")).collect()),
+        list(r.shifters.iter().map(u32::to_string).collect()),
         r.rom_bits.to_string(),
         r.register_bits.to_string(),
         r.latency.to_string(),
@@ -242,6 +243,7 @@ fn table(args: &TableArgs) -> CommandResult {
         "squarers",
         "adders",
         "dividers",
+        "shifters",
         "ROM bits",
         "register bits",
         "latency",

@@ -15,11 +15,13 @@
 use core::fmt::Write as _;
 
 use crate::datapath::{Datapath, NodeId, Op};
+use crate::exp2::Exp2Unit;
 use crate::fixed::Format;
 use crate::lobes::HwLobe;
 use crate::log2::Log2Unit;
 
 mod testbench;
+mod units;
 
 pub use testbench::{
     default_vectors, exhaustive_vectors, test_vectors, testbench, testbench_in, EXHAUSTIVE_BITS,
@@ -28,44 +30,6 @@ pub use testbench::{
 
 /// Bits of the intermediates the Verilog computes exact results in (signed).
 const EXACT_BITS: u32 = 64;
-
-const RESIZE_MODULE: &str = r#"`ifndef SPECULA_RESIZE
-`define SPECULA_RESIZE
-// Rounds x (an exact value with SHIFT more fraction bits than the result) by dropping SHIFT
-// bits, to nearest with ties to even or towards minus infinity, or appends -SHIFT zero bits;
-// then saturates to [MIN, MAX] and keeps the low WIDTH bits (the result's format: every
-// value in [MIN, MAX] fits). The Rust model's Format::resize, bit for bit.
-module specula_resize #(
-    parameter integer SHIFT = 0,
-    parameter integer ROUND_HALF_EVEN = 1,
-    parameter signed [63:0] MIN = 0,
-    parameter signed [63:0] MAX = 0,
-    parameter integer WIDTH = 64
-) (
-    input wire signed [63:0] x,
-    output wire [WIDTH-1:0] y
-);
-    wire signed [63:0] rounded;
-    generate
-        if (SHIFT > 0) begin : drop
-            wire signed [63:0] floor_x = x >>> SHIFT;
-            wire signed [63:0] remainder = x - (floor_x <<< SHIFT);
-            wire signed [63:0] half = 64'sd1 <<< (SHIFT - 1);
-            wire up = (ROUND_HALF_EVEN != 0)
-                && ((remainder > half) || ((remainder == half) && floor_x[0]));
-            assign rounded = floor_x + (up ? 64'sd1 : 64'sd0);
-        end else begin : widen
-            assign rounded = x <<< (-SHIFT);
-        end
-    endgenerate
-    // Above WIDTH the saturated value only repeats its sign: those bits are dropped.
-    /* verilator lint_off UNUSEDSIGNAL */
-    wire signed [63:0] saturated = (rounded < MIN) ? MIN : ((rounded > MAX) ? MAX : rounded);
-    /* verilator lint_on UNUSEDSIGNAL */
-    assign y = saturated[WIDTH-1:0];
-endmodule
-`endif
-"#;
 
 /// A signed 64-bit literal.
 fn literal(value: i128) -> String {
@@ -121,6 +85,8 @@ impl Emitter<'_> {
     fn exact(&self, id: NodeId, prelude: &mut String) -> (String, u32, u32) {
         let node = self.datapath.node(id);
         let out = node.format;
+        let width_of = |operand: NodeId| self.datapath.node(operand).format.width();
+        let fb_of = |operand: NodeId| self.datapath.node(operand).format.frac_bits;
         let aligned = |(expr, format): (String, Format), frac: u32| {
             let shift = frac - format.frac_bits;
             (format!("({expr} <<< {shift})"), format.width() + shift)
@@ -156,27 +122,37 @@ impl Emitter<'_> {
                 )
             }
             Op::Div(a, b) => {
-                let (a, b) = (self.operand(id, *a), self.operand(id, *b));
-                let shift =
-                    i64::from(out.frac_bits) + i64::from(b.1.frac_bits) - i64::from(a.1.frac_bits);
-                let (numerator, denominator, bits) = if shift >= 0 {
-                    (
-                        format!("({} <<< {shift})", a.0),
-                        b.0.clone(),
-                        a.1.width() + shift as u32,
-                    )
-                } else {
-                    (
-                        a.0.clone(),
-                        format!("({} <<< {})", b.0, -shift),
-                        b.1.width() - shift as u32,
-                    )
+                let shift = i64::from(out.frac_bits) + i64::from(fb_of(*b)) - i64::from(fb_of(*a));
+                let (dividend, divisor) = (self.operand_reg(id, *a), self.operand_reg(id, *b));
+                let (wa, wb) = (width_of(*a), width_of(*b));
+                // Unsigned and as wide as the operands: the divider synthesis builds is the
+                // one the model describes, not a 64-bit one.
+                let (low_a, low_b) = (shift.max(0) as u32, (-shift).max(0) as u32);
+                let bits = (wa + low_a).max(wb + low_b);
+                let widen = |name: &str, width: u32, low: u32| {
+                    let mut parts = Vec::new();
+                    if bits > width + low {
+                        parts.push(format!("{}'d0", bits - width - low));
+                    }
+                    parts.push(name.to_owned());
+                    if low > 0 {
+                        parts.push(format!("{low}'d0"));
+                    }
+                    format!("{{{}}}", parts.join(", "))
                 };
-                let expr = format!(
-                    "(({} == 64'sd0) ? 64'sd0 : {numerator} / {denominator})",
-                    b.0
+                let wire = self.reg(id);
+                let _ = writeln!(
+                    prelude,
+                    "    wire [{top}:0] {wire}_dividend = {};\n    wire [{top}:0] {wire}_divisor = {};\n    wire [{top}:0] {wire}_quotient = ({wire}_divisor == {bits}'d0) ? {bits}'d0 : {wire}_dividend / {wire}_divisor;",
+                    widen(&dividend, wa, low_a),
+                    widen(&divisor, wb, low_b),
+                    top = bits - 1
                 );
-                (expr, out.frac_bits, bits)
+                (
+                    format!("$signed({{{}'d0, {wire}_quotient}})", EXACT_BITS - bits),
+                    out.frac_bits,
+                    bits,
+                )
             }
             Op::NonZero(a) => {
                 let (a, _) = self.operand(id, *a);
@@ -192,7 +168,19 @@ impl Emitter<'_> {
                     "    wire signed [63:0] {wire};\n    {}_{}_log2 {wire}_unit (.x({operand}), .y({wire}));",
                     self.datapath.name, node.name
                 );
-                (wire, frac, EXACT_BITS - 1)
+                (wire, frac, log2_bound(*unit, input, out, frac))
+            }
+            Op::Exp2Neg(a, _) => {
+                let operand = self.operand_reg(id, *a);
+                let wire = format!("{}_exp2", self.reg(id));
+                let _ = writeln!(
+                    prelude,
+                    "    wire signed [63:0] {wire};\n    {}_{}_exp2 {wire}_unit (.x({operand}), .y({wire}));",
+                    self.datapath.name, node.name
+                );
+                // 2^-f <= 1, shifted right: below 2^(frac + 1).
+                let frac = Exp2Unit::frac_bits(out.frac_bits);
+                (wire, frac, frac + 1)
             }
             Op::Rom { index, table } => {
                 let index = self.operand_reg(id, *index);
@@ -247,118 +235,14 @@ impl Emitter<'_> {
     }
 }
 
-/// The log2 unit of node `id` as its own module.
-fn log2_module(datapath: &Datapath, id: NodeId, unit: Log2Unit, input: Format) -> String {
-    let node = datapath.node(id);
-    let out = node.format;
-    let width = input.width();
-    let mantissa = width - 1;
-    let frac = unit.frac_bits(input, out.frac_bits);
-    let (zero, _) = unit.eval(0, input, out.frac_bits, out);
-    let mut v = String::new();
-    let _ = writeln!(
-        v,
-        "// log2 of a {} input, {} unit: exact result with {frac} fraction bits.",
-        input.name(),
-        unit.name()
-    );
-    let _ = writeln!(
-        v,
-        "module {}_{}_log2 (\n    input wire [{}:0] x,\n    output reg signed [63:0] y\n);",
-        datapath.name,
-        node.name,
-        width - 1
-    );
-    let _ = writeln!(
-        v,
-        "    integer i;\n    reg [6:0] p;\n    reg [{}:0] f;\n    reg signed [63:0] e;\n    // x shifted so its leading one is the top bit, which f then drops.\n    /* verilator lint_off UNUSEDSIGNAL */\n    reg [{}:0] normalised;\n    /* verilator lint_on UNUSEDSIGNAL */",
-        mantissa - 1,
-        width - 1
-    );
-    if let Log2Unit::Table { segments_log2: k } = unit {
-        assert!(mantissa >= k, "the table index needs {k} mantissa bits");
-        let table = unit.table(frac);
-        let _ = writeln!(
-            v,
-            "    reg [{k}:0] index;\n    reg signed [63:0] low, high, fraction;"
-        );
-        let _ = writeln!(
-            v,
-            "    function signed [63:0] entry(input [{k}:0] at);\n        case (at)"
-        );
-        for (i, value) in table.iter().enumerate() {
-            let _ = writeln!(
-                v,
-                "            {i}: entry = {};",
-                literal(i128::from(*value))
-            );
-        }
-        let _ = writeln!(
-            v,
-            "            default: entry = {};\n        endcase\n    endfunction",
-            literal(i128::from(table[table.len() - 1]))
-        );
-    }
-    let _ = writeln!(v, "    always @* begin\n        p = 7'd0;");
-    if matches!(unit, Log2Unit::Table { .. }) {
-        // Assigned on every path, so the block stays combinational (no latch for x = 0).
-        let _ = writeln!(
-            v,
-            "        index = 0;\n        low = 64'sd0;\n        high = 64'sd0;\n        fraction = 64'sd0;"
-        );
-    }
-    let _ = writeln!(
-        v,
-        "        for (i = 0; i < {width}; i = i + 1)\n            if (x[i]) p = i[6:0];"
-    );
-    let _ = writeln!(
-        v,
-        "        normalised = x << ({mantissa} - p);\n        f = normalised[{}:0];\n        e = $signed({{57'd0, p}}) - {};",
-        mantissa - 1,
-        input.frac_bits
-    );
-    let _ = writeln!(
-        v,
-        "        if (x == 0) begin\n            y = {};\n        end else begin",
-        literal(zero)
-    );
-    match unit {
-        Log2Unit::Mitchell => {
-            let _ = writeln!(
-                v,
-                "            y = (e <<< {mantissa}) + $signed({{{}'d0, f}});",
-                EXACT_BITS - mantissa
-            );
-        }
-        Log2Unit::Table { segments_log2: k } => {
-            let rest = mantissa - k;
-            let _ = writeln!(
-                v,
-                "            index = {{1'b0, f[{}:{rest}]}};",
-                mantissa - 1
-            );
-            let _ = writeln!(
-                v,
-                "            low = entry(index);\n            high = entry(index + 1);"
-            );
-            if rest > 0 {
-                let _ = writeln!(
-                    v,
-                    "            fraction = $signed({{{}'d0, f[{}:0]}});",
-                    EXACT_BITS - rest,
-                    rest - 1
-                );
-            } else {
-                let _ = writeln!(v, "            fraction = 64'sd0;");
-            }
-            let _ = writeln!(
-                v,
-                "            y = (e <<< {frac}) + low + (((high - low) * fraction) >>> {rest});"
-            );
-        }
-    }
-    let _ = writeln!(v, "        end\n    end\nendmodule\n");
-    v
+/// Bits that bound the magnitude of a log2 unit's exact result: `(e + f) 2^frac` with the
+/// leading-one position `|e| <=` the input's larger part, or the saturated minimum for 0.
+fn log2_bound(unit: Log2Unit, input: Format, out: Format, frac: u32) -> u32 {
+    let largest_exponent = input.frac_bits.max(input.int_bits) + 1;
+    let normal = frac + (u32::BITS - largest_exponent.leading_zeros());
+    let zero = out.width() + frac.saturating_sub(out.frac_bits);
+    debug_assert_eq!(frac, unit.frac_bits(input, out.frac_bits));
+    normal.max(zero)
 }
 
 /// How a datapath is laid out in Verilog.
@@ -428,16 +312,23 @@ pub fn module_in(datapath: &Datapath, lobe: HwLobe, bits: u32, form: Form) -> St
             Form::Combinational => "combinational, no register".to_owned(),
         }
     );
-    v.push_str(RESIZE_MODULE);
+    v.push_str(units::RESIZE_MODULE);
     v.push('\n');
     for (k, node) in datapath.nodes().iter().enumerate() {
-        if let Op::Log2(a, unit) = node.op {
-            v.push_str(&log2_module(
+        match node.op {
+            Op::Log2(a, unit) => v.push_str(&units::log2_module(
                 datapath,
                 NodeId(k),
                 unit,
                 datapath.node(a).format,
-            ));
+            )),
+            Op::Exp2Neg(a, unit) => v.push_str(&units::exp2_module(
+                datapath,
+                NodeId(k),
+                unit,
+                datapath.node(a).format,
+            )),
+            _ => {}
         }
     }
     let output = datapath.node(datapath.output()).format;
@@ -481,8 +372,10 @@ pub fn module_in(datapath: &Datapath, lobe: HwLobe, bits: u32, form: Form) -> St
         } else {
             let mut prelude = String::new();
             let (expr, frac, exact_bits) = emitter.exact(id, &mut prelude);
+            // The magnitude and a sign bit; resize rounds in 64 bits, so no carry bit is needed.
+            let exact_width = exact_bits + 1;
             assert!(
-                exact_bits < EXACT_BITS,
+                exact_width < EXACT_BITS,
                 "{}: exact result needs {exact_bits} bits",
                 node.name
             );
@@ -491,7 +384,7 @@ pub fn module_in(datapath: &Datapath, lobe: HwLobe, bits: u32, form: Form) -> St
             let _ = writeln!(v, "    wire [{}:0] {reg}_next;", width - 1);
             let _ = writeln!(
                 v,
-                "    specula_resize #(.SHIFT({shift}), .ROUND_HALF_EVEN({}), .MIN({}), .MAX({}), .WIDTH({width})) {reg}_resize (\n        .x({expr}),\n        .y({reg}_next)\n    );",
+                "    specula_resize #(.XW({exact_width}), .SHIFT({shift}), .ROUND_HALF_EVEN({}), .MIN({}), .MAX({}), .WIDTH({width})) {reg}_resize (\n        .x({expr}),\n        .y({reg}_next)\n    );",
                 i32::from(node.rounding == crate::fixed::Rounding::HalfEven),
                 literal(i128::from(node.format.min_raw())),
                 literal(i128::from(node.format.max_raw()))
@@ -528,6 +421,7 @@ pub fn describe(datapath: &Datapath, op: &Op) -> String {
         Op::Div(a, b) => format!("{} / {}", name(a), name(b)),
         Op::Shift(a, s) => format!("{} * 2^{s}", name(a)),
         Op::Log2(a, unit) => format!("log2 {} ({})", name(a), unit.name()),
+        Op::Exp2Neg(a, unit) => format!("2^-{} ({})", name(a), unit.name()),
         Op::Min(a, b) => format!("min({}, {})", name(a), name(b)),
         Op::NonZero(a) => format!("{} != 0", name(a)),
         Op::Rom { index, table } => format!("ROM[{}] ({} words)", name(index), table.len()),

@@ -1,0 +1,107 @@
+//! Synthesis results on disk, keyed by everything that determines them.
+//!
+//! A key hashes the Verilog, the flow and the tool versions (FNV-1a, 64 bits), so a result is
+//! reused exactly when the tools would be given the same work; the entry also stores its key,
+//! checked on load. Entries are written atomically (a temporary file renamed into place), so
+//! an interrupted run leaves no partial entry.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::Synthesis;
+
+/// Bumped when [`Synthesis`] changes shape, so old entries are not misread.
+const FORMAT: &str = "specula-synth 1";
+
+/// The key for `parts` (each separated, so `["ab", "c"]` and `["a", "bc"]` differ).
+#[must_use]
+pub fn key(parts: &[&str]) -> String {
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    for part in core::iter::once(&FORMAT).chain(parts) {
+        for byte in part.bytes().chain([0xff]) {
+            hash ^= u64::from(byte);
+            hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+    format!("{hash:016x}")
+}
+
+/// A directory of results.
+#[derive(Clone, Debug)]
+pub struct Cache {
+    directory: PathBuf,
+}
+
+#[derive(Serialize, Deserialize)]
+struct Entry {
+    key: String,
+    result: Synthesis,
+}
+
+impl Cache {
+    /// A cache in `directory` (created on the first store).
+    #[must_use]
+    pub fn new(directory: impl Into<PathBuf>) -> Self {
+        Self {
+            directory: directory.into(),
+        }
+    }
+
+    /// `$SPECULA_CACHE_DIR/synth`, else `$XDG_CACHE_HOME/specula/synth`, else
+    /// `$HOME/.cache/specula/synth`; none when no variable is set.
+    #[must_use]
+    pub fn default_location() -> Option<Self> {
+        let var = |name: &str| std::env::var_os(name).filter(|value| !value.is_empty());
+        let base = var("SPECULA_CACHE_DIR")
+            .map(PathBuf::from)
+            .or_else(|| var("XDG_CACHE_HOME").map(|d| Path::new(&d).join("specula")))
+            .or_else(|| var("HOME").map(|d| Path::new(&d).join(".cache/specula")))?;
+        Some(Self::new(base.join("synth")))
+    }
+
+    /// The directory.
+    #[must_use]
+    pub fn directory(&self) -> &Path {
+        &self.directory
+    }
+
+    fn path(&self, key: &str) -> PathBuf {
+        self.directory.join(format!("{key}.json"))
+    }
+
+    /// The result stored under `key`, if there is a readable one.
+    #[must_use]
+    pub fn load(&self, key: &str) -> Option<Synthesis> {
+        let text = std::fs::read_to_string(self.path(key)).ok()?;
+        let entry: Entry = serde_json::from_str(&text).ok()?;
+        (entry.key == key).then_some(entry.result)
+    }
+
+    /// Stores `result` under `key`, atomically.
+    pub fn store(&self, key: &str, result: &Synthesis) -> std::io::Result<()> {
+        std::fs::create_dir_all(&self.directory)?;
+        let entry = Entry {
+            key: key.to_owned(),
+            result: result.clone(),
+        };
+        let text = serde_json::to_string_pretty(&entry).map_err(std::io::Error::other)?;
+        let mut file = tempfile::NamedTempFile::new_in(&self.directory)?;
+        file.write_all(text.as_bytes())?;
+        file.persist(self.path(key)).map_err(|e| e.error)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_separate_their_parts_and_are_stable() {
+        assert_ne!(key(&["ab", "c"]), key(&["a", "bc"]));
+        assert_eq!(key(&["x"]), key(&["x"]));
+        assert_eq!(key(&["x"]).len(), 16);
+    }
+}
