@@ -76,11 +76,13 @@ enum Command {
         after_help = "Examples:\n  specula bench render\n  specula bench gpu\n  specula bench render --width 640 --height 360 --frames 3"
     )]
     Bench(commands::bench::Args),
-    /// Hardware datapaths: error against word length and resources, Verilog, block diagrams.
+    /// Hardware datapaths: error against word length and resources, Verilog, block diagrams,
+    /// synthesis.
     #[command(
         after_help = "Examples:\n  specula hw table --lobe cosquad,logexp --bits 8..24 --n 64\n  \
                             specula hw verilog --lobe cosquad --bits 16 -o cosquad.v --testbench cosquad_tb.v\n  \
-                            specula hw diagram --lobe logexp -o logexp.svg"
+                            specula hw diagram --lobe logexp -o logexp.svg\n  \
+                            specula hw synth --target ice40 --device hx8k --bits 12 --lobe cosquad,pow,sg"
     )]
     Hw(commands::hw::Args),
     /// Serve the interactive BRDF explorer (page and JSON API) on 127.0.0.1.

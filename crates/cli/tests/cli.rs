@@ -104,14 +104,25 @@ fn analyze_defaults_cover_every_lobe_and_exponent() {
 fn claims_json_has_the_documented_schema() {
     let claims = json(&["claims", "--format", "json"]);
     let claims = claims.as_array().expect("an array");
-    assert_eq!(claims.len(), 7);
-    for claim in claims {
+    // SPEC's seven, then the hardware claim, which needs Yosys and nextpnr: without them (not
+    // allowed when CI=true) it is there with a null verdict saying why.
+    assert_eq!(claims.len(), 8);
+    let tools_required = std::env::var("CI").as_deref() == Ok("true");
+    for (k, claim) in claims.iter().enumerate() {
         for key in ["claim", "measured", "verdict", "reading", "figures"] {
             assert!(claim.get(key).is_some(), "missing {key} in {claim}");
         }
-        let verdict = claim["verdict"].as_str().unwrap();
-        assert!(["holds", "does not hold", "holds with qualification"].contains(&verdict));
+        match claim["verdict"].as_str() {
+            Some(verdict) => {
+                assert!(["holds", "does not hold", "holds with qualification"].contains(&verdict))
+            }
+            None => assert!(k == 7 && !tools_required, "{claim}"),
+        }
     }
+    assert!(claims[7]["claim"]
+        .as_str()
+        .expect("text")
+        .starts_with("8: "));
 }
 
 #[test]

@@ -116,3 +116,90 @@ fn bad_requests_name_the_problem_and_write_nothing() {
         "no file written"
     );
 }
+
+/// Whether `tool` runs; when it does not, CI (`CI=true`) fails and a local run skips.
+fn have(tool: &str, version_flag: &str, package: &str) -> bool {
+    let found = std::process::Command::new(tool)
+        .arg(version_flag)
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !found {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "{tool} is not installed, and CI=true requires it: apt-get install {package}"
+        );
+        eprintln!("skipped: {tool} is not installed (apt-get install {package})");
+    }
+    found
+}
+
+/// `hw synth` reports Yosys's own cell counts with its version; a cached rerun agrees.
+#[test]
+fn synth_json_carries_the_tools_figures_and_versions() {
+    if !have("yosys", "-V", "yosys") {
+        return;
+    }
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let cache = directory.path().join("cache");
+    let run = || {
+        let output = assert_cmd::Command::cargo_bin("specula")
+            .expect("binary built")
+            .env("SPECULA_CACHE_DIR", &cache)
+            .args(words(
+                "hw synth --target generic --bits 8 --lobe cosquad,sg --format json",
+            ))
+            .output()
+            .expect("runs");
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&output.stdout).expect("JSON")
+    };
+    let results = run();
+    let results = results.as_array().expect("array");
+    assert_eq!(results.len(), 2);
+    for result in results {
+        assert!(result["cells"]["logic"].as_u64().expect("gates") > 0);
+        assert!(result["cells"]["flip_flops"].as_u64().expect("FFs") > 0);
+        assert!(result["tools"]["yosys"]
+            .as_str()
+            .expect("version")
+            .starts_with("Yosys"));
+        assert!(result["fmax_mhz"].is_null(), "generic gates have no timing");
+    }
+    assert_eq!(run().as_array().expect("array"), results);
+}
+
+/// Without Yosys on the path: one line naming the package, exit 2, nothing printed.
+#[test]
+fn synth_without_yosys_names_the_package() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let output = assert_cmd::Command::cargo_bin("specula")
+        .expect("binary built")
+        .env("PATH", directory.path())
+        .args(words("hw synth --lobe cosquad --bits 8"))
+        .output()
+        .expect("runs");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("install the Debian package `yosys`"),
+        "{stderr}"
+    );
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    assert!(output.stdout.is_empty());
+}
+
+#[test]
+fn synth_refuses_an_unknown_target_with_the_valid_ones() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let output = specula(directory.path(), &words("hw synth --target asic"));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr.contains("generic") && stderr.contains("ice40") && stderr.contains("xilinx"),
+        "{stderr}"
+    );
+}

@@ -89,8 +89,8 @@ fn an_impossible_accuracy_leaves_the_exact_lobe_and_bad_requests_are_refused() {
     }
 }
 
-/// The FPGA estimate: only lobes with a fixed-point datapath can meet, each named with the
-/// word length costed, and the datapath's error is what `specula hw table` measures there.
+/// On the FPGA only lobes with a fixed-point datapath can meet, each named with the word
+/// length costed, and the datapath's error is what `specula hw table` measures there.
 #[test]
 fn fpga_answers_come_from_the_datapaths() {
     let rows = json("recommend --target fpga --n 64 --max-error 1% --format json");

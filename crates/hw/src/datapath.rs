@@ -220,6 +220,18 @@ impl Datapath {
         &self.inputs
     }
 
+    /// Each input's name and width in bits, in order: the module's input ports.
+    #[must_use]
+    pub fn input_ports(&self) -> Vec<(&str, u32)> {
+        self.inputs
+            .iter()
+            .map(|&id| {
+                let node = self.node(id);
+                (node.name.as_str(), node.format.width())
+            })
+            .collect()
+    }
+
     /// The output node.
     #[must_use]
     pub fn output(&self) -> NodeId {

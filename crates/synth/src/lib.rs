@@ -18,6 +18,8 @@
 //! datapath models stay pure, and the CLI and the report ask here.
 
 pub mod cache;
+pub mod claim;
+pub mod harness;
 pub mod report;
 mod tools;
 
@@ -103,27 +105,38 @@ impl Target {
     }
 
     /// The Yosys script, run in the scratch directory, that synthesizes `top` from
-    /// [`SOURCE`] and writes `stat -json` to [`STAT`], and for iCE40 the netlist nextpnr
-    /// reads to [`NETLIST`].
+    /// [`SOURCE`] and writes `stat -json` to [`STAT`]; for iCE40 it then synthesizes the
+    /// timing harness around it ([`harness`]) into the netlist nextpnr reads, [`NETLIST`].
     fn yosys_script(self, top: &str) -> String {
-        let synth = match self {
-            Target::Generic => format!("synth -flatten -top {top}"),
-            Target::Ice40(device) => format!(
-                "synth_ice40 -top {top}{} -json {NETLIST}",
+        let ice40 = |device: Ice40Device, top: &str| {
+            format!(
+                "synth_ice40 -top {top}{}",
                 if device == Ice40Device::Up5k {
                     " -dsp"
                 } else {
                     ""
-                },
-            ),
+                }
+            )
+        };
+        let synth = match self {
+            Target::Generic => format!("synth -flatten -top {top}"),
+            Target::Ice40(device) => ice40(device, top),
             Target::Xilinx => format!("synth_xilinx -top {top} -family xc7"),
         };
-        format!("read_verilog {SOURCE}; {synth}; tee -q -o {STAT} stat -json")
+        let stat = format!("read_verilog {SOURCE}; {synth}; tee -q -o {STAT} stat -json");
+        match self {
+            Target::Ice40(device) => format!(
+                "{stat}; design -reset; read_verilog {SOURCE} {HARNESS_SOURCE}; {} -json {NETLIST}",
+                ice40(device, harness::HARNESS)
+            ),
+            Target::Generic | Target::Xilinx => stat,
+        }
     }
 }
 
 /// The scratch directory's files (plain names: Yosys's `tee -o` takes no quoting).
 const SOURCE: &str = "source.v";
+const HARNESS_SOURCE: &str = "harness.v";
 const STAT: &str = "stat.json";
 const NETLIST: &str = "net.json";
 const PLACED: &str = "report.json";
@@ -141,11 +154,13 @@ pub struct Synthesis {
     pub tools: ToolVersions,
     /// The resources, from Yosys's `stat -json`.
     pub cells: report::Cells,
-    /// Placed-and-routed Fmax in MHz (nextpnr's report), for the iCE40 flows.
+    /// Placed-and-routed Fmax in MHz (nextpnr's report, the datapath in its timing
+    /// [`harness`]), for the iCE40 flows.
     pub fmax_mhz: Option<f64>,
     /// Why there is no Fmax, when there is none.
     pub fmax_note: Option<String>,
-    /// Logic cells nextpnr placed (a LUT, its flip-flop and carry share one).
+    /// Logic cells nextpnr placed (a LUT, its flip-flop and carry share one), the harness's
+    /// shift register and output included.
     pub logic_cells_placed: Option<u64>,
     /// The pipeline's latency in clock cycles (one result per clock after it).
     pub latency: u32,
@@ -212,17 +227,51 @@ pub fn synthesize(
     target: Target,
     cache: Option<&cache::Cache>,
 ) -> Result<Synthesis, SynthError> {
+    let result = synthesize_or(lobe, bits, target, cache, OnMiss::Synthesize)?;
+    Ok(result.expect("a miss is synthesized"))
+}
+
+/// What to do when the cache does not hold a result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OnMiss {
+    /// Run the tools.
+    Synthesize,
+    /// Return nothing: for callers that must stay fast (a quick report).
+    Skip,
+}
+
+/// [`synthesize`], or on a cache miss with [`OnMiss::Skip`], `None`.
+pub fn synthesize_or(
+    lobe: HwLobe,
+    bits: u32,
+    target: Target,
+    cache: Option<&cache::Cache>,
+    on_miss: OnMiss,
+) -> Result<Option<Synthesis>, SynthError> {
     let datapath = lobe.build(bits)?;
     let tools = ToolVersions::find(target)?;
     let source = verilog::module(&datapath, lobe, bits);
-    let key = cache::key(&[&source, &target.name(), &tools.describe()]);
+    let (script, timing_harness) = (
+        target.yosys_script(&datapath.name),
+        harness::harness(&datapath),
+    );
+    let key = cache::key(&[
+        &source,
+        &timing_harness,
+        &script,
+        &target.name(),
+        &tools.describe(),
+    ]);
     if let Some(hit) = cache.and_then(|cache| cache.load(&key)) {
-        return Ok(hit);
+        return Ok(Some(hit));
+    }
+    if on_miss == OnMiss::Skip {
+        return Ok(None);
     }
     let scratch = tempfile::tempdir()?;
     let design = format!("{} at {bits} bits for {}", lobe.id(), target.name());
     std::fs::write(scratch.path().join(SOURCE), &source)?;
-    let script = target.yosys_script(&datapath.name);
+    std::fs::write(scratch.path().join(HARNESS_SOURCE), timing_harness)?;
     tools::run(
         Tool::Yosys,
         &["-q", "-p", &script],
@@ -253,7 +302,7 @@ pub fn synthesize(
     if let Some(cache) = cache {
         cache.store(&key, &result)?;
     }
-    Ok(result)
+    Ok(Some(result))
 }
 
 /// Runs nextpnr on the synthesized netlist in `scratch`, or notes why the design does not fit.

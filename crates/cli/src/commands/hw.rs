@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use specula_hw::analysis::{sweep, WidthSweep, MEETS_TOLERANCE};
 use specula_hw::{diagram, integer_exponent, verilog, HwLobe, Resources, BITS};
 
-use super::{print_json, CommandResult};
+use super::{print_json, synth, CommandResult};
 use crate::args::Format;
 use crate::output::{percent, sig, Table};
 
@@ -28,6 +28,8 @@ enum Action {
     Verilog(VerilogArgs),
     /// The structural scheme as an SVG block diagram.
     Diagram(DiagramArgs),
+    /// Synthesized resources (Yosys) and placed-and-routed Fmax (nextpnr-ice40) per datapath.
+    Synth(SynthArgs),
 }
 
 /// A datapath id, parsed with the valid ids in the message.
@@ -119,6 +121,25 @@ struct VerilogArgs {
 }
 
 #[derive(Debug, clap::Args)]
+struct SynthArgs {
+    /// Datapaths, comma separated (default: all).
+    #[arg(long, value_parser = parse_lobe, value_delimiter = ',')]
+    lobe: Vec<HwLobe>,
+    /// The word length.
+    #[arg(long, value_parser = parse_bits, default_value = "16")]
+    bits: u32,
+    /// The synthesis flow.
+    #[arg(long, value_enum, default_value_t)]
+    target: synth::TargetArg,
+    /// The iCE40 part (with --target ice40).
+    #[arg(long, value_enum, default_value_t)]
+    device: synth::DeviceArg,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t)]
+    format: synth::SynthFormat,
+}
+
+#[derive(Debug, clap::Args)]
 struct DiagramArgs {
     /// The datapath.
     #[arg(long, value_parser = parse_lobe)]
@@ -141,6 +162,12 @@ pub fn run(args: &Args) -> CommandResult {
             let title = format!("{}: structural scheme at W = {}", args.lobe.id(), args.bits);
             write_text(&args.output, &diagram::svg(&datapath, &title))
         }
+        Action::Synth(args) => synth::run(
+            &args.lobe,
+            args.bits,
+            synth::target(args.target, args.device),
+            args.format,
+        ),
     }
 }
 

@@ -13,6 +13,7 @@ pub mod render;
 pub mod report;
 pub mod serve;
 pub mod shader;
+pub mod synth;
 
 /// What a command reports when it fails: a one-line message.
 pub type CommandResult = Result<(), String>;

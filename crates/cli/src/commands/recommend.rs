@@ -115,7 +115,7 @@ fn parse_percent(text: &str) -> Result<f64, String> {
 struct Candidate {
     lobe: String,
     /// On `fpga`, the datapath and word length costed (at the first exponent); `None` where
-    /// the lobe has no datapath that meets its float model.
+    /// the lobe has no datapath.
     #[serde(skip_serializing_if = "Option::is_none")]
     datapath: Option<String>,
     /// The worst error over the exponents, as a fraction.
@@ -152,9 +152,16 @@ enum Costing {
     Measured,
     /// The GPU cost model of one family.
     Modelled(GpuFamily),
-    /// Estimated from the fixed-point datapaths' sweeps, per exponent.
+    /// Estimated from the fixed-point datapaths' sweeps, per exponent (without Yosys).
     Estimated(Vec<(Exponent, Vec<WidthSweep>)>),
+    /// Synthesized and placed (Yosys, nextpnr-ice40 on an iCE40 HX8K; cached), at the word
+    /// lengths the sweeps choose.
+    Synthesized(Vec<(Exponent, Vec<WidthSweep>)>),
 }
+
+/// Where recommend's FPGA costs are synthesized: every operator in LUTs, one area figure.
+const FPGA_TARGET: specula_synth::Target =
+    specula_synth::Target::Ice40(specula_synth::Ice40Device::Hx8k);
 
 /// One lobe at one exponent: its error, its cost figure (higher is cheaper), and on the FPGA
 /// the datapath costed.
@@ -173,7 +180,16 @@ impl Costing {
             Target::Cpu => Costing::Measured,
             Target::GpuNvidia => Costing::Modelled(family("gpu-nvidia")?),
             Target::GpuAmd => Costing::Modelled(family("gpu-amd")?),
-            Target::Fpga => Costing::Estimated(hardware_sweeps(exponents)?),
+            Target::Fpga => {
+                let sweeps = hardware_sweeps(exponents)?;
+                match specula_synth::ToolVersions::find(FPGA_TARGET) {
+                    Ok(_) => Costing::Synthesized(sweeps),
+                    Err(missing) => {
+                        eprintln!("note: {missing}; FPGA costs are the formula estimate instead");
+                        Costing::Estimated(sweeps)
+                    }
+                }
+            }
         })
     }
 
@@ -182,11 +198,17 @@ impl Costing {
             Costing::Measured => "evals/s, 1 thread",
             Costing::Modelled(_) => "evals/clock/multiprocessor (modelled)",
             Costing::Estimated(_) => "evals/clock per 1000 logic cells (estimated)",
+            Costing::Synthesized(_) => "results/us per 1000 LUTs (synthesized, iCE40 HX8K)",
         }
     }
 
     /// `lobe` at its exponent, or `None` where the target cannot run it (no datapath).
-    fn point(&self, lobe: &Lobe, zone: ZoneChoice) -> Result<Option<Point>, String> {
+    fn point(
+        &self,
+        lobe: &Lobe,
+        zone: ZoneChoice,
+        max_error: f64,
+    ) -> Result<Option<Point>, String> {
         let float_error = || zone_error(&error_figures(lobe, &mut Precision::F64, 20_001), zone);
         Ok(match self {
             Costing::Measured => Some(Point {
@@ -202,15 +224,45 @@ impl Costing {
                     datapath: None,
                 })
             }
-            Costing::Estimated(hardware) => hardware
-                .iter()
-                .find(|(at, _)| *at == lobe.exponent())
-                .and_then(|(_, sweeps)| cheapest_datapath(sweeps, lobe.kind(), zone))
-                .map(|(error, cells, name)| Point {
-                    error,
-                    rate: 1e3 / cells as f64,
-                    datapath: Some(name),
-                }),
+            Costing::Estimated(hardware) | Costing::Synthesized(hardware) => {
+                let Some(chosen) = hardware
+                    .iter()
+                    .find(|(at, _)| *at == lobe.exponent())
+                    .and_then(|(_, sweeps)| {
+                        cheapest_datapath(sweeps, lobe.kind(), zone, max_error)
+                    })
+                else {
+                    return Ok(None);
+                };
+                let mut datapath = format!("{} at {} bits", chosen.lobe.id(), chosen.bits);
+                let rate = match self {
+                    // A datapath that cannot reach the error is not worth the tools' minutes:
+                    // it is listed, with its error, as not meeting.
+                    Costing::Synthesized(_) if chosen.error > max_error => {
+                        datapath += " (not synthesized: short of the error)";
+                        0.0
+                    }
+                    Costing::Synthesized(_) => {
+                        let cache = specula_synth::cache::Cache::default_location();
+                        let synthesis = specula_synth::synthesize(
+                            chosen.lobe,
+                            chosen.bits,
+                            FPGA_TARGET,
+                            cache.as_ref(),
+                        )
+                        .map_err(|e| e.to_string())?;
+                        synthesis
+                            .logic_ns_per_result()
+                            .map_or(0.0, |lut_ns| 1e6 / lut_ns)
+                    }
+                    _ => 1e3 / chosen.cells as f64,
+                };
+                Some(Point {
+                    error: chosen.error,
+                    rate,
+                    datapath: Some(datapath),
+                })
+            }
         })
     }
 }
@@ -234,26 +286,40 @@ fn hardware_sweeps(exponents: &[Exponent]) -> Result<Vec<(Exponent, Vec<WidthSwe
         .collect()
 }
 
-/// Of `kind`'s datapaths at `n`, the one with the fewest estimated logic cells at the
-/// smallest word length that meets its float model: `(its error, cells, "name at W bits")`.
+/// A datapath at a word length, with its error there and its formula estimate.
+pub(crate) struct Chosen {
+    pub lobe: HwLobe,
+    pub bits: u32,
+    pub error: f64,
+    pub cells: u64,
+}
+
+/// Of `kind`'s datapaths at `n`, each at the smallest word length whose `zone` error is at
+/// most `max_error` (or at its widest, where none is), the one with the fewest estimated
+/// logic cells among those within the bound, else the most accurate.
 pub(crate) fn cheapest_datapath(
     sweeps: &[WidthSweep],
     kind: LobeKind,
     zone: ZoneChoice,
-) -> Option<(f64, u64, String)> {
+    max_error: f64,
+) -> Option<Chosen> {
     sweeps
         .iter()
         .filter(|sweep| sweep.lobe.float_kind() == kind)
         .filter_map(|sweep| {
-            let width = sweep.minimum_width()?;
-            let row = sweep.rows.iter().find(|row| row.bits == width)?;
-            Some((
-                zone_error(&row.errors, zone),
-                logic_cells(&row.resources),
-                format!("{} at {width} bits", sweep.lobe.id()),
-            ))
+            let row = sweep
+                .rows
+                .iter()
+                .find(|row| zone_error(&row.errors, zone) <= max_error)
+                .or_else(|| sweep.rows.last())?;
+            Some(Chosen {
+                lobe: sweep.lobe,
+                bits: row.bits,
+                error: zone_error(&row.errors, zone),
+                cells: logic_cells(&row.resources),
+            })
         })
-        .min_by_key(|(_, cells, _)| *cells)
+        .min_by_key(|chosen| (chosen.error > max_error, chosen.cells))
 }
 
 /// Which of `points` (error, rate) no other point dominates.
@@ -288,7 +354,7 @@ pub fn run(args: &Args) -> CommandResult {
         for &n in exponents {
             let lobe = Lobe::new(kind, n);
             energy = energy.max(energy_ratio(&lobe));
-            match costing.point(&lobe, args.zone)? {
+            match costing.point(&lobe, args.zone, args.max_error)? {
                 Some(point) => {
                     error = error.max(point.error);
                     cheapest = cheapest.min(point.rate);
@@ -412,7 +478,7 @@ fn why(c: &Candidate, best: Option<&str>, pow_rate: f64, args: &Args) -> String 
     };
     if !c.meets {
         if args.target == Target::Fpga && c.datapath.is_none() {
-            return "no fixed-point datapath meets its float model at every n".to_owned();
+            return "no fixed-point datapath for this lobe".to_owned();
         }
         if c.error > args.max_error {
             return format!(

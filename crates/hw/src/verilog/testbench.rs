@@ -114,14 +114,7 @@ pub fn testbench_in(datapath: &Datapath, vectors: &[(Vec<i64>, i64)], form: Form
         Form::Combinational => 1,
     };
     let output = datapath.node(datapath.output()).format;
-    let inputs: Vec<(&str, u32)> = datapath
-        .inputs()
-        .iter()
-        .map(|&id| {
-            let node = datapath.node(id);
-            (node.name.as_str(), node.format.width())
-        })
-        .collect();
+    let inputs = datapath.input_ports();
     let name = &form.module_name(datapath);
     let count = vectors.len();
     let mut v = String::new();

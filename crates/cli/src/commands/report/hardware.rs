@@ -8,6 +8,11 @@ use super::html::{figure, paragraph, table};
 use super::plot::{Chart, Series};
 use super::sections::colour;
 use super::Context;
+use specula_hw::analysis::WidthSweep;
+use specula_synth::cache::Cache;
+use specula_synth::claim::{self, CLAIM_N};
+
+use crate::commands::fpga_estimate::logic_cells;
 use crate::commands::hw::resource_cells;
 use crate::output::{percent, sig};
 
@@ -18,6 +23,117 @@ const DIAGRAM_BITS: u32 = 16;
 fn arithmetic(r: &Resources) -> String {
     let [multipliers, squarers, adders, dividers, ..] = resource_cells(r);
     format!("mul {multipliers}; sq {squarers}; add {adders}; div {dividers}")
+}
+
+/// Claim 8 by synthesis: every datapath at equal error, through Yosys and nextpnr (cached),
+/// or, without the tools or a cached result, the formula estimate, labelled as such.
+fn synthesized(context: &Context, all: &[(u32, Vec<WidthSweep>)]) -> Result<String, String> {
+    let sweeps = all
+        .iter()
+        .find(|(n, _)| *n == CLAIM_N)
+        .map(|(_, sweeps)| sweeps.as_slice())
+        .ok_or_else(|| format!("the hardware sweeps lack n = {CLAIM_N}"))?;
+    let claim = claim::evaluate(
+        sweeps,
+        Cache::default_location().as_ref(),
+        context.sizes.synthesis,
+        &|| {},
+    );
+    let (target, designs) = claim::designs(sweeps);
+    let estimate = |lobe: HwLobe, bits: Option<u32>| -> String {
+        let resources = bits.and_then(|bits| {
+            sweeps
+                .iter()
+                .find(|sweep| sweep.lobe == lobe)?
+                .rows
+                .iter()
+                .find(|row| row.bits == bits)
+                .map(|row| row.resources.clone())
+        });
+        resources.map_or("-".to_owned(), |r| logic_cells(&r).to_string())
+    };
+    let mut html = format!("<h3>Claim {}</h3>\n", super::html::escape(claim::STATEMENT));
+    let complete = claim.as_ref().ok().filter(|claim| {
+        claim
+            .designs
+            .iter()
+            .all(|design| design.bits.is_none() || design.synthesis.is_some())
+    });
+    let Some(claim) = complete else {
+        let why = match &claim {
+            Err(problem) => problem.to_string(),
+            Ok(_) => "not every design is in the synthesis cache (a quick report does not synthesize; run the full report or `specula claims`)".to_owned(),
+        };
+        html += &paragraph(&format!(
+            "Not measured: {why}. In its place, a fallback that is not a synthesis: the formula \
+             estimate of LUT4 logic cells (commands/fpga_estimate.rs) for each datapath at the \
+             smallest width reaching {} epicentre error at n = {CLAIM_N}.",
+            percent(target)
+        ));
+        let rows: Vec<Vec<String>> = designs
+            .iter()
+            .map(|design| {
+                vec![
+                    design.lobe.id().to_owned(),
+                    design
+                        .bits
+                        .map_or("not by 24".to_owned(), |b| b.to_string()),
+                    estimate(design.lobe, design.bits),
+                ]
+            })
+            .collect();
+        html += &table(&["datapath", "W", "estimated logic cells (formula)"], &rows);
+        return Ok(html);
+    };
+    html += &paragraph(&format!(
+        "Verdict: {}. {}. Reading: {}.",
+        claim.verdict.name(),
+        claim.measured,
+        claim.reading
+    ));
+    let rows: Vec<Vec<String>> = claim
+        .designs
+        .iter()
+        .map(|design| {
+            let synthesis = design.synthesis.as_ref();
+            let cell = |f: &dyn Fn(&specula_synth::Synthesis) -> String| {
+                synthesis.map_or("-".to_owned(), f)
+            };
+            vec![
+                design.lobe.id().to_owned(),
+                design
+                    .bits
+                    .map_or("not by 24".to_owned(), |b| b.to_string()),
+                design.epicentre_max_rel.map_or("-".to_owned(), percent),
+                cell(&|s| s.cells.logic.to_string()),
+                cell(&|s| s.cells.carry.to_string()),
+                cell(&|s| s.cells.flip_flops.to_string()),
+                cell(&|s| s.fmax_mhz.map_or("-".to_owned(), |f| format!("{f:.1}"))),
+                cell(&|s| s.latency.to_string()),
+                cell(&|s| {
+                    s.logic_ns_per_result()
+                        .map_or("-".to_owned(), |v| format!("{v:.0}"))
+                }),
+                estimate(design.lobe, design.bits),
+            ]
+        })
+        .collect();
+    html += &table(
+        &[
+            "datapath",
+            "W",
+            "epicentre max rel",
+            "SB_LUT4",
+            "SB_CARRY",
+            "FF",
+            "Fmax MHz",
+            "latency",
+            "LUT x ns/result",
+            "formula estimate (cells)",
+        ],
+        &rows,
+    );
+    Ok(html)
 }
 
 pub fn hardware(context: &mut Context) -> Result<String, String> {
@@ -31,7 +147,7 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
          The Verilog of every datapath is co-simulated with Icarus Verilog, bit-exact, in the tests."
     ));
     let mut rows = Vec::new();
-    for (n, results) in all {
+    for (n, results) in &all {
         let series: Vec<Series> = results
             .iter()
             .map(|result| Series {
@@ -63,7 +179,7 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
             &chart,
             &format!("every datapath's epicentre error against its word length, n = {n}"),
         )?;
-        for result in &results {
+        for result in results {
             let width = result.minimum_width();
             let at = width.and_then(|w| result.rows.iter().find(|row| row.bits == w));
             rows.push(vec![
@@ -93,6 +209,7 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
         ],
         &rows,
     );
+    html += &synthesized(context, &all)?;
     html += &paragraph(&format!(
         "The structural schemes, drawn from the same descriptions as the models and the Verilog, at W = {DIAGRAM_BITS}: one column per pipeline stage."
     ));

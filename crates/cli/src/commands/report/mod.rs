@@ -55,6 +55,9 @@ pub struct Sizes {
     pub render: (u32, u32, u32),
     /// The (integer) exponents the hardware section sweeps word lengths at.
     pub hardware_exponents: &'static [u32],
+    /// Whether the hardware claim's designs are synthesized when the cache lacks them (the
+    /// first time, minutes) or only read from it.
+    pub synthesis: specula_synth::OnMiss,
 }
 
 /// What a section works with: where files go, how much to compute, and what it wrote.

@@ -9,6 +9,7 @@ use specula::claims::{evaluate_all, ClaimOptions, Verdict};
 use specula::normalisation::lobe_constant;
 use specula::zones::{bloom_angle, epicentre_angle};
 use specula::{Brdf, ClassicModel, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
+use specula_synth::OnMiss;
 
 use super::html::{escape, paragraph, table};
 use super::plot::{Chart, Series, PALETTE};
@@ -569,6 +570,7 @@ pub fn sizes(quick: bool) -> Sizes {
             },
             render: (240, 135, 1),
             hardware_exponents: &[64],
+            synthesis: OnMiss::Skip,
         }
     } else {
         Sizes {
@@ -578,6 +580,7 @@ pub fn sizes(quick: bool) -> Sizes {
             claims: ClaimOptions::default(),
             render: (480, 270, 2),
             hardware_exponents: &[8, 64, 512],
+            synthesis: OnMiss::Synthesize,
         }
     }
 }

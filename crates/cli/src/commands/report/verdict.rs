@@ -90,11 +90,16 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
         for bound in ACCURACIES {
             let best = LobeKind::ALL
                 .into_iter()
-                .filter_map(|kind| cheapest_datapath(sweeps, kind, ZoneChoice::Epicentre))
-                .filter(|(error, ..)| *error <= bound)
-                .min_by_key(|(_, cells, _)| *cells);
-            row.push(best.map_or("-".to_owned(), |(_, cells, name)| {
-                format!("{name} ({cells} cells)")
+                .filter_map(|kind| cheapest_datapath(sweeps, kind, ZoneChoice::Epicentre, bound))
+                .filter(|chosen| chosen.error <= bound)
+                .min_by_key(|chosen| chosen.cells);
+            row.push(best.map_or("-".to_owned(), |chosen| {
+                format!(
+                    "{} at {} bits ({} cells)",
+                    chosen.lobe.id(),
+                    chosen.bits,
+                    chosen.cells
+                )
             }));
         }
         rows.push(row);
@@ -105,9 +110,10 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
     );
     html += &paragraph(
         "FPGA rows: the fixed-point datapath with the fewest estimated logic cells (a LUT4 \
-         fabric without DSPs, from its operators) at the smallest word length that meets its \
-         float model, whose epicentre error there is within the bound; an estimate until the \
-         datapaths are synthesized. '-': no datapath meets it.",
+         fabric without DSPs, from its operators), each at the smallest word length whose \
+         epicentre error is within the bound. A formula estimate, which undercounts what \
+         Yosys builds about fourfold (the Hardware section has synthesized figures at equal \
+         error); `specula recommend --target fpga` synthesizes. '-': no datapath meets it.",
     );
     let plotted_n = &by_n
         .iter()
