@@ -92,7 +92,37 @@ enum Command {
     Serve(commands::serve::Args),
 }
 
+/// Exit status after an interrupt (128 + SIGINT), as shells report it.
+const INTERRUPTED: i32 = 130;
+/// Exit status when the reader of standard output has gone (128 + SIGPIPE): what `ls | head`
+/// reports for `ls`.
+const BROKEN_PIPE: i32 = 141;
+
+/// Standard output errors end the process as Unix tools end: quietly when the reader has gone
+/// (`specula models | head -c1`), with one line and status 1 otherwise (`> /dev/full`).
+/// `println!` reports both by panicking, so the hook turns those panics into exits.
+fn install_output_error_hook() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if let Some(cause) = message.strip_prefix("failed printing to stdout: ") {
+            if cause.contains("Broken pipe") {
+                std::process::exit(BROKEN_PIPE);
+            }
+            eprintln!("error: writing to standard output: {cause}");
+            std::process::exit(1);
+        }
+        default(info);
+    }));
+}
+
 fn main() -> ExitCode {
+    install_output_error_hook();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(error) if !error.use_stderr() => {
@@ -105,6 +135,15 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if !matches!(cli.command, Command::Serve(_)) {
+        // The server shuts down on its own signal handling; everything else removes its
+        // temporary files and exits.
+        let _ = ctrlc::set_handler(|| {
+            specula_render::remove_temporaries();
+            eprintln!("interrupted");
+            std::process::exit(INTERRUPTED);
+        });
+    }
     let result = match cli.command {
         Command::Models(args) => commands::models::run(&args),
         Command::Recommend(args) => commands::recommend::run(&args),

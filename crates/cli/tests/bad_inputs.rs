@@ -220,3 +220,187 @@ fn earlier_outputs_survive_failed_and_interrupted_renders() {
         "no partial or temporary file"
     );
 }
+
+/// Outputs as Unix tools write them: a device or FIFO in place, `-` to standard output, a
+/// symlink followed (the link stays a link), an existing file's permissions kept, one file
+/// not named twice, and temporary files of dead runs cleaned up.
+#[test]
+fn outputs_follow_unix_conventions() {
+    use std::os::unix::fs::{FileTypeExt, PermissionsExt};
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let path = directory.path();
+    let verilog = |output: &str| {
+        specula(
+            path,
+            &[
+                "hw", "verilog", "--lobe", "cosquad", "--bits", "8", "-o", output,
+            ],
+        )
+    };
+    // A device stays a device.
+    assert!(verilog("/dev/null").status.success());
+    let null = std::fs::metadata("/dev/null").expect("exists");
+    assert!(
+        null.file_type().is_char_device(),
+        "/dev/null is still a device"
+    );
+    // Standard output.
+    let stdout = verilog("-");
+    assert!(String::from_utf8_lossy(&stdout.stdout).contains("module specula_cosquad_w8"));
+    // A FIFO is written in place, read by whoever opened it.
+    let fifo = path.join("pipe.v");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo")
+        .success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read_to_string(fifo).expect("read the FIFO"))
+    };
+    assert!(verilog("pipe.v").status.success());
+    assert!(reader
+        .join()
+        .expect("reader")
+        .contains("module specula_cosquad_w8"));
+    assert!(std::fs::symlink_metadata(&fifo)
+        .expect("exists")
+        .file_type()
+        .is_fifo());
+    // A symlink is followed; the link stays a link, the target is replaced.
+    std::fs::write(path.join("target.v"), "old").expect("write");
+    std::os::unix::fs::symlink("target.v", path.join("link.v")).expect("symlink");
+    assert!(verilog("link.v").status.success());
+    assert!(std::fs::symlink_metadata(path.join("link.v"))
+        .expect("exists")
+        .file_type()
+        .is_symlink());
+    assert!(std::fs::read_to_string(path.join("target.v"))
+        .expect("read")
+        .contains("module"));
+    // An existing file's permissions are kept.
+    std::fs::write(path.join("private.v"), "old").expect("write");
+    std::fs::set_permissions(
+        path.join("private.v"),
+        std::fs::Permissions::from_mode(0o640),
+    )
+    .expect("chmod");
+    assert!(verilog("private.v").status.success());
+    let mode = std::fs::metadata(path.join("private.v"))
+        .expect("exists")
+        .permissions()
+        .mode();
+    assert_eq!(mode & 0o777, 0o640);
+    // The module and its testbench in one file would lose one of them.
+    let same = specula(
+        path,
+        &[
+            "hw",
+            "verilog",
+            "--lobe",
+            "cosquad",
+            "--bits",
+            "8",
+            "-o",
+            "same.v",
+            "--testbench",
+            "./same.v",
+        ],
+    );
+    assert_eq!(same.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&same.stderr).contains("its own file"));
+    assert!(!path.join("same.v").exists());
+    // A dead run's temporary file is removed by the next write there; a live one's is not.
+    let dead = path.join(".specula-999999999-abcdef.tmp");
+    let live = path.join(format!(".specula-{}-abcdef.tmp", std::process::id()));
+    std::fs::write(&dead, "left by a killed run").expect("write");
+    std::fs::write(&live, "being written").expect("write");
+    assert!(verilog("fresh.v").status.success());
+    assert!(
+        !dead.exists(),
+        "a dead process's temporary file is cleaned up"
+    );
+    assert!(
+        live.exists(),
+        "a running process's temporary file is left alone"
+    );
+}
+
+/// SIGINT or SIGTERM: exit 130 with one line, the earlier output untouched, no file left.
+#[test]
+fn interrupted_commands_leave_nothing_behind() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let path = directory.path();
+    std::fs::write(path.join("out.png"), "the previous output").expect("write");
+    for signal in ["-INT", "-TERM"] {
+        let child = Command::new(env!("CARGO_BIN_EXE_specula"))
+            .current_dir(path)
+            .args([
+                "render",
+                "--width",
+                "8000",
+                "--height",
+                "8000",
+                "--samples",
+                "2",
+            ])
+            .args(["-o", "out.png"])
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("start a render");
+        std::thread::sleep(Duration::from_millis(400));
+        assert!(Command::new("kill")
+            .arg(signal)
+            .arg(child.id().to_string())
+            .status()
+            .expect("kill")
+            .success());
+        let output = child.wait_with_output().expect("wait");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(130), "{signal}: {stderr}");
+        assert_eq!(stderr.trim(), "interrupted", "{signal}");
+        assert_eq!(
+            files(path),
+            ["out.png"],
+            "{signal}: no partial or temporary file"
+        );
+        assert_eq!(
+            std::fs::read_to_string(path.join("out.png")).expect("read"),
+            "the previous output"
+        );
+    }
+}
+
+/// Standard output's reader gone: a quiet exit (141, as `ls | head` reports); a full disk:
+/// one line and status 1. Never a panic.
+#[test]
+fn standard_output_errors_end_like_unix_tools() {
+    let many: Vec<String> = (1..=200).map(|n| n.to_string()).collect();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_specula"))
+        .args(["analyze", "--format", "json", "--n", &many.join(",")])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start");
+    drop(child.stdout.take());
+    let output = child.wait_with_output().expect("wait");
+    assert_eq!(output.status.code(), Some(141));
+    assert!(
+        output.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .expect("/dev/full");
+    let output = Command::new(env!("CARGO_BIN_EXE_specula"))
+        .args(["models"])
+        .stdout(full)
+        .output()
+        .expect("run");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("writing to standard output"), "{stderr}");
+}

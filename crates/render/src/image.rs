@@ -5,12 +5,13 @@
 //! destination's directory and renamed into place, so a failed or interrupted write never
 //! leaves a partial image behind.
 
-use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
+
+use crate::output::write_atomically;
 
 /// A linear RGB image, row-major from the top-left pixel.
 #[derive(Clone, Debug, PartialEq)]
@@ -228,39 +229,6 @@ fn format_of(path: &Path) -> Result<Format, ImageError> {
 /// Checks that `path` names a format this module writes (before any long work starts).
 pub fn check_output_path(path: &Path) -> Result<(), ImageError> {
     format_of(path).map(|_| ())
-}
-
-/// Writes `bytes` to `path` atomically: a temporary file beside it, renamed into place.
-pub fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<(), String>,
-) -> Result<(), ImageError> {
-    let io = |source| ImageError::Io {
-        path: path.display().to_string(),
-        source,
-    };
-    let directory = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".specula-").suffix(".tmp");
-    // A temporary file is private (0600); the image should get the usual mode (0666 less the
-    // umask), as if created directly.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut file = builder.tempfile_in(directory).map_err(io)?;
-    {
-        let mut writer = BufWriter::new(file.as_file_mut());
-        write(&mut writer).map_err(|message| ImageError::Codec {
-            path: path.display().to_string(),
-            message,
-        })?;
-        writer.flush().map_err(io)?;
-    }
-    file.as_file().sync_all().map_err(io)?;
-    file.persist(path).map_err(|error| io(error.error))?;
-    Ok(())
 }
 
 /// Writes 8-bit sRGB bytes (three per pixel) as a PNG, atomically.

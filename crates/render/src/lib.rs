@@ -28,6 +28,7 @@ mod load;
 mod material;
 mod mesh;
 pub mod metrics;
+mod output;
 mod phong;
 mod pipeline;
 mod raster;
@@ -39,12 +40,13 @@ pub use camera::{Camera, InvalidCamera, Projection};
 pub use description::{LoadedScene, SceneError};
 pub use grid::{render_grid, render_grid_with, GridError, GridOptions, Srgb8Image};
 pub use image::{
-    check_output_path, encode_png_srgb8, read_image, srgb_decode, srgb_encode, write_atomically,
-    write_image, write_png_srgb8, Display, Image, ImageError, ToneMap,
+    check_output_path, encode_png_srgb8, read_image, srgb_decode, srgb_encode, write_image,
+    write_png_srgb8, Display, Image, ImageError, ToneMap,
 };
 pub use load::{load_mesh, parse_mesh, LoadError, LoadedMesh, MeshFormat, MESH_EXTENSIONS};
 pub use material::{IlluminationModel, Light, Material, Shader, Shading};
 pub use mesh::{Mesh, MeshError};
+pub use output::{remove_temporaries, write_atomically, SeekWrite};
 pub use pipeline::{overdraw, render, RenderError, MAX_PIXELS, MAX_SAMPLES};
 pub use scene::{Object, Overrides, Scene, Settings, DEFAULT_SCENE};
 pub use shapes::{plane, sphere, torus};

@@ -1,7 +1,6 @@
 //! `specula hw`: the hardware datapaths: error against word length and resources, Verilog with
 //! a self-checking testbench, and the block diagram, all from one description per lobe.
 
-use std::io::Write as _;
 use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -104,7 +103,7 @@ struct VerilogArgs {
     /// The word length.
     #[arg(long, value_parser = parse_bits)]
     bits: u32,
-    /// The module's file (.v).
+    /// The module's file (.v; `-` for standard output).
     #[arg(short, long)]
     output: PathBuf,
     /// Also write a self-checking testbench here, with vectors from the Rust model.
@@ -179,6 +178,15 @@ fn write_text(path: &std::path::Path, text: &str) -> CommandResult {
 }
 
 fn write_verilog(args: &VerilogArgs) -> CommandResult {
+    if let Some(bench) = &args.testbench {
+        let absolute = |path: &std::path::Path| std::path::absolute(path).ok();
+        if absolute(bench) == absolute(&args.output) && args.output != std::path::Path::new("-") {
+            return Err(format!(
+                "--testbench and -o both name {}; give the testbench its own file",
+                args.output.display()
+            ));
+        }
+    }
     let datapath = args.lobe.build(args.bits).map_err(|e| e.to_string())?;
     let form = if args.combinational {
         verilog::Form::Combinational

@@ -1,6 +1,5 @@
 //! `specula shader`: one lobe as a self-contained shader function for another pipeline.
 
-use std::io::Write as _;
 use std::path::PathBuf;
 
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
