@@ -131,7 +131,7 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
         Err(error) => {
-            eprintln!("{}", one_line(&error.render().to_string()));
+            eprintln!("{}", printable_line(&one_line(&error.render().to_string())));
             return ExitCode::from(2);
         }
     };
@@ -161,10 +161,32 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
-            eprintln!("error: {message}");
+            eprintln!("error: {}", printable_line(&message));
             ExitCode::from(2)
         }
     }
+}
+
+/// `message` as one line a terminal shows as written: line breaks (a library's multi-line
+/// error) become `; `, and other control characters (an escape sequence in a bad argument)
+/// are shown escaped rather than interpreted.
+fn printable_line(message: &str) -> String {
+    message
+        .lines()
+        .map(str::trim)
+        .filter(|line| !line.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
+        .chars()
+        .flat_map(|c| {
+            let escaped: Vec<char> = if c.is_control() {
+                c.escape_default().collect()
+            } else {
+                vec![c]
+            };
+            escaped
+        })
+        .collect()
 }
 
 /// Clap's message folded onto one line, without the usage and `--help` trailer.

@@ -404,3 +404,40 @@ fn standard_output_errors_end_like_unix_tools() {
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
     assert!(stderr.contains("writing to standard output"), "{stderr}");
 }
+
+/// A huge unknown key or id is quoted in part (its length named), and costs no edit-distance
+/// search over its megabytes.
+#[test]
+fn huge_identifiers_are_quoted_in_part() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let path = directory.path();
+    let key = "x".repeat(5_000_000);
+    std::fs::write(
+        path.join("huge-key.toml"),
+        format!("[camera]\neye = [0, -5, 1]\ntarget = [0, 0, 0]\n{key} = 1\n"),
+    )
+    .expect("write");
+    let started = std::time::Instant::now();
+    let output = specula(path, &["render", "huge-key.toml", "-o", "out.png"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr.contains("(5000000 characters)"),
+        "{}",
+        &stderr[..stderr.len().min(300)]
+    );
+    assert!(
+        stderr.len() < 400,
+        "the message quotes at most a line: {} bytes",
+        stderr.len()
+    );
+    assert!(started.elapsed() < Duration::from_secs(10), "no hang");
+    let lobe = "y".repeat(100_000);
+    let output = specula(path, &["eval", "--lobe", &lobe, "--n", "8", "--cos", "0.5"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr.contains("(100000 characters)") && stderr.len() < 400,
+        "{stderr}"
+    );
+}

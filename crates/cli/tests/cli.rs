@@ -140,6 +140,11 @@ fn eval_matches_closed_forms() {
         "eval", "--lobe", "logexp", "--n", "10", "--cos", "-0.5", "--json",
     ]);
     assert_eq!(below["value"].as_f64(), Some(0.0));
+    // A negative number in exponent notation is a value, not a flag.
+    let tiny = json(&[
+        "eval", "--lobe", "logexp", "--n", "10", "--cos", "-1e-5", "--json",
+    ]);
+    assert_eq!(tiny["t"].as_f64(), Some(-1e-5));
 }
 
 #[test]
@@ -157,6 +162,11 @@ fn bad_input_is_a_one_line_error_with_exit_code_two() {
             &["eval", "--lobe", "pow", "--n", "-1", "--cos", "0.5"],
             "[1, 1000]",
         ),
+        (
+            &["hw", "table", "--bits", "-3"],
+            "`-3` is not a word length",
+        ),
+        (&["models", "--n", "-1e-3"], "[1, 1000]"),
         (
             &["eval", "--lobe", "pow", "--n", "NaN", "--cos", "0.5"],
             "[1, 1000]",

@@ -126,7 +126,7 @@ impl HwLobe {
         Self::ALL
             .into_iter()
             .find(|lobe| lobe.id() == text)
-            .ok_or_else(|| HwError::UnknownLobe(text.to_owned()))
+            .ok_or_else(|| HwError::UnknownLobe(specula::excerpt(text)))
     }
 
     /// The float model it implements.

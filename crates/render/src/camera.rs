@@ -6,6 +6,10 @@
 use glam::{Mat4, Vec3};
 use thiserror::Error;
 
+/// The largest coordinate a camera's eye or target (and a scene's light position or object
+/// translation) may have: beyond it, squared distances overflow `f32`.
+pub const MAX_COORDINATE: f32 = 1e6;
+
 /// A camera description that cannot be used, and why.
 #[derive(Clone, Debug, Error, PartialEq)]
 #[error("{0}")]
@@ -52,6 +56,11 @@ impl Camera {
         let fail = |message: &str| Err(InvalidCamera(message.to_owned()));
         if !(eye.is_finite() && target.is_finite() && up.is_finite()) {
             return fail("eye, target and up must be finite");
+        }
+        if eye.abs().max_element() > MAX_COORDINATE || target.abs().max_element() > MAX_COORDINATE {
+            return fail(&format!(
+                "eye and target must lie within {MAX_COORDINATE:e} scene units of the origin in each coordinate (squared distances must stay finite in f32)"
+            ));
         }
         let Some(forward) = (target - eye).try_normalize() else {
             return fail("eye and target coincide; the camera needs a direction to look in");

@@ -9,6 +9,8 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use glam::{EulerRot, Mat3, Vec3};
+
+use crate::camera::MAX_COORDINATE;
 use serde::Deserialize;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use thiserror::Error;
@@ -43,11 +45,31 @@ pub struct LoadedScene {
     pub warnings: Vec<String>,
 }
 
+/// Three numbers, exactly. serde's arrays stop after their length, so a `[f32; 3]` would take
+/// `[0, 0, 5, 7]` as `[0, 0, 5]`; this refuses the extra element.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Triple([f32; 3]);
+
+impl<'de> Deserialize<'de> for Triple {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let values = Vec::<f32>::deserialize(deserializer)?;
+        <[f32; 3]>::try_from(values.as_slice())
+            .map(Triple)
+            .map_err(|_| serde::de::Error::invalid_length(values.len(), &"exactly 3 numbers"))
+    }
+}
+
+impl From<Triple> for Vec3 {
+    fn from(triple: Triple) -> Self {
+        Vec3::from_array(triple.0)
+    }
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SceneDescription {
     #[serde(default)]
-    ambient: Option<Spanned<[f32; 3]>>,
+    ambient: Option<Spanned<Triple>>,
     camera: Spanned<CameraDescription>,
     #[serde(default)]
     render: RenderDescription,
@@ -60,10 +82,10 @@ struct SceneDescription {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CameraDescription {
-    eye: [f32; 3],
-    target: [f32; 3],
+    eye: Triple,
+    target: Triple,
     #[serde(default = "z_up")]
-    up: [f32; 3],
+    up: Triple,
     fov: Option<f32>,
     orthographic: Option<f32>,
     #[serde(default = "default_near")]
@@ -72,8 +94,8 @@ struct CameraDescription {
     far: f32,
 }
 
-fn z_up() -> [f32; 3] {
-    [0.0, 0.0, 1.0]
+fn z_up() -> Triple {
+    Triple([0.0, 0.0, 1.0])
 }
 fn default_near() -> f32 {
     0.1
@@ -91,7 +113,7 @@ struct RenderDescription {
     shading: Shading,
     model: IlluminationModel,
     cull_back_faces: bool,
-    background: Spanned<[f32; 3]>,
+    background: Spanned<Triple>,
     exposure: Spanned<f32>,
     tonemap: ToneMap,
 }
@@ -106,7 +128,7 @@ impl Default for RenderDescription {
             shading: settings.shading,
             model: settings.model,
             cull_back_faces: settings.cull_back_faces,
-            background: Spanned::new(0..0, settings.background.to_array()),
+            background: Spanned::new(0..0, Triple(settings.background.to_array())),
             exposure: Spanned::new(0..0, Display::default().exposure),
             tonemap: Display::default().tonemap,
         }
@@ -124,14 +146,14 @@ enum LightKind {
 #[serde(deny_unknown_fields)]
 struct LightDescription {
     kind: LightKind,
-    towards: Option<[f32; 3]>,
-    position: Option<[f32; 3]>,
+    towards: Option<Triple>,
+    position: Option<Triple>,
     #[serde(default = "white")]
-    intensity: [f32; 3],
+    intensity: Triple,
 }
 
-fn white() -> [f32; 3] {
-    [1.0; 3]
+fn white() -> Triple {
+    Triple([1.0; 3])
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -158,9 +180,9 @@ struct ObjectDescription {
     level: Option<Spanned<u32>>,
     path: Option<Spanned<String>>,
     #[serde(default)]
-    translate: [f32; 3],
+    translate: Triple,
     #[serde(default)]
-    rotate: [f32; 3],
+    rotate: Triple,
     #[serde(default = "one")]
     scale: Spanned<f32>,
     #[serde(default)]
@@ -177,8 +199,8 @@ struct MaterialDescription {
     ka: Spanned<f32>,
     kd: Spanned<f32>,
     ks: Spanned<f32>,
-    colour: Spanned<[f32; 3]>,
-    specular_colour: Spanned<[f32; 3]>,
+    colour: Spanned<Triple>,
+    specular_colour: Spanned<Triple>,
     lobe: Spanned<String>,
     n: Spanned<f64>,
     geometry: Spanned<String>,
@@ -192,8 +214,8 @@ impl Default for MaterialDescription {
             ka: unspanned(0.1),
             kd: unspanned(0.6),
             ks: unspanned(0.4),
-            colour: Spanned::new(0..0, [0.8; 3]),
-            specular_colour: Spanned::new(0..0, [1.0; 3]),
+            colour: Spanned::new(0..0, Triple([0.8; 3])),
+            specular_colour: Spanned::new(0..0, Triple([1.0; 3])),
             lobe: Spanned::new(0..0, "pow".to_owned()),
             n: Spanned::new(0..0, 32.0),
             geometry: Spanned::new(0..0, "phong".to_owned()),
@@ -211,6 +233,16 @@ fn with_nearest_choice(message: &str) -> String {
     let Some((typed, rest)) = unknown.and_then(|rest| rest.split_once('`')) else {
         return message.to_owned();
     };
+    if typed.chars().count() > specula::QUOTED_CHARACTERS {
+        // Too long to be a typo of a key: quoted in part, and no distance computed (its cost
+        // grows with the length).
+        let kind = if message.starts_with("unknown field") {
+            "field"
+        } else {
+            "variant"
+        };
+        return format!("unknown {kind} `{}`{rest}", specula::excerpt(typed));
+    }
     // The choices are the back-quoted words after "expected".
     let choices = rest.split('`').skip(1).step_by(2);
     let nearest = choices
@@ -257,12 +289,8 @@ impl Locator<'_> {
         }
     }
 
-    fn finite_non_negative(
-        &self,
-        key: &str,
-        value: &Spanned<[f32; 3]>,
-    ) -> Result<Vec3, SceneError> {
-        let v = *value.get_ref();
+    fn finite_non_negative(&self, key: &str, value: &Spanned<Triple>) -> Result<Vec3, SceneError> {
+        let v = value.get_ref().0;
         if v.iter().all(|c| c.is_finite() && *c >= 0.0) {
             Ok(Vec3::from_array(v))
         } else {
@@ -365,7 +393,7 @@ fn build_camera(
         },
         (None, Some(height)) => Projection::Orthographic { height },
     };
-    let v = Vec3::from_array;
+    let v = Vec3::from;
     Camera::try_new(v(c.eye), v(c.target), v(c.up), projection, c.near, c.far)
         .map_err(|error| locate.error(camera.span(), format!("camera: {error}")))
 }
@@ -376,15 +404,18 @@ fn build_light(locate: &Locator, light: &Spanned<LightDescription>) -> Result<Li
         locate.finite_non_negative("intensity", &Spanned::new(light.span(), l.intensity))?;
     let fail = |message: &str| Err(locate.error(light.span(), message));
     match (l.kind, l.towards, l.position) {
-        (LightKind::Directional, Some(towards), None) => match Vec3::from_array(towards).try_normalize() {
+        (LightKind::Directional, Some(towards), None) => match Vec3::from(towards).try_normalize() {
             Some(towards) => Ok(Light::Directional { towards, intensity }),
             None => fail("lights.towards: must be a finite, non-zero direction (towards the light)"),
         },
-        (LightKind::Point, None, Some(position)) if Vec3::from_array(position).is_finite() => {
-            Ok(Light::Point { position: Vec3::from_array(position), intensity })
+        (LightKind::Point, None, Some(position))
+            if Vec3::from(position).is_finite()
+                && Vec3::from(position).abs().max_element() <= MAX_COORDINATE =>
+        {
+            Ok(Light::Point { position: Vec3::from(position), intensity })
         }
         (LightKind::Directional, ..) => fail("lights: a directional light takes `towards` (the direction to the light) and no `position`"),
-        (LightKind::Point, ..) => fail("lights: a point light takes a finite `position` and no `towards`"),
+        (LightKind::Point, ..) => fail("lights: a point light takes a `position` (finite, each coordinate within 1e6) and no `towards`"),
     }
 }
 
@@ -490,10 +521,16 @@ fn build_object(
             format!("scale: must be a positive number, got {scale}"),
         ));
     }
-    let translate = Vec3::from_array(o.translate);
-    let r = o.rotate.map(f32::to_radians);
+    let translate = Vec3::from(o.translate);
+    let r = o.rotate.0.map(f32::to_radians);
     if !(translate.is_finite() && r.iter().all(|a| a.is_finite())) {
         return Err(locate.error(object.span(), "translate and rotate must be finite"));
+    }
+    if translate.abs().max_element() > MAX_COORDINATE {
+        return Err(locate.error(
+            object.span(),
+            format!("translate: each coordinate must be within {MAX_COORDINATE:e} scene units"),
+        ));
     }
     let rotation = Mat3::from_euler(EulerRot::ZYX, r[2], r[1], r[0]);
     let mesh = transform(&mesh, rotation, scale, translate);

@@ -36,7 +36,7 @@ mod scene;
 mod shapes;
 mod teapot;
 
-pub use camera::{Camera, InvalidCamera, Projection};
+pub use camera::{Camera, InvalidCamera, Projection, MAX_COORDINATE};
 pub use description::{LoadedScene, SceneError};
 pub use grid::{render_grid, render_grid_with, GridError, GridOptions, Srgb8Image};
 pub use image::{

@@ -190,7 +190,24 @@ fn read_ply(reader: &mut impl BufRead) -> Result<Parts, String> {
     use ply_rs_bw::ply::{DefaultElement, Property};
     let ply = Parser::<DefaultElement>::new()
         .read_ply(reader)
-        .map_err(|e| format!("not a valid PLY file ({e})"))?;
+        .map_err(|e| {
+            // The parser's message repeats itself over several lines ("Line 11: Couldn't read
+            // element line.", then the text and the grammar's expectations): its first line
+            // names where, the offending text says what.
+            let text = e.to_string();
+            let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+            let at = lines.next().unwrap_or("unreadable");
+            let offending = lines
+                .find_map(|l| l.strip_prefix("String: "))
+                .map(|s| {
+                    format!(
+                        ": '{}'",
+                        s.trim_matches(|c: char| c == '\'' || c.is_whitespace())
+                    )
+                })
+                .unwrap_or_default();
+            format!("not a valid PLY file ({at}{offending})")
+        })?;
     let empty = Vec::new();
     let vertices = ply.payload.get("vertex").unwrap_or(&empty);
     let scalar = |element: &DefaultElement, index: usize, key: &str| {

@@ -52,6 +52,22 @@ pub enum Error {
 /// Shorthand for results of this crate.
 pub type Result<T, E = Error> = core::result::Result<T, E>;
 
+/// The most characters of a user's text a message quotes.
+pub const QUOTED_CHARACTERS: usize = 80;
+
+/// `text` as a message quotes it: whole up to [`QUOTED_CHARACTERS`], else its start and its
+/// length (a 50 MB typo is not echoed back).
+#[must_use]
+pub fn excerpt(text: &str) -> String {
+    let count = text.chars().count();
+    if count <= QUOTED_CHARACTERS {
+        text.to_owned()
+    } else {
+        let start: String = text.chars().take(QUOTED_CHARACTERS - 20).collect();
+        format!("{start}... ({count} characters)")
+    }
+}
+
 /// Finds `text` (case-insensitively, trimmed) among `choices` by their names, or says which
 /// names are valid.
 pub(crate) fn parse_choice<T: Copy>(
@@ -66,7 +82,7 @@ pub(crate) fn parse_choice<T: Copy>(
         .find(|&c| name(c).eq_ignore_ascii_case(text.trim()))
         .ok_or_else(|| Error::UnknownName {
             what,
-            name: text.to_owned(),
+            name: excerpt(text),
             valid: choices
                 .iter()
                 .map(|&c| name(c))

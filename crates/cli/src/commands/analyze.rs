@@ -17,7 +17,7 @@ pub struct Args {
     #[arg(long, value_parser = LobeParser, value_delimiter = ',')]
     lobe: Vec<LobeKind>,
     /// Exponents, comma separated (default: 1,2,4,8,16,32,64,128,256,512,1000).
-    #[arg(long, value_parser = parse_exponent, value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_exponent, value_delimiter = ',', allow_hyphen_values = true)]
     n: Vec<Exponent>,
     /// Output format.
     #[arg(long, value_enum, default_value_t)]

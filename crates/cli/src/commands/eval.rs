@@ -15,14 +15,14 @@ pub struct Args {
     #[arg(long, value_parser = LobeParser)]
     lobe: LobeKind,
     /// Specular exponent n, in [1, 1000].
-    #[arg(long, value_parser = parse_exponent, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_exponent, allow_hyphen_values = true)]
     n: Exponent,
     /// The lobe's cosine t (R.V for Phong, N.H for Blinn), in [-1, 1].
-    #[arg(long, value_parser = parse_cosine, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_cosine, allow_hyphen_values = true)]
     cos: Option<f64>,
     /// The angle from the lobe's axis, in degrees. Angle-native lobes (cheb2, cheb2-thesis,
     /// minimax2) take it directly, without an acos.
-    #[arg(long, value_parser = parse_degrees, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_degrees, allow_hyphen_values = true)]
     angle: Option<f64>,
     /// Which cosine t is: R.V (phong) or N.H (blinn). It names the point and selects the
     /// normalisations listed.

@@ -55,7 +55,10 @@ fn parse_bits(text: &str) -> Result<u32, String> {
 fn parse_bits_range(text: &str) -> Result<(u32, u32), String> {
     let (low, high) = text
         .split_once("..")
-        .or_else(|| text.split_once('-'))
+        .or_else(|| {
+            text.split_once('-')
+                .filter(|(low, _)| !low.trim().is_empty())
+        })
         .unwrap_or((text, text));
     let (low, high) = (parse_bits(low)?, parse_bits(high)?);
     if low <= high {
@@ -82,10 +85,10 @@ struct TableArgs {
     #[arg(long, value_parser = parse_lobe, value_delimiter = ',')]
     lobe: Vec<HwLobe>,
     /// Word lengths: LOW..HIGH or one width.
-    #[arg(long, value_parser = parse_bits_range, default_value = "8..24")]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_bits_range, default_value = "8..24")]
     bits: (u32, u32),
     /// The integer exponent.
-    #[arg(long, value_parser = parse_integer_exponent, default_value = "64")]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_integer_exponent, default_value = "64")]
     n: u32,
     /// Angles sampled per zone.
     #[arg(long, default_value_t = 20_000, value_parser = clap::value_parser!(u32).range(100..=1_000_000))]
@@ -101,7 +104,7 @@ struct VerilogArgs {
     #[arg(long, value_parser = parse_lobe)]
     lobe: HwLobe,
     /// The word length.
-    #[arg(long, value_parser = parse_bits)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_bits)]
     bits: u32,
     /// The module's file (.v; `-` for standard output).
     #[arg(short, long)]
@@ -125,7 +128,7 @@ struct SynthArgs {
     #[arg(long, value_parser = parse_lobe, value_delimiter = ',')]
     lobe: Vec<HwLobe>,
     /// The word length.
-    #[arg(long, value_parser = parse_bits, default_value = "16")]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_bits, default_value = "16")]
     bits: u32,
     /// The synthesis flow.
     #[arg(long, value_enum, default_value_t)]
@@ -144,7 +147,7 @@ struct DiagramArgs {
     #[arg(long, value_parser = parse_lobe)]
     lobe: HwLobe,
     /// The word length the formats are shown for.
-    #[arg(long, value_parser = parse_bits, default_value = "16")]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_bits, default_value = "16")]
     bits: u32,
     /// The SVG file.
     #[arg(short, long)]

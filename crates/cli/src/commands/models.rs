@@ -13,7 +13,7 @@ use crate::output::Table;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The exponent at which operations are counted (some lobes' cost depends on n).
-    #[arg(long, default_value = "100", value_parser = parse_exponent)]
+    #[arg(long, allow_hyphen_values = true, default_value = "100", value_parser = parse_exponent)]
     n: Exponent,
     /// Output format.
     #[arg(long, value_enum, default_value_t)]

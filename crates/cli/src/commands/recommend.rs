@@ -53,10 +53,10 @@ pub struct Args {
     #[arg(long, value_enum)]
     target: Target,
     /// The exponent, or a range `LOW..HIGH` over which the answer must hold.
-    #[arg(long, default_value = "64", value_parser = parse_exponents)]
+    #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = parse_exponents)]
     n: Exponents,
     /// The largest error allowed, as a percentage (`1%` or `1`).
-    #[arg(long, value_parser = parse_percent)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_percent)]
     max_error: f64,
     /// Which error.
     #[arg(long, value_enum, default_value_t = ZoneChoice::Epicentre)]

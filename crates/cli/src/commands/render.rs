@@ -26,7 +26,7 @@ pub struct Args {
     #[arg(long, value_parser = LobeParser)]
     lobe: Option<LobeKind>,
     /// Every material's exponent, in [1, 1000].
-    #[arg(long, value_parser = parse_exponent, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_exponent, allow_hyphen_values = true)]
     n: Option<Exponent>,
     /// Every material's geometry.
     #[arg(long, value_parser = choice(&Geometry::ALL, Geometry::id))]

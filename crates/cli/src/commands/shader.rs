@@ -15,7 +15,7 @@ pub struct Args {
     #[arg(long, value_parser = LobeParser)]
     lobe: LobeKind,
     /// The exponent, in [1, 1000]; the lobe's constants are prepared for it.
-    #[arg(long, value_parser = parse_exponent, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_exponent, allow_hyphen_values = true)]
     n: Exponent,
     /// How the lobe's cosine is formed.
     #[arg(long, value_parser = choice(&Geometry::ALL, Geometry::id), default_value = "phong")]

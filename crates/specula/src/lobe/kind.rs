@@ -272,7 +272,7 @@ impl LobeKind {
             .into_iter()
             .find(|kind| kind.id().eq_ignore_ascii_case(id))
             .ok_or_else(|| Error::UnknownLobe {
-                id: id.to_owned(),
+                id: crate::error::excerpt(id),
                 valid: Self::valid_ids(),
             })?;
         match (kind, params) {

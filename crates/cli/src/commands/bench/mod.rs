@@ -43,7 +43,7 @@ pub struct Args {
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     frames: u32,
     /// The exponent the lobes are prepared for (`bench lobes`).
-    #[arg(long, default_value = "64", value_parser = crate::args::parse_exponent)]
+    #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = crate::args::parse_exponent)]
     n: specula::Exponent,
     /// Output format (`bench lobes`, `bench gpu-lobes`).
     #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
