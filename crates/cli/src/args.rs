@@ -149,3 +149,19 @@ pub fn choice<T: Copy + Send + Sync + 'static>(
             .expect("clap only passes listed names")
     })
 }
+
+/// The input-file limit: a flag of the commands that read meshes or images.
+#[derive(Debug, clap::Args)]
+pub struct InputLimit {
+    /// The largest mesh or image file to read, in MiB (files are checked before reading; a
+    /// path that is not a regular file is refused).
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u64).range(1..=65_536))]
+    max_input_mib: u64,
+}
+
+impl InputLimit {
+    /// Makes it the process's limit.
+    pub fn apply(&self) {
+        specula_render::input::set_max_input_bytes(self.max_input_mib << 20);
+    }
+}

@@ -441,3 +441,121 @@ fn huge_identifiers_are_quoted_in_part() {
         "{stderr}"
     );
 }
+
+/// CRC-32 (IEEE), for patching a PNG header in the test below.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0_u32;
+    for &byte in bytes {
+        crc ^= u32::from(byte);
+        for _ in 0..8 {
+            crc = (crc >> 1) ^ (0xedb8_8320 & (crc & 1).wrapping_neg());
+        }
+    }
+    !crc
+}
+
+/// Every size an input controls is bounded before anything is allocated or read: non-regular
+/// files, files over the input limit, images declaring more pixels than allowed, too many
+/// objects, a grid over the pixel limit.
+#[test]
+fn sizes_an_input_declares_are_bounded_before_reading() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let path = directory.path();
+    let refused = |args: &[&str], expected: &str| {
+        let started = std::time::Instant::now();
+        let output = specula(path, args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains(expected),
+            "{args:?}: expected `{expected}` in {stderr}"
+        );
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+        assert!(
+            started.elapsed() < Duration::from_secs(10),
+            "{args:?}: no hang"
+        );
+    };
+    let camera = "[camera]\neye = [0, -5, 1]\ntarget = [0, 0, 0]\n";
+    let mesh_scene = |name: &str, mesh: &str| {
+        std::fs::write(
+            path.join(name),
+            format!("{camera}[[objects]]\nshape = \"mesh\"\npath = \"{mesh}\"\n"),
+        )
+        .expect("write");
+    };
+    // A mesh that is a symlink to an endless device, and a scene that is a FIFO.
+    std::os::unix::fs::symlink("/dev/zero", path.join("zero.obj")).expect("symlink");
+    mesh_scene("zero.toml", "zero.obj");
+    refused(
+        &["render", "zero.toml", "-o", "out.png"],
+        "is a device, not a regular file",
+    );
+    assert!(Command::new("mkfifo")
+        .arg(path.join("fifo.toml"))
+        .status()
+        .expect("mkfifo")
+        .success());
+    refused(
+        &["render", "fifo.toml", "-o", "out.png"],
+        "is a FIFO, not a regular file",
+    );
+    // A mesh over the input limit (raised or lowered by --max-input-mib).
+    std::fs::write(path.join("big.obj"), "v 0 0 0\n".repeat(300_000)).expect("write");
+    mesh_scene("big.toml", "big.obj");
+    refused(
+        &[
+            "render",
+            "big.toml",
+            "-o",
+            "out.png",
+            "--max-input-mib",
+            "1",
+        ],
+        "above the input limit of 1048576 bytes",
+    );
+    // A PNG whose header declares 20000 x 20000 pixels (a real 8 x 8 image, patched).
+    assert!(specula(
+        path,
+        &["render", "--width", "8", "--height", "8", "-o", "small.png"]
+    )
+    .status
+    .success());
+    let mut png = std::fs::read(path.join("small.png")).expect("read");
+    png[16..20].copy_from_slice(&20_000_u32.to_be_bytes());
+    png[20..24].copy_from_slice(&20_000_u32.to_be_bytes());
+    let crc = crc32(&png[12..29]);
+    png[29..33].copy_from_slice(&crc.to_be_bytes());
+    std::fs::write(path.join("huge.png"), png).expect("write");
+    refused(
+        &["diff", "small.png", "huge.png"],
+        "declares 20000x20000 pixels",
+    );
+    // Too many objects.
+    let many = format!(
+        "{camera}{}",
+        "[[objects]]\nshape = \"plane\"\n".repeat(10_001)
+    );
+    std::fs::write(path.join("many.toml"), many).expect("write");
+    refused(&["render", "many.toml", "-o", "out.png"], "at most 10000");
+    // A grid over the pixel limit.
+    refused(
+        &[
+            "render",
+            "--grid",
+            "lobes=pow,schlick",
+            "--width",
+            "8192",
+            "--height",
+            "8192",
+            "-o",
+            "grid.png",
+        ],
+        "above the limit of 67108864",
+    );
+    let outputs: Vec<String> = files(path)
+        .into_iter()
+        .filter(|name| name.starts_with("out") || name.starts_with("grid"))
+        .collect();
+    assert!(outputs.is_empty(), "no output written: {outputs:?}");
+}

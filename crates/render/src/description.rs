@@ -20,7 +20,7 @@ use crate::camera::Projection;
 use crate::load::load_mesh;
 use crate::material::{IlluminationModel, Light, Material, Shading};
 use crate::scene::{Object, Settings};
-use crate::{plane, sphere, teapot, torus, Camera, Display, Mesh, Scene, ToneMap};
+use crate::{plane, sphere, teapot, torus, Camera, Display, Mesh, Scene, ToneMap, TEAPOT_PATCHES};
 
 /// A scene file that cannot be used: where, and why.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -44,6 +44,13 @@ pub struct LoadedScene {
     /// Things the user should know, one line each.
     pub warnings: Vec<String>,
 }
+
+/// The most triangles a scene may have, over all its objects: 8,388,608 (about 0.9 GB of
+/// transformed geometry while rendering). Procedural shapes are charged before they are
+/// tessellated.
+pub const MAX_TRIANGLES: u64 = 1 << 23;
+/// The most objects a scene may have.
+pub const MAX_OBJECTS: usize = 10_000;
 
 /// Three numbers, exactly. serde's arrays stop after their length, so a `[f32; 3]` would take
 /// `[0, 0, 5, 7]` as `[0, 0, 5]`; this refuses the extra element.
@@ -305,12 +312,14 @@ impl Locator<'_> {
 impl Scene {
     /// Reads a scene file; mesh paths in it are relative to the file's directory.
     pub fn from_file(path: &Path) -> Result<LoadedScene, SceneError> {
-        let source = std::fs::read_to_string(path).map_err(|error| SceneError {
+        let fail = |message: String| SceneError {
             file: path.display().to_string(),
             line: 0,
             column: 0,
-            message: format!("cannot read the scene file: {error}"),
-        })?;
+            message: format!("cannot read the scene file: {message}"),
+        };
+        let bytes = crate::input::read_within(path, crate::input::MAX_SCENE_BYTES).map_err(fail)?;
+        let source = String::from_utf8(bytes).map_err(|e| fail(format!("not UTF-8 text ({e})")))?;
         let base = path.parent().map(Path::to_path_buf);
         Scene::from_toml(&source, &path.display().to_string(), base.as_deref())
     }
@@ -350,10 +359,20 @@ impl Scene {
             .iter()
             .map(|light| build_light(&locate, light))
             .collect::<Result<_, _>>()?;
+        if let Some(extra) = description.objects.get(MAX_OBJECTS) {
+            return Err(locate.error(
+                extra.span(),
+                format!(
+                    "the scene has {} objects; at most {MAX_OBJECTS}",
+                    description.objects.len()
+                ),
+            ));
+        }
+        let mut budget = MAX_TRIANGLES;
         let objects = description
             .objects
             .iter()
-            .map(|object| build_object(&locate, object, base, &mut warnings))
+            .map(|object| build_object(&locate, object, base, &mut warnings, &mut budget))
             .collect::<Result<_, _>>()?;
         let ambient = match &description.ambient {
             Some(value) => locate.finite_non_negative("ambient", value)?,
@@ -435,6 +454,7 @@ fn build_object(
     object: &Spanned<ObjectDescription>,
     base: Option<&Path>,
     warnings: &mut Vec<String>,
+    budget: &mut u64,
 ) -> Result<Object, SceneError> {
     let o = object.get_ref();
     let given: [(&str, Option<Range<usize>>); 9] = [
@@ -482,20 +502,47 @@ fn build_object(
                 ),
             )),
         };
+    // Each shape's triangles are charged to the scene's budget before it is tessellated.
+    let mut charge = |triangles: u64| {
+        if triangles > *budget {
+            Err(locate.error(
+                object.span(),
+                format!(
+                    "this object's {triangles} triangles take the scene past its limit of {MAX_TRIANGLES} triangles"
+                ),
+            ))
+        } else {
+            *budget -= triangles;
+            Ok(())
+        }
+    };
     let mesh = match o.shape {
-        ShapeKind::Sphere => sphere(
-            length("radius", &o.radius, 1.0)?,
-            count("segments", &o.segments, 96, 3..4097)?,
-            count("rings", &o.rings, 48, 2..4097)?,
-        ),
-        ShapeKind::Torus => torus(
-            length("major", &o.major, 1.0)?,
-            length("minor", &o.minor, 0.3)?,
-            count("segments", &o.segments, 96, 3..4097)?,
-            count("sides", &o.sides, 48, 3..4097)?,
-        ),
-        ShapeKind::Plane => plane(length("size", &o.size, 10.0)?),
-        ShapeKind::Teapot => teapot(count("level", &o.level, 12, 1..65)?),
+        ShapeKind::Sphere => {
+            let radius = length("radius", &o.radius, 1.0)?;
+            let segments = count("segments", &o.segments, 96, 3..4097)?;
+            let rings = count("rings", &o.rings, 48, 2..4097)?;
+            charge(2 * u64::from(segments) * u64::from(rings))?;
+            sphere(radius, segments, rings)
+        }
+        ShapeKind::Torus => {
+            let (major, minor) = (
+                length("major", &o.major, 1.0)?,
+                length("minor", &o.minor, 0.3)?,
+            );
+            let segments = count("segments", &o.segments, 96, 3..4097)?;
+            let sides = count("sides", &o.sides, 48, 3..4097)?;
+            charge(2 * u64::from(segments) * u64::from(sides))?;
+            torus(major, minor, segments, sides)
+        }
+        ShapeKind::Plane => {
+            charge(2)?;
+            plane(length("size", &o.size, 10.0)?)
+        }
+        ShapeKind::Teapot => {
+            let level = count("level", &o.level, 12, 1..65)?;
+            charge(2 * TEAPOT_PATCHES as u64 * u64::from(level) * u64::from(level))?;
+            teapot(level)
+        }
         ShapeKind::Mesh => {
             let Some(path) = &o.path else {
                 return Err(locate.error(object.span(), "path: a mesh object needs `path`, a .obj, .stl or .ply file relative to the scene"));
@@ -504,6 +551,7 @@ fn build_object(
                 base.map_or_else(|| PathBuf::from(path.get_ref()), |b| b.join(path.get_ref()));
             let loaded = load_mesh(&full)
                 .map_err(|error| locate.error(path.span(), format!("path: {error}")))?;
+            charge(loaded.mesh.triangles().len() as u64)?;
             if loaded.degenerate_triangles > 0 {
                 warnings.push(format!(
                     "{}: skipped {} degenerate triangle(s)",

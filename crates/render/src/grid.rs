@@ -6,6 +6,8 @@ use font8x8::UnicodeFonts;
 use specula::LobeKind;
 use thiserror::Error;
 
+use crate::pipeline::MAX_PIXELS;
+
 use crate::metrics::compare;
 use crate::{render, Overrides, RenderError, Scene};
 
@@ -28,6 +30,18 @@ pub enum GridError {
     /// A render failed.
     #[error("{0}")]
     Render(String),
+    /// The grid would exceed the renderer's pixel limit.
+    #[error("a grid of {lobes} lobes at {width}x{height} is {pixels} pixels (two rows of renders and FLIP maps), above the limit of {MAX_PIXELS}; use fewer lobes or a smaller --width/--height")]
+    TooLarge {
+        /// Lobes asked for.
+        lobes: usize,
+        /// Render width.
+        width: u32,
+        /// Render height.
+        height: u32,
+        /// The grid's pixels.
+        pixels: u64,
+    },
 }
 
 /// An 8-bit sRGB image (three bytes per pixel).
@@ -107,6 +121,16 @@ pub fn render_grid_with(
 ) -> Result<Srgb8Image, GridError> {
     if options.lobes.is_empty() {
         return Err(GridError::Empty);
+    }
+    let (width, height) = (scene.settings.width, scene.settings.height);
+    let pixels = 2 * options.lobes.len() as u64 * u64::from(width) * u64::from(height);
+    if pixels > MAX_PIXELS {
+        return Err(GridError::TooLarge {
+            lobes: options.lobes.len(),
+            width,
+            height,
+            pixels,
+        });
     }
     let mut with_lobe = |kind: LobeKind, index: usize| {
         let mut variant = scene.clone();

@@ -285,46 +285,80 @@ pub fn write_image(path: &Path, image: &Image, display: Display) -> Result<(), I
     }
 }
 
-/// Reads a PNG (decoded from sRGB to linear) or an OpenEXR file (its first RGB(A) layer).
+/// The most pixels an image read from a file may have: 16,777,216 (4096 x 4096). What the
+/// file declares is checked before any pixel is decoded, and FLIP (`specula diff`) needs
+/// about 60 bytes per pixel beside the two images.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 24;
+
+/// Reads a PNG (decoded from sRGB to linear) or an OpenEXR file (its first RGB(A) layer): a
+/// regular file within the input limit, whose declared size is at most [`MAX_IMAGE_PIXELS`].
 pub fn read_image(path: &Path) -> Result<Image, ImageError> {
     let codec = |message: String| ImageError::Codec {
         path: path.display().to_string(),
         message,
     };
-    match format_of(path)? {
+    let format = format_of(path)?;
+    let bytes = crate::input::read_regular(path).map_err(codec)?;
+    let check = |width: u64, height: u64| {
+        if width * height > MAX_IMAGE_PIXELS {
+            Err(codec(format!(
+                "declares {width}x{height} pixels, above the limit of {MAX_IMAGE_PIXELS} (4096 x 4096)"
+            )))
+        } else {
+            Ok(())
+        }
+    };
+    match format {
         Format::Png => {
-            let decoded = image::open(path).map_err(|e| match e {
-                image::ImageError::IoError(source) => ImageError::Io {
-                    path: path.display().to_string(),
-                    source,
-                },
-                other => codec(other.to_string()),
-            })?;
+            let reader = || {
+                image::ImageReader::with_format(
+                    std::io::Cursor::new(bytes.as_slice()),
+                    image::ImageFormat::Png,
+                )
+            };
+            let (width, height) = reader()
+                .into_dimensions()
+                .map_err(|e| codec(e.to_string()))?;
+            check(u64::from(width), u64::from(height))?;
+            let mut limits = image::Limits::default();
+            limits.max_alloc = Some(16 * MAX_IMAGE_PIXELS);
+            let mut limited = reader();
+            limited.limits(limits);
+            let decoded = limited.decode().map_err(|e| codec(e.to_string()))?;
             let rgb = decoded.to_rgb8();
             Image::from_srgb8(rgb.width(), rgb.height(), rgb.as_raw())
                 .ok_or_else(|| codec("inconsistent image size".into()))
         }
         Format::Exr => {
-            let read = exr::prelude::read_first_rgba_layer_from_file(
-                path,
-                |resolution, _| {
-                    Image::new(
-                        resolution.width() as u32,
-                        resolution.height() as u32,
-                        Vec3::ZERO,
-                    )
-                },
-                |image: &mut Image, position, (r, g, b, _a): (f32, f32, f32, f32)| {
-                    image.set(position.x() as u32, position.y() as u32, Vec3::new(r, g, b));
-                },
+            use exr::prelude::{ReadChannels as _, ReadLayers as _};
+            let meta = exr::meta::MetaData::read_from_buffered(
+                std::io::Cursor::new(bytes.as_slice()),
+                false,
             )
-            .map_err(|e| match e {
-                exr::error::Error::Io(source) => ImageError::Io {
-                    path: path.display().to_string(),
-                    source,
-                },
-                other => codec(other.to_string()),
-            })?;
+            .map_err(|e| codec(e.to_string()))?;
+            for header in meta.headers.iter() {
+                let size = header.layer_size;
+                check(size.width() as u64, size.height() as u64)?;
+            }
+            let read = exr::prelude::read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .rgba_channels(
+                    |resolution, _| {
+                        Image::new(
+                            resolution.width() as u32,
+                            resolution.height() as u32,
+                            Vec3::ZERO,
+                        )
+                    },
+                    |image: &mut Image, position, (r, g, b, _a): (f32, f32, f32, f32)| {
+                        image.set(position.x() as u32, position.y() as u32, Vec3::new(r, g, b));
+                    },
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(std::io::Cursor::new(bytes.as_slice()))
+                .map_err(|e| codec(e.to_string()))?;
             Ok(read.layer_data.channel_data.pixels)
         }
     }

@@ -24,6 +24,7 @@ mod clip;
 mod description;
 mod grid;
 mod image;
+pub mod input;
 mod load;
 mod material;
 mod mesh;
@@ -37,11 +38,11 @@ mod shapes;
 mod teapot;
 
 pub use camera::{Camera, InvalidCamera, Projection, MAX_COORDINATE};
-pub use description::{LoadedScene, SceneError};
+pub use description::{LoadedScene, SceneError, MAX_OBJECTS, MAX_TRIANGLES};
 pub use grid::{render_grid, render_grid_with, GridError, GridOptions, Srgb8Image};
 pub use image::{
     check_output_path, encode_png_srgb8, read_image, srgb_decode, srgb_encode, write_image,
-    write_png_srgb8, Display, Image, ImageError, ToneMap,
+    write_png_srgb8, Display, Image, ImageError, ToneMap, MAX_IMAGE_PIXELS,
 };
 pub use load::{load_mesh, parse_mesh, LoadError, LoadedMesh, MeshFormat, MESH_EXTENSIONS};
 pub use material::{IlluminationModel, Light, Material, Shader, Shading};

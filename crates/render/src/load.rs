@@ -6,7 +6,6 @@
 //! Degenerate triangles (repeated corners, zero area) are dropped and counted, so a caller can
 //! say so; non-finite coordinates and out-of-range indices refuse the file with the reason.
 
-use std::fs::File;
 use std::io::{BufRead, BufReader, Seek};
 use std::path::Path;
 
@@ -75,7 +74,7 @@ pub fn load_mesh(path: &Path) -> Result<LoadedMesh, LoadError> {
         message,
     };
     let format = MeshFormat::of_path(path).map_err(fail)?;
-    let file = File::open(path).map_err(|e| fail(e.to_string()))?;
+    let file = crate::input::open_regular(path).map_err(fail)?;
     parse_mesh(BufReader::new(file), format).map_err(fail)
 }
 

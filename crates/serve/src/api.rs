@@ -21,14 +21,12 @@ use serde_json::json;
 use specula::analysis::{analyze, Precision};
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use specula_render::{IlluminationModel, Shading};
-use tokio::sync::Semaphore;
 
 use super::explorer::{curves, render_png, Object, RenderRequest};
+use super::guard::{Hosts, Limiter};
 
 /// The largest render side, in pixels.
 pub const MAX_RENDER_SIZE: u32 = 1024;
-/// Renders computed at once; more wait their turn.
-pub const CONCURRENT_RENDERS: usize = 2;
 
 /// A lobe's cost on one target, as the explorer shows it beside its errors.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -59,8 +57,9 @@ pub fn cpu_cost(lobe: &Lobe) -> TargetCost {
 /// What the handlers share.
 #[derive(Clone)]
 pub struct AppState {
-    renders: Arc<Semaphore>,
+    computations: Limiter,
     costs: CostModel,
+    hosts: Hosts,
 }
 
 impl AppState {
@@ -68,9 +67,22 @@ impl AppState {
     #[must_use]
     pub fn with_costs(costs: CostModel) -> Self {
         Self {
-            renders: Arc::new(Semaphore::new(CONCURRENT_RENDERS)),
+            computations: Limiter::default(),
             costs,
+            hosts: Hosts::default(),
         }
+    }
+
+    /// The state answering only to `hosts` (the default: loopback names, any port).
+    #[must_use]
+    pub fn answering(self, hosts: Hosts) -> Self {
+        Self { hosts, ..self }
+    }
+
+    /// The host names it answers to.
+    #[must_use]
+    pub fn hosts(&self) -> Hosts {
+        self.hosts.clone()
     }
 }
 
@@ -278,7 +290,10 @@ pub async fn models() -> impl IntoResponse {
     }))
 }
 
-pub async fn evaluate(query: QueryPairs) -> Result<impl IntoResponse, ApiError> {
+pub async fn evaluate(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<Response, ApiError> {
     let params = Params::new(
         pairs(query)?,
         &["lobe", "n", "geometry", "normalisation", "theta_in"],
@@ -286,16 +301,24 @@ pub async fn evaluate(query: QueryPairs) -> Result<impl IntoResponse, ApiError> 
     let (kind, n) = (params.lobe()?, params.exponent()?);
     let (geometry, normalisation) = (params.geometry()?, params.normalisation()?);
     let theta_in = params.number("theta_in", 0.0..=89.0, 30.0)?.to_radians();
+    let _turn = match state.computations.turn().await {
+        Ok(turn) => turn,
+        Err(busy) => return Ok(busy),
+    };
     let data = blocking(move || curves(kind, n, geometry, normalisation, theta_in)).await?;
-    Ok(Json(data))
+    Ok(Json(data).into_response())
 }
 
 pub async fn analyze_lobe(
     State(state): State<AppState>,
     query: QueryPairs,
-) -> Result<impl IntoResponse, ApiError> {
+) -> Result<Response, ApiError> {
     let params = Params::new(pairs(query)?, &["lobe", "n"])?;
     let (kind, n) = (params.lobe()?, params.exponent()?);
+    let _turn = match state.computations.turn().await {
+        Ok(turn) => turn,
+        Err(busy) => return Ok(busy),
+    };
     let costs = state.costs.clone();
     let (report, costs) = blocking(move || {
         let report = analyze(kind, n, &mut Precision::F64);
@@ -305,13 +328,13 @@ pub async fn analyze_lobe(
     let costs = costs.map_err(ApiError::internal)?;
     let mut body = serde_json::to_value(report).map_err(|e| ApiError::internal(e.to_string()))?;
     body["costs"] = json!(costs);
-    Ok(Json(body))
+    Ok(Json(body).into_response())
 }
 
 pub async fn render(
     State(state): State<AppState>,
     query: QueryPairs,
-) -> Result<impl IntoResponse, ApiError> {
+) -> Result<Response, ApiError> {
     let params = Params::new(
         pairs(query)?,
         &[
@@ -351,11 +374,10 @@ pub async fn render(
             .to_radians(),
         size: params.number("size", 16.0..=f64::from(MAX_RENDER_SIZE), 512.0)? as u32,
     };
-    let _permit = state
-        .renders
-        .acquire()
-        .await
-        .map_err(|e| ApiError::internal(e.to_string()))?;
+    let _turn = match state.computations.turn().await {
+        Ok(turn) => turn,
+        Err(busy) => return Ok(busy),
+    };
     let png = blocking(move || render_png(&request))
         .await?
         .map_err(ApiError::internal)?;
@@ -365,5 +387,6 @@ pub async fn render(
             (header::CACHE_CONTROL, "no-store"),
         ],
         png,
-    ))
+    )
+        .into_response())
 }

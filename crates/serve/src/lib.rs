@@ -3,18 +3,24 @@
 //! A page and a JSON API over the library and the CPU renderer; `specula serve` runs it.
 //!
 //! The page, its script and its styles are compiled in (`assets/`); nothing is fetched from
-//! the network. The server binds to 127.0.0.1 unless `--bind` says otherwise. Computations run
-//! on the blocking pool, renders at most [`CONCURRENT_RENDERS`] at a time, and request
-//! bodies are capped (the API takes none).
+//! the network. The server binds to 127.0.0.1 unless `--bind` says otherwise, answers only to
+//! its own host names ([`Hosts`]), serves at most [`MAX_CONNECTIONS`] connections with header
+//! and idle timeouts (`listen.rs`), runs [`CONCURRENT_COMPUTATIONS`] computations at once on
+//! the blocking pool behind a queue of [`QUEUED_COMPUTATIONS`] (a full queue answers 503), and
+//! caps request bodies (the API takes none).
 
 mod api;
 mod explorer;
+mod guard;
+mod listen;
 #[cfg(test)]
 mod tests;
 
 use std::net::SocketAddr;
 
-pub use api::{cpu_cost, AppState, CostModel, TargetCost, CONCURRENT_RENDERS, MAX_RENDER_SIZE};
+pub use api::{cpu_cost, AppState, CostModel, TargetCost, MAX_RENDER_SIZE};
+pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
+pub use listen::{CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT, MAX_CONNECTIONS};
 
 use axum::extract::DefaultBodyLimit;
 use axum::http::header;
@@ -32,6 +38,7 @@ pub fn router() -> Router {
 
 /// The explorer's routes: the page, its assets and the API.
 pub fn router_with(state: api::AppState) -> Router {
+    let hosts = state.hosts();
     let asset = |content_type: &'static str, body: &'static str| {
         get(move || async move { ([(header::CONTENT_TYPE, content_type)], body).into_response() })
     };
@@ -60,6 +67,10 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/render", get(api::render))
         .fallback(api::not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
+        .layer(axum::middleware::from_fn_with_state(
+            hosts,
+            guard::check_host,
+        ))
         .with_state(state)
 }
 
@@ -85,12 +96,12 @@ pub fn serve(address: SocketAddr, open: bool, costs: api::CostModel) -> Result<(
         if open {
             open_browser(&url);
         }
-        axum::serve(listener, router_with(api::AppState::with_costs(costs)))
-            .with_graceful_shutdown(async {
-                let _ = tokio::signal::ctrl_c().await;
-            })
-            .await
-            .map_err(|e| format!("the server stopped: {e}"))
+        let state = api::AppState::with_costs(costs)
+            .answering(Hosts::new(Some(local.ip()), Some(local.port())));
+        listen::serve(listener, router_with(state), async {
+            let _ = tokio::signal::ctrl_c().await;
+        })
+        .await
     })
 }
 

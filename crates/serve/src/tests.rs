@@ -144,9 +144,11 @@ async fn bodies_are_refused_and_the_page_is_self_contained() {
     }
 }
 
-/// 200 requests at once, renders among them: every one answered, none an error.
+/// 200 requests at once, renders among them: every one answered, with 200 or, once the
+/// computation queue is full, 503 and `Retry-After`; the catalogue never waits; and as many
+/// computations as the queue holds succeed.
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
-async fn two_hundred_parallel_requests_all_succeed() {
+async fn two_hundred_parallel_requests_are_answered_or_deferred() {
     let app = router();
     let requests = (0..200).map(|k| {
         let app = app.clone();
@@ -161,17 +163,131 @@ async fn two_hundred_parallel_requests_all_succeed() {
                 .oneshot(Request::get(&uri).body(Body::empty()).expect("request"))
                 .await
                 .expect("infallible");
-            (uri, response.status())
+            let retry = response
+                .headers()
+                .get(axum::http::header::RETRY_AFTER)
+                .cloned();
+            (uri, response.status(), retry)
         })
     });
-    let mut failures = Vec::new();
+    let (mut succeeded, mut deferred) = (0, 0);
     for handle in requests.collect::<Vec<_>>() {
-        let (uri, status) = handle.await.expect("task");
-        if status != StatusCode::OK {
-            failures.push((uri, status));
+        let (uri, status, retry) = handle.await.expect("task");
+        match status {
+            StatusCode::OK => succeeded += 1,
+            StatusCode::SERVICE_UNAVAILABLE if !uri.ends_with("models") => {
+                assert_eq!(retry.as_ref().map(|v| v.to_str().ok()), Some(Some("1")));
+                deferred += 1;
+            }
+            other => panic!("{uri}: {other}"),
         }
     }
-    assert!(failures.is_empty(), "{failures:?}");
+    assert_eq!(succeeded + deferred, 200);
+    assert!(
+        succeeded >= 50 + crate::QUEUED_COMPUTATIONS.min(150),
+        "{succeeded} succeeded"
+    );
+}
+
+/// A `Host` that names another server (DNS rebinding) is refused with 421; the loopback
+/// names with the server's port are answered.
+#[tokio::test]
+async fn other_host_names_are_refused() {
+    let app = crate::router_with(
+        crate::AppState::default().answering(crate::Hosts::new(None, Some(8123))),
+    );
+    let status = |host: &'static str| {
+        let app = app.clone();
+        async move {
+            app.oneshot(
+                Request::get("/api/models")
+                    .header("host", host)
+                    .body(Body::empty())
+                    .expect("request"),
+            )
+            .await
+            .expect("infallible")
+            .status()
+        }
+    };
+    assert_eq!(
+        status("evil.example:8123").await,
+        StatusCode::MISDIRECTED_REQUEST
+    );
+    assert_eq!(
+        status("localhost:9999").await,
+        StatusCode::MISDIRECTED_REQUEST
+    );
+    assert_eq!(status("localhost:8123").await, StatusCode::OK);
+    assert_eq!(status("127.0.0.1:8123").await, StatusCode::OK);
+}
+
+/// Idle connections and slow headers are closed after their timeouts; connections beyond the
+/// limit get an immediate 503, so the server answers while flooded.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn floods_of_idle_connections_are_bounded_and_timed_out() {
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
+        .await
+        .expect("bind");
+    let address = listener.local_addr().expect("address");
+    tokio::spawn(crate::listen::serve(
+        listener,
+        router(),
+        std::future::pending(),
+    ));
+    let mut idle = Vec::new();
+    for _ in 0..crate::MAX_CONNECTIONS {
+        idle.push(
+            tokio::net::TcpStream::connect(address)
+                .await
+                .expect("connect"),
+        );
+    }
+    let mut slow = tokio::net::TcpStream::connect(address)
+        .await
+        .expect("connect");
+    slow.write_all(b"GET / HTTP/1.1\r\nHost: loc")
+        .await
+        .expect("send");
+    // One more: answered at once, with 503.
+    let mut extra = tokio::net::TcpStream::connect(address)
+        .await
+        .expect("connect");
+    let mut answer = Vec::new();
+    tokio::time::timeout(
+        std::time::Duration::from_secs(2),
+        extra.read_to_end(&mut answer),
+    )
+    .await
+    .expect("answered at once")
+    .expect("read");
+    let answer = String::from_utf8_lossy(&answer);
+    assert!(
+        answer.starts_with("HTTP/1.1 503") && answer.contains("Retry-After: 1"),
+        "{answer}"
+    );
+    // The idle ones, and the slow header, are closed by the server after their timeouts.
+    let limit = crate::IDLE_TIMEOUT.max(crate::HEADER_TIMEOUT) + std::time::Duration::from_secs(5);
+    let mut buffer = [0_u8; 64];
+    let closed = tokio::time::timeout(limit, idle[0].read(&mut buffer))
+        .await
+        .expect("the idle connection is closed in time");
+    assert!(matches!(closed, Ok(0) | Err(_)), "{closed:?}");
+    // hyper may answer 408 or just close: either ends the read in time.
+    let _ = tokio::time::timeout(limit, slow.read(&mut buffer))
+        .await
+        .expect("the slow header is cut off in time");
+    drop(idle);
+    // And then a request is served.
+    let mut fresh = tokio::net::TcpStream::connect(address)
+        .await
+        .expect("connect");
+    let head = format!("GET /api/models HTTP/1.1\r\nHost: {address}\r\n\r\n");
+    fresh.write_all(head.as_bytes()).await.expect("send");
+    let mut response = Vec::new();
+    fresh.read_to_end(&mut response).await.expect("read");
+    assert!(String::from_utf8_lossy(&response).starts_with("HTTP/1.1 200"));
 }
 
 /// The resident set size of this process, in KiB (Linux), if it can be read.
@@ -191,7 +307,11 @@ async fn loopback_load_test_has_no_error_and_bounded_memory() {
         .await
         .expect("bind");
     let address = listener.local_addr().expect("address");
-    tokio::spawn(async move { axum::serve(listener, router()).await });
+    tokio::spawn(crate::listen::serve(
+        listener,
+        router(),
+        std::future::pending(),
+    ));
     let before = resident_kib();
     let request = |k: usize| async move {
         let path = match k % 4 {

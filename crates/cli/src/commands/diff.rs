@@ -13,6 +13,8 @@ use crate::output::Table;
 /// Arguments of `specula diff`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
+    #[command(flatten)]
+    input_limit: crate::args::InputLimit,
     /// The reference image (.png or .exr).
     reference: PathBuf,
     /// The image compared with it (.png or .exr).
@@ -43,6 +45,7 @@ struct Report {
 
 /// Compares and prints.
 pub fn run(args: &Args) -> CommandResult {
+    args.input_limit.apply();
     if !(args.exposure.is_finite() && args.exposure > 0.0) {
         return Err(format!(
             "--exposure must be a positive number, got {}",

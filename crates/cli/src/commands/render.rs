@@ -17,6 +17,8 @@ use crate::args::{choice, parse_exponent, LobeParser, RendererArg};
 /// Arguments of `specula render`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
+    #[command(flatten)]
+    input_limit: crate::args::InputLimit,
     /// A scene file (TOML); the embedded default scene when omitted.
     scene: Option<PathBuf>,
     /// Output image: .png (8-bit sRGB) or .exr (linear f32 radiance).
@@ -111,6 +113,7 @@ fn load(args: &Args) -> Result<Scene, String> {
 
 /// Renders and writes the image.
 pub fn run(args: &Args) -> CommandResult {
+    args.input_limit.apply();
     if args.dump_default_scene {
         print!("{DEFAULT_SCENE}");
         return Ok(());
