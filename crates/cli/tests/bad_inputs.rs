@@ -531,6 +531,30 @@ fn sizes_an_input_declares_are_bounded_before_reading() {
         &["diff", "small.png", "huge.png"],
         "declares 20000x20000 pixels",
     );
+    // An EXR whose header declares 100000 x 100000 (its data and display windows patched).
+    assert!(specula(
+        path,
+        &["render", "--width", "8", "--height", "8", "-o", "small.exr"]
+    )
+    .status
+    .success());
+    let mut exr = std::fs::read(path.join("small.exr")).expect("read");
+    for name in [&b"dataWindow\0box2i\0"[..], &b"displayWindow\0box2i\0"[..]] {
+        let at = exr
+            .windows(name.len())
+            .position(|w| w == name)
+            .expect("the attribute")
+            + name.len()
+            + 4;
+        for (k, value) in [0_i32, 0, 99_999, 99_999].into_iter().enumerate() {
+            exr[at + 4 * k..at + 4 * k + 4].copy_from_slice(&value.to_le_bytes());
+        }
+    }
+    std::fs::write(path.join("huge.exr"), exr).expect("write");
+    refused(
+        &["diff", "small.exr", "huge.exr"],
+        "declares 100000x100000 pixels",
+    );
     // Too many objects.
     let many = format!(
         "{camera}{}",
