@@ -145,6 +145,17 @@ fn eval_matches_closed_forms() {
         "eval", "--lobe", "logexp", "--n", "10", "--cos", "-1e-5", "--json",
     ]);
     assert_eq!(tiny["t"].as_f64(), Some(-1e-5));
+    // Where t^n underflows to 0 a relative error is undefined: absolute only, never `inf`.
+    let underflow = json(&[
+        "eval", "--lobe", "schlick", "--n", "1000", "--cos", "1e-300", "--json",
+    ]);
+    assert_eq!(underflow["reference"].as_f64(), Some(0.0));
+    assert!(underflow["rel_error"].is_null() && underflow["abs_error"].as_f64() > Some(0.0));
+    let text = specula(&[
+        "eval", "--lobe", "schlick", "--n", "1000", "--cos", "1e-300",
+    ]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("absolute") && !text.contains("inf"), "{text}");
 }
 
 #[test]

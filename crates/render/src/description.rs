@@ -45,10 +45,18 @@ pub struct LoadedScene {
     pub warnings: Vec<String>,
 }
 
-/// The most triangles a scene may have, over all its objects: 8,388,608 (about 0.9 GB of
-/// transformed geometry while rendering). Procedural shapes are charged before they are
-/// tessellated.
+/// The most triangles a scene may have by default, over all its objects: 8,388,608 (about
+/// 0.9 GB of transformed geometry while rendering). Procedural shapes are charged before they
+/// are tessellated. `--max-triangles` changes it ([`set_max_triangles`]).
 pub const MAX_TRIANGLES: u64 = 1 << 23;
+
+static TRIANGLE_LIMIT: std::sync::atomic::AtomicU64 =
+    std::sync::atomic::AtomicU64::new(MAX_TRIANGLES);
+
+/// Sets the most triangles a scene this process loads may have.
+pub fn set_max_triangles(triangles: u64) {
+    TRIANGLE_LIMIT.store(triangles, std::sync::atomic::Ordering::Relaxed);
+}
 /// The most objects a scene may have.
 pub const MAX_OBJECTS: usize = 10_000;
 
@@ -369,11 +377,12 @@ impl Scene {
             ));
         }
         prepare_lobes(&description.objects);
-        let mut budget = MAX_TRIANGLES;
+        let limit = TRIANGLE_LIMIT.load(std::sync::atomic::Ordering::Relaxed);
+        let mut budget = limit;
         let objects = description
             .objects
             .iter()
-            .map(|object| build_object(&locate, object, base, &mut warnings, &mut budget))
+            .map(|object| build_object(&locate, object, base, &mut warnings, &mut budget, limit))
             .collect::<Result<_, _>>()?;
         let ambient = match &description.ambient {
             Some(value) => locate.finite_non_negative("ambient", value)?,
@@ -456,6 +465,7 @@ fn build_object(
     base: Option<&Path>,
     warnings: &mut Vec<String>,
     budget: &mut u64,
+    limit: u64,
 ) -> Result<Object, SceneError> {
     let o = object.get_ref();
     let given: [(&str, Option<Range<usize>>); 9] = [
@@ -509,7 +519,7 @@ fn build_object(
             Err(locate.error(
                 object.span(),
                 format!(
-                    "this object's {triangles} triangles take the scene past its limit of {MAX_TRIANGLES} triangles"
+                    "this object's {triangles} triangles take the scene past its limit of {limit} triangles (raise it with --max-triangles)"
                 ),
             ))
         } else {

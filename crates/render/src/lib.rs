@@ -38,7 +38,7 @@ mod shapes;
 mod teapot;
 
 pub use camera::{Camera, InvalidCamera, Projection, MAX_COORDINATE};
-pub use description::{LoadedScene, SceneError, MAX_OBJECTS, MAX_TRIANGLES};
+pub use description::{set_max_triangles, LoadedScene, SceneError, MAX_OBJECTS, MAX_TRIANGLES};
 pub use grid::{render_grid, render_grid_with, GridError, GridOptions, Srgb8Image};
 pub use image::{
     check_output_path, encode_png_srgb8, read_image, srgb_decode, srgb_encode, write_image,

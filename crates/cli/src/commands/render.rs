@@ -19,6 +19,10 @@ use crate::args::{choice, parse_exponent, LobeParser, RendererArg};
 pub struct Args {
     #[command(flatten)]
     input_limit: crate::args::InputLimit,
+    /// The most triangles a scene may have (procedural shapes are counted before they are
+    /// built; about 100 bytes of memory each while rendering).
+    #[arg(long, default_value_t = specula_render::MAX_TRIANGLES, value_parser = clap::value_parser!(u64).range(1..=1 << 28))]
+    max_triangles: u64,
     /// A scene file (TOML); the embedded default scene when omitted.
     scene: Option<PathBuf>,
     /// Output image: .png (8-bit sRGB) or .exr (linear f32 radiance).
@@ -114,6 +118,7 @@ fn load(args: &Args) -> Result<Scene, String> {
 /// Renders and writes the image.
 pub fn run(args: &Args) -> CommandResult {
     args.input_limit.apply();
+    specula_render::set_max_triangles(args.max_triangles);
     if args.dump_default_scene {
         print!("{DEFAULT_SCENE}");
         return Ok(());
