@@ -79,7 +79,9 @@ enum Command {
     /// Hardware datapaths: error against word length and resources, Verilog, block diagrams,
     /// synthesis.
     #[command(
-        after_help = "Examples:\n  specula hw table --lobe cosquad,logexp --bits 8..24 --n 64\n  \
+        after_help = "Datapaths (--lobe): schlick, schlick-mod, cheb2, logexp, logexp-mitchell, cosquad, pow, sg\n\
+                      Word lengths (--bits): 8 to 24 bits; n: an integer in [1, 1000]\n\n\
+                      Examples:\n  specula hw table --lobe cosquad,logexp --bits 8..24 --n 64\n  \
                             specula hw verilog --lobe cosquad --bits 16 -o cosquad.v --testbench cosquad_tb.v\n  \
                             specula hw diagram --lobe logexp -o logexp.svg\n  \
                             specula hw synth --target ice40 --device hx8k --bits 12 --lobe cosquad,pow,sg"
@@ -121,7 +123,32 @@ fn install_output_error_hook() {
     }));
 }
 
+/// Gives the Vulkan loader a private `XDG_RUNTIME_DIR` when the session has none (CI, SSH,
+/// containers): Mesa's drivers probe for a Wayland display through it and otherwise print
+/// "XDG_RUNTIME_DIR is invalid or not set" on every GPU path. Runs first, before any thread
+/// exists, since it sets an environment variable.
+fn provide_runtime_directory() {
+    let valid = std::env::var_os("XDG_RUNTIME_DIR")
+        .is_some_and(|dir| std::fs::metadata(dir).is_ok_and(|m| m.is_dir()));
+    if valid {
+        return;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{DirBuilderExt, MetadataExt};
+        let uid = std::fs::metadata("/proc/self").map_or(0, |m| m.uid());
+        let dir = std::env::temp_dir().join(format!("specula-runtime-{uid}"));
+        let created = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        let usable =
+            created.is_ok() || std::fs::metadata(&dir).is_ok_and(|m| m.is_dir() && m.uid() == uid);
+        if usable {
+            std::env::set_var("XDG_RUNTIME_DIR", dir);
+        }
+    }
+}
+
 fn main() -> ExitCode {
+    provide_runtime_directory();
     install_output_error_hook();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,

@@ -177,6 +177,14 @@ fn bad_input_is_a_one_line_error_with_exit_code_two() {
             &["hw", "table", "--bits", "-3"],
             "`-3` is not a word length",
         ),
+        (
+            &["eval", "--lobe", "cosqaud", "--n", "8", "--cos", "0.5"],
+            "did you mean 'cosquad'?",
+        ),
+        (
+            &["hw", "table", "--lobe", "logexp-mitchel"],
+            "did you mean 'logexp-mitchell'?",
+        ),
         (&["models", "--n", "-1e-3"], "[1, 1000]"),
         (
             &["eval", "--lobe", "pow", "--n", "NaN", "--cos", "0.5"],

@@ -293,3 +293,36 @@ fn bench_gpu_lobes_lists_every_lobe_against_pow() {
         "{text}"
     );
 }
+
+/// Without a session's `XDG_RUNTIME_DIR` (CI, SSH), the GPU path prints nothing but its
+/// result: no driver noise on stderr.
+#[test]
+fn the_gpu_path_keeps_stderr_clean() {
+    if !have_gpu() {
+        return;
+    }
+    let directory = tempfile::tempdir().unwrap();
+    let output = Command::cargo_bin("specula")
+        .unwrap()
+        .current_dir(directory.path())
+        .env_remove("XDG_RUNTIME_DIR")
+        .args([
+            "render",
+            "--backend",
+            "gpu",
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ])
+        .args(["-o", "gpu.png"])
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert!(
+        lines.len() == 1 && lines[0].starts_with("wrote gpu.png"),
+        "stderr: {stderr}"
+    );
+}

@@ -203,3 +203,17 @@ fn synth_refuses_an_unknown_target_with_the_valid_ones() {
         "{stderr}"
     );
 }
+
+/// `hw --help` names every datapath id (from the registry, so it cannot drift) and the widths.
+#[test]
+fn help_lists_the_datapaths_and_widths() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let help = ok(directory.path(), &["hw", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    let listed = help
+        .lines()
+        .find_map(|line| line.strip_prefix("Datapaths (--lobe): "))
+        .expect("a datapaths line");
+    assert_eq!(listed, specula_hw::HwLobe::valid_ids());
+    assert!(help.contains("8 to 24 bits"));
+}

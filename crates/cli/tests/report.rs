@@ -53,6 +53,47 @@ fn the_quick_report_is_complete_and_well_formed() {
     for verdict in ["holds", "does not hold"] {
         assert!(text.contains(verdict), "no '{verdict}' verdict");
     }
+    // Every row of the renders table, recomputed by `specula diff` from the images it names.
+    let table = document
+        .descendants()
+        .filter(|n| n.has_tag_name("table"))
+        .find(|t| {
+            t.descendants()
+                .any(|n| n.has_tag_name("th") && n.text() == Some("PSNR vs pow (dB)"))
+        })
+        .expect("the renders table");
+    let rows: Vec<Vec<String>> = table
+        .descendants()
+        .filter(|n| n.has_tag_name("tr"))
+        .skip(1)
+        .map(|row| {
+            row.children()
+                .filter(|n| n.has_tag_name("td"))
+                .map(|cell| cell.text().unwrap_or("").to_owned())
+                .collect()
+        })
+        .collect();
+    assert_eq!(
+        rows.len(),
+        specula::LobeKind::ALL.len() - 1,
+        "every lobe but pow"
+    );
+    for row in &rows {
+        let [lobe, image, psnr, _, flip] = row.as_slice() else {
+            panic!("five cells: {row:?}");
+        };
+        assert_eq!(
+            image,
+            &format!("render-{lobe}.png"),
+            "the row names its own image"
+        );
+        let output = ok(&out, &["diff", "render-pow.png", image, "--format", "json"]);
+        let measured: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+        let measured_psnr = measured["psnr_db"].as_f64().map_or(999.0, |p| p.min(999.0));
+        assert_eq!(psnr, &format!("{measured_psnr:.1}"), "{lobe}: PSNR");
+        let measured_flip = measured["mean_flip"].as_f64().expect("FLIP");
+        assert_eq!(flip, &format!("{measured_flip:.5}"), "{lobe}: FLIP");
+    }
     // Nothing but the report was written: no temporary files left.
     let stray = std::fs::read_dir(&out)
         .unwrap()

@@ -77,7 +77,7 @@ impl Serialize for HwLobe {
 #[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum HwError {
     /// Not a datapath id.
-    #[error("unknown hardware datapath `{0}`; valid: {valid}", valid = HwLobe::valid_ids())]
+    #[error("unknown hardware datapath `{0}`; valid: {valid}{hint}", valid = HwLobe::valid_ids(), hint = specula::did_you_mean(.0, HwLobe::ALL.map(HwLobe::id)))]
     UnknownLobe(String),
     /// A word length outside [`BITS`].
     #[error("word length {0} is out of range; valid: 8 to 24 bits")]

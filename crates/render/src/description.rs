@@ -260,29 +260,10 @@ fn with_nearest_choice(message: &str) -> String {
     }
     // The choices are the back-quoted words after "expected".
     let choices = rest.split('`').skip(1).step_by(2);
-    let nearest = choices
-        .map(|choice| (edit_distance(typed, choice), choice))
-        .min()
-        .filter(|&(distance, choice)| distance <= (choice.len() / 3).max(2));
-    match nearest {
-        Some((_, choice)) => format!("{message}; did you mean `{choice}`?"),
+    match specula::nearest(typed, choices) {
+        Some(choice) => format!("{message}; did you mean `{choice}`?"),
         None => message.to_owned(),
     }
-}
-
-/// Levenshtein distance between `a` and `b` (characters inserted, deleted or replaced).
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut previous: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut current = vec![i + 1];
-        for (j, &cb) in b.iter().enumerate() {
-            let replace = previous[j] + usize::from(ca != cb);
-            current.push(replace.min(previous[j + 1] + 1).min(current[j] + 1));
-        }
-        previous = current;
-    }
-    previous[b.len()]
 }
 
 /// Turns byte spans into `file:line:column` errors.

@@ -16,12 +16,14 @@ pub enum Error {
         value: f64,
     },
     /// A lobe id the registry does not know.
-    #[error("unknown lobe '{id}'; valid lobes: {valid}")]
+    #[error("unknown lobe '{id}'; valid lobes: {valid}{hint}")]
     UnknownLobe {
         /// The rejected id.
         id: String,
         /// The registry's ids, comma separated.
         valid: String,
+        /// `; did you mean 'x'?` when a valid id is close, else empty.
+        hint: String,
     },
     /// A lobe parameter that is unknown, malformed or out of range.
     #[error("invalid parameter for lobe '{lobe}': {message}")]
@@ -38,7 +40,7 @@ pub enum Error {
         value: f64,
     },
     /// A name (geometry, normalisation, ...) that is not one of the valid choices.
-    #[error("unknown {what} '{name}'; valid choices: {valid}")]
+    #[error("unknown {what} '{name}'; valid choices: {valid}{hint}")]
     UnknownName {
         /// What kind of name it was meant to be.
         what: &'static str,
@@ -46,6 +48,8 @@ pub enum Error {
         name: String,
         /// The valid names, comma separated.
         valid: String,
+        /// `; did you mean 'x'?` when a valid name is close, else empty.
+        hint: String,
     },
 }
 
@@ -68,6 +72,46 @@ pub fn excerpt(text: &str) -> String {
     }
 }
 
+/// The longest text a "did you mean" is computed for: identifiers, not pasted files.
+const SUGGESTED_UP_TO: usize = 40;
+
+/// Of `choices`, the one nearest `typed` when it is close enough to be a typo: at most a third
+/// of its length in edits (and at least 2 allowed). Only for short text.
+#[must_use]
+pub fn nearest<'a>(typed: &str, choices: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let typed = typed.trim().to_ascii_lowercase();
+    if typed.chars().count() > SUGGESTED_UP_TO {
+        return None;
+    }
+    choices
+        .into_iter()
+        .map(|choice| (edit_distance(&typed, choice), choice))
+        .min()
+        .filter(|&(distance, choice)| distance > 0 && distance <= (choice.len() / 3).max(2))
+        .map(|(_, choice)| choice)
+}
+
+/// `; did you mean 'x'?` for [`nearest`], or nothing.
+#[must_use]
+pub fn did_you_mean<'a>(typed: &str, choices: impl IntoIterator<Item = &'a str>) -> String {
+    nearest(typed, choices).map_or_else(String::new, |c| format!("; did you mean '{c}'?"))
+}
+
+/// Levenshtein distance between `a` and `b` (characters inserted, deleted or replaced).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut previous: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut current = vec![i + 1];
+        for (j, &cb) in b.iter().enumerate() {
+            let replace = previous[j] + usize::from(ca != cb);
+            current.push(replace.min(previous[j + 1] + 1).min(current[j] + 1));
+        }
+        previous = current;
+    }
+    previous[b.len()]
+}
+
 /// Finds `text` (case-insensitively, trimmed) among `choices` by their names, or says which
 /// names are valid.
 pub(crate) fn parse_choice<T: Copy>(
@@ -88,5 +132,6 @@ pub(crate) fn parse_choice<T: Copy>(
                 .map(|&c| name(c))
                 .collect::<Vec<_>>()
                 .join(", "),
+            hint: did_you_mean(text, choices.iter().map(|&c| name(c))),
         })
 }

@@ -274,6 +274,7 @@ impl LobeKind {
             .ok_or_else(|| Error::UnknownLobe {
                 id: crate::error::excerpt(id),
                 valid: Self::valid_ids(),
+                hint: crate::error::did_you_mean(id, Self::ALL.map(LobeKind::id)),
             })?;
         match (kind, params) {
             (_, None) => Ok(kind),

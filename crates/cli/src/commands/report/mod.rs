@@ -150,10 +150,22 @@ impl Context {
         bytes: &[u8],
         caption: &str,
     ) -> Result<String, String> {
+        self.write_png_file(name, width, height, bytes)?;
+        Ok(html::figure(name, caption))
+    }
+
+    /// Writes 8-bit sRGB pixels as a PNG beside the page (no figure).
+    fn write_png_file(
+        &mut self,
+        name: &str,
+        width: u32,
+        height: u32,
+        bytes: &[u8],
+    ) -> Result<(), String> {
         write_png_srgb8(&self.directory.join(name), width, height, bytes)
             .map_err(|e| e.to_string())?;
         self.files.push(name.to_owned());
-        Ok(html::figure(name, caption))
+        Ok(())
     }
 }
 
