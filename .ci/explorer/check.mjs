@@ -61,6 +61,20 @@ try {
   const restored = await other.evaluate(() => [...document.querySelectorAll("#lobes input:checked")].map((c) => c.value).join(","));
   if (restored !== "logexp,cosquad" && restored !== "cosquad,logexp") failures.push(`the shared address restored ${restored}`);
 
+  // Energy creation is said, and a bad address is reported rather than silently fixed.
+  const warned = await browser.newPage();
+  await warned.goto(url + "?lobes=pow&geometry=blinn&normalisation=lobe&n=64");
+  await warned.waitForFunction(() => Number(document.body.dataset.updates) > 0, null, { timeout: 30000 });
+  const warning = await warned.evaluate(() => document.getElementById("warning").textContent);
+  if (!/Albedo reaches [0-9.]+ \(pow/.test(warning)) failures.push(`no albedo warning for Blinn with the lobe normalisation: '${warning}'`);
+  const defaulted = await page.evaluate(() => document.getElementById("warning").textContent);
+  if (defaulted) failures.push(`the default view warns: ${defaulted}`);
+  const corrected = await browser.newPage();
+  await corrected.goto(url + "?lobes=nope,pow&n=5000");
+  await corrected.waitForFunction(() => Number(document.body.dataset.updates) > 0, null, { timeout: 30000 });
+  const notes = await corrected.evaluate(() => document.getElementById("notes").textContent);
+  if (!notes.includes("unknown lobe 'nope'") || !notes.includes("outside [1, 1000]")) failures.push(`the corrected address is not reported: '${notes}'`);
+
   await page.screenshot({ path: screenshot, fullPage: true });
   if (messages.length) failures.push(...messages.map((m) => `console: ${m}`));
 } finally {
@@ -71,4 +85,4 @@ if (failures.length) {
   console.error("explorer check failed:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`explorer check: loaded, moved n, changed lobes, restored from the address; no console message; screenshot ${screenshot}`);
+console.log(`explorer check: loaded, moved n, changed lobes, restored from the address, warned about albedo above 1, reported a corrected address; no console message; screenshot ${screenshot}`);

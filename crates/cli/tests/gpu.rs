@@ -188,8 +188,8 @@ fn bench_gpu_lists_every_lobe_with_its_ratio_to_pow() {
     assert!(text.contains("1.00x"), "{text}");
 }
 
-/// The README's recipe: paste the exported declarations (from `struct Lobe` to before the
-/// example's `main`, without its `layout` lines) into a shader of one's own; glslang accepts it.
+/// The README's recipe: the exported text, as it is, at the top of a shader of one's own that
+/// calls `specula_specular`; glslang accepts it.
 #[test]
 fn the_readmes_glsl_paste_recipe_compiles() {
     let found = std::process::Command::new("glslangValidator")
@@ -223,15 +223,8 @@ fn the_readmes_glsl_paste_recipe_compiles() {
         ],
     );
     let exported = String::from_utf8(output.stdout).unwrap();
-    let start = exported.find("struct Lobe").unwrap();
-    let end = exported.find("void main()").unwrap();
-    let pasted: Vec<&str> = exported[start..end]
-        .lines()
-        .filter(|l| !l.starts_with("layout("))
-        .collect();
     let shader = format!(
-        "#version 450\n{}\n{}",
-        pasted.join("\n"),
+        "{exported}\n{}",
         "layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 0) out vec4 colour;
@@ -325,4 +318,85 @@ fn the_gpu_path_keeps_stderr_clean() {
         lines.len() == 1 && lines[0].starts_with("wrote gpu.png"),
         "stderr: {stderr}"
     );
+}
+
+/// Every lobe exports to GLSL 4.50 and ES 3.00 as functions a shader of one's own calls as
+/// they are (no edit, no example to cut out, no `while (true)`), and glslang accepts each
+/// such shader; GLSL ES 1.00 is refused with the reason.
+#[test]
+fn exported_glsl_compiles_unedited_for_each_version() {
+    let found = std::process::Command::new("glslangValidator")
+        .arg("--version")
+        .output()
+        .is_ok();
+    if !found {
+        assert_ne!(
+            std::env::var("CI").as_deref(),
+            Ok("true"),
+            "CI=true but no glslangValidator"
+        );
+        return;
+    }
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    for kind in specula::LobeKind::ALL {
+        for (version, output) in [
+            ("450", "layout(location = 0) out vec4 colour;"),
+            ("300es", "out vec4 colour;"),
+        ] {
+            let exported = ok(
+                d,
+                &[
+                    "shader",
+                    "--lobe",
+                    kind.id(),
+                    "--n",
+                    "64",
+                    "--lang",
+                    "glsl",
+                    "--glsl-version",
+                    version,
+                ],
+            );
+            let exported = String::from_utf8(exported.stdout).unwrap();
+            assert!(
+                !exported.contains("while(true)"),
+                "{kind} {version}: a loop"
+            );
+            assert!(
+                !exported.contains("void main"),
+                "{kind} {version}: an example"
+            );
+            let shader = format!(
+                "{exported}\n{output}\nvoid main() {{\n    float s = specula_specular(vec3(0.0, 0.0, 1.0), normalize(vec3(0.2, 0.1, 1.0)), normalize(vec3(-0.2, 0.0, 1.0)));\n    colour = vec4(s, s, s, 1.0);\n}}\n"
+            );
+            let file = d.join(format!("{}-{version}.frag", kind.id()));
+            std::fs::write(&file, shader).unwrap();
+            let check = std::process::Command::new("glslangValidator")
+                .arg(&file)
+                .output()
+                .unwrap();
+            assert!(
+                check.status.success(),
+                "{kind} {version}: {}",
+                String::from_utf8_lossy(&check.stdout)
+            );
+        }
+    }
+    let refused = specula(
+        d,
+        &[
+            "shader",
+            "--lobe",
+            "pow",
+            "--n",
+            "8",
+            "--lang",
+            "glsl",
+            "--glsl-version",
+            "100",
+        ],
+    );
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("use --glsl-version 300es"));
 }

@@ -7,10 +7,13 @@
 //! - `specula_cos_lobe(normal, wo, wi)`: `t` for the chosen geometry (unit vectors, pointing
 //!   away from the surface);
 //! - `specula_specular(normal, wo, wi)`: `N(n) lobe(t)`, the specular factor per unit `ks`;
-//! - an example fragment shader `fs_main` that shows the call.
+//! - an example fragment shader `fs_main` that shows the call ([`Options::example`]; GLSL
+//!   leaves it out by default, so the text is what a user pastes into a shader of their own).
 //!
-//! It is generated as WGSL from the same library the renderer uses, validated, compacted
-//! (unused lobes dropped), and written by naga's back ends.
+//! It is generated as WGSL from the same library the renderer uses, with the squaring loops
+//! unrolled for this lobe's constant count (a GLSL driver gets straight-line code, not a
+//! `while (true)`), validated, compacted (unused lobes dropped), and written by naga's back
+//! ends.
 
 use core::fmt::Write as _;
 
@@ -56,6 +59,47 @@ impl Language {
             Language::Spirv => "spirv",
         }
     }
+}
+
+/// A GLSL dialect.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum GlslVersion {
+    /// GLSL 4.50 (Vulkan, desktop OpenGL 4.5).
+    #[default]
+    Desktop450,
+    /// GLSL ES 3.00 (OpenGL ES 3, WebGL 2).
+    Es300,
+    /// GLSL ES 1.00 (OpenGL ES 2, WebGL 1): not written, and refused with the reason.
+    Es100,
+}
+
+impl GlslVersion {
+    /// Every version, as named on the command line.
+    pub const ALL: [GlslVersion; 3] = [
+        GlslVersion::Desktop450,
+        GlslVersion::Es300,
+        GlslVersion::Es100,
+    ];
+
+    /// The name on the command line.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            GlslVersion::Desktop450 => "450",
+            GlslVersion::Es300 => "300es",
+            GlslVersion::Es100 => "100",
+        }
+    }
+}
+
+/// How an export is written.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    /// Keep the example fragment shader (always kept outside GLSL, whose back ends need an
+    /// entry point to write a module).
+    pub example: bool,
+    /// The GLSL dialect (for [`Language::Glsl`]).
+    pub glsl: GlslVersion,
 }
 
 /// What an export produces: source text, or SPIR-V words.
@@ -168,7 +212,42 @@ fn fs_main(
         function = wgsl::lobe_function(kind),
         cosine = geometry.cosine_name(),
     );
-    source
+    unroll_squarings(&source, lobe.packed().squarings)
+}
+
+/// The library's `for (var i = 0u; i < lobe.squarings; i++) { x = x * x; }` loops written out
+/// as `count` squarings: the exported lobe's count is a constant.
+fn unroll_squarings(source: &str, count: u32) -> String {
+    const LOOP: &str = "for (var i = 0u; i < lobe.squarings; i++) {";
+    let mut out = String::with_capacity(source.len());
+    let mut lines = source.lines();
+    while let Some(line) = lines.next() {
+        if line.trim() != LOOP {
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        }
+        let indent = &line[..line.len() - line.trim_start().len()];
+        let body = lines.next().unwrap_or_default().trim().to_owned();
+        let _closing = lines.next();
+        for _ in 0..count {
+            let _ = writeln!(out, "{indent}{body}");
+        }
+    }
+    out
+}
+
+/// naga's GLSL without the example: its stage's inputs and outputs (the globals naga names
+/// `_vs2fs_*` and `_fs2p_*`) and its `void main()`, which naga writes last.
+fn without_example(text: &str) -> String {
+    let before_main = text.split("\nvoid main() {").next().unwrap_or(text);
+    let mut kept: String = before_main
+        .lines()
+        .filter(|line| !line.contains("_vs2fs_") && !line.contains("_fs2p_"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    kept.push('\n');
+    kept
 }
 
 /// Exports the lobe in `language`.
@@ -177,11 +256,17 @@ pub fn export(
     geometry: Geometry,
     normalisation: Normalisation,
     language: Language,
+    options: Options,
 ) -> Result<ShaderCode, ExportError> {
     let fail = |message: String| ExportError {
         language: language.id(),
         message,
     };
+    if language == Language::Glsl && options.glsl == GlslVersion::Es100 {
+        return Err(fail(
+            "GLSL ES 1.00 has no unsigned integers or bit casts, which the lobe constants and the bit-trick lobes use; use --glsl-version 300es (WebGL 2) or 450".to_owned(),
+        ));
+    }
     let source = export_wgsl_source(lobe, geometry, normalisation);
     let (mut module, _) = wgsl::validate(&source).map_err(fail)?;
     naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
@@ -204,8 +289,15 @@ pub fn export(
         }
         Language::Glsl => {
             let mut text = String::new();
-            let options = naga::back::glsl::Options {
-                version: naga::back::glsl::Version::Desktop(450),
+            let version = match options.glsl {
+                GlslVersion::Es300 => naga::back::glsl::Version::Embedded {
+                    version: 300,
+                    is_webgl: false,
+                },
+                _ => naga::back::glsl::Version::Desktop(450),
+            };
+            let glsl_options = naga::back::glsl::Options {
+                version,
                 ..naga::back::glsl::Options::default()
             };
             let pipeline = naga::back::glsl::PipelineOptions {
@@ -217,12 +309,15 @@ pub fn export(
                 &mut text,
                 &module,
                 &info,
-                &options,
+                &glsl_options,
                 &pipeline,
                 naga::proc::BoundsCheckPolicies::default(),
             )
             .and_then(|mut writer| writer.write())
             .map_err(|e| fail(e.to_string()))?;
+            if !options.example {
+                text = without_example(&text);
+            }
             // The `#version` line must stay first.
             let (version, body) = text.split_once('\n').unwrap_or((&text, ""));
             Ok(ShaderCode::Text(format!(

@@ -7,7 +7,7 @@ mod common;
 use std::process::Command;
 
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-use specula_gpu::export::{export, export_wgsl_source, Language, ShaderCode};
+use specula_gpu::export::{export, export_wgsl_source, GlslVersion, Language, Options, ShaderCode};
 use specula_gpu::{wgsl, LobeEvaluator};
 
 /// Every lobe of `LobeKind::ALL` has its WGSL function, and `lobe_eval` dispatches its index
@@ -63,7 +63,11 @@ fn every_lobe_exports_to_every_language_and_validates() {
             (Geometry::Blinn, Normalisation::BlinnApprox),
         ] {
             for language in Language::ALL {
-                let code = export(&lobe, geometry, normalisation, language)
+                let options = Options {
+                    example: true,
+                    glsl: GlslVersion::Desktop450,
+                };
+                let code = export(&lobe, geometry, normalisation, language, options)
                     .unwrap_or_else(|e| panic!("{kind} {language:?}: {e}"));
                 let label = format!("{kind} {geometry:?} {language:?}");
                 match (&code, language) {

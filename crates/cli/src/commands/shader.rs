@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-use specula_gpu::export::{export, Language, ShaderCode};
+use specula_gpu::export::{export, GlslVersion, Language, Options, ShaderCode};
 
 use super::CommandResult;
 use crate::args::{choice, parse_exponent, LobeParser};
@@ -26,6 +26,14 @@ pub struct Args {
     /// The shading language.
     #[arg(long, value_parser = choice(&Language::ALL, Language::id))]
     lang: Language,
+    /// The GLSL dialect (with --lang glsl): 450 (Vulkan, OpenGL 4.5) or 300es (OpenGL ES 3,
+    /// WebGL 2); 100 is refused with the reason.
+    #[arg(long, value_parser = choice(&GlslVersion::ALL, GlslVersion::id), default_value = "450")]
+    glsl_version: GlslVersion,
+    /// Include the example fragment shader that calls the functions (GLSL leaves it out by
+    /// default, so the text pastes into a shader of one's own; the other languages keep it).
+    #[arg(long)]
+    example: bool,
     /// Write to this file instead of standard output (required for SPIR-V, a binary).
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -37,8 +45,12 @@ pub fn run(args: &Args) -> CommandResult {
         return Err("SPIR-V is binary; give an output file with -o (e.g. -o lobe.spv)".into());
     }
     let lobe = Lobe::new(args.lobe, args.n);
-    let code =
-        export(&lobe, args.geometry, args.normalisation, args.lang).map_err(|e| e.to_string())?;
+    let options = Options {
+        example: args.example,
+        glsl: args.glsl_version,
+    };
+    let code = export(&lobe, args.geometry, args.normalisation, args.lang, options)
+        .map_err(|e| e.to_string())?;
     match &args.output {
         Some(path) => specula_render::write_atomically(path, |writer| {
             writer

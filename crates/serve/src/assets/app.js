@@ -3,10 +3,14 @@
 "use strict";
 
 const PALETTE = ["#000000", "#e6194b", "#3c8c3c", "#f58230", "#0082c8", "#911eb4", "#aa6e28", "#f032e6", "#808000", "#008080", "#000080", "#800000", "#d29600"];
-const DEFAULTS = { lobes: "pow,schlick,schlick-mod", n: "64", geometry: "blinn", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0" };
+// Phong geometry with the lobe's own normalisation: energy-conserving (albedo <= 1) for every
+// lobe, so the first view is physically sensible.
+const DEFAULTS = { lobes: "pow,schlick,schlick-mod", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "" };
 const $ = (id) => document.getElementById(id);
 let registry = null;
 let generation = 0;
+// The lobe the renders show: the one the user chose last.
+let renderLobe = "";
 
 function readState() {
   const query = new URLSearchParams(location.search);
@@ -15,14 +19,16 @@ function readState() {
   return state;
 }
 
-function nFromSlider(v) { return Math.round(Math.pow(10, v / 100) * 100) / 100; }
+// The slider is logarithmic and lands on integers; the number box takes any n in [1, 1000].
+function nFromSlider(v) { return Math.min(1000, Math.max(1, Math.round(Math.pow(10, v / 100)))); }
 function sliderFromN(n) { return Math.round(100 * Math.log10(n)); }
 
 function currentState() {
   const lobes = [...document.querySelectorAll("#lobes input:checked")].map((c) => c.value);
+  if (!lobes.includes(renderLobe)) renderLobe = lobes.length ? lobes[lobes.length - 1] : "";
   return {
     lobes: lobes.join(","),
-    n: String(nFromSlider(Number($("n").value))),
+    n: $("n-box").value,
     geometry: $("geometry").value,
     normalisation: $("normalisation").value,
     shading: $("shading").value,
@@ -31,6 +37,7 @@ function currentState() {
     light_theta: $("light_theta").value,
     light_phi: $("light_phi").value,
     log: $("log").checked ? "1" : "0",
+    render: renderLobe,
   };
 }
 
@@ -40,27 +47,48 @@ function fillSelect(id, values, chosen) {
 }
 
 function buildControls(state) {
-  const chosen = new Set(state.lobes.split(","));
+  // What the address asked for and could not have is said, not silently replaced.
+  const notes = [];
+  const known = new Set(registry.lobes.map((l) => l.id));
+  const asked = state.lobes.split(",").filter((id) => id);
+  for (const id of asked.filter((id) => !known.has(id))) notes.push(`unknown lobe '${id}' left out`);
+  const chosen = new Set(asked.filter((id) => known.has(id)));
   $("lobes").replaceChildren(...registry.lobes.map((lobe, k) => {
     const label = document.createElement("label");
     const box = Object.assign(document.createElement("input"), { type: "checkbox", value: lobe.id, checked: chosen.has(lobe.id) });
+    box.addEventListener("change", () => { if (box.checked) renderLobe = lobe.id; });
     const swatch = Object.assign(document.createElement("span"), { className: "swatch", title: lobe.formula });
     swatch.style.background = PALETTE[k % PALETTE.length];
     label.append(box, swatch, lobe.id);
     label.title = lobe.summary;
     return label;
   }));
-  fillSelect("geometry", registry.geometries, state.geometry);
-  fillSelect("normalisation", registry.normalisations, state.normalisation);
-  fillSelect("shading", registry.shadings, state.shading);
-  fillSelect("model", registry.models, state.model);
-  $("n").value = sliderFromN(Number(state.n) || 64);
+  const select = (id, values) => {
+    if (!values.includes(state[id])) {
+      notes.push(`${id} '${state[id]}' is not one of ${values.join(", ")}; using ${DEFAULTS[id]}`);
+      state[id] = DEFAULTS[id];
+    }
+    fillSelect(id, values, state[id]);
+  };
+  select("geometry", registry.geometries);
+  select("normalisation", registry.normalisations);
+  select("shading", registry.shadings);
+  select("model", registry.models);
+  let n = Number(state.n);
+  if (!(n >= 1 && n <= 1000)) {
+    notes.push(`n = '${state.n}' is outside [1, 1000]; using ${DEFAULTS.n}`);
+    n = Number(DEFAULTS.n);
+  }
+  $("n-box").value = String(n);
+  $("n").value = sliderFromN(n);
+  renderLobe = chosen.has(state.render) ? state.render : "";
   for (const id of ["theta_in", "light_theta", "light_phi"]) $(id).value = state[id];
   $("log").checked = state.log === "1";
+  $("notes").textContent = notes.length ? "From the address: " + notes.join("; ") + "." : "";
 }
 
 function showValues(state) {
-  $("n-value").textContent = state.n;
+  $("render-lobe").textContent = state.render || "no lobe";
   $("theta_in-value").textContent = state.theta_in + "°";
   $("light_theta-value").textContent = state.light_theta + "°";
   $("light_phi-value").textContent = state.light_phi + "°";
@@ -179,9 +207,10 @@ async function update() {
     const reports = await Promise.all(lobes.map((lobe) => getJson("/api/analyze?" + new URLSearchParams({ lobe, n: state.n }))));
     if (mine !== generation) return;
     draw(data, state);
+    warnAboutAlbedo(data, state);
     $("analysis").innerHTML = lobes.length ? analysisTable(reports) : "<p>Choose a lobe.</p>";
     if (lobes.length) {
-      const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: lobes[0], ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
+      const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: state.render, ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
       await Promise.all([loadImage($("sphere"), render("sphere")), loadImage($("teapot"), render("teapot"))]);
     }
     if (mine !== generation) return;
@@ -211,12 +240,29 @@ function draw(data, state) {
   if (first) drawSlice($("slice"), first);
 }
 
+// Above 1, the BRDF reflects more than it receives: said whenever it happens.
+function warnAboutAlbedo(data, state) {
+  let worst = null;
+  for (const d of data) {
+    const top = Math.max(...d.albedo);
+    if (!worst || top > worst.top) worst = { lobe: d.lobe, top };
+  }
+  $("warning").textContent = worst && worst.top > 1.0005
+    ? `Albedo reaches ${worst.top.toPrecision(3)} (${worst.lobe}, ${state.geometry} geometry, ${state.normalisation} normalisation): above 1, this BRDF creates energy. Phong geometry with the lobe normalisation conserves it.`
+    : "";
+}
+
 let pending = null;
 function schedule() { clearTimeout(pending); pending = setTimeout(update, 60); }
 
 async function start() {
   registry = await getJson("/api/models");
   buildControls(readState());
+  $("n").addEventListener("input", () => { $("n-box").value = String(nFromSlider(Number($("n").value))); });
+  $("n-box").addEventListener("input", () => {
+    const n = Number($("n-box").value);
+    if (n >= 1 && n <= 1000) $("n").value = sliderFromN(n);
+  });
   document.querySelectorAll("#controls input, #controls select").forEach((el) => el.addEventListener("input", schedule));
   $("lobes").addEventListener("change", schedule);
   await update();
