@@ -275,7 +275,14 @@ pub async fn models() -> impl IntoResponse {
         .iter()
         .map(|kind| {
             let info = kind.info();
-            json!({ "id": kind.id(), "summary": info.summary, "formula": info.formula })
+            let style = kind.line_style();
+            json!({
+                "id": kind.id(),
+                "summary": info.summary,
+                "formula": info.formula,
+                "colour": style.hex(),
+                "dashed": style.dashed,
+            })
         })
         .collect();
     Json(json!({

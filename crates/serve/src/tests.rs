@@ -393,3 +393,17 @@ async fn analyze_carries_the_cost_model() {
     let value: serde_json::Value = serde_json::from_slice(&body).expect("json");
     assert_eq!(value["costs"][0]["value"].as_f64(), Some(20.0));
 }
+
+/// The page draws each lobe with the library's colour and dash, the report's.
+#[tokio::test]
+async fn the_catalogue_carries_each_lobes_line_style() {
+    let (status, models) = json("/api/models").await;
+    assert_eq!(status, StatusCode::OK);
+    let lobes = models["lobes"].as_array().expect("lobes");
+    assert_eq!(lobes.len(), specula::LobeKind::ALL.len());
+    for (lobe, kind) in lobes.iter().zip(specula::LobeKind::ALL) {
+        let style = kind.line_style();
+        assert_eq!(lobe["colour"], style.hex(), "{kind}");
+        assert_eq!(lobe["dashed"], style.dashed, "{kind}");
+    }
+}

@@ -53,7 +53,7 @@ pub use brdf::{Brdf, ClassicModel, Rgb};
 pub use error::{did_you_mean, excerpt, nearest, Error, Result, QUOTED_CHARACTERS};
 pub use exponent::Exponent;
 pub use geometry::Geometry;
-pub use lobe::{Lobe, LobeKind};
+pub use lobe::{LineStyle, Lobe, LobeKind};
 pub use normalisation::Normalisation;
 pub use real::Real;
 pub use zones::Zone;

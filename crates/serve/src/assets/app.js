@@ -2,7 +2,8 @@
 // canvases. The state lives in the address (history.replaceState), so a view can be shared.
 "use strict";
 
-const PALETTE = ["#000000", "#e6194b", "#3c8c3c", "#f58230", "#0082c8", "#911eb4", "#aa6e28", "#f032e6", "#808000", "#008080", "#000080", "#800000", "#d29600"];
+// Each lobe's colour and dash come from the library (/api/models), the same as the report's.
+const DASH = [7, 4];
 // Phong geometry with the lobe's own normalisation: energy-conserving (albedo <= 1) for every
 // lobe, so the first view is physically sensible.
 const DEFAULTS = { lobes: "pow,schlick,schlick-mod", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "" };
@@ -53,12 +54,14 @@ function buildControls(state) {
   const asked = state.lobes.split(",").filter((id) => id);
   for (const id of asked.filter((id) => !known.has(id))) notes.push(`unknown lobe '${id}' left out`);
   const chosen = new Set(asked.filter((id) => known.has(id)));
-  $("lobes").replaceChildren(...registry.lobes.map((lobe, k) => {
+  $("lobes").replaceChildren(...registry.lobes.map((lobe) => {
     const label = document.createElement("label");
     const box = Object.assign(document.createElement("input"), { type: "checkbox", value: lobe.id, checked: chosen.has(lobe.id) });
     box.addEventListener("change", () => { if (box.checked) renderLobe = lobe.id; });
     const swatch = Object.assign(document.createElement("span"), { className: "swatch", title: lobe.formula });
-    swatch.style.background = PALETTE[k % PALETTE.length];
+    swatch.style.background = lobe.dashed
+      ? `repeating-linear-gradient(90deg, ${lobe.colour} 0 4px, #fff 4px 6px)`
+      : lobe.colour;
     label.append(box, swatch, lobe.id);
     label.title = lobe.summary;
     return label;
@@ -94,7 +97,9 @@ function showValues(state) {
   $("light_phi-value").textContent = state.light_phi + "°";
 }
 
-function colourOf(id) { return PALETTE[registry.lobes.findIndex((l) => l.id === id) % PALETTE.length]; }
+function lobeOf(id) { return registry.lobes.find((l) => l.id === id) ?? { colour: "#000", dashed: false }; }
+function colourOf(id) { return lobeOf(id).colour; }
+function dashOf(id) { return lobeOf(id).dashed ? DASH : []; }
 
 async function getJson(url) {
   const response = await fetch(url);
@@ -152,10 +157,11 @@ function drawPolar(canvas, data, thetaIn) {
   g.strokeStyle = "#e0a000"; g.setLineDash([4, 3]);
   g.beginPath(); g.moveTo(cx, cy); g.lineTo(...at((thetaIn * Math.PI) / 180, 1)); g.stroke(); g.setLineDash([]);
   for (const d of data) {
-    g.strokeStyle = colourOf(d.lobe); g.lineWidth = 2; g.beginPath();
+    g.strokeStyle = colourOf(d.lobe); g.lineWidth = 2; g.setLineDash(dashOf(d.lobe)); g.beginPath();
     d.polar_deg.forEach((deg, i) => { const p = at((deg * Math.PI) / 180, d.polar[i] / peak); i ? g.lineTo(...p) : g.moveTo(...p); });
     g.stroke();
   }
+  g.setLineDash([]);
   g.fillStyle = "#444"; g.font = "11px sans-serif";
   g.fillText("light (dashed) at " + thetaIn + "°; radius: f / " + peak.toPrecision(3), 8, 14);
 }
@@ -227,16 +233,16 @@ function draw(data, state) {
   const bands = first ? [[0, first.epicentre_deg, "rgba(255,200,0,0.18)"], [first.epicentre_deg, first.bloom_deg, "rgba(0,120,255,0.08)"]] : [];
   const logY = state.log === "1";
   plot($("cartesian"), {
-    series: data.map((d) => ({ points: zip(d.angles_deg, d.values), colour: colourOf(d.lobe) })).concat(first ? [{ points: zip(first.angles_deg, first.reference), colour: "#888", width: 1, dash: [5, 4] }] : []),
+    series: data.map((d) => ({ points: zip(d.angles_deg, d.values), colour: colourOf(d.lobe), dash: dashOf(d.lobe) })).concat(first ? [{ points: zip(first.angles_deg, first.reference), colour: "#888", width: 1, dash: [5, 4] }] : []),
     x: [0, right], y: logY ? [1e-4, 1] : [0, 1.05], logY, bands,
     xLabel: "angle from the lobe's axis (degrees); dashed: t^n", yLabel: "lobe",
   });
   const errors = data.flatMap((d) => d.error);
   const spread = Math.max(1e-6, ...errors.map(Math.abs));
-  plot($("error"), { series: data.map((d) => ({ points: zip(d.angles_deg, d.error), colour: colourOf(d.lobe) })), x: [0, right], y: [-spread * 1.05, spread * 1.05], bands, xLabel: "angle (degrees)", yLabel: "lobe - t^n" });
+  plot($("error"), { series: data.map((d) => ({ points: zip(d.angles_deg, d.error), colour: colourOf(d.lobe), dash: dashOf(d.lobe) })), x: [0, right], y: [-spread * 1.05, spread * 1.05], bands, xLabel: "angle (degrees)", yLabel: "lobe - t^n" });
   drawPolar($("polar"), data, Number(state.theta_in));
   const albedoTop = Math.max(1.05, ...data.flatMap((d) => d.albedo));
-  plot($("albedo"), { series: data.map((d) => ({ points: zip(d.albedo_deg, d.albedo), colour: colourOf(d.lobe) })), x: [0, 90], y: [0, albedoTop], xLabel: "angle of incidence (degrees)", yLabel: "albedo" });
+  plot($("albedo"), { series: data.map((d) => ({ points: zip(d.albedo_deg, d.albedo), colour: colourOf(d.lobe), dash: dashOf(d.lobe) })), x: [0, 90], y: [0, albedoTop], xLabel: "angle of incidence (degrees)", yLabel: "albedo" });
   if (first) drawSlice($("slice"), first);
 }
 

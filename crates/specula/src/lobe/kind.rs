@@ -103,6 +103,23 @@ pub struct LobeInfo {
     pub origin: Origin,
 }
 
+/// How a lobe's curves are drawn: [`LobeKind::line_style`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LineStyle {
+    /// Red, green, blue.
+    pub rgb: [u8; 3],
+    /// Dashed rather than solid.
+    pub dashed: bool,
+}
+
+impl LineStyle {
+    /// The colour as `#rrggbb`.
+    #[must_use]
+    pub fn hex(self) -> String {
+        format!("#{:02x}{:02x}{:02x}", self.rgb[0], self.rgb[1], self.rgb[2])
+    }
+}
+
 const COSQUAD_V: ParamInfo = ParamInfo {
     name: "v",
     description: "number of squarings; the lobe is a polynomial of degree 2^v in the cosine",
@@ -130,6 +147,37 @@ impl LobeKind {
         LobeKind::FastPow,
         LobeKind::FasterPow,
     ];
+
+    /// How every plot draws the lobe (the report's and the explorer's): a colour of Okabe and
+    /// Ito's colour-blind-safe set, a family sharing one and its variants dashed, so that no
+    /// two lobes look alike even without colour vision.
+    #[must_use]
+    pub fn line_style(self) -> LineStyle {
+        const BLACK: [u8; 3] = [0, 0, 0];
+        const ORANGE: [u8; 3] = [230, 159, 0];
+        const SKY_BLUE: [u8; 3] = [86, 180, 233];
+        const BLUISH_GREEN: [u8; 3] = [0, 158, 115];
+        const BLUE: [u8; 3] = [0, 114, 178];
+        const VERMILLION: [u8; 3] = [213, 94, 0];
+        const REDDISH_PURPLE: [u8; 3] = [204, 121, 167];
+        const GREY: [u8; 3] = [120, 120, 120];
+        let (rgb, dashed) = match self {
+            LobeKind::Pow => (BLACK, false),
+            LobeKind::Schlick => (VERMILLION, false),
+            LobeKind::SchlickMod => (VERMILLION, true),
+            LobeKind::Cheb2Thesis => (BLUE, true),
+            LobeKind::Cheb2 => (BLUE, false),
+            LobeKind::Minimax2 => (SKY_BLUE, false),
+            LobeKind::LogExp => (BLUISH_GREEN, false),
+            LobeKind::LogExpRr => (BLUISH_GREEN, true),
+            LobeKind::CosQuad { .. } => (ORANGE, false),
+            LobeKind::Sg => (REDDISH_PURPLE, false),
+            LobeKind::SgKaris => (REDDISH_PURPLE, true),
+            LobeKind::FastPow => (GREY, false),
+            LobeKind::FasterPow => (GREY, true),
+        };
+        LineStyle { rgb, dashed }
+    }
 
     /// The registry entry.
     #[must_use]
@@ -364,6 +412,24 @@ mod tests {
         );
         for bad in ["cosquad:v=11", "cosquad:w=3", "cosquad:v", "schlick:v=2"] {
             assert!(LobeKind::parse(bad).is_err(), "{bad} accepted");
+        }
+    }
+
+    /// No two lobes share a colour and a dash, and every colour is dark enough to read on
+    /// white (luma below 0.7, which leaves out the set's yellow).
+    #[test]
+    fn every_lobe_has_its_own_readable_line_style() {
+        let styles: Vec<LineStyle> = LobeKind::ALL.map(LobeKind::line_style).to_vec();
+        for (i, a) in styles.iter().enumerate() {
+            for b in &styles[i + 1..] {
+                assert_ne!(a, b, "two lobes look alike");
+            }
+            let [r, g, b] = a.rgb.map(|c| f64::from(c) / 255.0);
+            assert!(
+                0.2126 * r + 0.7152 * g + 0.0722 * b < 0.7,
+                "{} too light",
+                a.hex()
+            );
         }
     }
 }

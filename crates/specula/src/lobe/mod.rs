@@ -30,7 +30,7 @@ mod sg_karis;
 
 pub use cheb2_thesis::thesis_coefficients;
 pub use cosquad::CosQuad;
-pub use kind::{LobeInfo, LobeKind, Origin, ParamInfo};
+pub use kind::{LineStyle, LobeInfo, LobeKind, Origin, ParamInfo};
 pub use quadratic::AngleQuadratic;
 pub use sg_karis::KARIS_OFFSET;
 

@@ -160,6 +160,9 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
                 colour: colour(result.lobe.float_kind()),
                 width: 2,
                 markers: false,
+                // Mitchell's log2 shares logexp's float model, and so its colour.
+                dashed: result.lobe == HwLobe::LogExpMitchell
+                    || result.lobe.float_kind().line_style().dashed,
             })
             .collect();
         let chart = Chart {

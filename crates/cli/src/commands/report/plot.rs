@@ -12,6 +12,8 @@ pub struct Series {
     pub width: u32,
     /// Draw the points as dots instead of joining them.
     pub markers: bool,
+    /// A dashed line (a lobe family's variant; see `LobeKind::line_style`).
+    pub dashed: bool,
 }
 
 /// A chart: axes, curves and shaded bands along `x`.
@@ -43,21 +45,15 @@ fn tick(value: &f64) -> String {
     }
 }
 
-/// The lobes' colours, in registry order (pow, the reference, is black).
-pub const PALETTE: [RGBColor; specula::LobeKind::ALL.len()] = [
-    RGBColor(0, 0, 0),
-    RGBColor(230, 25, 75),
-    RGBColor(60, 140, 60),
-    RGBColor(245, 130, 48),
-    RGBColor(0, 130, 200),
-    RGBColor(145, 30, 180),
-    RGBColor(170, 110, 40),
-    RGBColor(240, 50, 230),
-    RGBColor(128, 128, 0),
-    RGBColor(0, 128, 128),
-    RGBColor(0, 0, 128),
-    RGBColor(128, 0, 0),
-    RGBColor(210, 150, 0),
+/// Colours for series that are not lobes (exponents, references), in order: Okabe and Ito's
+/// colour-blind-safe set. Lobes take theirs from `LobeKind::line_style`.
+pub const SEQUENCE: [RGBColor; 6] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
 ];
 
 impl Chart {
@@ -147,13 +143,22 @@ impl Chart {
                         + Circle::new((0, 0), 5, series.colour.filled())
                         + Text::new(name.clone(), (8, -6), ("sans-serif", 12))
                 }))
+            } else if series.dashed {
+                chart.draw_series(DashedLineSeries::new(clipped, 7, 4, style))
             } else {
                 chart.draw_series(LineSeries::new(clipped, style))
             };
+            let dashed = series.dashed;
             drawn
                 .map_err(error)?
                 .label(series.name.clone())
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], style));
+                .legend(move |(x, y)| {
+                    // Two strokes for a dashed series, one for a solid one.
+                    let gap = if dashed { 5 } else { 0 };
+                    EmptyElement::at((x, y))
+                        + PathElement::new([(0, 0), (8 - gap / 2, 0)], style)
+                        + PathElement::new([(8 + gap / 2, 0), (16, 0)], style)
+                });
         }
         chart
             .configure_series_labels()

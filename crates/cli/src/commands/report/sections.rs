@@ -12,7 +12,7 @@ use specula::{Brdf, ClassicModel, Exponent, Geometry, Lobe, LobeKind, Normalisat
 use specula_synth::OnMiss;
 
 use super::html::{escape, paragraph, table};
-use super::plot::{Chart, Series, PALETTE};
+use super::plot::{Chart, Series, SEQUENCE};
 use super::{Context, Sizes};
 use crate::output::sig;
 
@@ -26,9 +26,10 @@ fn exponents(steps: usize) -> Vec<Exponent> {
         .collect()
 }
 
-/// The lobe's colour, the same in every plot.
+/// The lobe's colour, the same in every plot and in the explorer (`LobeKind::line_style`).
 pub(super) fn colour(kind: LobeKind) -> plotters::style::RGBColor {
-    PALETTE[kind.index() as usize]
+    let [r, g, b] = kind.line_style().rgb;
+    plotters::style::RGBColor(r, g, b)
 }
 
 pub(super) fn series(kind: LobeKind, points: Vec<(f64, f64)>) -> Series {
@@ -36,8 +37,9 @@ pub(super) fn series(kind: LobeKind, points: Vec<(f64, f64)>) -> Series {
         name: kind.to_string(),
         points,
         colour: colour(kind),
-        width: if kind == LobeKind::Pow { 3 } else { 1 },
+        width: if kind == LobeKind::Pow { 3 } else { 2 },
         markers: false,
+        dashed: kind.line_style().dashed,
     }
 }
 
@@ -164,9 +166,10 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
                 Series {
                     name: format!("n = {n}"),
                     points,
-                    colour: PALETTE[k + 1],
+                    colour: SEQUENCE[k % SEQUENCE.len()],
                     width: 1,
                     markers: false,
+                    dashed: false,
                 }
             })
             .collect();
@@ -334,16 +337,18 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
                     .iter()
                     .map(|n| (n.get(), 1.063 * n.get() / (n.get() + 1.0)))
                     .collect(),
-                colour: PALETTE[1],
+                colour: SEQUENCE[1],
                 width: 2,
                 markers: false,
+                dashed: false,
             },
             Series {
                 name: "1".into(),
                 points: vec![(1.0, 1.0), (1000.0, 1.0)],
-                colour: PALETTE[0],
+                colour: plotters::style::RGBColor(0, 0, 0),
                 width: 1,
                 markers: false,
+                dashed: true,
             },
         ],
         bands: Vec::new(),

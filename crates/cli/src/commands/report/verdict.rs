@@ -148,6 +148,7 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
             colour: plotters::style::RGBColor(150, 150, 150),
             width: 1,
             markers: false,
+            dashed: false,
         });
         let most = plotted.iter().map(|p| p.1).fold(0.0, f64::max);
         let chart = Chart {
