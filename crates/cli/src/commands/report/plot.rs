@@ -28,14 +28,19 @@ pub struct Chart {
     pub series: Vec<Series>,
     /// `(from, to, colour, label)` bands over the whole height.
     pub bands: Vec<(f64, f64, RGBColor, &'static str)>,
-    /// Put the legend in the lower right corner instead of the upper right.
+    /// Align the legend with the bottom of the plot instead of its top (it sits to the right
+    /// of the plotting area either way, never on the data).
     pub legend_below: bool,
 }
 
-/// Tick labels: plain decimals in `[1e-3, 1e4)`, powers of ten outside.
+/// Pixels to the right of the plotting area, for the legend.
+const LEGEND_WIDTH: u32 = 150;
+
+/// Tick labels: plain decimals in `[1e-3, 1e4)`, powers of ten outside, and 0 for the
+/// rounding residue a linear axis computes for its zero tick (`2e-18`).
 fn tick(value: &f64) -> String {
     let v = *value;
-    if v == 0.0 {
+    if v.abs() < 1e-12 {
         "0".to_owned()
     } else if (1e-3..1e4).contains(&v.abs()) {
         let text = format!("{v:.3}");
@@ -57,11 +62,12 @@ pub const SEQUENCE: [RGBColor; 6] = [
 ];
 
 impl Chart {
-    /// The chart as an SVG document of `width x height` pixels.
+    /// The chart as an SVG document: a `width x height` plot and, to its right, the legend.
     pub fn to_svg(&self, width: u32, height: u32) -> Result<String, String> {
         let mut svg = String::new();
         {
-            let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+            let root = SVGBackend::with_string(&mut svg, (width + LEGEND_WIDTH, height))
+                .into_drawing_area();
             root.fill(&WHITE).map_err(|e| e.to_string())?;
             let mut low = self.y.0;
             if self.log_y {
@@ -104,6 +110,7 @@ impl Chart {
         let mut chart = ChartBuilder::on(root)
             .caption(&self.title, ("sans-serif", 18))
             .margin(10)
+            .margin_right(10 + LEGEND_WIDTH)
             .x_label_area_size(40)
             .y_label_area_size(60)
             .build_cartesian_2d(x, y)
@@ -117,17 +124,13 @@ impl Chart {
             .y_label_formatter(&tick)
             .draw()
             .map_err(error)?;
-        for &(from, to, colour, label) in &self.bands {
+        for &(from, to, colour, _) in &self.bands {
             chart
                 .draw_series([Rectangle::new(
                     [(from, self.y.0), (to, self.y.1)],
                     colour.mix(0.12).filled(),
                 )])
-                .map_err(error)?
-                .label(label)
-                .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 16, y + 5)], colour.mix(0.3).filled())
-                });
+                .map_err(error)?;
         }
         for series in &self.series {
             let style = series.colour.stroke_width(series.width);
@@ -148,30 +151,53 @@ impl Chart {
             } else {
                 chart.draw_series(LineSeries::new(clipped, style))
             };
-            let dashed = series.dashed;
-            drawn
-                .map_err(error)?
-                .label(series.name.clone())
-                .legend(move |(x, y)| {
-                    // Two strokes for a dashed series, one for a solid one.
-                    let gap = if dashed { 5 } else { 0 };
-                    EmptyElement::at((x, y))
-                        + PathElement::new([(0, 0), (8 - gap / 2, 0)], style)
-                        + PathElement::new([(8 + gap / 2, 0), (16, 0)], style)
-                });
+            drawn.map_err(error)?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(200, 200, 200))
-            .label_font(("sans-serif", 12))
-            .position(if self.legend_below {
-                SeriesLabelPosition::LowerRight
-            } else {
-                SeriesLabelPosition::UpperRight
-            })
-            .draw()
+        // The legend, drawn beside the plotting area (plotters keeps its own inside, on the
+        // data): one row per band and series, a swatch and the name.
+        let (x_range, y_range) = chart.plotting_area().get_pixel_range();
+        let entries = self.bands.len() + self.series.len();
+        let row = 18;
+        let height = row * entries as i32;
+        let x0 = x_range.end + 14;
+        let y0 = if self.legend_below {
+            (y_range.end - height).max(y_range.start)
+        } else {
+            y_range.start + 4
+        };
+        let font = ("sans-serif", 12).into_font().color(&BLACK);
+        for (k, &(_, _, colour, label)) in self.bands.iter().enumerate() {
+            let y = y0 + row * k as i32 + row / 2;
+            root.draw(&Rectangle::new(
+                [(x0, y - 5), (x0 + 16, y + 5)],
+                colour.mix(0.3).filled(),
+            ))
             .map_err(error)?;
+            root.draw(&Text::new(label, (x0 + 22, y - 7), font.clone()))
+                .map_err(error)?;
+        }
+        for (k, series) in self.series.iter().enumerate() {
+            let y = y0 + row * (self.bands.len() + k) as i32 + row / 2;
+            let style = series.colour.stroke_width(series.width);
+            if series.markers {
+                root.draw(&Circle::new((x0 + 8, y), 4, series.colour.filled()))
+                    .map_err(error)?;
+            } else if series.dashed {
+                root.draw(&PathElement::new([(x0, y), (x0 + 6, y)], style))
+                    .map_err(error)?;
+                root.draw(&PathElement::new([(x0 + 10, y), (x0 + 16, y)], style))
+                    .map_err(error)?;
+            } else {
+                root.draw(&PathElement::new([(x0, y), (x0 + 16, y)], style))
+                    .map_err(error)?;
+            }
+            root.draw(&Text::new(
+                series.name.clone(),
+                (x0 + 22, y - 7),
+                font.clone(),
+            ))
+            .map_err(error)?;
+        }
         Ok(())
     }
 }
