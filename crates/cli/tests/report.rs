@@ -25,9 +25,10 @@ fn the_quick_report_is_complete_and_well_formed() {
         .filter(|n| n.has_tag_name("section"))
         .count();
     assert_eq!(sections, 10);
-    // The verdict opens the page.
+    // The answer opens the page, the claims follow, then the details.
     let verdict = page.find("Which lobe when").expect("a verdict section");
-    assert!(verdict < page.find("Models").expect("a models section"));
+    let claims = page.find("The thesis's claims").expect("a claims section");
+    assert!(verdict < claims && claims < page.find("Models").expect("a models section"));
     let sources: Vec<&str> = document
         .descendants()
         .filter(|n| n.has_tag_name("img"))

@@ -4,7 +4,7 @@
 use specula_hw::analysis::MEETS_TOLERANCE;
 use specula_hw::{diagram, HwLobe, Resources, BITS};
 
-use super::html::{figure, paragraph, table};
+use super::html::{linked_figure, paragraph, table};
 use super::plot::{Chart, Series};
 use super::sections::colour;
 use super::Context;
@@ -221,7 +221,7 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
         let name = format!("hardware-{}.svg", lobe.id());
         let title = format!("{}: structural scheme at W = {DIAGRAM_BITS}", lobe.id());
         context.write(&name, diagram::svg(&datapath, &title).as_bytes())?;
-        html += &figure(&name, &title);
+        html += &linked_figure(&name, &title);
     }
     Ok(html)
 }

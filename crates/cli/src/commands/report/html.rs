@@ -28,6 +28,15 @@ pub fn table(header: &[&str], rows: &[Vec<String>]) -> String {
     html
 }
 
+/// A large image shown at page width, linked to itself at full size.
+pub fn linked_figure(file: &str, caption: &str) -> String {
+    format!(
+        "<figure><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"/></a><figcaption>{1} (select it for full size)</figcaption></figure>\n",
+        escape(file),
+        escape(caption)
+    )
+}
+
 /// An image (a file beside the page) with a caption.
 pub fn figure(file: &str, caption: &str) -> String {
     format!(

@@ -176,14 +176,15 @@ const HARDWARE_SECTIONS: [&str; 2] = [VERDICT, HARDWARE];
 const VERDICT: &str = "Which lobe when";
 const HARDWARE: &str = "Hardware";
 
+/// The answer first (which lobe when), then the thesis's claims, then the details.
 const SECTIONS: [Section; 10] = [
     (VERDICT, verdict::verdict),
+    ("The thesis's claims", sections::claims),
     ("Models", sections::models),
     ("Lobe shapes", sections::shapes),
     ("Error against the angle and against n", sections::errors),
     ("Energy and normalisation", sections::energy),
     ("Reciprocity and white furnace", sections::reciprocity),
-    ("The thesis's claims", sections::claims),
     ("Renders", renders::renders),
     (sections::COST, sections::cost),
     (HARDWARE, hardware::hardware),
