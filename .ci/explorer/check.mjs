@@ -75,6 +75,15 @@ try {
   const notes = await corrected.evaluate(() => document.getElementById("notes").textContent);
   if (!notes.includes("unknown lobe 'nope'") || !notes.includes("outside [1, 1000]")) failures.push(`the corrected address is not reported: '${notes}'`);
 
+  // cosquad's v has a control, it changes the plots, and the address keeps it.
+  before = await updates();
+  const beforeV = await snapshot();
+  await page.locator("#param-cosquad-v").fill("2");
+  await settled(before);
+  const afterV = await snapshot();
+  if (afterV.plots[0] === beforeV.plots[0]) failures.push("changing cosquad's v did not change the lobe plot");
+  if (!afterV.address.includes("cosquad%3Av%3D2")) failures.push(`v is not in the address: ${afterV.address}`);
+
   await page.screenshot({ path: screenshot, fullPage: true });
   if (messages.length) failures.push(...messages.map((m) => `console: ${m}`));
 } finally {
@@ -85,4 +94,4 @@ if (failures.length) {
   console.error("explorer check failed:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`explorer check: loaded, moved n, changed lobes, restored from the address, warned about albedo above 1, reported a corrected address; no console message; screenshot ${screenshot}`);
+console.log(`explorer check: loaded, moved n, changed lobes, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v; no console message; screenshot ${screenshot}`);

@@ -276,12 +276,26 @@ pub async fn models() -> impl IntoResponse {
         .map(|kind| {
             let info = kind.info();
             let style = kind.line_style();
+            let params: Vec<_> = info
+                .params
+                .iter()
+                .map(|p| {
+                    json!({
+                        "name": p.name,
+                        "description": p.description,
+                        "default": p.default,
+                        "min": p.min,
+                        "max": p.max,
+                    })
+                })
+                .collect();
             json!({
                 "id": kind.id(),
                 "summary": info.summary,
                 "formula": info.formula,
                 "colour": style.hex(),
                 "dashed": style.dashed,
+                "params": params,
             })
         })
         .collect();

@@ -405,5 +405,23 @@ async fn the_catalogue_carries_each_lobes_line_style() {
         let style = kind.line_style();
         assert_eq!(lobe["colour"], style.hex(), "{kind}");
         assert_eq!(lobe["dashed"], style.dashed, "{kind}");
+        // Every parameter, for the page's controls.
+        let params = lobe["params"].as_array().expect("params");
+        assert_eq!(params.len(), kind.info().params.len(), "{kind}");
+        for (given, info) in params.iter().zip(kind.info().params) {
+            assert_eq!(given["name"], info.name);
+            assert_eq!(
+                (
+                    given["min"].as_u64(),
+                    given["max"].as_u64(),
+                    given["default"].as_u64()
+                ),
+                (
+                    Some(info.min.into()),
+                    Some(info.max.into()),
+                    Some(info.default.into())
+                )
+            );
+        }
     }
 }

@@ -24,9 +24,22 @@ function readState() {
 function nFromSlider(v) { return Math.min(1000, Math.max(1, Math.round(Math.pow(10, v / 100)))); }
 function sliderFromN(n) { return Math.round(100 * Math.log10(n)); }
 
+// A lobe as the API names it: its id, and each parameter that differs from its default
+// (`cosquad:v=2`).
+function lobeName(box) {
+  const lobe = registry.lobes.find((l) => l.id === box.value);
+  const given = (lobe.params ?? [])
+    .map((p) => [p, Number(document.getElementById(`param-${lobe.id}-${p.name}`).value)])
+    .filter(([p, value]) => value !== p.default)
+    .map(([p, value]) => `${p.name}=${value}`);
+  return given.length ? `${lobe.id}:${given.join(",")}` : lobe.id;
+}
+
 function currentState() {
-  const lobes = [...document.querySelectorAll("#lobes input:checked")].map((c) => c.value);
-  if (!lobes.includes(renderLobe)) renderLobe = lobes.length ? lobes[lobes.length - 1] : "";
+  const boxes = [...document.querySelectorAll("#lobes input[type=checkbox]:checked")];
+  const lobes = boxes.map(lobeName);
+  const ids = boxes.map((box) => box.value);
+  if (!ids.includes(renderLobe)) renderLobe = ids.length ? ids[ids.length - 1] : "";
   return {
     lobes: lobes.join(","),
     n: $("n-box").value,
@@ -38,7 +51,7 @@ function currentState() {
     light_theta: $("light_theta").value,
     light_phi: $("light_phi").value,
     log: $("log").checked ? "1" : "0",
-    render: renderLobe,
+    render: lobes[ids.indexOf(renderLobe)] ?? "",
   };
 }
 
@@ -51,9 +64,11 @@ function buildControls(state) {
   // What the address asked for and could not have is said, not silently replaced.
   const notes = [];
   const known = new Set(registry.lobes.map((l) => l.id));
-  const asked = state.lobes.split(",").filter((id) => id);
-  for (const id of asked.filter((id) => !known.has(id))) notes.push(`unknown lobe '${id}' left out`);
-  const chosen = new Set(asked.filter((id) => known.has(id)));
+  const asked = state.lobes.split(",").filter((name) => name);
+  const idOf = (name) => name.split(":")[0];
+  const paramsOf = (name) => Object.fromEntries((name.split(":")[1] ?? "").split(",").filter((p) => p).map((p) => p.split("=")));
+  for (const name of asked.filter((name) => !known.has(idOf(name)))) notes.push(`unknown lobe '${name}' left out`);
+  const chosen = new Map(asked.filter((name) => known.has(idOf(name))).map((name) => [idOf(name), paramsOf(name)]));
   $("lobes").replaceChildren(...registry.lobes.map((lobe) => {
     const label = document.createElement("label");
     const box = Object.assign(document.createElement("input"), { type: "checkbox", value: lobe.id, checked: chosen.has(lobe.id) });
@@ -63,6 +78,18 @@ function buildControls(state) {
       ? `repeating-linear-gradient(90deg, ${lobe.colour} 0 4px, #fff 4px 6px)`
       : lobe.colour;
     label.append(box, swatch, lobe.id);
+    // Every lobe parameter gets a control (cosquad's v).
+    for (const p of lobe.params ?? []) {
+      const asked = Number((chosen.get(lobe.id) ?? {})[p.name] ?? p.default);
+      const valid = Number.isInteger(asked) && asked >= p.min && asked <= p.max;
+      if (!valid) notes.push(`${lobe.id} ${p.name} = '${asked}' is outside [${p.min}, ${p.max}]; using ${p.default}`);
+      const input = Object.assign(document.createElement("input"), {
+        type: "number", id: `param-${lobe.id}-${p.name}`, min: p.min, max: p.max, step: 1,
+        value: valid ? asked : p.default, title: p.description, className: "param",
+      });
+      input.setAttribute("aria-label", `${lobe.id} ${p.name}`);
+      label.append(` ${p.name} `, input);
+    }
     label.title = lobe.summary;
     return label;
   }));
@@ -84,7 +111,7 @@ function buildControls(state) {
   }
   $("n-box").value = String(n);
   $("n").value = sliderFromN(n);
-  renderLobe = chosen.has(state.render) ? state.render : "";
+  renderLobe = [...chosen.keys()].includes(idOf(state.render)) ? idOf(state.render) : "";
   for (const id of ["theta_in", "light_theta", "light_phi"]) $(id).value = state[id];
   $("log").checked = state.log === "1";
   $("notes").textContent = notes.length ? "From the address: " + notes.join("; ") + "." : "";
@@ -97,7 +124,7 @@ function showValues(state) {
   $("light_phi-value").textContent = state.light_phi + "°";
 }
 
-function lobeOf(id) { return registry.lobes.find((l) => l.id === id) ?? { colour: "#000", dashed: false }; }
+function lobeOf(name) { return registry.lobes.find((l) => l.id === name.split(":")[0]) ?? { colour: "#000", dashed: false }; }
 function colourOf(id) { return lobeOf(id).colour; }
 function dashOf(id) { return lobeOf(id).dashed ? DASH : []; }
 
