@@ -271,6 +271,14 @@ function draw(data, state) {
   const albedoTop = Math.max(1.05, ...data.flatMap((d) => d.albedo));
   plot($("albedo"), { series: data.map((d) => ({ points: zip(d.albedo_deg, d.albedo), colour: colourOf(d.lobe), dash: dashOf(d.lobe) })), x: [0, 90], y: [0, albedoTop], xLabel: "angle of incidence (degrees)", yLabel: "albedo" });
   if (first) drawSlice($("slice"), first);
+  // A legend under each plot: every lobe drawn, in its colour and dash.
+  const entry = (colour, dashed, name) => {
+    const line = dashed ? `repeating-linear-gradient(90deg, ${colour} 0 5px, transparent 5px 8px)` : colour;
+    return `<span class="entry"><span class="line" style="background:${line}"></span>${name}</span>`;
+  };
+  const entries = data.map((d) => entry(colourOf(d.lobe), lobeOf(d.lobe).dashed, d.lobe)).join("");
+  $("legend-cartesian").innerHTML = entries + (first ? entry("#888", true, "t<sup>n</sup>") : "");
+  for (const id of ["error", "polar", "albedo"]) $("legend-" + id).innerHTML = entries;
 }
 
 // Above 1, the BRDF reflects more than it receives: said whenever it happens.
