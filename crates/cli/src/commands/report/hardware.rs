@@ -180,7 +180,7 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
         html += &context.svg(
             &format!("hardware-error-n{n}.svg"),
             &chart,
-            &format!("every datapath's epicentre error against its word length, n = {n}"),
+            &format!("every datapath's epicentre error against its word length, n = {n}: where each curve flattens, extra bits stop paying; the floor is the float model's own error"),
         )?;
         for result in results {
             let width = result.minimum_width();

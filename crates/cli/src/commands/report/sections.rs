@@ -134,7 +134,11 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
             html += &context.svg(
                 &name,
                 &chart,
-                &format!("lobes at n = {n}{}", if log_y { ", log scale" } else { "" }),
+                &if log_y {
+                    format!("lobes at n = {n}, log scale: look at the tail, where a lobe that falls too slowly (schlick, sg) or stops short (the quadratics) shows")
+                } else {
+                    format!("lobes at n = {n}: look at the epicentre (shaded first), where a lobe that departs from pow changes the highlight's core")
+                },
             )?;
         }
     }
@@ -189,7 +193,7 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
         html += &context.svg(
             &format!("error-angle-{}.svg", kind.id()),
             &chart,
-            &format!("{kind}: error against the angle"),
+            &format!("{kind}: error against the angle, one curve per n; an error that keeps its shape across n is the model's, one that grows with n is its approximation breaking down"),
         )?;
     }
     let sizes = context.sizes.clone();
@@ -255,7 +259,8 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
             bands: Vec::new(),
             legend_below: true,
         };
-        html += &context.svg(file, &chart, title)?;
+        let caption = format!("{title} against n for every lobe: flat lines are errors that hold at every n; rising ones grow with the exponent");
+        html += &context.svg(file, &chart, &caption)?;
     }
     let rows: Vec<Vec<String>> = kinds
         .iter()
@@ -321,7 +326,7 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
         legend_below: false,
     };
     let mut html = paragraph("Energy ratio 1 means the lobe reflects what t^n reflects; the analytic (n+1)/(2 pi) applied to an approximation scales its energy by exactly this ratio.");
-    html += &context.svg("energy-ratio.svg", &chart, "energy ratio against n")?;
+    html += &context.svg("energy-ratio.svg", &chart, "energy ratio against n: 1 reflects what t^n reflects; above 1 a lobe with t^n's normalisation creates energy, below it darkens")?;
     let coef1 = Chart {
         title: "the thesis's coef1 = 1.063 n / (2 pi) against the exact (n + 1) / (2 pi)".into(),
         x_label: "n".into(),
@@ -354,7 +359,7 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
         bands: Vec::new(),
         legend_below: false,
     };
-    html += &context.svg("coef1.svg", &coef1, "coef1 against the exact normalisation")?;
+    html += &context.svg("coef1.svg", &coef1, "coef1 against the exact normalisation: it crosses 1 at a single n, so the thesis's coefficient is right only there")?;
     let table_n = [1.0, 8.0, 64.0, 512.0, 1000.0].map(Exponent::new);
     let rows: Vec<Vec<String>> = kinds
         .iter()
@@ -553,7 +558,7 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
             bands: Vec::new(),
             legend_below: true,
         };
-        html += &context.svg("pareto.svg", &chart, "error against speed")?;
+        html += &context.svg("pareto.svg", &chart, "error against time per evaluation: lower left is better; a lobe below and left of another beats it on both")?;
     } else {
         html += &paragraph("Run `specula report --bench` to add measured throughput, each kernel's share of its bound and the error-against-speed plot.");
     }
