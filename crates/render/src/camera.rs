@@ -10,6 +10,12 @@ use thiserror::Error;
 /// translation) may have: beyond it, squared distances overflow `f32`.
 pub const MAX_COORDINATE: f32 = 1e6;
 
+/// Whether `point` is finite and within [`MAX_COORDINATE`] of the origin in each coordinate.
+#[must_use]
+pub fn in_scene_range(point: Vec3) -> bool {
+    point.is_finite() && point.abs().max_element() <= MAX_COORDINATE
+}
+
 /// A camera description that cannot be used, and why.
 #[derive(Clone, Debug, Error, PartialEq)]
 #[error("{0}")]
@@ -57,7 +63,7 @@ impl Camera {
         if !(eye.is_finite() && target.is_finite() && up.is_finite()) {
             return fail("eye, target and up must be finite");
         }
-        if eye.abs().max_element() > MAX_COORDINATE || target.abs().max_element() > MAX_COORDINATE {
+        if !(in_scene_range(eye) && in_scene_range(target)) {
             return fail(&format!(
                 "eye and target must lie within {MAX_COORDINATE:e} scene units of the origin in each coordinate (squared distances must stay finite in f32)"
             ));
