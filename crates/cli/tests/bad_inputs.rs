@@ -442,6 +442,14 @@ fn huge_identifiers_are_quoted_in_part() {
     );
 }
 
+/// An 8 x 8 render written to `name` in `directory`, and its bytes: a real image whose header
+/// the test below patches.
+fn small_render(directory: &Path, name: &str) -> Vec<u8> {
+    let args = ["render", "--width", "8", "--height", "8", "-o", name];
+    assert!(specula(directory, &args).status.success());
+    std::fs::read(directory.join(name)).expect("read")
+}
+
 /// CRC-32 (IEEE), for patching a PNG header in the test below.
 fn crc32(bytes: &[u8]) -> u32 {
     let mut crc = !0_u32;
@@ -515,13 +523,7 @@ fn sizes_an_input_declares_are_bounded_before_reading() {
         "above the input limit of 1048576 bytes",
     );
     // A PNG whose header declares 20000 x 20000 pixels (a real 8 x 8 image, patched).
-    assert!(specula(
-        path,
-        &["render", "--width", "8", "--height", "8", "-o", "small.png"]
-    )
-    .status
-    .success());
-    let mut png = std::fs::read(path.join("small.png")).expect("read");
+    let mut png = small_render(path, "small.png");
     png[16..20].copy_from_slice(&20_000_u32.to_be_bytes());
     png[20..24].copy_from_slice(&20_000_u32.to_be_bytes());
     let crc = crc32(&png[12..29]);
@@ -532,13 +534,7 @@ fn sizes_an_input_declares_are_bounded_before_reading() {
         "declares 20000x20000 pixels",
     );
     // An EXR whose header declares 100000 x 100000 (its data and display windows patched).
-    assert!(specula(
-        path,
-        &["render", "--width", "8", "--height", "8", "-o", "small.exr"]
-    )
-    .status
-    .success());
-    let mut exr = std::fs::read(path.join("small.exr")).expect("read");
+    let mut exr = small_render(path, "small.exr");
     for name in [&b"dataWindow\0box2i\0"[..], &b"displayWindow\0box2i\0"[..]] {
         let at = exr
             .windows(name.len())

@@ -154,8 +154,19 @@ pub fn write_atomically(
 }
 
 /// Removes `.specula-<pid>-*.tmp` files in `directory` whose process no longer runs (read
-/// from `/proc`; elsewhere nothing is removed, since liveness is unknown).
+/// from `/proc`; elsewhere nothing is removed, since liveness is unknown). Once per directory
+/// and process: a report writes sixty files into one folder.
 fn remove_stale_temporaries(directory: &Path) {
+    static CLEANED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+    {
+        let mut cleaned = CLEANED
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if cleaned.iter().any(|d| d == directory) {
+            return;
+        }
+        cleaned.push(directory.to_owned());
+    }
     if !Path::new("/proc/self").exists() {
         return;
     }

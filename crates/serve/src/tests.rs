@@ -227,15 +227,7 @@ async fn other_host_names_are_refused() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn floods_of_idle_connections_are_bounded_and_timed_out() {
     use tokio::io::{AsyncReadExt, AsyncWriteExt};
-    let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
-        .await
-        .expect("bind");
-    let address = listener.local_addr().expect("address");
-    tokio::spawn(crate::listen::serve(
-        listener,
-        router(),
-        std::future::pending(),
-    ));
+    let address = spawn_server().await;
     let mut idle = Vec::new();
     for _ in 0..crate::MAX_CONNECTIONS {
         idle.push(
@@ -290,6 +282,20 @@ async fn floods_of_idle_connections_are_bounded_and_timed_out() {
     assert!(String::from_utf8_lossy(&response).starts_with("HTTP/1.1 200"));
 }
 
+/// The real server (accept loop and all) on a free loopback port, until the test ends.
+async fn spawn_server() -> std::net::SocketAddr {
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
+        .await
+        .expect("bind");
+    let address = listener.local_addr().expect("address");
+    tokio::spawn(crate::listen::serve(
+        listener,
+        router(),
+        std::future::pending(),
+    ));
+    address
+}
+
 /// The resident set size of this process, in KiB (Linux), if it can be read.
 fn resident_kib() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -303,15 +309,7 @@ fn resident_kib() -> Option<u64> {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn loopback_load_test_has_no_error_and_bounded_memory() {
     use tokio::io::{AsyncReadExt, AsyncWriteExt};
-    let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
-        .await
-        .expect("bind");
-    let address = listener.local_addr().expect("address");
-    tokio::spawn(crate::listen::serve(
-        listener,
-        router(),
-        std::future::pending(),
-    ));
+    let address = spawn_server().await;
     let before = resident_kib();
     let request = |k: usize| async move {
         let path = match k % 4 {

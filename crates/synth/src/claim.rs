@@ -13,6 +13,7 @@
 //! `cosquad` costs less than both baselines, the exact `pow` and the engines' spherical
 //! Gaussian `sg`; with qualification if it beats only `pow`.
 
+use rayon::prelude::*;
 use serde::Serialize;
 use specula::claims::{Figure, Verdict};
 use specula_hw::analysis::WidthSweep;
@@ -101,25 +102,17 @@ pub fn evaluate(
     on_each: &(dyn Fn() + Sync),
 ) -> Result<HardwareClaim, SynthError> {
     let (target, mut designs) = designs(sweeps);
-    let results: Vec<Result<Option<Synthesis>, SynthError>> = std::thread::scope(|scope| {
-        // One thread per design: each waits on a single-threaded tool.
-        let handles: Vec<_> = designs
-            .iter()
-            .map(|design| {
-                scope.spawn(move || {
-                    let result = design.bits.map_or(Ok(None), |bits| {
-                        synthesize_or(design.lobe, bits, CLAIM_TARGET, cache, on_miss)
-                    });
-                    on_each();
-                    result
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|handle| handle.join().expect("a synthesis thread panicked"))
-            .collect()
-    });
+    // One tool run per core at a time, as `specula hw synth` runs them.
+    let results: Vec<Result<Option<Synthesis>, SynthError>> = designs
+        .par_iter()
+        .map(|design| {
+            let result = design.bits.map_or(Ok(None), |bits| {
+                synthesize_or(design.lobe, bits, CLAIM_TARGET, cache, on_miss)
+            });
+            on_each();
+            result
+        })
+        .collect();
     for (design, result) in designs.iter_mut().zip(results) {
         design.synthesis = result?;
     }

@@ -2,6 +2,7 @@
 
 use std::path::Path;
 use std::process::Command;
+use std::sync::OnceLock;
 
 use serde::{Deserialize, Serialize};
 
@@ -35,8 +36,24 @@ impl Tool {
         }
     }
 
-    /// The first line of the tool's version output, or why there is none.
+    /// The first line of the tool's version output, or why there is none. Found once per
+    /// process: every synthesis (cache hits included) names its tools, and a version cannot
+    /// change while the process runs (a missing tool is looked for again).
     pub fn version(self) -> Result<String, SynthError> {
+        static YOSYS: OnceLock<String> = OnceLock::new();
+        static NEXTPNR: OnceLock<String> = OnceLock::new();
+        let cell = match self {
+            Tool::Yosys => &YOSYS,
+            Tool::Nextpnr => &NEXTPNR,
+        };
+        if let Some(version) = cell.get() {
+            return Ok(version.clone());
+        }
+        let version = self.ask_version()?;
+        Ok(cell.get_or_init(|| version).clone())
+    }
+
+    fn ask_version(self) -> Result<String, SynthError> {
         let flag = match self {
             Tool::Yosys => "-V",
             Tool::Nextpnr => "--version",

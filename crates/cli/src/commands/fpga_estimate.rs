@@ -1,13 +1,15 @@
-//! An FPGA cost estimate from a datapath's operators, until the datapaths are synthesized:
-//! logic cells of a LUT4 fabric without DSP blocks (an iCE40-class part, where each cell is
+//! An FPGA cost estimate from a datapath's operators, the fallback where Yosys is missing and
+//! the quick figure where synthesizing every width would take minutes (the report's "Which
+//! lobe when" rows): logic cells of a LUT4 fabric without DSP blocks (an iCE40-class part, where each cell is
 //! one 4-input LUT, one flip-flop and a carry link). Per operator, the textbook mapping:
 //! a `b`-bit adder or comparator takes `b` cells (one per bit on the carry chain); an `a x b`
 //! array multiplier `a b` cells (a partial-product AND and a full adder per bit); a `b`-bit
 //! squarer half that (the product's symmetric half); an `a / b` divider `a b` cells (`a`
 //! stages of a `b`-bit subtract-and-select); a leading-one detector `b` cells; a `b`-bit barrel
-//! shifter `b ceil(log2 b)` cells (a 2:1 multiplexer per bit and stage); a ROM 1 cell per 16 bits (a LUT4 is a 16 x 1 ROM). Flip-flops pack into the cells the logic uses, so the
-//! estimate is the larger of the logic cells and the register bits. `specula recommend
-//! --target fpga` labels every figure from here "estimated".
+//! shifter `b ceil(log2 b)` cells (a 2:1 multiplexer per bit and stage); a ROM 1 cell per 16
+//! bits (a LUT4 is a 16 x 1 ROM). Flip-flops pack into the cells the logic uses, so the
+//! estimate is the larger of the logic cells and the register bits. Every figure from here is
+//! labelled "estimated"; Yosys builds about four times as many LUTs (`specula hw synth`).
 
 use specula_hw::Resources;
 

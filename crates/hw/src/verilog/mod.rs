@@ -168,7 +168,7 @@ impl Emitter<'_> {
                     "    wire signed [63:0] {wire};\n    {}_{}_log2 {wire}_unit (.x({operand}), .y({wire}));",
                     self.datapath.name, node.name
                 );
-                (wire, frac, log2_bound(*unit, input, out, frac))
+                (wire, frac, log2_bound(*unit, input, out))
             }
             Op::Exp2Neg(a, _) => {
                 let operand = self.operand_reg(id, *a);
@@ -237,11 +237,11 @@ impl Emitter<'_> {
 
 /// Bits that bound the magnitude of a log2 unit's exact result: `(e + f) 2^frac` with the
 /// leading-one position `|e| <=` the input's larger part, or the saturated minimum for 0.
-fn log2_bound(unit: Log2Unit, input: Format, out: Format, frac: u32) -> u32 {
+fn log2_bound(unit: Log2Unit, input: Format, out: Format) -> u32 {
+    let frac = unit.frac_bits(input, out.frac_bits);
     let largest_exponent = input.frac_bits.max(input.int_bits) + 1;
     let normal = frac + (u32::BITS - largest_exponent.leading_zeros());
     let zero = out.width() + frac.saturating_sub(out.frac_bits);
-    debug_assert_eq!(frac, unit.frac_bits(input, out.frac_bits));
     normal.max(zero)
 }
 

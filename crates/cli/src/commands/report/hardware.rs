@@ -39,7 +39,6 @@ fn synthesized(context: &Context, all: &[(u32, Vec<WidthSweep>)]) -> Result<Stri
         context.sizes.synthesis,
         &|| {},
     );
-    let (target, designs) = claim::designs(sweeps);
     let estimate = |lobe: HwLobe, bits: Option<u32>| -> String {
         let resources = bits.and_then(|bits| {
             sweeps
@@ -64,6 +63,7 @@ fn synthesized(context: &Context, all: &[(u32, Vec<WidthSweep>)]) -> Result<Stri
             Err(problem) => problem.to_string(),
             Ok(_) => "not every design is in the synthesis cache (a quick report does not synthesize; run the full report or `specula claims`)".to_owned(),
         };
+        let (target, designs) = claim::designs(sweeps);
         html += &paragraph(&format!(
             "Not measured: {why}. In its place, a fallback that is not a synthesis: the formula \
              estimate of LUT4 logic cells (commands/fpga_estimate.rs) for each datapath at the \

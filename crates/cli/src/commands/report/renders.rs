@@ -102,7 +102,8 @@ pub fn renders(context: &mut Context) -> Result<String, String> {
         ],
         &rows,
     );
-    let reference_image = cpu(&base)?;
+    // The reference render, kept for the CPU-against-GPU comparison below.
+    let reference_image = renders[0].take().ok_or("the grid did not render pow")?;
 
     html += &paragraph("The same scene under the three shading methods (pow):");
     for shading in Shading::ALL {
