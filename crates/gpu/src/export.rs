@@ -23,6 +23,8 @@ use thiserror::Error;
 use crate::uniforms::LobeBlock;
 use crate::wgsl;
 
+mod es100;
+
 /// A shading language naga writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Language {
@@ -69,7 +71,7 @@ pub enum GlslVersion {
     Desktop450,
     /// GLSL ES 3.00 (OpenGL ES 3, WebGL 2).
     Es300,
-    /// GLSL ES 1.00 (OpenGL ES 2, WebGL 1): not written, and refused with the reason.
+    /// GLSL ES 1.00 (OpenGL ES 2, WebGL 1), for the lobes without bit operations.
     Es100,
 }
 
@@ -262,11 +264,6 @@ pub fn export(
         language: language.id(),
         message,
     };
-    if language == Language::Glsl && options.glsl == GlslVersion::Es100 {
-        return Err(fail(
-            "GLSL ES 1.00 has no unsigned integers or bit casts, which the lobe constants and the bit-trick lobes use; use --glsl-version 300es (WebGL 2) or 450".to_owned(),
-        ));
-    }
     let source = export_wgsl_source(lobe, geometry, normalisation);
     let (mut module, _) = wgsl::validate(&source).map_err(fail)?;
     naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
@@ -290,11 +287,12 @@ pub fn export(
         Language::Glsl => {
             let mut text = String::new();
             let version = match options.glsl {
-                GlslVersion::Es300 => naga::back::glsl::Version::Embedded {
+                // naga writes ES 3.00, from which es100 derives ES 1.00.
+                GlslVersion::Es300 | GlslVersion::Es100 => naga::back::glsl::Version::Embedded {
                     version: 300,
                     is_webgl: false,
                 },
-                _ => naga::back::glsl::Version::Desktop(450),
+                GlslVersion::Desktop450 => naga::back::glsl::Version::Desktop(450),
             };
             let glsl_options = naga::back::glsl::Options {
                 version,
@@ -317,6 +315,15 @@ pub fn export(
             .map_err(|e| fail(e.to_string()))?;
             if !options.example {
                 text = without_example(&text);
+            }
+            if options.glsl == GlslVersion::Es100 {
+                text = es100::from_es300(&text).map_err(|construct| ExportError {
+                    language: "GLSL ES 1.00",
+                    message: format!(
+                        "{} uses {construct}, which GLSL ES 1.00 lacks; use --glsl-version 300es (WebGL 2) or 450, or a lobe without bit operations",
+                        lobe.kind()
+                    ),
+                })?;
             }
             // The `#version` line must stay first.
             let (version, body) = text.split_once('\n').unwrap_or((&text, ""));

@@ -26,8 +26,8 @@ pub struct Args {
     /// The shading language.
     #[arg(long, value_parser = choice(&Language::ALL, Language::id))]
     lang: Language,
-    /// The GLSL dialect (with --lang glsl): 450 (Vulkan, OpenGL 4.5) or 300es (OpenGL ES 3,
-    /// WebGL 2); 100 is refused with the reason.
+    /// The GLSL dialect (with --lang glsl): 450 (Vulkan, OpenGL 4.5), 300es (OpenGL ES 3,
+    /// WebGL 2) or 100 (OpenGL ES 2, WebGL 1; lobes that read a float's bits are refused).
     #[arg(long, value_parser = choice(&GlslVersion::ALL, GlslVersion::id), default_value = "450")]
     glsl_version: GlslVersion,
     /// Include the example fragment shader that calls the functions (GLSL leaves it out by
