@@ -36,6 +36,26 @@ pub struct Chart {
 /// Pixels to the right of the plotting area, for the legend.
 const LEGEND_WIDTH: u32 = 150;
 
+/// plotters' SVG back end writes whole-pixel coordinates, which turns a steep curve into
+/// stairs; charts are drawn this many times larger and shown at their size through the
+/// `viewBox`, so points land on quarter pixels. Every size in a drawing is multiplied by it.
+const SUPERSAMPLE: u32 = 4;
+
+/// `pixels` in the supersampled drawing.
+const fn px(pixels: u32) -> u32 {
+    pixels * SUPERSAMPLE
+}
+
+/// A signed coordinate offset of `pixels` in the supersampled drawing.
+const fn offset(pixels: i32) -> i32 {
+    pixels * SUPERSAMPLE as i32
+}
+
+/// The font size for text shown `points` high.
+fn font(points: u32) -> (&'static str, u32) {
+    ("sans-serif", px(points))
+}
+
 /// Tick labels: plain decimals in `[1e-3, 1e4)`, powers of ten outside, and 0 for the
 /// rounding residue a linear axis computes for its zero tick (`2e-18`).
 fn tick(value: &f64) -> String {
@@ -65,9 +85,10 @@ impl Chart {
     /// The chart as an SVG document: a `width x height` plot and, to its right, the legend.
     pub fn to_svg(&self, width: u32, height: u32) -> Result<String, String> {
         let mut svg = String::new();
+        let (drawn_width, drawn_height) = (px(width + LEGEND_WIDTH), px(height));
         {
-            let root = SVGBackend::with_string(&mut svg, (width + LEGEND_WIDTH, height))
-                .into_drawing_area();
+            let root =
+                SVGBackend::with_string(&mut svg, (drawn_width, drawn_height)).into_drawing_area();
             root.fill(&WHITE).map_err(|e| e.to_string())?;
             let mut low = self.y.0;
             if self.log_y {
@@ -91,7 +112,15 @@ impl Chart {
             }?;
             root.present().map_err(|e| e.to_string())?;
         }
-        Ok(svg)
+        let drawn = format!(r#"<svg width="{drawn_width}" height="{drawn_height}""#);
+        let shown = format!(r#"<svg width="{}" height="{height}""#, width + LEGEND_WIDTH);
+        if !svg.starts_with(&drawn) {
+            return Err(format!(
+                "plotters wrote an unexpected SVG header: {:.80}",
+                svg
+            ));
+        }
+        Ok(svg.replacen(&drawn, &shown, 1))
     }
 
     fn draw<X, Y>(
@@ -108,18 +137,23 @@ impl Chart {
     {
         let error = |e: DrawingAreaErrorKind<_>| e.to_string();
         let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, ("sans-serif", 18))
-            .margin(10)
-            .margin_right(10 + LEGEND_WIDTH)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
+            .caption(&self.title, font(18))
+            .margin(px(10))
+            .margin_right(px(10 + LEGEND_WIDTH))
+            .x_label_area_size(px(40))
+            .y_label_area_size(px(60))
             .build_cartesian_2d(x, y)
             .map_err(error)?;
         chart
             .configure_mesh()
             .x_desc(&self.x_label)
             .y_desc(&self.y_label)
-            .light_line_style(RGBColor(235, 235, 235))
+            .light_line_style(RGBColor(235, 235, 235).stroke_width(px(1)))
+            .bold_line_style(BLACK.mix(0.2).stroke_width(px(1)))
+            .axis_style(BLACK.stroke_width(px(1)))
+            .label_style(font(12))
+            .axis_desc_style(font(13))
+            .set_all_tick_mark_size(px(5))
             .x_label_formatter(&tick)
             .y_label_formatter(&tick)
             .draw()
@@ -133,7 +167,7 @@ impl Chart {
                 .map_err(error)?;
         }
         for series in &self.series {
-            let style = series.colour.stroke_width(series.width);
+            let style = series.colour.stroke_width(px(series.width));
             let clipped = series
                 .points
                 .iter()
@@ -143,11 +177,11 @@ impl Chart {
                 let name = series.name.clone();
                 chart.draw_series(clipped.map(|p| {
                     EmptyElement::at(p)
-                        + Circle::new((0, 0), 5, series.colour.filled())
-                        + Text::new(name.clone(), (8, -6), ("sans-serif", 12))
+                        + Circle::new((0, 0), px(5), series.colour.filled())
+                        + Text::new(name.clone(), (offset(8), offset(-6)), font(12))
                 }))
             } else if series.dashed {
-                chart.draw_series(DashedLineSeries::new(clipped, 7, 4, style))
+                chart.draw_series(DashedLineSeries::new(clipped, px(7), px(4), style))
             } else {
                 chart.draw_series(LineSeries::new(clipped, style))
             };
@@ -157,47 +191,114 @@ impl Chart {
         // data): one row per band and series, a swatch and the name.
         let (x_range, y_range) = chart.plotting_area().get_pixel_range();
         let entries = self.bands.len() + self.series.len();
-        let row = 18;
+        let row = offset(18);
         let height = row * entries as i32;
-        let x0 = x_range.end + 14;
+        let x0 = x_range.end + offset(14);
         let y0 = if self.legend_below {
             (y_range.end - height).max(y_range.start)
         } else {
-            y_range.start + 4
+            y_range.start + offset(4)
         };
-        let font = ("sans-serif", 12).into_font().color(&BLACK);
+        let text = font(12).into_font().color(&BLACK);
+        let (swatch, half, gap) = (offset(16), offset(5), offset(22));
         for (k, &(_, _, colour, label)) in self.bands.iter().enumerate() {
             let y = y0 + row * k as i32 + row / 2;
             root.draw(&Rectangle::new(
-                [(x0, y - 5), (x0 + 16, y + 5)],
+                [(x0, y - half), (x0 + swatch, y + half)],
                 colour.mix(0.3).filled(),
             ))
             .map_err(error)?;
-            root.draw(&Text::new(label, (x0 + 22, y - 7), font.clone()))
+            root.draw(&Text::new(label, (x0 + gap, y - offset(7)), text.clone()))
                 .map_err(error)?;
         }
         for (k, series) in self.series.iter().enumerate() {
             let y = y0 + row * (self.bands.len() + k) as i32 + row / 2;
-            let style = series.colour.stroke_width(series.width);
+            let style = series.colour.stroke_width(px(series.width));
             if series.markers {
-                root.draw(&Circle::new((x0 + 8, y), 4, series.colour.filled()))
-                    .map_err(error)?;
+                root.draw(&Circle::new(
+                    (x0 + swatch / 2, y),
+                    px(4),
+                    series.colour.filled(),
+                ))
+                .map_err(error)?;
             } else if series.dashed {
-                root.draw(&PathElement::new([(x0, y), (x0 + 6, y)], style))
+                root.draw(&PathElement::new([(x0, y), (x0 + offset(6), y)], style))
                     .map_err(error)?;
-                root.draw(&PathElement::new([(x0 + 10, y), (x0 + 16, y)], style))
-                    .map_err(error)?;
+                root.draw(&PathElement::new(
+                    [(x0 + offset(10), y), (x0 + swatch, y)],
+                    style,
+                ))
+                .map_err(error)?;
             } else {
-                root.draw(&PathElement::new([(x0, y), (x0 + 16, y)], style))
+                root.draw(&PathElement::new([(x0, y), (x0 + swatch, y)], style))
                     .map_err(error)?;
             }
             root.draw(&Text::new(
                 series.name.clone(),
-                (x0 + 22, y - 7),
-                font.clone(),
+                (x0 + gap, y - offset(7)),
+                text.clone(),
             ))
             .map_err(error)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A diagonal drawn at 580 x 360 must resolve finer than whole pixels: with whole-pixel
+    /// coordinates its 2,000 points could take at most one height per displayed pixel row.
+    #[test]
+    fn curves_are_placed_finer_than_whole_pixels_at_the_displayed_size() {
+        let chart = Chart {
+            title: "diagonal".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            x: (0.0, 1.0),
+            y: (0.0, 1.0),
+            log_x: false,
+            log_y: false,
+            series: vec![Series {
+                name: "y = x".into(),
+                points: (0..=2000)
+                    .map(|i| f64::from(i) / 2000.0)
+                    .map(|v| (v, v))
+                    .collect(),
+                colour: SEQUENCE[0],
+                width: 1,
+                markers: false,
+                dashed: false,
+            }],
+            bands: Vec::new(),
+            legend_below: false,
+        };
+        let svg = chart.to_svg(580, 360).unwrap();
+        let header = format!(
+            r#"<svg width="{}" height="360" viewBox="0 0 {} {}""#,
+            580 + LEGEND_WIDTH,
+            px(580 + LEGEND_WIDTH),
+            px(360)
+        );
+        assert!(svg.starts_with(&header), "{:.120}", svg);
+        let polyline = svg
+            .split("<polyline")
+            .find(|element| element.contains(r##"stroke="#0072B2""##))
+            .expect("the curve's polyline");
+        let points = polyline.split("points=\"").nth(1).unwrap();
+        let heights: std::collections::BTreeSet<u32> = points
+            .split('"')
+            .next()
+            .unwrap()
+            .split_whitespace()
+            .map(|pair| pair.split(',').nth(1).unwrap().parse().unwrap())
+            .collect();
+        let rows = 360;
+        assert!(
+            heights.len() > rows,
+            "{} distinct heights for at most {rows} displayed rows",
+            heights.len()
+        );
     }
 }
