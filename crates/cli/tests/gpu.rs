@@ -201,10 +201,10 @@ fn have_glslang() -> bool {
     found
 }
 
-/// The README's recipe: the exported text, as it is, at the top of a shader of one's own that
+/// The recipe in docs/gpu.md: the exported text, as it is, at the top of a shader of one's own that
 /// calls `specula_specular`; glslang accepts it.
 #[test]
-fn the_readmes_glsl_paste_recipe_compiles() {
+fn the_documented_glsl_paste_recipe_compiles() {
     if !have_glslang() {
         return;
     }

@@ -15,7 +15,7 @@
 //!   (about `1e-3`).
 //!
 //! Set on llvmpipe (LLVM 15.0.6, 256 bits), Mesa 22.3.6, where the measured maxima are about
-//! half these bounds; the README lists them.
+//! half these bounds; docs/gpu.md lists them.
 
 mod common;
 

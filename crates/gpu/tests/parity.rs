@@ -2,7 +2,7 @@
 //! scene, compared by mean FLIP and PSNR (on display values, as `specula diff` does).
 //!
 //! Thresholds set on llvmpipe (LLVM 15.0.6, 256 bits), Mesa 22.3.6, where the worst case
-//! measured is listed in the README: the two rasterizers agree on coverage except where a
+//! measured is listed in docs/gpu.md: the two rasterizers agree on coverage except where a
 //! pixel centre lies within rounding of an edge, and shading differs by `f32` rounding (more
 //! for the angle lobes, through the driver's `acos`).
 

@@ -1,6 +1,6 @@
 //! A scene ready to render: camera, lights, objects in world space with their materials, and
 //! the render settings. Scenes are usually read from TOML ([`Scene::from_toml`], format in
-//! `description.rs` and the README); [`DEFAULT_SCENE`] is embedded.
+//! `description/` and docs/renderer.md); [`DEFAULT_SCENE`] is embedded.
 
 use glam::Vec3;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};

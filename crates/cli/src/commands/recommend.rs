@@ -30,7 +30,7 @@ pub enum Target {
     GpuNvidia,
     /// AMD RDNA GPUs: modelled from the shader's instructions.
     GpuAmd,
-    /// FPGA: estimated from the fixed-point datapaths' operators (see the README).
+    /// FPGA: estimated from the fixed-point datapaths' operators (see docs/analysis.md).
     Fpga,
 }
 
