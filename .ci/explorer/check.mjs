@@ -84,6 +84,11 @@ try {
   if (afterV.plots[0] === beforeV.plots[0]) failures.push("changing cosquad's v did not change the lobe plot");
   if (!afterV.address.includes("cosquad%3Av%3D2")) failures.push(`v is not in the address: ${afterV.address}`);
 
+  // Axis ticks are round numbers, counted by hand: 1, 2 or 5 times a power of ten.
+  const ticks = await page.evaluate(() => [[0, 21.4], [-0.129, 0.129], [0, 1.05], [0, 90]].map(([lo, hi]) => niceTicks(lo, hi).map(([, label]) => label).join(" ")));
+  const expected = ["0 5 10 15 20", "-0.10 -0.05 0.00 0.05 0.10", "0.0 0.2 0.4 0.6 0.8 1.0", "0 20 40 60 80"];
+  ticks.forEach((got, k) => { if (got !== expected[k]) failures.push(`ticks: '${got}', expected '${expected[k]}'`); });
+
   await page.screenshot({ path: screenshot, fullPage: true });
   if (messages.length) failures.push(...messages.map((m) => `console: ${m}`));
 } finally {
@@ -94,4 +99,4 @@ if (failures.length) {
   console.error("explorer check failed:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`explorer check: loaded, moved n, changed lobes, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v; no console message; screenshot ${screenshot}`);
+console.log(`explorer check: loaded, moved n, changed lobes, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, round ticks; no console message; screenshot ${screenshot}`);

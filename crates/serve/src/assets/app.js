@@ -136,6 +136,29 @@ async function getJson(url) {
 }
 
 // A line plot: axes with ticks, optional shaded bands, one polyline per series.
+// Ticks at multiples of 1, 2 or 5 times a power of ten, the step giving the count nearest
+// `count` across [lo, hi], each labelled with the digits its step needs (0.05, not
+// 0.0516).
+function niceTicks(lo, hi, count = 5) {
+  const power = Math.pow(10, Math.floor(Math.log10((hi - lo) / count)));
+  const misses = (step) => Math.abs((hi - lo) / step - count);
+  const step = [1, 2, 5, 10].map((f) => f * power).reduce((best, s) => (misses(s) < misses(best) ? s : best));
+  const digits = Math.max(0, -Math.floor(Math.log10(step) + 1e-9));
+  const ticks = [];
+  for (let k = Math.ceil(lo / step - 1e-9); k * step <= hi + 1e-9 * step; k++) {
+    const v = k * step;
+    ticks.push([v, (Math.abs(v) < step / 2 ? 0 : v).toFixed(digits)]);
+  }
+  return ticks;
+}
+
+// The whole powers of ten in [10^lo, 10^hi], as exponents.
+function decades(lo, hi) {
+  const exponents = [];
+  for (let k = Math.ceil(lo - 1e-9); k <= hi + 1e-9; k++) exponents.push(k);
+  return exponents;
+}
+
 function plot(canvas, { series, x, y, logY = false, bands = [], xLabel = "", yLabel = "" }) {
   const g = canvas.getContext("2d");
   const [w, h] = [canvas.width, canvas.height];
@@ -151,12 +174,20 @@ function plot(canvas, { series, x, y, logY = false, bands = [], xLabel = "", yLa
   }
   g.strokeStyle = "#999"; g.fillStyle = "#444"; g.font = "11px sans-serif"; g.lineWidth = 1;
   g.strokeRect(m.l, m.t, w - m.l - m.r, h - m.t - m.b);
-  for (let i = 0; i <= 5; i++) {
-    const vx = x[0] + ((x[1] - x[0]) * i) / 5;
-    g.fillText(Number(vx.toPrecision(3)).toString(), px(vx) - 10, h - m.b + 14);
-    const vy = logY ? Math.pow(10, y0 + ((y1 - y0) * i) / 5) : y0 + ((y1 - y0) * i) / 5;
-    g.fillText(logY ? vy.toExponential(0) : Number(vy.toPrecision(3)).toString(), 20, py(vy) + 4);
+  g.textAlign = "center";
+  for (const [v, label] of niceTicks(x[0], x[1])) {
+    g.beginPath(); g.moveTo(px(v), h - m.b); g.lineTo(px(v), h - m.b + 4); g.stroke();
+    g.fillText(label, px(v), h - m.b + 15);
   }
+  g.textAlign = "right";
+  const yTicks = logY
+    ? decades(y0, y1).map((k) => [Math.pow(10, k), `1e${k}`])
+    : niceTicks(y0, y1);
+  for (const [v, label] of yTicks) {
+    g.beginPath(); g.moveTo(m.l - 4, py(v)); g.lineTo(m.l, py(v)); g.stroke();
+    g.fillText(label, m.l - 6, py(v) + 4);
+  }
+  g.textAlign = "left";
   g.fillText(xLabel, w / 2 - 40, h - 6);
   g.save(); g.translate(12, h / 2 + 30); g.rotate(-Math.PI / 2); g.fillText(yLabel, 0, 0); g.restore();
   g.save(); g.beginPath(); g.rect(m.l, m.t, w - m.l - m.r, h - m.t - m.b); g.clip();
@@ -193,22 +224,64 @@ function drawPolar(canvas, data, thetaIn) {
   g.fillText("light (dashed) at " + thetaIn + "°; radius: f / " + peak.toPrecision(3), 8, 14);
 }
 
+// The slice's colour map, from 0 (the bottom of the range) to 1 (its top).
+function sliceColour(s) {
+  return [255 * Math.min(1, 1.6 * s), 255 * Math.max(0, 2 * s - 1) * 0.9, 255 * (0.3 + 0.7 * Math.max(0, s - 0.5))];
+}
+
+// The slice with its axes: theta_h across on the API's square-root scale (column i at
+// 90 (i / (size - 1))^2 degrees), theta_d down, and a colour bar in decades of f.
 function drawSlice(canvas, d) {
   const g = canvas.getContext("2d");
   const size = d.slice_size;
-  const image = g.createImageData(size, size);
+  const [left, top, right, bottom] = [38, 22, 62, 36];
+  const [w, h] = [canvas.width - left - right, canvas.height - top - bottom];
   const logs = d.slice.map((v) => (v > 0 ? Math.log10(v) : -Infinity));
-  const top = Math.max(...logs.filter(Number.isFinite));
-  const bottom = top - 6;
+  const high = Math.max(...logs.filter(Number.isFinite));
+  const low = high - 6;
+  const image = g.createImageData(size, size);
   logs.forEach((v, k) => {
-    const s = Number.isFinite(v) ? Math.min(1, Math.max(0, (v - bottom) / (top - bottom))) : 0;
-    image.data.set([255 * Math.min(1, 1.6 * s), 255 * Math.max(0, 2 * s - 1) * 0.9, 255 * (0.3 + 0.7 * Math.max(0, s - 0.5)), 255], 4 * k);
+    const s = Number.isFinite(v) ? Math.min(1, Math.max(0, (v - low) / (high - low))) : 0;
+    image.data.set([...sliceColour(s), 255], 4 * k);
   });
   const scratch = Object.assign(document.createElement("canvas"), { width: size, height: size });
   scratch.getContext("2d").putImageData(image, 0, 0);
-  g.imageSmoothingEnabled = false;
   g.clearRect(0, 0, canvas.width, canvas.height);
-  g.drawImage(scratch, 0, 0, canvas.width, canvas.height);
+  g.imageSmoothingEnabled = false;
+  g.drawImage(scratch, left, top, w, h);
+  g.fillStyle = "#333"; g.strokeStyle = "#333"; g.font = "11px sans-serif"; g.lineWidth = 1;
+  g.fillText(`${d.lobe}: specular term f, log scale, phi_d = 90°`, left, 14);
+  // Ticks sit at the centre of the column or row that holds the angle.
+  const column = (deg) => left + ((size - 1) * Math.sqrt(deg / 90) + 0.5) * (w / size);
+  const row = (deg) => top + ((size - 1) * (deg / 90) + 0.5) * (h / size);
+  g.textAlign = "center";
+  for (const deg of [0, 1, 5, 10, 20, 45, 90]) {
+    const x = column(deg);
+    g.beginPath(); g.moveTo(x, top + h); g.lineTo(x, top + h + 4); g.stroke();
+    g.fillText(String(deg), x, top + h + 15);
+  }
+  g.fillText("θh (degrees, square-root scale)", left + w / 2, top + h + 30);
+  g.textAlign = "right";
+  for (const deg of [0, 15, 30, 45, 60, 75, 90]) {
+    const y = row(deg);
+    g.beginPath(); g.moveTo(left - 4, y); g.lineTo(left, y); g.stroke();
+    g.fillText(String(deg), left - 6, y + 4);
+  }
+  g.save(); g.translate(10, top + h / 2); g.rotate(-Math.PI / 2); g.textAlign = "center";
+  g.fillText("θd (degrees)", 0, 0); g.restore();
+  // The colour bar: its top is the slice's largest value, six decades down is black.
+  const [barX, barW] = [left + w + 10, 12];
+  for (let y = 0; y < h; y++) {
+    g.fillStyle = `rgb(${sliceColour(1 - y / (h - 1)).join(",")})`;
+    g.fillRect(barX, top + y, barW, 1);
+  }
+  g.fillStyle = "#333"; g.textAlign = "left";
+  for (const k of decades(low, high)) {
+    const y = top + (h - 1) * (1 - (k - low) / (high - low));
+    g.beginPath(); g.moveTo(barX + barW, y); g.lineTo(barX + barW + 3, y); g.stroke();
+    g.fillText(`1e${k}`, barX + barW + 5, y + 4);
+  }
+  g.textAlign = "left";
 }
 
 function analysisTable(reports) {
