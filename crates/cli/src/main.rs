@@ -87,6 +87,14 @@ enum Command {
                             specula hw synth --target ice40 --device hx8k --bits 12 --lobe cosquad,pow,sg"
     )]
     Hw(commands::hw::Args),
+    /// Render a volume (the Shepp-Logan head, Marschner-Lobb) by ray marching, any lobe as its
+    /// specular term.
+    #[command(
+        after_help = "Examples:\n  specula volume --input phantom --lobe cosquad -o head.png\n  \
+                            specula volume --input marschner-lobb --size 64 --view axial -o ml.png\n  \
+                            specula volume --eye 400,-300,200 --transfer ct-soft-tissue -o side.png"
+    )]
+    Volume(commands::volume::Args),
     /// Serve the interactive BRDF explorer (page and JSON API) on 127.0.0.1.
     #[command(
         after_help = "Examples:\n  specula serve --open\n  specula serve --port 9000\n  specula serve --port 0   # a free port, printed"
@@ -179,6 +187,7 @@ fn main() -> ExitCode {
         Command::Claims(args) => commands::claims::run(&args),
         Command::Report(args) => commands::report::run(&args),
         Command::Render(args) => commands::render::run(&args),
+        Command::Volume(args) => commands::volume::run(&args),
         Command::Diff(args) => commands::diff::run(&args),
         Command::Shader(args) => commands::shader::run(&args),
         Command::Bench(args) => commands::bench::run(&args),

@@ -3,7 +3,7 @@
 //! Built on the core (`specula`): scenes (TOML, with an embedded default), meshes (built-in
 //! shapes, Newell's teapot, OBJ/STL/PLY files), a tiled parallel rasterizer, flat, Gouraud and
 //! Phong shading with any lobe, geometry and normalisation, images (PNG, OpenEXR) and image
-//! metrics (PSNR, FLIP).
+//! metrics (PSNR, FLIP), and volumes (the built-in phantoms, direct volume rendering).
 //!
 //! ## Design
 //! - **Exact coverage.** Vertices are snapped to 1/256 pixel and edge functions evaluated in
@@ -36,6 +36,7 @@ mod raster;
 mod scene;
 mod shapes;
 mod teapot;
+pub mod volume;
 
 pub use camera::{Camera, InvalidCamera, Projection, MAX_COORDINATE};
 pub use description::{set_max_triangles, LoadedScene, SceneError, MAX_OBJECTS, MAX_TRIANGLES};

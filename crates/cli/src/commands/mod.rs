@@ -14,6 +14,7 @@ pub mod report;
 pub mod serve;
 pub mod shader;
 pub mod synth;
+pub mod volume;
 
 /// What a command reports when it fails: a one-line message.
 pub type CommandResult = Result<(), String>;
