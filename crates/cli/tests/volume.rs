@@ -34,12 +34,12 @@ fn bad_volume_requests_are_refused_in_one_line() {
     let d = directory.path();
     for (args, expected) in [
         (
-            vec!["volume", "--input", "brain"],
-            "built in: phantom, marschner-lobb",
+            vec!["volume", "--input", "phantm"],
+            "built in: phantom, marschner-lobb; did you mean 'phantom'?",
         ),
         (
             vec!["volume", "--transfer", "ct-boen"],
-            "presets: ct-bone, ct-soft-tissue, mr",
+            "presets: ct-bone, ct-soft-tissue, mr, or a .toml file; did you mean 'ct-bone'?",
         ),
         (
             vec!["volume", "--eye", "0,0,0"],

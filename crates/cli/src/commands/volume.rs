@@ -43,7 +43,7 @@ pub struct Args {
     #[arg(long, value_parser = choice(&Normalisation::ALL, Normalisation::id), default_value = "none")]
     normalisation: Normalisation,
     /// The view: axial (from the feet), sagittal (from the left) or coronal (from the front).
-    #[arg(long, value_parser = choice(&[View::Axial, View::Sagittal, View::Coronal], view_id), default_value = "coronal", conflicts_with = "eye")]
+    #[arg(long, value_parser = choice(&View::STANDARD, View::id), default_value = "coronal", conflicts_with = "eye")]
     view: View,
     /// A perspective view from this point (millimetres, `x,y,z`) towards the volume's centre.
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
@@ -57,14 +57,6 @@ pub struct Args {
     /// Output image: .png (8-bit sRGB) or .exr (linear f32).
     #[arg(short, long, default_value = "volume.png")]
     output: PathBuf,
-}
-
-fn view_id(view: View) -> &'static str {
-    match view {
-        View::Axial => "axial",
-        View::Sagittal => "sagittal",
-        View::Coronal | View::Eye(_) => "coronal",
-    }
 }
 
 fn parse_point(text: &str) -> Result<Vec3, String> {
@@ -90,18 +82,19 @@ fn parse_point(text: &str) -> Result<Vec3, String> {
 /// The volume `--input` names.
 fn load(args: &Args) -> Result<Volume, String> {
     let side = args.size as usize;
-    match args.input.as_str() {
+    let built = match args.input.as_str() {
         "phantom" => phantom::shepp_logan(side),
         "marschner-lobb" => phantom::marschner_lobb(side),
         other => {
             return Err(format!(
-                "unknown volume '{}'; built in: {}",
+                "unknown volume '{}'; built in: {}{}",
                 specula::excerpt(other),
-                BUILT_IN.join(", ")
+                BUILT_IN.join(", "),
+                specula::did_you_mean(other, BUILT_IN)
             ))
         }
-    }
-    .map_err(|e| e.to_string())
+    };
+    built.map_err(|e| e.to_string())
 }
 
 /// The transfer function `--transfer` names, in the volume's values.

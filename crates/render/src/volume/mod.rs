@@ -184,17 +184,29 @@ impl Volume {
     /// The (fractional) grid index of a world position.
     #[must_use]
     pub fn index(&self, world: Vec3) -> Vec3 {
-        self.to_index * (world - self.origin)
+        self.index_direction(world - self.origin)
+    }
+
+    /// The largest grid index along each axis: the grid spans `[0, last_index]`.
+    #[must_use]
+    pub fn last_index(&self) -> Vec3 {
+        Vec3::new(
+            (self.dims[0] - 1) as f32,
+            (self.dims[1] - 1) as f32,
+            (self.dims[2] - 1) as f32,
+        )
+    }
+
+    /// A world direction (or displacement) in grid index units.
+    #[must_use]
+    pub fn index_direction(&self, world: Vec3) -> Vec3 {
+        self.to_index * world
     }
 
     /// The eight corners of the grid in world space.
     #[must_use]
     pub fn corners(&self) -> [Vec3; 8] {
-        let top = Vec3::new(
-            (self.dims[0] - 1) as f32,
-            (self.dims[1] - 1) as f32,
-            (self.dims[2] - 1) as f32,
-        );
+        let top = self.last_index();
         core::array::from_fn(|c| {
             let pick = |bit: usize, high: f32| if c >> bit & 1 == 1 { high } else { 0.0 };
             self.world(Vec3::new(pick(0, top.x), pick(1, top.y), pick(2, top.z)))
@@ -226,11 +238,7 @@ impl Volume {
     /// The trilinear interpolation at a fractional grid index (clamped to the grid).
     #[must_use]
     pub fn sample(&self, index: Vec3) -> f32 {
-        let top = |d: usize| (d - 1) as f32;
-        let p = index.clamp(
-            Vec3::ZERO,
-            Vec3::new(top(self.dims[0]), top(self.dims[1]), top(self.dims[2])),
-        );
+        let p = index.clamp(Vec3::ZERO, self.last_index());
         let base = p.floor();
         let f = p - base;
         let (i, j, k) = (base.x as isize, base.y as isize, base.z as isize);

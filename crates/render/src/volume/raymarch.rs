@@ -35,8 +35,19 @@ pub enum View {
 }
 
 impl View {
-    /// The names of the standard views.
-    pub const NAMES: [&'static str; 3] = ["axial", "sagittal", "coronal"];
+    /// The standard views, as the command line names them.
+    pub const STANDARD: [View; 3] = [View::Axial, View::Sagittal, View::Coronal];
+
+    /// The view's name (`eye` for a perspective view).
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            View::Axial => "axial",
+            View::Sagittal => "sagittal",
+            View::Coronal => "coronal",
+            View::Eye(_) => "eye",
+        }
+    }
 }
 
 /// A pinhole or parallel camera framing the volume.
@@ -134,7 +145,7 @@ pub struct Shading {
     pub geometry: Geometry,
     /// The specular normalisation.
     pub normalisation: Normalisation,
-    /// Ambient, diffuse and specular weights.
+    /// Ambient weight.
     pub ka: f32,
     /// Diffuse weight.
     pub kd: f32,
@@ -179,12 +190,7 @@ impl DvrSettings {
 
 /// Where a ray (in grid coordinates, advancing `direction` per millimetre) is inside the grid.
 fn inside_grid(volume: &Volume, origin: Vec3, direction: Vec3) -> Option<(f32, f32)> {
-    let dims = volume.dims();
-    let high = Vec3::new(
-        (dims[0] - 1) as f32,
-        (dims[1] - 1) as f32,
-        (dims[2] - 1) as f32,
-    );
+    let high = volume.last_index();
     let (mut near, mut far) = (0.0_f32, f32::INFINITY);
     for axis in 0..3 {
         let (o, d, h) = (origin[axis], direction[axis], high[axis]);
@@ -222,14 +228,9 @@ pub fn render_dvr(
     let camera = RayCamera::new(settings.view, volume)?;
     let spacing = volume.spacing();
     let step = settings.step_fraction * spacing.min_element();
-    let (lo, hi) = volume.range();
-    let gradient_reference = (0.02 * (hi - lo) / spacing.min_element()).max(f32::MIN_POSITIVE);
-    let threshold = transfer.threshold();
-    let light = camera.light();
-    let prepared = settings
+    let lighting = settings
         .shading
-        .map(|s| (s, s.normalisation.constant_for(&s.lobe) as f32));
-    let to_index = volume.to_world().inverse();
+        .map(|shading| Lighting::new(shading, volume, camera.light()));
     let mut pixels = vec![settings.background; width as usize * height as usize];
     pixels
         .par_chunks_mut(width as usize)
@@ -238,7 +239,8 @@ pub fn render_dvr(
             for (x, pixel) in row.iter_mut().enumerate() {
                 let (origin, direction) = camera.ray(x as u32, y as u32, width, height);
                 let wo = -direction;
-                let (grid_origin, grid_direction) = (volume.index(origin), to_index * direction);
+                let (grid_origin, grid_direction) =
+                    (volume.index(origin), volume.index_direction(direction));
                 let Some((start, end)) = inside_grid(volume, grid_origin, grid_direction) else {
                     continue;
                 };
@@ -254,27 +256,14 @@ pub fn render_dvr(
                     t += segment;
                     let length = segment;
                     segment = step;
-                    let value = volume.sample(index);
-                    if value < threshold {
-                        continue;
-                    }
-                    let (sigma, base) = transfer.at(value);
+                    let (sigma, base) = transfer.at(volume.sample(index));
                     if sigma <= 0.0 {
                         continue;
                     }
                     let alpha = 1.0 - (-sigma * length).exp();
-                    let shaded = match prepared {
+                    let shaded = match &lighting {
                         None => base,
-                        Some((shading, scale)) => shade(
-                            volume,
-                            index,
-                            base,
-                            wo,
-                            light,
-                            &shading,
-                            scale,
-                            gradient_reference,
-                        ),
+                        Some(lighting) => lighting.shade(volume, index, base, wo),
                     };
                     colour += transmittance * alpha * shaded;
                     transmittance *= 1.0 - alpha;
@@ -296,32 +285,50 @@ fn pixel_jitter(x: u32, y: u32) -> f32 {
     ((h >> 8) as f32 + 1.0) / (1 << 24) as f32
 }
 
-/// A sample's colour lit by the classic model, with the gradient as the normal.
-#[allow(clippy::too_many_arguments)]
-fn shade(
-    volume: &Volume,
-    index: Vec3,
-    base: Vec3,
-    wo: Vec3,
-    wi: Vec3,
-    shading: &Shading,
+/// What every shaded sample of one render shares, prepared once.
+#[derive(Clone, Copy, Debug)]
+struct Lighting {
+    shading: Shading,
+    /// The normalisation's constant for the lobe.
     normalisation: f32,
+    /// `wi`: towards the light.
+    light: Vec3,
+    /// The gradient magnitude at which a sample is fully shaded: 2 % of the value range per
+    /// voxel.
     gradient_reference: f32,
-) -> Vec3 {
-    let gradient = volume.gradient(index);
-    let strength = gradient.length();
-    if !(strength > 0.0 && strength.is_finite()) {
-        return base;
+}
+
+impl Lighting {
+    fn new(shading: Shading, volume: &Volume, light: Vec3) -> Self {
+        let (lo, hi) = volume.range();
+        let voxel = volume.spacing().min_element();
+        Self {
+            shading,
+            normalisation: shading.normalisation.constant_for(&shading.lobe) as f32,
+            light,
+            gradient_reference: (0.02 * (hi - lo) / voxel).max(f32::MIN_POSITIVE),
+        }
     }
-    let mut normal = -gradient / strength;
-    if normal.dot(wo) < 0.0 {
-        normal = -normal;
+
+    /// A sample's colour `base` lit by the classic model, with the gradient as the normal,
+    /// seen along `wo`.
+    fn shade(&self, volume: &Volume, index: Vec3, base: Vec3, wo: Vec3) -> Vec3 {
+        let gradient = volume.gradient(index);
+        let strength = gradient.length();
+        if !(strength > 0.0 && strength.is_finite()) {
+            return base;
+        }
+        let mut normal = -gradient / strength;
+        if normal.dot(wo) < 0.0 {
+            normal = -normal;
+        }
+        let (shading, wi) = (&self.shading, self.light);
+        let diffuse = normal.dot(wi).max(0.0);
+        let t = shading.geometry.cos_lobe_f32(normal, wo, wi);
+        let specular = shading.ks * self.normalisation * shading.lobe.eval(t);
+        let lit = base * (shading.ka + shading.kd * diffuse) + Vec3::splat(specular);
+        base.lerp(lit, (strength / self.gradient_reference).min(1.0))
     }
-    let diffuse = normal.dot(wi).max(0.0);
-    let t = shading.geometry.cos_lobe_f32(normal, wo, wi);
-    let specular = shading.ks * normalisation * shading.lobe.eval(t);
-    let lit = base * (shading.ka + shading.kd * diffuse) + Vec3::splat(specular);
-    base.lerp(lit, (strength / gradient_reference).min(1.0))
 }
 
 #[cfg(test)]

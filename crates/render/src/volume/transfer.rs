@@ -130,9 +130,10 @@ impl TransferFunction {
             ),
             _ => {
                 return Err(VolumeError(format!(
-                    "unknown transfer function '{}'; presets: {}, or a .toml file",
+                    "unknown transfer function '{}'; presets: {}, or a .toml file{}",
                     specula::excerpt(name),
-                    PRESETS.join(", ")
+                    PRESETS.join(", "),
+                    specula::did_you_mean(name, PRESETS)
                 )))
             }
         };
@@ -228,16 +229,6 @@ impl TransferFunction {
         let last = points[points.len() - 1];
         (last.sigma, last.colour)
     }
-
-    /// The smallest value with a non-zero extinction (below it the function is empty space).
-    #[must_use]
-    pub fn threshold(&self) -> f32 {
-        let points = &self.points;
-        match points.iter().position(|p| p.sigma > 0.0) {
-            Some(0) | None => f32::NEG_INFINITY,
-            Some(k) => points[k - 1].value,
-        }
-    }
 }
 
 #[cfg(test)]
@@ -260,7 +251,6 @@ mod tests {
             (sigma - 0.25).abs() < 1e-6 && (colour - Vec3::new(0.25, 0.125, 0.0)).length() < 1e-6
         );
         assert_eq!(f.at(50.0).0, 1.0);
-        assert_eq!(f.threshold(), 0.0);
     }
 
     #[test]
