@@ -26,6 +26,20 @@ fn corpus_copy() -> tempfile::TempDir {
     directory
 }
 
+/// A render to `out.png` large enough to take a while on any machine, for the tests that
+/// stop one part-way.
+const SLOW_RENDER: [&str; 9] = [
+    "render",
+    "--width",
+    "8000",
+    "--height",
+    "8000",
+    "--samples",
+    "2",
+    "-o",
+    "out.png",
+];
+
 fn files(directory: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(directory)
         .expect("list")
@@ -189,20 +203,10 @@ fn earlier_outputs_survive_failed_and_interrupted_renders() {
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
-    // A render killed part-way (large enough to take a while on any machine).
+    // A render killed part-way.
     let mut child = Command::new(env!("CARGO_BIN_EXE_specula"))
         .current_dir(path)
-        .args([
-            "render",
-            "--width",
-            "8000",
-            "--height",
-            "8000",
-            "--samples",
-            "2",
-            "-o",
-            "out.png",
-        ])
+        .args(SLOW_RENDER)
         .spawn()
         .expect("start a render");
     std::thread::sleep(Duration::from_millis(400));
@@ -335,16 +339,7 @@ fn interrupted_commands_leave_nothing_behind() {
     for signal in ["-INT", "-TERM"] {
         let child = Command::new(env!("CARGO_BIN_EXE_specula"))
             .current_dir(path)
-            .args([
-                "render",
-                "--width",
-                "8000",
-                "--height",
-                "8000",
-                "--samples",
-                "2",
-            ])
-            .args(["-o", "out.png"])
+            .args(SLOW_RENDER)
             .stderr(std::process::Stdio::piped())
             .spawn()
             .expect("start a render");

@@ -5,7 +5,7 @@
 mod common;
 
 use assert_cmd::Command;
-use common::{ok, specula};
+use common::{have_tool, ok, specula};
 use serde_json::Value;
 
 fn have_gpu() -> bool {
@@ -188,24 +188,11 @@ fn bench_gpu_lists_every_lobe_with_its_ratio_to_pow() {
     assert!(text.contains("1.00x"), "{text}");
 }
 
-/// Whether `glslangValidator` runs: required under CI (`CI=true`), else the test skips.
-fn have_glslang() -> bool {
-    let found = std::process::Command::new("glslangValidator")
-        .arg("--version")
-        .output()
-        .is_ok();
-    assert!(
-        found || std::env::var("CI").as_deref() != Ok("true"),
-        "CI=true but no glslangValidator"
-    );
-    found
-}
-
 /// The recipe in docs/gpu.md: the exported text, as it is, at the top of a shader of one's own that
 /// calls `specula_specular`; glslang accepts it.
 #[test]
 fn the_documented_glsl_paste_recipe_compiles() {
-    if !have_glslang() {
+    if !have_tool("glslangValidator", "--version", "glslang-tools") {
         return;
     }
     let directory = tempfile::tempdir().unwrap();
@@ -331,7 +318,7 @@ fn the_gpu_path_keeps_stderr_clean() {
 /// the construct named.
 #[test]
 fn exported_glsl_compiles_unedited_for_each_version() {
-    if !have_glslang() {
+    if !have_tool("glslangValidator", "--version", "glslang-tools") {
         return;
     }
     let directory = tempfile::tempdir().unwrap();

@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{ok, specula};
+use common::{have_tool, ok, specula};
 
 /// A command line's words.
 fn words(line: &str) -> Vec<&str> {
@@ -117,26 +117,10 @@ fn bad_requests_name_the_problem_and_write_nothing() {
     );
 }
 
-/// Whether `tool` runs; when it does not, CI (`CI=true`) fails and a local run skips.
-fn have(tool: &str, version_flag: &str, package: &str) -> bool {
-    let found = std::process::Command::new(tool)
-        .arg(version_flag)
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !found {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "{tool} is not installed, and CI=true requires it: apt-get install {package}"
-        );
-        eprintln!("skipped: {tool} is not installed (apt-get install {package})");
-    }
-    found
-}
-
 /// `hw synth` reports Yosys's own cell counts with its version; a cached rerun agrees.
 #[test]
 fn synth_json_carries_the_tools_figures_and_versions() {
-    if !have("yosys", "-V", "yosys") {
+    if !have_tool("yosys", "-V", "yosys") {
         return;
     }
     let directory = tempfile::tempdir().expect("temporary directory");

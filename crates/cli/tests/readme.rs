@@ -10,6 +10,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+mod common;
+
+use common::have_tool;
+
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
@@ -85,30 +89,17 @@ fn the_two_set_up_commands_lead_the_readme_and_ci_runs_the_test_command() {
     );
 }
 
-/// A tool a command needs, found or not; with `CI=true` a missing one fails the test.
-fn have(tool: &str) -> bool {
-    let found = Command::new("sh")
-        .args(["-c", &format!("command -v {tool}")])
-        .output()
-        .is_ok_and(|output| output.status.success());
-    assert!(
-        found || std::env::var("CI").as_deref() != Ok("true"),
-        "CI=true but no {tool}"
-    );
-    if !found {
-        eprintln!("skipped: commands that need {tool}");
-    }
-    found
-}
-
-/// The tools a command line needs besides specula.
-fn tools(line: &str) -> Vec<&'static str> {
+/// The tools a command line needs besides specula: `(tool, version flag, Debian package)`.
+fn tools(line: &str) -> Vec<(&'static str, &'static str, &'static str)> {
     let mut needed = Vec::new();
     if line.contains("iverilog") {
-        needed.extend(["iverilog", "vvp"]);
+        needed.extend([("iverilog", "-V", "iverilog"), ("vvp", "-V", "iverilog")]);
     }
     if line.contains("hw synth") {
-        needed.extend(["yosys", "nextpnr-ice40"]);
+        needed.extend([
+            ("yosys", "-V", "yosys"),
+            ("nextpnr-ice40", "--version", "nextpnr-ice40"),
+        ]);
     }
     needed
 }
@@ -190,7 +181,10 @@ fn every_command_in_the_readme_and_docs_runs_as_written() {
                 ["specula", "iverilog"].contains(&program),
                 "{document}: {line:?} runs neither specula nor a tool this test knows"
             );
-            if !tools(&line).into_iter().all(have) {
+            if !tools(&line)
+                .into_iter()
+                .all(|(tool, flag, package)| have_tool(tool, flag, package))
+            {
                 continue;
             }
             if line.starts_with("specula serve") {

@@ -1,4 +1,6 @@
-//! Running the `specula` binary in a directory of the test's own.
+//! Running the `specula` binary in a directory of the test's own, and the tools some tests
+//! need. Each test file compiles this module on its own and uses part of it.
+#![allow(dead_code)]
 
 use std::path::Path;
 
@@ -23,4 +25,22 @@ pub fn ok(directory: &Path, args: &[&str]) -> std::process::Output {
         String::from_utf8_lossy(&output.stderr)
     );
     output
+}
+
+/// Whether `tool` runs (`tool version_flag` succeeds). When it does not, a run with `CI=true`
+/// fails, naming the Debian package, and any other run prints `skipped: ...` and the caller
+/// skips.
+pub fn have_tool(tool: &str, version_flag: &str, package: &str) -> bool {
+    let found = std::process::Command::new(tool)
+        .arg(version_flag)
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !found {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "{tool} is not installed, and CI=true requires it: apt-get install {package}"
+        );
+        eprintln!("skipped: {tool} is not installed (apt-get install {package})");
+    }
+    found
 }
