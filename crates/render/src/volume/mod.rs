@@ -7,12 +7,18 @@
 //! field, one voxel apart, taken to world units by the inverse transpose of the map.
 //!
 //! - [`phantom`]: the built-in volumes (the 3D Shepp-Logan head, the Marschner-Lobb signal);
+//! - [`nifti`] and [`dicom`]: the files scanners and research tools write ([`read`] and
+//!   [`write`] choose by path);
 //! - [`transfer`]: transfer functions (extinction and colour by value) and their presets;
 //! - [`raymarch`]: direct volume rendering with any lobe as the specular term.
+
+use std::path::Path;
 
 use glam::{Mat3, Vec3};
 use thiserror::Error;
 
+pub mod dicom;
+pub mod nifti;
 pub mod phantom;
 pub mod raymarch;
 pub mod transfer;
@@ -260,6 +266,31 @@ impl Volume {
             difference(Vec3::Z),
         );
         self.to_index.transpose() * along_index
+    }
+}
+
+/// Reads the volume at `path`: a folder is a DICOM series, a `.nii` or `.nii.gz` file is
+/// NIfTI-1.
+pub fn read(path: &Path) -> Result<Volume, VolumeError> {
+    if path.is_dir() {
+        dicom::read_series(path)
+    } else if nifti::is_nifti_path(path) {
+        nifti::read(path)
+    } else {
+        Err(VolumeError(format!(
+            "{}: not a volume; give a .nii or .nii.gz file or a folder holding a DICOM series",
+            path.display()
+        )))
+    }
+}
+
+/// Writes `volume` to `path`: NIfTI-1 when it ends in `.nii` or `.nii.gz`, otherwise a DICOM
+/// series in the new folder `path`.
+pub fn write(volume: &Volume, path: &Path) -> Result<(), VolumeError> {
+    if nifti::is_nifti_path(path) {
+        nifti::write(volume, path)
+    } else {
+        dicom::write_series(volume, path)
     }
 }
 
