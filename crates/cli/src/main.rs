@@ -87,14 +87,22 @@ enum Command {
                             specula hw synth --target ice40 --device hx8k --bits 12 --lobe cosquad,pow,sg"
     )]
     Hw(commands::hw::Args),
-    /// Render a volume (the Shepp-Logan head, Marschner-Lobb) by ray marching, any lobe as its
-    /// specular term.
+    /// Render a volume (the Shepp-Logan head, Marschner-Lobb, NIfTI, a DICOM series) by ray
+    /// marching or as an isosurface, any lobe as its specular term, on the CPU or GPU.
     #[command(
-        after_help = "Examples:\n  specula volume --input phantom --lobe cosquad -o head.png\n  \
-                            specula volume --input marschner-lobb --size 64 --view axial -o ml.png\n  \
-                            specula volume --eye 400,-300,200 --transfer ct-soft-tissue -o side.png"
+        after_help = "Examples:\n  specula volume --input phantom --mode dvr --lobe cosquad -o head.png\n  \
+                            specula volume --input head.nii.gz --mode iso --iso 0.5 --backend gpu -o skull.png\n  \
+                            specula volume --input ct-series/ --transfer ct-bone --view axial -o ct.png\n  \
+                            specula volume --input marschner-lobb --size 64 --eye 400,-300,200 -o ml.png"
     )]
     Volume(commands::volume::Args),
+    /// Write a volume (built in, NIfTI or a DICOM series) as NIfTI-1 or as a DICOM series.
+    #[command(
+        after_help = "Examples:\n  specula volume-convert --input phantom -o head.nii.gz\n  \
+                            specula volume-convert --input phantom -o head-dicom\n  \
+                            specula volume-convert --input ct-series/ -o ct.nii.gz"
+    )]
+    VolumeConvert(commands::volume::ConvertArgs),
     /// Serve the interactive BRDF explorer (page and JSON API) on 127.0.0.1.
     #[command(
         after_help = "Examples:\n  specula serve --open\n  specula serve --port 9000\n  specula serve --port 0   # a free port, printed"
@@ -188,6 +196,7 @@ fn main() -> ExitCode {
         Command::Report(args) => commands::report::run(&args),
         Command::Render(args) => commands::render::run(&args),
         Command::Volume(args) => commands::volume::run(&args),
+        Command::VolumeConvert(args) => commands::volume::convert(&args),
         Command::Diff(args) => commands::diff::run(&args),
         Command::Shader(args) => commands::shader::run(&args),
         Command::Bench(args) => commands::bench::run(&args),

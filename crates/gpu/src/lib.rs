@@ -24,9 +24,11 @@ mod render;
 pub mod shader_ops;
 pub mod throughput;
 pub mod uniforms;
+mod volume;
 pub mod wgsl;
 
 pub use context::{Gpu, GpuError};
 pub use evaluate::{evaluate_wgsl_function, GpuEvaluator, LobeEvaluator};
 pub use frame::{FrameTime, GpuFrame};
 pub use render::GpuRenderer;
+pub use volume::GpuVolumeRenderer;

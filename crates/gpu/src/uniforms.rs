@@ -42,6 +42,15 @@ impl LobeBlock {
     }
 }
 
+/// The id geometry.wgsl's `cos_lobe` switches on.
+#[must_use]
+pub fn geometry_id(geometry: Geometry) -> u32 {
+    match geometry {
+        Geometry::Phong => 0,
+        Geometry::Blinn => 1,
+    }
+}
+
 /// `struct Material` of brdf.wgsl (80 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -65,10 +74,7 @@ impl MaterialBlock {
         let (geometry, model) = shader.geometry_and_model();
         Self {
             ambient: ambient.to_array(),
-            geometry: match geometry {
-                Geometry::Phong => 0,
-                Geometry::Blinn => 1,
-            },
+            geometry: geometry_id(geometry),
             diffuse: diffuse.to_array(),
             model: match model {
                 IlluminationModel::Classic => 0,

@@ -2,8 +2,8 @@
 //!
 //! `lobes.wgsl` is the library (one function per lobe, `lobe_eval` dispatching on the kind's
 //! index); `geometry.wgsl` computes the lobe's cosine; `brdf.wgsl` adds the illumination
-//! models; `render.wgsl` and
-//! `evaluate.wgsl` are the entry points. A module is the concatenation of the files it needs
+//! models; `render.wgsl`, `evaluate.wgsl` and `volume.wgsl` (the ray marcher) are the entry
+//! points. A module is the concatenation of the files it needs
 //! (WGSL declarations may come in any order).
 
 use specula::LobeKind;
@@ -16,6 +16,8 @@ pub const GEOMETRY: &str = include_str!("../shaders/geometry.wgsl");
 pub const BRDF: &str = include_str!("../shaders/brdf.wgsl");
 /// The render pipeline's entry points.
 pub const RENDER: &str = include_str!("../shaders/render.wgsl");
+/// The direct-volume-rendering compute shader.
+pub const VOLUME: &str = include_str!("../shaders/volume.wgsl");
 /// The lobe-evaluation compute shader.
 pub const EVALUATE: &str = include_str!("../shaders/evaluate.wgsl");
 
@@ -29,6 +31,12 @@ pub fn lobe_function(kind: LobeKind) -> String {
 #[must_use]
 pub fn render_module() -> String {
     [LOBES, GEOMETRY, BRDF, RENDER].concat()
+}
+
+/// The volume ray marcher's source.
+#[must_use]
+pub fn volume_module() -> String {
+    [LOBES, GEOMETRY, VOLUME].concat()
 }
 
 /// The compute module's source.

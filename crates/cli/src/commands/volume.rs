@@ -1,4 +1,6 @@
-//! `specula volume`: direct volume rendering of a built-in volume with any lobe.
+//! `specula volume`: a volume (built in, NIfTI or a DICOM series) rendered with any lobe, by
+//! ray marching or as an isosurface, on the CPU or the GPU; `specula volume-convert` writes
+//! one as NIfTI or DICOM.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -6,13 +8,26 @@ use std::time::Instant;
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+use specula_gpu::{Gpu, GpuRenderer, GpuVolumeRenderer};
+use specula_render::volume::isosurface::{
+    default_isovalue, iso_scene, marching_cubes, IsoSettings,
+};
 use specula_render::volume::raymarch::{render_dvr, DvrSettings, Shading, View};
 use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::{phantom, Volume};
-use specula_render::{check_output_path, write_image, Display};
+use specula_render::volume::{self, phantom, Volume};
+use specula_render::{check_output_path, render, write_image, Display, Image};
 
 use super::CommandResult;
-use crate::args::{choice, parse_exponent, LobeParser};
+use crate::args::{choice, parse_exponent, InputLimit, LobeParser, RendererArg};
+
+/// How the volume is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Mode {
+    /// Direct volume rendering: rays through a transfer function, shaded by the gradient.
+    Dvr,
+    /// The surface at `--iso` by marching cubes, drawn by the rasterizer.
+    Iso,
+}
 
 /// The volumes built in.
 const BUILT_IN: [&str; 2] = ["phantom", "marschner-lobb"];
@@ -20,12 +35,17 @@ const BUILT_IN: [&str; 2] = ["phantom", "marschner-lobb"];
 /// Arguments of `specula volume`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The volume: `phantom` (the 3D Shepp-Logan head) or `marschner-lobb` (the test signal).
-    #[arg(long, default_value = "phantom")]
-    input: String,
-    /// Voxels along each side of a built-in volume.
-    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=512))]
-    size: u32,
+    #[command(flatten)]
+    source: Source,
+    /// How to draw it.
+    #[arg(long, value_enum, default_value = "dvr")]
+    mode: Mode,
+    /// The isovalue of --mode iso; by default 300 (bone) for CT, else the middle of the range.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
+    iso: Option<f32>,
+    /// How --mode iso interpolates its lighting.
+    #[arg(long, value_parser = choice(&specula_render::Shading::ALL, specula_render::Shading::id), default_value = "phong")]
+    shading: specula_render::Shading,
     /// The transfer function: a preset (ct-bone, ct-soft-tissue, mr) or a .toml file; by
     /// default ct-bone for CT and mr otherwise.
     #[arg(long)]
@@ -54,9 +74,46 @@ pub struct Args {
     /// Image height in pixels.
     #[arg(long, default_value_t = 384, value_parser = clap::value_parser!(u32).range(1..=8192))]
     height: u32,
+    /// Which renderer draws.
+    #[arg(long, value_enum, default_value = "cpu")]
+    backend: RendererArg,
     /// Output image: .png (8-bit sRGB) or .exr (linear f32).
     #[arg(short, long, default_value = "volume.png")]
     output: PathBuf,
+}
+
+/// Where a volume comes from (shared by `volume` and `volume-convert`).
+#[derive(Debug, clap::Args)]
+pub struct Source {
+    /// The volume: `phantom` (the 3D Shepp-Logan head), `marschner-lobb` (the test signal), a
+    /// NIfTI-1 file (.nii, .nii.gz) or a folder holding one DICOM series.
+    #[arg(long, default_value = "phantom")]
+    input: String,
+    /// Voxels along each side of a built-in volume.
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=512))]
+    size: u32,
+    #[command(flatten)]
+    input_limit: InputLimit,
+}
+
+/// Arguments of `specula volume-convert`.
+#[derive(Debug, clap::Args)]
+pub struct ConvertArgs {
+    #[command(flatten)]
+    source: Source,
+    /// Where to write: a .nii or .nii.gz file, or else a new folder for a DICOM series.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+fn parse_finite(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(value) if value.is_finite() => Ok(value),
+        _ => Err(format!(
+            "'{}' must be a finite number",
+            specula::excerpt(text)
+        )),
+    }
 }
 
 fn parse_point(text: &str) -> Result<Vec3, String> {
@@ -80,14 +137,16 @@ fn parse_point(text: &str) -> Result<Vec3, String> {
 }
 
 /// The volume `--input` names.
-fn load(args: &Args) -> Result<Volume, String> {
-    let side = args.size as usize;
-    let built = match args.input.as_str() {
+fn load(source: &Source) -> Result<Volume, String> {
+    source.input_limit.apply();
+    let side = source.size as usize;
+    let built = match source.input.as_str() {
         "phantom" => phantom::shepp_logan(side),
         "marschner-lobb" => phantom::marschner_lobb(side),
+        path if std::path::Path::new(path).exists() => volume::read(std::path::Path::new(path)),
         other => {
             return Err(format!(
-                "unknown volume '{}'; built in: {}{}",
+                "'{}' is neither a built-in volume ({}) nor an existing file or folder{}",
                 specula::excerpt(other),
                 BUILT_IN.join(", "),
                 specula::did_you_mean(other, BUILT_IN)
@@ -115,8 +174,7 @@ fn transfer(args: &Args, volume: &Volume) -> Result<TransferFunction, String> {
 pub fn run(args: &Args) -> CommandResult {
     check_output_path(&args.output).map_err(|e| e.to_string())?;
     let started = Instant::now();
-    let volume = load(args)?;
-    let transfer = transfer(args, &volume)?;
+    let volume = load(&args.source)?;
     let shading = Shading {
         lobe: Lobe::new(args.lobe, args.n),
         geometry: args.geometry,
@@ -126,25 +184,108 @@ pub fn run(args: &Args) -> CommandResult {
         ks: 0.5,
     };
     let view = args.eye.map_or(args.view, View::Eye);
-    let settings = DvrSettings::new(args.width, args.height, view, Some(shading));
-    let bar = ProgressBar::new(u64::from(args.height)).with_style(
-        ProgressStyle::with_template("ray marching {bar:30} {percent}% {elapsed}")
+    let gpu = match args.backend {
+        RendererArg::Cpu => None,
+        RendererArg::Gpu => Some(Gpu::new().map_err(|e| e.to_string())?),
+    };
+    let bar = ProgressBar::new(1).with_style(
+        ProgressStyle::with_template("{msg} {bar:30} {percent}% {elapsed}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let image =
-        render_dvr(&volume, &transfer, &settings, &|| bar.inc(1)).map_err(|e| e.to_string())?;
+    let image = match args.mode {
+        Mode::Dvr => {
+            let transfer = transfer(args, &volume)?;
+            let settings = DvrSettings::new(args.width, args.height, view, Some(shading));
+            match &gpu {
+                Some(gpu) => GpuVolumeRenderer::new(gpu)
+                    .and_then(|renderer| renderer.render(&volume, &transfer, &settings))
+                    .map_err(|e| e.to_string())?,
+                None => {
+                    bar.set_message("ray marching");
+                    bar.set_length(u64::from(args.height));
+                    render_dvr(&volume, &transfer, &settings, &|| bar.inc(1))
+                        .map_err(|e| e.to_string())?
+                }
+            }
+        }
+        Mode::Iso => iso(args, &volume, view, shading, gpu.as_ref(), &bar)?,
+    };
     bar.finish_and_clear();
     write_image(&args.output, &image, Display::default()).map_err(|e| e.to_string())?;
     let [nx, ny, nz] = volume.dims();
+    let device = gpu.map_or_else(|| "CPU".to_owned(), |gpu| gpu.adapter_name());
     eprintln!(
-        "wrote {} ({}x{}, {} {nx}x{ny}x{nz}, {} n = {}, {:.2} s)",
+        "wrote {} ({}x{}, {} {nx}x{ny}x{nz}, {}, {} n = {}, {device}, {:.2} s)",
         args.output.display(),
         args.width,
         args.height,
-        args.input,
+        args.source.input,
+        match args.mode {
+            Mode::Dvr => "ray marched".to_owned(),
+            Mode::Iso => format!(
+                "isosurface at {}",
+                args.iso.unwrap_or_else(|| default_isovalue(&volume))
+            ),
+        },
         args.lobe,
         args.n,
         started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// Extracts and draws the isosurface.
+fn iso(
+    args: &Args,
+    volume: &Volume,
+    view: View,
+    shading: Shading,
+    gpu: Option<&Gpu>,
+    bar: &ProgressBar,
+) -> Result<Image, String> {
+    let iso = args.iso.unwrap_or_else(|| default_isovalue(volume));
+    let (lo, hi) = volume.range();
+    if !(lo..=hi).contains(&iso) {
+        return Err(format!(
+            "--iso {iso} is outside the volume's values [{lo}, {hi}]; no surface would be drawn"
+        ));
+    }
+    bar.set_message("marching cubes");
+    let mesh = marching_cubes(volume, iso).map_err(|e| e.to_string())?;
+    let settings = IsoSettings {
+        width: args.width,
+        height: args.height,
+        view,
+        iso,
+        shading,
+        method: args.shading,
+        samples: 2,
+    };
+    let scene = iso_scene(volume, mesh, &settings).map_err(|e| e.to_string())?;
+    match gpu {
+        Some(gpu) => GpuRenderer::new(gpu)
+            .and_then(|renderer| renderer.render(&scene))
+            .map_err(|e| e.to_string()),
+        None => {
+            bar.set_message("rasterizing");
+            render(&scene, &|done, total| {
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+            })
+            .map_err(|e| e.to_string())
+        }
+    }
+}
+
+/// Writes the volume as NIfTI or a DICOM series.
+pub fn convert(args: &ConvertArgs) -> CommandResult {
+    let volume = load(&args.source)?;
+    volume::write(&volume, &args.output).map_err(|e| e.to_string())?;
+    let [nx, ny, nz] = volume.dims();
+    eprintln!(
+        "wrote {} ({} {nx}x{ny}x{nz})",
+        args.output.display(),
+        args.source.input
     );
     Ok(())
 }

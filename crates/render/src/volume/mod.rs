@@ -18,6 +18,7 @@ use glam::{Mat3, Vec3};
 use thiserror::Error;
 
 pub mod dicom;
+pub mod isosurface;
 pub mod nifti;
 pub mod phantom;
 pub mod raymarch;

@@ -115,8 +115,61 @@ pub const HEAD_MM: f32 = 256.0;
 
 /// The 3D Shepp-Logan head on a `side^3` grid spanning [`HEAD_MM`], centred on the origin,
 /// `x` the phantom's first axis (towards the patient's right), `y` anterior, `z` superior.
+///
+/// Each voxel is the density's mean over its cell (3 x 3 x 3 points), as a scanner's
+/// detector integrates it: voxels that straddle a boundary take a value between the two
+/// tissues (the partial-volume effect). Point samples would make every surface a staircase
+/// whose gradients, and so whose highlights, follow the grid rather than the ellipsoids.
 pub fn shepp_logan(side: usize) -> Result<Volume, VolumeError> {
-    grid(side, HEAD_MM, shepp_logan_density)
+    Volume::check_dims([side; 3])?;
+    let prepared: Vec<(DMat3, DVec3, DVec3, f64)> = SHEPP_LOGAN
+        .iter()
+        .map(|e| {
+            (
+                rotation(e.angles),
+                DVec3::from_array(e.centre),
+                DVec3::from_array(e.axes).recip(),
+                e.density,
+            )
+        })
+        .collect();
+    let density = |p: DVec3| -> f64 {
+        prepared
+            .iter()
+            .filter(|(turn, centre, inverse_axes, _)| {
+                ((*turn * p - *centre) * *inverse_axes).length_squared() <= 1.0
+            })
+            .map(|&(.., density)| density)
+            .sum()
+    };
+    let cell = 2.0 / (side - 1) as f64;
+    grid(side, HEAD_MM, |p| {
+        let centre = density(p);
+        let probes = [
+            DVec3::X,
+            DVec3::NEG_X,
+            DVec3::Y,
+            DVec3::NEG_Y,
+            DVec3::Z,
+            DVec3::NEG_Z,
+        ];
+        if probes
+            .iter()
+            .all(|&d| density(p + 0.5 * cell * d) == centre)
+        {
+            return centre;
+        }
+        let offsets = [-1.0 / 3.0, 0.0, 1.0 / 3.0];
+        let mut sum = 0.0;
+        for dz in offsets {
+            for dy in offsets {
+                for dx in offsets {
+                    sum += density(p + cell * DVec3::new(dx, dy, dz));
+                }
+            }
+        }
+        sum / 27.0
+    })
 }
 
 /// `f_M`, the Marschner-Lobb signal's frequency.

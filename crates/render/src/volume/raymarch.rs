@@ -20,6 +20,7 @@ use specula::{Geometry, Lobe, Normalisation};
 use super::transfer::TransferFunction;
 use super::{Volume, VolumeError};
 use crate::image::Image;
+use crate::{Camera, Projection};
 
 /// Where the volume is seen from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,20 +51,26 @@ impl View {
     }
 }
 
-/// A pinhole or parallel camera framing the volume.
-#[derive(Clone, Copy, Debug)]
-struct RayCamera {
-    eye: Vec3,
-    forward: Vec3,
-    right: Vec3,
-    up: Vec3,
+/// A view's rays: parallel ones from a plane, or a pinhole's from the eye.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayCamera {
+    /// The eye (pinhole), or the centre of the plane the parallel rays start from.
+    pub eye: Vec3,
+    /// The view direction.
+    pub forward: Vec3,
+    /// The image's `+x` in the world.
+    pub right: Vec3,
+    /// The image's `+y` in the world.
+    pub up: Vec3,
     /// Half the view's height: in millimetres (parallel) or as `tan(fov / 2)` (pinhole).
-    half_height: f32,
-    parallel: bool,
+    pub half_height: f32,
+    /// Parallel rays (the standard views) or a pinhole (`--eye`).
+    pub parallel: bool,
 }
 
 impl RayCamera {
-    fn new(view: View, volume: &Volume) -> Result<Self, VolumeError> {
+    /// The rays that frame `volume` from `view`.
+    pub fn new(view: View, volume: &Volume) -> Result<Self, VolumeError> {
         let corners = volume.corners();
         let centre = corners.iter().copied().sum::<Vec3>() / 8.0;
         let radius = corners
@@ -131,9 +138,40 @@ impl RayCamera {
     }
 
     /// The light: at the eye, offset up and to the left.
-    fn light(&self) -> Vec3 {
+    #[must_use]
+    pub fn light(&self) -> Vec3 {
         (-self.forward + 0.35 * self.up - 0.35 * self.right).normalize()
     }
+}
+
+/// The rasterizer's camera for `view` of `volume`, framed as the ray marcher frames it, and
+/// the direction towards the light.
+pub fn surface_camera(view: View, volume: &Volume) -> Result<(Camera, Vec3), VolumeError> {
+    let rays = RayCamera::new(view, volume)?;
+    let corners = volume.corners();
+    let reach = corners
+        .iter()
+        .map(|c| c.distance(rays.eye))
+        .fold(0.0, f32::max);
+    let projection = if rays.parallel {
+        Projection::Orthographic {
+            height: 2.0 * rays.half_height,
+        }
+    } else {
+        Projection::Perspective {
+            fov_y_degrees: (2.0 * rays.half_height.atan()).to_degrees(),
+        }
+    };
+    let camera = Camera::try_new(
+        rays.eye,
+        rays.eye + rays.forward,
+        rays.up,
+        projection,
+        1e-3 * reach,
+        1.01 * reach,
+    )
+    .map_err(|e| VolumeError(e.to_string()))?;
+    Ok((camera, rays.light()))
 }
 
 /// The specular material every sample shares.
@@ -207,6 +245,41 @@ fn inside_grid(volume: &Volume, origin: Vec3, direction: Vec3) -> Option<(f32, f
     (near < far).then_some((near, far))
 }
 
+/// What a render fixes before its first ray, so that another backend can march the same rays.
+#[derive(Clone, Copy, Debug)]
+pub struct DvrPlan {
+    /// The rays.
+    pub camera: RayCamera,
+    /// Segment length in millimetres.
+    pub step: f32,
+    /// The prepared shading, if any.
+    pub lighting: Option<Lighting>,
+}
+
+impl DvrPlan {
+    /// Checks `settings` against `volume` and prepares the render.
+    pub fn new(volume: &Volume, settings: &DvrSettings) -> Result<Self, VolumeError> {
+        let (width, height) = (settings.width, settings.height);
+        if width == 0 || height == 0 || u64::from(width) * u64::from(height) > crate::MAX_PIXELS {
+            return Err(VolumeError(format!(
+                "an image of {width} x {height}: width and height must be at least 1 and the image at most {} pixels",
+                crate::MAX_PIXELS
+            )));
+        }
+        if !(settings.step_fraction > 0.0 && settings.step_fraction <= 4.0) {
+            return Err(VolumeError("the step must be in (0, 4] voxels".into()));
+        }
+        let camera = RayCamera::new(settings.view, volume)?;
+        Ok(Self {
+            camera,
+            step: settings.step_fraction * volume.spacing().min_element(),
+            lighting: settings
+                .shading
+                .map(|shading| Lighting::new(shading, volume, camera.light())),
+        })
+    }
+}
+
 /// Renders `volume` through `transfer` (already in the volume's values: see
 /// [`TransferFunction::for_volume`]). `progress` is called once per finished row.
 pub fn render_dvr(
@@ -216,21 +289,11 @@ pub fn render_dvr(
     progress: &(dyn Fn() + Sync),
 ) -> Result<Image, VolumeError> {
     let (width, height) = (settings.width, settings.height);
-    if width == 0 || height == 0 || u64::from(width) * u64::from(height) > crate::MAX_PIXELS {
-        return Err(VolumeError(format!(
-            "an image of {width} x {height}: width and height must be at least 1 and the image at most {} pixels",
-            crate::MAX_PIXELS
-        )));
-    }
-    if !(settings.step_fraction > 0.0 && settings.step_fraction <= 4.0) {
-        return Err(VolumeError("the step must be in (0, 4] voxels".into()));
-    }
-    let camera = RayCamera::new(settings.view, volume)?;
-    let spacing = volume.spacing();
-    let step = settings.step_fraction * spacing.min_element();
-    let lighting = settings
-        .shading
-        .map(|shading| Lighting::new(shading, volume, camera.light()));
+    let DvrPlan {
+        camera,
+        step,
+        lighting,
+    } = DvrPlan::new(volume, settings)?;
     let mut pixels = vec![settings.background; width as usize * height as usize];
     pixels
         .par_chunks_mut(width as usize)
@@ -277,7 +340,8 @@ pub fn render_dvr(
 }
 
 /// A fraction in `(0, 1]` that is fixed per pixel (a hash of its coordinates).
-fn pixel_jitter(x: u32, y: u32) -> f32 {
+#[must_use]
+pub fn pixel_jitter(x: u32, y: u32) -> f32 {
     let mut h = x.wrapping_mul(0x9E37_79B9) ^ y.wrapping_mul(0x85EB_CA6B);
     h ^= h >> 15;
     h = h.wrapping_mul(0x2C1B_3C6D);
@@ -287,15 +351,16 @@ fn pixel_jitter(x: u32, y: u32) -> f32 {
 
 /// What every shaded sample of one render shares, prepared once.
 #[derive(Clone, Copy, Debug)]
-struct Lighting {
-    shading: Shading,
+pub struct Lighting {
+    /// The material.
+    pub shading: Shading,
     /// The normalisation's constant for the lobe.
-    normalisation: f32,
+    pub normalisation: f32,
     /// `wi`: towards the light.
-    light: Vec3,
+    pub light: Vec3,
     /// The gradient magnitude at which a sample is fully shaded: 2 % of the value range per
     /// voxel.
-    gradient_reference: f32,
+    pub gradient_reference: f32,
 }
 
 impl Lighting {

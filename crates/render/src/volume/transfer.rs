@@ -208,6 +208,12 @@ impl TransferFunction {
         }
     }
 
+    /// The control points, by increasing value.
+    #[must_use]
+    pub fn points(&self) -> &[ControlPoint] {
+        &self.points
+    }
+
     /// Extinction (per mm) and colour at `value`.
     #[must_use]
     pub fn at(&self, value: f32) -> (f32, Vec3) {

@@ -1,0 +1,199 @@
+// Direct volume rendering: a transcription of crates/render/src/volume/raymarch.rs, one
+// invocation per pixel. The volume is an r32float 3D texture read with textureLoad and
+// interpolated here, as the CPU does, so the two agree sample for sample (a hardware sampler
+// would filter in 8-bit fixed-point weights).
+
+struct Params {
+    // xyz; w = half the view's height.
+    eye: vec4<f32>,
+    // xyz; w = 1 for parallel rays, 0 for a pinhole.
+    forward: vec4<f32>,
+    // xyz; w = the segment length in millimetres.
+    right: vec4<f32>,
+    // xyz; w = the opacity at which a ray stops.
+    up: vec4<f32>,
+    // World to grid index: the three columns of the linear part.
+    to_index_x: vec4<f32>,
+    to_index_y: vec4<f32>,
+    to_index_z: vec4<f32>,
+    // xyz = the world position of voxel (0, 0, 0); w = the gradient of full shading.
+    origin: vec4<f32>,
+    // xyz = towards the light; w = the normalisation's constant.
+    light: vec4<f32>,
+    // ka, kd, ks, and 1 when samples are shaded.
+    weights: vec4<f32>,
+    background: vec4<f32>,
+    // width, height, transfer points, geometry id.
+    size: vec4<u32>,
+    // nx, ny, nz.
+    dims: vec4<u32>,
+    lobe: Lobe,
+}
+
+struct ControlPoint {
+    value: f32,
+    sigma: f32,
+    colour: vec4<f32>,
+}
+
+@group(0) @binding(0) var<storage, read> params: Params;
+@group(0) @binding(1) var<storage, read> points: array<ControlPoint>;
+@group(0) @binding(2) var grid: texture_3d<f32>;
+@group(0) @binding(3) var<storage, read_write> pixels: array<vec4<f32>>;
+
+fn voxel(i: i32, j: i32, k: i32) -> f32 {
+    let high = vec3<i32>(params.dims.xyz) - vec3<i32>(1);
+    let at = clamp(vec3<i32>(i, j, k), vec3<i32>(0), high);
+    return textureLoad(grid, at, 0).x;
+}
+
+fn lerp(a: f32, b: f32, t: f32) -> f32 {
+    return a + (b - a) * t;
+}
+
+fn last_index() -> vec3<f32> {
+    return vec3<f32>(params.dims.xyz) - vec3<f32>(1.0);
+}
+
+fn sample_at(index: vec3<f32>) -> f32 {
+    let p = clamp(index, vec3<f32>(0.0), last_index());
+    let base = floor(p);
+    let f = p - base;
+    let i = i32(base.x);
+    let j = i32(base.y);
+    let k = i32(base.z);
+    let r00 = lerp(voxel(i, j, k), voxel(i + 1, j, k), f.x);
+    let r10 = lerp(voxel(i, j + 1, k), voxel(i + 1, j + 1, k), f.x);
+    let r01 = lerp(voxel(i, j, k + 1), voxel(i + 1, j, k + 1), f.x);
+    let r11 = lerp(voxel(i, j + 1, k + 1), voxel(i + 1, j + 1, k + 1), f.x);
+    return lerp(lerp(r00, r10, f.y), lerp(r01, r11, f.y), f.z);
+}
+
+fn to_index() -> mat3x3<f32> {
+    return mat3x3<f32>(params.to_index_x.xyz, params.to_index_y.xyz, params.to_index_z.xyz);
+}
+
+fn gradient(index: vec3<f32>) -> vec3<f32> {
+    let dx = 0.5 * (sample_at(index + vec3<f32>(1.0, 0.0, 0.0)) - sample_at(index - vec3<f32>(1.0, 0.0, 0.0)));
+    let dy = 0.5 * (sample_at(index + vec3<f32>(0.0, 1.0, 0.0)) - sample_at(index - vec3<f32>(0.0, 1.0, 0.0)));
+    let dz = 0.5 * (sample_at(index + vec3<f32>(0.0, 0.0, 1.0)) - sample_at(index - vec3<f32>(0.0, 0.0, 1.0)));
+    return transpose(to_index()) * vec3<f32>(dx, dy, dz);
+}
+
+// Extinction (w) and colour (xyz) at a value: piecewise linear, clamped beyond the ends.
+fn transfer(value: f32) -> vec4<f32> {
+    let count = params.size.z;
+    let first = points[0];
+    if value <= first.value {
+        return vec4<f32>(first.colour.xyz, first.sigma);
+    }
+    for (var p = 1u; p < count; p++) {
+        let a = points[p - 1u];
+        let b = points[p];
+        if value <= b.value {
+            let t = (value - a.value) / (b.value - a.value);
+            return vec4<f32>(a.colour.xyz + (b.colour.xyz - a.colour.xyz) * t, a.sigma + (b.sigma - a.sigma) * t);
+        }
+    }
+    let last = points[count - 1u];
+    return vec4<f32>(last.colour.xyz, last.sigma);
+}
+
+fn shade(index: vec3<f32>, base: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    let g = gradient(index);
+    let strength = length(g);
+    if !(strength > 0.0) {
+        return base;
+    }
+    var normal = -g / strength;
+    if dot(normal, wo) < 0.0 {
+        normal = -normal;
+    }
+    let wi = params.light.xyz;
+    let w = params.weights;
+    let diffuse = max(dot(normal, wi), 0.0);
+    let t = cos_lobe(params.size.w, normal, wo, wi);
+    let specular = w.z * params.light.w * lobe_eval(params.lobe, t);
+    let lit = base * (w.x + w.y * diffuse) + vec3<f32>(specular);
+    let weight = min(strength / params.origin.w, 1.0);
+    return base + (lit - base) * weight;
+}
+
+fn pixel_jitter(x: u32, y: u32) -> f32 {
+    var h = (x * 0x9E3779B9u) ^ (y * 0x85EBCA6Bu);
+    h ^= h >> 15u;
+    h *= 0x2C1B3C6Du;
+    h ^= h >> 12u;
+    return (f32(h >> 8u) + 1.0) / 16777216.0;
+}
+
+@compute @workgroup_size(8, 8)
+fn march(@builtin(global_invocation_id) id: vec3<u32>) {
+    let width = params.size.x;
+    let height = params.size.y;
+    if id.x >= width || id.y >= height {
+        return;
+    }
+    let half_height = params.eye.w;
+    let aspect = f32(width) / f32(height);
+    let sx = ((f32(id.x) + 0.5) / f32(width) * 2.0 - 1.0) * aspect * half_height;
+    let sy = (1.0 - (f32(id.y) + 0.5) / f32(height) * 2.0) * half_height;
+    var origin = params.eye.xyz;
+    var direction = params.forward.xyz;
+    if params.forward.w > 0.5 {
+        origin = origin + sx * params.right.xyz + sy * params.up.xyz;
+    } else {
+        direction = normalize(direction + sx * params.right.xyz + sy * params.up.xyz);
+    }
+    let wo = -direction;
+    let grid_origin = to_index() * (origin - params.origin.xyz);
+    let grid_direction = to_index() * direction;
+    // The slab test: where the ray is inside [0, last index] on every axis.
+    let high = last_index();
+    var near = 0.0;
+    var far = 3.0e38;
+    var missed = false;
+    for (var axis = 0; axis < 3; axis++) {
+        let o = grid_origin[axis];
+        let d = grid_direction[axis];
+        if abs(d) < 1e-12 {
+            if o < 0.0 || o > high[axis] {
+                missed = true;
+            }
+            continue;
+        }
+        let a = (0.0 - o) / d;
+        let b = (high[axis] - o) / d;
+        near = max(near, min(a, b));
+        far = min(far, max(a, b));
+    }
+    let index_of_pixel = id.y * width + id.x;
+    if missed || !(near < far) {
+        pixels[index_of_pixel] = vec4<f32>(params.background.xyz, 1.0);
+        return;
+    }
+    let step = params.right.w;
+    var colour = vec3<f32>(0.0);
+    var transmittance = 1.0;
+    var t = near;
+    var segment = step * pixel_jitter(id.x, id.y);
+    while t < far && 1.0 - transmittance < params.up.w {
+        segment = min(segment, far - t);
+        let index = grid_origin + grid_direction * (t + 0.5 * segment);
+        t += segment;
+        let span = segment;
+        segment = step;
+        let medium = transfer(sample_at(index));
+        if medium.w <= 0.0 {
+            continue;
+        }
+        let alpha = 1.0 - exp(-medium.w * span);
+        var shaded = medium.xyz;
+        if params.weights.w > 0.5 {
+            shaded = shade(index, medium.xyz, wo);
+        }
+        colour += transmittance * alpha * shaded;
+        transmittance *= 1.0 - alpha;
+    }
+    pixels[index_of_pixel] = vec4<f32>(colour + transmittance * params.background.xyz, 1.0);
+}

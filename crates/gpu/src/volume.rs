@@ -1,0 +1,248 @@
+//! Direct volume rendering on the GPU: `shaders/volume.wgsl`, one compute invocation per
+//! pixel, marching the rays the CPU's [`DvrPlan`] fixes through the volume uploaded as an
+//! `r32float` 3D texture.
+
+use bytemuck::{Pod, Zeroable};
+use specula_render::volume::raymarch::{DvrPlan, DvrSettings};
+use specula_render::volume::transfer::TransferFunction;
+use specula_render::volume::Volume;
+use specula_render::Image;
+use wgpu::util::DeviceExt;
+
+use crate::uniforms::{geometry_id, LobeBlock};
+use crate::{wgsl, Gpu, GpuError};
+
+/// `struct Params` of volume.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct Params {
+    eye: [f32; 4],
+    forward: [f32; 4],
+    right: [f32; 4],
+    up: [f32; 4],
+    to_index: [[f32; 4]; 3],
+    origin: [f32; 4],
+    light: [f32; 4],
+    weights: [f32; 4],
+    background: [f32; 4],
+    size: [u32; 4],
+    dims: [u32; 4],
+    lobe: LobeBlock,
+}
+
+/// The compiled ray marcher.
+#[derive(Debug)]
+pub struct GpuVolumeRenderer<'gpu> {
+    gpu: &'gpu Gpu,
+    pipeline: wgpu::ComputePipeline,
+}
+
+fn with_w(v: glam::Vec3, w: f32) -> [f32; 4] {
+    [v.x, v.y, v.z, w]
+}
+
+impl<'gpu> GpuVolumeRenderer<'gpu> {
+    /// Compiles the shader for `gpu`.
+    pub fn new(gpu: &'gpu Gpu) -> Result<Self, GpuError> {
+        let source = wgsl::volume_module();
+        let pipeline = gpu.checked(|| {
+            let module = gpu
+                .device
+                .create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some("specula volume"),
+                    source: wgpu::ShaderSource::Wgsl(source.into()),
+                });
+            gpu.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("specula volume"),
+                    layout: None,
+                    module: &module,
+                    entry_point: Some("march"),
+                    compilation_options: wgpu::PipelineCompilationOptions::default(),
+                    cache: None,
+                })
+        })?;
+        Ok(Self { gpu, pipeline })
+    }
+
+    /// Renders as [`specula_render::volume::raymarch::render_dvr`] does.
+    pub fn render(
+        &self,
+        volume: &Volume,
+        transfer: &TransferFunction,
+        settings: &DvrSettings,
+    ) -> Result<Image, GpuError> {
+        let plan = DvrPlan::new(volume, settings).map_err(|e| GpuError::Unsupported(e.0))?;
+        let device = &self.gpu.device;
+        let limits = device.limits();
+        let dims = volume.dims();
+        let side = dims.iter().copied().max().unwrap_or(0);
+        if side > limits.max_texture_dimension_3d as usize {
+            return Err(GpuError::Unsupported(format!(
+                "a volume {side} voxels wide; this GPU's 3D textures hold at most {} per side (use --backend cpu)",
+                limits.max_texture_dimension_3d
+            )));
+        }
+        let (width, height) = (settings.width, settings.height);
+        let output_bytes = u64::from(width) * u64::from(height) * 16;
+        if output_bytes > limits.max_storage_buffer_binding_size {
+            return Err(GpuError::Unsupported(format!(
+                "a {width} x {height} image needs {output_bytes} bytes; this GPU binds at most {} (use --backend cpu or a smaller image)",
+                limits.max_storage_buffer_binding_size
+            )));
+        }
+        let params = params(volume, transfer, settings, &plan);
+        let points: Vec<[f32; 8]> = transfer
+            .points()
+            .iter()
+            .map(|p| {
+                [
+                    p.value, p.sigma, 0.0, 0.0, p.colour.x, p.colour.y, p.colour.z, 0.0,
+                ]
+            })
+            .collect();
+        let readback = self.gpu.checked(|| {
+            let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("volume params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let points = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("transfer function"),
+                contents: bytemuck::cast_slice(&points),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let extent = wgpu::Extent3d {
+                width: dims[0] as u32,
+                height: dims[1] as u32,
+                depth_or_array_layers: dims[2] as u32,
+            };
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("volume"),
+                size: extent,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: wgpu::TextureFormat::R32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            });
+            self.gpu.queue.write_texture(
+                texture.as_image_copy(),
+                bytemuck::cast_slice(volume.samples()),
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * dims[0] as u32),
+                    rows_per_image: Some(dims[1] as u32),
+                },
+                extent,
+            );
+            let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+            let output = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("volume pixels"),
+                size: output_bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let readback = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("volume pixels readback"),
+                size: output_bytes,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("volume"),
+                layout: &self.pipeline.get_bind_group_layout(0),
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: points.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: output.as_entire_binding(),
+                    },
+                ],
+            });
+            let mut encoder =
+                device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &bind_group, &[]);
+                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+            }
+            encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, output_bytes);
+            self.gpu.queue.submit([encoder.finish()]);
+            readback
+        })?;
+        let bytes = self.gpu.read_buffer(&readback)?;
+        let pixels = bytes
+            .chunks_exact(16)
+            .map(|b| {
+                let channel = |c: usize| {
+                    f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])
+                };
+                glam::Vec3::new(channel(0), channel(1), channel(2))
+            })
+            .collect();
+        Image::from_pixels(width, height, pixels)
+            .ok_or_else(|| GpuError::Unsupported("the image could not be assembled".into()))
+    }
+}
+
+fn params(
+    volume: &Volume,
+    transfer: &TransferFunction,
+    settings: &DvrSettings,
+    plan: &DvrPlan,
+) -> Params {
+    let camera = &plan.camera;
+    let to_index = volume.to_world().inverse();
+    let [nx, ny, nz] = volume.dims();
+    let (light, weights, gradient_reference, normalisation, geometry, lobe) = match &plan.lighting {
+        Some(lighting) => {
+            let shading = &lighting.shading;
+            (
+                lighting.light,
+                [shading.ka, shading.kd, shading.ks, 1.0],
+                lighting.gradient_reference,
+                lighting.normalisation,
+                geometry_id(shading.geometry),
+                LobeBlock::new(&shading.lobe),
+            )
+        }
+        None => (glam::Vec3::Z, [0.0; 4], 1.0, 0.0, 0, LobeBlock::default()),
+    };
+    Params {
+        eye: with_w(camera.eye, camera.half_height),
+        forward: with_w(camera.forward, if camera.parallel { 1.0 } else { 0.0 }),
+        right: with_w(camera.right, plan.step),
+        up: with_w(camera.up, settings.opacity_cutoff),
+        to_index: [
+            with_w(to_index.x_axis, 0.0),
+            with_w(to_index.y_axis, 0.0),
+            with_w(to_index.z_axis, 0.0),
+        ],
+        origin: with_w(volume.origin(), gradient_reference),
+        light: with_w(light, normalisation),
+        weights,
+        background: with_w(settings.background, 0.0),
+        size: [
+            settings.width,
+            settings.height,
+            transfer.points().len() as u32,
+            geometry,
+        ],
+        dims: [nx as u32, ny as u32, nz as u32, 0],
+        lobe,
+    }
+}
