@@ -5,21 +5,8 @@
 mod common;
 
 use assert_cmd::Command;
-use common::{have_tool, ok, specula};
+use common::{have_gpu, have_tool, ok, specula};
 use serde_json::Value;
-
-fn have_gpu() -> bool {
-    match specula_gpu::Gpu::new() {
-        Ok(_) => true,
-        Err(error) if std::env::var("CI").as_deref() == Ok("true") => {
-            panic!("CI=true but no GPU: {error}")
-        }
-        Err(error) => {
-            eprintln!("skipped: {error}");
-            false
-        }
-    }
-}
 
 #[test]
 fn gpu_render_writes_the_image_the_cpu_writes() {

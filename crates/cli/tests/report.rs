@@ -24,7 +24,7 @@ fn the_quick_report_is_complete_and_well_formed() {
         .descendants()
         .filter(|n| n.has_tag_name("section"))
         .count();
-    assert_eq!(sections, 10);
+    assert_eq!(sections, 11);
     // The answer opens the page, the claims follow, then the details.
     let verdict = page.find("Which lobe when").expect("a verdict section");
     let claims = page.find("The thesis's claims").expect("a claims section");
@@ -54,46 +54,23 @@ fn the_quick_report_is_complete_and_well_formed() {
     for verdict in ["holds", "does not hold"] {
         assert!(text.contains(verdict), "no '{verdict}' verdict");
     }
-    // Every row of the renders table, recomputed by `specula diff` from the images it names.
-    let table = document
-        .descendants()
-        .filter(|n| n.has_tag_name("table"))
-        .find(|t| {
-            t.descendants()
-                .any(|n| n.has_tag_name("th") && n.text() == Some("PSNR vs pow (dB)"))
-        })
-        .expect("the renders table");
-    let rows: Vec<Vec<String>> = table
-        .descendants()
-        .filter(|n| n.has_tag_name("tr"))
-        .skip(1)
-        .map(|row| {
-            row.children()
-                .filter(|n| n.has_tag_name("td"))
-                .map(|cell| cell.text().unwrap_or("").to_owned())
-                .collect()
-        })
-        .collect();
+    // Every row of the renders and volume tables, recomputed by `specula diff` from the
+    // images it names.
+    let rows = table_rows(&document, "PSNR vs pow (dB)");
     assert_eq!(
         rows.len(),
         specula::LobeKind::ALL.len() - 1,
         "every lobe but pow"
     );
     for row in &rows {
-        let [lobe, image, psnr, _, flip] = row.as_slice() else {
-            panic!("five cells: {row:?}");
-        };
-        assert_eq!(
-            image,
-            &format!("render-{lobe}.png"),
-            "the row names its own image"
-        );
-        let output = ok(&out, &["diff", "render-pow.png", image, "--format", "json"]);
-        let measured: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
-        let measured_psnr = measured["psnr_db"].as_f64().map_or(999.0, |p| p.min(999.0));
-        assert_eq!(psnr, &format!("{measured_psnr:.1}"), "{lobe}: PSNR");
-        let measured_flip = measured["mean_flip"].as_f64().expect("FLIP");
-        assert_eq!(flip, &format!("{measured_flip:.5}"), "{lobe}: FLIP");
+        assert_eq!(row.len(), 5, "{row:?}");
+        check_row(&out, "render", &row[0], &row[1], &row[2], &row[4]);
+    }
+    let rows = table_rows(&document, "PSNR vs the pow image (dB)");
+    assert_eq!(rows.len(), specula::LobeKind::ALL.len(), "every lobe");
+    for row in &rows {
+        assert_eq!(row.len(), 7, "{row:?}");
+        check_row(&out, "volume", &row[0], &row[1], &row[2], &row[3]);
     }
     // Nothing but the report was written: no temporary files left.
     let stray = std::fs::read_dir(&out)
@@ -107,4 +84,43 @@ fn the_quick_report_is_complete_and_well_formed() {
         })
         .count();
     assert_eq!(stray, 0);
+}
+
+/// The cells of the table with a column headed `header`, below its header row.
+fn table_rows(document: &roxmltree::Document, header: &str) -> Vec<Vec<String>> {
+    let table = document
+        .descendants()
+        .filter(|n| n.has_tag_name("table"))
+        .find(|t| {
+            t.descendants()
+                .any(|n| n.has_tag_name("th") && n.text() == Some(header))
+        })
+        .unwrap_or_else(|| panic!("a table with '{header}'"));
+    table
+        .descendants()
+        .filter(|n| n.has_tag_name("tr"))
+        .skip(1)
+        .map(|row| {
+            row.children()
+                .filter(|n| n.has_tag_name("td"))
+                .map(|cell| cell.text().unwrap_or("").to_owned())
+                .collect()
+        })
+        .collect()
+}
+
+/// A row names its own image, and `specula diff` against `<prefix>-pow.png` gives its figures.
+fn check_row(out: &std::path::Path, prefix: &str, lobe: &str, image: &str, psnr: &str, flip: &str) {
+    assert_eq!(
+        image,
+        format!("{prefix}-{lobe}.png"),
+        "the row names its own image"
+    );
+    let reference = format!("{prefix}-pow.png");
+    let output = ok(out, &["diff", &reference, image, "--format", "json"]);
+    let measured: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    let measured_psnr = measured["psnr_db"].as_f64().map_or(999.0, |p| p.min(999.0));
+    assert_eq!(psnr, format!("{measured_psnr:.1}"), "{lobe}: PSNR");
+    let measured_flip = measured["mean_flip"].as_f64().expect("FLIP");
+    assert_eq!(flip, format!("{measured_flip:.5}"), "{lobe}: FLIP");
 }

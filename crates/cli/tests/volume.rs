@@ -1,9 +1,85 @@
-//! `specula volume` from the command line: a shaded image of a built-in volume, bad input
-//! refused in one line.
+//! `specula volume` and `volume-convert` from the command line: the phantom, and the same
+//! head as NIfTI and as a DICOM series, drawn on the CPU and the GPU, by ray marching and as
+//! an isosurface; bad input refused in one line.
 
 mod common;
 
-use common::{ok, specula};
+use std::path::Path;
+
+use common::{have_gpu, ok, specula};
+use specula_render::metrics::compare;
+use specula_render::{read_image, Display};
+
+fn mean_flip(d: &Path, a: &str, b: &str) -> f64 {
+    let (a, b) = (
+        read_image(&d.join(a)).unwrap(),
+        read_image(&d.join(b)).unwrap(),
+    );
+    compare(&a, &b, Display::default()).unwrap().mean_flip
+}
+
+#[test]
+fn the_head_as_phantom_nifti_and_dicom_renders_alike_on_cpu_and_gpu() {
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    let size = ["--size", "48", "--width", "96", "--height", "96"];
+    ok(
+        d,
+        &[
+            "volume-convert",
+            "--input",
+            "phantom",
+            "--size",
+            "48",
+            "-o",
+            "head.nii.gz",
+        ],
+    );
+    ok(
+        d,
+        &[
+            "volume-convert",
+            "--input",
+            "phantom",
+            "--size",
+            "48",
+            "-o",
+            "head-dicom",
+        ],
+    );
+    assert_eq!(std::fs::read_dir(d.join("head-dicom")).unwrap().count(), 48);
+    let gpu = have_gpu();
+    for (input, name) in [
+        ("phantom", "phantom"),
+        ("head.nii.gz", "nifti"),
+        ("head-dicom", "dicom"),
+    ] {
+        for mode in ["dvr", "iso"] {
+            let cpu = format!("{name}-{mode}-cpu.png");
+            let base = [
+                "volume", "--input", input, "--mode", mode, "--lobe", "cosquad",
+            ];
+            ok(d, &[&base[..], &size, &["-o", &cpu]].concat());
+            let reference = format!("phantom-{mode}-cpu.png");
+            // NIfTI keeps f32 exactly and the phantom's tissues survive 16-bit DICOM.
+            assert!(mean_flip(d, &reference, &cpu) < 1e-3, "{name} {mode}");
+            if gpu {
+                let on_gpu = format!("{name}-{mode}-gpu.png");
+                ok(
+                    d,
+                    &[&base[..], &size, &["--backend", "gpu", "-o", &on_gpu]].concat(),
+                );
+                let flip = mean_flip(d, &cpu, &on_gpu);
+                assert!(
+                    flip < 1e-3,
+                    "{name} {mode}: CPU and GPU differ by mean FLIP {flip}"
+                );
+            }
+        }
+    }
+    // Not vacuous: the isosurface and the ray-marched head are different images.
+    assert!(mean_flip(d, "phantom-dvr-cpu.png", "phantom-iso-cpu.png") > 0.05);
+}
 
 #[test]
 fn the_phantom_renders_with_every_view_and_a_lobe() {
@@ -32,10 +108,38 @@ fn the_phantom_renders_with_every_view_and_a_lobe() {
 fn bad_volume_requests_are_refused_in_one_line() {
     let directory = tempfile::tempdir().unwrap();
     let d = directory.path();
+    std::fs::write(d.join("notes.txt"), "not a volume").unwrap();
+    std::fs::write(d.join("bad.nii"), [0_u8; 400]).unwrap();
     for (args, expected) in [
         (
             vec!["volume", "--input", "phantm"],
-            "built in: phantom, marschner-lobb; did you mean 'phantom'?",
+            "nor an existing file or folder; did you mean 'phantom'?",
+        ),
+        (vec!["volume", "--input", "."], "no DICOM files"),
+        (
+            vec!["volume", "--input", "notes.txt"],
+            "give a .nii or .nii.gz file",
+        ),
+        (vec!["volume", "--input", "bad.nii"], "not a NIfTI-1 header"),
+        (
+            vec!["volume", "--mode", "iso", "--iso", "7", "--size", "16"],
+            "outside the volume's values",
+        ),
+        (
+            vec!["volume", "--mode", "iso", "--iso", "nan"],
+            "finite number",
+        ),
+        (
+            vec![
+                "volume-convert",
+                "--input",
+                "phantom",
+                "--size",
+                "16",
+                "-o",
+                ".",
+            ],
+            "not an empty folder",
         ),
         (
             vec!["volume", "--transfer", "ct-boen"],

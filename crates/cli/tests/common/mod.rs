@@ -44,3 +44,18 @@ pub fn have_tool(tool: &str, version_flag: &str, package: &str) -> bool {
     }
     found
 }
+
+/// Whether wgpu finds an adapter. Without one a test is skipped, except under `CI=true`,
+/// where `.ci/run` installs Mesa's lavapipe and a missing adapter is a failure.
+pub fn have_gpu() -> bool {
+    match specula_gpu::Gpu::new() {
+        Ok(_) => true,
+        Err(error) if std::env::var("CI").as_deref() == Ok("true") => {
+            panic!("CI=true but no GPU: {error}")
+        }
+        Err(error) => {
+            eprintln!("skipped: {error}");
+            false
+        }
+    }
+}

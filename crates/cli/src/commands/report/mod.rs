@@ -12,6 +12,7 @@ mod plot;
 mod renders;
 mod sections;
 mod verdict;
+mod volumes;
 
 use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
@@ -53,6 +54,8 @@ pub struct Sizes {
     pub claims: ClaimOptions,
     /// Render width, height and samples per axis.
     pub render: (u32, u32, u32),
+    /// The medical section's phantom side (voxels) and image side (pixels).
+    pub volume: (usize, u32),
     /// The (integer) exponents the hardware section sweeps word lengths at.
     pub hardware_exponents: &'static [u32],
     /// Whether the hardware claim's designs are synthesized when the cache lacks them (the
@@ -177,7 +180,7 @@ const VERDICT: &str = "Which lobe when";
 const HARDWARE: &str = "Hardware";
 
 /// The answer first (which lobe when), then the thesis's claims, then the details.
-const SECTIONS: [Section; 10] = [
+const SECTIONS: [Section; 11] = [
     (VERDICT, verdict::verdict),
     ("The thesis's claims", sections::claims),
     ("Models", sections::models),
@@ -186,6 +189,7 @@ const SECTIONS: [Section; 10] = [
     ("Energy and normalisation", sections::energy),
     ("Reciprocity and white furnace", sections::reciprocity),
     ("Renders", renders::renders),
+    ("Medical volumes", volumes::volumes),
     (sections::COST, sections::cost),
     (HARDWARE, hardware::hardware),
 ];

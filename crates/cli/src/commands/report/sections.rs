@@ -579,6 +579,7 @@ pub fn sizes(quick: bool) -> Sizes {
                 ..ClaimOptions::default()
             },
             render: (240, 135, 1),
+            volume: (48, 128),
             hardware_exponents: &[64],
             synthesis: OnMiss::Skip,
         }
@@ -589,6 +590,7 @@ pub fn sizes(quick: bool) -> Sizes {
             reciprocity_pairs: 20_000,
             claims: ClaimOptions::default(),
             render: (480, 270, 2),
+            volume: (128, 256),
             hardware_exponents: &[8, 64, 512],
             synthesis: OnMiss::Synthesize,
         }
