@@ -54,8 +54,9 @@ pub struct Sizes {
     pub claims: ClaimOptions,
     /// Render width, height and samples per axis.
     pub render: (u32, u32, u32),
-    /// The medical section's phantom side (voxels) and image side (pixels).
-    pub volume: (usize, u32),
+    /// The medical section's phantom side (voxels), image side (pixels) and frames timed per
+    /// lobe and backend.
+    pub volume: (usize, u32, usize),
     /// The (integer) exponents the hardware section sweeps word lengths at.
     pub hardware_exponents: &'static [u32],
     /// Whether the hardware claim's designs are synthesized when the cache lacks them (the

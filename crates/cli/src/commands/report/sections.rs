@@ -579,7 +579,7 @@ pub fn sizes(quick: bool) -> Sizes {
                 ..ClaimOptions::default()
             },
             render: (240, 135, 1),
-            volume: (48, 128),
+            volume: (32, 96, 1),
             hardware_exponents: &[64],
             synthesis: OnMiss::Skip,
         }
@@ -590,7 +590,7 @@ pub fn sizes(quick: bool) -> Sizes {
             reciprocity_pairs: 20_000,
             claims: ClaimOptions::default(),
             render: (480, 270, 2),
-            volume: (128, 256),
+            volume: (64, 192, 2),
             hardware_exponents: &[8, 64, 512],
             synthesis: OnMiss::Synthesize,
         }

@@ -36,11 +36,14 @@ fn shading(kind: LobeKind) -> Result<Shading, String> {
     })
 }
 
-/// The best of three wall-clock runs, in milliseconds, and the image.
-fn timed(mut draw: impl FnMut() -> Result<Image, String>) -> Result<(f64, Image), String> {
+/// The best of `runs` wall-clock runs, in milliseconds, and the image.
+fn timed(
+    runs: usize,
+    mut draw: impl FnMut() -> Result<Image, String>,
+) -> Result<(f64, Image), String> {
     let mut best = f64::INFINITY;
     let mut image = None;
-    for _ in 0..3 {
+    for _ in 0..runs {
         let started = Instant::now();
         image = Some(draw()?);
         best = best.min(started.elapsed().as_secs_f64() * 1e3);
@@ -49,7 +52,7 @@ fn timed(mut draw: impl FnMut() -> Result<Image, String>) -> Result<(f64, Image)
 }
 
 pub fn volumes(context: &mut Context) -> Result<String, String> {
-    let (side, pixels) = context.sizes.volume;
+    let (side, pixels, runs) = context.sizes.volume;
     let volume = phantom::shepp_logan(side).map_err(|e| e.to_string())?;
     let transfer = TransferFunction::default_for(&volume).for_volume(&volume);
     let gpu = Gpu::new();
@@ -58,17 +61,18 @@ pub fn volumes(context: &mut Context) -> Result<String, String> {
         Err(_) => None,
     };
     let mut html = paragraph(&format!(
-        "The 3D Shepp-Logan head ({side}³ voxels, each the mean over its cell) ray-marched at {pixels}x{pixels}, coronal view, with the mr transfer function and the thesis's normalisation, Blinn geometry, n = {EXPONENT}: every lobe is the specular term of the gradient-shaded samples (specula volume --input phantom --size {side} --lobe L --normalisation thesis-phong). FLIP and PSNR are against the pow image; times are the best of three frames, on all CPU cores and on the GPU (upload, march and read-back)."
+        "The 3D Shepp-Logan head ({side}³ voxels, each the mean over its cell) ray-marched at {pixels}x{pixels}, coronal view, with the mr transfer function and the thesis's normalisation, Blinn geometry, n = {EXPONENT}: every lobe is the specular term of the gradient-shaded samples (specula volume --input phantom --size {side} --lobe L --normalisation thesis-phong). FLIP and PSNR are against the pow image; times are the best of {runs} frame(s), on all CPU cores and on the GPU (upload, march and read-back)."
     ));
     let mut rows = Vec::new();
     let mut figures = String::new();
     let mut reference: Option<Image> = None;
     for kind in LobeKind::ALL {
         let settings = DvrSettings::new(pixels, pixels, View::Coronal, Some(shading(kind)?));
-        let (cpu_ms, image) =
-            timed(|| render_dvr(&volume, &transfer, &settings, &|| {}).map_err(|e| e.to_string()))?;
+        let (cpu_ms, image) = timed(runs, || {
+            render_dvr(&volume, &transfer, &settings, &|| {}).map_err(|e| e.to_string())
+        })?;
         let gpu = match &renderer {
-            Some(renderer) => Some(timed(|| {
+            Some(renderer) => Some(timed(runs, || {
                 renderer
                     .render(&volume, &transfer, &settings)
                     .map_err(|e| e.to_string())
