@@ -23,30 +23,18 @@ fn the_head_as_phantom_nifti_and_dicom_renders_alike_on_cpu_and_gpu() {
     let directory = tempfile::tempdir().unwrap();
     let d = directory.path();
     let size = ["--size", "48", "--width", "96", "--height", "96"];
-    ok(
-        d,
-        &[
+    for output in ["head.nii.gz", "head-dicom"] {
+        let convert = [
             "volume-convert",
             "--input",
             "phantom",
             "--size",
             "48",
             "-o",
-            "head.nii.gz",
-        ],
-    );
-    ok(
-        d,
-        &[
-            "volume-convert",
-            "--input",
-            "phantom",
-            "--size",
-            "48",
-            "-o",
-            "head-dicom",
-        ],
-    );
+            output,
+        ];
+        ok(d, &convert);
+    }
     assert_eq!(std::fs::read_dir(d.join("head-dicom")).unwrap().count(), 48);
     let gpu = have_gpu();
     for (input, name) in [

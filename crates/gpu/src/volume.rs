@@ -206,7 +206,7 @@ fn params(
     plan: &DvrPlan,
 ) -> Params {
     let camera = &plan.camera;
-    let to_index = volume.to_world().inverse();
+    let to_index = volume.to_index();
     let [nx, ny, nz] = volume.dims();
     let (light, weights, gradient_reference, normalisation, geometry, lobe) = match &plan.lighting {
         Some(lighting) => {

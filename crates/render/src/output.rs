@@ -23,7 +23,7 @@ use crate::image::ImageError;
 pub trait SeekWrite: Write + Seek {}
 impl<T: Write + Seek> SeekWrite for T {}
 
-/// The temporary files that exist now.
+/// The temporary files (and staging folders) that exist now.
 static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// The prefix of this process's temporary files.
@@ -39,11 +39,15 @@ pub fn remove_temporaries() {
         Err(poisoned) => poisoned.into_inner().clone(),
     };
     for path in paths {
-        let _ = std::fs::remove_file(path);
+        if std::fs::remove_file(&path).is_err() {
+            let _ = std::fs::remove_dir_all(&path);
+        }
     }
 }
 
-fn register(path: &Path, present: bool) {
+/// Adds `path` to (or, once it is gone or kept, removes it from) what an interrupted run
+/// deletes.
+pub(crate) fn register(path: &Path, present: bool) {
     let mut paths = TEMPORARIES
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);

@@ -451,10 +451,27 @@ fn volumes_written_as_nifti_and_dicom_read_back_in_place() {
             // 16-bit DICOM keeps a 65000th of the range; NIfTI keeps f32 exactly.
             assert!(worst <= (hi - lo) / 65_000.0 + 1e-3, "{name}: {worst}");
         }
-        let again = volume::write(
-            &original,
-            &directory.path().join(format!("{units:?}-series")),
-        );
+        // The written headers say, in DICOM's LPS, what the grid says in RAS (x and y flip):
+        // rows step along RAS (0, 0.8, 0), columns along (-0.6, 0, 0), slices by (0.3, 0, 2).
+        let series = directory.path().join(format!("{units:?}-series"));
+        for (file, position) in [
+            ("slice-0001.dcm", [12.0, -7.5, 40.0]),
+            ("slice-0002.dcm", [11.7, -7.5, 42.0]),
+        ] {
+            let header = dicom_object::open_file(series.join(file)).unwrap();
+            let numbers = |tag| header.element(tag).unwrap().to_multi_float64().unwrap();
+            let close = |a: Vec<f64>, b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-4);
+            assert!(
+                close(numbers(tags::IMAGE_POSITION_PATIENT), &position),
+                "{file}"
+            );
+            assert!(close(
+                numbers(tags::IMAGE_ORIENTATION_PATIENT),
+                &[0.0, -1.0, 0.0, 1.0, 0.0, 0.0]
+            ));
+            assert!(close(numbers(tags::PIXEL_SPACING), &[0.6, 0.8]));
+        }
+        let again = volume::write(&original, &series);
         assert!(again.unwrap_err().0.contains("not an empty folder"));
     }
 }

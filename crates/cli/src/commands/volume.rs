@@ -192,11 +192,11 @@ pub fn run(args: &Args) -> CommandResult {
         ProgressStyle::with_template("{msg} {bar:30} {percent}% {elapsed}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let image = match args.mode {
+    let (image, drawn) = match args.mode {
         Mode::Dvr => {
             let transfer = transfer(args, &volume)?;
             let settings = DvrSettings::new(args.width, args.height, view, Some(shading));
-            match &gpu {
+            let image = match &gpu {
                 Some(gpu) => GpuVolumeRenderer::new(gpu)
                     .and_then(|renderer| renderer.render(&volume, &transfer, &settings))
                     .map_err(|e| e.to_string())?,
@@ -206,9 +206,14 @@ pub fn run(args: &Args) -> CommandResult {
                     render_dvr(&volume, &transfer, &settings, &|| bar.inc(1))
                         .map_err(|e| e.to_string())?
                 }
-            }
+            };
+            (image, "ray marched".to_owned())
         }
-        Mode::Iso => iso(args, &volume, view, shading, gpu.as_ref(), &bar)?,
+        Mode::Iso => {
+            let value = args.iso.unwrap_or_else(|| default_isovalue(&volume));
+            let image = iso(args, &volume, value, view, shading, gpu.as_ref(), &bar)?;
+            (image, format!("isosurface at {value}"))
+        }
     };
     bar.finish_and_clear();
     write_image(&args.output, &image, Display::default()).map_err(|e| e.to_string())?;
@@ -220,13 +225,7 @@ pub fn run(args: &Args) -> CommandResult {
         args.width,
         args.height,
         args.source.input,
-        match args.mode {
-            Mode::Dvr => "ray marched".to_owned(),
-            Mode::Iso => format!(
-                "isosurface at {}",
-                args.iso.unwrap_or_else(|| default_isovalue(&volume))
-            ),
-        },
+        drawn,
         args.lobe,
         args.n,
         started.elapsed().as_secs_f64()
@@ -234,16 +233,16 @@ pub fn run(args: &Args) -> CommandResult {
     Ok(())
 }
 
-/// Extracts and draws the isosurface.
+/// Extracts and draws the isosurface at `iso`.
 fn iso(
     args: &Args,
     volume: &Volume,
+    iso: f32,
     view: View,
     shading: Shading,
     gpu: Option<&Gpu>,
     bar: &ProgressBar,
 ) -> Result<Image, String> {
-    let iso = args.iso.unwrap_or_else(|| default_isovalue(volume));
     let (lo, hi) = volume.range();
     if !(lo..=hi).contains(&iso) {
         return Err(format!(

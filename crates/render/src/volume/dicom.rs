@@ -23,6 +23,7 @@ use rayon::prelude::*;
 
 use super::{Units, Volume, VolumeError, MAX_SIDE};
 use crate::input;
+use crate::output::register;
 
 /// LPS to RAS (and back): `x` and `y` change sign.
 const LPS_TO_RAS: DVec3 = DVec3::new(-1.0, -1.0, 1.0);
@@ -318,6 +319,8 @@ pub fn write_series(volume: &Volume, dir: &Path) -> Result<(), VolumeError> {
         .prefix(".specula-series-")
         .tempdir_in(&parent)
         .map_err(|e| fail(e.to_string()))?;
+    // Registered, so that an interrupted run's signal handler removes it.
+    register(staging.path(), true);
     let [nx, ny, nz] = volume.dims();
     let (lo, hi) = volume.range();
     let (slope, intercept, modality, class) = match volume.units() {
@@ -414,15 +417,14 @@ pub fn write_series(volume: &Volume, dir: &Path) -> Result<(), VolumeError> {
             &staging.path().join(format!("slice-{:04}.dcm", k + 1)),
         )
     });
-    written.map_err(fail)?;
-    if dir.exists() {
-        std::fs::remove_dir(dir).map_err(|e| fail(e.to_string()))?;
-    }
+    // rename(2) replaces an empty folder, so an existing empty target needs no removal.
     let staged = staging.keep();
-    std::fs::rename(&staged, dir).map_err(|e| {
+    let result = written.and_then(|()| std::fs::rename(&staged, dir).map_err(|e| e.to_string()));
+    if result.is_err() {
         let _ = std::fs::remove_dir_all(&staged);
-        fail(e.to_string())
-    })
+    }
+    register(&staged, false);
+    result.map_err(fail)
 }
 
 fn write_slice(object: &DefaultDicomObject, path: &Path) -> Result<(), String> {

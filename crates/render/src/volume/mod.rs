@@ -166,6 +166,12 @@ impl Volume {
         self.to_world
     }
 
+    /// World to grid index: the inverse of [`Volume::to_world`], computed once.
+    #[must_use]
+    pub fn to_index(&self) -> Mat3 {
+        self.to_index
+    }
+
     /// The world position of voxel `(0, 0, 0)`.
     #[must_use]
     pub fn origin(&self) -> Vec3 {

@@ -96,17 +96,37 @@ fn rotation([phi, theta, psi]: [f64; 3]) -> DMat3 {
     )
 }
 
+/// An ellipsoid ready to test points against: its rotation, centre and inverse semi-axes.
+struct Placed {
+    turn: DMat3,
+    centre: DVec3,
+    inverse_axes: DVec3,
+    density: f64,
+}
+
+/// The table's ellipsoids, placed once.
+fn placed() -> &'static [Placed] {
+    static PLACED: std::sync::OnceLock<Vec<Placed>> = std::sync::OnceLock::new();
+    PLACED.get_or_init(|| {
+        SHEPP_LOGAN
+            .iter()
+            .map(|e| Placed {
+                turn: rotation(e.angles),
+                centre: DVec3::from_array(e.centre),
+                inverse_axes: DVec3::from_array(e.axes).recip(),
+                density: e.density,
+            })
+            .collect()
+    })
+}
+
 /// The Shepp-Logan density at `p` in `[-1, 1]^3`.
 #[must_use]
 pub fn shepp_logan_density(p: DVec3) -> f64 {
-    SHEPP_LOGAN
+    placed()
         .iter()
-        .filter(|ellipsoid| {
-            let q = rotation(ellipsoid.angles) * p - DVec3::from_array(ellipsoid.centre);
-            let a = DVec3::from_array(ellipsoid.axes);
-            (q / a).length_squared() <= 1.0
-        })
-        .map(|ellipsoid| ellipsoid.density)
+        .filter(|e| ((e.turn * p - e.centre) * e.inverse_axes).length_squared() <= 1.0)
+        .map(|e| e.density)
         .sum()
 }
 
@@ -121,30 +141,9 @@ pub const HEAD_MM: f32 = 256.0;
 /// tissues (the partial-volume effect). Point samples would make every surface a staircase
 /// whose gradients, and so whose highlights, follow the grid rather than the ellipsoids.
 pub fn shepp_logan(side: usize) -> Result<Volume, VolumeError> {
-    Volume::check_dims([side; 3])?;
-    let prepared: Vec<(DMat3, DVec3, DVec3, f64)> = SHEPP_LOGAN
-        .iter()
-        .map(|e| {
-            (
-                rotation(e.angles),
-                DVec3::from_array(e.centre),
-                DVec3::from_array(e.axes).recip(),
-                e.density,
-            )
-        })
-        .collect();
-    let density = |p: DVec3| -> f64 {
-        prepared
-            .iter()
-            .filter(|(turn, centre, inverse_axes, _)| {
-                ((*turn * p - *centre) * *inverse_axes).length_squared() <= 1.0
-            })
-            .map(|&(.., density)| density)
-            .sum()
-    };
     let cell = 2.0 / (side - 1) as f64;
     grid(side, HEAD_MM, |p| {
-        let centre = density(p);
+        let centre = shepp_logan_density(p);
         let probes = [
             DVec3::X,
             DVec3::NEG_X,
@@ -155,7 +154,7 @@ pub fn shepp_logan(side: usize) -> Result<Volume, VolumeError> {
         ];
         if probes
             .iter()
-            .all(|&d| density(p + 0.5 * cell * d) == centre)
+            .all(|&d| shepp_logan_density(p + 0.5 * cell * d) == centre)
         {
             return centre;
         }
@@ -164,7 +163,7 @@ pub fn shepp_logan(side: usize) -> Result<Volume, VolumeError> {
         for dz in offsets {
             for dy in offsets {
                 for dx in offsets {
-                    sum += density(p + cell * DVec3::new(dx, dy, dz));
+                    sum += shepp_logan_density(p + cell * DVec3::new(dx, dy, dz));
                 }
             }
         }
