@@ -1,6 +1,7 @@
 // Drives `specula serve` in Debian's Chromium: loads the explorer, moves the n slider, changes
-// the lobes, and requires that the plots and the renders change and that the console stays
-// silent. Saves a screenshot. Usage: node check.mjs SPECULA_BINARY SCREENSHOT.png
+// the lobes and the volume view's lobe and volume, and requires that the plots and the renders
+// change and that the console stays silent. Saves a screenshot.
+// Usage: node check.mjs SPECULA_BINARY SCREENSHOT.png
 import { spawn } from "node:child_process";
 import { chromium } from "playwright-core";
 
@@ -22,44 +23,81 @@ try {
   const messages = [];
   page.on("console", (message) => messages.push(`${message.type()}: ${message.text()}`));
   page.on("pageerror", (error) => messages.push(`pageerror: ${error.message}`));
-  const updates = () => page.evaluate(() => Number(document.body.dataset.updates));
-  const settled = async (before) => page.waitForFunction((n) => Number(document.body.dataset.updates) > n, before, { timeout: 30000 });
-  const snapshot = () => page.evaluate(() => ({
-    plots: ["cartesian", "error", "polar", "albedo", "slice"].map((id) => document.getElementById(id).toDataURL()),
-    sphere: document.getElementById("sphere").src,
-    teapot: document.getElementById("teapot").src,
-    address: location.search,
-  }));
+  // Each user action may start an update before the next action lands (the page debounces by
+  // 60 ms, a loaded machine acts slower), so a change has settled only once the page has
+  // drawn the address it holds and that address has `key` at `value` (list values in any
+  // order).
+  const drawn = (key, value) => page.waitForFunction(([k, v]) => {
+    const shown = document.body.dataset.drawn ?? "";
+    const got = (new URLSearchParams(shown).get(k) ?? "").split(",").sort().join(",");
+    return shown === location.search && got === v;
+  }, [key, value.split(",").sort().join(",")], { timeout: 60000 });
+  const snapshot = () => page.evaluate(() => {
+    // An image's pixels, not its address: a re-rendered image must look different.
+    const pixels = (img) => {
+      const canvas = document.createElement("canvas");
+      [canvas.width, canvas.height] = [img.naturalWidth, img.naturalHeight];
+      canvas.getContext("2d").drawImage(img, 0, 0);
+      return canvas.toDataURL();
+    };
+    return {
+      plots: ["cartesian", "error", "polar", "albedo", "slice"].map((id) => document.getElementById(id).toDataURL()),
+      sphere: document.getElementById("sphere").src,
+      teapot: document.getElementById("teapot").src,
+      volume: pixels(document.getElementById("volume-image")),
+      volumePow: pixels(document.getElementById("volume-pow")),
+      address: location.search,
+    };
+  });
   const changed = (a, b, what) => {
     a.plots.forEach((plot, k) => { if (plot === b.plots[k]) failures.push(`${what}: plot ${k} did not change`); });
     if (a.sphere === b.sphere) failures.push(`${what}: the sphere was not re-rendered`);
   };
 
   await page.goto(url + "?lobes=schlick,cosquad&n=16");
-  await settled(0);
+  await drawn("lobes", "schlick,cosquad");
   const first = await snapshot();
   if (!first.address.includes("lobes=schlick%2Ccosquad")) failures.push(`the address does not hold the state: ${first.address}`);
 
-  let before = await updates();
   await page.locator("#n").evaluate((slider) => { slider.value = "250"; slider.dispatchEvent(new Event("input", { bubbles: true })); });
-  await settled(before);
+  await drawn("n", "316");
   const moved = await snapshot();
   changed(first, moved, "moving n");
-  if (!moved.address.includes("n=316")) failures.push(`n is not in the address: ${moved.address}`);
+  if (moved.volume === first.volume || moved.volumePow === first.volumePow) failures.push("moving n: the volume was not re-rendered");
 
-  before = await updates();
   await page.locator('#lobes input[value="schlick"]').uncheck();
   await page.locator('#lobes input[value="logexp"]').check();
-  await settled(before);
-  changed(moved, await snapshot(), "changing the lobes");
+  await drawn("lobes", "logexp,cosquad");
+  const relobed = await snapshot();
+  changed(moved, relobed, "changing the lobes");
+
+  // The volume view's own lobe selector re-renders the lobe's image and leaves pow's alone;
+  // the volume selector changes both.
+  await page.locator("#volume_lobe").selectOption("schlick");
+  await drawn("volume_lobe", "schlick");
+  const volumeLobe = await snapshot();
+  if (volumeLobe.volume === relobed.volume) failures.push("choosing the volume's lobe did not change its image");
+  if (volumeLobe.volumePow !== relobed.volumePow) failures.push("choosing the volume's lobe changed the pow image");
+  const psnr = await page.evaluate(() => document.getElementById("volume-psnr").textContent);
+  if (!/^PSNR [0-9.]+ dB against pow/.test(psnr)) failures.push(`schlick's volume has no PSNR against pow: '${psnr}'`);
+  await page.locator("#volume_lobe").selectOption("pow");
+  await drawn("volume_lobe", "pow");
+  const same = await page.evaluate(() => document.getElementById("volume-psnr").textContent);
+  if (same !== "identical to pow") failures.push(`pow against itself: '${same}'`);
+  await page.locator("#volume_lobe").selectOption("schlick");
+  await drawn("volume_lobe", "schlick");
+  await page.locator("#volume").selectOption("marschner-lobb");
+  await drawn("volume", "marschner-lobb");
+  const otherVolume = await snapshot();
+  if (otherVolume.volume === volumeLobe.volume || otherVolume.volumePow === volumeLobe.volumePow) failures.push("choosing another volume did not change the images");
 
   // The shared address restores the view.
   const shared = page.url();
   const other = await browser.newPage();
   await other.goto(shared);
   await other.waitForFunction(() => Number(document.body.dataset.updates) > 0, null, { timeout: 30000 });
-  const restored = await other.evaluate(() => [...document.querySelectorAll("#lobes input:checked")].map((c) => c.value).join(","));
-  if (restored !== "logexp,cosquad" && restored !== "cosquad,logexp") failures.push(`the shared address restored ${restored}`);
+  const restored = await other.evaluate(() => [...document.querySelectorAll("#lobes input:checked")].map((c) => c.value).sort().join(",") + " " + document.getElementById("volume_lobe").value + " " + document.getElementById("volume").value);
+  if (restored !== "cosquad,logexp schlick marschner-lobb") failures.push(`the shared address restored ${restored}`);
 
   // Energy creation is said, and a bad address is reported rather than silently fixed.
   const warned = await browser.newPage();
@@ -76,10 +114,9 @@ try {
   if (!notes.includes("unknown lobe 'nope'") || !notes.includes("outside [1, 1000]")) failures.push(`the corrected address is not reported: '${notes}'`);
 
   // cosquad's v has a control, it changes the plots, and the address keeps it.
-  before = await updates();
   const beforeV = await snapshot();
   await page.locator("#param-cosquad-v").fill("2");
-  await settled(before);
+  await drawn("lobes", "logexp,cosquad:v=2");
   const afterV = await snapshot();
   if (afterV.plots[0] === beforeV.plots[0]) failures.push("changing cosquad's v did not change the lobe plot");
   if (!afterV.address.includes("cosquad%3Av%3D2")) failures.push(`v is not in the address: ${afterV.address}`);
@@ -99,4 +136,4 @@ if (failures.length) {
   console.error("explorer check failed:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`explorer check: loaded, moved n, changed lobes, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, round ticks; no console message; screenshot ${screenshot}`);
+console.log(`explorer check: loaded, moved n, changed lobes, changed the volume's lobe and volume, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, round ticks; no console message; screenshot ${screenshot}`);

@@ -92,6 +92,44 @@ fn the_phantom_renders_with_every_view_and_a_lobe() {
     }
 }
 
+/// Marschner-Lobb's value falls from 0.8 at its bottom face to 0.2 at its top, so its 0.5
+/// isosurface spans the whole cube: seen from above, every ray through the middle of the frame
+/// must meet it. By default the signal is drawn as that surface (lit, at least the ambient
+/// term everywhere); the `mr` preset shows the same cube as a faint fog.
+#[test]
+fn marschner_lobb_is_drawn_as_its_mid_range_surface_by_default() {
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    let base = [
+        "volume",
+        "--input",
+        "marschner-lobb",
+        "--size",
+        "41",
+        "--view",
+        "axial",
+        "--width",
+        "64",
+        "--height",
+        "64",
+    ];
+    ok(d, &[&base[..], &["-o", "surface.png"]].concat());
+    ok(
+        d,
+        &[&base[..], &["--transfer", "mr", "-o", "fog.png"]].concat(),
+    );
+    let middle = |name: &str| {
+        let image = read_image(&d.join(name)).unwrap();
+        (16..48)
+            .flat_map(|y| (16..48).map(move |x| (x, y)))
+            .map(|(x, y)| image.get(x, y).min_element())
+            .fold(f32::INFINITY, f32::min)
+    };
+    // The ambient weight (0.25) times the surface's darkest colour (0.8), nearly opaque.
+    assert!(middle("surface.png") > 0.15, "{}", middle("surface.png"));
+    assert!(middle("fog.png") < 0.05, "{}", middle("fog.png"));
+}
+
 #[test]
 fn bad_volume_requests_are_refused_in_one_line() {
     let directory = tempfile::tempdir().unwrap();
@@ -131,7 +169,7 @@ fn bad_volume_requests_are_refused_in_one_line() {
         ),
         (
             vec!["volume", "--transfer", "ct-boen"],
-            "presets: ct-bone, ct-soft-tissue, mr, or a .toml file; did you mean 'ct-bone'?",
+            "presets: ct-bone, ct-soft-tissue, mr, surface, or a .toml file; did you mean 'ct-bone'?",
         ),
         (
             vec!["volume", "--eye", "0,0,0"],

@@ -18,14 +18,11 @@ const MAX_MEAN_FLIP: f64 = 1e-3;
 const MIN_PSNR_DB: f64 = 65.0;
 
 fn shading(kind: LobeKind) -> Shading {
-    Shading {
-        lobe: Lobe::new(kind, Exponent::try_new(32.0).unwrap()),
-        geometry: Geometry::Blinn,
-        normalisation: Normalisation::ThesisPhong,
-        ka: 0.25,
-        kd: 0.7,
-        ks: 0.5,
-    }
+    Shading::new(
+        Lobe::new(kind, Exponent::try_new(32.0).unwrap()),
+        Geometry::Blinn,
+        Normalisation::ThesisPhong,
+    )
 }
 
 #[test]

@@ -6,7 +6,9 @@
 //! - `GET /api/analyze?lobe&n`: the error, energy and albedo figures (`specula analyze`'s),
 //!   and `costs`, the lobe's cost on every target the server's cost model knows;
 //! - `GET /api/render?object&lobe&n&geometry&normalisation&shading&model&light_theta&light_phi&size`:
-//!   a PNG from the CPU renderer.
+//!   a PNG from the CPU renderer;
+//! - `GET /api/volume?volume&view&lobe&n&geometry&normalisation&size`: a built-in volume ray
+//!   marched on the CPU, as a PNG.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -20,10 +22,14 @@ use serde::Serialize;
 use serde_json::json;
 use specula::analysis::{analyze, Precision};
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+use specula_render::volume::raymarch::View;
 use specula_render::{IlluminationModel, Shading};
 
 use super::explorer::{curves, render_png, Object, RenderRequest};
 use super::guard::{Hosts, Limiter};
+use specula_render::volume::phantom::BuiltIn;
+
+use super::volume::{volume_png, VolumeRequest, MAX_VOLUME_SIZE};
 
 /// The largest render side, in pixels.
 pub const MAX_RENDER_SIZE: u32 = 1024;
@@ -130,6 +136,12 @@ impl ApiError {
 impl IntoResponse for ApiError {
     fn into_response(self) -> Response {
         (self.status, Json(&self)).into_response()
+    }
+}
+
+impl From<ApiError> for Response {
+    fn from(error: ApiError) -> Self {
+        error.into_response()
     }
 }
 
@@ -241,23 +253,26 @@ impl Params {
         self.choice("geometry", &Geometry::ALL, Geometry::id, Geometry::Blinn)
     }
 
-    fn normalisation(&self) -> Result<Normalisation, ApiError> {
+    fn normalisation(&self, default: Normalisation) -> Result<Normalisation, ApiError> {
         self.choice(
             "normalisation",
             &Normalisation::ALL,
             Normalisation::id,
-            Normalisation::Lobe,
+            default,
         )
     }
 }
 
-/// Runs `work` on the blocking pool; a panic inside becomes a 500, never a dropped server.
-async fn blocking<T: Send + 'static>(
+/// Runs `work` on the blocking pool once a worker is free, or answers the full queue's 503; a
+/// panic inside becomes a 500, never a dropped server.
+async fn compute<T: Send + 'static>(
+    state: &AppState,
     work: impl FnOnce() -> T + Send + 'static,
-) -> Result<T, ApiError> {
+) -> Result<T, Response> {
+    let _turn = state.computations.turn().await?;
     tokio::task::spawn_blocking(work)
         .await
-        .map_err(|e| ApiError::internal(format!("the computation failed: {e}")))
+        .map_err(|e| ApiError::internal(format!("the computation failed: {e}")).into())
 }
 
 /// Any other path.
@@ -266,7 +281,7 @@ pub async fn not_found() -> ApiError {
         status: StatusCode::NOT_FOUND,
         error: "no such page or endpoint".into(),
         parameter: None,
-        valid: Some("/, /api/models, /api/evaluate, /api/analyze, /api/render".into()),
+        valid: Some("/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume".into()),
     }
 }
 
@@ -308,40 +323,41 @@ pub async fn models() -> impl IntoResponse {
         "objects": Object::ALL.map(Object::id),
         "n": [1.0, 1000.0],
         "max_render_size": MAX_RENDER_SIZE,
+        "volumes": BuiltIn::ALL.map(BuiltIn::id),
+        "views": View::STANDARD.map(View::id),
+        "max_volume_size": MAX_VOLUME_SIZE,
     }))
 }
 
 pub async fn evaluate(
     State(state): State<AppState>,
     query: QueryPairs,
-) -> Result<Response, ApiError> {
+) -> Result<Response, Response> {
     let params = Params::new(
         pairs(query)?,
         &["lobe", "n", "geometry", "normalisation", "theta_in"],
     )?;
     let (kind, n) = (params.lobe()?, params.exponent()?);
-    let (geometry, normalisation) = (params.geometry()?, params.normalisation()?);
+    let (geometry, normalisation) = (
+        params.geometry()?,
+        params.normalisation(Normalisation::Lobe)?,
+    );
     let theta_in = params.number("theta_in", 0.0..=89.0, 30.0)?.to_radians();
-    let _turn = match state.computations.turn().await {
-        Ok(turn) => turn,
-        Err(busy) => return Ok(busy),
-    };
-    let data = blocking(move || curves(kind, n, geometry, normalisation, theta_in)).await?;
+    let data = compute(&state, move || {
+        curves(kind, n, geometry, normalisation, theta_in)
+    })
+    .await?;
     Ok(Json(data).into_response())
 }
 
 pub async fn analyze_lobe(
     State(state): State<AppState>,
     query: QueryPairs,
-) -> Result<Response, ApiError> {
+) -> Result<Response, Response> {
     let params = Params::new(pairs(query)?, &["lobe", "n"])?;
     let (kind, n) = (params.lobe()?, params.exponent()?);
-    let _turn = match state.computations.turn().await {
-        Ok(turn) => turn,
-        Err(busy) => return Ok(busy),
-    };
     let costs = state.costs.clone();
-    let (report, costs) = blocking(move || {
+    let (report, costs) = compute(&state, move || {
         let report = analyze(kind, n, &mut Precision::F64);
         (report, costs(&Lobe::new(kind, n)))
     })
@@ -355,7 +371,7 @@ pub async fn analyze_lobe(
 pub async fn render(
     State(state): State<AppState>,
     query: QueryPairs,
-) -> Result<Response, ApiError> {
+) -> Result<Response, Response> {
     let params = Params::new(
         pairs(query)?,
         &[
@@ -376,12 +392,7 @@ pub async fn render(
         kind: params.lobe()?,
         n: params.exponent()?,
         geometry: params.geometry()?,
-        normalisation: params.choice(
-            "normalisation",
-            &Normalisation::ALL,
-            Normalisation::id,
-            Normalisation::None,
-        )?,
+        normalisation: params.normalisation(Normalisation::None)?,
         shading: params.choice("shading", &Shading::ALL, Shading::id, Shading::Phong)?,
         model: params.choice(
             "model",
@@ -395,19 +406,47 @@ pub async fn render(
             .to_radians(),
         size: params.number("size", 16.0..=f64::from(MAX_RENDER_SIZE), 512.0)? as u32,
     };
-    let _turn = match state.computations.turn().await {
-        Ok(turn) => turn,
-        Err(busy) => return Ok(busy),
+    let encoded = compute(&state, move || render_png(&request)).await?;
+    Ok(png(encoded.map_err(ApiError::internal)?))
+}
+
+pub async fn volume(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<Response, Response> {
+    let params = Params::new(
+        pairs(query)?,
+        &[
+            "volume",
+            "view",
+            "lobe",
+            "n",
+            "geometry",
+            "normalisation",
+            "size",
+        ],
+    )?;
+    let request = VolumeRequest {
+        volume: params.choice("volume", &BuiltIn::ALL, BuiltIn::id, BuiltIn::SheppLogan)?,
+        view: params.choice("view", &View::STANDARD, View::id, View::Coronal)?,
+        kind: params.lobe()?,
+        n: params.exponent()?,
+        geometry: params.geometry()?,
+        normalisation: params.normalisation(Normalisation::ThesisPhong)?,
+        size: params.number("size", 16.0..=f64::from(MAX_VOLUME_SIZE), 256.0)? as u32,
     };
-    let png = blocking(move || render_png(&request))
-        .await?
-        .map_err(ApiError::internal)?;
-    Ok((
+    let encoded = compute(&state, move || volume_png(&request)).await?;
+    Ok(png(encoded.map_err(ApiError::internal)?))
+}
+
+/// The encoded image as a PNG response.
+fn png(encoded: Vec<u8>) -> Response {
+    (
         [
             (header::CONTENT_TYPE, "image/png"),
             (header::CACHE_CONTROL, "no-store"),
         ],
-        png,
+        encoded,
     )
-        .into_response())
+        .into_response()
 }

@@ -1,6 +1,7 @@
 //! # specula-serve: the BRDF explorer
 //!
-//! A page and a JSON API over the library and the CPU renderer; `specula serve` runs it.
+//! A page and a JSON API over the library, the CPU renderer and its ray marcher; `specula
+//! serve` runs it.
 //!
 //! The page, its script and its styles are compiled in (`assets/`); nothing is fetched from
 //! the network. The server binds to 127.0.0.1 unless `--bind` says otherwise, answers only to
@@ -15,12 +16,14 @@ mod guard;
 mod listen;
 #[cfg(test)]
 mod tests;
+mod volume;
 
 use std::net::SocketAddr;
 
 pub use api::{cpu_cost, AppState, CostModel, TargetCost, MAX_RENDER_SIZE};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
 pub use listen::{CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT, MAX_CONNECTIONS};
+pub use volume::MAX_VOLUME_SIZE;
 
 use axum::extract::DefaultBodyLimit;
 use axum::http::header;
@@ -65,6 +68,7 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/evaluate", get(api::evaluate))
         .route("/api/analyze", get(api::analyze_lobe))
         .route("/api/render", get(api::render))
+        .route("/api/volume", get(api::volume))
         .fallback(api::not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
         .layer(axum::middleware::from_fn_with_state(

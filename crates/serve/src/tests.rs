@@ -71,6 +71,66 @@ async fn render_returns_a_png_that_depends_on_the_lobe() {
     assert_eq!((status, &teapot[1..4]), (StatusCode::OK, &b"PNG"[..]));
 }
 
+/// The PNG's width and height, from its IHDR chunk.
+fn png_size(png: &[u8]) -> (u32, u32) {
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let word = |at: usize| u32::from_be_bytes(png[at..at + 4].try_into().expect("4 bytes"));
+    (word(16), word(20))
+}
+
+/// The volume view is the library's ray marcher with the parameters named in the address:
+/// its bytes are those of `render_dvr` called directly with them, and each parameter changes
+/// the image.
+#[tokio::test]
+async fn volume_renders_the_named_volume_view_and_lobe() {
+    use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+    use specula_render::volume::raymarch::{render_dvr, DvrSettings, Shading, View};
+    use specula_render::volume::{phantom, transfer::TransferFunction};
+
+    let uri = "/api/volume?volume=phantom&view=axial&lobe=cosquad&n=40&geometry=phong&normalisation=lobe&size=48";
+    let (status, served) = get(uri).await;
+    assert_eq!(
+        status,
+        StatusCode::OK,
+        "{}",
+        String::from_utf8_lossy(&served)
+    );
+    assert_eq!(png_size(&served), (48, 48));
+
+    let volume = phantom::shepp_logan(64).expect("phantom");
+    let shading = Shading::new(
+        Lobe::new(
+            LobeKind::parse("cosquad").expect("a lobe"),
+            Exponent::new(40.0),
+        ),
+        Geometry::Phong,
+        Normalisation::Lobe,
+    );
+    let settings = DvrSettings::new(48, 48, View::Axial, Some(shading));
+    let transfer = TransferFunction::preset("mr")
+        .expect("a preset")
+        .for_volume(&volume);
+    let image = render_dvr(&volume, &transfer, &settings, &|| {}).expect("render");
+    let direct =
+        specula_render::encode_png_srgb8(48, 48, &image.to_srgb8(Default::default())).expect("png");
+    assert!(
+        served == direct,
+        "the served image is not the library's render"
+    );
+
+    for other in [
+        uri.replace("lobe=cosquad", "lobe=schlick"),
+        uri.replace("n=40", "n=400"),
+        uri.replace("view=axial", "view=sagittal"),
+        uri.replace("volume=phantom", "volume=marschner-lobb"),
+        uri.replace("normalisation=lobe", "normalisation=none"),
+    ] {
+        let (status, changed) = get(&other).await;
+        assert_eq!(status, StatusCode::OK, "{other}");
+        assert!(changed != served, "{other} drew the same image");
+    }
+}
+
 #[tokio::test]
 async fn bad_parameters_get_400_naming_the_parameter_and_the_valid_values() {
     let cases = [
@@ -96,6 +156,19 @@ async fn bad_parameters_get_400_naming_the_parameter_and_the_valid_values() {
             "flat, gouraud, phong",
         ),
         ("/api/render?light_phi=720", "light_phi", "[-180, 180]"),
+        (
+            "/api/volume?volume=brain",
+            "volume",
+            "phantom, marschner-lobb",
+        ),
+        (
+            "/api/volume?view=oblique",
+            "view",
+            "axial, sagittal, coronal",
+        ),
+        ("/api/volume?size=2048", "size", "[16, 512]"),
+        ("/api/volume?lobe=gauss", "lobe", "cosquad"),
+        ("/api/volume?object=sphere", "object", "volume, view, lobe"),
     ];
     for (uri, parameter, valid) in cases {
         let (status, body) = json(uri).await;
@@ -118,7 +191,7 @@ async fn bad_parameters_get_400_naming_the_parameter_and_the_valid_values() {
     assert!(body["valid"]
         .as_str()
         .expect("routes")
-        .contains("/api/render"));
+        .contains("/api/volume"));
 }
 
 #[tokio::test]

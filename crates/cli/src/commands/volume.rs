@@ -12,9 +12,10 @@ use specula_gpu::{Gpu, GpuRenderer, GpuVolumeRenderer};
 use specula_render::volume::isosurface::{
     default_isovalue, iso_scene, marching_cubes, IsoSettings,
 };
+use specula_render::volume::phantom::BuiltIn;
 use specula_render::volume::raymarch::{render_dvr, DvrSettings, Shading, View};
 use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::{self, phantom, Volume};
+use specula_render::volume::{self, Volume};
 use specula_render::{check_output_path, render, write_image, Display, Image};
 
 use super::CommandResult;
@@ -28,9 +29,6 @@ pub enum Mode {
     /// The surface at `--iso` by marching cubes, drawn by the rasterizer.
     Iso,
 }
-
-/// The volumes built in.
-const BUILT_IN: [&str; 2] = ["phantom", "marschner-lobb"];
 
 /// Arguments of `specula volume`.
 #[derive(Debug, clap::Args)]
@@ -46,8 +44,8 @@ pub struct Args {
     /// How --mode iso interpolates its lighting.
     #[arg(long, value_parser = choice(&specula_render::Shading::ALL, specula_render::Shading::id), default_value = "phong")]
     shading: specula_render::Shading,
-    /// The transfer function: a preset (ct-bone, ct-soft-tissue, mr) or a .toml file; by
-    /// default ct-bone for CT and mr otherwise.
+    /// The transfer function: a preset (ct-bone, ct-soft-tissue, mr, surface) or a .toml file; by
+    /// default surface for marschner-lobb, ct-bone for CT and mr otherwise.
     #[arg(long)]
     transfer: Option<String>,
     /// The specular lobe.
@@ -140,17 +138,18 @@ fn parse_point(text: &str) -> Result<Vec3, String> {
 fn load(source: &Source) -> Result<Volume, String> {
     source.input_limit.apply();
     let side = source.size as usize;
-    let built = match source.input.as_str() {
-        "phantom" => phantom::shepp_logan(side),
-        "marschner-lobb" => phantom::marschner_lobb(side),
-        path if std::path::Path::new(path).exists() => volume::read(std::path::Path::new(path)),
-        other => {
+    let input = source.input.as_str();
+    let built = match BuiltIn::parse(input) {
+        Some(built_in) => built_in.make(side),
+        None if std::path::Path::new(input).exists() => volume::read(std::path::Path::new(input)),
+        None => {
+            let names = BuiltIn::ALL.map(BuiltIn::id);
             return Err(format!(
                 "'{}' is neither a built-in volume ({}) nor an existing file or folder{}",
-                specula::excerpt(other),
-                BUILT_IN.join(", "),
-                specula::did_you_mean(other, BUILT_IN)
-            ))
+                specula::excerpt(input),
+                names.join(", "),
+                specula::did_you_mean(input, names)
+            ));
         }
     };
     built.map_err(|e| e.to_string())
@@ -159,7 +158,8 @@ fn load(source: &Source) -> Result<Volume, String> {
 /// The transfer function `--transfer` names, in the volume's values.
 fn transfer(args: &Args, volume: &Volume) -> Result<TransferFunction, String> {
     let function = match &args.transfer {
-        None => TransferFunction::default_for(volume),
+        None => BuiltIn::parse(&args.source.input)
+            .map_or_else(|| TransferFunction::default_for(volume), BuiltIn::transfer),
         Some(name) if name.ends_with(".toml") => {
             let bytes = specula_render::input::read_within(std::path::Path::new(name), 1 << 20)?;
             let text = String::from_utf8(bytes).map_err(|_| format!("{name}: not UTF-8 text"))?;
@@ -175,14 +175,11 @@ pub fn run(args: &Args) -> CommandResult {
     check_output_path(&args.output).map_err(|e| e.to_string())?;
     let started = Instant::now();
     let volume = load(&args.source)?;
-    let shading = Shading {
-        lobe: Lobe::new(args.lobe, args.n),
-        geometry: args.geometry,
-        normalisation: args.normalisation,
-        ka: 0.25,
-        kd: 0.7,
-        ks: 0.5,
-    };
+    let shading = Shading::new(
+        Lobe::new(args.lobe, args.n),
+        args.geometry,
+        args.normalisation,
+    );
     let view = args.eye.map_or(args.view, View::Eye);
     let gpu = match args.backend {
         RendererArg::Cpu => None,

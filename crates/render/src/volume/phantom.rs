@@ -14,6 +14,7 @@ use core::f64::consts::PI;
 
 use glam::{DMat3, DVec3, Vec3};
 
+use super::transfer::TransferFunction;
 use super::{Units, Volume, VolumeError};
 
 /// One ellipsoid: density added inside, semi-axes, centre, Euler angles (degrees, `phi`,
@@ -132,6 +133,55 @@ pub fn shepp_logan_density(p: DVec3) -> f64 {
 
 /// Side of the head the phantom represents, in millimetres.
 pub const HEAD_MM: f32 = 256.0;
+
+/// A built-in volume: no file needed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BuiltIn {
+    /// The 3D Shepp-Logan head ([`shepp_logan`]).
+    SheppLogan,
+    /// The Marschner-Lobb signal ([`marschner_lobb`]).
+    MarschnerLobb,
+}
+
+impl BuiltIn {
+    /// Every built-in volume.
+    pub const ALL: [BuiltIn; 2] = [BuiltIn::SheppLogan, BuiltIn::MarschnerLobb];
+
+    /// Its name as `--input` takes it.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            BuiltIn::SheppLogan => "phantom",
+            BuiltIn::MarschnerLobb => "marschner-lobb",
+        }
+    }
+
+    /// The built-in volume called `name`, if one is.
+    #[must_use]
+    pub fn parse(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|b| b.id() == name)
+    }
+
+    /// The volume on a `side^3` grid.
+    pub fn make(self, side: usize) -> Result<Volume, VolumeError> {
+        match self {
+            BuiltIn::SheppLogan => shepp_logan(side),
+            BuiltIn::MarschnerLobb => marschner_lobb(side),
+        }
+    }
+
+    /// The transfer function it is drawn with unless another is asked for: `mr` for the head
+    /// (its densities are relative, like MR's), `surface` for Marschner-Lobb (its 0.5
+    /// isosurface is how the signal is always shown).
+    #[must_use]
+    pub fn transfer(self) -> TransferFunction {
+        let name = match self {
+            BuiltIn::SheppLogan => "mr",
+            BuiltIn::MarschnerLobb => "surface",
+        };
+        TransferFunction::preset(name).expect("presets are valid")
+    }
+}
 
 /// The 3D Shepp-Logan head on a `side^3` grid spanning [`HEAD_MM`], centred on the origin,
 /// `x` the phantom's first axis (towards the patient's right), `y` anterior, `z` superior.

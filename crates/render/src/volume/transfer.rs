@@ -10,6 +10,9 @@
 //! - `mr` (relative to the volume's range, since MR has no absolute scale): the lowest tenth
 //!   transparent, the low values (brain on the phantom, 0.2) faint, a band at 0.3 (the
 //!   phantom's tumours) dense and yellow, the top (bone) translucent ivory;
+//! - `surface` (relative): transparent below 45 % of the range and opaque (60 per mm) above
+//!   half of it, an isosurface at mid-range drawn by the ray marcher: how Marschner-Lobb's
+//!   0.5 isosurface is shown.
 //!
 //! A file (`--transfer FILE`) is TOML: `units = "hounsfield"` or `"relative"`, and `points =
 //! [[value, sigma, r, g, b], ...]` with values increasing.
@@ -47,7 +50,7 @@ pub struct TransferFunction {
 }
 
 /// The presets' names.
-pub const PRESETS: [&str; 3] = ["ct-bone", "ct-soft-tissue", "mr"];
+pub const PRESETS: [&str; 4] = ["ct-bone", "ct-soft-tissue", "mr", "surface"];
 
 /// The most control points a file may give.
 pub const MAX_POINTS: usize = 256;
@@ -125,6 +128,14 @@ impl TransferFunction {
                     point(0.3, 0.06, 1.0, 0.8, 0.35),
                     point(0.5, 0.01, 0.9, 0.85, 0.8),
                     point(1.0, 0.03, 1.0, 0.98, 0.92),
+                ],
+                Scale::Relative,
+            ),
+            "surface" => (
+                vec![
+                    point(0.45, 0.0, 0.9, 0.85, 0.8),
+                    point(0.5, 60.0, 0.95, 0.9, 0.85),
+                    point(1.0, 80.0, 1.0, 0.95, 0.9),
                 ],
                 Scale::Relative,
             ),
@@ -263,7 +274,7 @@ mod tests {
     fn bad_functions_and_names_are_refused_with_the_choices() {
         let refused = TransferFunction::preset("ct-boen").unwrap_err();
         assert!(
-            refused.0.contains("ct-bone, ct-soft-tissue, mr"),
+            refused.0.contains("ct-bone, ct-soft-tissue, mr, surface"),
             "{refused}"
         );
         let refused = TransferFunction::from_toml(

@@ -6,7 +6,7 @@
 const DASH = [7, 4];
 // Phong geometry with the lobe's own normalisation: energy-conserving (albedo <= 1) for every
 // lobe, so the first view is physically sensible.
-const DEFAULTS = { lobes: "pow,schlick,schlick-mod", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "" };
+const DEFAULTS = { lobes: "pow,schlick,schlick-mod", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "", volume: "phantom", view: "coronal", volume_lobe: "cosquad" };
 const $ = (id) => document.getElementById(id);
 let registry = null;
 let generation = 0;
@@ -52,6 +52,9 @@ function currentState() {
     light_phi: $("light_phi").value,
     log: $("log").checked ? "1" : "0",
     render: lobes[ids.indexOf(renderLobe)] ?? "",
+    volume: $("volume").value,
+    view: $("view").value,
+    volume_lobe: lobeName({ value: $("volume_lobe").value }),
   };
 }
 
@@ -104,6 +107,11 @@ function buildControls(state) {
   select("normalisation", registry.normalisations);
   select("shading", registry.shadings);
   select("model", registry.models);
+  select("volume", registry.volumes);
+  select("view", registry.views);
+  const volumeLobe = state.volume_lobe.split(":")[0];
+  if (!known.has(volumeLobe)) notes.push(`volume_lobe '${state.volume_lobe}' is not a lobe; using ${DEFAULTS.volume_lobe}`);
+  fillSelect("volume_lobe", [...known], known.has(volumeLobe) ? volumeLobe : DEFAULTS.volume_lobe);
   let n = Number(state.n);
   if (!(n >= 1 && n <= 1000)) {
     notes.push(`n = '${state.n}' is outside [1, 1000]; using ${DEFAULTS.n}`);
@@ -119,6 +127,9 @@ function buildControls(state) {
 
 function showValues(state) {
   $("render-lobe").textContent = state.render || "no lobe";
+  $("volume-lobe-name").textContent = state.volume_lobe;
+  $("volume-image").style.borderColor = colourOf(state.volume_lobe);
+  $("volume-pow").style.borderColor = colourOf("pow");
   $("theta_in-value").textContent = state.theta_in + "°";
   $("light_theta-value").textContent = state.light_theta + "°";
   $("light_phi-value").textContent = state.light_phi + "°";
@@ -293,7 +304,10 @@ function analysisTable(reports) {
   return `<table><thead><tr><th>lobe</th><th>epicentre max rel</th><th>bloom max abs</th><th>rms</th><th>energy ratio</th><th>max albedo (lobe-normalised)</th>${costHeads}</tr></thead><tbody>${rows.join("")}</tbody></table>${units ? `<p class="note">Costs: ${units}.</p>` : ""}`;
 }
 
+// An image already showing `url` is left alone: the volume renders take the server a while,
+// and most controls do not change them.
 function loadImage(img, url) {
+  if (img.getAttribute("src") === url && img.complete && img.naturalWidth > 0) return Promise.resolve();
   return new Promise((resolve, reject) => {
     img.onload = () => resolve();
     img.onerror = () => reject(new Error("render failed: " + url));
@@ -304,7 +318,8 @@ function loadImage(img, url) {
 async function update() {
   const state = currentState();
   showValues(state);
-  history.replaceState(null, "", "?" + new URLSearchParams(state).toString());
+  const query = "?" + new URLSearchParams(state).toString();
+  history.replaceState(null, "", query);
   const mine = ++generation;
   const lobes = state.lobes ? state.lobes.split(",") : [];
   const common = { n: state.n, geometry: state.geometry, normalisation: state.normalisation };
@@ -319,12 +334,45 @@ async function update() {
       const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: state.render, ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
       await Promise.all([loadImage($("sphere"), render("sphere")), loadImage($("teapot"), render("teapot"))]);
     }
+    const volume = (lobe) => "/api/volume?" + new URLSearchParams({ volume: state.volume, view: state.view, lobe, ...common, size: "256" });
+    await Promise.all([loadImage($("volume-image"), volume(state.volume_lobe)), loadImage($("volume-pow"), volume("pow"))]);
     if (mine !== generation) return;
+    drawDifference($("volume-image"), $("volume-pow"), $("volume-diff"), $("volume-psnr"));
     $("status").textContent = "";
+    // What is on the page now: the count of finished updates and the state they drew.
+    document.body.dataset.drawn = query;
     document.body.dataset.updates = String(Number(document.body.dataset.updates) + 1);
   } catch (error) {
     $("status").textContent = error.message;
   }
+}
+
+const DIFFERENCE_GAIN = 8;
+
+// |a - b| per 8-bit sRGB channel, amplified, and the PSNR of a against b over the frame.
+function drawDifference(a, b, canvas, caption) {
+  const pixelsOf = (img) => {
+    const c = Object.assign(document.createElement("canvas"), { width: img.naturalWidth, height: img.naturalHeight });
+    const g = c.getContext("2d");
+    g.drawImage(img, 0, 0);
+    return g.getImageData(0, 0, c.width, c.height);
+  };
+  const [pa, pb] = [pixelsOf(a), pixelsOf(b)];
+  [canvas.width, canvas.height] = [pa.width, pa.height];
+  const g = canvas.getContext("2d");
+  const out = g.createImageData(pa.width, pa.height);
+  let squares = 0;
+  for (let k = 0; k < pa.data.length; k += 4) {
+    for (let c = 0; c < 3; c++) {
+      const d = pa.data[k + c] - pb.data[k + c];
+      squares += d * d;
+      out.data[k + c] = Math.min(255, DIFFERENCE_GAIN * Math.abs(d));
+    }
+    out.data[k + 3] = 255;
+  }
+  g.putImageData(out, 0, 0);
+  const mse = squares / (3 * pa.width * pa.height);
+  caption.textContent = mse === 0 ? "identical to pow" : `PSNR ${(10 * Math.log10(255 * 255 / mse)).toFixed(1)} dB against pow (8-bit sRGB)`;
 }
 
 function draw(data, state) {
@@ -377,7 +425,7 @@ async function start() {
     const n = Number($("n-box").value);
     if (n >= 1 && n <= 1000) $("n").value = sliderFromN(n);
   });
-  document.querySelectorAll("#controls input, #controls select").forEach((el) => el.addEventListener("input", schedule));
+  document.querySelectorAll("#controls input, #controls select, #volume-controls select").forEach((el) => el.addEventListener("input", schedule));
   $("lobes").addEventListener("change", schedule);
   await update();
 }

@@ -23,17 +23,12 @@ use crate::output::sig;
 const EXPONENT: f64 = 32.0;
 
 fn shading(kind: LobeKind) -> Result<Shading, String> {
-    Ok(Shading {
-        lobe: Lobe::new(
-            kind,
-            Exponent::try_new(EXPONENT).map_err(|e| e.to_string())?,
-        ),
-        geometry: Geometry::Blinn,
-        normalisation: Normalisation::ThesisPhong,
-        ka: 0.25,
-        kd: 0.7,
-        ks: 0.5,
-    })
+    let n = Exponent::try_new(EXPONENT).map_err(|e| e.to_string())?;
+    Ok(Shading::new(
+        Lobe::new(kind, n),
+        Geometry::Blinn,
+        Normalisation::ThesisPhong,
+    ))
 }
 
 /// The best of `runs` wall-clock runs, in milliseconds, and the image.
