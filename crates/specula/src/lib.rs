@@ -46,6 +46,7 @@ pub mod normalisation;
 pub mod ops;
 pub mod quadrature;
 mod real;
+pub mod sampling;
 pub mod simd;
 pub mod zones;
 

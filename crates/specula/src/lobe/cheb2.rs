@@ -16,6 +16,8 @@
 //! - **Domain**: `g in [0, pi/2)`; from a cosine, `g = acos(t)`.
 //! - **Cost**: two multiplies, two adds (Horner), plus the `acos` when fed a cosine; the
 //!   coefficients come from a table indexed by `n` (a ROM in hardware).
+//! - **Sampling**: Newton on the quadratic's closed-form integral (see `quadratic.rs`), or
+//!   a table when the fit overshoots 1 at the peak and is clamped.
 //! - **Source**: the thesis's method; coefficients computed by specula.
 
 use super::quadratic::AngleQuadratic;

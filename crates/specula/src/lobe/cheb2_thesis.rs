@@ -20,6 +20,8 @@
 //! - **Parameters**: the exponent `n`.
 //! - **Domain**: `g in [0, pi/2)`; from a cosine, `g = acos(t)`.
 //! - **Cost**: two multiplies, two adds (Horner), plus the `acos` when fed a cosine.
+//! - **Sampling**: Newton on the quadratic's closed-form integral (see `quadratic.rs`), or
+//!   a table when the fit overshoots 1 at the peak and is clamped.
 //! - **Source**: the thesis, slide "Approximating the BRDF with Chebyshev polynomials".
 
 use super::quadratic::AngleQuadratic;

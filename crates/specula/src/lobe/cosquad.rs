@@ -17,6 +17,9 @@
 //! - **Domain**: `t in (0, 1]`; the base is at most 1, so the value lies in `[0, 1]`.
 //! - **Cost**: two adds, one multiply (by the per-material constant `a`), one comparison,
 //!   `v` squarings.
+//! - **Sampling**: analytic. With `m = 2^v` and `x = a (t - 1) + 1`, `int_t^1 cosquad =
+//!   (1 - max(0, x)^(m+1)) / (a (m + 1))`, inverted: `x = (1 - u (1 - x_0^(m+1)))^(1/(m+1))`,
+//!   `x_0 = max(0, 1 - a)` the base at `t = 0`.
 //! - **Source**: the thesis, slide "A model based on a cosine-quadratic function".
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
@@ -67,6 +70,31 @@ impl CosQuad {
             value = value.square();
         }
         value
+    }
+
+    /// `m + 1 = 2^v + 1`, the power of the integrated base.
+    fn power_plus_one(&self) -> f64 {
+        f64::from(1u32 << self.v) + 1.0
+    }
+
+    /// `int_t^1 cosquad(s) ds`, with `1 - x^(m+1)` as `-expm1((m + 1) ln x)`.
+    pub(crate) fn tail(&self, t: f64) -> f64 {
+        let power = self.power_plus_one();
+        let base = self.a * (t - 1.0) + 1.0;
+        let remaining = if base > 0.0 {
+            -(power * (self.a * (t - 1.0)).ln_1p()).exp_m1()
+        } else {
+            1.0
+        };
+        remaining / (self.a * power)
+    }
+
+    /// The cosine whose tail is the fraction `u` of the whole.
+    pub(crate) fn tail_inverse(&self, u: f64) -> f64 {
+        let power = self.power_plus_one();
+        let floor = (1.0 - self.a).max(0.0).powf(power);
+        let log_base = (-u * (1.0 - floor)).ln_1p() / power;
+        (1.0 + log_base.exp_m1() / self.a).max(0.0)
     }
 }
 

@@ -18,6 +18,7 @@
 //! - **Parameters**: the exponent `n`.
 //! - **Domain**: `t in (0, 1]`.
 //! - **Cost**: two multiply-adds and two float/int conversions: the cheapest lobe here.
+//! - **Sampling**: table (`sampling::CosineDistribution`), as `fastpow`.
 //! - **Source**: P. Mineiro, fastapprox (`fasterlog2`, `fasterpow2`, `fasterpow`), 2011;
 //!   N. N. Schraudolph, "A fast, compact approximation of the exponential function" (1999).
 

@@ -24,6 +24,8 @@
 //! - **Parameters**: the exponent `n`.
 //! - **Domain**: `t in (0, 1]`.
 //! - **Cost**: two divides, a few multiply-adds, two float/int conversions; no transcendental.
+//! - **Sampling**: table (`sampling::CosineDistribution`): the bit trick is piecewise, with
+//!   kinks at every binade, so it has no closed-form integral worth inverting.
 //! - **Source**: P. Mineiro, fastapprox (`fastlog2`, `fastpow2`, `fastpow`), 2011;
 //!   N. N. Schraudolph, "A fast, compact approximation of the exponential function" (1999).
 

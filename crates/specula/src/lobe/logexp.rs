@@ -13,6 +13,8 @@
 //! - **Parameters**: the exponent `n`.
 //! - **Domain**: `t in (0, 1]`; `1 - y >= 1`, so the value lies in `[0, 1]`.
 //! - **Cost**: two log2, two multiplies, two adds, one comparison.
+//! - **Sampling**: table (`sampling::CosineDistribution`): the lobe is a chain of
+//!   approximations with no useful closed-form integral.
 //! - **Source**: the thesis, slide "Models based on the logarithmic and exponential functions".
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};

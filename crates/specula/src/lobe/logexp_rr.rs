@@ -14,6 +14,7 @@
 //! - **Parameters**: the exponent `n`.
 //! - **Domain**: `t in (0, 1]`; the value lies in `(0, 1]`.
 //! - **Cost**: two log2, two multiplies, three adds, one rounding, one shift.
+//! - **Sampling**: table (`sampling::CosineDistribution`), as `logexp`.
 //! - **Source**: specula.
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};

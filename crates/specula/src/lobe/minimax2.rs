@@ -13,6 +13,8 @@
 //! - **Parameters**: the exponent `n`.
 //! - **Domain**: `g in [0, pi/2)`; from a cosine, `g = acos(t)`.
 //! - **Cost**: as `cheb2`.
+//! - **Sampling**: Newton on the quadratic's closed-form integral (see `quadratic.rs`), or
+//!   a table when the fit overshoots 1 at the peak and is clamped.
 //! - **Source**: specula (a variant measured like the thesis's models, SPEC section 2).
 
 use super::quadratic::AngleQuadratic;

@@ -17,6 +17,7 @@ mod cheb2_thesis;
 mod cosquad;
 mod fasterpow;
 mod fastpow;
+mod invert;
 mod kind;
 mod logexp;
 mod logexp_rr;
@@ -30,6 +31,7 @@ mod sg_karis;
 
 pub use cheb2_thesis::thesis_coefficients;
 pub use cosquad::CosQuad;
+pub use invert::Inverted;
 pub use kind::{LineStyle, LobeInfo, LobeKind, Origin, ParamInfo};
 pub use quadratic::AngleQuadratic;
 pub use sg_karis::KARIS_OFFSET;
@@ -56,6 +58,32 @@ pub struct PackedLobe {
     pub quadratic: [f64; 3],
     /// A quadratic-in-angle lobe's cut-off angle (radians).
     pub cutoff: f64,
+}
+
+/// How a lobe's cosine is drawn from a uniform number for importance sampling: each lobe's
+/// manual page says which, and why.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Warp {
+    /// The closed-form integral `int_t^1 lobe` inverted in closed form.
+    Analytic,
+    /// The closed-form integral inverted by safeguarded Newton iterations.
+    Newton,
+    /// A tabulated inverse CDF, built when the sampler is prepared
+    /// ([`crate::sampling::CosineDistribution`]).
+    Table,
+}
+
+impl Warp {
+    /// The name tables print.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            Warp::Analytic => "analytic",
+            Warp::Newton => "newton",
+            Warp::Table => "table",
+        }
+    }
 }
 
 /// A lobe function prepared for one exponent `n`.
@@ -167,6 +195,55 @@ impl Lobe {
             Model::FastPow(m) => m.kinks(),
             Model::FasterPow(m) => m.kinks(),
             _ => Vec::new(),
+        }
+    }
+
+    /// How the lobe's cosine is sampled.
+    #[must_use]
+    pub fn warp(&self) -> Warp {
+        match &self.model {
+            Model::Pow(_) | Model::Sg(_) | Model::CosQuad(_) => Warp::Analytic,
+            Model::Schlick(_) => Warp::Newton,
+            Model::AngleQuadratic(m) if m.has_closed_form_tail() => Warp::Newton,
+            Model::AngleQuadratic(_)
+            | Model::SchlickMod(_)
+            | Model::LogExp(_)
+            | Model::LogExpRr(_)
+            | Model::FastPow(_)
+            | Model::FasterPow(_) => Warp::Table,
+        }
+    }
+
+    /// `int_t^1 lobe(s) ds` for `t` in `[0, 1]`, in closed form; `None` for a lobe sampled
+    /// from a table.
+    #[must_use]
+    pub fn tail(&self, t: f64) -> Option<f64> {
+        let t = t.clamp(0.0, 1.0);
+        match (&self.model, self.warp()) {
+            (_, Warp::Table) => None,
+            (Model::Pow(m), _) => Some(m.tail(t)),
+            (Model::Sg(m), _) => Some(m.tail(t)),
+            (Model::CosQuad(m), _) => Some(m.tail(t)),
+            (Model::Schlick(m), _) => Some(m.tail(t)),
+            (Model::AngleQuadratic(m), _) => Some(m.tail(t)),
+            _ => None,
+        }
+    }
+
+    /// The cosine `t` with `tail(t) = u tail(0)`, `u` in `[0, 1]`, and the iterations it
+    /// took (0 for a closed form); `None` for a lobe sampled from a table.
+    #[must_use]
+    pub fn tail_inverse(&self, u: f64) -> Option<Inverted> {
+        let u = u.clamp(0.0, 1.0);
+        let exact = |x| Some(Inverted { x, iterations: 0 });
+        match (&self.model, self.warp()) {
+            (_, Warp::Table) => None,
+            (Model::Pow(m), _) => exact(m.tail_inverse(u)),
+            (Model::Sg(m), _) => exact(m.tail_inverse(u)),
+            (Model::CosQuad(m), _) => exact(m.tail_inverse(u)),
+            (Model::Schlick(m), _) => Some(m.tail_inverse(u)),
+            (Model::AngleQuadratic(m), _) => Some(m.tail_inverse(u)),
+            _ => None,
         }
     }
 

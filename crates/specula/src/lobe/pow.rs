@@ -10,6 +10,8 @@
 //! - **Parameters**: the exponent `n` only.
 //! - **Domain**: `t in (0, 1]` (the dispatcher maps `t <= 0` to 0 and clamps `t` to 1).
 //! - **Cost**: one general power, i.e. `exp2(n * log2 t)` in a math library.
+//! - **Sampling**: analytic. `int_t^1 s^n ds = (1 - t^(n+1)) / (n + 1)`, inverted:
+//!   `t = (1 - u)^(1/(n+1))`, the classic Phong warp.
 //! - **Source**: B. T. Phong (1975); J. F. Blinn (1977); the thesis's reference function.
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
@@ -34,6 +36,16 @@ impl Pow {
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {
         t.powf(R::from_f64(self.n))
+    }
+
+    /// `int_t^1 s^n ds`, with `1 - t^(n+1)` as `-expm1((n + 1) ln t)` (exact near the peak).
+    pub(crate) fn tail(&self, t: f64) -> f64 {
+        -((self.n + 1.0) * t.ln()).exp_m1() / (self.n + 1.0)
+    }
+
+    /// The cosine whose tail is the fraction `u` of the whole.
+    pub(crate) fn tail_inverse(&self, u: f64) -> f64 {
+        ((-u).ln_1p() / (self.n + 1.0)).exp()
     }
 }
 

@@ -5,8 +5,15 @@
 //! would go negative (concave fit) or climb again (convex fit). The zero, `cutoff`, is solved
 //! once when the lobe is prepared; the evaluation returns 0 from there on and clamps to 1 in
 //! case a fit overshoots the peak, so the lobe obeys SPEC section 1's range rule.
+//!
+//! **Sampling**: Newton in the angle. `int_t^1 lobe = int_0^g (C + B x + A x^2) sin x dx =
+//! C (1 - cos g) + B (sin g - g cos g) + A (2 g sin g + (2 - g^2) cos g - 2)` in closed form
+//! (a series below `g = 1/2`, where the brackets cancel), with no closed-form inverse;
+//! safeguarded Newton solves it from the Gaussian guess `g = sqrt(2 u L / C)`. A fit that
+//! overshoots 1 (clamped, so no longer the quadratic) is sampled from a table instead.
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::invert::{solve_increasing, Inverted};
 use crate::real::Real;
 use crate::simd::math::{acos, ACOS};
 use crate::simd::tally::{Class, Instructions};
@@ -50,6 +57,65 @@ impl AngleQuadratic {
             (R::from_f64(c) + g * (R::from_f64(b) + R::from_f64(a) * g)).min(R::from_f64(1.0))
         } else {
             R::from_f64(0.0)
+        }
+    }
+
+    /// Whether the quadratic stays at or below 1 before its cut-off, so that its closed-form
+    /// integral is the lobe's.
+    pub(crate) fn has_closed_form_tail(&self) -> bool {
+        let [c, b, a] = self.coeffs;
+        let vertex = -b / (2.0 * a);
+        let peak = if a < 0.0 && vertex > 0.0 && vertex < self.cutoff {
+            c - b * b / (4.0 * a)
+        } else {
+            c.max(c + self.cutoff * (b + a * self.cutoff))
+        };
+        peak <= 1.0
+    }
+
+    /// `int_0^g (C + B x + A x^2) sin x dx`, `g` capped at the cut-off.
+    fn tail_angle(&self, g: f64) -> f64 {
+        let [c, b, a] = self.coeffs;
+        let g = g.clamp(0.0, self.cutoff);
+        let (sin, cos) = g.sin_cos();
+        let one_minus_cos = 2.0 * (0.5 * g).sin().powi(2);
+        // int_0^g x sin x = sum_k (-1)^k g^(2k+3) / ((2k+1)! (2k+3)), and the x^2 moment with
+        // (2k+4) in place of (2k+3).
+        let (first, second) = if g < 0.5 {
+            let mut term = g; // (-1)^k g^(2k+1) / (2k+1)!
+            let (mut first, mut second) = (0.0, 0.0);
+            for k in 0..10 {
+                let k = f64::from(k);
+                first += term * g * g / (2.0 * k + 3.0);
+                second += term * g * g * g / (2.0 * k + 4.0);
+                term *= -g * g / ((2.0 * k + 2.0) * (2.0 * k + 3.0));
+            }
+            (first, second)
+        } else {
+            (sin - g * cos, 2.0 * g * sin + (2.0 - g * g) * cos - 2.0)
+        };
+        c * one_minus_cos + b * first + a * second
+    }
+
+    /// `int_t^1 lobe(s) ds` (valid when [`Self::has_closed_form_tail`]).
+    pub(crate) fn tail(&self, t: f64) -> f64 {
+        self.tail_angle(t.clamp(0.0, 1.0).acos())
+    }
+
+    /// The cosine whose tail is the fraction `u` of the whole, by Newton in the angle.
+    pub(crate) fn tail_inverse(&self, u: f64) -> Inverted {
+        let [c, b, a] = self.coeffs;
+        let target = u * self.tail_angle(self.cutoff);
+        let root = solve_increasing(
+            |g| self.tail_angle(g),
+            |g| (c + g * (b + a * g)).max(0.0) * g.sin(),
+            target,
+            (0.0, self.cutoff),
+            (2.0 * target / c.max(f64::MIN_POSITIVE)).sqrt(),
+        );
+        Inverted {
+            x: root.x.cos(),
+            ..root
         }
     }
 }

@@ -13,9 +13,14 @@
 //! - **Domain**: `t in (0, 1]`; the value lies in `(0, 1]` because the denominator is at
 //!   least `t`.
 //! - **Cost**: one multiply, two adds, one divide.
+//! - **Sampling**: Newton. With `c = n - 1` and `d = 1 - t`, `int_t^1 schlick =
+//!   (n / c^2) ln(1 + c d) - d / c` (a series in `c d` where that cancels), which mixes `d`
+//!   and `ln d` and has no closed-form inverse; safeguarded Newton solves it from the
+//!   near-peak guess `d = expm1(c u L) / c`.
 //! - **Source**: C. Schlick, "A customizable reflectance model for everyday rendering" (1993).
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::invert::{solve_increasing, Inverted};
 use crate::real::Real;
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
@@ -36,6 +41,48 @@ impl Schlick {
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {
         schlick_denominator_ratio(t, t, self.n)
+    }
+
+    /// `int_{1-d}^1 schlick(s) ds = int_0^d (1 - s) / (1 + c s) ds`, `c = n - 1`.
+    fn tail_from_peak(&self, d: f64) -> f64 {
+        let c = self.n - 1.0;
+        let x = c * d;
+        if x < 0.05 {
+            // (n / c^2) ln(1 + x) - d / c = d - n d^2 sum_k (-x)^k / (k + 2).
+            let series = (0..16)
+                .rev()
+                .fold(0.0, |sum, k| sum * -x + 1.0 / f64::from(k + 2));
+            d - self.n * d * d * series
+        } else {
+            self.n / (c * c) * x.ln_1p() - d / c
+        }
+    }
+
+    /// `int_t^1 schlick(s) ds`.
+    pub(crate) fn tail(&self, t: f64) -> f64 {
+        self.tail_from_peak(1.0 - t)
+    }
+
+    /// The cosine whose tail is the fraction `u` of the whole, by Newton on the tail.
+    pub(crate) fn tail_inverse(&self, u: f64) -> Inverted {
+        let c = self.n - 1.0;
+        let target = u * self.tail_from_peak(1.0);
+        let guess = if c > 0.0 {
+            (c * target).exp_m1() / c
+        } else {
+            target
+        };
+        let root = solve_increasing(
+            |d| self.tail_from_peak(d),
+            |d| self.eval(1.0 - d),
+            target,
+            (0.0, 1.0),
+            guess,
+        );
+        Inverted {
+            x: 1.0 - root.x,
+            ..root
+        }
     }
 }
 

@@ -19,6 +19,9 @@
 //! - **Parameters**: the exponent `n` (which fixes `a`).
 //! - **Domain**: `t in (0, 1]`; the value lies in `(0, 1]` since `t^a <= t <= n (1 - t) + t`.
 //! - **Cost**: `log2(a)` squarings, one multiply, two adds, one divide.
+//! - **Sampling**: table. `int t^a / (n (1 - t) + t)` has a closed form only as a long
+//!   polynomial division plus a logarithm for each `a`; the tabulated density
+//!   (`sampling::CosineDistribution`) is exact enough and cheaper to trust.
 //! - **Source**: the thesis, slide "Modified Schlick BRDF".
 
 use super::schlick::schlick_denominator_ratio;

@@ -15,6 +15,8 @@
 //! - **Domain**: `t in (0, 1]`; the value lies in `(0, 1]`. At `t <= 0` the dispatcher's
 //!   rule gives 0, where the Gaussian itself would still be `exp(-n)`.
 //! - **Cost**: one add, one multiply and one `exp2`.
+//! - **Sampling**: analytic. With `k = n` (or `n + offset`), `int_t^1 exp(k (s - 1)) ds =
+//!   -expm1(-k (1 - t)) / k`, inverted: `t = 1 + ln(1 + u expm1(-k)) / k`.
 //! - **Source**: S. Lagarde, "Spherical Gaussian approximation for Blinn-Phong, Phong and
 //!   Fresnel" (2012); the Gaussian form of the Phong lobe behind real-time engines' cheap
 //!   specular.
@@ -49,6 +51,23 @@ impl Sg {
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {
         ((t - R::from_f64(1.0)) * R::from_f64(self.rate)).exp2()
+    }
+
+    /// The natural rate `k` of `exp(k (t - 1))`.
+    fn natural_rate(&self) -> f64 {
+        self.rate * core::f64::consts::LN_2
+    }
+
+    /// `int_t^1 exp(k (s - 1)) ds`.
+    pub(crate) fn tail(&self, t: f64) -> f64 {
+        let k = self.natural_rate();
+        -(-k * (1.0 - t)).exp_m1() / k
+    }
+
+    /// The cosine whose tail is the fraction `u` of the whole.
+    pub(crate) fn tail_inverse(&self, u: f64) -> f64 {
+        let k = self.natural_rate();
+        (1.0 + (u * (-k).exp_m1()).ln_1p() / k).max(0.0)
     }
 
     pub(crate) fn kernel(&self) -> SgKernel {
