@@ -96,6 +96,15 @@ enum Command {
                             specula volume --input marschner-lobb --size 64 --eye 400,-300,200 -o ml.png"
     )]
     Volume(commands::volume::Args),
+    /// Draw directions from a lobe's importance sampler (wi and pdf per line), or run the
+    /// chi-square suite over every lobe.
+    #[command(
+        after_help = "Examples:\n  specula sample --lobe cosquad --n 64 --theta-o 30 --count 5\n  \
+                            specula sample --lobe schlick --n 8 --form blinn --format json --count 3\n  \
+                            specula sample --test\n  \
+                            specula sample --test --lobe sg --n 512 --theta-o 70 --images chi2/"
+    )]
+    Sample(commands::sample::Args),
     /// Write a volume (built in, NIfTI or a DICOM series) as NIfTI-1 or as a DICOM series.
     #[command(
         after_help = "Examples:\n  specula volume-convert --input phantom -o head.nii.gz\n  \
@@ -196,6 +205,7 @@ fn main() -> ExitCode {
         Command::Report(args) => commands::report::run(&args),
         Command::Render(args) => commands::render::run(&args),
         Command::Volume(args) => commands::volume::run(&args),
+        Command::Sample(args) => commands::sample::run(&args),
         Command::VolumeConvert(args) => commands::volume::convert(&args),
         Command::Diff(args) => commands::diff::run(&args),
         Command::Shader(args) => commands::shader::run(&args),

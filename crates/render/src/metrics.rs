@@ -85,15 +85,21 @@ impl Difference {
     /// The FLIP map coloured with FLIP's magma map, as 8-bit sRGB bytes.
     #[must_use]
     pub fn heatmap_srgb8(&self) -> Vec<u8> {
-        let lut = nv_flip::magma_lut().to_vec();
-        self.flip_map
-            .iter()
-            .flat_map(|&v| {
-                let k = 3 * (v.clamp(0.0, 1.0) * 255.0).round() as usize;
-                [lut[k], lut[k + 1], lut[k + 2]]
-            })
-            .collect()
+        magma_srgb8(&self.flip_map)
     }
+}
+
+/// Each value in `[0, 1]` (clamped) in FLIP's magma colour map, as 8-bit sRGB bytes.
+#[must_use]
+pub fn magma_srgb8(values: &[f32]) -> Vec<u8> {
+    let lut = nv_flip::magma_lut().to_vec();
+    values
+        .iter()
+        .flat_map(|&v| {
+            let k = 3 * (v.clamp(0.0, 1.0) * 255.0).round() as usize;
+            [lut[k], lut[k + 1], lut[k + 2]]
+        })
+        .collect()
 }
 
 #[cfg(test)]

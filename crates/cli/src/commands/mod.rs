@@ -11,6 +11,7 @@ pub mod models;
 pub mod recommend;
 pub mod render;
 pub mod report;
+pub mod sample;
 pub mod serve;
 pub mod shader;
 pub mod synth;
