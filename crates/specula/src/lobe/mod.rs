@@ -219,13 +219,12 @@ impl Lobe {
     #[must_use]
     pub fn tail(&self, t: f64) -> Option<f64> {
         let t = t.clamp(0.0, 1.0);
-        match (&self.model, self.warp()) {
-            (_, Warp::Table) => None,
-            (Model::Pow(m), _) => Some(m.tail(t)),
-            (Model::Sg(m), _) => Some(m.tail(t)),
-            (Model::CosQuad(m), _) => Some(m.tail(t)),
-            (Model::Schlick(m), _) => Some(m.tail(t)),
-            (Model::AngleQuadratic(m), _) => Some(m.tail(t)),
+        match &self.model {
+            Model::Pow(m) => Some(m.tail(t)),
+            Model::Sg(m) => Some(m.tail(t)),
+            Model::CosQuad(m) => Some(m.tail(t)),
+            Model::Schlick(m) => Some(m.tail(t)),
+            Model::AngleQuadratic(m) if m.has_closed_form_tail() => Some(m.tail(t)),
             _ => None,
         }
     }
@@ -236,13 +235,12 @@ impl Lobe {
     pub fn tail_inverse(&self, u: f64) -> Option<Inverted> {
         let u = u.clamp(0.0, 1.0);
         let exact = |x| Some(Inverted { x, iterations: 0 });
-        match (&self.model, self.warp()) {
-            (_, Warp::Table) => None,
-            (Model::Pow(m), _) => exact(m.tail_inverse(u)),
-            (Model::Sg(m), _) => exact(m.tail_inverse(u)),
-            (Model::CosQuad(m), _) => exact(m.tail_inverse(u)),
-            (Model::Schlick(m), _) => Some(m.tail_inverse(u)),
-            (Model::AngleQuadratic(m), _) => Some(m.tail_inverse(u)),
+        match &self.model {
+            Model::Pow(m) => exact(m.tail_inverse(u)),
+            Model::Sg(m) => exact(m.tail_inverse(u)),
+            Model::CosQuad(m) => exact(m.tail_inverse(u)),
+            Model::Schlick(m) => Some(m.tail_inverse(u)),
+            Model::AngleQuadratic(m) if m.has_closed_form_tail() => Some(m.tail_inverse(u)),
             _ => None,
         }
     }

@@ -26,15 +26,22 @@ pub struct AngleQuadratic {
     coeffs: [f64; 3],
     /// The first angle in `[0, pi/2]` at which the quadratic stops being positive.
     cutoff: f64,
+    /// `int_0^1 lobe` in closed form, or `None` when the fit overshoots 1 and is clamped.
+    total: Option<f64>,
 }
 
 impl AngleQuadratic {
     /// Prepares `C + B g + A g^2` (`coeffs = [C, B, A]`).
     pub(crate) fn new(coeffs: [f64; 3]) -> Self {
-        Self {
+        let mut quadratic = Self {
             coeffs,
             cutoff: first_zero(coeffs),
-        }
+            total: None,
+        };
+        quadratic.total = quadratic
+            .stays_below_one()
+            .then(|| quadratic.tail_angle(quadratic.cutoff));
+        quadratic
     }
 
     /// `[C, B, A]`.
@@ -63,6 +70,10 @@ impl AngleQuadratic {
     /// Whether the quadratic stays at or below 1 before its cut-off, so that its closed-form
     /// integral is the lobe's.
     pub(crate) fn has_closed_form_tail(&self) -> bool {
+        self.total.is_some()
+    }
+
+    fn stays_below_one(&self) -> bool {
         let [c, b, a] = self.coeffs;
         let vertex = -b / (2.0 * a);
         let peak = if a < 0.0 && vertex > 0.0 && vertex < self.cutoff {
@@ -105,7 +116,7 @@ impl AngleQuadratic {
     /// The cosine whose tail is the fraction `u` of the whole, by Newton in the angle.
     pub(crate) fn tail_inverse(&self, u: f64) -> Inverted {
         let [c, b, a] = self.coeffs;
-        let target = u * self.tail_angle(self.cutoff);
+        let target = u * self.total.unwrap_or(0.0);
         let root = solve_increasing(
             |g| self.tail_angle(g),
             |g| (c + g * (b + a * g)).max(0.0) * g.sin(),

@@ -30,11 +30,18 @@ use crate::Exponent;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Schlick {
     n: f64,
+    /// `int_0^1 schlick`, the tail a draw's fraction is taken of.
+    total: f64,
 }
 
 impl Schlick {
     pub(crate) fn new(n: Exponent) -> Self {
-        Self { n: n.get() }
+        let mut schlick = Self {
+            n: n.get(),
+            total: 0.0,
+        };
+        schlick.total = schlick.tail_from_peak(1.0);
+        schlick
     }
 
     /// Evaluates at `t in (0, 1]`.
@@ -66,7 +73,7 @@ impl Schlick {
     /// The cosine whose tail is the fraction `u` of the whole, by Newton on the tail.
     pub(crate) fn tail_inverse(&self, u: f64) -> Inverted {
         let c = self.n - 1.0;
-        let target = u * self.tail_from_peak(1.0);
+        let target = u * self.total;
         let guess = if c > 0.0 {
             (c * target).exp_m1() / c
         } else {

@@ -21,7 +21,7 @@ use core::f64::consts::{PI, TAU};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::SpecularSampler;
+use super::{mirror, SpecularSampler};
 use crate::Geometry;
 
 /// Cells with fewer expected samples than this are pooled, as Pearson's approximation needs.
@@ -120,7 +120,7 @@ struct Domain {
 
 impl Domain {
     fn new(sampler: &SpecularSampler, wo: DVec3) -> Self {
-        let axis = DVec3::new(-wo.x, -wo.y, wo.z);
+        let axis = mirror(wo);
         let (b1, b2) = axis.any_orthonormal_pair();
         let spread = match sampler.geometry() {
             Geometry::Phong => 1.0,

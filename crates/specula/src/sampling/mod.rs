@@ -51,6 +51,12 @@ pub struct SpecularSampler {
     scale: f64,
 }
 
+/// The mirror direction of `wo` about the normal: the Phong lobe's axis.
+#[must_use]
+pub fn mirror(wo: DVec3) -> DVec3 {
+    DVec3::new(-wo.x, -wo.y, wo.z)
+}
+
 /// `v` mirrored about the unit vector `axis`.
 fn reflect(v: DVec3, axis: DVec3) -> DVec3 {
     2.0 * v.dot(axis) * axis - v
@@ -110,7 +116,7 @@ impl SpecularSampler {
     #[must_use]
     pub fn axis(&self, wo: DVec3) -> DVec3 {
         match self.geometry {
-            Geometry::Phong => DVec3::new(-wo.x, -wo.y, wo.z),
+            Geometry::Phong => mirror(wo),
             Geometry::Blinn => DVec3::Z,
         }
     }
