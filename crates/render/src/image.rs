@@ -25,8 +25,8 @@ pub struct Image {
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum ImageError {
-    /// The extension is neither `.png` nor `.exr`.
-    #[error("{path}: unknown image format; use a file name ending in .png (8-bit sRGB) or .exr (linear f32)")]
+    /// The extension is none of `.png`, `.exr` and `.hdr`.
+    #[error("{path}: unknown image format; use a file name ending in .png (8-bit sRGB), .exr (linear f32) or .hdr (Radiance RGBE)")]
     UnknownFormat {
         /// The path.
         path: String,
@@ -209,6 +209,7 @@ impl Image {
 enum Format {
     Png,
     Exr,
+    Hdr,
 }
 
 fn format_of(path: &Path) -> Result<Format, ImageError> {
@@ -220,6 +221,7 @@ fn format_of(path: &Path) -> Result<Format, ImageError> {
     {
         Some("png") => Ok(Format::Png),
         Some("exr") => Ok(Format::Exr),
+        Some("hdr") => Ok(Format::Hdr),
         _ => Err(ImageError::UnknownFormat {
             path: path.display().to_string(),
         }),
@@ -260,7 +262,8 @@ fn png_into(
         .map_err(|e| e.to_string())
 }
 
-/// Writes `image` to `path`: `.png` as 8-bit sRGB through `display`, `.exr` as linear `f32`.
+/// Writes `image` to `path`: `.png` as 8-bit sRGB through `display`, `.exr` as linear `f32`,
+/// `.hdr` as linear Radiance RGBE (negative and non-finite values are written as 0).
 pub fn write_image(path: &Path, image: &Image, display: Display) -> Result<(), ImageError> {
     use exr::prelude::{
         Encoding, Image as ExrImage, Layer, LayerAttributes, SpecificChannels, WritableImage,
@@ -282,6 +285,17 @@ pub fn write_image(path: &Path, image: &Image, display: Display) -> Result<(), I
                 .to_buffered(writer)
                 .map_err(|e| e.to_string())
         }),
+        Format::Hdr => write_atomically(path, |writer| {
+            let finite = |v: f32| if v.is_finite() { v.max(0.0) } else { 0.0 };
+            let pixels: Vec<image::Rgb<f32>> = image
+                .pixels()
+                .iter()
+                .map(|p| image::Rgb([finite(p.x), finite(p.y), finite(p.z)]))
+                .collect();
+            image::codecs::hdr::HdrEncoder::new(writer)
+                .encode(&pixels, image.width as usize, image.height as usize)
+                .map_err(|e| e.to_string())
+        }),
     }
 }
 
@@ -290,7 +304,8 @@ pub fn write_image(path: &Path, image: &Image, display: Display) -> Result<(), I
 /// about 60 bytes per pixel beside the two images.
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 24;
 
-/// Reads a PNG (decoded from sRGB to linear) or an OpenEXR file (its first RGB(A) layer): a
+/// Reads a PNG (decoded from sRGB to linear), an OpenEXR file (its first RGB(A) layer) or a
+/// Radiance HDR file (RGBE, linear): a
 /// regular file within the input limit, whose declared size is at most [`MAX_IMAGE_PIXELS`].
 pub fn read_image(path: &Path) -> Result<Image, ImageError> {
     let codec = |message: String| ImageError::Codec {
@@ -327,6 +342,22 @@ pub fn read_image(path: &Path) -> Result<Image, ImageError> {
             let decoded = limited.decode().map_err(|e| codec(e.to_string()))?;
             let rgb = decoded.to_rgb8();
             Image::from_srgb8(rgb.width(), rgb.height(), rgb.as_raw())
+                .ok_or_else(|| codec("inconsistent image size".into()))
+        }
+        Format::Hdr => {
+            let decoder =
+                image::codecs::hdr::HdrDecoder::new(std::io::Cursor::new(bytes.as_slice()))
+                    .map_err(|e| codec(e.to_string()))?;
+            let meta = decoder.metadata();
+            check(u64::from(meta.width), u64::from(meta.height))?;
+            let decoded = image::DynamicImage::from_decoder(decoder)
+                .map_err(|e| codec(e.to_string()))?
+                .to_rgb32f();
+            let pixels = decoded
+                .pixels()
+                .map(|p| Vec3::new(p[0], p[1], p[2]))
+                .collect();
+            Image::from_pixels(decoded.width(), decoded.height(), pixels)
                 .ok_or_else(|| codec("inconsistent image size".into()))
         }
         Format::Exr => {

@@ -3,7 +3,8 @@
 //! Built on the core (`specula`): scenes (TOML, with an embedded default), meshes (built-in
 //! shapes, Newell's teapot, OBJ/STL/PLY files), a tiled parallel rasterizer, flat, Gouraud and
 //! Phong shading with any lobe, geometry and normalisation, images (PNG, OpenEXR) and image
-//! metrics (PSNR, FLIP), and volumes (the built-in phantoms, direct volume rendering).
+//! metrics (PSNR, FLIP), image-based lighting (environment maps, Monte Carlo with multiple
+//! importance sampling), and volumes (the built-in phantoms, direct volume rendering).
 //!
 //! ## Design
 //! - **Exact coverage.** Vertices are snapped to 1/256 pixel and edge functions evaluated in
@@ -23,6 +24,7 @@ mod camera;
 mod clip;
 mod description;
 mod grid;
+pub mod ibl;
 mod image;
 pub mod input;
 mod load;
@@ -49,7 +51,9 @@ pub use load::{load_mesh, parse_mesh, LoadError, LoadedMesh, MeshFormat, MESH_EX
 pub use material::{IlluminationModel, Light, Material, Shader, Shading};
 pub use mesh::{Mesh, MeshError};
 pub use output::{remove_temporaries, write_atomically, SeekWrite};
-pub use pipeline::{overdraw, render, RenderError, MAX_PIXELS, MAX_SAMPLES};
-pub use scene::{Object, Overrides, Scene, Settings, DEFAULT_SCENE};
+pub use pipeline::{
+    overdraw, render, surfaces, RenderError, SurfacePoint, MAX_PIXELS, MAX_SAMPLES,
+};
+pub use scene::{Object, Overrides, Scene, Settings, DEFAULT_SCENE, IBL_SCENE};
 pub use shapes::{plane, sphere, torus};
 pub use teapot::{teapot, BezierPatch, TEAPOT_PATCHES};

@@ -42,6 +42,12 @@ pub enum RenderError {
         /// Samples per pixel per axis.
         samples: u32,
     },
+    /// The samples per pixel of a Monte Carlo render are out of range.
+    #[error("cannot render with {spp} samples per pixel: spp must be in [1, {max}]", max = crate::ibl::MAX_SPP)]
+    Spp {
+        /// The samples asked for.
+        spp: u32,
+    },
 }
 
 /// A triangle after clipping and setup, with what its fragments need.
@@ -85,14 +91,9 @@ pub fn render(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Image, RenderError> {
     let settings = &scene.settings;
-    settings.validate()?;
+    let shaders = prepare(scene)?;
     let (width, height, samples) = (settings.width, settings.height, settings.samples);
-    let shaders: Vec<Shader> = scene
-        .objects
-        .iter()
-        .map(|object| Shader::new(&object.material, settings.model))
-        .collect();
-    let primitives = setup_primitives(scene, &shaders);
+    let primitives = setup_primitives(scene, &shaders, settings.shading);
     let tiles_x = width.div_ceil(TILE);
     let tiles_y = height.div_ceil(TILE);
     let bins = bin(&primitives, tiles_x, tiles_y, TILE * samples);
@@ -115,18 +116,87 @@ pub fn render(
     Ok(image)
 }
 
+/// What one sample position sees: the nearest surface's interpolated position and unit
+/// normal, and the index of its object in the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// World position.
+    pub position: Vec3,
+    /// Unit shading normal (the face's where the interpolated one vanishes).
+    pub normal: Vec3,
+    /// The object's index in `scene.objects`.
+    pub object: u32,
+}
+
+/// The visible surface at every sample position (`width * samples` by `height * samples`,
+/// row-major), `None` where nothing is drawn: the rasterizer's coverage and visibility,
+/// with the surface handed back instead of shaded (a G-buffer, for renderers that light
+/// the surface themselves, such as the environment lighting of [`crate::ibl`]).
+pub fn surfaces(scene: &Scene) -> Result<Vec<Option<SurfacePoint>>, RenderError> {
+    let settings = &scene.settings;
+    let shaders = prepare(scene)?;
+    let primitives = setup_primitives(scene, &shaders, Shading::Phong);
+    let s = settings.samples;
+    let (tiles_x, tiles_y) = (
+        settings.width.div_ceil(TILE),
+        settings.height.div_ceil(TILE),
+    );
+    let bins = bin(&primitives, tiles_x, tiles_y, TILE * s);
+    let (width, height) = (settings.width * s, settings.height * s);
+    let tiles: Vec<Vec<(usize, SurfacePoint)>> = bins
+        .par_iter()
+        .enumerate()
+        .map_init(
+            || (Vec::new(), Vec::new()),
+            |(depth, visible), (tile, bin)| {
+                let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);
+                let rect = PixelRect {
+                    x0: tx * TILE * s,
+                    y0: ty * TILE * s,
+                    x1: ((tx + 1) * TILE * s).min(width) - 1,
+                    y1: ((ty + 1) * TILE * s).min(height) - 1,
+                };
+                resolve_visibility(&primitives, bin, rect, depth, visible);
+                let sample_width = rect.x1 - rect.x0 + 1;
+                visible
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &slot)| slot != u32::MAX)
+                    .map(|(k, &slot)| {
+                        let primitive = &primitives[bin[slot as usize] as usize];
+                        let (x, y) = (
+                            rect.x0 + k as u32 % sample_width,
+                            rect.y0 + k as u32 / sample_width,
+                        );
+                        let edges = primitive.setup.edge_weights_near(rect.x0, rect.y0);
+                        let weights = perspective_weights(primitive, edges.at(x, y));
+                        let point = SurfacePoint {
+                            position: blend(primitive, weights, |v| v.position),
+                            normal: blend(primitive, weights, |v| v.normal)
+                                .try_normalize()
+                                .unwrap_or(primitive.face_normal),
+                            object: primitive.shader,
+                        };
+                        ((y * width + x) as usize, point)
+                    })
+                    .collect()
+            },
+        )
+        .collect();
+    let mut points = vec![None; (width * height) as usize];
+    for (index, point) in tiles.into_iter().flatten() {
+        points[index] = Some(point);
+    }
+    Ok(points)
+}
+
 /// How many fragments each sample position receives, before the depth test: an overdraw map
 /// of `width * samples` by `height * samples` counts, row-major. The same vertex stage,
 /// clipping, culling and rasterization as [`render`]; a closed convex surface seen from
 /// outside (or from inside, flipped) covers every sample it hides exactly once.
 pub fn overdraw(scene: &Scene) -> Result<Vec<u32>, RenderError> {
     let settings = &scene.settings;
-    settings.validate()?;
-    let shaders: Vec<Shader> = scene
-        .objects
-        .iter()
-        .map(|object| Shader::new(&object.material, settings.model))
-        .collect();
+    let shaders = prepare(scene)?;
     let (width, height) = (
         settings.width * settings.samples,
         settings.height * settings.samples,
@@ -138,7 +208,7 @@ pub fn overdraw(scene: &Scene) -> Result<Vec<u32>, RenderError> {
         x1: width - 1,
         y1: height - 1,
     };
-    for primitive in setup_primitives(scene, &shaders) {
+    for primitive in setup_primitives(scene, &shaders, settings.shading) {
         primitive.setup.for_each_covered(all, |x, y, _| {
             counts[(y * width + x) as usize] += 1;
         });
@@ -146,8 +216,19 @@ pub fn overdraw(scene: &Scene) -> Result<Vec<u32>, RenderError> {
     Ok(counts)
 }
 
-/// Vertex stage, clipping and triangle setup for every object, in submission order.
-fn setup_primitives(scene: &Scene, shaders: &[Shader]) -> Vec<Primitive> {
+/// Checks the settings and prepares each object's material for the illumination model.
+fn prepare(scene: &Scene) -> Result<Vec<Shader>, RenderError> {
+    scene.settings.validate()?;
+    Ok(scene
+        .objects
+        .iter()
+        .map(|object| Shader::new(&object.material, scene.settings.model))
+        .collect())
+}
+
+/// Vertex stage, clipping and triangle setup for every object, in submission order; the
+/// vertices (Gouraud) or faces (flat) are lit here when `shading` asks for it.
+fn setup_primitives(scene: &Scene, shaders: &[Shader], shading: Shading) -> Vec<Primitive> {
     let settings = &scene.settings;
     let (width, height) = (
         settings.width * settings.samples,
@@ -184,7 +265,7 @@ fn setup_primitives(scene: &Scene, shaders: &[Shader]) -> Vec<Primitive> {
                 varyings: Varyings {
                     position,
                     normal,
-                    colour: if settings.shading == Shading::Gouraud {
+                    colour: if shading == Shading::Gouraud {
                         shade(shader, position, normal)
                     } else {
                         Vec3::ZERO
@@ -203,7 +284,7 @@ fn setup_primitives(scene: &Scene, shaders: &[Shader]) -> Vec<Primitive> {
                     let Some(face_normal) = (b - a).cross(c - a).try_normalize() else {
                         return Vec::new();
                     };
-                    let flat_colour = if settings.shading == Shading::Flat {
+                    let flat_colour = if shading == Shading::Flat {
                         shade(shader, (a + b + c) / 3.0, face_normal)
                     } else {
                         Vec3::ZERO
@@ -291,23 +372,9 @@ fn render_tile(
         samples,
         phong: phong_scratch,
     } = scratch;
-    depth.clear();
-    depth.resize(count, f32::INFINITY);
-    visible.clear();
-    visible.resize(count, u32::MAX);
+    resolve_visibility(primitives, bin, rect, depth, visible);
     radiance.clear();
     radiance.resize(count, settings.background);
-    for (slot, &index) in bin.iter().enumerate() {
-        primitives[index as usize]
-            .setup
-            .for_each_covered(rect, |x, y, z| {
-                let k = ((y - rect.y0) * sample_width + (x - rect.x0)) as usize;
-                if z < depth[k] {
-                    depth[k] = z;
-                    visible[k] = slot as u32;
-                }
-            });
-    }
     let position = |k: usize| {
         (
             rect.x0 + k as u32 % sample_width,
@@ -384,6 +451,34 @@ fn render_tile(
             }
             *pixel = sum * scale;
         }
+    }
+}
+
+/// The samples of `rect` (a tile's sample positions), row-major: the depth of the nearest
+/// fragment and its primitive's slot in `bin`, `u32::MAX` where none covers the sample.
+fn resolve_visibility(
+    primitives: &[Primitive],
+    bin: &[u32],
+    rect: PixelRect,
+    depth: &mut Vec<f32>,
+    visible: &mut Vec<u32>,
+) {
+    let sample_width = rect.x1 - rect.x0 + 1;
+    let count = (sample_width * (rect.y1 - rect.y0 + 1)) as usize;
+    depth.clear();
+    depth.resize(count, f32::INFINITY);
+    visible.clear();
+    visible.resize(count, u32::MAX);
+    for (slot, &index) in bin.iter().enumerate() {
+        primitives[index as usize]
+            .setup
+            .for_each_covered(rect, |x, y, z| {
+                let k = ((y - rect.y0) * sample_width + (x - rect.x0)) as usize;
+                if z < depth[k] {
+                    depth[k] = z;
+                    visible[k] = slot as u32;
+                }
+            });
     }
 }
 

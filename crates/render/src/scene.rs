@@ -11,6 +11,10 @@ use crate::{Camera, Display, Mesh};
 /// The embedded default scene: a row of spheres with `n` = 4 ... 1000 and a teapot.
 pub const DEFAULT_SCENE: &str = include_str!("../data/default-scene.toml");
 
+/// The embedded environment-lighting scene: a sphere and the teapot, no lights, the physical
+/// model (what `specula render --env` draws when given no scene file).
+pub const IBL_SCENE: &str = include_str!("../data/ibl-scene.toml");
+
 /// How to render: image size, supersampling, shading method and illumination model.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Settings {
@@ -120,6 +124,14 @@ impl Scene {
     pub fn default_scene() -> Scene {
         Scene::from_toml(DEFAULT_SCENE, "<default scene>", None)
             .expect("the embedded default scene is valid (tested)")
+            .scene
+    }
+
+    /// The embedded environment-lighting scene.
+    #[must_use]
+    pub fn ibl_scene() -> Scene {
+        Scene::from_toml(IBL_SCENE, "<environment scene>", None)
+            .expect("the embedded environment scene is valid (tested)")
             .scene
     }
 }

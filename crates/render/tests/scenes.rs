@@ -227,3 +227,19 @@ fn broken_mesh_files_are_refused_and_degenerate_triangles_counted() {
     let truncated = write(directory.path(), "t.stl", &truncated);
     assert!(load_mesh(&truncated).is_err());
 }
+
+#[test]
+fn the_environment_scene_is_a_sphere_and_a_teapot_without_lights() {
+    let scene = Scene::ibl_scene();
+    assert!(scene.lights.is_empty());
+    assert_eq!(scene.objects.len(), 2);
+    assert_eq!(
+        scene.settings.model,
+        specula_render::IlluminationModel::Physical
+    );
+    // The sphere of radius 0.9 rests on z = 0; the teapot (height 3.15 x 0.55) stands there too.
+    let sphere = scene.objects[0].mesh.bounds().unwrap();
+    assert!(sphere.0.z.abs() < 1e-3 && (sphere.1.z - 1.8).abs() < 1e-3);
+    let teapot = scene.objects[1].mesh.bounds().unwrap();
+    assert!(teapot.0.z.abs() < 1e-3 && (teapot.1.z - 0.55 * 3.15).abs() < 1e-3);
+}

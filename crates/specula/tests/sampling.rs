@@ -17,7 +17,8 @@ use rayon::prelude::*;
 use specula::analysis::albedo::specular_albedo_per_unit;
 use specula::lobe::Warp;
 use specula::quadrature::integrate;
-use specula::sampling::chi2::{self, sidak, uniform, Outcome, Settings};
+use specula::sampling::chi2::{self, sidak, Outcome, Settings};
+use specula::sampling::uniform;
 use specula::sampling::SpecularSampler;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 

@@ -21,7 +21,7 @@ use core::f64::consts::{PI, TAU};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::{mirror, SpecularSampler};
+use super::{mirror, uniform, SpecularSampler};
 use crate::Geometry;
 
 /// Cells with fewer expected samples than this are pooled, as Pearson's approximation needs.
@@ -92,20 +92,6 @@ impl Outcome {
 #[must_use]
 pub fn sidak(alpha: f64, tests: usize) -> f64 {
     1.0 - (1.0 - alpha).powf(1.0 / tests.max(1) as f64)
-}
-
-/// A uniform number in `[0, 1)` for draw `index`, dimension `dimension` of stream `seed`
-/// (SplitMix64's finaliser over the three, 53 bits kept).
-#[must_use]
-pub fn uniform(seed: u64, index: u64, dimension: u64) -> f64 {
-    let mut z = seed
-        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        .wrapping_add(index.wrapping_mul(0xD1B5_4A32_D192_ED03))
-        .wrapping_add(dimension.wrapping_mul(0x8CB9_2BA7_2F3D_8DD7));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
-    (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// The sphere in the lobe's frame, mapped to the unit square.

@@ -20,8 +20,10 @@
 
 pub mod chi2;
 mod cosine;
+mod distribution;
 
 pub use cosine::{CosineDistribution, TABLE_BINS};
+pub use distribution::{power_heuristic, Distribution1D, Distribution2D, Draw1D, Draw2D};
 
 use core::f64::consts::TAU;
 
@@ -49,6 +51,20 @@ pub struct SpecularSampler {
     cosine: CosineDistribution,
     geometry: Geometry,
     scale: f64,
+}
+
+/// A uniform number (counter-based, so a draw is the same on any thread and in any order) in `[0, 1)` for draw `index`, dimension `dimension` of stream `seed`
+/// (SplitMix64's finaliser over the three, 53 bits kept).
+#[must_use]
+pub fn uniform(seed: u64, index: u64, dimension: u64) -> f64 {
+    let mut z = seed
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add(index.wrapping_mul(0xD1B5_4A32_D192_ED03))
+        .wrapping_add(dimension.wrapping_mul(0x8CB9_2BA7_2F3D_8DD7));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// The mirror direction of `wo` about the normal: the Phong lobe's axis.

@@ -1,0 +1,230 @@
+//! An environment map: radiance arriving from infinitely far away, stored as an
+//! equirectangular (latitude-longitude) image, looked up and importance sampled.
+//!
+//! **Mapping** (world `z` up): row `y` of `H` covers polar angles `theta` in
+//! `[pi y / H, pi (y + 1) / H]` from the zenith, so the top row is the sky; column `x` of `W`
+//! covers azimuths from `phi = 3 pi / 2 - 2 pi x / W` downwards, so the image's middle column
+//! looks along `+y` (where the default cameras look) and its right half lies towards `+x`:
+//! the panorama is seen from inside unmirrored, as the usual lat-long files are.
+//!
+//! **Sampling**: each pixel's weight is its luminance times `sin theta` (the solid angle of
+//! its row), and a [`Distribution2D`] over those weights draws a pixel and a point within it.
+//! The density over the unit square becomes one over solid angle by the Jacobian
+//! `1 / (2 pi^2 sin theta)`. Radiance is constant over each pixel (nearest lookup), so the
+//! sampled density is exactly proportional to `luminance(L) sin theta` on the square: bright
+//! pixels (the sun) are drawn in proportion to the light they send.
+
+use core::f64::consts::{PI, TAU};
+use std::path::Path;
+
+use glam::{DVec3, Vec3};
+use specula::sampling::Distribution2D;
+use thiserror::Error;
+
+use crate::{read_image, Image, ImageError};
+
+/// Rec. 709 luminance weights: how bright a linear RGB radiance looks, for the sampling
+/// weights.
+const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
+
+/// An environment that cannot be used, and why.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum EnvironmentError {
+    /// The file could not be read or decoded.
+    #[error(transparent)]
+    Image(#[from] ImageError),
+    /// A pixel is NaN, infinite or negative: radiance is finite and non-negative.
+    #[error("{name}: pixel ({x}, {y}) is {value}; an environment's radiance must be finite and non-negative in every channel")]
+    BadPixel {
+        /// The map's name (its path, or what built it).
+        name: String,
+        /// Column.
+        x: u32,
+        /// Row.
+        y: u32,
+        /// The offending value.
+        value: f32,
+    },
+    /// The map is too small to be a panorama, or its weights overflow.
+    #[error("{name}: {width}x{height} pixels cannot be an equirectangular environment; it needs at least 2x1 pixels whose radiances sum to a finite value")]
+    Shape {
+        /// The map's name.
+        name: String,
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+    },
+}
+
+/// A direction drawn from the environment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvironmentSample {
+    /// Unit direction towards the environment (world space).
+    pub wi: DVec3,
+    /// Density with respect to solid angle.
+    pub pdf: f64,
+    /// The radiance arriving from `wi`.
+    pub radiance: Vec3,
+}
+
+/// An equirectangular environment map, ready to look up and sample.
+#[derive(Clone, Debug)]
+pub struct Environment {
+    image: Image,
+    distribution: Distribution2D,
+}
+
+impl Environment {
+    /// The environment of a linear-radiance lat-long `image`, or why it cannot be one.
+    pub fn from_image(image: Image, name: &str) -> Result<Self, EnvironmentError> {
+        let (width, height) = (image.width(), image.height());
+        for (index, pixel) in image.pixels().iter().enumerate() {
+            if let Some(&value) = pixel
+                .to_array()
+                .iter()
+                .find(|v| !v.is_finite() || **v < 0.0)
+            {
+                return Err(EnvironmentError::BadPixel {
+                    name: name.to_owned(),
+                    x: index as u32 % width,
+                    y: index as u32 / width,
+                    value,
+                });
+            }
+        }
+        let weights: Vec<f64> = image
+            .pixels()
+            .iter()
+            .enumerate()
+            .map(|(index, pixel)| {
+                let row = (index as u32 / width.max(1)) as f64;
+                let sine = (PI * (row + 0.5) / f64::from(height)).sin();
+                f64::from(pixel.dot(LUMINANCE)) * sine
+            })
+            .collect();
+        let distribution = (width >= 2)
+            .then(|| Distribution2D::new(&weights, width as usize))
+            .flatten()
+            .ok_or_else(|| EnvironmentError::Shape {
+                name: name.to_owned(),
+                width,
+                height,
+            })?;
+        Ok(Self {
+            image,
+            distribution,
+        })
+    }
+
+    /// Reads an environment from a `.hdr` (Radiance), `.exr` or `.png` (sRGB decoded) file:
+    /// a regular file within the input limit and the image size limit.
+    pub fn load(path: &Path) -> Result<Self, EnvironmentError> {
+        Self::from_image(read_image(path)?, &path.display().to_string())
+    }
+
+    /// A constant environment: `radiance` from every direction (a white furnace when 1).
+    #[must_use]
+    pub fn constant(radiance: Vec3) -> Self {
+        let image = Image::new(2, 1, radiance.max(Vec3::ZERO));
+        Self::from_image(image, "constant").expect("a finite constant map is valid")
+    }
+
+    /// The image the environment is stored in.
+    #[must_use]
+    pub fn image(&self) -> &Image {
+        &self.image
+    }
+
+    /// The radiance arriving from the unit direction `wi` (world space).
+    #[must_use]
+    pub fn radiance(&self, wi: DVec3) -> Vec3 {
+        let [x, y] = to_square(wi);
+        let (width, height) = (self.image.width(), self.image.height());
+        let column = ((x * f64::from(width)) as u32).min(width - 1);
+        let row = ((y * f64::from(height)) as u32).min(height - 1);
+        self.image.get(column, row)
+    }
+
+    /// A direction for the uniform numbers `u`, drawn in proportion to luminance times
+    /// solid angle; `None` on the poles' measure-zero lines, where the Jacobian vanishes.
+    #[must_use]
+    pub fn sample(&self, u: [f64; 2]) -> Option<EnvironmentSample> {
+        let draw = self.distribution.sample(u);
+        let (wi, sine) = from_square(draw.point);
+        if sine <= 0.0 {
+            return None;
+        }
+        Some(EnvironmentSample {
+            wi,
+            pdf: draw.pdf / (2.0 * PI * PI * sine),
+            radiance: self.radiance(wi),
+        })
+    }
+
+    /// The density of the unit direction `wi` under [`Environment::sample`], per solid angle.
+    #[must_use]
+    pub fn pdf(&self, wi: DVec3) -> f64 {
+        let sine = (1.0 - wi.z * wi.z).max(0.0).sqrt();
+        if sine <= 0.0 {
+            return 0.0;
+        }
+        self.distribution.pdf(to_square(wi)) / (2.0 * PI * PI * sine)
+    }
+}
+
+/// The point of the unit square a unit direction maps to.
+fn to_square(wi: DVec3) -> [f64; 2] {
+    let theta = wi.z.clamp(-1.0, 1.0).acos();
+    let phi = wi.y.atan2(wi.x);
+    let x = (0.75 - phi / TAU).rem_euclid(1.0);
+    [
+        x.min(1.0 - f64::EPSILON),
+        (theta / PI).min(1.0 - f64::EPSILON),
+    ]
+}
+
+/// The unit direction of a point of the unit square, and `sin theta` there.
+pub(super) fn from_square([x, y]: [f64; 2]) -> (DVec3, f64) {
+    let (sine, cosine) = (PI * y).sin_cos();
+    let (sin_phi, cos_phi) = (1.5 * PI - TAU * x).sin_cos();
+    (DVec3::new(sine * cos_phi, sine * sin_phi, cosine), sine)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_mapping_inverts_and_puts_plus_y_in_the_middle() {
+        let [x, y] = to_square(DVec3::Y);
+        assert!((x - 0.5).abs() < 1e-12 && (y - 0.5).abs() < 1e-12);
+        let [x, _] = to_square(DVec3::X);
+        assert!((x - 0.75).abs() < 1e-12, "+x is right of the middle");
+        assert!(to_square(DVec3::Z)[1] < 1e-12, "the zenith is the top row");
+        for i in 0..100 {
+            let point = [(i as f64 * 0.618_034) % 1.0, (i as f64 + 0.5) / 100.0];
+            let (wi, _) = from_square(point);
+            let back = to_square(wi);
+            assert!((back[0] - point[0]).abs() < 1e-9 && (back[1] - point[1]).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn bad_maps_are_refused_by_name() {
+        let mut image = Image::new(4, 2, Vec3::ONE);
+        image.set(3, 1, Vec3::new(0.0, f32::NAN, 0.0));
+        let error = Environment::from_image(image, "sky.exr")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("sky.exr") && error.contains("(3, 1)"),
+            "{error}"
+        );
+        let error = Environment::from_image(Image::new(4, 2, -Vec3::ONE), "m").unwrap_err();
+        assert!(error.to_string().contains("non-negative"), "{error}");
+        let error = Environment::from_image(Image::new(1, 1, Vec3::ONE), "m").unwrap_err();
+        assert!(error.to_string().contains("at least 2x1"), "{error}");
+    }
+}
