@@ -190,3 +190,78 @@ fn bench_render_prints_a_row_per_shading_method() {
     }
     assert!(text.contains("threads"), "{text}");
 }
+
+/// `--env`: the sky and a file (an .hdr this command wrote) both light the environment
+/// scene; a seed gives the same image every time and another seed another image; bad
+/// environments and sample counts are refused with what is wrong, writing nothing.
+#[test]
+fn renders_lit_by_an_environment_and_refuses_bad_ones() {
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    let small = ["--width", "48", "--height", "27", "--spp", "4"];
+    let env_render = |output: &str, env: &str, seed: &str| {
+        let mut args = vec!["render", "--env", env, "--seed", seed, "-o", output];
+        args.extend(small);
+        ok(d, &args)
+    };
+    let output = env_render("a.png", "sky", "1");
+    assert!(
+        String::from_utf8_lossy(&output.stderr).contains("4 spp, lit by sky"),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(png_size(&d.join("a.png")), (48, 27));
+    env_render("b.png", "sky", "1");
+    env_render("c.png", "sky", "2");
+    let read = |name: &str| std::fs::read(d.join(name)).unwrap();
+    assert_eq!(
+        read("a.png"),
+        read("b.png"),
+        "the same seed, the same image"
+    );
+    assert_ne!(read("a.png"), read("c.png"), "another seed, another image");
+    // A panorama written by `render` itself lights the scene from a file.
+    ok(
+        d,
+        &[
+            "render", "-o", "pano.hdr", "--width", "64", "--height", "32",
+        ],
+    );
+    env_render("d.png", "pano.hdr", "1");
+    assert_eq!(png_size(&d.join("d.png")), (48, 27));
+
+    std::fs::create_dir(d.join("folder.hdr")).unwrap();
+    let exr = specula_render::Image::from_pixels(
+        2,
+        1,
+        vec![glam::Vec3::ONE, glam::Vec3::new(f32::NAN, 0.0, 0.0)],
+    )
+    .unwrap();
+    specula_render::write_image(&d.join("nan.exr"), &exr, specula_render::Display::default())
+        .unwrap();
+    let before = files(d);
+    let cases: [(&[&str], &str); 9] = [
+        (&["--env", "missing.hdr"], "missing.hdr"),
+        (&["--env", "folder.hdr"], "a directory"),
+        (&["--env", "nan.exr"], "pixel (1, 0) is NaN"),
+        (&["--env", "notes.txt"], "unknown image format"),
+        (&["--env", "sky", "--spp", "0"], "1..=65536"),
+        (&["--env", "sky", "--spp", "70000"], "1..=65536"),
+        (&["--spp", "16"], "--env"),
+        (
+            &["--env", "sky", "--shading", "flat"],
+            "cannot be used with",
+        ),
+        (&["--env", "sky", "--backend", "gpu"], "CPU only"),
+    ];
+    for (args, message) in cases {
+        let mut command = vec!["render", "-o", "out.png"];
+        command.extend(args);
+        let output = common::specula(d, &command);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(message), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+    }
+    assert_eq!(files(d), before, "nothing written");
+}

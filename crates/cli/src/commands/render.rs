@@ -6,9 +6,10 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use specula::{Exponent, Geometry, LobeKind, Normalisation};
 use specula_gpu::{Gpu, GpuRenderer};
+use specula_render::ibl::{render_ibl, Environment, IblSettings, Strategy, MAX_SPP, SKY_WIDTH};
 use specula_render::{
     check_output_path, render, render_grid_with, write_image, write_png_srgb8, GridOptions,
-    IlluminationModel, Image, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE,
+    IlluminationModel, Image, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE, IBL_SCENE,
 };
 
 use super::CommandResult;
@@ -61,6 +62,18 @@ pub struct Args {
     /// The renderer: the CPU rasterizer, or wgpu (a GPU, or Mesa's lavapipe without one).
     #[arg(long, value_enum, default_value_t)]
     backend: RendererArg,
+    /// Light the scene by an environment instead of its lights: `sky` (built in) or an
+    /// equirectangular .hdr, .exr or .png file (at most 4096 x 4096), rendered by Monte Carlo
+    /// with multiple importance sampling on the CPU, physical model. Without a scene file,
+    /// the embedded environment scene (a sphere and the teapot).
+    #[arg(long, value_name = "sky|FILE", conflicts_with_all = ["shading", "model"])]
+    env: Option<PathBuf>,
+    /// Samples per pixel with --env.
+    #[arg(long, requires = "env", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SPP)))]
+    spp: u32,
+    /// The random stream with --env: renders with different seeds are independent.
+    #[arg(long, requires = "env", default_value_t = 0)]
+    seed: u64,
     /// Print the embedded default scene (a starting point for your own) and exit.
     #[arg(long, exclusive = true)]
     dump_default_scene: bool,
@@ -93,9 +106,10 @@ fn load(args: &Args) -> Result<Scene, String> {
     let LoadedScene {
         mut scene,
         warnings,
-    } = match &args.scene {
-        Some(path) => Scene::from_file(path),
-        None => Scene::from_toml(DEFAULT_SCENE, "<default scene>", None),
+    } = match (&args.scene, &args.env) {
+        (Some(path), _) => Scene::from_file(path),
+        (None, None) => Scene::from_toml(DEFAULT_SCENE, "<default scene>", None),
+        (None, Some(_)) => Scene::from_toml(IBL_SCENE, "<environment scene>", None),
     }
     .map_err(|e| e.to_string())?;
     for warning in warnings {
@@ -127,6 +141,14 @@ pub fn run(args: &Args) -> CommandResult {
     let scene = load(args)?;
     let started = Instant::now();
     let bar = progress_bar("rendering");
+    let environment = match &args.env {
+        Some(_) if args.backend == RendererArg::Gpu => {
+            return Err("--env renders on the CPU only; drop --backend gpu".into())
+        }
+        Some(path) if path.as_os_str() == "sky" => Some(Environment::sky(SKY_WIDTH)),
+        Some(path) => Some(Environment::load(path).map_err(|e| e.to_string())?),
+        None => None,
+    };
     let gpu = match args.backend {
         RendererArg::Cpu => None,
         RendererArg::Gpu => Some(Gpu::new().map_err(|e| e.to_string())?),
@@ -135,21 +157,28 @@ pub fn run(args: &Args) -> CommandResult {
         Some(gpu) => Some(GpuRenderer::new(gpu).map_err(|e| e.to_string())?),
         None => None,
     };
+    let ibl = IblSettings {
+        spp: args.spp,
+        seed: args.seed,
+        strategy: Strategy::Mis,
+    };
     let renders = 1 + args.grid.as_ref().map_or(0, |LobeList(lobes)| lobes.len());
     // Renders the `index`-th image of `renders`, on the chosen backend, with progress.
     let mut draw = |scene: &Scene, index: usize| -> Result<Image, String> {
-        match &gpu_renderer {
-            Some(renderer) => {
+        let progress = |done: usize, total: usize| {
+            bar.set_length((renders * total) as u64);
+            bar.set_position((index * total + done) as u64);
+        };
+        match (&gpu_renderer, &environment) {
+            (Some(renderer), _) => {
                 let image = renderer.render(scene).map_err(|e| e.to_string());
-                bar.set_length(renders as u64);
-                bar.set_position(index as u64 + 1);
+                progress(1, 1);
                 image
             }
-            None => render(scene, &|done, total| {
-                bar.set_length((renders * total) as u64);
-                bar.set_position((index * total + done) as u64);
-            })
-            .map_err(|e| e.to_string()),
+            (None, Some(environment)) => {
+                render_ibl(scene, environment, &ibl, &progress).map_err(|e| e.to_string())
+            }
+            (None, None) => render(scene, &progress).map_err(|e| e.to_string()),
         }
     };
     let (width, height) = match &args.grid {
@@ -178,11 +207,17 @@ pub fn run(args: &Args) -> CommandResult {
         }
     };
     let device = gpu.map_or_else(|| "CPU".to_owned(), |gpu| gpu.adapter_name());
+    let method = match &args.env {
+        Some(env) => format!("{} spp, lit by {}", args.spp, env.display()),
+        None => format!(
+            "{} shading, {} model",
+            scene.settings.shading.id(),
+            scene.settings.model.id()
+        ),
+    };
     eprintln!(
-        "wrote {} ({width}x{height}, {} shading, {} model, {device}, {:.2} s)",
+        "wrote {} ({width}x{height}, {method}, {device}, {:.2} s)",
         args.output.display(),
-        scene.settings.shading.id(),
-        scene.settings.model.id(),
         started.elapsed().as_secs_f64()
     );
     Ok(())
