@@ -1,6 +1,7 @@
 // Drives `specula serve` in Debian's Chromium: loads the explorer, moves the n slider, changes
-// the lobes and the volume view's lobe and volume, and requires that the plots and the renders
-// change and that the console stays silent. Saves a screenshot.
+// the lobes (the environment view follows the lobe chosen last) and the volume view's lobe and
+// volume, and requires that the plots and the renders change and that the console stays
+// silent. Saves a screenshot.
 // Usage: node check.mjs SPECULA_BINARY SCREENSHOT.png
 import { spawn } from "node:child_process";
 import { chromium } from "playwright-core";
@@ -44,6 +45,9 @@ try {
       plots: ["cartesian", "error", "polar", "albedo", "slice"].map((id) => document.getElementById(id).toDataURL()),
       sphere: document.getElementById("sphere").src,
       teapot: document.getElementById("teapot").src,
+      environment: pixels(document.getElementById("environment-image")),
+      environmentPow: pixels(document.getElementById("environment-pow")),
+      environmentPsnr: document.getElementById("environment-psnr").textContent,
       volume: pixels(document.getElementById("volume-image")),
       volumePow: pixels(document.getElementById("volume-pow")),
       address: location.search,
@@ -64,12 +68,17 @@ try {
   const moved = await snapshot();
   changed(first, moved, "moving n");
   if (moved.volume === first.volume || moved.volumePow === first.volumePow) failures.push("moving n: the volume was not re-rendered");
+  if (moved.environment === first.environment || moved.environmentPow === first.environmentPow) failures.push("moving n: the environment view was not re-rendered");
 
   await page.locator('#lobes input[value="schlick"]').uncheck();
   await page.locator('#lobes input[value="logexp"]').check();
   await drawn("lobes", "logexp,cosquad");
   const relobed = await snapshot();
   changed(moved, relobed, "changing the lobes");
+  // The environment view follows the lobe chosen last (logexp) and keeps pow's image.
+  if (relobed.environment === moved.environment) failures.push("changing the lobes: the environment view did not re-render the chosen lobe");
+  if (relobed.environmentPow !== moved.environmentPow) failures.push("changing the lobes changed the environment's pow image");
+  if (!/^PSNR [0-9.]+ dB against pow/.test(relobed.environmentPsnr)) failures.push(`logexp under the sky has no PSNR against pow: '${relobed.environmentPsnr}'`);
 
   // The volume view's own lobe selector re-renders the lobe's image and leaves pow's alone;
   // the volume selector changes both.
@@ -136,4 +145,4 @@ if (failures.length) {
   console.error("explorer check failed:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`explorer check: loaded, moved n, changed lobes, changed the volume's lobe and volume, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, round ticks; no console message; screenshot ${screenshot}`);
+console.log(`explorer check: loaded, moved n, changed lobes (and the environment view), changed the volume's lobe and volume, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, round ticks; no console message; screenshot ${screenshot}`);

@@ -54,17 +54,22 @@ fn the_quick_report_is_complete_and_well_formed() {
     for verdict in ["holds", "does not hold"] {
         assert!(text.contains(verdict), "no '{verdict}' verdict");
     }
-    // Every row of the renders and volume tables, recomputed by `specula diff` from the
-    // images it names.
-    let rows = table_rows(&document, "PSNR vs pow (dB)");
-    assert_eq!(
-        rows.len(),
-        specula::LobeKind::ALL.len() - 1,
-        "every lobe but pow"
-    );
-    for row in &rows {
-        assert_eq!(row.len(), 5, "{row:?}");
-        check_row(&out, "render", &row[0], &row[1], &row[2], &row[4]);
+    // Every row of the renders, environment and volume tables, recomputed by `specula diff`
+    // from the images it names.
+    for (header, prefix) in [
+        ("PSNR vs pow (dB)", "render"),
+        ("PSNR vs pow, lit by the sky (dB)", "environment"),
+    ] {
+        let rows = table_rows(&document, header);
+        assert_eq!(
+            rows.len(),
+            specula::LobeKind::ALL.len() - 1,
+            "{prefix}: every lobe but pow"
+        );
+        for row in &rows {
+            assert_eq!(row.len(), 5, "{row:?}");
+            check_row(&out, prefix, &row[0], &row[1], &row[2], &row[4]);
+        }
     }
     let rows = table_rows(&document, "PSNR vs the pow image (dB)");
     assert_eq!(rows.len(), specula::LobeKind::ALL.len(), "every lobe");

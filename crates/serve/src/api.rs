@@ -8,7 +8,9 @@
 //! - `GET /api/render?object&lobe&n&geometry&normalisation&shading&model&light_theta&light_phi&size`:
 //!   a PNG from the CPU renderer;
 //! - `GET /api/volume?volume&view&lobe&n&geometry&normalisation&size`: a built-in volume ray
-//!   marched on the CPU, as a PNG.
+//!   marched on the CPU, as a PNG;
+//! - `GET /api/environment?lobe&n&geometry&normalisation&size&spp`: the environment scene lit
+//!   by the procedural sky (Monte Carlo, CPU), as a PNG.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -29,6 +31,9 @@ use super::explorer::{curves, render_png, Object, RenderRequest};
 use super::guard::{Hosts, Limiter};
 use specula_render::volume::phantom::BuiltIn;
 
+use super::environment::{
+    environment_png, EnvironmentRequest, MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP,
+};
 use super::volume::{volume_png, VolumeRequest, MAX_VOLUME_SIZE};
 
 /// The largest render side, in pixels.
@@ -281,7 +286,10 @@ pub async fn not_found() -> ApiError {
         status: StatusCode::NOT_FOUND,
         error: "no such page or endpoint".into(),
         parameter: None,
-        valid: Some("/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume".into()),
+        valid: Some(
+            "/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume, /api/environment"
+                .into(),
+        ),
     }
 }
 
@@ -326,6 +334,8 @@ pub async fn models() -> impl IntoResponse {
         "volumes": BuiltIn::ALL.map(BuiltIn::id),
         "views": View::STANDARD.map(View::id),
         "max_volume_size": MAX_VOLUME_SIZE,
+        "max_environment_size": MAX_ENVIRONMENT_SIZE,
+        "max_environment_spp": MAX_ENVIRONMENT_SPP,
     }))
 }
 
@@ -436,6 +446,26 @@ pub async fn volume(
         size: params.number("size", 16.0..=f64::from(MAX_VOLUME_SIZE), 256.0)? as u32,
     };
     let encoded = compute(&state, move || volume_png(&request)).await?;
+    Ok(png(encoded.map_err(ApiError::internal)?))
+}
+
+pub async fn environment(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<Response, Response> {
+    let params = Params::new(
+        pairs(query)?,
+        &["lobe", "n", "geometry", "normalisation", "size", "spp"],
+    )?;
+    let request = EnvironmentRequest {
+        kind: params.lobe()?,
+        n: params.exponent()?,
+        geometry: params.geometry()?,
+        normalisation: params.normalisation(Normalisation::Lobe)?,
+        size: params.number("size", 16.0..=f64::from(MAX_ENVIRONMENT_SIZE), 384.0)? as u32,
+        spp: params.number("spp", 1.0..=f64::from(MAX_ENVIRONMENT_SPP), 16.0)? as u32,
+    };
+    let encoded = compute(&state, move || environment_png(&request)).await?;
     Ok(png(encoded.map_err(ApiError::internal)?))
 }
 

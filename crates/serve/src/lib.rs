@@ -11,6 +11,7 @@
 //! caps request bodies (the API takes none).
 
 mod api;
+mod environment;
 mod explorer;
 mod guard;
 mod listen;
@@ -21,6 +22,7 @@ mod volume;
 use std::net::SocketAddr;
 
 pub use api::{cpu_cost, AppState, CostModel, TargetCost, MAX_RENDER_SIZE};
+pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
 pub use listen::{CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT, MAX_CONNECTIONS};
 pub use volume::MAX_VOLUME_SIZE;
@@ -69,6 +71,7 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/analyze", get(api::analyze_lobe))
         .route("/api/render", get(api::render))
         .route("/api/volume", get(api::volume))
+        .route("/api/environment", get(api::environment))
         .fallback(api::not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
         .layer(axum::middleware::from_fn_with_state(

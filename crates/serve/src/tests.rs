@@ -78,6 +78,19 @@ fn png_size(png: &[u8]) -> (u32, u32) {
     (word(16), word(20))
 }
 
+/// The PNG served at `uri`, required to be `size`.
+async fn served_png(uri: &str, size: (u32, u32)) -> Vec<u8> {
+    let (status, served) = get(uri).await;
+    assert_eq!(
+        status,
+        StatusCode::OK,
+        "{uri}: {}",
+        String::from_utf8_lossy(&served)
+    );
+    assert_eq!(png_size(&served), size, "{uri}");
+    served
+}
+
 /// The volume view is the library's ray marcher with the parameters named in the address:
 /// its bytes are those of `render_dvr` called directly with them, and each parameter changes
 /// the image.
@@ -88,14 +101,7 @@ async fn volume_renders_the_named_volume_view_and_lobe() {
     use specula_render::volume::{phantom, transfer::TransferFunction};
 
     let uri = "/api/volume?volume=phantom&view=axial&lobe=cosquad&n=40&geometry=phong&normalisation=lobe&size=48";
-    let (status, served) = get(uri).await;
-    assert_eq!(
-        status,
-        StatusCode::OK,
-        "{}",
-        String::from_utf8_lossy(&served)
-    );
-    assert_eq!(png_size(&served), (48, 48));
+    let served = served_png(uri, (48, 48)).await;
 
     let volume = phantom::shepp_logan(64).expect("phantom");
     let shading = Shading::new(
@@ -125,9 +131,60 @@ async fn volume_renders_the_named_volume_view_and_lobe() {
         uri.replace("volume=phantom", "volume=marschner-lobb"),
         uri.replace("normalisation=lobe", "normalisation=none"),
     ] {
-        let (status, changed) = get(&other).await;
-        assert_eq!(status, StatusCode::OK, "{other}");
-        assert!(changed != served, "{other} drew the same image");
+        assert!(
+            served_png(&other, png_size(&served)).await != served,
+            "{other} drew the same image"
+        );
+    }
+}
+
+/// The environment view is the library's environment render of its scene with the lobe,
+/// exponent, geometry and normalisation the address names, at seed 0: the served bytes are
+/// those of `render_ibl` called directly, and each parameter changes the image.
+#[tokio::test]
+async fn environment_renders_the_named_lobe_under_the_sky() {
+    use specula::{Exponent, Geometry, LobeKind, Normalisation};
+    use specula_render::ibl::{render_ibl, Environment, IblSettings, Strategy, SKY_WIDTH};
+    use specula_render::{Overrides, Scene};
+
+    let uri = "/api/environment?lobe=cheb2&n=100&geometry=blinn&normalisation=lobe&size=64&spp=4";
+    let served = served_png(uri, (64, 36)).await;
+
+    let mut scene = Scene::ibl_scene();
+    scene.apply(&Overrides {
+        lobe: Some(LobeKind::Cheb2),
+        n: Some(Exponent::new(100.0)),
+        geometry: Some(Geometry::Blinn),
+        normalisation: Some(Normalisation::Lobe),
+        width: Some(64),
+        height: Some(36),
+        ..Overrides::default()
+    });
+    let settings = IblSettings {
+        spp: 4,
+        seed: 0,
+        strategy: Strategy::Mis,
+    };
+    let image =
+        render_ibl(&scene, &Environment::sky(SKY_WIDTH), &settings, &|_, _| {}).expect("render");
+    let direct =
+        specula_render::encode_png_srgb8(64, 36, &image.to_srgb8(scene.display)).expect("png");
+    assert!(
+        served == direct,
+        "the served image is not the library's render"
+    );
+
+    for other in [
+        uri.replace("lobe=cheb2", "lobe=pow"),
+        uri.replace("n=100", "n=10"),
+        uri.replace("geometry=blinn", "geometry=phong"),
+        uri.replace("normalisation=lobe", "normalisation=none"),
+        uri.replace("spp=4", "spp=8"),
+    ] {
+        assert!(
+            served_png(&other, png_size(&served)).await != served,
+            "{other} drew the same image"
+        );
     }
 }
 
@@ -169,6 +226,15 @@ async fn bad_parameters_get_400_naming_the_parameter_and_the_valid_values() {
         ("/api/volume?size=2048", "size", "[16, 512]"),
         ("/api/volume?lobe=gauss", "lobe", "cosquad"),
         ("/api/volume?object=sphere", "object", "volume, view, lobe"),
+        ("/api/environment?size=4096", "size", "[16, 768]"),
+        ("/api/environment?spp=0", "spp", "[1, 256]"),
+        ("/api/environment?spp=1e6", "spp", "[1, 256]"),
+        ("/api/environment?lobe=ggx", "lobe", "cosquad"),
+        (
+            "/api/environment?env=studio.hdr",
+            "env",
+            "lobe, n, geometry",
+        ),
     ];
     for (uri, parameter, valid) in cases {
         let (status, body) = json(uri).await;
@@ -191,7 +257,7 @@ async fn bad_parameters_get_400_naming_the_parameter_and_the_valid_values() {
     assert!(body["valid"]
         .as_str()
         .expect("routes")
-        .contains("/api/volume"));
+        .contains("/api/environment"));
 }
 
 #[tokio::test]

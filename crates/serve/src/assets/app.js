@@ -127,6 +127,9 @@ function buildControls(state) {
 
 function showValues(state) {
   $("render-lobe").textContent = state.render || "no lobe";
+  $("environment-lobe").textContent = state.render || "no lobe";
+  $("environment-image").style.borderColor = colourOf(state.render);
+  $("environment-pow").style.borderColor = colourOf("pow");
   $("volume-lobe-name").textContent = state.volume_lobe;
   $("volume-image").style.borderColor = colourOf(state.volume_lobe);
   $("volume-pow").style.borderColor = colourOf("pow");
@@ -333,6 +336,10 @@ async function update() {
     if (lobes.length) {
       const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: state.render, ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
       await Promise.all([loadImage($("sphere"), render("sphere")), loadImage($("teapot"), render("teapot"))]);
+      const environment = (lobe) => "/api/environment?" + new URLSearchParams({ lobe, ...common, size: "384", spp: "16" });
+      await Promise.all([loadImage($("environment-image"), environment(state.render)), loadImage($("environment-pow"), environment("pow"))]);
+      if (mine !== generation) return;
+      drawDifference($("environment-image"), $("environment-pow"), $("environment-diff"), $("environment-psnr"));
     }
     const volume = (lobe) => "/api/volume?" + new URLSearchParams({ volume: state.volume, view: state.view, lobe, ...common, size: "256" });
     await Promise.all([loadImage($("volume-image"), volume(state.volume_lobe)), loadImage($("volume-pow"), volume("pow"))]);

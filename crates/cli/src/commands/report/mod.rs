@@ -54,6 +54,8 @@ pub struct Sizes {
     pub claims: ClaimOptions,
     /// Render width, height and samples per axis.
     pub render: (u32, u32, u32),
+    /// The environment-lit renders' width, height and samples per pixel.
+    pub environment: (u32, u32, u32),
     /// The medical section's phantom side (voxels), image side (pixels) and frames timed per
     /// lobe and backend.
     pub volume: (usize, u32, usize),

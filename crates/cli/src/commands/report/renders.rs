@@ -1,8 +1,10 @@
 //! The report's render section: the default scene per lobe with FLIP against `pow`, the three
-//! shading methods, and CPU against GPU when an adapter exists.
+//! shading methods, CPU against GPU when an adapter exists, and the environment scene per
+//! lobe lit by the sky, with FLIP against `pow`.
 
 use specula::LobeKind;
 use specula_gpu::{Gpu, GpuRenderer};
+use specula_render::ibl::{render_ibl, Environment, IblSettings, SKY_WIDTH};
 use specula_render::metrics::compare;
 use specula_render::{
     render, render_grid_with, Display, GridOptions, Image, Overrides, Scene, Shading,
@@ -28,8 +30,18 @@ fn cpu(scene: &Scene) -> Result<Image, String> {
     render(scene, &|_, _| {}).map_err(|e| e.to_string())
 }
 
-pub fn renders(context: &mut Context) -> Result<String, String> {
-    let base = scene(context, Overrides::default());
+/// Every lobe's render of `base` by `draw`, as a grid with FLIP against pow below each tile,
+/// then a table whose rows each name their image file (`<prefix>-<lobe>.png`) and are
+/// computed from that file's pixels (8-bit sRGB, as written), so that
+/// `specula diff <prefix>-pow.png <prefix>-<lobe>.png` prints the same figures. Returns the
+/// HTML and the images, the reference first.
+fn lobe_table(
+    context: &mut Context,
+    base: &Scene,
+    prefix: &str,
+    header: &str,
+    draw: &dyn Fn(&Scene) -> Result<Image, String>,
+) -> Result<(String, Vec<Option<Image>>), String> {
     let options = GridOptions {
         lobes: LobeKind::ALL.to_vec(),
         reference: LobeKind::Pow,
@@ -37,25 +49,19 @@ pub fn renders(context: &mut Context) -> Result<String, String> {
     // The grid draws the reference as render 0 and each other lobe as render `column + 1`;
     // keeping them by that index (not by arrival) ties every image to its lobe.
     let mut renders: Vec<Option<Image>> = vec![None; 1 + options.lobes.len()];
-    let grid = render_grid_with(&base, &options, &mut |variant, index| {
-        let image = cpu(variant)?;
+    let grid = render_grid_with(base, &options, &mut |variant, index| {
+        let image = draw(variant)?;
         renders[index] = Some(image.clone());
         Ok(image)
     })
     .map_err(|e| e.to_string())?;
-    let (width, height, samples) = context.sizes.render;
-    let mut html = paragraph(&format!(
-        "The default scene ({width}x{height}, {samples}x{samples} samples, classic model, Phong shading) with every material's lobe replaced, and below each its FLIP error map against pow. Look for where the highlights' size and falloff differ from pow's."
-    ));
-    html += &context.png_srgb8(
-        "renders-lobes.png",
+    let mut html = context.png_srgb8(
+        &format!("{prefix}s-lobes.png"),
         grid.width,
         grid.height,
         &grid.bytes,
         "every lobe, FLIP against pow below",
     )?;
-    // Each row names its image file and is computed from that file's pixels (8-bit sRGB, as
-    // written), so `specula diff render-pow.png render-<lobe>.png` prints the same figures.
     let mut written = Vec::new();
     for (column, &kind) in options.lobes.iter().enumerate() {
         let index = if kind == options.reference {
@@ -66,7 +72,7 @@ pub fn renders(context: &mut Context) -> Result<String, String> {
         let image = renders[index]
             .as_ref()
             .ok_or_else(|| format!("the grid did not render {kind}"))?;
-        let name = format!("render-{}.png", kind.id());
+        let name = format!("{prefix}-{}.png", kind.id());
         let bytes = image.to_srgb8(base.display);
         context.write_png_file(&name, image.width(), image.height(), &bytes)?;
         let decoded = Image::from_srgb8(image.width(), image.height(), &bytes)
@@ -93,15 +99,20 @@ pub fn renders(context: &mut Context) -> Result<String, String> {
         })
         .collect::<Result<_, String>>()?;
     html += &table(
-        &[
-            "lobe",
-            "image",
-            "PSNR vs pow (dB)",
-            "max abs error",
-            "mean FLIP",
-        ],
+        &["lobe", "image", header, "max abs error", "mean FLIP"],
         &rows,
     );
+    Ok((html, renders))
+}
+
+pub fn renders(context: &mut Context) -> Result<String, String> {
+    let base = scene(context, Overrides::default());
+    let (width, height, samples) = context.sizes.render;
+    let mut html = paragraph(&format!(
+        "The default scene ({width}x{height}, {samples}x{samples} samples, classic model, Phong shading) with every material's lobe replaced, and below each its FLIP error map against pow. Look for where the highlights' size and falloff differ from pow's."
+    ));
+    let (table_html, mut renders) = lobe_table(context, &base, "render", "PSNR vs pow (dB)", &cpu)?;
+    html += &table_html;
     // The reference render, kept for the CPU-against-GPU comparison below.
     let reference_image = renders[0].take().ok_or("the grid did not render pow")?;
 
@@ -145,5 +156,38 @@ pub fn renders(context: &mut Context) -> Result<String, String> {
         }
         Err(error) => html += &paragraph(&format!("CPU against GPU: not run ({error}).")),
     }
+    html += &environment_lit(context)?;
+    Ok(html)
+}
+
+/// Every lobe in the environment scene lit by the procedural sky: the same seed for every
+/// lobe, so the environment's draws are shared and the differences are the lobes', not the
+/// noise's.
+fn environment_lit(context: &mut Context) -> Result<String, String> {
+    let (width, height, spp) = context.sizes.environment;
+    let mut base = Scene::ibl_scene();
+    base.apply(&Overrides {
+        width: Some(width),
+        height: Some(height),
+        ..Overrides::default()
+    });
+    let sky = Environment::sky(SKY_WIDTH);
+    let settings = IblSettings {
+        spp,
+        ..IblSettings::default()
+    };
+    let mut html = paragraph(&format!(
+        "A sphere and the teapot lit by the procedural sky alone ({width}x{height}, {spp} samples per pixel, multiple importance sampling between each lobe's own sampler and the sky, the lobe normalisation, physical model: specula render --env sky --spp {spp} --lobe L). Every lobe's render uses the same random numbers, so what differs from pow is the reflected sun's and sky's shape; the residual Monte Carlo noise sets the floor of these figures."
+    ));
+    let draw =
+        |scene: &Scene| render_ibl(scene, &sky, &settings, &|_, _| {}).map_err(|e| e.to_string());
+    let (table_html, _) = lobe_table(
+        context,
+        &base,
+        "environment",
+        "PSNR vs pow, lit by the sky (dB)",
+        &draw,
+    )?;
+    html += &table_html;
     Ok(html)
 }

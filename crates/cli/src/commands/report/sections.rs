@@ -579,6 +579,7 @@ pub fn sizes(quick: bool) -> Sizes {
                 ..ClaimOptions::default()
             },
             render: (240, 135, 1),
+            environment: (240, 135, 16),
             volume: (32, 96, 1),
             hardware_exponents: &[64],
             synthesis: OnMiss::Skip,
@@ -590,6 +591,7 @@ pub fn sizes(quick: bool) -> Sizes {
             reciprocity_pairs: 20_000,
             claims: ClaimOptions::default(),
             render: (480, 270, 2),
+            environment: (480, 270, 128),
             volume: (64, 192, 2),
             hardware_exponents: &[8, 64, 512],
             synthesis: OnMiss::Synthesize,
