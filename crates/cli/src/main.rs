@@ -53,11 +53,13 @@ enum Command {
         after_help = "Examples:\n  specula report\n  specula report --quick --out /tmp/report\n  specula report --bench"
     )]
     Report(commands::report::Args),
-    /// Render a scene (TOML, or the embedded default) on the CPU to PNG or EXR.
+    /// Render a scene (TOML, or the embedded default) to PNG, EXR or HDR, lit by its lights or by an environment map.
     #[command(after_help = "Examples:\n  specula render -o out.png\n  \
                             specula render scene.toml --lobe schlick-mod --n 256 -o out.exr\n  \
                             specula render --shading gouraud --width 640 --height 360\n  \
                             specula render --grid lobes=pow,schlick,schlick-mod,cheb2,logexp -o grid.png\n  \
+                            specula render --env sky --spp 64 -o sky.png\n  \
+                            specula render scene.toml --env studio.hdr --spp 256 -o lit.exr\n  \
                             specula render --dump-default-scene > my-scene.toml")]
     Render(commands::render::Args),
     /// Compare two images: PSNR, largest error, mean FLIP, and a FLIP heatmap.

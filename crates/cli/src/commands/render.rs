@@ -26,7 +26,7 @@ pub struct Args {
     max_triangles: u64,
     /// A scene file (TOML); the embedded default scene when omitted.
     scene: Option<PathBuf>,
-    /// Output image: .png (8-bit sRGB) or .exr (linear f32 radiance).
+    /// Output image: .png (8-bit sRGB), .exr (linear f32 radiance) or .hdr (linear RGBE).
     #[arg(short, long, default_value = "render.png")]
     output: PathBuf,
     /// Every material's lobe.

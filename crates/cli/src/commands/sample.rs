@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
+use specula::lobe::Warp;
 use specula::sampling::chi2::{self, sidak, Outcome, Settings};
 use specula::sampling::uniform;
 use specula::sampling::SpecularSampler;
@@ -189,7 +190,7 @@ fn suite(args: &Args) -> CommandResult {
         settings.samples
     );
     println!(
-        "lobe           n     form   theta_o  warp      p-value   dof   pdf integral  verdict"
+        "lobe           n     form   theta_o  warp      newton     p-value   dof   pdf integral  verdict"
     );
     let bar = ProgressBar::new(cases.len() as u64).with_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed}")
@@ -205,14 +206,22 @@ fn suite(args: &Args) -> CommandResult {
         let outcome = chi2::run(&sampler, view(degrees), &settings);
         let passed = outcome.passes(alpha);
         failed += usize::from(!passed);
+        let newton = match sampler.warp() {
+            Warp::Newton => format!(
+                "{:.2}/{}",
+                outcome.newton_iterations.0, outcome.newton_iterations.1
+            ),
+            _ => "-".to_owned(),
+        };
         bar.suspend(|| {
             println!(
-                "{:<14} {:<5} {:<6} {:<8} {:<9} {:<9.3e} {:<5} {:<13.6} {}",
+                "{:<14} {:<5} {:<6} {:<8} {:<9} {:<10} {:<9.3e} {:<5} {:<13.6} {}",
                 kind.to_string(),
                 n,
                 geometry.id(),
                 degrees,
                 sampler.warp().id(),
+                newton,
                 outcome.p_value,
                 outcome.dof,
                 outcome.pdf_integral,

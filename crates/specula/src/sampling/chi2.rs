@@ -68,6 +68,9 @@ pub struct Outcome {
     pub pdf_integral: f64,
     /// The fraction of draws that returned a direction.
     pub drawn_fraction: f64,
+    /// Newton iterations per returned direction: the mean and the most (0 for closed forms
+    /// and tables).
+    pub newton_iterations: (f64, u32),
     /// Counts per cell, row-major (`rows x columns`).
     pub histogram: Vec<f64>,
     /// Expected counts per cell, row-major.
@@ -248,41 +251,60 @@ fn expected_counts(
 }
 
 /// Counts per cell of `samples` draws, and how many returned a direction.
+/// Where the draws fell, and what drawing them cost.
+#[derive(Default)]
+struct Histogram {
+    /// Draws per cell, row-major.
+    counts: Vec<f64>,
+    /// Draws that returned a direction.
+    drawn: u64,
+    /// Newton iterations over those draws.
+    iterations: u64,
+    /// The most any draw took.
+    most_iterations: u32,
+}
+
+/// Draws `settings.samples` directions and counts them per cell.
 fn histogram(
     sampler: &SpecularSampler,
     wo: DVec3,
     domain: &Domain,
     settings: &Settings,
-) -> (Vec<f64>, u64) {
+) -> Histogram {
     const CHUNK: usize = 1 << 14;
     let (columns, rows) = (settings.columns, settings.rows);
     let chunks = settings.samples.div_ceil(CHUNK);
+    let empty = || Histogram {
+        counts: vec![0.0; rows * columns],
+        ..Histogram::default()
+    };
     (0..chunks)
         .into_par_iter()
         .map(|chunk| {
-            let mut counts = vec![0.0; rows * columns];
-            let mut drawn = 0;
+            let mut part = empty();
             let end = ((chunk + 1) * CHUNK).min(settings.samples);
             for index in chunk * CHUNK..end {
                 let u = [0, 1].map(|d| uniform(settings.seed, index as u64, d));
                 let Some(sample) = sampler.sample(wo, u) else {
                     continue;
                 };
-                drawn += 1;
+                part.drawn += 1;
+                part.iterations += u64::from(sample.iterations);
+                part.most_iterations = part.most_iterations.max(sample.iterations);
                 let (x, y) = domain.backward(sample.wi);
                 let column = ((x * columns as f64) as usize).min(columns - 1);
                 let row = ((y * rows as f64) as usize).min(rows - 1);
-                counts[row * columns + column] += 1.0;
+                part.counts[row * columns + column] += 1.0;
             }
-            (counts, drawn)
+            part
         })
-        .reduce(
-            || (vec![0.0; rows * columns], 0),
-            |(mut a, da), (b, db)| {
-                a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
-                (a, da + db)
-            },
-        )
+        .reduce(empty, |mut a, b| {
+            a.counts.iter_mut().zip(b.counts).for_each(|(x, y)| *x += y);
+            a.drawn += b.drawn;
+            a.iterations += b.iterations;
+            a.most_iterations = a.most_iterations.max(b.most_iterations);
+            a
+        })
 }
 
 /// Pearson's statistic with cells expecting fewer than [`MIN_EXPECTED`] pooled (smallest
@@ -323,7 +345,12 @@ pub fn pearson(observed: &[f64], expected: &[f64]) -> (f64, usize, u64) {
 pub fn run(sampler: &SpecularSampler, wo: DVec3, settings: &Settings) -> Outcome {
     let domain = Domain::new(sampler, wo);
     let expected = expected_counts(sampler, wo, &domain, settings);
-    let (histogram, drawn) = histogram(sampler, wo, &domain, settings);
+    let Histogram {
+        counts: histogram,
+        drawn,
+        iterations,
+        most_iterations,
+    } = histogram(sampler, wo, &domain, settings);
     let (statistic, dof, impossible) = pearson(&histogram, &expected);
     let n = settings.samples as f64;
     Outcome {
@@ -333,6 +360,7 @@ pub fn run(sampler: &SpecularSampler, wo: DVec3, settings: &Settings) -> Outcome
         impossible,
         pdf_integral: expected.iter().sum::<f64>() / n,
         drawn_fraction: drawn as f64 / n,
+        newton_iterations: (iterations as f64 / drawn.max(1) as f64, most_iterations),
         histogram,
         expected,
         columns: settings.columns,
