@@ -62,10 +62,10 @@ pub struct Args {
     /// The renderer: the CPU rasterizer, or wgpu (a GPU, or Mesa's lavapipe without one).
     #[arg(long, value_enum, default_value_t)]
     backend: RendererArg,
-    /// Light the scene by an environment instead of its lights: `sky` (built in) or an
-    /// equirectangular .hdr, .exr or .png file (at most 4096 x 4096), rendered by Monte Carlo
-    /// with multiple importance sampling on the CPU, physical model. Without a scene file,
-    /// the embedded environment scene (a sphere and the teapot).
+    /// Light the scene by an environment instead of its lights: `sky` (built in; a file named
+    /// sky is `./sky`) or an equirectangular .hdr, .exr or .png file (at most 4096 x 4096),
+    /// rendered by Monte Carlo with multiple importance sampling on the CPU, physical model.
+    /// Without a scene file, the embedded environment scene (a sphere and the teapot).
     #[arg(long, value_name = "sky|FILE", conflicts_with_all = ["shading", "model"])]
     env: Option<PathBuf>,
     /// Samples per pixel with --env.

@@ -23,9 +23,9 @@ use thiserror::Error;
 
 use crate::{read_image, Image, ImageError};
 
-/// Rec. 709 luminance weights: how bright a linear RGB radiance looks, for the sampling
-/// weights.
-const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
+/// Rec. 709 luminance weights: how bright a linear RGB radiance looks (the map's sampling
+/// weights, and the split of BRDF draws between a material's terms).
+pub(super) const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
 
 /// An environment that cannot be used, and why.
 #[derive(Debug, Error)]

@@ -7,14 +7,13 @@ use glam::{DVec3, Vec3, Vec4};
 use rayon::prelude::*;
 use specula::sampling::{power_heuristic, uniform, SpecularSampler};
 
+use super::environment::LUMINANCE;
 use super::{Environment, IblSettings, Strategy, MAX_SPP};
 use crate::pipeline::{surfaces, SurfacePoint};
 use crate::{Image, Material, RenderError, Scene};
 
-/// Rec. 709 luminance: how much a material's colour weighs when splitting draws between
-/// its diffuse and specular terms.
 fn luminance(colour: DVec3) -> f64 {
-    colour.dot(DVec3::new(0.2126, 0.7152, 0.0722))
+    colour.dot(LUMINANCE.as_dvec3())
 }
 
 /// A material prepared for environment lighting: the physical model's BRDF
