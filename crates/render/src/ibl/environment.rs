@@ -96,12 +96,13 @@ impl Environment {
         }
         let weights: Vec<f64> = image
             .pixels()
-            .iter()
+            .chunks(width.max(1) as usize)
             .enumerate()
-            .map(|(index, pixel)| {
-                let row = (index as u32 / width.max(1)) as f64;
-                let sine = (PI * (row + 0.5) / f64::from(height)).sin();
-                f64::from(pixel.dot(LUMINANCE)) * sine
+            .flat_map(|(row, pixels)| {
+                let sine = (PI * (row as f64 + 0.5) / f64::from(height)).sin();
+                pixels
+                    .iter()
+                    .map(move |p| f64::from(p.dot(LUMINANCE)) * sine)
             })
             .collect();
         let distribution = (width >= 2)

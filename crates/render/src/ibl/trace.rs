@@ -12,13 +12,14 @@ use super::{Environment, IblSettings, Strategy, MAX_SPP};
 use crate::pipeline::{surfaces, SurfacePoint};
 use crate::{Image, Material, RenderError, Scene};
 
+/// How bright a colour looks: the weight of a material's term when BRDF draws are split.
 fn luminance(colour: DVec3) -> f64 {
     colour.dot(LUMINANCE.as_dvec3())
 }
 
 /// A material prepared for environment lighting: the physical model's BRDF
 /// `kd C / pi + ks S N(n) lobe(t)` and how its directions are drawn.
-pub(super) struct Surface {
+struct Surface {
     /// `kd C / pi`.
     diffuse: DVec3,
     /// `ks S`; the sampler's value carries `N(n) lobe(t)`.
@@ -29,7 +30,7 @@ pub(super) struct Surface {
 }
 
 impl Surface {
-    pub(super) fn new(material: &Material) -> Self {
+    fn new(material: &Material) -> Self {
         let diffuse = (material.kd * material.colour).as_dvec3();
         let specular = (material.ks * material.specular_colour).as_dvec3();
         let (d, s) = (luminance(diffuse), luminance(specular));
@@ -41,61 +42,64 @@ impl Surface {
         }
     }
 
-    /// The BRDF for local `wo` and `wi` (both above the surface, else 0).
-    fn brdf(&self, wo: DVec3, wi: DVec3) -> DVec3 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return DVec3::ZERO;
-        }
-        self.diffuse + self.specular * self.sampler.value(wo, wi)
-    }
-
-    /// The density of the BRDF strategy: the mixture of the cosine and the lobe.
-    fn brdf_pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
+    /// The BRDF and the BRDF strategy's density (the mixture of the cosine and the lobe) at
+    /// local `wi`, for `wo` above the surface.
+    fn brdf_and_pdf(&self, wo: DVec3, wi: DVec3) -> (DVec3, f64) {
         if wi.z <= 0.0 {
-            return 0.0;
+            return (DVec3::ZERO, 0.0);
         }
-        let share = self.specular_share;
-        let lobe = if share > 0.0 {
+        let lobe_pdf = if self.specular_share > 0.0 {
             self.sampler.pdf(wo, wi)
         } else {
             0.0
         };
-        (1.0 - share) * wi.z * FRAC_1_PI + share * lobe
+        self.combine(wi, self.sampler.value(wo, wi), lobe_pdf)
     }
 
-    /// A direction from the BRDF strategy: `u[0]` picks the term, `u[1..3]` draw in it.
-    fn brdf_sample(&self, wo: DVec3, u: [f64; 3]) -> Option<DVec3> {
+    /// The BRDF and the mixture density at `wi` from the lobe's value and density there.
+    fn combine(&self, wi: DVec3, lobe_value: f64, lobe_pdf: f64) -> (DVec3, f64) {
+        let share = self.specular_share;
+        (
+            self.diffuse + self.specular * lobe_value,
+            (1.0 - share) * wi.z * FRAC_1_PI + share * lobe_pdf,
+        )
+    }
+
+    /// A direction from the BRDF strategy with the BRDF and the density there: `u[0]` picks
+    /// the term, `u[1..3]` draw in it. A lobe draw brings its own value and density.
+    fn brdf_sample(&self, wo: DVec3, u: [f64; 3]) -> Option<(DVec3, DVec3, f64)> {
         if u[0] < self.specular_share {
-            self.sampler.sample(wo, [u[1], u[2]]).map(|s| s.wi)
+            let drawn = self.sampler.sample(wo, [u[1], u[2]])?;
+            let (f, pdf) = self.combine(drawn.wi, drawn.value, drawn.pdf);
+            Some((drawn.wi, f, pdf))
         } else {
             let (sine, cosine) = (u[1].sqrt(), (1.0 - u[1]).sqrt());
             let (s, c) = (TAU * u[2]).sin_cos();
-            (cosine > 0.0).then(|| DVec3::new(sine * c, sine * s, cosine))
+            let wi = DVec3::new(sine * c, sine * s, cosine);
+            let (f, pdf) = self.brdf_and_pdf(wo, wi);
+            Some((wi, f, pdf))
         }
     }
 
-    /// One sample of the radiance leaving towards `wo` (local) at a surface with the
-    /// orthonormal `frame` (tangent, bitangent, normal), lit by `environment`: one draw from
-    /// the environment and one from the BRDF, combined as `strategy` says. `u` holds five
-    /// uniform numbers.
-    pub(super) fn estimate(
+    /// One sample of the radiance leaving towards `wo` (local, above the surface) at a
+    /// surface with `frame`, lit by `environment`: one draw from the environment and one from
+    /// the BRDF, combined as `strategy` says. `u` holds five uniform numbers.
+    fn estimate(
         &self,
         environment: &Environment,
-        frame: [DVec3; 3],
+        frame: &Frame,
         wo: DVec3,
         strategy: Strategy,
         u: [f64; 5],
     ) -> DVec3 {
-        let to_local = |v: DVec3| DVec3::new(v.dot(frame[0]), v.dot(frame[1]), v.dot(frame[2]));
-        let to_world = |v: DVec3| frame[0] * v.x + frame[1] * v.y + frame[2] * v.z;
         let mut radiance = DVec3::ZERO;
         if strategy != Strategy::Brdf {
             if let Some(light) = environment.sample([u[0], u[1]]) {
-                let wi = to_local(light.wi);
-                let f = self.brdf(wo, wi);
+                let wi = frame.to_local(light.wi);
+                let (f, brdf_pdf) = self.brdf_and_pdf(wo, wi);
                 if f != DVec3::ZERO {
                     let weight = match strategy {
-                        Strategy::Mis => power_heuristic(light.pdf, self.brdf_pdf(wo, wi)),
+                        Strategy::Mis => power_heuristic(light.pdf, brdf_pdf),
                         _ => 1.0,
                     };
                     radiance += f * light.radiance.as_dvec3() * (wi.z * weight / light.pdf);
@@ -103,11 +107,9 @@ impl Surface {
             }
         }
         if strategy != Strategy::Environment {
-            if let Some(wi) = self.brdf_sample(wo, [u[2], u[3], u[4]]) {
-                let pdf = self.brdf_pdf(wo, wi);
-                let f = self.brdf(wo, wi);
+            if let Some((wi, f, pdf)) = self.brdf_sample(wo, [u[2], u[3], u[4]]) {
                 if pdf > 0.0 && f != DVec3::ZERO {
-                    let world = to_world(wi);
+                    let world = frame.to_world(wi);
                     let weight = match strategy {
                         Strategy::Mis => power_heuristic(pdf, environment.pdf(world)),
                         _ => 1.0,
@@ -118,6 +120,50 @@ impl Surface {
         }
         radiance
     }
+}
+
+/// An orthonormal frame about a unit normal: world directions to the local frame (`z` the
+/// normal) and back.
+struct Frame {
+    tangent: DVec3,
+    bitangent: DVec3,
+    normal: DVec3,
+}
+
+impl Frame {
+    fn new(normal: DVec3) -> Self {
+        let (tangent, bitangent) = normal.any_orthonormal_pair();
+        Self {
+            tangent,
+            bitangent,
+            normal,
+        }
+    }
+
+    fn to_local(&self, v: DVec3) -> DVec3 {
+        DVec3::new(
+            v.dot(self.tangent),
+            v.dot(self.bitangent),
+            v.dot(self.normal),
+        )
+    }
+
+    fn to_world(&self, v: DVec3) -> DVec3 {
+        self.tangent * v.x + self.bitangent * v.y + self.normal * v.z
+    }
+}
+
+/// What one sample position of a pixel sees, prepared once for all the samples it takes.
+enum View<'a> {
+    /// Radiance that needs no sampling: the environment behind nothing, or black where the
+    /// surface faces away from the camera (an interpolated normal past the silhouette).
+    Fixed(DVec3),
+    /// A surface to integrate over.
+    Surface {
+        surface: &'a Surface,
+        frame: Frame,
+        wo: DVec3,
+    },
 }
 
 /// The unit camera ray through each sample position's centre, for the background.
@@ -176,37 +222,39 @@ pub fn render_ibl(
         scene.settings.height,
         scene.settings.samples,
     );
+    let positions = (s * s) as usize;
     let done = AtomicUsize::new(0);
     let mut image = Image::new(width, height, Vec3::ZERO);
     image
         .pixels_mut()
         .par_chunks_mut(width as usize)
         .enumerate()
-        .for_each(|(y, row)| {
+        .for_each_init(Vec::new, |views, (y, row)| {
             let y = y as u32;
             for (x, pixel) in (0..width).zip(row.iter_mut()) {
+                // Each position the pixel's samples visit, prepared once.
+                views.clear();
+                views.extend((0..positions.min(settings.spp as usize)).map(|position| {
+                    let (sx, sy) = (x * s + position as u32 % s, y * s + position as u32 / s);
+                    match points[(sy * width * s + sx) as usize] {
+                        None => {
+                            View::Fixed(environment.radiance(rays.direction(sx, sy)).as_dvec3())
+                        }
+                        Some(point) => view(&surfaces, scene, point),
+                    }
+                }));
                 let index = u64::from(y * width + x);
                 let mut sum = DVec3::ZERO;
                 for i in 0..settings.spp {
-                    let position = i % (s * s);
-                    let (sx, sy) = (x * s + position % s, y * s + position / s);
-                    let point = points[(sy * width * s + sx) as usize];
-                    let u = core::array::from_fn(|d| {
-                        uniform(
-                            settings.seed,
-                            index * u64::from(settings.spp) + u64::from(i),
-                            d as u64,
-                        )
-                    });
-                    let radiance = match point {
-                        None => environment.radiance(rays.direction(sx, sy)).as_dvec3(),
-                        Some(point) => {
-                            shade(&surfaces, environment, scene, point, settings.strategy, u)
+                    sum += match &views[i as usize % positions] {
+                        View::Fixed(radiance) => *radiance,
+                        View::Surface { surface, frame, wo } => {
+                            let draw = index * u64::from(settings.spp) + u64::from(i);
+                            let u =
+                                core::array::from_fn(|d| uniform(settings.seed, draw, d as u64));
+                            surface.estimate(environment, frame, *wo, settings.strategy, u)
                         }
                     };
-                    if radiance.is_finite() {
-                        sum += radiance;
-                    }
                 }
                 *pixel = (sum / f64::from(settings.spp)).as_vec3();
             }
@@ -215,23 +263,16 @@ pub fn render_ibl(
     Ok(image)
 }
 
-/// One sample at a visible surface point.
-fn shade(
-    surfaces: &[Surface],
-    environment: &Environment,
-    scene: &Scene,
-    point: SurfacePoint,
-    strategy: Strategy,
-    u: [f64; 5],
-) -> DVec3 {
-    let normal = point.normal.as_dvec3();
-    let (tangent, bitangent) = normal.any_orthonormal_pair();
-    let frame = [tangent, bitangent, normal];
-    let wo_world = scene.camera.towards_viewer(point.position).as_dvec3();
-    let wo = DVec3::new(
-        wo_world.dot(tangent),
-        wo_world.dot(bitangent),
-        wo_world.dot(normal),
-    );
-    surfaces[point.object as usize].estimate(environment, frame, wo, strategy, u)
+/// What a visible surface point shows: its material, frame and `wo` in that frame.
+fn view<'a>(surfaces: &'a [Surface], scene: &Scene, point: SurfacePoint) -> View<'a> {
+    let frame = Frame::new(point.normal.as_dvec3());
+    let wo = frame.to_local(scene.camera.towards_viewer(point.position).as_dvec3());
+    if wo.z <= 0.0 {
+        return View::Fixed(DVec3::ZERO);
+    }
+    View::Surface {
+        surface: &surfaces[point.object as usize],
+        frame,
+        wo,
+    }
 }
