@@ -38,6 +38,7 @@ pub mod brdf;
 pub mod claims;
 mod error;
 mod exponent;
+pub mod expression;
 pub mod fit;
 pub mod geometry;
 pub mod gpu_cost;

@@ -216,6 +216,10 @@ impl Real for Counted {
         });
         Counted(self.0.bits_exp2())
     }
+    fn select_less(self, bound: Self, then: Self, otherwise: Self) -> Self {
+        tally(|c| c.cmp += 1);
+        Counted(self.0.select_less(bound.0, then.0, otherwise.0))
+    }
 }
 
 #[cfg(test)]

@@ -71,6 +71,11 @@ pub trait Real:
     /// relative steps); in `f64` it is the exact piecewise-linear function.
     #[must_use]
     fn bits_exp2(self) -> Self;
+    /// `then` where `self < bound`, else `otherwise` (a comparison and a select; false for
+    /// NaN). Models choose with this rather than an `if`, so that a recorded expression
+    /// ([`crate::expression`]) keeps both sides and a target evaluates the choice itself.
+    #[must_use]
+    fn select_less(self, bound: Self, then: Self, otherwise: Self) -> Self;
 }
 
 macro_rules! impl_real_for_float {
@@ -144,6 +149,14 @@ macro_rules! impl_real_for_float {
             #[inline(always)]
             fn bits_exp2(self) -> Self {
                 BitTricks::bits_exp2_fields(self)
+            }
+            #[inline(always)]
+            fn select_less(self, bound: Self, then: Self, otherwise: Self) -> Self {
+                if self < bound {
+                    then
+                } else {
+                    otherwise
+                }
             }
         }
     };

@@ -7,6 +7,7 @@
 //! ([`cached_angle_quadratic`]) so that building a lobe twice never fits twice.
 
 mod chebyshev;
+mod microfacet;
 mod minimax;
 mod polynomial;
 
@@ -14,6 +15,7 @@ use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
 
 pub use chebyshev::ChebyshevSeries;
+pub use microfacet::{ggx, microfacet, MicrofacetFit};
 pub use minimax::{minimax, ErrorWeight, MinimaxError, MinimaxFit};
 pub use polynomial::Polynomial;
 

@@ -251,21 +251,26 @@ impl Lobe {
     pub fn eval<R: Real>(&self, t: R) -> R {
         let zero = R::from_f64(0.0);
         if t > zero {
-            let t = t.min(R::from_f64(1.0));
-            match &self.model {
-                Model::Pow(m) => m.eval(t),
-                Model::Schlick(m) => m.eval(t),
-                Model::SchlickMod(m) => m.eval(t),
-                Model::AngleQuadratic(m) => m.eval_angle(t.acos()),
-                Model::LogExp(m) => m.eval(t),
-                Model::LogExpRr(m) => m.eval(t),
-                Model::CosQuad(m) => m.eval(t),
-                Model::Sg(m) => m.eval(t),
-                Model::FastPow(m) => m.eval(t),
-                Model::FasterPow(m) => m.eval(t),
-            }
+            self.eval_unit(t.min(R::from_f64(1.0)))
         } else {
             zero
+        }
+    }
+
+    /// The model's own formula, for `t` in `(0, 1]` (what [`Lobe::expression`] records).
+    #[inline]
+    pub(crate) fn eval_unit<R: Real>(&self, t: R) -> R {
+        match &self.model {
+            Model::Pow(m) => m.eval(t),
+            Model::Schlick(m) => m.eval(t),
+            Model::SchlickMod(m) => m.eval(t),
+            Model::AngleQuadratic(m) => m.eval_angle(t.acos()),
+            Model::LogExp(m) => m.eval(t),
+            Model::LogExpRr(m) => m.eval(t),
+            Model::CosQuad(m) => m.eval(t),
+            Model::Sg(m) => m.eval(t),
+            Model::FastPow(m) => m.eval(t),
+            Model::FasterPow(m) => m.eval(t),
         }
     }
 

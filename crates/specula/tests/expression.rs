@@ -1,0 +1,117 @@
+//! The recorded expression is the lobe: run back in `f32` it gives the fast path's bits, in
+//! `f64` the reference's, and its bit-trick-free lowering gives the same `f32` bits.
+
+use specula::expression::{record, Branched, Node};
+use specula::{Lobe, LobeKind, Real};
+
+const EXPONENTS: [f64; 8] = [1.0, 2.5, 8.0, 16.0, 64.0, 100.0, 512.0, 1000.0];
+
+fn kinds() -> Vec<LobeKind> {
+    let mut kinds = LobeKind::ALL.to_vec();
+    kinds.extend([0u8, 1, 7, 10].map(|v| LobeKind::CosQuad { v }));
+    kinds
+}
+
+/// Cosines spread over every scale a lobe sees: log-spaced from the smallest normal `f32` to
+/// 1, linear over (0, 1], every power of two and its neighbours (the bit tricks' binade
+/// edges), and 1.
+fn cosines() -> Vec<f32> {
+    let mut t: Vec<f32> = (0..=4000)
+        .map(|k| (f64::from(f32::MIN_POSITIVE).ln() * (1.0 - f64::from(k) / 4000.0)).exp() as f32)
+        .collect();
+    t.extend((1..=20000).map(|k| k as f32 / 20000.0));
+    for e in 0..126 {
+        let p = (-(e as f32)).exp2();
+        t.extend([
+            p,
+            f32::from_bits(p.to_bits() - 1),
+            f32::from_bits(p.to_bits() + 1),
+        ]);
+    }
+    t.retain(|t| *t >= f32::MIN_POSITIVE && *t <= 1.0);
+    t
+}
+
+#[test]
+fn the_record_evaluates_to_the_lobes_own_bits() {
+    let cosines = cosines();
+    for kind in kinds() {
+        for n in EXPONENTS {
+            let lobe = Lobe::try_new(kind, n).unwrap();
+            let expression = lobe.expression();
+            let lowered = expression.lowered();
+            assert!(
+                !lowered.has_bit_tricks(),
+                "{kind} n = {n}: lowering left a bit trick"
+            );
+            for &t in &cosines {
+                let fast = lobe.eval(t);
+                assert_eq!(
+                    expression.eval(t).to_bits(),
+                    fast.to_bits(),
+                    "{kind} n = {n} t = {t:e}: record {} vs lobe {fast}",
+                    expression.eval(t)
+                );
+                assert_eq!(
+                    lowered.eval(t).to_bits(),
+                    fast.to_bits(),
+                    "{kind} n = {n} t = {t:e}: lowered {} vs lobe {fast}",
+                    lowered.eval(t)
+                );
+                let reference = lobe.eval(f64::from(t));
+                assert_eq!(
+                    expression.eval(f64::from(t)).to_bits(),
+                    reference.to_bits(),
+                    "{kind} n = {n} t = {t:e} in f64"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn only_the_bit_trick_lobes_need_lowering() {
+    for kind in kinds() {
+        let lobe = Lobe::try_new(kind, 64.0).unwrap();
+        let expected = matches!(
+            kind,
+            LobeKind::FastPow | LobeKind::FasterPow | LobeKind::LogExpRr
+        );
+        assert_eq!(lobe.expression().has_bit_tricks(), expected, "{kind}");
+    }
+}
+
+#[test]
+fn constants_are_folded_in_and_unused_nodes_dropped() {
+    let lobe = Lobe::try_new(LobeKind::Pow, 64.0).unwrap();
+    assert_eq!(
+        lobe.expression().nodes(),
+        [Node::Input, Node::Constant(64.0), Node::Pow(0, 1)]
+    );
+    let cosquad = Lobe::try_new(LobeKind::CosQuad { v: 4 }, 16.0).unwrap();
+    let squarings = cosquad
+        .expression()
+        .nodes()
+        .iter()
+        .filter(|node| matches!(node, Node::Square(_)))
+        .count();
+    assert_eq!(squarings, 4, "K_4 squares four times");
+    let unused = record(|t| {
+        let _discarded = t.log2();
+        t + t
+    })
+    .unwrap();
+    assert_eq!(unused.nodes(), [Node::Input, Node::Add(0, 0)]);
+}
+
+#[test]
+fn a_branch_on_a_traced_value_is_refused() {
+    let branching = record(|t| {
+        if t > Real::from_f64(0.5) {
+            t
+        } else {
+            t.square()
+        }
+    });
+    assert_eq!(branching, Err(Branched));
+}

@@ -1,0 +1,142 @@
+//! An [`Expression`] written as straight-line code in a C-like language.
+//!
+//! Every target writes the same statements: a node used more than once (or a select, whose
+//! operands a reader wants named) becomes a local; a node used once is written in place,
+//! fully parenthesised, so no target's precedence rules matter. A [`Dialect`] says how each
+//! operation is spelled; constants are `f32`, as every target computes in `f32`.
+
+use core::fmt::Write as _;
+
+use specula::expression::{Expression, Node};
+
+/// How one language spells the operations of an expression.
+pub trait Dialect {
+    /// A local definition of `name` as `value`, one line.
+    fn local(&self, name: &str, value: &str) -> String;
+    /// A function call (`log2`, `exp2`, `sqrt`, `acos`, `cos`, `pow`, `max`, `min`, `ceil`,
+    /// and the bit-trick helpers `specula_shift`, `specula_mantissa`, `specula_exponent`,
+    /// `specula_bits_exp2` for targets that keep them).
+    fn call(&self, function: &str, arguments: &[String]) -> String {
+        format!("{function}({})", arguments.join(", "))
+    }
+    /// `then` where `a < b`, else `otherwise`.
+    fn select_less(&self, a: &str, b: &str, then: &str, otherwise: &str) -> String;
+    /// A constant.
+    fn constant(&self, value: f32) -> String {
+        float_literal(value)
+    }
+}
+
+/// `value` in the shortest form that reads back as the same `f32`, always with a `.` or an
+/// exponent, so every target reads it as a float.
+#[must_use]
+pub fn float_literal(value: f32) -> String {
+    let text = format!("{value:?}");
+    if text.contains(['.', 'e', 'E']) || !value.is_finite() {
+        text
+    } else {
+        format!("{text}.0")
+    }
+}
+
+/// The statements computing `expression` of the variable `input`, and the expression of its
+/// result.
+#[must_use]
+pub fn straight_line(
+    expression: &Expression,
+    input: &str,
+    dialect: &dyn Dialect,
+) -> (Vec<String>, String) {
+    let nodes = expression.nodes();
+    let uses = expression.uses();
+    let mut text: Vec<String> = Vec::with_capacity(nodes.len());
+    let mut statements = Vec::new();
+    for (index, node) in nodes.iter().enumerate() {
+        let at = |i: usize| text[i].clone();
+        let call = |function: &str, operands: &[usize]| {
+            dialect.call(
+                function,
+                &operands.iter().map(|&i| at(i)).collect::<Vec<_>>(),
+            )
+        };
+        let written = match *node {
+            Node::Input => input.to_owned(),
+            Node::Constant(value) => dialect.constant(value as f32),
+            Node::Add(a, b) => format!("({} + {})", at(a), at(b)),
+            Node::Sub(a, b) => format!("({} - {})", at(a), at(b)),
+            Node::Mul(a, b) => format!("({} * {})", at(a), at(b)),
+            Node::Div(a, b) => format!("({} / {})", at(a), at(b)),
+            Node::Neg(a) => format!("(-{})", at(a)),
+            Node::Square(a) => format!("({} * {})", at(a), at(a)),
+            Node::Sqrt(a) => call("sqrt", &[a]),
+            Node::Log2(a) => call("log2", &[a]),
+            Node::Exp2(a) => call("exp2", &[a]),
+            Node::Acos(a) => call("acos", &[a]),
+            Node::Cos(a) => call("cos", &[a]),
+            Node::Pow(a, b) => call("pow", &[a, b]),
+            Node::Max(a, b) => call("max", &[a, b]),
+            Node::Min(a, b) => call("min", &[a, b]),
+            Node::Ceil(a) => call("ceil", &[a]),
+            Node::Shift(a, k) => call("specula_shift", &[a, k]),
+            Node::Mantissa(a) => call("specula_mantissa", &[a]),
+            Node::Exponent(a) => call("specula_exponent", &[a]),
+            Node::BitsExp2(a) => call("specula_bits_exp2", &[a]),
+            Node::SelectLess {
+                a,
+                b,
+                then,
+                otherwise,
+            } => dialect.select_less(&at(a), &at(b), &at(then), &at(otherwise)),
+        };
+        let leaf = matches!(node, Node::Input | Node::Constant(_));
+        let shared = uses[index] > 1 || matches!(node, Node::SelectLess { .. });
+        if !leaf && shared && index + 1 < nodes.len() {
+            let name = format!("v{index}");
+            statements.push(dialect.local(&name, &written));
+            text.push(name);
+        } else {
+            text.push(written);
+        }
+    }
+    let result = text.pop().unwrap_or_else(|| input.to_owned());
+    (statements, strip_outer_parentheses(result))
+}
+
+/// `(a + b)` as `a + b` where the outer pair encloses the whole text.
+fn strip_outer_parentheses(text: String) -> String {
+    let bytes = text.as_bytes();
+    if bytes.first() != Some(&b'(') || bytes.last() != Some(&b')') {
+        return text;
+    }
+    let mut depth = 0;
+    for (i, byte) in bytes.iter().enumerate() {
+        match byte {
+            b'(' => depth += 1,
+            b')' => {
+                depth -= 1;
+                if depth == 0 && i + 1 < bytes.len() {
+                    return text;
+                }
+            }
+            _ => {}
+        }
+    }
+    text[1..text.len() - 1].to_owned()
+}
+
+/// The statements and the result as a function body: each statement on its own line with
+/// `indent`, then `return_keyword result terminator`.
+#[must_use]
+pub fn body(
+    statements: &[String],
+    result: &str,
+    indent: &str,
+    return_line: impl Fn(&str) -> String,
+) -> String {
+    let mut out = String::new();
+    for statement in statements {
+        let _ = writeln!(out, "{indent}{statement}");
+    }
+    let _ = writeln!(out, "{indent}{}", return_line(result));
+    out
+}

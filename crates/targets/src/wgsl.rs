@@ -1,0 +1,70 @@
+//! WGSL: a prepared lobe as one function, with the bit tricks as bit casts (WGSL has them).
+//! `specula-gpu`'s export builds on it and hands it to naga for GLSL, HLSL, MSL and SPIR-V.
+
+use core::fmt::Write as _;
+
+use specula::Lobe;
+
+use crate::code::{body, straight_line, Dialect};
+
+struct Wgsl;
+
+impl Dialect for Wgsl {
+    fn local(&self, name: &str, value: &str) -> String {
+        format!("let {name} = {value};")
+    }
+    fn select_less(&self, a: &str, b: &str, then: &str, otherwise: &str) -> String {
+        format!("select({otherwise}, {then}, {a} < {b})")
+    }
+}
+
+/// The bit tricks, as `Real`'s `f32` implementation computes them.
+const HELPERS: &str = "
+// t = m 2^e with m in [1/2, 1), read off the bits (specula's Real::frexp).
+fn specula_mantissa(t: f32) -> f32 {
+    return bitcast<f32>((bitcast<u32>(t) & 0x007fffffu) | 0x3f000000u);
+}
+
+fn specula_exponent(t: f32) -> f32 {
+    return f32((bitcast<u32>(t) >> 23u) & 0xffu) - 126.0;
+}
+
+// The float whose bits, read with 23 fraction bits, are x + 127 (Real::bits_exp2).
+fn specula_bits_exp2(x: f32) -> f32 {
+    return bitcast<f32>(u32(max(x, -127.0) * 8388608.0 + 1065353216.0));
+}
+
+// x 2^k for an integer-valued k, built from the exponent field; 0 once 2^k underflows the
+// normal range (Real::shift).
+fn specula_shift(x: f32, k: f32) -> f32 {
+    let biased = i32(k) + 127;
+    if biased <= 0 {
+        return 0.0;
+    }
+    return x * bitcast<f32>(u32(biased) << 23u);
+}
+";
+
+/// `fn {name}(t: f32) -> f32`: the lobe for `t` in `(0, 1]`, generated from
+/// [`Lobe::expression`], preceded by the bit-trick helpers it calls.
+#[must_use]
+pub fn lobe_function(lobe: &Lobe, name: &str) -> String {
+    let expression = lobe.expression();
+    let (statements, result) = straight_line(&expression, "t", &Wgsl);
+    let mut out = String::new();
+    if expression.has_bit_tricks() {
+        out.push_str(HELPERS);
+    }
+    let _ = write!(
+        out,
+        "
+// {} at cosine t in (0, 1] (n = {}), generated from specula's description of the lobe.
+fn {name}(t: f32) -> f32 {{
+{}}}
+",
+        lobe.kind(),
+        lobe.exponent(),
+        body(&statements, &result, "    ", |r| format!("return {r};")),
+    );
+    out
+}
