@@ -10,17 +10,15 @@
 //! - an example fragment shader `fs_main` that shows the call ([`Options::example`]; GLSL
 //!   leaves it out by default, so the text is what a user pastes into a shader of their own).
 //!
-//! It is generated as WGSL from the same library the renderer uses, with the squaring loops
-//! unrolled for this lobe's constant count (a GLSL driver gets straight-line code, not a
-//! `while (true)`), validated, compacted (unused lobes dropped), and written by naga's back
-//! ends.
+//! It is generated as WGSL from the lobe's recorded expression ([`specula_targets::wgsl`]):
+//! straight-line code with the prepared constants folded in (the squarings written out, so a
+//! GLSL driver gets no loop), validated, compacted, and written by naga's back ends.
 
 use core::fmt::Write as _;
 
 use specula::{Geometry, Lobe, Normalisation};
 use thiserror::Error;
 
-use crate::uniforms::LobeBlock;
 use crate::wgsl;
 
 mod es100;
@@ -142,9 +140,6 @@ fn float(value: f32) -> String {
 /// The WGSL module an export starts from.
 #[must_use]
 pub fn export_wgsl_source(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> String {
-    let block = LobeBlock::new(lobe);
-    let fields = bytemuck::cast::<LobeBlock, [u32; 8]>(block);
-    let f = |k: usize| float(f32::from_bits(fields[k]));
     let scale = normalisation.constant_for(lobe) as f32;
     let kind = lobe.kind();
     let mut source = String::new();
@@ -156,13 +151,14 @@ pub fn export_wgsl_source(lobe: &Lobe, geometry: Geometry, normalisation: Normal
         normalisation.id(),
         float(scale),
     );
-    source.push_str(wgsl::LOBES);
+    source.push_str(&specula_targets::wgsl::lobe_function(
+        lobe,
+        "specula_lobe_unit",
+    ));
     source.push_str(wgsl::GEOMETRY);
     let _ = write!(
         source,
         "
-// The prepared lobe: kind, squarings, n, slope, quadratic C B A, cut-off angle.
-const SPECULA_LOBE: Lobe = Lobe({}u, {}u, {}, {}, vec3<f32>({}, {}, {}), {});
 const SPECULA_NORMALISATION: f32 = {};
 const SPECULA_GEOMETRY: u32 = {}u;
 
@@ -171,7 +167,7 @@ fn specula_lobe(t: f32) -> f32 {{
     if !(t > 0.0) {{
         return 0.0;
     }}
-    return {function}(SPECULA_LOBE, min(t, 1.0));
+    return specula_lobe_unit(min(t, 1.0));
 }}
 
 // The lobe's cosine ({cosine}) from unit vectors pointing away from the surface.
@@ -197,46 +193,15 @@ fn fs_main(
     return vec4<f32>(value, value, value, 1.0);
 }}
 ",
-        fields[0],
-        fields[1],
-        f(2),
-        f(3),
-        f(4),
-        f(5),
-        f(6),
-        f(7),
         float(scale),
         match geometry {
             Geometry::Phong => 0,
             Geometry::Blinn => 1,
         },
         n = lobe.exponent(),
-        function = wgsl::lobe_function(kind),
         cosine = geometry.cosine_name(),
     );
-    unroll_squarings(&source, lobe.packed().squarings)
-}
-
-/// The library's `for (var i = 0u; i < lobe.squarings; i++) { x = x * x; }` loops written out
-/// as `count` squarings: the exported lobe's count is a constant.
-fn unroll_squarings(source: &str, count: u32) -> String {
-    const LOOP: &str = "for (var i = 0u; i < lobe.squarings; i++) {";
-    let mut out = String::with_capacity(source.len());
-    let mut lines = source.lines();
-    while let Some(line) = lines.next() {
-        if line.trim() != LOOP {
-            out.push_str(line);
-            out.push('\n');
-            continue;
-        }
-        let indent = &line[..line.len() - line.trim_start().len()];
-        let body = lines.next().unwrap_or_default().trim().to_owned();
-        let _closing = lines.next();
-        for _ in 0..count {
-            let _ = writeln!(out, "{indent}{body}");
-        }
-    }
-    out
+    source
 }
 
 /// naga's GLSL without the example: its stage's inputs and outputs (the globals naga names

@@ -48,7 +48,13 @@ pub fn straight_line(
     dialect: &dyn Dialect,
 ) -> (Vec<String>, String) {
     let nodes = expression.nodes();
-    let uses = expression.uses();
+    let mut uses = expression.uses();
+    // A square writes its operand twice.
+    for node in nodes {
+        if let Node::Square(a) = node {
+            uses[*a] += 1;
+        }
+    }
     let mut text: Vec<String> = Vec::with_capacity(nodes.len());
     let mut statements = Vec::new();
     for (index, node) in nodes.iter().enumerate() {
