@@ -23,6 +23,13 @@ pub trait Real:
 {
     /// Converts an `f64` constant (rounding to nearest for narrower types).
     fn from_f64(x: f64) -> Self;
+    /// A per-material constant the model prepared from `n`, by name (`n`, `slope`, ...): the
+    /// number itself, except to a recorded expression, which keeps the name so that a target
+    /// can expose it as an input ([`crate::expression::Node::Parameter`]).
+    #[inline(always)]
+    fn parameter(_name: &'static str, value: f64) -> Self {
+        Self::from_f64(value)
+    }
     /// Widens to `f64` (exact for `f32` and `f64`).
     fn to_f64(self) -> f64;
     /// `self * self`, counted as a squaring rather than a general multiply.

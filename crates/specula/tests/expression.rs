@@ -86,7 +86,14 @@ fn constants_are_folded_in_and_unused_nodes_dropped() {
     let lobe = Lobe::try_new(LobeKind::Pow, 64.0).unwrap();
     assert_eq!(
         lobe.expression().nodes(),
-        [Node::Input, Node::Constant(64.0), Node::Pow(0, 1)]
+        [
+            Node::Input,
+            Node::Parameter {
+                name: "n",
+                value: 64.0
+            },
+            Node::Pow(0, 1)
+        ]
     );
     let cosquad = Lobe::try_new(LobeKind::CosQuad { v: 4 }, 16.0).unwrap();
     let squarings = cosquad
@@ -114,4 +121,74 @@ fn a_branch_on_a_traced_value_is_refused() {
         }
     });
     assert_eq!(branching, Err(Branched));
+}
+
+/// Every named parameter's recorded preparation gives, from `n`, the value the lobe was
+/// prepared with; only the fitted angle quadratics have none.
+#[test]
+fn parameters_follow_from_n_as_prepared() {
+    for kind in kinds() {
+        for n in EXPONENTS {
+            let lobe = Lobe::try_new(kind, n).unwrap();
+            let parameters = lobe.parameters();
+            assert!(!parameters.is_empty(), "{kind}: no named parameter");
+            for parameter in parameters {
+                match &parameter.preparation {
+                    Some(preparation) => assert_eq!(
+                        preparation.eval(n).to_bits(),
+                        parameter.value.to_bits(),
+                        "{kind} n = {n}: {}",
+                        parameter.name
+                    ),
+                    None => assert!(
+                        lobe.angle_quadratic().is_some(),
+                        "{kind}: {} has no preparation",
+                        parameter.name
+                    ),
+                }
+            }
+        }
+    }
+}
+
+/// Across its structural range a lobe's record differs only in its parameters' values, so a
+/// target that takes `n` as an input and prepares the parameters computes the lobe at that
+/// `n`.
+#[test]
+fn within_the_structural_range_only_parameters_change() {
+    let shape = |lobe: &Lobe| -> Vec<Node> {
+        lobe.expression()
+            .nodes()
+            .iter()
+            .map(|node| match node {
+                Node::Parameter { name, .. } => Node::Parameter { name, value: 0.0 },
+                other => *other,
+            })
+            .collect()
+    };
+    for kind in kinds() {
+        for n in EXPONENTS {
+            let lobe = Lobe::try_new(kind, n).unwrap();
+            let [low, high] = lobe.structural_range();
+            assert!(
+                low <= n && n <= high,
+                "{kind} n = {n}: outside [{low}, {high}]"
+            );
+            for other in [low, high, 0.5 * (low + high)] {
+                let moved = Lobe::try_new(kind, other).unwrap();
+                assert_eq!(
+                    shape(&moved),
+                    shape(&lobe),
+                    "{kind}: n = {n} against {other}"
+                );
+            }
+        }
+    }
+    let schlick_mod = |n| Lobe::try_new(LobeKind::SchlickMod, n).unwrap();
+    assert_eq!(schlick_mod(100.0).structural_range()[0], 64.0);
+    assert_ne!(
+        shape(&schlick_mod(100.0)),
+        shape(&schlick_mod(128.0)),
+        "the range must end where the squarings change"
+    );
 }

@@ -39,6 +39,15 @@ pub fn float_literal(value: f32) -> String {
     }
 }
 
+/// How a named parameter ([`Node::Parameter`]) is written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Parameters {
+    /// As its value for the recorded `n` (a target with constants baked in).
+    Baked,
+    /// By its name (a target that takes it, or `n`, as an input).
+    Named,
+}
+
 /// The statements computing `expression` of the variable `input`, and the expression of its
 /// result.
 #[must_use]
@@ -46,6 +55,7 @@ pub fn straight_line(
     expression: &Expression,
     input: &str,
     dialect: &dyn Dialect,
+    parameters: Parameters,
 ) -> (Vec<String>, String) {
     let nodes = expression.nodes();
     let mut uses = expression.uses();
@@ -68,6 +78,10 @@ pub fn straight_line(
         let written = match *node {
             Node::Input => input.to_owned(),
             Node::Constant(value) => dialect.constant(value as f32),
+            Node::Parameter { value, .. } if parameters == Parameters::Baked => {
+                dialect.constant(value as f32)
+            }
+            Node::Parameter { name, .. } => name.to_owned(),
             Node::Add(a, b) => format!("({} + {})", at(a), at(b)),
             Node::Sub(a, b) => format!("({} - {})", at(a), at(b)),
             Node::Mul(a, b) => format!("({} * {})", at(a), at(b)),
@@ -94,7 +108,10 @@ pub fn straight_line(
                 otherwise,
             } => dialect.select_less(&at(a), &at(b), &at(then), &at(otherwise)),
         };
-        let leaf = matches!(node, Node::Input | Node::Constant(_));
+        let leaf = matches!(
+            node,
+            Node::Input | Node::Constant(_) | Node::Parameter { .. }
+        );
         let shared = uses[index] > 1 || matches!(node, Node::SelectLess { .. });
         if !leaf && shared && index + 1 < nodes.len() {
             let name = format!("v{index}");
@@ -145,4 +162,75 @@ pub fn body(
     }
     let _ = writeln!(out, "{indent}{}", return_line(result));
     out
+}
+
+/// What a target with inputs (a node's sockets, a plugin's properties) exposes for a lobe.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Inputs {
+    /// `n` as an input, kept within `[low, high]` (the lobe's structural range), when every
+    /// parameter follows from it; `None` for a fitted lobe, whose constants are inputs.
+    pub exponent: Option<[f64; 2]>,
+    /// The parameters given as inputs, with their values for the exported `n` as defaults.
+    pub fitted: Vec<(&'static str, f64)>,
+    /// The parameters computed from `n`, other than `n` itself, with their preparation.
+    pub derived: Vec<(&'static str, Expression)>,
+    /// Every parameter's name, in the order the lobe function takes them.
+    pub order: Vec<&'static str>,
+}
+
+impl Inputs {
+    /// The inputs of `lobe`.
+    #[must_use]
+    pub fn of(lobe: &specula::Lobe) -> Self {
+        let parameters = lobe.parameters();
+        let order = parameters.iter().map(|p| p.name).collect();
+        if parameters.iter().all(|p| p.preparation.is_some()) {
+            Self {
+                exponent: Some(lobe.structural_range()),
+                fitted: Vec::new(),
+                derived: parameters
+                    .into_iter()
+                    .filter(|p| p.name != "n")
+                    .filter_map(|p| p.preparation.map(|e| (p.name, e)))
+                    .collect(),
+                order,
+            }
+        } else {
+            Self {
+                exponent: None,
+                fitted: parameters.iter().map(|p| (p.name, p.value)).collect(),
+                derived: Vec::new(),
+                order,
+            }
+        }
+    }
+
+    /// The local definitions of the derived parameters from the variable `exponent`.
+    #[must_use]
+    pub fn preparation(&self, exponent: &str, dialect: &dyn Dialect) -> Vec<String> {
+        let mut lines = Vec::new();
+        for (name, expression) in &self.derived {
+            let (statements, result) =
+                straight_line(expression, exponent, dialect, Parameters::Baked);
+            lines.extend(statements);
+            lines.push(dialect.local(name, &result));
+        }
+        lines
+    }
+
+    /// The arguments of a call to the lobe function: each parameter's variable, with `n`
+    /// read from `exponent`.
+    #[must_use]
+    pub fn arguments(&self, exponent: &str) -> Vec<String> {
+        self.order
+            .iter()
+            .map(|name| {
+                if *name == "n" {
+                    exponent.to_owned()
+                } else {
+                    (*name).to_owned()
+                }
+            })
+            .collect()
+    }
 }

@@ -6,8 +6,39 @@
 //! - [`wgsl`]: the WGSL function behind `specula shader` (and, through naga, GLSL, HLSL, MSL
 //!   and SPIR-V);
 //! - [`osl`]: a Blender Cycles script node (OSL);
-//! - [`code`]: the straight-line writer they share.
+//! - [`code`]: the straight-line writer they share, and the inputs a node or plugin exposes.
 
 pub mod code;
 pub mod osl;
 pub mod wgsl;
+
+use specula::{Geometry, Lobe, Normalisation};
+
+/// A renderer's own format, written from a lobe's description.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Renderer {
+    /// An OSL script node for Blender Cycles.
+    Osl,
+}
+
+impl Renderer {
+    /// Every renderer format.
+    pub const ALL: [Renderer; 1] = [Renderer::Osl];
+
+    /// The name on the command line.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            Renderer::Osl => "osl",
+        }
+    }
+
+    /// The file `lobe` becomes, in `geometry`, its specular term scaled by `normalisation`
+    /// where the format has a physically based form.
+    #[must_use]
+    pub fn write(self, lobe: &Lobe, geometry: Geometry, _normalisation: Normalisation) -> String {
+        match self {
+            Renderer::Osl => osl::shader(lobe, geometry, &specula::fit::microfacet(lobe, geometry)),
+        }
+    }
+}

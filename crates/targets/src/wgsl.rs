@@ -5,7 +5,7 @@ use core::fmt::Write as _;
 
 use specula::Lobe;
 
-use crate::code::{body, straight_line, Dialect};
+use crate::code::{body, straight_line, Dialect, Parameters};
 
 struct Wgsl;
 
@@ -50,7 +50,7 @@ fn specula_shift(x: f32, k: f32) -> f32 {
 #[must_use]
 pub fn lobe_function(lobe: &Lobe, name: &str) -> String {
     let expression = lobe.expression();
-    let (statements, result) = straight_line(&expression, "t", &Wgsl);
+    let (statements, result) = straight_line(&expression, "t", &Wgsl, Parameters::Baked);
     let mut out = String::new();
     if expression.has_bit_tricks() {
         out.push_str(HELPERS);

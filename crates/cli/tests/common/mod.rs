@@ -59,3 +59,100 @@ pub fn have_gpu() -> bool {
         }
     }
 }
+
+/// The Python that has the renderers' packages (`bpy`, `mitsuba`, `MaterialX`): `$SPECULA_PYTHON`,
+/// or the virtual environment `.ci/run` makes in the build folder.
+pub fn python() -> std::path::PathBuf {
+    std::env::var_os("SPECULA_PYTHON").map_or_else(
+        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/venv/bin/python"),
+        std::path::PathBuf::from,
+    )
+}
+
+/// Whether [`python`] imports `module`. When it does not, a run with `CI=true` fails, naming
+/// the package, and any other run prints `skipped: ...` and the caller skips.
+pub fn have_python_module(module: &str, package: &str) -> bool {
+    let found = std::process::Command::new(python())
+        .args(["-c", &format!("import {module}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !found {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "{} cannot import {module}, and CI=true requires it: .ci/run installs {package} into target/venv",
+            python().display()
+        );
+        eprintln!("skipped: {module} is not importable (pip install {package} into target/venv)");
+    }
+    found
+}
+
+/// A harness script of the renderer tests (`tests/renderers/`).
+pub fn renderer_script(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/renderers")
+        .join(name)
+}
+
+/// Runs [`python`] on `script` with `args` in `directory`, requiring success.
+pub fn run_python(directory: &Path, script: &str, args: &[String]) -> std::process::Output {
+    let output = std::process::Command::new(python())
+        .current_dir(directory)
+        .arg(renderer_script(script))
+        .args(args)
+        .output()
+        .expect("python runs");
+    assert!(
+        output.status.success(),
+        "{script} {args:?}:\n{}\n{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output
+}
+
+/// A UV sphere of `radius` at the origin as OBJ text, with exact unit normals (`vn`), so
+/// that two renderers given the file shade the same surface.
+pub fn sphere_obj(radius: f64, segments: u32, rings: u32) -> String {
+    use core::f64::consts::{PI, TAU};
+    use std::fmt::Write as _;
+    let mut obj = String::from("# UV sphere with exact normals\n");
+    for ring in 0..=rings {
+        let polar = PI * f64::from(ring) / f64::from(rings);
+        for segment in 0..=segments {
+            let azimuth = TAU * f64::from(segment) / f64::from(segments);
+            let n = [
+                polar.sin() * azimuth.cos(),
+                polar.sin() * azimuth.sin(),
+                polar.cos(),
+            ];
+            let _ = writeln!(
+                obj,
+                "v {} {} {}",
+                radius * n[0],
+                radius * n[1],
+                radius * n[2]
+            );
+            let _ = writeln!(obj, "vn {} {} {}", n[0], n[1], n[2]);
+        }
+    }
+    let index = |ring: u32, segment: u32| ring * (segments + 1) + segment + 1;
+    for ring in 0..rings {
+        for segment in 0..segments {
+            let [a, b, c, d] = [
+                index(ring, segment),
+                index(ring + 1, segment),
+                index(ring + 1, segment + 1),
+                index(ring, segment + 1),
+            ];
+            // Counter-clockwise seen from outside; the poles' degenerate halves left out.
+            if ring + 1 < rings {
+                let _ = writeln!(obj, "f {a}//{a} {b}//{b} {c}//{c}");
+            }
+            if ring > 0 {
+                let _ = writeln!(obj, "f {a}//{a} {c}//{c} {d}//{d}");
+            }
+        }
+    }
+    obj
+}

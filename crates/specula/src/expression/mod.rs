@@ -30,6 +30,15 @@ pub enum Node {
     Input,
     /// A constant, kept in `f64` as the model computed it; targets round it to `f32`.
     Constant(f64),
+    /// A per-material constant prepared from `n` ([`Real::parameter`]): its name and its
+    /// value for the lobe's `n`. A target writes the value, or exposes the name as an input
+    /// and computes it from `n` ([`Lobe::preparation`]).
+    Parameter {
+        /// The model's name for it.
+        name: &'static str,
+        /// Its value for the recorded lobe.
+        value: f64,
+    },
     /// `a + b`.
     Add(usize, usize),
     /// `a - b`.
@@ -86,7 +95,7 @@ impl Node {
     #[must_use]
     pub fn operands(&self) -> Vec<usize> {
         match *self {
-            Node::Input | Node::Constant(_) => Vec::new(),
+            Node::Input | Node::Constant(_) | Node::Parameter { .. } => Vec::new(),
             Node::Neg(a)
             | Node::Square(a)
             | Node::Sqrt(a)
@@ -227,6 +236,9 @@ impl Real for Traced {
     fn from_f64(x: f64) -> Self {
         push(Node::Constant(x))
     }
+    fn parameter(name: &'static str, value: f64) -> Self {
+        push(Node::Parameter { name, value })
+    }
     /// A traced value has no number until a target computes it.
     fn to_f64(self) -> f64 {
         f64::NAN
@@ -330,11 +342,22 @@ impl Expression {
 
     fn run<R: Real>(&self, t: R, lower_bit_tricks: bool) -> R {
         let mut values: Vec<R> = Vec::with_capacity(self.nodes.len());
+        // A lowered frexp, computed once for its mantissa and exponent nodes.
+        let mut split: Option<(usize, (R, R))> = None;
+        let mut lowered_frexp = |a: usize, x: R| match split {
+            Some((operand, parts)) if operand == a => parts,
+            _ => {
+                let parts = lower::frexp(x);
+                split = Some((a, parts));
+                parts
+            }
+        };
         for &node in &self.nodes {
             let at = |i: usize| values[i];
             let value = match node {
                 Node::Input => t,
                 Node::Constant(c) => R::from_f64(c),
+                Node::Parameter { name, value } => R::parameter(name, value),
                 Node::Add(a, b) => at(a) + at(b),
                 Node::Sub(a, b) => at(a) - at(b),
                 Node::Mul(a, b) => at(a) * at(b),
@@ -352,9 +375,9 @@ impl Expression {
                 Node::Ceil(a) => at(a).ceil(),
                 Node::Shift(a, k) if lower_bit_tricks => lower::shift(at(a), at(k)),
                 Node::Shift(a, k) => at(a).shift(at(k)),
-                Node::Mantissa(a) if lower_bit_tricks => lower::frexp(at(a)).0,
+                Node::Mantissa(a) if lower_bit_tricks => lowered_frexp(a, at(a)).0,
                 Node::Mantissa(a) => at(a).frexp().0,
-                Node::Exponent(a) if lower_bit_tricks => lower::frexp(at(a)).1,
+                Node::Exponent(a) if lower_bit_tricks => lowered_frexp(a, at(a)).1,
                 Node::Exponent(a) => at(a).frexp().1,
                 Node::BitsExp2(a) if lower_bit_tricks => lower::bits_exp2(at(a)),
                 Node::BitsExp2(a) => at(a).bits_exp2(),
@@ -375,6 +398,7 @@ fn remap(node: Node, map: impl Fn(usize) -> usize) -> Node {
     match node {
         Node::Input => Node::Input,
         Node::Constant(c) => Node::Constant(c),
+        Node::Parameter { name, value } => Node::Parameter { name, value },
         Node::Add(a, b) => Node::Add(map(a), map(b)),
         Node::Sub(a, b) => Node::Sub(map(a), map(b)),
         Node::Mul(a, b) => Node::Mul(map(a), map(b)),
@@ -408,7 +432,54 @@ fn remap(node: Node, map: impl Fn(usize) -> usize) -> Node {
     }
 }
 
+/// A named parameter of a lobe's expression.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parameter {
+    /// Its name ([`Real::parameter`]).
+    pub name: &'static str,
+    /// Its value for the recorded lobe.
+    pub value: f64,
+    /// How it follows from `n`, an expression whose input is `n`; `None` for a fitted one.
+    pub preparation: Option<Expression>,
+}
+
+impl Expression {
+    /// The named parameters, each once, in order of first use.
+    #[must_use]
+    pub fn parameters(&self) -> Vec<(&'static str, f64)> {
+        let mut found: Vec<(&'static str, f64)> = Vec::new();
+        for node in &self.nodes {
+            if let Node::Parameter { name, value } = *node {
+                if found.iter().all(|(seen, _)| *seen != name) {
+                    found.push((name, value));
+                }
+            }
+        }
+        found
+    }
+}
+
 impl Lobe {
+    /// The named parameters of [`Lobe::expression`] with their preparation from `n`.
+    #[must_use]
+    pub fn parameters(&self) -> Vec<Parameter> {
+        self.expression()
+            .parameters()
+            .into_iter()
+            .map(|(name, value)| {
+                let derived = self.preparation::<f64>(name, 0.0).is_some();
+                let preparation = derived
+                    .then(|| record(|n| self.preparation(name, n).unwrap_or(n)).ok())
+                    .flatten();
+                Parameter {
+                    name,
+                    value,
+                    preparation,
+                }
+            })
+            .collect()
+    }
+
     /// The lobe's formula for `t` in `(0, 1]` as a recorded [`Expression`], its constants
     /// for this `n` folded in. The shared rules (`t <= 0` or NaN gives 0, `t > 1` counts as
     /// 1) are not part of it: every target writes them once around it.

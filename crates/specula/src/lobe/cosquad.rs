@@ -44,9 +44,14 @@ impl CosQuad {
     pub(crate) fn new(n: Exponent, v: u8) -> Self {
         let v = v.min(Self::MAX_V);
         Self {
-            a: (n.get() + 1.0) / (f64::from(1u32 << v) + 1.0),
+            a: Self::slope_for(n.get(), v),
             v,
         }
+    }
+
+    /// `a = (n + 1) / (2^v + 1)`, written once for the preparation and its recorded form.
+    pub(crate) fn slope_for<R: Real>(n: R, v: u8) -> R {
+        (n + R::from_f64(1.0)) / R::from_f64(f64::from(1u32 << v) + 1.0)
     }
 
     /// The per-material slope `a = (n + 1) / (2^v + 1)`.
@@ -65,7 +70,7 @@ impl CosQuad {
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {
         let one = R::from_f64(1.0);
-        let mut value = (R::from_f64(self.a) * (t - one) + one).max(R::from_f64(0.0));
+        let mut value = (R::parameter("slope", self.a) * (t - one) + one).max(R::from_f64(0.0));
         for _ in 0..self.v {
             value = value.square();
         }

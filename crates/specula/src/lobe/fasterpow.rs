@@ -56,7 +56,7 @@ impl FasterPow {
         let c = R::from_f64;
         let (m, e) = t.frexp();
         let log = (m - c(1.0)) * c(2.0) + (e + c(127.0 - OFFSET));
-        log * c(self.n) + c(OFFSET - 127.0)
+        log * R::parameter("n", self.n) + c(OFFSET - 127.0)
     }
 
     /// Where the lobe is not smooth: binade boundaries and integer arguments of `bits_exp2`.

@@ -115,7 +115,7 @@ impl FastPow {
         let (m, e) = t.frexp();
         let u = m - c(1.0);
         let numerator = u * (u * c(LOG_B) + c(LOG_N1)) + c(LOG_N0);
-        c(self.n) * (numerator / (u + c(LOG_C + 1.0)) + e)
+        R::parameter("n", self.n) * (numerator / (u + c(LOG_C + 1.0)) + e)
     }
 
     /// The corrected argument of `bits_exp2` for power `p`.

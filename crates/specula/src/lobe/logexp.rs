@@ -38,7 +38,7 @@ impl LogExp {
     /// Evaluates at `t in (0, 1]`.
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {
-        let y = R::from_f64(self.n) * t.log2();
+        let y = R::parameter("n", self.n) * t.log2();
         exp2_by_log2(y).max(R::from_f64(0.0))
     }
 }

@@ -39,7 +39,7 @@ impl LogExpRr {
     /// Evaluates at `t in (0, 1]`.
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {
-        let y = R::from_f64(self.n) * t.log2();
+        let y = R::parameter("n", self.n) * t.log2();
         let k = y.ceil();
         exp2_by_log2(y - k).shift(k)
     }

@@ -292,6 +292,49 @@ impl Lobe {
         }
     }
 
+    /// The named parameter `name` of [`Lobe::expression`] computed from the exponent `n`, as
+    /// the preparation computes it; `None` where specula prepares it numerically (a fit),
+    /// so that a target cannot derive it from `n`.
+    pub fn preparation<R: Real>(&self, name: &str, n: R) -> Option<R> {
+        match (&self.model, name) {
+            (Model::AngleQuadratic(_), _) => None,
+            (_, "n") => Some(n),
+            (Model::CosQuad(m), "slope") => Some(CosQuad::slope_for(n, m.squarings() as u8)),
+            (Model::Sg(_), "rate") => {
+                let offset = match self.kind {
+                    LobeKind::SgKaris => KARIS_OFFSET,
+                    _ => 0.0,
+                };
+                Some(sg::Sg::rate_for(n, offset))
+            }
+            _ => None,
+        }
+    }
+
+    /// The exponents whose lobes share this one's recorded operations (only the named
+    /// parameters differ), as `[low, high]`: a target with `n` as an input keeps it there.
+    /// `schlick-mod`'s squarings change at every power of two from 8 on; the fitted lobes'
+    /// constants cannot follow `n` at all, so their range is this `n` alone.
+    #[must_use]
+    pub fn structural_range(&self) -> [f64; 2] {
+        let n = self.n.get();
+        match &self.model {
+            Model::AngleQuadratic(_) => [n, n],
+            Model::SchlickMod(m) => {
+                let squarings = m.squarings();
+                let low = if squarings == 0 {
+                    Exponent::MIN
+                } else {
+                    f64::from(1u32 << (squarings + 2))
+                };
+                let next = f64::from(1u32 << (squarings + 3));
+                // Below the next power of two by an amount `f32` still resolves.
+                [low, (next * (1.0 - 2f64.powi(-20))).min(Exponent::MAX)]
+            }
+            _ => [Exponent::MIN, Exponent::MAX],
+        }
+    }
+
     /// The operations one evaluation from a cosine performs, counted by running
     /// [`Lobe::eval`] on [`Counted`] at a cosine inside the epicentre.
     #[must_use]

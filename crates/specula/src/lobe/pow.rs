@@ -35,7 +35,7 @@ impl Pow {
     /// Evaluates at `t in (0, 1]`.
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {
-        t.powf(R::from_f64(self.n))
+        t.powf(R::parameter("n", self.n))
     }
 
     /// `int_t^1 s^n ds`, with `1 - t^(n+1)` as `-expm1((n + 1) ln t)` (exact near the peak).

@@ -60,9 +60,13 @@ impl AngleQuadratic {
     #[inline(always)]
     pub(crate) fn eval_angle<R: Real>(&self, g: R) -> R {
         let [c, b, a] = self.coeffs;
-        let value =
-            (R::from_f64(c) + g * (R::from_f64(b) + R::from_f64(a) * g)).min(R::from_f64(1.0));
-        g.select_less(R::from_f64(self.cutoff), value, R::from_f64(0.0))
+        let (c, b, a) = (
+            R::parameter("c", c),
+            R::parameter("b", b),
+            R::parameter("a", a),
+        );
+        let value = (c + g * (b + a * g)).min(R::from_f64(1.0));
+        g.select_less(R::parameter("cutoff", self.cutoff), value, R::from_f64(0.0))
     }
 
     /// Whether the quadratic stays at or below 1 before its cut-off, so that its closed-form

@@ -96,7 +96,7 @@ impl Schlick {
 /// `numerator / (n (1 - t) + t)`, the shared tail of `schlick` and `schlick-mod`.
 #[inline(always)]
 pub(crate) fn schlick_denominator_ratio<R: Real>(numerator: R, t: R, n: f64) -> R {
-    numerator / (R::from_f64(n) * (R::from_f64(1.0) - t) + t)
+    numerator / (R::parameter("n", n) * (R::from_f64(1.0) - t) + t)
 }
 
 /// The batch kernel: `t / (n (1 - t) + t)` with the denominator fused; `t` clamped to

@@ -38,8 +38,13 @@ impl Sg {
     /// The Gaussian `exp((n + offset) (t - 1))`.
     pub(crate) fn new(n: Exponent, offset: f64) -> Self {
         Self {
-            rate: core::f64::consts::LOG2_E * (n.get() + offset),
+            rate: Self::rate_for(n.get(), offset),
         }
+    }
+
+    /// `r = log2(e) (n + offset)`, written once for the preparation and its recorded form.
+    pub(crate) fn rate_for<R: Real>(n: R, offset: f64) -> R {
+        R::from_f64(core::f64::consts::LOG2_E) * (n + R::from_f64(offset))
     }
 
     /// `log2(e)` times the Gaussian's sharpness: the constant a shader uploads.
@@ -50,7 +55,7 @@ impl Sg {
     /// Evaluates at `t in (0, 1]`.
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {
-        ((t - R::from_f64(1.0)) * R::from_f64(self.rate)).exp2()
+        ((t - R::from_f64(1.0)) * R::parameter("rate", self.rate)).exp2()
     }
 
     /// The natural rate `k` of `exp(k (t - 1))`.
