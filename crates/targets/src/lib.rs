@@ -6,9 +6,11 @@
 //! - [`wgsl`]: the WGSL function behind `specula shader` (and, through naga, GLSL, HLSL, MSL
 //!   and SPIR-V);
 //! - [`osl`]: a Blender Cycles script node (OSL);
+//! - [`materialx`]: a MaterialX document (the lobe as a node graph, and a BSDF);
 //! - [`code`]: the straight-line writer they share, and the inputs a node or plugin exposes.
 
 pub mod code;
+pub mod materialx;
 pub mod osl;
 pub mod wgsl;
 
@@ -19,26 +21,31 @@ use specula::{Geometry, Lobe, Normalisation};
 pub enum Renderer {
     /// An OSL script node for Blender Cycles.
     Osl,
+    /// A MaterialX document: the lobe as a node, and a BSDF.
+    MaterialX,
 }
 
 impl Renderer {
     /// Every renderer format.
-    pub const ALL: [Renderer; 1] = [Renderer::Osl];
+    pub const ALL: [Renderer; 2] = [Renderer::Osl, Renderer::MaterialX];
 
     /// The name on the command line.
     #[must_use]
     pub fn id(self) -> &'static str {
         match self {
             Renderer::Osl => "osl",
+            Renderer::MaterialX => "mtlx",
         }
     }
 
     /// The file `lobe` becomes, in `geometry`, its specular term scaled by `normalisation`
     /// where the format has a physically based form.
     #[must_use]
-    pub fn write(self, lobe: &Lobe, geometry: Geometry, _normalisation: Normalisation) -> String {
+    pub fn write(self, lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> String {
+        let fit = specula::fit::microfacet(lobe, geometry);
         match self {
-            Renderer::Osl => osl::shader(lobe, geometry, &specula::fit::microfacet(lobe, geometry)),
+            Renderer::Osl => osl::shader(lobe, geometry, &fit),
+            Renderer::MaterialX => materialx::document(lobe, geometry, normalisation, &fit),
         }
     }
 }

@@ -25,7 +25,7 @@ pub struct Args {
     #[arg(long, value_parser = choice(&Normalisation::ALL, Normalisation::id), default_value = "none")]
     normalisation: Normalisation,
     /// The shading language: wgsl, glsl, hlsl, msl, spirv (a function for one's own
-    /// shader), or osl (a Blender Cycles script node).
+    /// shader), osl (a Blender Cycles script node) or mtlx (a MaterialX document).
     #[arg(long, value_parser = choice(&Lang::ALL, Lang::id))]
     lang: Lang,
     /// The GLSL dialect (with --lang glsl): 450 (Vulkan, OpenGL 4.5), 300es (OpenGL ES 3,
@@ -49,13 +49,14 @@ enum Lang {
 }
 
 impl Lang {
-    const ALL: [Lang; 6] = [
+    const ALL: [Lang; 7] = [
         Lang::Naga(Language::Wgsl),
         Lang::Naga(Language::Glsl),
         Lang::Naga(Language::Hlsl),
         Lang::Naga(Language::Msl),
         Lang::Naga(Language::Spirv),
         Lang::Renderer(Renderer::Osl),
+        Lang::Renderer(Renderer::MaterialX),
     ];
 
     fn id(self) -> &'static str {
