@@ -20,6 +20,7 @@ use serde::Serialize;
 
 use crate::error::{parse_choice, Error, Result};
 use crate::quadrature::integrate_pieces;
+use crate::real::Real;
 use crate::{zones, Exponent, Lobe};
 
 /// A normalisation of the specular lobe.
@@ -73,14 +74,23 @@ impl Normalisation {
     /// The analytic constant, a function of `n` alone (`lobe` gives that of `t^n`).
     #[must_use]
     pub fn analytic(self, n: Exponent) -> f64 {
-        let n = n.get();
+        self.formula(n.get())
+    }
+
+    /// [`Normalisation::analytic`] in any [`Real`], so that a target with `n` as an input
+    /// records it ([`crate::expression`]) and computes it from `n`.
+    #[must_use]
+    pub fn formula<R: Real>(self, n: R) -> R {
+        let c = R::from_f64;
         match self {
-            Normalisation::None => 1.0,
-            Normalisation::Lobe => (n + 1.0) / (2.0 * PI),
-            Normalisation::ThesisPhong => 1.063 * n / (2.0 * PI),
-            Normalisation::Lafortune => (n + 2.0) / (2.0 * PI),
-            Normalisation::Blinn => (n + 2.0) * (n + 4.0) / (8.0 * PI * ((-n / 2.0).exp2() + n)),
-            Normalisation::BlinnApprox => (n + 8.0) / (8.0 * PI),
+            Normalisation::None => c(1.0),
+            Normalisation::Lobe => (n + c(1.0)) / c(2.0 * PI),
+            Normalisation::ThesisPhong => c(1.063) * n / c(2.0 * PI),
+            Normalisation::Lafortune => (n + c(2.0)) / c(2.0 * PI),
+            Normalisation::Blinn => {
+                (n + c(2.0)) * (n + c(4.0)) / (c(8.0 * PI) * ((-n / c(2.0)).exp2() + n))
+            }
+            Normalisation::BlinnApprox => (n + c(8.0)) / c(8.0 * PI),
         }
     }
 

@@ -21,9 +21,9 @@ pub trait Dialect {
     }
     /// `then` where `a < b`, else `otherwise`.
     fn select_less(&self, a: &str, b: &str, then: &str, otherwise: &str) -> String;
-    /// A constant.
-    fn constant(&self, value: f32) -> String {
-        float_literal(value)
+    /// A constant, computed by the model in `f64`; targets in `f32` round it.
+    fn constant(&self, value: f64) -> String {
+        float_literal(value as f32)
     }
 }
 
@@ -77,9 +77,9 @@ pub fn straight_line(
         };
         let written = match *node {
             Node::Input => input.to_owned(),
-            Node::Constant(value) => dialect.constant(value as f32),
+            Node::Constant(value) => dialect.constant(value),
             Node::Parameter { value, .. } if parameters == Parameters::Baked => {
-                dialect.constant(value as f32)
+                dialect.constant(value)
             }
             Node::Parameter { name, .. } => name.to_owned(),
             Node::Add(a, b) => format!("({} + {})", at(a), at(b)),

@@ -7,10 +7,12 @@
 //!   and SPIR-V);
 //! - [`osl`]: a Blender Cycles script node (OSL);
 //! - [`materialx`]: a MaterialX document (the lobe as a node graph, and a BSDF);
+//! - [`mitsuba`]: a Mitsuba 3 BSDF plugin (Python, Dr.Jit), with the lobe's sampling;
 //! - [`code`]: the straight-line writer they share, and the inputs a node or plugin exposes.
 
 pub mod code;
 pub mod materialx;
+pub mod mitsuba;
 pub mod osl;
 pub mod wgsl;
 
@@ -23,11 +25,13 @@ pub enum Renderer {
     Osl,
     /// A MaterialX document: the lobe as a node, and a BSDF.
     MaterialX,
+    /// A Mitsuba 3 BSDF plugin in Python (Dr.Jit).
+    Mitsuba,
 }
 
 impl Renderer {
     /// Every renderer format.
-    pub const ALL: [Renderer; 2] = [Renderer::Osl, Renderer::MaterialX];
+    pub const ALL: [Renderer; 3] = [Renderer::Osl, Renderer::MaterialX, Renderer::Mitsuba];
 
     /// The name on the command line.
     #[must_use]
@@ -35,6 +39,7 @@ impl Renderer {
         match self {
             Renderer::Osl => "osl",
             Renderer::MaterialX => "mtlx",
+            Renderer::Mitsuba => "mitsuba",
         }
     }
 
@@ -46,6 +51,7 @@ impl Renderer {
         match self {
             Renderer::Osl => osl::shader(lobe, geometry, &fit),
             Renderer::MaterialX => materialx::document(lobe, geometry, normalisation, &fit),
+            Renderer::Mitsuba => mitsuba::plugin(lobe, geometry, normalisation),
         }
     }
 }

@@ -25,7 +25,8 @@ pub struct Args {
     #[arg(long, value_parser = choice(&Normalisation::ALL, Normalisation::id), default_value = "none")]
     normalisation: Normalisation,
     /// The shading language: wgsl, glsl, hlsl, msl, spirv (a function for one's own
-    /// shader), osl (a Blender Cycles script node) or mtlx (a MaterialX document).
+    /// shader), osl (a Blender Cycles script node), mtlx (a MaterialX
+    /// document) or mitsuba (a Mitsuba 3 BSDF plugin in Python).
     #[arg(long, value_parser = choice(&Lang::ALL, Lang::id))]
     lang: Lang,
     /// The GLSL dialect (with --lang glsl): 450 (Vulkan, OpenGL 4.5), 300es (OpenGL ES 3,
@@ -49,7 +50,7 @@ enum Lang {
 }
 
 impl Lang {
-    const ALL: [Lang; 7] = [
+    const ALL: [Lang; 8] = [
         Lang::Naga(Language::Wgsl),
         Lang::Naga(Language::Glsl),
         Lang::Naga(Language::Hlsl),
@@ -57,6 +58,7 @@ impl Lang {
         Lang::Naga(Language::Spirv),
         Lang::Renderer(Renderer::Osl),
         Lang::Renderer(Renderer::MaterialX),
+        Lang::Renderer(Renderer::Mitsuba),
     ];
 
     fn id(self) -> &'static str {

@@ -1,0 +1,177 @@
+//! Mitsuba 3: a Python BSDF plugin per lobe, written in Dr.Jit operations, so that one file
+//! runs in the `scalar_*` variants and the JIT `llvm_*`/`cuda_*` ones.
+//!
+//! The BRDF is specula's, `f = kd / pi + ks N(n) lobe(t)` (Mitsuba's `eval` returns it times
+//! `cos theta_i`), in either geometry, with any of specula's normalisations. What is
+//! generated from the lobe's description: the lobe in Dr.Jit operations (lowered), the same
+//! formula in Python's `math` for the plugin's set-up, the preparation of its constants from
+//! `n`, and the normalisation's formula. What the template adds, once for every lobe: the
+//! sampling, which draws the cosine from specula's tabulated distribution (the density
+//! linear in `t` between the lobe's values at the cosines of the angles
+//! `(pi/2) (k/1024)^2`, those that coincide in `f32` merged; Mitsuba's
+//! `IrregularContinuousDistribution`) about the mirror
+//! direction (Phong) or the normal (Blinn's half vector), and mixes in cosine-weighted
+//! diffuse draws in proportion to the two terms' luminance, as specula's renderer does.
+
+use core::fmt::Write as _;
+
+use specula::expression::record;
+use specula::{Geometry, Lobe, Normalisation};
+
+use crate::code::{body, straight_line, Dialect, Inputs, Parameters};
+
+/// Dr.Jit, on the plugin's arrays (or Python floats in the scalar variants).
+struct DrJit;
+
+impl Dialect for DrJit {
+    fn local(&self, name: &str, value: &str) -> String {
+        format!("{name} = {value}")
+    }
+    fn call(&self, function: &str, arguments: &[String]) -> String {
+        let function = match function {
+            "pow" => "power",
+            "max" => "maximum",
+            "min" => "minimum",
+            other => other,
+        };
+        format!("dr.{function}({})", arguments.join(", "))
+    }
+    fn select_less(&self, a: &str, b: &str, then: &str, otherwise: &str) -> String {
+        format!("dr.select({a} < {b}, {then}, {otherwise})")
+    }
+}
+
+/// Python's `math`, in double precision, for the set-up.
+struct PythonMath;
+
+impl Dialect for PythonMath {
+    fn local(&self, name: &str, value: &str) -> String {
+        format!("{name} = {value}")
+    }
+    fn call(&self, function: &str, arguments: &[String]) -> String {
+        let arguments = arguments.join(", ");
+        match function {
+            "exp2" => format!("math.pow(2.0, {arguments})"),
+            "ceil" => format!("float(math.ceil({arguments}))"),
+            "max" | "min" => format!("{function}({arguments})"),
+            other => format!("math.{other}({arguments})"),
+        }
+    }
+    fn select_less(&self, a: &str, b: &str, then: &str, otherwise: &str) -> String {
+        format!("({then} if {a} < {b} else {otherwise})")
+    }
+    fn constant(&self, value: f64) -> String {
+        format!("{value:?}")
+    }
+}
+
+/// The plugin's registered name for `lobe`.
+#[must_use]
+pub fn plugin_name(lobe: &Lobe) -> String {
+    crate::osl::shader_name(lobe)
+}
+
+fn function(dialect: &dyn Dialect, name: &str, arguments: &[&str], lobe: &Lobe) -> String {
+    let (statements, result) = straight_line(
+        &lobe.expression().lowered(),
+        "t",
+        dialect,
+        Parameters::Named,
+    );
+    format!(
+        "def {name}({}):\n{}",
+        arguments.join(", "),
+        body(&statements, &result, "    ", |r| format!("return {r}"))
+    )
+}
+
+/// The plugin for `lobe`, its defaults `geometry` and `normalisation`.
+#[must_use]
+pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> String {
+    let inputs = Inputs::of(lobe);
+    let mut arguments = vec!["t"];
+    arguments.extend(inputs.order.iter().copied());
+    let mut prepare = String::new();
+    let _ = writeln!(prepare, "def _prepare(n, props):");
+    let _ = writeln!(
+        prepare,
+        "    \"\"\"The lobe's parameters for exponent n (specula's preparation), by name.\"\"\""
+    );
+    match inputs.exponent {
+        Some(_) => {
+            let _ = writeln!(prepare, "    parameters = {{\"n\": n}}");
+            for (name, expression) in &inputs.derived {
+                let (statements, result) =
+                    straight_line(expression, "n", &PythonMath, Parameters::Baked);
+                for statement in statements {
+                    let _ = writeln!(prepare, "    {statement}");
+                }
+                let _ = writeln!(prepare, "    parameters[\"{name}\"] = {result}");
+            }
+        }
+        None => {
+            let _ = writeln!(
+                prepare,
+                "    # Fitted by specula for n = {}: properties, not derived from n.",
+                lobe.exponent()
+            );
+            let _ = writeln!(prepare, "    parameters = {{}}");
+            for (name, value) in &inputs.fitted {
+                let _ = writeln!(
+                    prepare,
+                    "    parameters[\"{name}\"] = float(props.get(\"{name}\", {value:?}))"
+                );
+            }
+        }
+    }
+    let _ = writeln!(prepare, "    return parameters");
+    let mut formulas = String::new();
+    for candidate in Normalisation::ALL {
+        if candidate == Normalisation::Lobe {
+            continue;
+        }
+        let expression = record(|n| candidate.formula(n))
+            .unwrap_or_else(|_| unreachable!("the formulas have no branch"));
+        let (statements, result) = straight_line(&expression, "n", &PythonMath, Parameters::Baked);
+        let _ = writeln!(formulas, "    if name == \"{}\":", candidate.id());
+        for statement in statements {
+            let _ = writeln!(formulas, "        {statement}");
+        }
+        let _ = writeln!(formulas, "        return {result}");
+    }
+    let [low, high] = lobe.structural_range();
+    let names: Vec<String> = Normalisation::ALL
+        .iter()
+        .map(|n| format!("\"{}\"", n.id()))
+        .collect();
+    TEMPLATE
+        .replace("{kind}", &lobe.kind().to_string())
+        .replace("{n}", &format!("{:?}", lobe.exponent().get()))
+        .replace("{low}", &format!("{low:?}"))
+        .replace("{high}", &format!("{high:?}"))
+        .replace("{name}", &plugin_name(lobe))
+        .replace("{geometry}", geometry.id())
+        .replace("{normalisation}", normalisation.id())
+        .replace("{normalisations}", &names.join(", "))
+        .replace(
+            "{lobe_drjit}",
+            &function(&DrJit, "_lobe_unit", &arguments, lobe),
+        )
+        .replace(
+            "{lobe_math}",
+            &function(&PythonMath, "_lobe_unit_math", &arguments, lobe),
+        )
+        .replace("{prepare}", &prepare)
+        .replace("{formulas}", &formulas)
+        .replace(
+            "{arguments}",
+            &inputs
+                .order
+                .iter()
+                .map(|name| format!("self.parameters[\"{name}\"]"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        )
+}
+
+const TEMPLATE: &str = include_str!("mitsuba_template.py");
