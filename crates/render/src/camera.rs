@@ -106,6 +106,18 @@ impl Camera {
         self.eye
     }
 
+    /// The point looked at.
+    #[must_use]
+    pub fn target(&self) -> Vec3 {
+        self.target
+    }
+
+    /// The up direction given (not necessarily orthogonal to the view).
+    #[must_use]
+    pub fn up(&self) -> Vec3 {
+        self.up
+    }
+
     /// The projection.
     #[must_use]
     pub fn projection(&self) -> Projection {
