@@ -66,11 +66,15 @@ enum Command {
     #[command(after_help = "Examples:\n  specula diff reference.png test.png\n  \
                             specula diff a.exr b.exr --heatmap flip.png --format json")]
     Diff(commands::diff::Args),
-    /// Export one lobe as a shader function: WGSL, GLSL, HLSL, MSL or SPIR-V (through naga).
+    /// Export one lobe: a shader function (WGSL, GLSL, HLSL, MSL, SPIR-V), or a Blender (OSL),
+    /// MaterialX or Mitsuba 3 file.
     #[command(
         after_help = "Examples:\n  specula shader --lobe schlick-mod --n 64 --lang glsl\n  \
                             specula shader --lobe cosquad --n 100 --geometry blinn --normalisation lobe --lang hlsl -o lobe.hlsl\n  \
-                            specula shader --lobe cheb2 --n 32 --lang spirv -o lobe.spv"
+                            specula shader --lobe cheb2 --n 32 --lang spirv -o lobe.spv\n  \
+                            specula shader --lobe cosquad --n 64 --lang osl -o specula_cosquad.osl\n  \
+                            specula shader --lobe cosquad --n 64 --lang mtlx -o specula_cosquad.mtlx\n  \
+                            specula shader --lobe cosquad --n 64 --normalisation lobe --lang mitsuba -o specula_cosquad.py"
     )]
     Shader(commands::shader::Args),
     /// Measure throughput (printed figures and ratios, not pass/fail).

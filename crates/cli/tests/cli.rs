@@ -214,6 +214,28 @@ fn bad_input_is_a_one_line_error_with_exit_code_two() {
         (&["analyze", "--lobe", "pow,blinn"], "valid lobes"),
         (&["analyze", "--n", "2000"], "[1, 1000]"),
         (&["analyze", "--format", "xml"], "table"),
+        (
+            &["shader", "--lobe", "pow", "--n", "64", "--lang", "blender"],
+            "osl, mtlx, mitsuba",
+        ),
+        (
+            &[
+                "shader",
+                "--lobe",
+                "cosquad:v=11",
+                "--n",
+                "64",
+                "--lang",
+                "osl",
+            ],
+            "[0, 10]",
+        ),
+        (
+            &[
+                "shader", "--lobe", "pow", "--n", "1001", "--lang", "mitsuba",
+            ],
+            "[1, 1000]",
+        ),
     ];
     for (args, expected) in cases {
         let output = specula(args);

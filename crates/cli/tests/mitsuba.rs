@@ -132,8 +132,8 @@ fn a_wrong_density_fails_the_test() {
     export(dir.path(), "pow", 64.0, "pow.py");
     let plugin = std::fs::read_to_string(dir.path().join("pow.py")).unwrap();
     let wrong = plugin.replace(
-        "return dr.select(inside, self.cosine.eval_pdf_normalized",
-        "return 1.25 * dr.select(inside, self.cosine.eval_pdf_normalized",
+        "return dr.select(inside, density, 0.0)",
+        "return 1.25 * dr.select(inside, density, 0.0)",
     );
     assert_ne!(wrong, plugin, "the density's line moved");
     std::fs::write(dir.path().join("wrong.py"), wrong).unwrap();

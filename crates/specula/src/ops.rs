@@ -181,6 +181,27 @@ impl Real for Counted {
     counted_unary_fn!(exp2, exp2);
     counted_unary_fn!(acos, acos);
     counted_unary_fn!(cos, cos);
+    /// Counted as an `exp2` (a scaling of the argument is free in a datapath's table).
+    fn exp(self) -> Self {
+        tally(|c| c.exp2 += 1);
+        Counted(self.0.exp())
+    }
+    /// Counted as a `log2` and an add.
+    fn ln_1p(self) -> Self {
+        tally(|c| {
+            c.log2 += 1;
+            c.add += 1;
+        });
+        Counted(self.0.ln_1p())
+    }
+    /// Counted as an `exp2` and an add.
+    fn exp_m1(self) -> Self {
+        tally(|c| {
+            c.exp2 += 1;
+            c.add += 1;
+        });
+        Counted(self.0.exp_m1())
+    }
     fn powf(self, exponent: Self) -> Self {
         tally(|c| c.pow += 1);
         Counted(self.0.powf(exponent.0))

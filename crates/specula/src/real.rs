@@ -47,6 +47,15 @@ pub trait Real:
     /// Arc cosine, in radians.
     #[must_use]
     fn acos(self) -> Self;
+    /// `e^self`.
+    #[must_use]
+    fn exp(self) -> Self;
+    /// `ln(1 + self)`, exact near 0 (sampling's tail inverses).
+    #[must_use]
+    fn ln_1p(self) -> Self;
+    /// `e^self - 1`, exact near 0 (sampling's tail inverses).
+    #[must_use]
+    fn exp_m1(self) -> Self;
     /// Cosine of an angle in radians.
     #[must_use]
     fn cos(self) -> Self;
@@ -119,6 +128,18 @@ macro_rules! impl_real_for_float {
             #[inline(always)]
             fn cos(self) -> Self {
                 <$float>::cos(self)
+            }
+            #[inline(always)]
+            fn exp(self) -> Self {
+                <$float>::exp(self)
+            }
+            #[inline(always)]
+            fn ln_1p(self) -> Self {
+                <$float>::ln_1p(self)
+            }
+            #[inline(always)]
+            fn exp_m1(self) -> Self {
+                <$float>::exp_m1(self)
             }
             #[inline(always)]
             fn powf(self, exponent: Self) -> Self {

@@ -2,6 +2,7 @@
 //! `f64` the reference's, and its bit-trick-free lowering gives the same `f32` bits.
 
 use specula::expression::{record, Branched, Node};
+use specula::lobe::Warp;
 use specula::{Lobe, LobeKind, Real};
 
 const EXPONENTS: [f64; 8] = [1.0, 2.5, 8.0, 16.0, 64.0, 100.0, 512.0, 1000.0];
@@ -191,4 +192,38 @@ fn within_the_structural_range_only_parameters_change() {
         shape(&schlick_mod(128.0)),
         "the range must end where the squarings change"
     );
+}
+
+/// The recorded closed-form sampling is the sampler's: its inverse gives `Lobe::tail_inverse`'s
+/// bits, its total the tail from 0.
+#[test]
+fn recorded_sampling_is_the_samplers() {
+    for kind in kinds() {
+        for n in EXPONENTS {
+            let lobe = Lobe::try_new(kind, n).unwrap();
+            let Some((inverse, total)) = lobe.sampling_expressions() else {
+                assert_ne!(
+                    lobe.warp(),
+                    Warp::Analytic,
+                    "{kind}: sampled in closed form, not recorded"
+                );
+                continue;
+            };
+            for k in 0..=1000 {
+                let u = f64::from(k) / 1000.0;
+                let expected = lobe.tail_inverse(u).unwrap().x;
+                assert_eq!(
+                    inverse.eval(u).to_bits(),
+                    expected.to_bits(),
+                    "{kind} n = {n} u = {u}"
+                );
+            }
+            let whole = lobe.tail(0.0).unwrap();
+            let recorded: f64 = total.eval(0.0);
+            assert!(
+                (recorded / whole - 1.0).abs() < 1e-13,
+                "{kind} n = {n}: {recorded} against {whole}"
+            );
+        }
+    }
 }

@@ -19,6 +19,14 @@ pub trait Dialect {
     fn call(&self, function: &str, arguments: &[String]) -> String {
         format!("{function}({})", arguments.join(", "))
     }
+    /// `ln(1 + x)`: `log(1 + x)` unless the language has `log1p`.
+    fn log1p(&self, x: &str) -> String {
+        self.call("log", &[format!("(1.0 + {x})")])
+    }
+    /// `e^x - 1`: `exp(x) - 1` unless the language has `expm1`.
+    fn expm1(&self, x: &str) -> String {
+        format!("({} - 1.0)", self.call("exp", &[x.to_owned()]))
+    }
     /// `then` where `a < b`, else `otherwise`.
     fn select_less(&self, a: &str, b: &str, then: &str, otherwise: &str) -> String;
     /// A constant, computed by the model in `f64`; targets in `f32` round it.
@@ -93,6 +101,9 @@ pub fn straight_line(
             Node::Exp2(a) => call("exp2", &[a]),
             Node::Acos(a) => call("acos", &[a]),
             Node::Cos(a) => call("cos", &[a]),
+            Node::Exp(a) => call("exp", &[a]),
+            Node::Ln1p(a) => dialect.log1p(&at(a)),
+            Node::ExpM1(a) => dialect.expm1(&at(a)),
             Node::Pow(a, b) => call("pow", &[a, b]),
             Node::Max(a, b) => call("max", &[a, b]),
             Node::Min(a, b) => call("min", &[a, b]),
@@ -162,6 +173,17 @@ pub fn body(
     }
     let _ = writeln!(out, "{indent}{}", return_line(result));
     out
+}
+
+/// `[low, high]` as a reader wants it: `[1, 1000]`, or `[64, 128)` where the range stops
+/// just below a power of two.
+#[must_use]
+pub fn describe_range([low, high]: [f64; 2]) -> String {
+    if high.fract() == 0.0 {
+        format!("[{low}, {high}]")
+    } else {
+        format!("[{low}, {})", high.ceil())
+    }
 }
 
 /// What a target with inputs (a node's sockets, a plugin's properties) exposes for a lobe.

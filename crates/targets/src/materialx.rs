@@ -93,7 +93,7 @@ pub fn document(
         n = lobe.exponent(),
         geometry = geometry.id(),
         exponent_note = match inputs.exponent {
-            Some([low, high]) => format!("n is an input from {low} to {high}."),
+            Some(range) => format!("n is an input in {}.", crate::code::describe_range(range)),
             None => "Its coefficients are inputs fitted for this n.".to_owned(),
         },
     );
@@ -340,6 +340,18 @@ impl Graph {
                 Node::Exp2(a) => self.node("power", &[("in1", graph_value(2.0)), ("in2", at(a))]),
                 Node::Acos(a) => self.node("acos", &[("in", at(a))]),
                 Node::Cos(a) => self.node("cos", &[("in", at(a))]),
+                Node::Exp(a) => self.node("exp", &[("in", at(a))]),
+                Node::Ln1p(a) => {
+                    let sum = self.node("add", &[("in1", graph_value(1.0)), ("in2", at(a))]);
+                    self.node("ln", &[("in", self.reference(sum))])
+                }
+                Node::ExpM1(a) => {
+                    let power = self.node("exp", &[("in", at(a))]);
+                    self.node(
+                        "subtract",
+                        &[("in1", self.reference(power)), ("in2", graph_value(1.0))],
+                    )
+                }
                 Node::Pow(a, b) => self.node("power", &[("in1", at(a)), ("in2", at(b))]),
                 Node::Max(a, b) => self.node("max", &[("in1", at(a)), ("in2", at(b))]),
                 Node::Min(a, b) => self.node("min", &[("in1", at(a)), ("in2", at(b))]),

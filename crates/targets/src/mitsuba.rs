@@ -5,13 +5,14 @@
 //! `cos theta_i`), in either geometry, with any of specula's normalisations. What is
 //! generated from the lobe's description: the lobe in Dr.Jit operations (lowered), the same
 //! formula in Python's `math` for the plugin's set-up, the preparation of its constants from
-//! `n`, and the normalisation's formula. What the template adds, once for every lobe: the
-//! sampling, which draws the cosine from specula's tabulated distribution (the density
-//! linear in `t` between the lobe's values at the cosines of the angles
+//! `n`, the normalisation's formula, and for a lobe sampled in closed form its recorded tail
+//! inverse and integral. What the template adds, once for every lobe: the rest of the
+//! sampling, which draws the cosine by that inverse or from specula's tabulated distribution
+//! (the density linear in `t` between the lobe's values at the cosines of the angles
 //! `(pi/2) (k/1024)^2`, those that coincide in `f32` merged; Mitsuba's
-//! `IrregularContinuousDistribution`) about the mirror
-//! direction (Phong) or the normal (Blinn's half vector), and mixes in cosine-weighted
-//! diffuse draws in proportion to the two terms' luminance, as specula's renderer does.
+//! `IrregularContinuousDistribution`), places it about the mirror direction (Phong) or the
+//! normal (Blinn's half vector), and mixes in cosine-weighted diffuse draws in proportion to
+//! the two terms' luminance, as specula's renderer does.
 
 use core::fmt::Write as _;
 
@@ -62,6 +63,12 @@ impl Dialect for PythonMath {
     }
     fn constant(&self, value: f64) -> String {
         format!("{value:?}")
+    }
+    fn log1p(&self, x: &str) -> String {
+        format!("math.log1p({x})")
+    }
+    fn expm1(&self, x: &str) -> String {
+        format!("math.expm1({x})")
     }
 }
 
@@ -140,6 +147,27 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
         let _ = writeln!(formulas, "        return {result}");
     }
     let [low, high] = lobe.structural_range();
+    let mut sampling_functions = String::new();
+    let warp = match lobe.sampling_expressions() {
+        Some((inverse, total)) => {
+            let (statements, result) = straight_line(&inverse, "u", &DrJit, Parameters::Named);
+            let _ = writeln!(
+                sampling_functions,
+                "\n# The cosine whose tail is the fraction u of the lobe's (specula's closed form).\ndef _tail_inverse(u, {}):\n{}",
+                inputs.order.join(", "),
+                body(&statements, &result, "    ", |r| format!("return {r}"))
+            );
+            let (statements, result) = straight_line(&total, "u", &PythonMath, Parameters::Named);
+            let _ = writeln!(
+                sampling_functions,
+                "\n# int_0^1 lobe, in closed form.\ndef _total_math({}):\n{}",
+                inputs.order.join(", "),
+                body(&statements, &result, "    ", |r| format!("return {r}"))
+            );
+            "its tail inverted in closed form, as specula's sampler does"
+        }
+        None => "from specula's table of it, the density linear in t between the lobe's values at\nthe cosines of the angles (pi/2) (k/1024)^2, k = 0 .. 1024 (Mitsuba's\nIrregularContinuousDistribution)",
+    };
     let names: Vec<String> = Normalisation::ALL
         .iter()
         .map(|n| format!("\"{}\"", n.id()))
@@ -147,6 +175,7 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
     TEMPLATE
         .replace("{kind}", &lobe.kind().to_string())
         .replace("{n}", &format!("{:?}", lobe.exponent().get()))
+        .replace("{range}", &crate::code::describe_range([low, high]))
         .replace("{low}", &format!("{low:?}"))
         .replace("{high}", &format!("{high:?}"))
         .replace("{name}", &plugin_name(lobe))
@@ -162,6 +191,16 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
             &function(&PythonMath, "_lobe_unit_math", &arguments, lobe),
         )
         .replace("{prepare}", &prepare)
+        .replace("{sampling_functions}", &sampling_functions)
+        .replace("{warp}", warp)
+        .replace(
+            "{closed_form}",
+            if lobe.sampling_expressions().is_some() {
+                "True"
+            } else {
+                "False"
+            },
+        )
         .replace("{formulas}", &formulas)
         .replace(
             "{arguments}",

@@ -2,7 +2,7 @@
 from specula's description of the lobe (exported for n = {n}).
 
 Import this file, then use `"type": "{name}"` (or `<bsdf type="{name}">`) with properties:
-- n: the exponent, from {low} to {high} (where the lobe's operations stay the same);
+- n: the exponent, in {range} (where the lobe's operations stay the same);
 - kd, ks: diffuse and specular reflectance (float or rgb), default 0 and 1;
 - geometry: "phong" (t = r.wi about the mirror direction) or "blinn" (t = n.h), default
   "{geometry}";
@@ -10,11 +10,9 @@ Import this file, then use `"type": "{name}"` (or `<bsdf type="{name}">`) with p
 
 The BRDF is f = kd / pi + ks N(n) lobe(t), and `eval` returns f cos(theta_i), as Mitsuba
 expects. Written in Dr.Jit operations only, so the same file runs in the scalar and the JIT
-(llvm, cuda) variants. The lobe's cosine is drawn from specula's table of it: the density is
-linear in t between the lobe's values at the cosines of the angles (pi/2) (k/1024)^2, k = 0
-.. 1024 (Mitsuba's IrregularContinuousDistribution), about the mirror direction (Phong) or
-the normal (Blinn's half vector); diffuse draws are cosine-weighted, and a draw picks the
-lobe in proportion to the luminance of ks against kd.
+(llvm, cuda) variants. The lobe's cosine is drawn as specula draws it: {warp}; about the
+mirror direction (Phong) or the normal (Blinn's half vector). Diffuse draws are
+cosine-weighted, and a draw picks the lobe in proportion to the luminance of ks against kd.
 """
 
 import math
@@ -28,6 +26,8 @@ N_RANGE = ({low}, {high})
 GEOMETRIES = ("phong", "blinn")
 NORMALISATIONS = ({normalisations})
 TABLE_BINS = 1024
+# Whether the lobe's tail is inverted in closed form (else it is tabulated).
+CLOSED_FORM = {closed_form}
 # Rec. 709 luminance, the weights specula splits its draws by.
 LUMINANCE = (0.2126, 0.7152, 0.0722)
 
@@ -37,7 +37,7 @@ LUMINANCE = (0.2126, 0.7152, 0.0722)
 
 # The same, in Python's math, for the set-up.
 {lobe_math}
-
+{sampling_functions}
 {prepare}
 
 def _analytic_normalisation(name, n):
@@ -94,21 +94,29 @@ class SpeculaBsdf(mi.BSDF):
         self.normalisation = _choice(props, "normalisation", "{normalisation}", NORMALISATIONS)
         self.kd = mi.Color3f(*self.kd_rgb)
         self.ks = mi.Color3f(*self.ks_rgb)
-        # The table, edges from t = 0 up to the peak t = 1 (the distribution wants them
-        # strictly ascending in float32, where the first dozen below the peak coincide).
+        if CLOSED_FORM:
+            self.total = _total_math({arguments})
+        else:
+            self.cosine = self._table()
+            self.total = _number(self.cosine.integral())
+        if self.normalisation == "lobe":
+            self.norm = 1.0 / (2.0 * math.pi * self.total)
+        else:
+            self.norm = _analytic_normalisation(self.normalisation, self.n)
+        self.p_spec = _specular_share(self.kd_rgb, self.ks_rgb)
+        self._set_flags()
+
+    def _table(self):
+        """specula's table of the lobe's cosine, edges from t = 0 up to the peak t = 1 (the
+        distribution wants them strictly ascending in float32, where the first dozen below
+        the peak coincide and are merged)."""
         edges = []
         for k in range(TABLE_BINS, -1, -1):
             edge = 0.0 if k == TABLE_BINS else _float32(math.cos(0.5 * math.pi * (k / TABLE_BINS) ** 2))
             if not edges or edge > edges[-1]:
                 edges.append(edge)
         values = [self._lobe_math(t) for t in edges]
-        self.cosine = mi.IrregularContinuousDistribution(_array(edges), _array(values))
-        if self.normalisation == "lobe":
-            self.norm = 1.0 / (2.0 * math.pi * _number(self.cosine.integral()))
-        else:
-            self.norm = _analytic_normalisation(self.normalisation, self.n)
-        self.p_spec = _specular_share(self.kd_rgb, self.ks_rgb)
-        self._set_flags()
+        return mi.IrregularContinuousDistribution(_array(edges), _array(values))
 
     def _lobe_math(self, t):
         return _lobe_unit_math(min(t, 1.0), {arguments}) if t > 0.0 else 0.0
@@ -137,7 +145,16 @@ class SpeculaBsdf(mi.BSDF):
     def _cosine_density(self, t):
         """The solid-angle density of a lobe draw about its axis at cosine t."""
         inside = (t > 0.0) & (t <= 1.0)
-        return dr.select(inside, self.cosine.eval_pdf_normalized(dr.clip(t, 0.0, 1.0)), 0.0) / (2.0 * dr.pi)
+        if CLOSED_FORM:
+            density = self._lobe(t) / self.total
+        else:
+            density = self.cosine.eval_pdf_normalized(dr.clip(t, 0.0, 1.0))
+        return dr.select(inside, density, 0.0) / (2.0 * dr.pi)
+
+    def _draw_cosine(self, u):
+        if CLOSED_FORM:
+            return dr.clip(_tail_inverse(u, {arguments}), 0.0, 1.0)
+        return dr.clip(self.cosine.sample(u), 0.0, 1.0)
 
     def _spec_pdf(self, wo, wi):
         if self.geometry == "phong":
@@ -159,7 +176,7 @@ class SpeculaBsdf(mi.BSDF):
         return active & (mi.Frame3f.cos_theta(wo) > 0.0) & (mi.Frame3f.cos_theta(wi) > 0.0)
 
     def _sample_lobe(self, wo, u):
-        t = dr.clip(self.cosine.sample(u.x), 0.0, 1.0)
+        t = self._draw_cosine(u.x)
         sin_t = dr.safe_sqrt(dr.fma(-t, t, 1.0))
         s, c = dr.sincos(dr.two_pi * u.y)
         around = mi.Vector3f(sin_t * c, sin_t * s, t)

@@ -19,7 +19,9 @@ use core::fmt::Write as _;
 use specula::fit::MicrofacetFit;
 use specula::{Geometry, Lobe};
 
-use crate::code::{body, float_literal, straight_line, Dialect, Inputs, Parameters};
+use crate::code::{
+    body, describe_range, float_literal, straight_line, Dialect, Inputs, Parameters,
+};
 
 struct Osl;
 
@@ -88,8 +90,9 @@ pub fn shader(lobe: &Lobe, geometry: Geometry, fit: &MicrofacetFit) -> String {
     }
     let arguments = inputs.arguments("exponent").join(", ");
     let exponent_note = match inputs.exponent {
-        Some([low, high]) => format!(
-            "`n` is an input, from {low} to {high}\n// (where the lobe's operations stay the same), and its constants are computed from it."
+        Some(range) => format!(
+            "`n` is an input in {}\n// (where the lobe's operations stay the same), and its constants are computed from it.",
+            describe_range(range)
         ),
         None => format!(
             "its coefficients are inputs,\n// fitted by specula for n = {} (export again for another n).",

@@ -61,6 +61,12 @@ pub enum Node {
     Acos(usize),
     /// `cos(a)`.
     Cos(usize),
+    /// `e^a`.
+    Exp(usize),
+    /// `ln(1 + a)`.
+    Ln1p(usize),
+    /// `e^a - 1`.
+    ExpM1(usize),
     /// `a^b`.
     Pow(usize, usize),
     /// `max(a, b)`.
@@ -103,6 +109,9 @@ impl Node {
             | Node::Exp2(a)
             | Node::Acos(a)
             | Node::Cos(a)
+            | Node::Exp(a)
+            | Node::Ln1p(a)
+            | Node::ExpM1(a)
             | Node::Ceil(a)
             | Node::Mantissa(a)
             | Node::Exponent(a)
@@ -249,6 +258,9 @@ impl Real for Traced {
     traced_unary_fn!(exp2, Exp2);
     traced_unary_fn!(acos, Acos);
     traced_unary_fn!(cos, Cos);
+    traced_unary_fn!(exp, Exp);
+    traced_unary_fn!(ln_1p, Ln1p);
+    traced_unary_fn!(exp_m1, ExpM1);
     traced_unary_fn!(ceil, Ceil);
     traced_unary_fn!(bits_exp2, BitsExp2);
     fn powf(self, exponent: Self) -> Self {
@@ -369,6 +381,9 @@ impl Expression {
                 Node::Exp2(a) => at(a).exp2(),
                 Node::Acos(a) => at(a).acos(),
                 Node::Cos(a) => at(a).cos(),
+                Node::Exp(a) => at(a).exp(),
+                Node::Ln1p(a) => at(a).ln_1p(),
+                Node::ExpM1(a) => at(a).exp_m1(),
                 Node::Pow(a, b) => at(a).powf(at(b)),
                 Node::Max(a, b) => at(a).max(at(b)),
                 Node::Min(a, b) => at(a).min(at(b)),
@@ -410,6 +425,9 @@ fn remap(node: Node, map: impl Fn(usize) -> usize) -> Node {
         Node::Exp2(a) => Node::Exp2(map(a)),
         Node::Acos(a) => Node::Acos(map(a)),
         Node::Cos(a) => Node::Cos(map(a)),
+        Node::Exp(a) => Node::Exp(map(a)),
+        Node::Ln1p(a) => Node::Ln1p(map(a)),
+        Node::ExpM1(a) => Node::ExpM1(map(a)),
         Node::Pow(a, b) => Node::Pow(map(a), map(b)),
         Node::Max(a, b) => Node::Max(map(a), map(b)),
         Node::Min(a, b) => Node::Min(map(a), map(b)),
@@ -478,6 +496,28 @@ impl Lobe {
                 }
             })
             .collect()
+    }
+
+    /// For a lobe sampled in closed form: the recorded inverse of its tail (an expression of
+    /// the uniform number `u`) and its whole integral `int_0^1 lobe` (an expression of
+    /// nothing but its parameters) ([`Lobe::closed_form_sampling`]).
+    #[must_use]
+    pub fn sampling_expressions(&self) -> Option<(Expression, Expression)> {
+        self.closed_form_sampling(0.5f64)?;
+        let part = |first: bool| {
+            record(|u| {
+                let (inverse, total) = self
+                    .closed_form_sampling(u)
+                    .unwrap_or_else(|| unreachable!("checked above"));
+                if first {
+                    inverse
+                } else {
+                    total
+                }
+            })
+            .unwrap_or_else(|_| unreachable!("the closed forms choose with max"))
+        };
+        Some((part(true), part(false)))
     }
 
     /// The lobe's formula for `t` in `(0, 1]` as a recorded [`Expression`], its constants

@@ -94,12 +94,28 @@ impl CosQuad {
         remaining / (self.a * power)
     }
 
-    /// The cosine whose tail is the fraction `u` of the whole.
-    pub(crate) fn tail_inverse(&self, u: f64) -> f64 {
-        let power = self.power_plus_one();
-        let floor = (1.0 - self.a).max(0.0).powf(power);
-        let log_base = (-u * (1.0 - floor)).ln_1p() / power;
-        (1.0 + log_base.exp_m1() / self.a).max(0.0)
+    /// The base at `t = 0` to the power `m + 1`: what the tail leaves out below the horizon.
+    fn floor<R: Real>(&self) -> R {
+        let one = R::from_f64(1.0);
+        (one - R::parameter("slope", self.a))
+            .max(R::from_f64(0.0))
+            .powf(R::from_f64(self.power_plus_one()))
+    }
+
+    /// `int_0^1 cosquad = (1 - floor) / (a (m + 1))`.
+    pub(crate) fn total<R: Real>(&self) -> R {
+        let slope = R::parameter("slope", self.a);
+        (R::from_f64(1.0) - self.floor()) / (slope * R::from_f64(self.power_plus_one()))
+    }
+
+    /// The cosine whose tail is the fraction `u` of the whole (generic, so that a target
+    /// that samples records it).
+    pub(crate) fn tail_inverse<R: Real>(&self, u: R) -> R {
+        let one = R::from_f64(1.0);
+        let power = R::from_f64(self.power_plus_one());
+        let floor: R = self.floor();
+        let log_base = (-u * (one - floor)).ln_1p() / power;
+        (one + log_base.exp_m1() / R::parameter("slope", self.a)).max(R::from_f64(0.0))
     }
 }
 

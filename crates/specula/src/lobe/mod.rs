@@ -292,6 +292,18 @@ impl Lobe {
         }
     }
 
+    /// For a lobe sampled in closed form ([`Warp::Analytic`]): the inverse of its tail,
+    /// `t(u)` with `int_t^1 lobe = u int_0^1 lobe`, and the whole `int_0^1 lobe`, written once
+    /// over [`Real`] so that a target that samples records them ([`crate::expression`]).
+    pub fn closed_form_sampling<R: Real>(&self, u: R) -> Option<(R, R)> {
+        match &self.model {
+            Model::Pow(m) => Some((m.tail_inverse(u), m.total())),
+            Model::Sg(m) => Some((m.tail_inverse(u), m.total())),
+            Model::CosQuad(m) => Some((m.tail_inverse(u), m.total())),
+            _ => None,
+        }
+    }
+
     /// The named parameter `name` of [`Lobe::expression`] computed from the exponent `n`, as
     /// the preparation computes it; `None` where specula prepares it numerically (a fit),
     /// so that a target cannot derive it from `n`.

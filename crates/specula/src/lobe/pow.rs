@@ -43,9 +43,15 @@ impl Pow {
         -((self.n + 1.0) * t.ln()).exp_m1() / (self.n + 1.0)
     }
 
-    /// The cosine whose tail is the fraction `u` of the whole.
-    pub(crate) fn tail_inverse(&self, u: f64) -> f64 {
-        ((-u).ln_1p() / (self.n + 1.0)).exp()
+    /// The cosine whose tail is the fraction `u` of the whole (generic, so that a target
+    /// that samples records it).
+    pub(crate) fn tail_inverse<R: Real>(&self, u: R) -> R {
+        ((-u).ln_1p() / (R::parameter("n", self.n) + R::from_f64(1.0))).exp()
+    }
+
+    /// `int_0^1 s^n ds = 1 / (n + 1)`.
+    pub(crate) fn total<R: Real>(&self) -> R {
+        R::from_f64(1.0) / (R::parameter("n", self.n) + R::from_f64(1.0))
     }
 }
 

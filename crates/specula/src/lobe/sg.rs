@@ -59,20 +59,27 @@ impl Sg {
     }
 
     /// The natural rate `k` of `exp(k (t - 1))`.
-    fn natural_rate(&self) -> f64 {
-        self.rate * core::f64::consts::LN_2
+    fn natural_rate<R: Real>(&self) -> R {
+        R::parameter("rate", self.rate) * R::from_f64(core::f64::consts::LN_2)
     }
 
     /// `int_t^1 exp(k (s - 1)) ds`.
     pub(crate) fn tail(&self, t: f64) -> f64 {
-        let k = self.natural_rate();
+        let k: f64 = self.natural_rate();
         -(-k * (1.0 - t)).exp_m1() / k
     }
 
-    /// The cosine whose tail is the fraction `u` of the whole.
-    pub(crate) fn tail_inverse(&self, u: f64) -> f64 {
-        let k = self.natural_rate();
-        (1.0 + (u * (-k).exp_m1()).ln_1p() / k).max(0.0)
+    /// `int_0^1 exp(k (s - 1)) ds = -expm1(-k) / k`.
+    pub(crate) fn total<R: Real>(&self) -> R {
+        let k: R = self.natural_rate();
+        -(-k).exp_m1() / k
+    }
+
+    /// The cosine whose tail is the fraction `u` of the whole (generic, so that a target
+    /// that samples records it).
+    pub(crate) fn tail_inverse<R: Real>(&self, u: R) -> R {
+        let k: R = self.natural_rate();
+        (R::from_f64(1.0) + (u * (-k).exp_m1()).ln_1p() / k).max(R::from_f64(0.0))
     }
 
     pub(crate) fn kernel(&self) -> SgKernel {

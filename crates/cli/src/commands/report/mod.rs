@@ -9,6 +9,7 @@
 mod hardware;
 mod html;
 mod plot;
+mod renderers;
 mod renders;
 mod sections;
 mod verdict;
@@ -183,7 +184,7 @@ const VERDICT: &str = "Which lobe when";
 const HARDWARE: &str = "Hardware";
 
 /// The answer first (which lobe when), then the thesis's claims, then the details.
-const SECTIONS: [Section; 11] = [
+const SECTIONS: [Section; 12] = [
     (VERDICT, verdict::verdict),
     ("The thesis's claims", sections::claims),
     ("Models", sections::models),
@@ -193,6 +194,7 @@ const SECTIONS: [Section; 11] = [
     ("Reciprocity and white furnace", sections::reciprocity),
     ("Renders", renders::renders),
     ("Medical volumes", volumes::volumes),
+    ("Into other renderers", renderers::renderers),
     (sections::COST, sections::cost),
     (HARDWARE, hardware::hardware),
 ];
