@@ -6,7 +6,7 @@
 mod common;
 
 use common::{have_python_module, have_tool, ok, run_python};
-use specula::LobeKind;
+use specula::{Lobe, LobeKind};
 
 const TARGETS: [&str; 5] = ["glsl", "essl", "msl", "osl", "mdl"];
 
@@ -80,5 +80,60 @@ fn every_lobes_document_validates_and_generates_every_language() {
     }
     for lobe in ["pow", "fastpow"] {
         check(lobe, "blinn");
+    }
+}
+
+/// The lobe's node graph, evaluated as MaterialX defines its nodes (an independent reader,
+/// in float32), is the lobe: within 1e-4 relative (plus 1e-7) of specula's `f64` value at
+/// 400 cosines, with `n` set through the node's input to another value than the exported one
+/// where the lobe takes `n` as an input.
+#[test]
+fn every_lobes_node_graph_evaluates_to_the_lobe() {
+    if !have_python_module("MaterialX", "materialx") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let cosines: Vec<f64> = (0..400)
+        .map(|k| -0.05 + 1.1 * f64::from(k) / 399.0)
+        .collect();
+    for kind in LobeKind::ALL {
+        let file = format!("{}.mtlx", kind.id());
+        ok(
+            dir.path(),
+            &[
+                "shader",
+                "--lobe",
+                kind.id(),
+                "--n",
+                "100",
+                "--lang",
+                "mtlx",
+                "-o",
+                &file,
+            ],
+        );
+        let exported = Lobe::try_new(kind, 100.0).unwrap();
+        let takes_n = exported.structural_range() != [100.0, 100.0];
+        let n = if takes_n { 80.0 } else { 100.0 };
+        let lobe = Lobe::try_new(kind, n).unwrap();
+        let node = format!("ND_specula_{}_float", kind.id().replace('-', "_"));
+        let mut args = vec![file.clone(), node, "--t".to_owned()];
+        args.extend(cosines.iter().map(f64::to_string));
+        if takes_n {
+            args.extend(["--input".to_owned(), format!("n={n}")]);
+        }
+        let output = run_python(dir.path(), "materialx_eval.py", &args);
+        let values: Vec<f64> = String::from_utf8_lossy(&output.stdout)
+            .lines()
+            .map(|line| line.parse().unwrap())
+            .collect();
+        assert_eq!(values.len(), cosines.len(), "{kind}");
+        for (t, value) in cosines.iter().zip(values) {
+            let expected = lobe.eval(*t);
+            assert!(
+                (value - expected).abs() <= 1e-4 * expected + 1e-7,
+                "{kind} n = {n} at t = {t}: graph {value}, lobe {expected}"
+            );
+        }
     }
 }
