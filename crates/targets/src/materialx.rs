@@ -161,7 +161,7 @@ pub fn document(
 
   <!-- GLSL, ESSL and MSL: the exact lobe under each light. -->
   <nodegraph name=\"NG_{id}_bsdf_genglsl\" nodedef=\"ND_{id}_bsdf\" target=\"genglsl\">
-{cosine}    <{id} name=\"lobe\" type=\"float\">
+{DIRECTIONS}{cosine}    <{id} name=\"lobe\" type=\"float\">
       <input name=\"t\" type=\"float\" nodename=\"t\" />
 {lobe_inputs}    </{id}>
 {RESPONSE}  </nodegraph>
@@ -385,8 +385,9 @@ impl Graph {
     }
 }
 
-/// `t = R.V = 2 (N.L)(N.V) - L.V` from the light and view of the closure being evaluated.
-const PHONG_COSINE: &str = r#"    <specula_closure_light name="L" type="vector3" />
+/// The light and view directions of the closure being evaluated, and their cosines with the
+/// normal (the response needs both).
+const DIRECTIONS: &str = r#"    <specula_closure_light name="L" type="vector3" />
     <specula_closure_view name="V" type="vector3" />
     <dotproduct name="NdotL" type="float">
       <input name="in1" type="vector3" interfacename="normal" />
@@ -396,7 +397,10 @@ const PHONG_COSINE: &str = r#"    <specula_closure_light name="L" type="vector3"
       <input name="in1" type="vector3" interfacename="normal" />
       <input name="in2" type="vector3" nodename="V" />
     </dotproduct>
-    <dotproduct name="LdotV" type="float">
+"#;
+
+/// `t = R.V = 2 (N.L)(N.V) - L.V`.
+const PHONG_COSINE: &str = r#"    <dotproduct name="LdotV" type="float">
       <input name="in1" type="vector3" nodename="L" />
       <input name="in2" type="vector3" nodename="V" />
     </dotproduct>
@@ -415,17 +419,7 @@ const PHONG_COSINE: &str = r#"    <specula_closure_light name="L" type="vector3"
 "#;
 
 /// `t = N.H`, `H` the normalised sum of the light and view directions.
-const BLINN_COSINE: &str = r#"    <specula_closure_light name="L" type="vector3" />
-    <specula_closure_view name="V" type="vector3" />
-    <dotproduct name="NdotL" type="float">
-      <input name="in1" type="vector3" interfacename="normal" />
-      <input name="in2" type="vector3" nodename="L" />
-    </dotproduct>
-    <dotproduct name="NdotV" type="float">
-      <input name="in1" type="vector3" interfacename="normal" />
-      <input name="in2" type="vector3" nodename="V" />
-    </dotproduct>
-    <add name="LplusV" type="vector3">
+const BLINN_COSINE: &str = r#"    <add name="LplusV" type="vector3">
       <input name="in1" type="vector3" nodename="L" />
       <input name="in2" type="vector3" nodename="V" />
     </add>

@@ -16,7 +16,7 @@
 
 use core::fmt::Write as _;
 
-use specula::expression::record;
+use specula::expression::{record, Expression};
 use specula::{Geometry, Lobe, Normalisation};
 
 use crate::code::{body, straight_line, Dialect, Inputs, Parameters};
@@ -78,13 +78,14 @@ pub fn plugin_name(lobe: &Lobe) -> String {
     crate::osl::shader_name(lobe)
 }
 
-fn function(dialect: &dyn Dialect, name: &str, arguments: &[&str], lobe: &Lobe) -> String {
-    let (statements, result) = straight_line(
-        &lobe.expression().lowered(),
-        "t",
-        dialect,
-        Parameters::Named,
-    );
+/// `def name(arguments):` computing `expression` of `arguments[0]` (its parameters by name).
+fn function(
+    dialect: &dyn Dialect,
+    name: &str,
+    arguments: &[&str],
+    expression: &Expression,
+) -> String {
+    let (statements, result) = straight_line(expression, arguments[0], dialect, Parameters::Named);
     format!(
         "def {name}({}):\n{}",
         arguments.join(", "),
@@ -96,6 +97,7 @@ fn function(dialect: &dyn Dialect, name: &str, arguments: &[&str], lobe: &Lobe) 
 #[must_use]
 pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> String {
     let inputs = Inputs::of(lobe);
+    let lowered = lobe.expression().lowered();
     let mut arguments = vec!["t"];
     arguments.extend(inputs.order.iter().copied());
     let mut prepare = String::new();
@@ -150,19 +152,13 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
     let mut sampling_functions = String::new();
     let warp = match lobe.sampling_expressions() {
         Some((inverse, total)) => {
-            let (statements, result) = straight_line(&inverse, "u", &DrJit, Parameters::Named);
+            let mut with_u = vec!["u"];
+            with_u.extend(inputs.order.iter().copied());
             let _ = writeln!(
                 sampling_functions,
-                "\n# The cosine whose tail is the fraction u of the lobe's (specula's closed form).\ndef _tail_inverse(u, {}):\n{}",
-                inputs.order.join(", "),
-                body(&statements, &result, "    ", |r| format!("return {r}"))
-            );
-            let (statements, result) = straight_line(&total, "u", &PythonMath, Parameters::Named);
-            let _ = writeln!(
-                sampling_functions,
-                "\n# int_0^1 lobe, in closed form.\ndef _total_math({}):\n{}",
-                inputs.order.join(", "),
-                body(&statements, &result, "    ", |r| format!("return {r}"))
+                "\n# The cosine whose tail is the fraction u of the lobe's (specula's closed form).\n{}\n# int_0^1 lobe, in closed form (of the parameters alone).\n{}",
+                function(&DrJit, "_tail_inverse", &with_u, &inverse),
+                function(&PythonMath, "_total_math", &with_u, &total),
             );
             "its tail inverted in closed form, as specula's sampler does"
         }
@@ -184,11 +180,11 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
         .replace("{normalisations}", &names.join(", "))
         .replace(
             "{lobe_drjit}",
-            &function(&DrJit, "_lobe_unit", &arguments, lobe),
+            &function(&DrJit, "_lobe_unit", &arguments, &lowered),
         )
         .replace(
             "{lobe_math}",
-            &function(&PythonMath, "_lobe_unit_math", &arguments, lobe),
+            &function(&PythonMath, "_lobe_unit_math", &arguments, &lowered),
         )
         .replace("{prepare}", &prepare)
         .replace("{sampling_functions}", &sampling_functions)

@@ -95,7 +95,7 @@ class SpeculaBsdf(mi.BSDF):
         self.kd = mi.Color3f(*self.kd_rgb)
         self.ks = mi.Color3f(*self.ks_rgb)
         if CLOSED_FORM:
-            self.total = _total_math({arguments})
+            self.total = _total_math(0.0, {arguments})
         else:
             self.cosine = self._table()
             self.total = _number(self.cosine.integral())
