@@ -236,6 +236,20 @@ fn bad_input_is_a_one_line_error_with_exit_code_two() {
             ],
             "[1, 1000]",
         ),
+        (
+            &[
+                "shader",
+                "--lobe",
+                "pow",
+                "--n",
+                "64",
+                "--normalisation",
+                "lobe",
+                "--lang",
+                "osl",
+            ],
+            "takes no --normalisation",
+        ),
     ];
     for (args, expected) in cases {
         let output = specula(args);

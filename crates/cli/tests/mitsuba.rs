@@ -94,35 +94,57 @@ fn every_lobe_passes_mitsubas_chi_square_test() {
     }
 }
 
+/// The same files in `scalar_rgb`: a closed-form lobe (`cosquad`) and a tabulated one
+/// (`schlick-mod`, Mitsuba's distribution given Python lists there).
 #[test]
-fn the_same_plugin_runs_in_the_scalar_variant() {
+fn the_same_plugins_run_in_the_scalar_variant() {
     if !have_python_module("mitsuba", "mitsuba") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    export(dir.path(), "cosquad", 64.0, "cosquad.py");
-    let output = run_python(
-        dir.path(),
-        "mitsuba_check.py",
-        &[
-            "chi2",
-            "--plugin",
-            "cosquad.py",
-            "--bsdf",
-            "specula_cosquad",
-            "--variant",
+    for lobe in ["cosquad", "schlick-mod"] {
+        let file = format!("{lobe}.py");
+        export(dir.path(), lobe, 64.0, &file);
+        let name = format!("specula_{}", lobe.replace('-', "_"));
+        let output = chi2(
+            dir.path(),
+            &file,
+            &name,
             "scalar_rgb",
-            "--n",
-            "64",
-            "--theta",
-            "35",
-        ]
-        .map(str::to_owned),
-    );
-    assert!(String::from_utf8_lossy(&output.stdout).contains("2 passed, 0 failed"));
+            &["--n", "64", "--theta", "35"],
+        );
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(
+            output.status.success() && stdout.contains("2 passed, 0 failed"),
+            "{lobe}:\n{stdout}"
+        );
+    }
 }
 
-/// A plugin that draws `n = 64` but reports the density of `n = 80` fails the test.
+/// Draws split between the lobe and a diffuse term (`kd` and `ks` both 0.5): the mixture's
+/// density is what the draws follow.
+#[test]
+fn the_diffuse_and_specular_mixture_passes() {
+    if !have_python_module("mitsuba", "mitsuba") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    export(dir.path(), "schlick", 64.0, "schlick.py");
+    let output = chi2(
+        dir.path(),
+        "schlick.py",
+        "specula_schlick",
+        "llvm_ad_rgb",
+        &["--n", "64", "--kd", "0.5", "--ks", "0.5"],
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success() && stdout.contains("6 passed, 0 failed"),
+        "{stdout}"
+    );
+}
+
+/// A plugin whose density is 25 % too high everywhere (the draws unchanged) fails the test.
 #[test]
 fn a_wrong_density_fails_the_test() {
     if !have_python_module("mitsuba", "mitsuba") {
@@ -238,7 +260,8 @@ fn mitsuba_scene(dir: &std::path::Path, objects: usize, size: [u32; 3]) -> Strin
 }
 
 /// Mitsuba's `direct` integrator (one emitter and one BSDF sample, MIS) with specula's
-/// plugin renders the environment scene's sphere as `specula render --env` does (one
+/// plugin renders the environment scene's sphere with every lobe as `specula render --env`
+/// does (one
 /// environment and one BSDF sample, MIS): the two images differ by no more than two renders
 /// of specula's with different seeds do (the RMS over all pixels of the difference, within
 /// 30 %), and their means agree within 1 %. Only the sphere: Mitsuba traces shadow rays,
@@ -298,7 +321,11 @@ fn mitsuba_renders_the_environment_scene_as_specula_does() {
             .sum::<f64>()
             / a.pixels().len() as f64
     };
-    for lobe in ["pow", "cosquad"] {
+    for kind in LobeKind::ALL {
+        let (lobe, name) = (
+            kind.id(),
+            format!("specula_{}", kind.id().replace('-', "_")),
+        );
         let render = |scene: Option<&str>, seed: &str, output: &str| {
             let mut args = vec!["render"];
             args.extend(scene);
@@ -330,7 +357,7 @@ fn mitsuba_renders_the_environment_scene_as_specula_does() {
                     "--plugin",
                     &format!("{lobe}.py"),
                     "--bsdf",
-                    &format!("specula_{lobe}"),
+                    &name,
                     "--scene",
                     scene,
                     "--output",
@@ -353,6 +380,11 @@ fn mitsuba_renders_the_environment_scene_as_specula_does() {
             against < 1.3 * noise && bias.abs() < 0.01,
             "{lobe}: Mitsuba {against} against noise {noise}, bias {bias}"
         );
+        // The whole scene's teapot has n = 256, which not every lobe's plugin exported for
+        // n = 64 takes (schlick-mod's and the fitted lobes' do not); pow shows the cost.
+        if kind != LobeKind::Pow {
+            continue;
+        }
         let whole = render(None, "1", "specula-scene.exr");
         let shadowed = mitsuba("scene.json", "mitsuba-scene.exr");
         let shadows = mean(&shadowed) / mean(&whole) - 1.0;

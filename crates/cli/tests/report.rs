@@ -24,7 +24,16 @@ fn the_quick_report_is_complete_and_well_formed() {
         .descendants()
         .filter(|n| n.has_tag_name("section"))
         .count();
-    assert_eq!(sections, 11);
+    assert_eq!(sections, 12);
+    // Into other renderers: every lobe's record and its lowering give the lobe's own bits.
+    let renderers = page
+        .find("Into other renderers")
+        .expect("a renderers section");
+    assert_eq!(
+        page[renderers..].matches("20000 / 20000").count(),
+        2 * specula::LobeKind::ALL.len(),
+        "every lobe's record and lowering are bit-exact"
+    );
     // The answer opens the page, the claims follow, then the details.
     let verdict = page.find("Which lobe when").expect("a verdict section");
     let claims = page.find("The thesis's claims").expect("a claims section");

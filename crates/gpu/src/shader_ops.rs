@@ -2,11 +2,10 @@
 //! ([`specula::gpu_cost`]): the exported lobe (constants baked in) is parsed and validated by
 //! naga, and the statements of `specula_lobe` and every function it calls are walked, each
 //! emitted expression counted once by class. The walk is over naga's IR, from which naga
-//! emits SPIR-V one instruction per arithmetic expression, because the IR keeps the loops'
-//! structure: the only loops in `lobes.wgsl` are the squaring loops, which run
-//! `lobe.squarings` times, so their bodies count that many times, without the counter's
-//! integer work (the trip count is baked in, and compilers unroll such loops). Of an `if`,
-//! the costlier branch counts (a divergent warp runs both; a uniform one, at most that).
+//! emits SPIR-V one instruction per arithmetic expression. The exported lobe is straight-line
+//! code (its squarings written out), so a loop, should one appear, counts its body once. Of
+//! an `if`, the costlier branch counts (a divergent warp runs both; a uniform one, at most
+//! that).
 
 use naga::{
     BinaryOperator, Block, Expression, Handle, MathFunction, Module, ScalarKind, Statement,
@@ -24,7 +23,6 @@ pub fn lobe_shader_ops(lobe: &Lobe) -> Result<ShaderOps, String> {
     let counter = Counter {
         module: &module,
         info: &info,
-        trips: lobe.packed().squarings,
     };
     let entry = find(&module, "specula_lobe").ok_or("no specula_lobe in the exported shader")?;
     Ok(counter.function(entry))
@@ -41,7 +39,6 @@ fn find(module: &Module, name: &str) -> Option<Handle<naga::Function>> {
 struct Counter<'a> {
     module: &'a Module,
     info: &'a naga::valid::ModuleInfo,
-    trips: u32,
 }
 
 impl Counter<'_> {
@@ -71,12 +68,7 @@ impl Counter<'_> {
             }
             Statement::Loop {
                 body, continuing, ..
-            } => {
-                let trip = self.block(function, body) + self.block(function, continuing);
-                // The trip count is a baked constant: compilers unroll the loop, and its
-                // counter's increment and exit test (its only integer work) vanish.
-                ShaderOps { integer: 0, ..trip } * self.trips
-            }
+            } => self.block(function, body) + self.block(function, continuing),
             Statement::Call {
                 function: callee, ..
             } => self.function(*callee),

@@ -1,5 +1,5 @@
-//! The GPU cost model's instruction counts against shaders counted by hand from
-//! `lobes.wgsl` and the exported wrapper (`if !(t > 0) { return 0 }`, `min(t, 1)`).
+//! The GPU cost model's instruction counts against shaders counted by hand from each lobe's
+//! formula and the exported wrapper (`if !(t > 0) { return 0 }`, `min(t, 1)`).
 
 use specula::gpu_cost::{GpuFamily, ShaderOps};
 use specula::{Exponent, Lobe, LobeKind};
@@ -34,8 +34,7 @@ fn hand_counted_shaders() {
             ..ShaderOps::default()
         }
     );
-    // max(a (t - 1) + 1, 0), then v = 4 squarings, a multiply each (the loop's counter is
-    // not counted: its trip count is baked in and compilers unroll it).
+    // max(a (t - 1) + 1, 0), then v = 4 squarings, a multiply each (written out).
     assert_eq!(
         ops(LobeKind::CosQuad { v: 4 }, 64.0),
         ShaderOps {

@@ -65,6 +65,19 @@ pub fn straight_line(
     dialect: &dyn Dialect,
     parameters: Parameters,
 ) -> (Vec<String>, String) {
+    straight_line_named(expression, input, dialect, parameters, "v")
+}
+
+/// [`straight_line`] with the locals named `prefix` and the node's index, so that two
+/// expressions written into one scope keep theirs apart.
+#[must_use]
+pub fn straight_line_named(
+    expression: &Expression,
+    input: &str,
+    dialect: &dyn Dialect,
+    parameters: Parameters,
+    prefix: &str,
+) -> (Vec<String>, String) {
     let nodes = expression.nodes();
     let mut uses = expression.uses();
     // A square writes its operand twice.
@@ -94,6 +107,8 @@ pub fn straight_line(
             Node::Sub(a, b) => format!("({} - {})", at(a), at(b)),
             Node::Mul(a, b) => format!("({} * {})", at(a), at(b)),
             Node::Div(a, b) => format!("({} / {})", at(a), at(b)),
+            // `-x`, parenthesised where x is itself a negative literal.
+            Node::Neg(a) if at(a).starts_with('-') => format!("(-({}))", at(a)),
             Node::Neg(a) => format!("(-{})", at(a)),
             Node::Square(a) => format!("({} * {})", at(a), at(a)),
             Node::Sqrt(a) => call("sqrt", &[a]),
@@ -125,7 +140,7 @@ pub fn straight_line(
         );
         let shared = uses[index] > 1 || matches!(node, Node::SelectLess { .. });
         if !leaf && shared && index + 1 < nodes.len() {
-            let name = format!("v{index}");
+            let name = format!("{prefix}{index}");
             statements.push(dialect.local(&name, &written));
             text.push(name);
         } else {
@@ -186,6 +201,18 @@ pub fn describe_range([low, high]: [f64; 2]) -> String {
     }
 }
 
+/// A lobe's name in the identifier alphabet of every target: `specula_` and its id with
+/// `-` and `:` as `_` (`specula_cosquad`, `specula_sg_karis`).
+#[must_use]
+pub fn identifier(lobe: &specula::Lobe) -> String {
+    format!(
+        "specula_{}",
+        lobe.kind()
+            .to_string()
+            .replace(|c: char| !c.is_ascii_alphanumeric(), "_")
+    )
+}
+
 /// What a target with inputs (a node's sockets, a plugin's properties) exposes for a lobe.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Inputs {
@@ -232,8 +259,13 @@ impl Inputs {
     pub fn preparation(&self, exponent: &str, dialect: &dyn Dialect) -> Vec<String> {
         let mut lines = Vec::new();
         for (name, expression) in &self.derived {
-            let (statements, result) =
-                straight_line(expression, exponent, dialect, Parameters::Baked);
+            let (statements, result) = straight_line_named(
+                expression,
+                exponent,
+                dialect,
+                Parameters::Baked,
+                &format!("{name}_v"),
+            );
             lines.extend(statements);
             lines.push(dialect.local(name, &result));
         }

@@ -43,15 +43,24 @@ impl Renderer {
         }
     }
 
-    /// The file `lobe` becomes, in `geometry`, its specular term scaled by `normalisation`
-    /// where the format has a physically based form.
-    #[must_use]
-    pub fn write(self, lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> String {
-        let fit = specula::fit::microfacet(lobe, geometry);
+    /// The file `lobe` becomes in `geometry`, its specular term scaled by `normalisation`.
+    /// OSL refuses a normalisation: its exact form is the thesis's specular term, which has
+    /// none, and its closure is GGX, normalised by construction.
+    pub fn write(
+        self,
+        lobe: &Lobe,
+        geometry: Geometry,
+        normalisation: Normalisation,
+    ) -> Result<String, String> {
+        let fit = || specula::fit::microfacet(lobe, geometry);
         match self {
-            Renderer::Osl => osl::shader(lobe, geometry, &fit),
-            Renderer::MaterialX => materialx::document(lobe, geometry, normalisation, &fit),
-            Renderer::Mitsuba => mitsuba::plugin(lobe, geometry, normalisation),
+            Renderer::Osl if normalisation != Normalisation::None => Err(format!(
+                "--lang osl takes no --normalisation (given {}): its Emission is the thesis's specular term, which has none, and its BSDF is GGX, normalised by construction; leave it out, or use --lang mtlx or mitsuba",
+                normalisation.id()
+            )),
+            Renderer::Osl => Ok(osl::shader(lobe, geometry, &fit())),
+            Renderer::MaterialX => Ok(materialx::document(lobe, geometry, normalisation, &fit())),
+            Renderer::Mitsuba => Ok(mitsuba::plugin(lobe, geometry, normalisation)),
         }
     }
 }

@@ -31,7 +31,7 @@ pub fn document(
     normalisation: Normalisation,
     fit: &MicrofacetFit,
 ) -> String {
-    let id = node_id(lobe);
+    let id = crate::code::identifier(lobe);
     let inputs = Inputs::of(lobe);
     let mut graph = Graph::default();
     let exponent = inputs.exponent.map(|[low, high]| {
@@ -198,17 +198,6 @@ pub fn document(
         error = 100.0 * fit.relative_error,
     );
     out
-}
-
-/// The node name of `lobe`: `specula_` and its id in MaterialX's name alphabet.
-#[must_use]
-pub fn node_id(lobe: &Lobe) -> String {
-    format!(
-        "specula_{}",
-        lobe.kind()
-            .to_string()
-            .replace(|c: char| !c.is_ascii_alphanumeric(), "_")
-    )
 }
 
 fn inputs_of_call(inputs: &Inputs) -> String {

@@ -72,12 +72,6 @@ impl Dialect for PythonMath {
     }
 }
 
-/// The plugin's registered name for `lobe`.
-#[must_use]
-pub fn plugin_name(lobe: &Lobe) -> String {
-    crate::osl::shader_name(lobe)
-}
-
 /// `def name(arguments):` computing `expression` of `arguments[0]` (its parameters by name).
 fn function(
     dialect: &dyn Dialect,
@@ -150,19 +144,32 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
     }
     let [low, high] = lobe.structural_range();
     let mut sampling_functions = String::new();
-    let warp = match lobe.sampling_expressions() {
+    let sampling = lobe.sampling_expressions();
+    let warp = match &sampling {
         Some((inverse, total)) => {
             let mut with_u = vec!["u"];
             with_u.extend(inputs.order.iter().copied());
             let _ = writeln!(
                 sampling_functions,
                 "\n# The cosine whose tail is the fraction u of the lobe's (specula's closed form).\n{}\n# int_0^1 lobe, in closed form (of the parameters alone).\n{}",
-                function(&DrJit, "_tail_inverse", &with_u, &inverse),
-                function(&PythonMath, "_total_math", &with_u, &total),
+                function(&DrJit, "_tail_inverse", &with_u, inverse),
+                function(&PythonMath, "_total_math", &with_u, total),
             );
             "its tail inverted in closed form, as specula's sampler does"
         }
+        None if lobe.warp() == specula::lobe::Warp::Newton => "from specula's table of it (specula's own sampler inverts this lobe's tail by Newton,\nwhich is not generated here), the density linear in t between the lobe's values at\nthe cosines of the angles (pi/2) (k/1024)^2, k = 0 .. 1024 (Mitsuba's\nIrregularContinuousDistribution)",
         None => "from specula's table of it, the density linear in t between the lobe's values at\nthe cosines of the angles (pi/2) (k/1024)^2, k = 0 .. 1024 (Mitsuba's\nIrregularContinuousDistribution)",
+    };
+    let exponent_property = match inputs.exponent {
+        Some(range) => format!(
+            "n: the exponent, in {} (where the lobe's operations stay the same)",
+            crate::code::describe_range(range)
+        ),
+        None => format!(
+            "n: {:?} only; the coefficients {} are properties too, fitted by\n  specula for that n (export again for another n)",
+            lobe.exponent().get(),
+            inputs.order.join(", ")
+        ),
     };
     let names: Vec<String> = Normalisation::ALL
         .iter()
@@ -171,10 +178,10 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
     TEMPLATE
         .replace("{kind}", &lobe.kind().to_string())
         .replace("{n}", &format!("{:?}", lobe.exponent().get()))
-        .replace("{range}", &crate::code::describe_range([low, high]))
+        .replace("{exponent_property}", &exponent_property)
         .replace("{low}", &format!("{low:?}"))
         .replace("{high}", &format!("{high:?}"))
-        .replace("{name}", &plugin_name(lobe))
+        .replace("{name}", &crate::code::identifier(lobe))
         .replace("{geometry}", geometry.id())
         .replace("{normalisation}", normalisation.id())
         .replace("{normalisations}", &names.join(", "))
@@ -191,11 +198,7 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
         .replace("{warp}", warp)
         .replace(
             "{closed_form}",
-            if lobe.sampling_expressions().is_some() {
-                "True"
-            } else {
-                "False"
-            },
+            if sampling.is_some() { "True" } else { "False" },
         )
         .replace("{formulas}", &formulas)
         .replace(

@@ -2,14 +2,15 @@
 from specula's description of the lobe (exported for n = {n}).
 
 Import this file, then use `"type": "{name}"` (or `<bsdf type="{name}">`) with properties:
-- n: the exponent, in {range} (where the lobe's operations stay the same);
+- {exponent_property};
 - kd, ks: diffuse and specular reflectance (float or rgb), default 0 and 1;
 - geometry: "phong" (t = r.wi about the mirror direction) or "blinn" (t = n.h), default
   "{geometry}";
 - normalisation: one of {normalisations}, default "{normalisation}".
 
 The BRDF is f = kd / pi + ks N(n) lobe(t), and `eval` returns f cos(theta_i), as Mitsuba
-expects. Written in Dr.Jit operations only, so the same file runs in the scalar and the JIT
+expects; the context's component and type masks are not consulted (both terms are always
+on, which is what the direct and path integrators ask for). Written in Dr.Jit operations only, so the same file runs in the scalar and the JIT
 (llvm, cuda) variants. The lobe's cosine is drawn as specula draws it: {warp}; about the
 mirror direction (Phong) or the normal (Blinn's half vector). Diffuse draws are
 cosine-weighted, and a draw picks the lobe in proportion to the luminance of ks against kd.

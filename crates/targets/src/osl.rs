@@ -20,7 +20,7 @@ use specula::fit::MicrofacetFit;
 use specula::{Geometry, Lobe};
 
 use crate::code::{
-    body, describe_range, float_literal, straight_line, Dialect, Inputs, Parameters,
+    body, describe_range, float_literal, identifier, straight_line, Dialect, Inputs, Parameters,
 };
 
 struct Osl;
@@ -34,24 +34,13 @@ impl Dialect for Osl {
     }
 }
 
-/// The shader's name for `lobe`: `specula_` and the id in OSL's identifier alphabet.
-#[must_use]
-pub fn shader_name(lobe: &Lobe) -> String {
-    format!(
-        "specula_{}",
-        lobe.kind()
-            .to_string()
-            .replace(|c: char| !c.is_ascii_alphanumeric(), "_")
-    )
-}
-
 /// The OSL source of the script node for `lobe` in `geometry`, with `fit` as its closure.
 #[must_use]
 pub fn shader(lobe: &Lobe, geometry: Geometry, fit: &MicrofacetFit) -> String {
     let expression = lobe.expression().lowered();
     let (statements, result) = straight_line(&expression, "t", &Osl, Parameters::Named);
     let inputs = Inputs::of(lobe);
-    let name = shader_name(lobe);
+    let name = identifier(lobe);
     let cosine = match geometry {
         Geometry::Phong => "dot(reflect(-wo, Nn), wi)",
         Geometry::Blinn => "dot(Nn, normalize(wo + wi))",

@@ -21,7 +21,8 @@ pub struct Args {
     /// How the lobe's cosine is formed.
     #[arg(long, value_parser = choice(&Geometry::ALL, Geometry::id), default_value = "phong")]
     geometry: Geometry,
-    /// The normalisation baked into `specula_specular`.
+    /// The normalisation N(n) of the specular term (`specula_specular`, MaterialX's BSDF, the
+    /// Mitsuba plugin's default); OSL takes none.
     #[arg(long, value_parser = choice(&Normalisation::ALL, Normalisation::id), default_value = "none")]
     normalisation: Normalisation,
     /// The shading language: wgsl, glsl, hlsl, msl, spirv (a function for one's own
@@ -85,7 +86,7 @@ pub fn run(args: &Args) -> CommandResult {
                 .map_err(|e| e.to_string())?
         }
         Lang::Renderer(renderer) => {
-            ShaderCode::Text(renderer.write(&lobe, args.geometry, args.normalisation))
+            ShaderCode::Text(renderer.write(&lobe, args.geometry, args.normalisation)?)
         }
     };
     match &args.output {

@@ -151,9 +151,11 @@ pub struct Expression {
 }
 
 /// An evaluation that compared traced values (an `if` on the value instead of
-/// [`Real::select_less`]), so its formula cannot be recorded.
+/// [`Real::select_less`]) or read one's number, so its formula cannot be recorded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("the evaluation branched on a traced value; write the choice with Real::select_less")]
+#[error(
+    "the evaluation branched on (or read) a traced value; write choices with Real::select_less"
+)]
 pub struct Branched;
 
 thread_local! {
@@ -248,8 +250,10 @@ impl Real for Traced {
     fn parameter(name: &'static str, value: f64) -> Self {
         push(Node::Parameter { name, value })
     }
-    /// A traced value has no number until a target computes it.
+    /// A traced value has no number until a target computes it: an evaluation that asks for
+    /// one is refused, as a branch is.
     fn to_f64(self) -> f64 {
+        TAPE.with(|tape| tape.borrow_mut().branched = true);
         f64::NAN
     }
     traced_unary_fn!(square, Square);

@@ -2,8 +2,8 @@
 //! MaterialX and Mitsuba 3 from one recorded description. Computed here, on every run: that
 //! the record and its lowering (no bit tricks) give the lobe's own `f32` bits, and the GGX
 //! roughness each lobe is given where a renderer only has microfacet closures. What the test
-//! suite verifies in the real renderers is stated with the tests that do it, not claimed by
-//! this report.
+//! suite verifies in the real renderers is not run here: the last table states it, naming
+//! the tests that do it.
 
 use rayon::prelude::*;
 use specula::fit::microfacet;
@@ -36,14 +36,10 @@ pub fn renderers(_: &mut Context) -> Result<String, String> {
         .map(|&kind| {
             let lobe = lobe(kind, DESCRIPTION_EXPONENT)?;
             let (record, lowered) = bit_exact(&lobe, &cosines);
-            let inputs = if lobe.parameters().iter().all(|p| p.preparation.is_some()) {
-                format!(
-                    "n in {}",
-                    specula_targets::code::describe_range(lobe.structural_range())
-                )
-            } else {
-                let names: Vec<&str> = lobe.parameters().iter().map(|p| p.name).collect();
-                format!("{} (fitted for n)", names.join(", "))
+            let described = specula_targets::code::Inputs::of(&lobe);
+            let inputs = match described.exponent {
+                Some(range) => format!("n in {}", specula_targets::code::describe_range(range)),
+                None => format!("{} (fitted for n)", described.order.join(", ")),
             };
             Ok(vec![
                 kind.id().to_owned(),
@@ -105,7 +101,7 @@ pub fn renderers(_: &mut Context) -> Result<String, String> {
             vec![
                 "MaterialX".into(),
                 "the lobe as a node graph of standard nodes; a BSDF exact under each light in GLSL, ESSL and MSL, GGX at the fitted roughness in OSL and MDL".into(),
-                "every lobe's document validates and MaterialX 1.39 generates GLSL, ESSL, MSL, OSL and MDL; glslangValidator and Blender's OSL compiler accept them; the lobe's node graph, evaluated as MaterialX defines its nodes, is the lobe within 1e-4 (crates/cli/tests/materialx.rs)".into(),
+                "every lobe's document validates and MaterialX 1.39 generates GLSL, ESSL, MSL, OSL and MDL; glslangValidator accepts the GLSL and ESSL, an OSL compiler the OSL (MSL and MDL are generated, not compiled); the lobe's node graph, evaluated as MaterialX defines its nodes, is the lobe within 1e-4 (crates/cli/tests/materialx.rs)".into(),
             ],
             vec![
                 "Mitsuba 3".into(),
