@@ -94,15 +94,15 @@ fn every_lobe_passes_mitsubas_chi_square_test() {
     }
 }
 
-/// The same files in `scalar_rgb`: a closed-form lobe (`cosquad`) and a tabulated one
-/// (`schlick-mod`, Mitsuba's distribution given Python lists there).
+/// The same files in `scalar_rgb`: a closed-form lobe (`cosquad`), a Newton one (`schlick`)
+/// and a tabulated one (`schlick-mod`, Mitsuba's distribution given Python lists there).
 #[test]
 fn the_same_plugins_run_in_the_scalar_variant() {
     if !have_python_module("mitsuba", "mitsuba") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    for lobe in ["cosquad", "schlick-mod"] {
+    for lobe in ["cosquad", "schlick", "schlick-mod"] {
         let file = format!("{lobe}.py");
         export(dir.path(), lobe, 64.0, &file);
         let name = format!("specula_{}", lobe.replace('-', "_"));

@@ -181,6 +181,11 @@ impl Real for Counted {
     counted_unary_fn!(exp2, exp2);
     counted_unary_fn!(acos, acos);
     counted_unary_fn!(cos, cos);
+    /// Counted as a cosine (the same unit, a quarter turn apart).
+    fn sin(self) -> Self {
+        tally(|c| c.cos += 1);
+        Counted(self.0.sin())
+    }
     /// Counted as an `exp2` (a scaling of the argument is free in a datapath's table).
     fn exp(self) -> Self {
         tally(|c| c.exp2 += 1);

@@ -59,6 +59,9 @@ pub trait Real:
     /// Cosine of an angle in radians.
     #[must_use]
     fn cos(self) -> Self;
+    /// Sine of an angle in radians.
+    #[must_use]
+    fn sin(self) -> Self;
     /// `self` raised to a real power (the reference `t^n`).
     #[must_use]
     fn powf(self, exponent: Self) -> Self;
@@ -128,6 +131,10 @@ macro_rules! impl_real_for_float {
             #[inline(always)]
             fn cos(self) -> Self {
                 <$float>::cos(self)
+            }
+            #[inline(always)]
+            fn sin(self) -> Self {
+                <$float>::sin(self)
             }
             #[inline(always)]
             fn exp(self) -> Self {

@@ -227,3 +227,49 @@ fn recorded_sampling_is_the_samplers() {
         }
     }
 }
+
+/// The recorded Newton forms are the solver's: the tail and slope at any `x` are the `f64`
+/// functions `Lobe::tail` inverts (so solving the record's tail gives `tail_inverse`'s root),
+/// and the cosine at the root is the drawn cosine.
+#[test]
+fn recorded_newton_forms_are_the_solvers() {
+    for kind in kinds() {
+        for n in EXPONENTS {
+            let lobe = Lobe::try_new(kind, n).unwrap();
+            let Some([tail, slope, cosine, upper, total]) = lobe.newton_expressions() else {
+                assert_ne!(
+                    lobe.warp(),
+                    Warp::Newton,
+                    "{kind} n = {n}: Newton, not recorded"
+                );
+                continue;
+            };
+            let (upper, total): (f64, f64) = (upper.eval(0.0), total.eval(0.0));
+            assert!(
+                (total / lobe.tail(0.0).unwrap() - 1.0).abs() < 1e-12,
+                "{kind} n = {n}"
+            );
+            for k in 0..=200 {
+                let x = upper * f64::from(k) / 200.0;
+                let t: f64 = cosine.eval(x);
+                // The tail from the peak to x is the lobe's tail from t.
+                let expected = lobe.tail(t).unwrap();
+                let recorded: f64 = tail.eval(x);
+                assert!(
+                    (recorded - expected).abs() <= 1e-12 * total,
+                    "{kind} n = {n} x = {x}"
+                );
+                // The slope is the tail's derivative (a central difference, where smooth).
+                let h = 1e-6 * upper;
+                if x > h && x < upper - h {
+                    let numeric = (tail.eval(x + h) - tail.eval(x - h)) / (2.0 * h);
+                    let analytic: f64 = slope.eval(x);
+                    assert!(
+                        (numeric - analytic).abs() <= 1e-5 * analytic.abs().max(total),
+                        "{kind} n = {n} x = {x}: {numeric} {analytic}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -116,6 +116,7 @@ pub fn straight_line_named(
             Node::Exp2(a) => call("exp2", &[a]),
             Node::Acos(a) => call("acos", &[a]),
             Node::Cos(a) => call("cos", &[a]),
+            Node::Sin(a) => call("sin", &[a]),
             Node::Exp(a) => call("exp", &[a]),
             Node::Ln1p(a) => dialect.log1p(&at(a)),
             Node::ExpM1(a) => dialect.expm1(&at(a)),

@@ -329,6 +329,7 @@ impl Graph {
                 Node::Exp2(a) => self.node("power", &[("in1", graph_value(2.0)), ("in2", at(a))]),
                 Node::Acos(a) => self.node("acos", &[("in", at(a))]),
                 Node::Cos(a) => self.node("cos", &[("in", at(a))]),
+                Node::Sin(a) => self.node("sin", &[("in", at(a))]),
                 Node::Exp(a) => self.node("exp", &[("in", at(a))]),
                 Node::Ln1p(a) => {
                     let sum = self.node("add", &[("in1", graph_value(1.0)), ("in2", at(a))]);

@@ -6,8 +6,10 @@
 //! generated from the lobe's description: the lobe in Dr.Jit operations (lowered), the same
 //! formula in Python's `math` for the plugin's set-up, the preparation of its constants from
 //! `n`, the normalisation's formula, and for a lobe sampled in closed form its recorded tail
-//! inverse and integral. What the template adds, once for every lobe: the rest of the
-//! sampling, which draws the cosine by that inverse or from specula's tabulated distribution
+//! inverse and integral (for one sampled by Newton, its recorded tail, slope and cosine).
+//! What the template adds, once for every lobe: the rest of the sampling, which draws the
+//! cosine by that inverse, by safeguarded Newton on that tail, or from specula's tabulated
+//! distribution
 //! (the density linear in `t` between the lobe's values at the cosines of the angles
 //! `(pi/2) (k/1024)^2`, those that coincide in `f32` merged; Mitsuba's
 //! `IrregularContinuousDistribution`), places it about the mirror direction (Phong) or the
@@ -157,8 +159,30 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
             );
             "its tail inverted in closed form, as specula's sampler does"
         }
-        None if lobe.warp() == specula::lobe::Warp::Newton => "from specula's table of it (specula's own sampler inverts this lobe's tail by Newton,\nwhich is not generated here), the density linear in t between the lobe's values at\nthe cosines of the angles (pi/2) (k/1024)^2, k = 0 .. 1024 (Mitsuba's\nIrregularContinuousDistribution)",
-        None => "from specula's table of it, the density linear in t between the lobe's values at\nthe cosines of the angles (pi/2) (k/1024)^2, k = 0 .. 1024 (Mitsuba's\nIrregularContinuousDistribution)",
+        None => match lobe.newton_expressions() {
+            Some([tail, slope, cosine, upper, total]) => {
+                let mut with_x = vec!["x"];
+                with_x.extend(inputs.order.iter().copied());
+                let _ = writeln!(
+                    sampling_functions,
+                    "\n# The lobe's closed-form tail in the variable x Newton's method solves in, its slope,\n# and the cosine x stands for (specula's).\n{}\n{}\n{}\n# The end of x's range, and int_0^1 lobe (of the parameters alone).\n{}\n{}",
+                    function(&DrJit, "_newton_tail", &with_x, &tail),
+                    function(&DrJit, "_newton_slope", &with_x, &slope),
+                    function(&DrJit, "_newton_cosine", &with_x, &cosine),
+                    function(&PythonMath, "_newton_upper_math", &with_x, &upper),
+                    function(&PythonMath, "_total_math", &with_x, &total),
+                );
+                "its closed-form tail inverted by Newton's method safeguarded by bisection, as\nspecula's sampler does (a fixed number of steps here, enough for float32)"
+            }
+            None => "from specula's table of it, the density linear in t between the lobe's values at\nthe cosines of the angles (pi/2) (k/1024)^2, k = 0 .. 1024 (Mitsuba's\nIrregularContinuousDistribution)",
+        },
+    };
+    let sampling_kind = if sampling.is_some() {
+        "closed-form"
+    } else if lobe.newton_expressions().is_some() {
+        "newton"
+    } else {
+        "table"
     };
     let exponent_property = match inputs.exponent {
         Some(range) => format!(
@@ -196,10 +220,7 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
         .replace("{prepare}", &prepare)
         .replace("{sampling_functions}", &sampling_functions)
         .replace("{warp}", warp)
-        .replace(
-            "{closed_form}",
-            if sampling.is_some() { "True" } else { "False" },
-        )
+        .replace("{sampling_kind}", sampling_kind)
         .replace("{formulas}", &formulas)
         .replace(
             "{arguments}",

@@ -27,8 +27,10 @@ N_RANGE = ({low}, {high})
 GEOMETRIES = ("phong", "blinn")
 NORMALISATIONS = ({normalisations})
 TABLE_BINS = 1024
-# Whether the lobe's tail is inverted in closed form (else it is tabulated).
-CLOSED_FORM = {closed_form}
+# How the lobe's cosine is drawn: "closed-form", "newton" or "table".
+SAMPLING = "{sampling_kind}"
+# Newton steps (each at least halves the bracket): float32's resolution on any bracket.
+NEWTON_STEPS = 40
 # Rec. 709 luminance, the weights specula splits its draws by.
 LUMINANCE = (0.2126, 0.7152, 0.0722)
 
@@ -95,7 +97,7 @@ class SpeculaBsdf(mi.BSDF):
         self.normalisation = _choice(props, "normalisation", "{normalisation}", NORMALISATIONS)
         self.kd = mi.Color3f(*self.kd_rgb)
         self.ks = mi.Color3f(*self.ks_rgb)
-        if CLOSED_FORM:
+        if SAMPLING != "table":
             self.total = _total_math(0.0, {arguments})
         else:
             self.cosine = self._table()
@@ -146,16 +148,37 @@ class SpeculaBsdf(mi.BSDF):
     def _cosine_density(self, t):
         """The solid-angle density of a lobe draw about its axis at cosine t."""
         inside = (t > 0.0) & (t <= 1.0)
-        if CLOSED_FORM:
+        if SAMPLING != "table":
             density = self._lobe(t) / self.total
         else:
             density = self.cosine.eval_pdf_normalized(dr.clip(t, 0.0, 1.0))
         return dr.select(inside, density, 0.0) / (2.0 * dr.pi)
 
     def _draw_cosine(self, u):
-        if CLOSED_FORM:
+        if SAMPLING == "closed-form":
             return dr.clip(_tail_inverse(u, {arguments}), 0.0, 1.0)
+        if SAMPLING == "newton":
+            return dr.clip(self._newton(u), 0.0, 1.0)
         return dr.clip(self.cosine.sample(u), 0.0, 1.0)
+
+    def _newton(self, u):
+        """The cosine whose tail is the fraction u of the whole: safeguarded Newton on the
+        tail in its own variable, from the middle of the bracket, as specula's solver."""
+        target = u * self.total
+        upper = _newton_upper_math(0.0, {arguments})
+        low = u * 0.0
+        high = low + upper
+        x = 0.5 * (low + high)
+        for _ in range(NEWTON_STEPS):
+            residual = _newton_tail(x, {arguments}) - target
+            below = residual < 0.0
+            low = dr.select(below, x, low)
+            high = dr.select(below, high, x)
+            slope = _newton_slope(x, {arguments})
+            step = x - residual / dr.select(slope > 0.0, slope, 1.0)
+            inside = (slope > 0.0) & (step > low) & (step < high)
+            x = dr.select(inside, step, 0.5 * (low + high))
+        return _newton_cosine(x, {arguments})
 
     def _spec_pdf(self, wo, wi):
         if self.geometry == "phong":

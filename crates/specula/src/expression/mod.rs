@@ -61,6 +61,8 @@ pub enum Node {
     Acos(usize),
     /// `cos(a)`.
     Cos(usize),
+    /// `sin(a)`.
+    Sin(usize),
     /// `e^a`.
     Exp(usize),
     /// `ln(1 + a)`.
@@ -109,6 +111,7 @@ impl Node {
             | Node::Exp2(a)
             | Node::Acos(a)
             | Node::Cos(a)
+            | Node::Sin(a)
             | Node::Exp(a)
             | Node::Ln1p(a)
             | Node::ExpM1(a)
@@ -262,6 +265,7 @@ impl Real for Traced {
     traced_unary_fn!(exp2, Exp2);
     traced_unary_fn!(acos, Acos);
     traced_unary_fn!(cos, Cos);
+    traced_unary_fn!(sin, Sin);
     traced_unary_fn!(exp, Exp);
     traced_unary_fn!(ln_1p, Ln1p);
     traced_unary_fn!(exp_m1, ExpM1);
@@ -385,6 +389,7 @@ impl Expression {
                 Node::Exp2(a) => at(a).exp2(),
                 Node::Acos(a) => at(a).acos(),
                 Node::Cos(a) => at(a).cos(),
+                Node::Sin(a) => at(a).sin(),
                 Node::Exp(a) => at(a).exp(),
                 Node::Ln1p(a) => at(a).ln_1p(),
                 Node::ExpM1(a) => at(a).exp_m1(),
@@ -429,6 +434,7 @@ fn remap(node: Node, map: impl Fn(usize) -> usize) -> Node {
         Node::Exp2(a) => Node::Exp2(map(a)),
         Node::Acos(a) => Node::Acos(map(a)),
         Node::Cos(a) => Node::Cos(map(a)),
+        Node::Sin(a) => Node::Sin(map(a)),
         Node::Exp(a) => Node::Exp(map(a)),
         Node::Ln1p(a) => Node::Ln1p(map(a)),
         Node::ExpM1(a) => Node::ExpM1(map(a)),
@@ -522,6 +528,30 @@ impl Lobe {
             .unwrap_or_else(|_| unreachable!("the closed forms choose with max"))
         };
         Some((part(true), part(false)))
+    }
+
+    /// For a lobe sampled by Newton ([`Lobe::newton_sampling`]): its tail, slope and cosine as
+    /// expressions of the solver's variable, and its bracket's end and whole integral as
+    /// expressions of its parameters alone, in that order.
+    #[must_use]
+    pub fn newton_expressions(&self) -> Option<[Expression; 5]> {
+        self.newton_sampling(0.5f64)?;
+        let part = |pick: fn(crate::lobe::NewtonForm<Traced>) -> Traced| {
+            record(|x| {
+                pick(
+                    self.newton_sampling(x)
+                        .unwrap_or_else(|| unreachable!("checked above")),
+                )
+            })
+            .unwrap_or_else(|_| unreachable!("the tails choose with select_less"))
+        };
+        Some([
+            part(|form| form.tail),
+            part(|form| form.slope),
+            part(|form| form.cosine),
+            part(|form| form.upper),
+            part(|form| form.total),
+        ])
     }
 
     /// The lobe's formula for `t` in `(0, 1]` as a recorded [`Expression`], its constants

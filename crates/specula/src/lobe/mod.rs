@@ -86,6 +86,23 @@ impl Warp {
     }
 }
 
+/// A lobe's tail as Newton's method inverts it ([`Lobe::newton_sampling`]): at the solver's
+/// variable `x`, in `[0, upper]`, where `tail` rises from 0 to `total` with slope `slope`, and
+/// the cosine that `x` stands for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonForm<R> {
+    /// `int` of the lobe from the peak to `x`.
+    pub tail: R,
+    /// Its derivative in `x`.
+    pub slope: R,
+    /// The cosine `t` at `x`.
+    pub cosine: R,
+    /// The end of `x`'s range.
+    pub upper: R,
+    /// The tail at `upper`: the lobe's whole integral.
+    pub total: R,
+}
+
 /// A lobe function prepared for one exponent `n`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lobe {
@@ -300,6 +317,30 @@ impl Lobe {
             Model::Pow(m) => Some((m.tail_inverse(u), m.total())),
             Model::Sg(m) => Some((m.tail_inverse(u), m.total())),
             Model::CosQuad(m) => Some((m.tail_inverse(u), m.total())),
+            _ => None,
+        }
+    }
+
+    /// For a lobe sampled by Newton on a closed-form tail ([`Warp::Newton`]), in the variable
+    /// `x` its solver works in (`d = 1 - t` for `schlick`, the angle for the quadratics),
+    /// written once over [`Real`] so that a target that samples records it.
+    pub fn newton_sampling<R: Real>(&self, x: R) -> Option<NewtonForm<R>> {
+        let one = R::from_f64(1.0);
+        match &self.model {
+            Model::Schlick(m) => Some(NewtonForm {
+                tail: m.tail_from_peak(x),
+                slope: m.eval(one - x),
+                cosine: one - x,
+                upper: one,
+                total: m.tail_from_peak(one),
+            }),
+            Model::AngleQuadratic(m) if m.has_closed_form_tail() => Some(NewtonForm {
+                tail: m.tail_angle(x),
+                slope: m.tail_slope(x),
+                cosine: x.cos(),
+                upper: m.cutoff_parameter(),
+                total: m.tail_angle(m.cutoff_parameter()),
+            }),
             _ => None,
         }
     }

@@ -86,27 +86,35 @@ impl AngleQuadratic {
         peak <= 1.0
     }
 
-    /// `int_0^g (C + B x + A x^2) sin x dx`, `g` capped at the cut-off.
-    fn tail_angle(&self, g: f64) -> f64 {
+    /// `int_0^g (C + B x + A x^2) sin x dx`, `g` capped at the cut-off (generic, so that a
+    /// target that samples records it).
+    pub(crate) fn tail_angle<R: Real>(&self, g: R) -> R {
         let [c, b, a] = self.coeffs;
-        let g = g.clamp(0.0, self.cutoff);
-        let (sin, cos) = g.sin_cos();
-        let one_minus_cos = 2.0 * (0.5 * g).sin().powi(2);
+        let (c, b, a) = (
+            R::parameter("c", c),
+            R::parameter("b", b),
+            R::parameter("a", a),
+        );
+        let k = R::from_f64;
+        let g = g.max(k(0.0)).min(R::parameter("cutoff", self.cutoff));
+        let (sin, cos) = (g.sin(), g.cos());
+        let one_minus_cos = k(2.0) * (k(0.5) * g).sin().square();
         // int_0^g x sin x = sum_k (-1)^k g^(2k+3) / ((2k+1)! (2k+3)), and the x^2 moment with
-        // (2k+4) in place of (2k+3).
-        let (first, second) = if g < 0.5 {
-            let mut term = g; // (-1)^k g^(2k+1) / (2k+1)!
-            let (mut first, mut second) = (0.0, 0.0);
-            for k in 0..10 {
-                let k = f64::from(k);
-                first += term * g * g / (2.0 * k + 3.0);
-                second += term * g * g * g / (2.0 * k + 4.0);
-                term *= -g * g / ((2.0 * k + 2.0) * (2.0 * k + 3.0));
-            }
-            (first, second)
-        } else {
-            (sin - g * cos, 2.0 * g * sin + (2.0 - g * g) * cos - 2.0)
-        };
+        // (2k+4) in place of (2k+3), where the closed forms cancel (below g = 1/2).
+        let mut term = g; // (-1)^k g^(2k+1) / (2k+1)!
+        let (mut first, mut second) = (k(0.0), k(0.0));
+        for j in 0..10 {
+            let j = f64::from(j);
+            first = first + term * g * g / k(2.0 * j + 3.0);
+            second = second + term * g * g * g / k(2.0 * j + 4.0);
+            term = term * (-g * g / k((2.0 * j + 2.0) * (2.0 * j + 3.0)));
+        }
+        let first = g.select_less(k(0.5), first, sin - g * cos);
+        let second = g.select_less(
+            k(0.5),
+            second,
+            k(2.0) * g * sin + (k(2.0) - g * g) * cos - k(2.0),
+        );
         c * one_minus_cos + b * first + a * second
     }
 
@@ -115,13 +123,29 @@ impl AngleQuadratic {
         self.tail_angle(t.clamp(0.0, 1.0).acos())
     }
 
+    /// The quadratic's slope of the tail in the angle, `max(0, C + B g + A g^2) sin g`.
+    pub(crate) fn tail_slope<R: Real>(&self, g: R) -> R {
+        let [c, b, a] = self.coeffs;
+        let (c, b, a) = (
+            R::parameter("c", c),
+            R::parameter("b", b),
+            R::parameter("a", a),
+        );
+        (c + g * (b + a * g)).max(R::from_f64(0.0)) * g.sin()
+    }
+
+    /// The cut-off, as a named parameter.
+    pub(crate) fn cutoff_parameter<R: Real>(&self) -> R {
+        R::parameter("cutoff", self.cutoff)
+    }
+
     /// The cosine whose tail is the fraction `u` of the whole, by Newton in the angle.
     pub(crate) fn tail_inverse(&self, u: f64) -> Inverted {
-        let [c, b, a] = self.coeffs;
+        let c = self.coeffs[0];
         let target = u * self.total.unwrap_or(0.0);
         let root = solve_increasing(
-            |g| self.tail_angle(g),
-            |g| (c + g * (b + a * g)).max(0.0) * g.sin(),
+            |g: f64| self.tail_angle(g),
+            |g: f64| self.tail_slope(g),
             target,
             (0.0, self.cutoff),
             (2.0 * target / c.max(f64::MIN_POSITIVE)).sqrt(),

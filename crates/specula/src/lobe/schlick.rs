@@ -50,19 +50,19 @@ impl Schlick {
         schlick_denominator_ratio(t, t, self.n)
     }
 
-    /// `int_{1-d}^1 schlick(s) ds = int_0^d (1 - s) / (1 + c s) ds`, `c = n - 1`.
-    fn tail_from_peak(&self, d: f64) -> f64 {
-        let c = self.n - 1.0;
+    /// `int_{1-d}^1 schlick(s) ds = int_0^d (1 - s) / (1 + c s) ds`, `c = n - 1` (generic,
+    /// so that a target that samples records it).
+    pub(crate) fn tail_from_peak<R: Real>(&self, d: R) -> R {
+        let n = R::parameter("n", self.n);
+        let c = n - R::from_f64(1.0);
         let x = c * d;
-        if x < 0.05 {
-            // (n / c^2) ln(1 + x) - d / c = d - n d^2 sum_k (-x)^k / (k + 2).
-            let series = (0..16)
-                .rev()
-                .fold(0.0, |sum, k| sum * -x + 1.0 / f64::from(k + 2));
-            d - self.n * d * d * series
-        } else {
-            self.n / (c * c) * x.ln_1p() - d / c
-        }
+        // (n / c^2) ln(1 + x) - d / c = d - n d^2 sum_k (-x)^k / (k + 2), where it cancels.
+        let series = (0..16).rev().fold(R::from_f64(0.0), |sum, k| {
+            sum * -x + R::from_f64(1.0 / f64::from(k + 2))
+        });
+        let near = d - n * d * d * series;
+        let far = n / (c * c) * x.ln_1p() - d / c;
+        x.select_less(R::from_f64(0.05), near, far)
     }
 
     /// `int_t^1 schlick(s) ds`.
@@ -80,8 +80,8 @@ impl Schlick {
             target
         };
         let root = solve_increasing(
-            |d| self.tail_from_peak(d),
-            |d| self.eval(1.0 - d),
+            |d: f64| self.tail_from_peak(d),
+            |d: f64| self.eval(1.0 - d),
             target,
             (0.0, 1.0),
             guess,

@@ -105,7 +105,7 @@ pub fn renderers(_: &mut Context) -> Result<String, String> {
             ],
             vec![
                 "Mitsuba 3".into(),
-                "Python BSDF plugin in Dr.Jit: eval, pdf, sample, eval_pdf, specula's normalisations; the cosine drawn by the recorded closed-form inverse (pow, sg, sg-karis, cosquad) or specula's table".into(),
+                "Python BSDF plugin in Dr.Jit: eval, pdf, sample, eval_pdf, specula's normalisations; the cosine drawn as specula draws it: the recorded closed-form inverse (pow, sg, sg-karis, cosquad), safeguarded Newton on the recorded tail (schlick, cheb2-thesis), specula's table (the rest)".into(),
                 "Mitsuba's chi-square test passes for every lobe at n = 8, 64, 512, both geometries, three angles; Mitsuba's direct integrator renders the environment scene's sphere within the noise of specula's (crates/cli/tests/mitsuba.rs)".into(),
             ],
         ],
