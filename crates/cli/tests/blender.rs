@@ -14,7 +14,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{have_python_module, ok, run_python, sphere_obj};
+use common::{export_lobe, have_python_module, ok, run_python, sphere_obj};
 use specula::LobeKind;
 
 const WIDTH: u32 = 160;
@@ -124,22 +124,7 @@ fn every_lobes_osl_compiles_in_blender() {
     for lobe in lobe_ids() {
         for geometry in ["phong", "blinn"] {
             let file = format!("{lobe}-{geometry}.osl");
-            ok(
-                dir.path(),
-                &[
-                    "shader",
-                    "--lobe",
-                    &lobe,
-                    "--n",
-                    "64",
-                    "--geometry",
-                    geometry,
-                    "--lang",
-                    "osl",
-                    "-o",
-                    &file,
-                ],
-            );
+            export_lobe(dir.path(), &lobe, 64.0, geometry, "osl", &file);
             files.push(file);
         }
     }
@@ -171,22 +156,7 @@ fn render_both(
     std::fs::write(dir.join("scene.toml"), scene(lobe, geometry, n)).unwrap();
     ok(dir, &["render", "scene.toml", "-o", &ours]);
     let shader = format!("{lobe}-{geometry}.osl");
-    ok(
-        dir,
-        &[
-            "shader",
-            "--lobe",
-            lobe,
-            "--n",
-            &exported.to_string(),
-            "--geometry",
-            geometry,
-            "--lang",
-            "osl",
-            "-o",
-            &shader,
-        ],
-    );
+    export_lobe(dir, lobe, exported, geometry, "osl", &shader);
     let mut args: Vec<String> = vec![
         "render".into(),
         "--osl".into(),

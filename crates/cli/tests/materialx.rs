@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{have_python_module, have_tool, ok, run_python};
+use common::{export_lobe, have_python_module, have_tool, run_python};
 use specula::{Lobe, LobeKind};
 
 const TARGETS: [&str; 5] = ["glsl", "essl", "msl", "osl", "mdl"];
@@ -13,22 +13,7 @@ const TARGETS: [&str; 5] = ["glsl", "essl", "msl", "osl", "mdl"];
 fn check(lobe: &str, geometry: &str) {
     let dir = tempfile::tempdir().unwrap();
     let file = format!("{lobe}-{geometry}.mtlx");
-    ok(
-        dir.path(),
-        &[
-            "shader",
-            "--lobe",
-            lobe,
-            "--n",
-            "100",
-            "--geometry",
-            geometry,
-            "--lang",
-            "mtlx",
-            "-o",
-            &file,
-        ],
-    );
+    export_lobe(dir.path(), lobe, 100.0, geometry, "mtlx", &file);
     let args = [
         file.as_str(),
         "--out",
@@ -98,20 +83,7 @@ fn every_lobes_node_graph_evaluates_to_the_lobe() {
         .collect();
     for kind in LobeKind::ALL {
         let file = format!("{}.mtlx", kind.id());
-        ok(
-            dir.path(),
-            &[
-                "shader",
-                "--lobe",
-                kind.id(),
-                "--n",
-                "100",
-                "--lang",
-                "mtlx",
-                "-o",
-                &file,
-            ],
-        );
+        export_lobe(dir.path(), kind.id(), 100.0, "phong", "mtlx", &file);
         let exported = Lobe::try_new(kind, 100.0).unwrap();
         let takes_n = exported.structural_range() != [100.0, 100.0];
         let n = if takes_n { 80.0 } else { 100.0 };

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{have_python_module, ok, run_python};
+use common::{export_lobe, have_python_module, ok, run_python};
 use specula::{Lobe, LobeKind};
 
 const EXPONENTS: [f64; 3] = [8.0, 64.0, 512.0];
@@ -39,20 +39,7 @@ fn chi2(
 }
 
 fn export(dir: &std::path::Path, lobe: &str, n: f64, file: &str) {
-    ok(
-        dir,
-        &[
-            "shader",
-            "--lobe",
-            lobe,
-            "--n",
-            &n.to_string(),
-            "--lang",
-            "mitsuba",
-            "-o",
-            file,
-        ],
-    );
+    export_lobe(dir, lobe, n, "phong", "mitsuba", file);
 }
 
 #[test]

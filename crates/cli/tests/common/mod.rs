@@ -156,3 +156,24 @@ pub fn sphere_obj(radius: f64, segments: u32, rings: u32) -> String {
     }
     obj
 }
+
+/// `specula shader --lobe LOBE --n N --geometry GEOMETRY --lang LANG -o FILE` in `directory`,
+/// requiring success: a lobe exported for a renderer test.
+pub fn export_lobe(directory: &Path, lobe: &str, n: f64, geometry: &str, lang: &str, file: &str) {
+    ok(
+        directory,
+        &[
+            "shader",
+            "--lobe",
+            lobe,
+            "--n",
+            &n.to_string(),
+            "--geometry",
+            geometry,
+            "--lang",
+            lang,
+            "-o",
+            file,
+        ],
+    );
+}

@@ -56,17 +56,24 @@ impl AngleQuadratic {
         self.cutoff
     }
 
-    /// Evaluates at the angle `g in [0, pi/2)`, by Horner: `C + g (B + A g)`.
+    /// `[C, B, A]` as the named parameters `c`, `b`, `a` (numbers, except to a recorded
+    /// expression).
     #[inline(always)]
-    pub(crate) fn eval_angle<R: Real>(&self, g: R) -> R {
+    fn named_coeffs<R: Real>(&self) -> [R; 3] {
         let [c, b, a] = self.coeffs;
-        let (c, b, a) = (
+        [
             R::parameter("c", c),
             R::parameter("b", b),
             R::parameter("a", a),
-        );
+        ]
+    }
+
+    /// Evaluates at the angle `g in [0, pi/2)`, by Horner: `C + g (B + A g)`.
+    #[inline(always)]
+    pub(crate) fn eval_angle<R: Real>(&self, g: R) -> R {
+        let [c, b, a]: [R; 3] = self.named_coeffs();
         let value = (c + g * (b + a * g)).min(R::from_f64(1.0));
-        g.select_less(R::parameter("cutoff", self.cutoff), value, R::from_f64(0.0))
+        g.select_less(self.cutoff_parameter(), value, R::from_f64(0.0))
     }
 
     /// Whether the quadratic stays at or below 1 before its cut-off, so that its closed-form
@@ -89,14 +96,9 @@ impl AngleQuadratic {
     /// `int_0^g (C + B x + A x^2) sin x dx`, `g` capped at the cut-off (generic, so that a
     /// target that samples records it).
     pub(crate) fn tail_angle<R: Real>(&self, g: R) -> R {
-        let [c, b, a] = self.coeffs;
-        let (c, b, a) = (
-            R::parameter("c", c),
-            R::parameter("b", b),
-            R::parameter("a", a),
-        );
+        let [c, b, a]: [R; 3] = self.named_coeffs();
         let k = R::from_f64;
-        let g = g.max(k(0.0)).min(R::parameter("cutoff", self.cutoff));
+        let g = g.max(k(0.0)).min(self.cutoff_parameter());
         let (sin, cos) = (g.sin(), g.cos());
         let one_minus_cos = k(2.0) * (k(0.5) * g).sin().square();
         // int_0^g x sin x = sum_k (-1)^k g^(2k+3) / ((2k+1)! (2k+3)), and the x^2 moment with
@@ -125,12 +127,7 @@ impl AngleQuadratic {
 
     /// The quadratic's slope of the tail in the angle, `max(0, C + B g + A g^2) sin g`.
     pub(crate) fn tail_slope<R: Real>(&self, g: R) -> R {
-        let [c, b, a] = self.coeffs;
-        let (c, b, a) = (
-            R::parameter("c", c),
-            R::parameter("b", b),
-            R::parameter("a", a),
-        );
+        let [c, b, a]: [R; 3] = self.named_coeffs();
         (c + g * (b + a * g)).max(R::from_f64(0.0)) * g.sin()
     }
 

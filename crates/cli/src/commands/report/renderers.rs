@@ -6,6 +6,7 @@
 //! the tests that do it.
 
 use rayon::prelude::*;
+use specula::expression::Expression;
 use specula::fit::microfacet;
 use specula::{Geometry, Lobe, LobeKind};
 
@@ -15,17 +16,17 @@ use super::Context;
 const FIT_EXPONENTS: [f64; 3] = [8.0, 64.0, 512.0];
 const DESCRIPTION_EXPONENT: f64 = 64.0;
 
-/// How many of `cosines` the record and its lowering evaluate to the lobe's `f32` bits.
-fn bit_exact(lobe: &Lobe, cosines: &[f32]) -> (usize, usize) {
-    let expression = lobe.expression();
+/// How many of `cosines` `expression` (the lobe's record) and its lowering evaluate to the
+/// lobe's `f32` bits.
+fn bit_exact(lobe: &Lobe, expression: &Expression, cosines: &[f32]) -> (usize, usize) {
     let lowered = expression.lowered();
-    let same = |e: &specula::expression::Expression| {
+    let same = |e: &Expression| {
         cosines
             .iter()
             .filter(|&&t| e.eval(t).to_bits() == lobe.eval(t).to_bits())
             .count()
     };
-    (same(&expression), same(&lowered))
+    (same(expression), same(&lowered))
 }
 
 pub fn renderers(_: &mut Context) -> Result<String, String> {
@@ -35,7 +36,8 @@ pub fn renderers(_: &mut Context) -> Result<String, String> {
         .par_iter()
         .map(|&kind| {
             let lobe = lobe(kind, DESCRIPTION_EXPONENT)?;
-            let (record, lowered) = bit_exact(&lobe, &cosines);
+            let expression = lobe.expression();
+            let (record, lowered) = bit_exact(&lobe, &expression, &cosines);
             let described = specula_targets::code::Inputs::of(&lobe);
             let inputs = match described.exponent {
                 Some(range) => format!("n in {}", specula_targets::code::describe_range(range)),
@@ -43,7 +45,7 @@ pub fn renderers(_: &mut Context) -> Result<String, String> {
             };
             Ok(vec![
                 kind.id().to_owned(),
-                lobe.expression().nodes().len().to_string(),
+                expression.nodes().len().to_string(),
                 inputs,
                 format!("{record} / {}", cosines.len()),
                 format!("{lowered} / {}", cosines.len()),
