@@ -33,6 +33,14 @@ pub enum Error {
         /// What is wrong, and what is valid.
         message: String,
     },
+    /// A user's lobe refused: its formula, its parameters, or its values at an `n`.
+    #[error("lobe '{lobe}': {message}")]
+    Formula {
+        /// The lobe's name.
+        lobe: String,
+        /// Where and what is wrong (one line).
+        message: String,
+    },
     /// A cosine outside `[-1, 1]`.
     #[error("cosine {value} is out of range: a cosine must be a finite number in [-1, 1]")]
     CosineOutOfRange {

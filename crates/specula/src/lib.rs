@@ -40,6 +40,7 @@ mod error;
 mod exponent;
 pub mod expression;
 pub mod fit;
+pub mod formula;
 pub mod geometry;
 pub mod gpu_cost;
 pub mod lobe;

@@ -42,7 +42,14 @@ pub enum LobeKind {
     FastPow,
     /// The IEEE bit-trick power without corrections (Schraudolph).
     FasterPow,
+    /// A lobe of the user's, written as a formula ([`crate::formula`]).
+    Formula(FormulaId),
 }
+
+/// A user's lobe: a formula and its parameter values, defined in this process
+/// ([`crate::formula::instance`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FormulaId(pub(crate) u32);
 
 /// A lobe parameter other than `n`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -71,6 +78,8 @@ pub enum Origin {
     Thesis,
     /// A variant added by specula, measured the same way.
     Specula,
+    /// Written by the user as a formula.
+    User,
 }
 
 impl Origin {
@@ -82,6 +91,7 @@ impl Origin {
             Origin::Literature => "literature",
             Origin::Thesis => "thesis",
             Origin::Specula => "specula",
+            Origin::User => "user",
         }
     }
 }
@@ -175,6 +185,13 @@ impl LobeKind {
             LobeKind::SgKaris => (REDDISH_PURPLE, true),
             LobeKind::FastPow => (GREY, false),
             LobeKind::FasterPow => (GREY, true),
+            // Paul Tol's wine, indigo, olive and teal: none of Okabe and Ito's set, so a user's
+            // lobe never looks like a built-in one.
+            LobeKind::Formula(FormulaId(id)) => {
+                const USER: [[u8; 3]; 4] =
+                    [[136, 34, 85], [51, 34, 136], [153, 153, 51], [68, 170, 153]];
+                (USER[id as usize % 4], (id / 4) % 2 == 1)
+            }
         };
         LineStyle { rgb, dashed }
     }
@@ -183,6 +200,7 @@ impl LobeKind {
     #[must_use]
     pub fn info(self) -> &'static LobeInfo {
         match self {
+            LobeKind::Formula(id) => crate::formula::registry::get(id).info(),
             LobeKind::Pow => &LobeInfo {
                 id: "pow",
                 summary: "the exact lobe t^n (Phong, Blinn): the reference",
@@ -305,24 +323,61 @@ impl LobeKind {
     /// The model's position in [`LobeKind::ALL`], parameters aside.
     #[must_use]
     pub fn index(self) -> u32 {
+        if let LobeKind::Formula(FormulaId(id)) = self {
+            return LobeKind::ALL.len() as u32 + id;
+        }
         let same = |k: &LobeKind| core::mem::discriminant(k) == core::mem::discriminant(&self);
         LobeKind::ALL.iter().position(same).unwrap_or_default() as u32
     }
 
-    /// Parses `ID` or `ID:param=value`, e.g. `schlick`, `cosquad:v=5`.
+    /// Parses `ID` or `ID:param=value`, e.g. `schlick`, `cosquad:v=5`; the name of a lobe
+    /// defined from a formula earlier in this process (`mine:k=2`); or `=FORMULA`, a formula
+    /// of `t` and `n` inline (`=exp2(n * (t - 1) * 1.4427)`).
     pub fn parse(text: &str) -> Result<Self> {
         let text = text.trim();
+        if let Some(formula) = text.strip_prefix('=') {
+            let definition = crate::formula::Definition {
+                name: "formula".to_owned(),
+                description: Some("a formula given inline".to_owned()),
+                formula: formula.to_owned(),
+                tail: None,
+                parameters: std::collections::BTreeMap::new(),
+            };
+            let formula = crate::formula::define(definition, crate::formula::Naming::Unique)?;
+            return crate::formula::instance(formula, &[]);
+        }
         let (id, params) = match text.split_once(':') {
             Some((id, params)) => (id, Some(params)),
             None => (text, None),
         };
+        if let Some(formula) = crate::formula::registry::find(id) {
+            let values = match params {
+                Some(params) => crate::formula::registry::parse_values(formula, params)?,
+                None => Vec::new(),
+            };
+            return crate::formula::instance(formula, &values);
+        }
         let kind = Self::ALL
             .into_iter()
             .find(|kind| kind.id().eq_ignore_ascii_case(id))
-            .ok_or_else(|| Error::UnknownLobe {
-                id: crate::error::excerpt(id),
-                valid: Self::valid_ids(),
-                hint: crate::error::did_you_mean(id, Self::ALL.map(LobeKind::id)),
+            .ok_or_else(|| {
+                let defined = crate::formula::registry::names();
+                let mut valid = Self::valid_ids();
+                for name in &defined {
+                    valid.push_str(", ");
+                    valid.push_str(name);
+                }
+                valid.push_str(
+                    " (or @FILE.toml for a lobe file, =FORMULA for a formula of t and n)",
+                );
+                Error::UnknownLobe {
+                    id: crate::error::excerpt(id),
+                    valid,
+                    hint: crate::error::did_you_mean(
+                        id,
+                        Self::ALL.map(LobeKind::id).into_iter().chain(defined),
+                    ),
+                }
             })?;
         match (kind, params) {
             (_, None) => Ok(kind),
@@ -367,9 +422,34 @@ impl core::fmt::Display for LobeKind {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             LobeKind::CosQuad { v } if *v != CosQuad::DEFAULT_V => write!(f, "cosquad:v={v}"),
+            LobeKind::Formula(id) => {
+                let instance = crate::formula::registry::get(*id);
+                f.write_str(kind_name(instance))
+                    .and_then(|()| write_values(f, instance))
+            }
             kind => f.write_str(kind.id()),
         }
     }
+}
+
+fn kind_name(instance: &crate::formula::Instance) -> &'static str {
+    instance.info().id
+}
+
+/// `:k=1.5,m=2` for the parameters that differ from their defaults.
+fn write_values(
+    f: &mut core::fmt::Formatter<'_>,
+    instance: &crate::formula::Instance,
+) -> core::fmt::Result {
+    let formula = instance.formula();
+    let mut separator = ':';
+    for (parameter, value) in formula.parameters().iter().zip(instance.values()) {
+        if *value != parameter.default {
+            write!(f, "{separator}{}={value}", parameter.name)?;
+            separator = ',';
+        }
+    }
+    Ok(())
 }
 
 impl core::str::FromStr for LobeKind {

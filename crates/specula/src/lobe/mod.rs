@@ -17,6 +17,7 @@ mod cheb2_thesis;
 mod cosquad;
 mod fasterpow;
 mod fastpow;
+mod formula;
 mod invert;
 mod kind;
 mod logexp;
@@ -32,7 +33,7 @@ mod sg_karis;
 pub use cheb2_thesis::thesis_coefficients;
 pub use cosquad::CosQuad;
 pub use invert::Inverted;
-pub use kind::{LineStyle, LobeInfo, LobeKind, Origin, ParamInfo};
+pub use kind::{FormulaId, LineStyle, LobeInfo, LobeKind, Origin, ParamInfo};
 pub use quadratic::AngleQuadratic;
 pub use sg_karis::KARIS_OFFSET;
 
@@ -124,6 +125,7 @@ enum Model {
     Sg(sg::Sg),
     FastPow(fastpow::FastPow),
     FasterPow(fasterpow::FasterPow),
+    Formula(formula::FormulaLobe),
 }
 
 impl Lobe {
@@ -144,6 +146,7 @@ impl Lobe {
             LobeKind::SgKaris => Model::Sg(sg_karis::new(n)),
             LobeKind::FastPow => Model::FastPow(fastpow::FastPow::new(n)),
             LobeKind::FasterPow => Model::FasterPow(fasterpow::FasterPow::new(n)),
+            LobeKind::Formula(id) => Model::Formula(formula::FormulaLobe::new(id, n)),
         };
         Self { kind, n, model }
     }
@@ -198,7 +201,8 @@ impl Lobe {
             | Model::LogExp(_)
             | Model::LogExpRr(_)
             | Model::FastPow(_)
-            | Model::FasterPow(_) => {}
+            | Model::FasterPow(_)
+            | Model::Formula(_) => {}
         }
         packed
     }
@@ -222,12 +226,14 @@ impl Lobe {
             Model::Pow(_) | Model::Sg(_) | Model::CosQuad(_) => Warp::Analytic,
             Model::Schlick(_) => Warp::Newton,
             Model::AngleQuadratic(m) if m.has_closed_form_tail() => Warp::Newton,
+            Model::Formula(m) if m.has_tail() => Warp::Newton,
             Model::AngleQuadratic(_)
             | Model::SchlickMod(_)
             | Model::LogExp(_)
             | Model::LogExpRr(_)
             | Model::FastPow(_)
-            | Model::FasterPow(_) => Warp::Table,
+            | Model::FasterPow(_)
+            | Model::Formula(_) => Warp::Table,
         }
     }
 
@@ -242,6 +248,7 @@ impl Lobe {
             Model::CosQuad(m) => Some(m.tail(t)),
             Model::Schlick(m) => Some(m.tail(t)),
             Model::AngleQuadratic(m) if m.has_closed_form_tail() => Some(m.tail(t)),
+            Model::Formula(m) => m.tail(t),
             _ => None,
         }
     }
@@ -258,6 +265,7 @@ impl Lobe {
             Model::CosQuad(m) => exact(m.tail_inverse(u)),
             Model::Schlick(m) => Some(m.tail_inverse(u)),
             Model::AngleQuadratic(m) if m.has_closed_form_tail() => Some(m.tail_inverse(u)),
+            Model::Formula(m) => m.tail_inverse(u),
             _ => None,
         }
     }
@@ -288,6 +296,7 @@ impl Lobe {
             Model::Sg(m) => m.eval(t),
             Model::FastPow(m) => m.eval(t),
             Model::FasterPow(m) => m.eval(t),
+            Model::Formula(m) => m.eval(t),
         }
     }
 
@@ -341,6 +350,7 @@ impl Lobe {
                 upper: m.cutoff_parameter(),
                 total: m.tail_angle(m.cutoff_parameter()),
             }),
+            Model::Formula(m) => m.newton_sampling(x),
             _ => None,
         }
     }
@@ -351,6 +361,7 @@ impl Lobe {
     pub fn preparation<R: Real>(&self, name: &str, n: R) -> Option<R> {
         match (&self.model, name) {
             (Model::AngleQuadratic(_), _) => None,
+            (Model::Formula(m), _) => m.preparation(name, n),
             (_, "n") => Some(n),
             (Model::CosQuad(m), "slope") => Some(CosQuad::slope_for(n, m.squarings() as u8)),
             (Model::Sg(_), "rate") => {

@@ -1,0 +1,207 @@
+//! Running a compiled formula on any [`Real`]: the operations' meaning, written once.
+//!
+//! A *tape* is a straight list of operations whose operands index earlier entries and whose
+//! last entry is the result; its leaves are `t`, `n`, parameters, constants and slots (the
+//! per-material constants). The formula's varying part, its tail and each slot's preparation
+//! are tapes cut from the compiled program ([`extract`]), so one loop runs them all.
+
+use super::compile::Op;
+use crate::real::Real;
+
+/// `op` applied to its operands' values (`at(i)` is operand `i`'s); leaves are the caller's.
+#[inline]
+pub(crate) fn apply<R: Real>(op: Op, at: impl Fn(usize) -> R) -> R {
+    match op {
+        Op::T | Op::N | Op::Param(_) | Op::Slot(_) => {
+            unreachable!("leaves are read by the caller")
+        }
+        Op::Const(c) => R::from_f64(c),
+        Op::Add(a, b) => at(a) + at(b),
+        Op::Sub(a, b) => at(a) - at(b),
+        Op::Mul(a, b) => at(a) * at(b),
+        Op::Div(a, b) => at(a) / at(b),
+        Op::Neg(a) => -at(a),
+        Op::Sqrt(a) => at(a).sqrt(),
+        Op::Log2(a) => at(a).log2(),
+        Op::Exp2(a) => at(a).exp2(),
+        Op::Exp(a) => at(a).exp(),
+        Op::Ln(a) => at(a).log2() * R::from_f64(core::f64::consts::LN_2),
+        Op::Acos(a) => at(a).acos(),
+        Op::Cos(a) => at(a).cos(),
+        Op::Sin(a) => at(a).sin(),
+        Op::Abs(a) => at(a).max(-at(a)),
+        Op::Floor(a) => -(-at(a)).ceil(),
+        Op::Ceil(a) => at(a).ceil(),
+        Op::Pow(a, b) => at(a).powf(at(b)),
+        Op::Powi(a, k) => powi(at(a), k),
+        Op::Min(a, b) => at(a).min(at(b)),
+        Op::Max(a, b) => at(a).max(at(b)),
+        Op::SelectLess {
+            a,
+            b,
+            then,
+            otherwise,
+        } => at(a).select_less(at(b), at(then), at(otherwise)),
+    }
+}
+
+/// `x^k` by squarings and multiplications (binary exponentiation): `x^16` is four squarings.
+#[inline]
+pub(crate) fn powi<R: Real>(x: R, k: i32) -> R {
+    by_squaring(x, k, R::from_f64(1.0), |a, b| a * b, R::square, |a, b| a / b)
+}
+
+/// Binary exponentiation over any type with a product, a square and a quotient (the scalar
+/// path's `Real` and the columns' vectors compute the same sequence of roundings).
+#[inline(always)]
+pub(crate) fn by_squaring<T: Copy>(
+    x: T,
+    k: i32,
+    one: T,
+    multiply: impl Fn(T, T) -> T,
+    square: impl Fn(T) -> T,
+    divide: impl Fn(T, T) -> T,
+) -> T {
+    let mut remaining = k.unsigned_abs();
+    if remaining == 0 {
+        return one;
+    }
+    let mut base = x;
+    let mut result: Option<T> = None;
+    loop {
+        if remaining & 1 == 1 {
+            result = Some(result.map_or(base, |r| multiply(r, base)));
+        }
+        remaining >>= 1;
+        if remaining == 0 {
+            break;
+        }
+        base = square(base);
+    }
+    let power = result.unwrap_or(base);
+    if k < 0 {
+        divide(one, power)
+    } else {
+        power
+    }
+}
+
+/// An operation of constants, folded in `f64`.
+pub(crate) fn fold(op: Op, at: impl Fn(usize) -> f64) -> f64 {
+    apply(op, at)
+}
+
+/// The tape computing `root` from `ops`: the operations it needs, in order, where `leaf(i)`
+/// replaces operation `i` (and everything below it) by a leaf when it returns one.
+pub(crate) fn extract(ops: &[Op], root: usize, leaf: impl Fn(usize) -> Option<Op>) -> Vec<Op> {
+    let mut needed = vec![false; ops.len()];
+    let mut replaced: Vec<Option<Op>> = vec![None; ops.len()];
+    needed[root] = true;
+    for index in (0..=root).rev() {
+        if !needed[index] {
+            continue;
+        }
+        match leaf(index) {
+            Some(op) => replaced[index] = Some(op),
+            None => {
+                for operand in ops[index].operands() {
+                    needed[operand] = true;
+                }
+            }
+        }
+    }
+    let mut renumber = vec![usize::MAX; ops.len()];
+    let mut tape = Vec::new();
+    for index in 0..=root {
+        if needed[index] {
+            renumber[index] = tape.len();
+            tape.push(replaced[index].unwrap_or_else(|| remap(ops[index], |i| renumber[i])));
+        }
+    }
+    tape
+}
+
+fn remap(op: Op, map: impl Fn(usize) -> usize) -> Op {
+    match op {
+        Op::T | Op::N | Op::Param(_) | Op::Const(_) | Op::Slot(_) => op,
+        Op::Add(a, b) => Op::Add(map(a), map(b)),
+        Op::Sub(a, b) => Op::Sub(map(a), map(b)),
+        Op::Mul(a, b) => Op::Mul(map(a), map(b)),
+        Op::Div(a, b) => Op::Div(map(a), map(b)),
+        Op::Neg(a) => Op::Neg(map(a)),
+        Op::Sqrt(a) => Op::Sqrt(map(a)),
+        Op::Log2(a) => Op::Log2(map(a)),
+        Op::Exp2(a) => Op::Exp2(map(a)),
+        Op::Exp(a) => Op::Exp(map(a)),
+        Op::Ln(a) => Op::Ln(map(a)),
+        Op::Acos(a) => Op::Acos(map(a)),
+        Op::Cos(a) => Op::Cos(map(a)),
+        Op::Sin(a) => Op::Sin(map(a)),
+        Op::Abs(a) => Op::Abs(map(a)),
+        Op::Floor(a) => Op::Floor(map(a)),
+        Op::Ceil(a) => Op::Ceil(map(a)),
+        Op::Pow(a, b) => Op::Pow(map(a), map(b)),
+        Op::Powi(a, k) => Op::Powi(map(a), k),
+        Op::Min(a, b) => Op::Min(map(a), map(b)),
+        Op::Max(a, b) => Op::Max(map(a), map(b)),
+        Op::SelectLess {
+            a,
+            b,
+            then,
+            otherwise,
+        } => Op::SelectLess {
+            a: map(a),
+            b: map(b),
+            then: map(then),
+            otherwise: map(otherwise),
+        },
+    }
+}
+
+/// The values a tape's leaves take.
+pub(crate) struct Leaves<'a, R> {
+    pub t: R,
+    pub n: R,
+    pub parameter: &'a dyn Fn(usize) -> R,
+    pub slot: &'a dyn Fn(usize) -> R,
+}
+
+/// Runs `tape`; its result.
+pub(crate) fn run<R: Real>(tape: &[Op], leaves: &Leaves<'_, R>) -> R {
+    let mut values: Vec<R> = Vec::with_capacity(tape.len());
+    for &op in tape {
+        let value = match op {
+            Op::T => leaves.t,
+            Op::N => leaves.n,
+            Op::Param(p) => (leaves.parameter)(p),
+            Op::Slot(s) => (leaves.slot)(s),
+            op => apply(op, |i| values[i]),
+        };
+        values.push(value);
+    }
+    values[values.len() - 1]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integer_powers_are_squarings_and_products() {
+        for k in -9..=64 {
+            let x = 0.93_f64;
+            let expected = x.powi(k);
+            assert!(
+                (powi(x, k) - expected).abs() <= 1e-14 * expected,
+                "{k}: {} vs {expected}",
+                powi(x, k)
+            );
+        }
+        // x^16 is exactly four squarings.
+        let x = 0.987_654_f32;
+        let squared = |v: f32| v * v;
+        assert_eq!(powi(x, 16), squared(squared(squared(squared(x)))));
+        let ops = crate::ops::count_ops(|| powi(crate::ops::Counted(0.5), 16)).1;
+        assert_eq!(ops.total(), 4, "{ops:?}");
+    }
+}

@@ -1,0 +1,284 @@
+//! The formula language against closed forms and the built-in lobes it can spell.
+
+use std::collections::BTreeMap;
+
+use super::*;
+use crate::simd::{BatchLoop, Level};
+
+fn definition(name: &str, formula: &str) -> Definition {
+    Definition {
+        name: name.to_owned(),
+        description: None,
+        formula: formula.to_owned(),
+        tail: None,
+        parameters: BTreeMap::new(),
+    }
+}
+
+fn kind_of(definition: Definition) -> LobeKind {
+    let formula = define(definition, Naming::Exact).expect("a valid formula");
+    instance(formula, &[]).expect("default parameters")
+}
+
+const K4: &str = "let a = (n + 1) / 17;\nmax(0, a * (t - 1) + 1) ^ 16";
+
+fn cosines() -> Vec<f32> {
+    (0..=2000)
+        .map(|i| 1.0 - (i as f32 / 2000.0).powi(2))
+        .chain([0.0, -0.0, -1.0, f32::NAN, 1.5, f32::INFINITY, 1e-30])
+        .collect()
+}
+
+/// K_4 written as a formula is the built-in `cosquad`: the same bits in `f64` and in the
+/// scalar `f32` path, the same recorded operations, and the same bits from the columns as
+/// from the built-in kernel (the multiply-add fused as it fuses it).
+#[test]
+fn cosquad_written_by_hand_is_the_built_in() {
+    let kind = kind_of(definition("k4-by-hand", K4));
+    for n in [1.0, 16.0, 64.0, 333.3, 1000.0] {
+        let n = Exponent::new(n);
+        let (mine, built_in) = (
+            Lobe::checked(kind, n).unwrap(),
+            Lobe::new(LobeKind::CosQuad { v: 4 }, n),
+        );
+        for i in 0..=1000 {
+            let t = f64::from(i) / 1000.0;
+            assert_eq!(
+                mine.eval(t).to_bits(),
+                built_in.eval(t).to_bits(),
+                "n = {n} t = {t}"
+            );
+            let t = t as f32;
+            assert_eq!(
+                mine.eval(t).to_bits(),
+                built_in.eval(t).to_bits(),
+                "n = {n} t = {t}"
+            );
+        }
+        let ts = cosines();
+        for level in Level::available() {
+            let (mut a, mut b) = (vec![0.0; ts.len()], vec![0.0; ts.len()]);
+            mine.eval_batch_with(level, BatchLoop::Explicit, &ts, &mut a);
+            built_in.eval_batch_with(level, BatchLoop::Explicit, &ts, &mut b);
+            for ((t, x), y) in ts.iter().zip(&a).zip(&b) {
+                assert_eq!(
+                    x.to_bits(),
+                    y.to_bits(),
+                    "n = {n} {level:?} t = {t}: {x} vs {y}"
+                );
+            }
+        }
+        let (record, reference) = (mine.expression(), built_in.expression());
+        for i in 1..=100 {
+            let t = f64::from(i) / 100.0;
+            assert_eq!(record.eval(t), reference.eval(t));
+        }
+        assert_eq!(
+            mine.ops().total(),
+            built_in.ops().total() + 2,
+            "the clamp's min and max"
+        );
+    }
+}
+
+/// The spherical Gaussian with its tail: the check accepts the true integral, sampling
+/// inverts it to the closed form's quantiles, and targets see `n` and the rate as
+/// parameters computed from `n`.
+#[test]
+fn a_tail_samples_exactly() {
+    let mut d = definition(
+        "sg-with-tail",
+        "let rate = n * 1.4426950408889634; exp2(rate * (t - 1))",
+    );
+    d.tail = Some("(1 - exp2(rate * (t - 1))) / (rate * 0.6931471805599453)".to_owned());
+    let kind = kind_of(d);
+    let n = Exponent::new(40.0);
+    let lobe = Lobe::checked(kind, n).unwrap();
+    assert_eq!(lobe.warp(), crate::lobe::Warp::Newton);
+    let whole = (1.0 - (-40.0_f64).exp()) / 40.0;
+    for u in [0.0, 0.1, 0.5, 0.9, 0.999] {
+        let t = lobe.tail_inverse(u).unwrap().x;
+        // int_t^1 e^(n(s-1)) ds = u * whole, solved for t.
+        let expected = 1.0 + (1.0 - u * whole * 40.0).ln() / 40.0;
+        assert!((t - expected).abs() < 1e-9, "u = {u}: {t} vs {expected}");
+    }
+    let names: Vec<&str> = lobe.parameters().iter().map(|p| p.name).collect();
+    assert_eq!(names, ["rate"]);
+    let prepared = lobe.preparation::<f64>("rate", 40.0).unwrap();
+    assert_eq!(prepared, 40.0 * core::f64::consts::LOG2_E);
+
+    let mut wrong = definition("sg-wrong-tail", "exp2(n * 1.4426950408889634 * (t - 1))");
+    wrong.tail = Some("1 - t".to_owned());
+    let message = Lobe::checked(kind_of(wrong), n).unwrap_err().to_string();
+    assert!(
+        message.contains("the tail is") && message.contains("n = 40"),
+        "{message}"
+    );
+}
+
+/// Values outside `[0, 1]` are refused at the `n` where they happen, and only there.
+#[test]
+fn values_outside_the_unit_interval_are_refused_at_their_n() {
+    let kind = kind_of(definition(
+        "above-one-below-n-4",
+        "(1 + max(0, 4 - n)) * t ^ n",
+    ));
+    let message = Lobe::checked(kind, Exponent::new(2.0))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("above 1") && message.contains("n = 2"),
+        "{message}"
+    );
+    assert!(Lobe::checked(kind, Exponent::new(4.0)).is_ok());
+    for (name, text, says) in [
+        ("negative-somewhere", "t - 0.5", "negative"),
+        ("infinite-at-zero", "1 / t", "not finite"),
+        ("nan-at-zero", "log(t) * 0", "not finite"),
+    ] {
+        let message = Lobe::checked(kind_of(definition(name, text)), Exponent::new(8.0))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains(says) && !message.contains('\n'),
+            "{name}: {message}"
+        );
+    }
+}
+
+/// Every refusal is one line naming the position and the problem.
+#[test]
+fn bad_formulas_get_one_line_each() {
+    for (text, says) in [
+        ("tt ^ n", "column 1: unknown name 'tt'; did you mean 't'?"),
+        (
+            "expp(t)",
+            "column 1: unknown function 'expp'; did you mean 'exp'?",
+        ),
+        ("t ^ n +", "column 8: expected a number"),
+        ("pow(t)", "pow takes 2 arguments, given 1"),
+        ("select(t, 1, 0)", "must be a comparison"),
+        ("t < 1", "only valid as the condition"),
+        ("let t = 2; t", "reserved"),
+        ("0.5", "does not depend on t"),
+        ("max", "is a function"),
+    ] {
+        let message = define(definition("bad", text), Naming::Unique)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains(says) && !message.contains('\n'),
+            "{text}: {message}"
+        );
+    }
+    let message = define(
+        definition("bad", "let a = 2;\nlet b = a +;\nt"),
+        Naming::Unique,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(message.contains("line 2, column 12"), "{message}");
+    let message = define(definition("pow", "t"), Naming::Unique)
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("built-in"), "{message}");
+}
+
+/// Declared parameters: defaults, values in range, the id showing what differs.
+#[test]
+fn parameters_have_ranges_and_appear_in_the_id() {
+    let mut d = definition("with-sharpness", "t ^ (n * k)");
+    d.parameters.insert(
+        "k".to_owned(),
+        ParameterDefinition {
+            default: 1.0,
+            min: 0.5,
+            max: 2.0,
+            description: None,
+        },
+    );
+    let formula = define(d, Naming::Exact).unwrap();
+    let default = instance(formula, &[]).unwrap();
+    assert_eq!(default.to_string(), "with-sharpness");
+    let sharper = LobeKind::parse("with-sharpness:k=2").unwrap();
+    assert_eq!(sharper.to_string(), "with-sharpness:k=2");
+    assert_eq!(LobeKind::parse(&sharper.to_string()).unwrap(), sharper);
+    let lobe = Lobe::new(sharper, Exponent::new(10.0));
+    assert!((lobe.eval(0.9_f64) - 0.9_f64.powf(20.0)).abs() < 1e-15);
+    let message = LobeKind::parse("with-sharpness:k=3")
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("[0.5, 2]"), "{message}");
+    let message = LobeKind::parse("with-sharpness:q=1")
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("unknown parameter 'q'"), "{message}");
+}
+
+/// The columns agree with the scalar `f32` path within the stated bound on formulas of every
+/// function, including lanes outside the polynomials' ranges (which go lane by lane).
+#[test]
+fn columns_match_the_scalar_path_for_every_function() {
+    let formulas = [
+        ("col-exp2", "exp2(n * (t - 1) * 1.4427)"),
+        ("col-exp", "exp(n * (t - 1))"),
+        ("col-pow", "pow(t, n)"),
+        ("col-log", "max(0, 1 + log(t) * n / 50)"),
+        (
+            "col-log2-acos",
+            "clamp(1 - acos(t) * sqrt(n) / 3 + log2(1 + t) * 0, 0, 1)",
+        ),
+        ("col-select", "if(t > 0.5, t ^ 3, 0.125 * (2 * t) ^ 4)"),
+        ("col-mix", "mix(t ^ n, exp(n * (t - 1)), 0.5)"),
+        (
+            "col-trig",
+            "abs(cos(acos(t))) ^ n * (floor(t) * 0 + 1) * min(1, ceil(t))",
+        ),
+        (
+            "col-quartic",
+            "let c = n / 8; max(0, 1 - c * (1 - t) + c * (1 - t) ^ 2 / 4) ^ 4",
+        ),
+        ("col-grows", "exp(t * 2) / exp(2) * t ^ -2 * t ^ 2"),
+        ("col-sin", "sin(t * pi / 2) ^ n"),
+        ("col-neg", "-(-t) ^ 2 * -1 * t ^ n / e * e"),
+    ];
+    let ts = cosines();
+    for (name, text) in formulas {
+        let kind = kind_of(definition(name, text));
+        for n in [1.0, 9.5, 100.0] {
+            let lobe = Lobe::new(kind, Exponent::new(n));
+            let bound = lobe.batch_ulp_bound() * f64::from(f32::EPSILON);
+            for level in Level::available() {
+                for batch_loop in [BatchLoop::Explicit, BatchLoop::Plain] {
+                    let mut out = vec![0.0; ts.len()];
+                    lobe.eval_batch_with(level, batch_loop, &ts, &mut out);
+                    for (&t, &value) in ts.iter().zip(&out) {
+                        let scalar: f32 = lobe.eval(t);
+                        assert!(
+                            f64::from((value - scalar).abs()) <= bound
+                                && (0.0..=1.0).contains(&value),
+                            "{text} n = {n} {level:?} {batch_loop:?} t = {t}: {value} vs {scalar}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Inline formulas get numbered names; the same text is the same lobe.
+#[test]
+fn inline_formulas_are_named_and_shared() {
+    let a = LobeKind::parse("=t ^ (n / 2)").unwrap();
+    let b = LobeKind::parse("= t ^ (n / 2)").unwrap();
+    let c = LobeKind::parse("=t ^ (n / 3)").unwrap();
+    assert_ne!(a, c);
+    assert_ne!(a.to_string(), c.to_string());
+    assert_eq!(LobeKind::parse(&c.to_string()).unwrap(), c);
+    assert_ne!(
+        a.to_string(),
+        b.to_string(),
+        "texts differ in a space: two definitions"
+    );
+    assert_eq!(LobeKind::parse("=t ^ (n / 2)").unwrap(), a);
+}

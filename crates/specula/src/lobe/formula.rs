@@ -1,0 +1,192 @@
+//! # A lobe of yours, from a formula
+//!
+//! The model behind [`LobeKind::Formula`](super::LobeKind::Formula): a formula compiled by
+//! [`crate::formula`] (whose page is the language's manual), prepared for one `n` by
+//! computing its per-material constants in `f64`.
+//!
+//! - **Parameters**: `n`, and the formula's declared parameters (fixed per
+//!   [`FormulaId`](super::FormulaId)).
+//! - **Domain**: `t in (0, 1]`; the value is clamped to `[0, 1]` (NaN to 0), a net under
+//!   the dense-grid check of [`Lobe::checked`](super::Lobe::checked).
+//! - **Cost**: what the formula writes; integer powers up to 64 are multiplications.
+//! - **Sampling**: Newton on the formula's own tail where it gives one, else a table.
+
+use super::batch::LobeKernel;
+use super::{Inverted, NewtonForm};
+use crate::formula::batch::Scalar;
+use crate::formula::{registry, Instance, MAX_SLOTS};
+use crate::real::Real;
+use crate::simd::tally::Instructions;
+use crate::simd::{BatchLoop, Job, Kernel, Lanes, Level};
+use crate::Exponent;
+
+/// The prepared formula.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FormulaLobe {
+    instance: &'static Instance,
+    slots: [f64; MAX_SLOTS],
+}
+
+impl PartialEq for FormulaLobe {
+    fn eq(&self, other: &Self) -> bool {
+        core::ptr::eq(self.instance, other.instance) && self.slots == other.slots
+    }
+}
+
+impl FormulaLobe {
+    pub(crate) fn new(id: super::FormulaId, n: Exponent) -> Self {
+        let instance = registry::get(id);
+        Self {
+            instance,
+            slots: instance.formula().prepare(n.get(), instance.values()),
+        }
+    }
+
+    /// Evaluates at `t in (0, 1]`, the value clamped to `[0, 1]`.
+    #[inline]
+    pub(crate) fn eval<R: Real>(&self, t: R) -> R {
+        let value: R = self.instance.formula().raw(t, &self.slots);
+        value.max(R::from_f64(0.0)).min(R::from_f64(1.0))
+    }
+
+    pub(crate) fn has_tail(&self) -> bool {
+        self.instance.formula().has_tail()
+    }
+
+    /// `int_t^1 lobe`, from the formula's tail.
+    pub(crate) fn tail<R: Real>(&self, t: R) -> Option<R> {
+        self.instance.formula().tail(t, &self.slots)
+    }
+
+    /// The cosine whose tail is the fraction `u` of the whole, by safeguarded Newton in
+    /// `x = 1 - t`, where the tail `int_{1-x}^1 lobe` rises from 0 with slope `lobe(1 - x)`.
+    pub(crate) fn tail_inverse(&self, u: f64) -> Option<Inverted> {
+        let total = self.tail(0.0)?;
+        let rising = |x: f64| self.tail(1.0 - x).unwrap_or(f64::NAN);
+        let found = super::invert::solve_increasing(
+            rising,
+            |x| self.eval(1.0 - x),
+            u * total,
+            (0.0, 1.0),
+            0.5,
+        );
+        Some(Inverted {
+            x: 1.0 - found.x,
+            iterations: found.iterations,
+        })
+    }
+
+    /// The tail in Newton's variable `x = 1 - t`.
+    pub(crate) fn newton_sampling<R: Real>(&self, x: R) -> Option<NewtonForm<R>> {
+        let one = R::from_f64(1.0);
+        let zero = R::from_f64(0.0);
+        let total = self.tail(zero)?;
+        Some(NewtonForm {
+            tail: self.tail(one - x)?,
+            slope: self.eval(one - x),
+            cosine: one - x,
+            upper: one,
+            total,
+        })
+    }
+
+    /// The constant `name` computed from `n` as the preparation computes it.
+    pub(crate) fn preparation<R: Real>(&self, name: &str, n: R) -> Option<R> {
+        if name == "n" {
+            return Some(n);
+        }
+        self.instance
+            .formula()
+            .preparation_of(name, n, self.instance.values())
+    }
+
+    /// The columns' scalars for this `n`, in `f32`.
+    fn scalars(&self) -> Vec<f32> {
+        self.instance
+            .formula()
+            .plan()
+            .scalars()
+            .iter()
+            .map(|s| match *s {
+                Scalar::Slot(k) => self.slots[k] as f32,
+                Scalar::Constant(c) => c as f32,
+            })
+            .collect()
+    }
+
+    /// The batch: the compiled columns, or the plain loop of the scalar `f32` formula.
+    pub(crate) fn eval_batch(
+        &self,
+        level: Level,
+        batch_loop: BatchLoop,
+        ts: &[f32],
+        out: &mut [f32],
+    ) {
+        match batch_loop {
+            BatchLoop::Explicit => {
+                let scalars = self.scalars();
+                crate::simd::dispatch(
+                    level,
+                    Columns {
+                        lobe: self,
+                        scalars: &scalars,
+                        ts,
+                        out,
+                    },
+                );
+            }
+            BatchLoop::Plain => crate::simd::plain_loop(self.kernel(), ts, out),
+        }
+    }
+
+    /// The lane-at-a-time kernel (the plain loop's formula).
+    pub(crate) fn kernel(&self) -> FormulaKernel {
+        FormulaKernel { lobe: *self }
+    }
+}
+
+struct Columns<'a> {
+    lobe: &'a FormulaLobe,
+    scalars: &'a [f32],
+    ts: &'a [f32],
+    out: &'a mut [f32],
+}
+
+impl Job for Columns<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<V: Lanes>(self, lanes: V) {
+        self.lobe
+            .instance
+            .formula()
+            .plan()
+            .run(lanes, self.scalars, self.ts, self.out);
+    }
+}
+
+/// The formula one lane at a time in scalar `f32`, with the shared rules.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FormulaKernel {
+    lobe: FormulaLobe,
+}
+
+impl Kernel for FormulaKernel {
+    fn apply<V: Lanes>(self, t: V) -> V {
+        let mut lanes = [0.0_f32; 64];
+        t.store(&mut lanes[..V::WIDTH]);
+        for value in &mut lanes[..V::WIDTH] {
+            *value = if *value > 0.0 {
+                self.lobe.eval(value.min(1.0))
+            } else {
+                0.0
+            };
+        }
+        t.load(&lanes[..V::WIDTH])
+    }
+}
+
+impl LobeKernel for FormulaKernel {
+    fn instructions(self) -> Instructions {
+        self.lobe.instance.formula().plan().instructions()
+    }
+}
