@@ -20,7 +20,8 @@ impl TypedValueParser for LobeParser {
         value: &std::ffi::OsStr,
     ) -> Result<LobeKind, clap::Error> {
         let text = value.to_string_lossy();
-        LobeKind::parse(&text).map_err(|error| invalid_value(cmd, arg, &error.to_string()))
+        specula_render::lobe_file::parse_lobe(&text, None)
+            .map_err(|error| invalid_value(cmd, arg, &error))
     }
 
     fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
@@ -164,4 +165,17 @@ impl InputLimit {
     pub fn apply(&self) {
         specula_render::input::set_max_input_bytes(self.max_input_mib << 20);
     }
+}
+
+/// Refuses, before any work, a user's lobe whose formula is not a lobe at one of `exponents`
+/// (see [`specula::Lobe::checked`]); built-in lobes pass.
+pub fn check_lobes(kinds: &[LobeKind], exponents: &[Exponent]) -> Result<(), String> {
+    for &kind in kinds {
+        if matches!(kind, LobeKind::Formula(_)) {
+            for &n in exponents {
+                specula::Lobe::checked(kind, n).map_err(|e| e.to_string())?;
+            }
+        }
+    }
+    Ok(())
 }

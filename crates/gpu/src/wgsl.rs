@@ -27,22 +27,58 @@ pub fn lobe_function(kind: LobeKind) -> String {
     format!("lobe_{}", kind.id().replace('-', "_"))
 }
 
+/// The lobe library with every user lobe defined so far ([`specula::formula::kinds`]): each
+/// formula's generated function of `n` and `t`, dispatched from `lobe_eval`'s default case
+/// by the kind's index, so that a user's lobe renders as the built-in ones do. A module
+/// built before a formula was defined does not know it (its index then gives 0).
+#[must_use]
+pub fn lobes() -> String {
+    let mut cases = String::new();
+    let mut functions = String::new();
+    for kind in specula::formula::kinds() {
+        let lobe = specula::Lobe::new(kind, specula::Exponent::new(1.0));
+        let name = format!("lobe_formula_{}", kind.index());
+        if let Some(function) = specula_targets::wgsl::lobe_function_of_n(&lobe, &name) {
+            functions.push_str(&function);
+            cases.push_str(&format!(
+                "        case {}u: {{ return {name}(lobe.n, t); }}\n",
+                kind.index()
+            ));
+        }
+    }
+    let dispatch = format!(
+        "
+// The user's lobes, by kind index (specula::formula).
+fn lobe_formula(lobe: Lobe, t: f32) -> f32 {{
+    switch lobe.kind {{
+{cases}        default: {{ return 0.0; }}
+    }}
+}}
+"
+    );
+    LOBES.replace(
+        "default: { return 0.0; }",
+        "default: { return lobe_formula(lobe, c); }",
+    ) + &functions
+        + &dispatch
+}
+
 /// The render module's source.
 #[must_use]
 pub fn render_module() -> String {
-    [LOBES, GEOMETRY, BRDF, RENDER].concat()
+    [lobes().as_str(), GEOMETRY, BRDF, RENDER].concat()
 }
 
 /// The volume ray marcher's source.
 #[must_use]
 pub fn volume_module() -> String {
-    [LOBES, GEOMETRY, VOLUME].concat()
+    [lobes().as_str(), GEOMETRY, VOLUME].concat()
 }
 
 /// The compute module's source.
 #[must_use]
 pub fn evaluate_module() -> String {
-    [LOBES, EVALUATE].concat()
+    [lobes().as_str(), EVALUATE].concat()
 }
 
 /// Parses and validates WGSL with naga, as wgpu will; the error names the line.

@@ -32,6 +32,9 @@ fn bound_in_ulps(kind: LobeKind, n: f64) -> f64 {
         LobeKind::Cheb2Thesis | LobeKind::Cheb2 | LobeKind::Minimax2 => 8192.0,
         LobeKind::Sg | LobeKind::SgKaris => 64.0,
         LobeKind::FastPow | LobeKind::FasterPow => 128.0 + 4.0 * n,
+        // The user lobes of the test below: a power of a base and an exponential, whose
+        // errors grow with n as the built-in ones'.
+        LobeKind::Formula(_) => 64.0 + 2.0 * n,
     }
 }
 
@@ -87,6 +90,35 @@ fn every_lobe_on_the_gpu_matches_f64_within_its_bound() {
             worst.0 / ULP,
             worst.1
         );
+    }
+}
+
+/// A user's lobe, defined before the evaluator is built, runs on the GPU as its generated
+/// WGSL (constants computed from `n` in the shader) and matches its own `f64` reference
+/// within the bound of the built-in lobe of the same shape.
+#[test]
+fn user_lobes_on_the_gpu_match_f64() {
+    let kinds = [
+        LobeKind::parse("=let a = (n + 1) / 17; max(0, a * (t - 1) + 1) ^ 16").unwrap(),
+        LobeKind::parse("=exp2(n * (t - 1) * 1.4427)").unwrap(),
+        LobeKind::parse("=let w = 1.875 / (n + 1); (1 - min(1, (1 - t) / w) ^ 2) ^ 2").unwrap(),
+    ];
+    let Some(gpu) = common::gpu() else { return };
+    let evaluator = LobeEvaluator::new(&gpu).unwrap();
+    let ts = cosines();
+    for kind in kinds {
+        for n in [1.0, 7.3, 64.0, 1000.0] {
+            let lobe = Lobe::new(kind, Exponent::new(n));
+            let values = evaluator.eval(&lobe, &ts).unwrap();
+            let bound = bound_in_ulps(kind, n) * ULP;
+            for (&t, &value) in ts.iter().zip(&values) {
+                let reference = lobe.eval(f64::from(t));
+                assert!(
+                    (f64::from(value) - reference).abs() <= bound,
+                    "{kind} n = {n} t = {t:e}: gpu {value:e}, f64 {reference:e}"
+                );
+            }
+        }
     }
 }
 

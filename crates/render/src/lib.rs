@@ -28,6 +28,7 @@ pub mod ibl;
 mod image;
 pub mod input;
 mod load;
+pub mod lobe_file;
 mod material;
 mod mesh;
 pub mod metrics;

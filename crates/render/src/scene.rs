@@ -119,6 +119,16 @@ impl Scene {
         }
     }
 
+    /// Refuses a user's lobe (after overrides) whose formula is not a lobe at its material's
+    /// `n` ([`specula::Lobe::checked`]).
+    pub fn check_lobes(&self) -> Result<(), String> {
+        for object in &self.objects {
+            let lobe = object.material.lobe;
+            Lobe::checked(lobe.kind(), lobe.exponent()).map_err(|e| e.to_string())?;
+        }
+        Ok(())
+    }
+
     /// The embedded default scene.
     #[must_use]
     pub fn default_scene() -> Scene {

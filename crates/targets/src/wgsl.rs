@@ -5,7 +5,7 @@ use core::fmt::Write as _;
 
 use specula::Lobe;
 
-use crate::code::{body, straight_line, Dialect, Parameters};
+use crate::code::{body, straight_line, Dialect, Inputs, Parameters};
 
 struct Wgsl;
 
@@ -44,6 +44,36 @@ fn specula_shift(x: f32, k: f32) -> f32 {
     return x * bitcast<f32>(u32(biased) << 23u);
 }
 ";
+
+/// `fn {name}(n: f32, t: f32) -> f32`: the lobe for `t` in `(0, 1]` with its constants
+/// computed from `n` in the shader (a renderer's material carries `n`, not the constants),
+/// for a lobe whose every parameter follows from `n` ([`Inputs::of`]); `None` for the
+/// fitted ones.
+#[must_use]
+pub fn lobe_function_of_n(lobe: &Lobe, name: &str) -> Option<String> {
+    let inputs = Inputs::of(lobe);
+    inputs.exponent?;
+    let expression = lobe.expression();
+    let (statements, result) = straight_line(&expression, "t", &Wgsl, Parameters::Named);
+    let mut lines = inputs.preparation("n", &Wgsl);
+    lines.extend(statements);
+    let mut out = String::new();
+    if expression.has_bit_tricks() {
+        out.push_str(HELPERS);
+    }
+    let _ = write!(
+        out,
+        "
+// {} at cosine t in (0, 1], its constants computed from n; generated from specula's
+// description of the lobe.
+fn {name}(n: f32, t: f32) -> f32 {{
+{}}}
+",
+        lobe.kind(),
+        body(&lines, &result, "    ", |r| format!("return {r};")),
+    );
+    Some(out)
+}
 
 /// `fn {name}(t: f32) -> f32`: the lobe for `t` in `(0, 1]`, generated from
 /// [`Lobe::expression`], preceded by the bit-trick helpers it calls.

@@ -43,6 +43,7 @@ pub fn run(args: &Args) -> CommandResult {
     } else {
         args.n.clone()
     };
+    crate::args::check_lobes(&lobes, &exponents)?;
     let jobs: Vec<(LobeKind, Exponent)> = lobes
         .iter()
         .flat_map(|&lobe| exponents.iter().map(move |&n| (lobe, n)))

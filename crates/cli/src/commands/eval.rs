@@ -52,7 +52,7 @@ struct Evaluation {
 
 /// Evaluates and prints.
 pub fn run(args: &Args) -> CommandResult {
-    let lobe = Lobe::new(args.lobe, args.n);
+    let lobe = Lobe::checked(args.lobe, args.n).map_err(|e| e.to_string())?;
     let geometry = Geometry::from(args.geometry);
     let (t, angle, value, value_f32) = match (args.cos, args.angle) {
         (Some(t), _) => (t, t.acos(), lobe.eval(t), lobe.eval(t as f32)),

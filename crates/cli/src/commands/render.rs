@@ -89,7 +89,7 @@ fn parse_grid(text: &str) -> Result<LobeList, String> {
     })?;
     list.split(',')
         .filter(|id| !id.is_empty())
-        .map(|id| LobeKind::parse(id.trim()).map_err(|e| e.to_string()))
+        .map(|id| specula_render::lobe_file::parse_lobe(id.trim(), None))
         .collect::<Result<_, _>>()
         .map(LobeList)
 }
@@ -126,6 +126,15 @@ fn load(args: &Args) -> Result<Scene, String> {
         height: args.height,
         samples: args.samples,
     });
+    scene.check_lobes()?;
+    if let Some(LobeList(lobes)) = &args.grid {
+        let exponents: Vec<Exponent> = scene
+            .objects
+            .iter()
+            .map(|o| o.material.lobe.exponent())
+            .collect();
+        crate::args::check_lobes(lobes, &exponents)?;
+    }
     Ok(scene)
 }
 

@@ -115,7 +115,8 @@ pub fn run(args: &Args) -> CommandResult {
         return Err("give --lobe and --n (or --test for the chi-square suite)".into());
     };
     let geometry = args.form.map_or(Geometry::Phong, Geometry::from);
-    let sampler = SpecularSampler::new(Lobe::new(kind, n), geometry, Normalisation::Lobe);
+    let lobe = Lobe::checked(kind, n).map_err(|e| e.to_string())?;
+    let sampler = SpecularSampler::new(lobe, geometry, Normalisation::Lobe);
     let wo = view(args.theta_o.unwrap_or(30.0));
     let drawn = (0..args.count).filter_map(|index| {
         let u = [0, 1].map(|d| uniform(args.seed, index, d));
@@ -164,6 +165,8 @@ fn suite(args: &Args) -> CommandResult {
     let views: Vec<f64> = args
         .theta_o
         .map_or_else(|| SUITE_VIEWS.to_vec(), |v| vec![v]);
+    let checked: Vec<Exponent> = exponents.iter().map(|&n| Exponent::new(n)).collect();
+    crate::args::check_lobes(&kinds, &checked)?;
     let mut cases = Vec::new();
     for &kind in &kinds {
         for &n in &exponents {

@@ -75,7 +75,7 @@ pub fn run(args: &Args) -> CommandResult {
     if args.lang == Lang::Naga(Language::Spirv) && args.output.is_none() {
         return Err("SPIR-V is binary; give an output file with -o (e.g. -o lobe.spv)".into());
     }
-    let lobe = Lobe::new(args.lobe, args.n);
+    let lobe = Lobe::checked(args.lobe, args.n).map_err(|e| e.to_string())?;
     let code = match args.lang {
         Lang::Naga(language) => {
             let options = Options {

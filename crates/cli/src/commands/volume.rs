@@ -176,7 +176,7 @@ pub fn run(args: &Args) -> CommandResult {
     let started = Instant::now();
     let volume = load(&args.source)?;
     let shading = Shading::new(
-        Lobe::new(args.lobe, args.n),
+        Lobe::checked(args.lobe, args.n).map_err(|e| e.to_string())?,
         args.geometry,
         args.normalisation,
     );

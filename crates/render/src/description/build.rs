@@ -279,8 +279,10 @@ fn build_material(locate: &Locator, m: &MaterialDescription) -> Result<Material,
     let invalid = |key: &'static str, span: Range<usize>| {
         move |error: specula::Error| locate.error(span, format!("material.{key}: {error}"))
     };
-    let kind = LobeKind::parse(m.lobe.get_ref()).map_err(invalid("lobe", m.lobe.span()))?;
+    let kind = crate::lobe_file::parse_lobe(m.lobe.get_ref(), locate.base)
+        .map_err(|error| locate.error(m.lobe.span(), format!("material.lobe: {error}")))?;
     let n = Exponent::try_new(*m.n.get_ref()).map_err(invalid("n", m.n.span()))?;
+    let lobe = Lobe::checked(kind, n).map_err(invalid("lobe", m.lobe.span()))?;
     let geometry =
         Geometry::parse(m.geometry.get_ref()).map_err(invalid("geometry", m.geometry.span()))?;
     let normalisation = Normalisation::parse(m.normalisation.get_ref())
@@ -292,7 +294,7 @@ fn build_material(locate: &Locator, m: &MaterialDescription) -> Result<Material,
         colour: locate.finite_non_negative("material.colour", &m.colour)?,
         specular_colour: locate
             .finite_non_negative("material.specular_colour", &m.specular_colour)?,
-        lobe: Lobe::new(kind, n),
+        lobe,
         geometry,
         normalisation,
     })

@@ -93,6 +93,8 @@ fn with_nearest_choice(message: &str) -> String {
 struct Locator<'a> {
     source: &'a str,
     file: &'a str,
+    /// The scene's directory: relative mesh and lobe-file paths start there.
+    base: Option<&'a Path>,
 }
 
 impl Locator<'_> {
@@ -142,7 +144,7 @@ impl Scene {
         file: &str,
         base: Option<&Path>,
     ) -> Result<LoadedScene, SceneError> {
-        let locate = Locator { source, file };
+        let locate = Locator { source, file, base };
         let description: SceneDescription = toml::from_str(source).map_err(|error| {
             locate.error(
                 error.span().unwrap_or(0..0),

@@ -38,7 +38,7 @@ mod syntax;
 use std::collections::BTreeMap;
 
 pub use compile::{FUNCTIONS, MAX_SLOTS};
-pub use registry::{define, instance, Instance, Naming, MAX_FORMULAS};
+pub use registry::{define, instance, kinds, parse_values, Instance, Naming, MAX_FORMULAS};
 pub use syntax::{MAX_DEPTH, MAX_LETS, MAX_NODES, MAX_SOURCE_BYTES};
 
 use crate::{Error, Exponent, Lobe, LobeKind};

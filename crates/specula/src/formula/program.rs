@@ -48,39 +48,66 @@ pub(crate) fn apply<R: Real>(op: Op, at: impl Fn(usize) -> R) -> R {
 /// `x^k` by squarings and multiplications (binary exponentiation): `x^16` is four squarings.
 #[inline]
 pub(crate) fn powi<R: Real>(x: R, k: i32) -> R {
-    by_squaring(x, k, R::from_f64(1.0), |a, b| a * b, R::square, |a, b| a / b)
+    by_squaring(OfReal(x), k).0
 }
 
-/// Binary exponentiation over any type with a product, a square and a quotient (the scalar
-/// path's `Real` and the columns' vectors compute the same sequence of roundings).
+/// What binary exponentiation needs: a product, a square and a reciprocal. Implemented for
+/// the scalar path's [`Real`] and the columns' vectors, so both compute the same sequence of
+/// roundings (methods, not closures: the columns call this from target-feature code).
+pub(crate) trait Multiplies: Copy {
+    fn times(self, other: Self) -> Self;
+    fn squared(self) -> Self;
+    fn reciprocal(self) -> Self;
+    fn one(self) -> Self;
+}
+
+#[derive(Clone, Copy)]
+struct OfReal<R>(R);
+
+impl<R: Real> Multiplies for OfReal<R> {
+    #[inline(always)]
+    fn times(self, other: Self) -> Self {
+        Self(self.0 * other.0)
+    }
+    #[inline(always)]
+    fn squared(self) -> Self {
+        Self(self.0.square())
+    }
+    #[inline(always)]
+    fn reciprocal(self) -> Self {
+        Self(R::from_f64(1.0) / self.0)
+    }
+    #[inline(always)]
+    fn one(self) -> Self {
+        Self(R::from_f64(1.0))
+    }
+}
+
+/// Binary exponentiation.
 #[inline(always)]
-pub(crate) fn by_squaring<T: Copy>(
-    x: T,
-    k: i32,
-    one: T,
-    multiply: impl Fn(T, T) -> T,
-    square: impl Fn(T) -> T,
-    divide: impl Fn(T, T) -> T,
-) -> T {
+pub(crate) fn by_squaring<T: Multiplies>(x: T, k: i32) -> T {
     let mut remaining = k.unsigned_abs();
     if remaining == 0 {
-        return one;
+        return x.one();
     }
     let mut base = x;
     let mut result: Option<T> = None;
     loop {
         if remaining & 1 == 1 {
-            result = Some(result.map_or(base, |r| multiply(r, base)));
+            result = Some(match result {
+                Some(r) => r.times(base),
+                None => base,
+            });
         }
         remaining >>= 1;
         if remaining == 0 {
             break;
         }
-        base = square(base);
+        base = base.squared();
     }
     let power = result.unwrap_or(base);
     if k < 0 {
-        divide(one, power)
+        power.reciprocal()
     } else {
         power
     }

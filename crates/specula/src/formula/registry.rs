@@ -265,13 +265,21 @@ pub(crate) fn find(name: &str) -> Option<&'static Formula> {
         .map(|(f, _)| *f)
 }
 
+/// Every user lobe (formula and parameter values) defined so far, in definition order.
+#[must_use]
+pub fn kinds() -> Vec<LobeKind> {
+    (0..read().instances.len())
+        .map(|i| LobeKind::Formula(FormulaId(i as u32)))
+        .collect()
+}
+
 /// Every defined formula's name.
 pub(crate) fn names() -> Vec<&'static str> {
     read().formulas.iter().map(|(_, info)| info.id).collect()
 }
 
-/// Parses `k=1.5,m=2` into pairs.
-pub(crate) fn parse_values(formula: &Formula, text: &str) -> Result<Vec<(String, f64)>, Error> {
+/// Parses a user lobe's parameter values, `k=1.5,m=2`, into pairs.
+pub fn parse_values(formula: &Formula, text: &str) -> Result<Vec<(String, f64)>, Error> {
     text.split(',')
         .map(|pair| {
             let (name, value) = pair.split_once('=').ok_or_else(|| Error::Formula {

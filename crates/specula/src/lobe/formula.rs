@@ -13,7 +13,7 @@
 
 use super::batch::LobeKernel;
 use super::{Inverted, NewtonForm};
-use crate::formula::batch::Scalar;
+use crate::formula::batch::Rules;
 use crate::formula::{registry, Instance, MAX_SLOTS};
 use crate::real::Real;
 use crate::simd::tally::Instructions;
@@ -25,6 +25,8 @@ use crate::Exponent;
 pub(crate) struct FormulaLobe {
     instance: &'static Instance,
     slots: [f64; MAX_SLOTS],
+    /// Which shared rules the batch's output needs at these constants.
+    rules: Rules,
 }
 
 impl PartialEq for FormulaLobe {
@@ -36,9 +38,11 @@ impl PartialEq for FormulaLobe {
 impl FormulaLobe {
     pub(crate) fn new(id: super::FormulaId, n: Exponent) -> Self {
         let instance = registry::get(id);
+        let slots = instance.formula().prepare(n.get(), instance.values());
         Self {
             instance,
-            slots: instance.formula().prepare(n.get(), instance.values()),
+            slots,
+            rules: instance.formula().plan().rules(&slots),
         }
     }
 
@@ -100,20 +104,6 @@ impl FormulaLobe {
             .preparation_of(name, n, self.instance.values())
     }
 
-    /// The columns' scalars for this `n`, in `f32`.
-    fn scalars(&self) -> Vec<f32> {
-        self.instance
-            .formula()
-            .plan()
-            .scalars()
-            .iter()
-            .map(|s| match *s {
-                Scalar::Slot(k) => self.slots[k] as f32,
-                Scalar::Constant(c) => c as f32,
-            })
-            .collect()
-    }
-
     /// The batch: the compiled columns, or the plain loop of the scalar `f32` formula.
     pub(crate) fn eval_batch(
         &self,
@@ -123,18 +113,14 @@ impl FormulaLobe {
         out: &mut [f32],
     ) {
         match batch_loop {
-            BatchLoop::Explicit => {
-                let scalars = self.scalars();
-                crate::simd::dispatch(
-                    level,
-                    Columns {
-                        lobe: self,
-                        scalars: &scalars,
-                        ts,
-                        out,
-                    },
-                );
-            }
+            BatchLoop::Explicit => crate::simd::dispatch(
+                level,
+                Columns {
+                    lobe: self,
+                    ts,
+                    out,
+                },
+            ),
             BatchLoop::Plain => crate::simd::plain_loop(self.kernel(), ts, out),
         }
     }
@@ -147,7 +133,6 @@ impl FormulaLobe {
 
 struct Columns<'a> {
     lobe: &'a FormulaLobe,
-    scalars: &'a [f32],
     ts: &'a [f32],
     out: &'a mut [f32],
 }
@@ -156,11 +141,12 @@ impl Job for Columns<'_> {
     type Output = ();
     #[inline(always)]
     fn run<V: Lanes>(self, lanes: V) {
-        self.lobe
-            .instance
-            .formula()
-            .plan()
-            .run(lanes, self.scalars, self.ts, self.out);
+        self.lobe.instance.formula().plan().run(
+            lanes,
+            (&self.lobe.slots, self.lobe.rules),
+            self.ts,
+            self.out,
+        );
     }
 }
 

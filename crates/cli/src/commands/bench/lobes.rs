@@ -81,6 +81,20 @@ impl Measured {
     }
 }
 
+/// The thesis's `K_4` written by hand as a formula (`docs/lobes/k4.toml`): the user lobe the
+/// benchmark holds against the built-in `cosquad` it spells.
+#[must_use]
+pub fn cosquad_formula() -> LobeKind {
+    let definition = specula_render::lobe_file::parse_definition(
+        include_str!("../../../../../docs/lobes/k4.toml"),
+        "docs/lobes/k4.toml",
+    )
+    .expect("docs/lobes/k4.toml is a lobe file");
+    specula::formula::define(definition, specula::formula::Naming::Exact)
+        .and_then(|formula| specula::formula::instance(formula, &[]))
+        .expect("docs/lobes/k4.toml is a valid formula")
+}
+
 fn cosines(len: usize) -> Vec<f32> {
     (0..len)
         .map(|i| 1.0 - 0.2 * ((i % 4093) as f32 / 4093.0).powi(2))
@@ -136,7 +150,11 @@ fn stream_rates(
 #[must_use]
 pub fn measure(n: Exponent, stream: bool, progress: &ProgressBar) -> Measured {
     let level = Level::detect();
-    progress.set_length(LobeKind::ALL.len() as u64 + 3);
+    let kinds: Vec<LobeKind> = LobeKind::ALL
+        .into_iter()
+        .chain([cosquad_formula()])
+        .collect();
+    progress.set_length(kinds.len() as u64 + 3);
     progress.set_message("peaks");
     let peaks_before = peak::measure(level);
     progress.inc(1);
@@ -153,7 +171,7 @@ pub fn measure(n: Exponent, stream: bool, progress: &ProgressBar) -> Measured {
     };
     let copy_before = copy_rates(&mut buffers);
     progress.inc(1);
-    let lobes = LobeKind::ALL
+    let lobes = kinds
         .iter()
         .map(|&kind| {
             progress.set_message(kind.to_string());
@@ -289,6 +307,22 @@ pub fn run(n: Exponent, format: Format) -> Result<(), String> {
             .map_or("-".into(), |c| format!("{} / {}", g(c[0]), g(c[1]))),
     );
     table.print(format);
+    let rate_of = |kind: LobeKind| {
+        measured
+            .lobes
+            .iter()
+            .find(|r| r.lobe == kind.to_string())
+            .map_or(f64::NAN, |r| r.explicit)
+    };
+    let (mine, built_in) = (
+        rate_of(cosquad_formula()),
+        rate_of(LobeKind::CosQuad { v: 4 }),
+    );
+    println!(
+        "cosquad written as a formula ({}, docs/lobes/k4.toml) runs at {} of the built-in          cosquad's kernel (the user-lobe floor is 50 %)",
+        cosquad_formula(),
+        percent(mine / built_in)
+    );
     Ok(())
 }
 

@@ -1,0 +1,833 @@
+//! A formula over a batch of cosines: its tape compiled to *columns*.
+//!
+//! An interpreter that dispatches on every operation for every vector spends more time
+//! choosing than computing. Here each operation runs over a whole block of
+//! [`BLOCK_VECTORS`] vectors before the next is chosen, so the choice is paid once per block
+//! and the loop inside is the kernel a compiler would write for that one operation (loads,
+//! the instruction, a store, all in L1). The per-material constants are splatted into
+//! registers once per batch; a multiply whose only use is an add becomes one fused
+//! multiply-add, as the built-in kernels compute it; registers are reused once their last
+//! reader has run.
+//!
+//! `log2`, `exp2` and `acos` are the built-in kernels' polynomials ([`crate::simd::math`]),
+//! valid on the ranges the lobes use; a block where any lane falls outside them (an `exp2`
+//! of a positive number, a `log2` of 0) is recomputed lane by lane with the standard library,
+//! so the columns are fast where the lobes live and right everywhere. `cos`, `sin`, `floor`
+//! and `ceil`, which no built-in lobe needs, always go lane by lane.
+
+mod chain;
+
+use super::compile::Op;
+use crate::simd::tally::{Class, Instructions};
+use crate::simd::{math, Lanes};
+pub(crate) use chain::Rules;
+use chain::{Chain, End, Link};
+
+/// Vectors per block: 16 vectors of 8 lanes keep a register in 512 bytes, so a formula's
+/// live registers stay in L1.
+pub const BLOCK_VECTORS: usize = 16;
+
+/// Where an operand comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Source {
+    /// A column register.
+    Register(usize),
+    /// A per-material constant (slot) or a folded constant, splatted.
+    Scalar(usize),
+}
+
+/// A scalar the batch splats: a slot's value or a constant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Scalar {
+    Slot(usize),
+    Constant(f64),
+}
+
+/// One step: a chain, or a column operation.
+#[derive(Clone, Debug, PartialEq)]
+enum Step {
+    Chain(Chain, End, End),
+    Unary(Unary, Source, usize),
+    Binary(Binary, Source, Source, usize),
+    Fma(Source, Source, Source, usize),
+    Powi(Source, i32, usize),
+    SelectLess([Source; 4], usize),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Unary {
+    Neg,
+    Sqrt,
+    Log2,
+    Exp2,
+    Exp,
+    Ln,
+    Acos,
+    Abs,
+    /// Lane by lane with the standard library.
+    Scalar(LaneFunction),
+}
+
+/// A function the columns compute lane by lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum LaneFunction {
+    Cos,
+    Sin,
+    Floor,
+    Ceil,
+}
+
+impl LaneFunction {
+    fn get(self) -> fn(f32) -> f32 {
+        match self {
+            LaneFunction::Cos => f32::cos,
+            LaneFunction::Sin => f32::sin,
+            LaneFunction::Floor => f32::floor,
+            LaneFunction::Ceil => f32::ceil,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Binary {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Min,
+    Max,
+    Pow,
+}
+
+/// A tape compiled to chains and column operations.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Plan {
+    scalars: Vec<Scalar>,
+    steps: Vec<Step>,
+    registers: usize,
+    /// Whether a column step reads `t` (register 0 then holds the clamped cosines).
+    needs_t: bool,
+    /// The result's register when no chain writes the output itself.
+    result: Option<Source>,
+}
+
+/// What a tape operation becomes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Role {
+    Scalar(usize),
+    T,
+    /// A link of a chain: its one varying operand and the link.
+    Link(usize, Link),
+    Column,
+}
+
+impl Plan {
+    /// Compiles `tape` (the formula's varying part).
+    pub(crate) fn new(tape: &[Op]) -> Self {
+        let mut uses = vec![0usize; tape.len()];
+        let mut last_use = vec![0usize; tape.len()];
+        for (index, op) in tape.iter().enumerate() {
+            for operand in op.operands() {
+                uses[operand] += 1;
+                last_use[operand] = index;
+            }
+        }
+        let mut scalars = Vec::new();
+        let mut roles: Vec<Role> = Vec::with_capacity(tape.len());
+        for &op in tape {
+            let role = match op {
+                Op::Slot(s) => {
+                    scalars.push(Scalar::Slot(s));
+                    Role::Scalar(scalars.len() - 1)
+                }
+                Op::Const(c) => {
+                    scalars.push(Scalar::Constant(c));
+                    Role::Scalar(scalars.len() - 1)
+                }
+                Op::T => Role::T,
+                op => link(op, &roles).map_or(Role::Column, |(x, l)| Role::Link(x, l)),
+            };
+            roles.push(role);
+        }
+        // A link continues into its one reader when that reader is a link taking it.
+        let continues = |index: usize| {
+            uses[index] == 1 && matches!(roles[last_use[index]], Role::Link(x, _) if x == index)
+        };
+        // A multiply read only by the add that follows it is fused into that add.
+        let fused_into_add = |index: usize| {
+            matches!(roles[index], Role::Column)
+                && matches!(tape[index], Op::Mul(..))
+                && uses[index] == 1
+                && matches!(roles[last_use[index]], Role::Column)
+                && matches!(tape[last_use[index]], Op::Add(a, b) if a == index || b == index)
+        };
+        let last = tape.len() - 1;
+        let mut source: Vec<Option<Source>> = vec![None; tape.len()];
+        let mut free: Vec<usize> = Vec::new();
+        let mut registers = 1;
+        let mut steps = Vec::new();
+        let mut needs_t = false;
+        let mut chains: Vec<Option<(usize, usize, Vec<Link>)>> = vec![None; tape.len()];
+        for index in 0..tape.len() {
+            let at = |i: usize| match roles[i] {
+                Role::Scalar(s) => Source::Scalar(s),
+                Role::T => Source::Register(0),
+                _ => source[i].unwrap_or(Source::Register(0)),
+            };
+            let mut take = |free: &mut Vec<usize>| {
+                free.pop().unwrap_or_else(|| {
+                    registers += 1;
+                    registers - 1
+                })
+            };
+            let release = |i: usize, reader: usize, free: &mut Vec<usize>| {
+                if last_use[i] == reader && matches!(roles[i], Role::Link(..) | Role::Column) {
+                    if let Some(Source::Register(r)) = source[i] {
+                        if r != 0 && !free.contains(&r) {
+                            free.push(r);
+                        }
+                    }
+                }
+            };
+            match roles[index] {
+                Role::Scalar(_) | Role::T => {}
+                Role::Link(x, l) => {
+                    // Extend the chain ending at `x`, or start one from `x`.
+                    let (head, first, mut links) =
+                        chains[x].take().unwrap_or((x, index, Vec::new()));
+                    push_fused(&mut links, l);
+                    if continues(index) {
+                        chains[index] = Some((head, first, links));
+                        continue;
+                    }
+                    let input = match roles[head] {
+                        Role::T => End::Batch,
+                        _ => End::Register(register_of(at(head))),
+                    };
+                    release(head, first, &mut free);
+                    let output = if index == last {
+                        End::Batch
+                    } else {
+                        let out = take(&mut free);
+                        source[index] = Some(Source::Register(out));
+                        End::Register(out)
+                    };
+                    steps.push(Step::Chain(Chain::new(links), input, output));
+                }
+                Role::Column => {
+                    if fused_into_add(index) {
+                        continue;
+                    }
+                    let op = tape[index];
+                    let operands = op.operands();
+                    needs_t |= operands.iter().any(|&i| roles[i] == Role::T);
+                    let out = take(&mut free);
+                    let step = match op {
+                        Op::Add(a, b) if fused_into_add(a) || fused_into_add(b) => {
+                            let (product, addend) = if fused_into_add(a) { (a, b) } else { (b, a) };
+                            let Op::Mul(x, y) = tape[product] else {
+                                unreachable!("fused_into_add holds multiplies")
+                            };
+                            needs_t |= [x, y].iter().any(|&i| roles[i] == Role::T);
+                            for i in [x, y] {
+                                release(i, product, &mut free);
+                            }
+                            release(addend, index, &mut free);
+                            Step::Fma(at(x), at(y), at(addend), out)
+                        }
+                        Op::SelectLess {
+                            a,
+                            b,
+                            then,
+                            otherwise,
+                        } => Step::SelectLess([at(a), at(b), at(then), at(otherwise)], out),
+                        Op::Powi(a, k) => Step::Powi(at(a), k, out),
+                        op => match (unary(op), binary(op)) {
+                            (Some(u), _) => Step::Unary(u, at(operands[0]), out),
+                            (_, Some(b)) => Step::Binary(b, at(operands[0]), at(operands[1]), out),
+                            _ => unreachable!("every operation of a tape is a step: {op:?}"),
+                        },
+                    };
+                    for &i in &operands {
+                        release(i, index, &mut free);
+                    }
+                    steps.push(step);
+                    source[index] = Some(Source::Register(out));
+                }
+            }
+        }
+        let result = match roles[last] {
+            Role::Link(..) => None,
+            Role::T => {
+                needs_t = true;
+                Some(Source::Register(0))
+            }
+            _ => source[last],
+        };
+        Self {
+            scalars,
+            steps,
+            registers,
+            needs_t,
+            result,
+        }
+    }
+
+    /// The rules a batch's output needs with these per-material constants (see [`Rules`]).
+    pub(crate) fn rules(&self, slots: &[f64]) -> Rules {
+        match self.steps.as_slice() {
+            [Step::Chain(chain, End::Batch, End::Batch)] => {
+                let values: Vec<f32> = self
+                    .scalars
+                    .iter()
+                    .map(|scalar| match *scalar {
+                        Scalar::Slot(k) => slots[k] as f32,
+                        Scalar::Constant(c) => c as f32,
+                    })
+                    .collect();
+                chain.rules(&values)
+            }
+            _ => Rules::ALL,
+        }
+    }
+
+    /// The instructions one vector costs (the loads and stores between steps aside), with
+    /// the shared rules.
+    pub(crate) fn instructions(&self) -> Instructions {
+        let rules = Instructions::of(&[(Class::MinMax, 4), (Class::Compare, 1), (Class::Logic, 1)]);
+        self.steps.iter().fold(rules, |total, step| {
+            total.and(match step {
+                Step::Chain(chain, ..) => chain
+                    .links
+                    .iter()
+                    .fold(Instructions::NONE, |sum, link| sum.and(link.instructions())),
+                Step::Fma(..) => Instructions::of(&[(Class::Fma, 1)]),
+                Step::Powi(_, k, _) => Link::Powi(*k).instructions(),
+                Step::SelectLess(..) => Instructions::of(&[(Class::Compare, 1), (Class::Blend, 1)]),
+                Step::Binary(b, ..) => match b {
+                    Binary::Add | Binary::Sub => Instructions::of(&[(Class::Add, 1)]),
+                    Binary::Mul => Instructions::of(&[(Class::Mul, 1)]),
+                    Binary::Div => Instructions::of(&[(Class::Div, 1)]),
+                    Binary::Min | Binary::Max => Instructions::of(&[(Class::MinMax, 1)]),
+                    Binary::Pow => Link::Pow(0).instructions(),
+                },
+                Step::Unary(u, ..) => match u {
+                    Unary::Neg => Link::Neg.instructions(),
+                    Unary::Abs => Link::Abs.instructions(),
+                    Unary::Sqrt => Link::Sqrt.instructions(),
+                    Unary::Log2 => Link::Log2.instructions(),
+                    Unary::Exp2 | Unary::Exp => Link::Exp2(1.0).instructions(),
+                    Unary::Ln => Link::Ln.instructions(),
+                    Unary::Acos => Link::Acos.instructions(),
+                    Unary::Scalar(f) => Link::Lane(*f).instructions(),
+                },
+            })
+        })
+    }
+
+    /// The formula at every cosine of `ts` into `out` (`slots` the per-material constants),
+    /// with the shared rules: `t` clamped to `[0, 1]`, the value clamped to `[0, 1]` (NaN to
+    /// 0), and 0 where `t <= 0` or NaN. The register file is the thread's, kept between
+    /// calls: a renderer calls this per tile, and an allocation per call would cost more
+    /// than the formula.
+    #[inline(always)]
+    pub(crate) fn run<V: Lanes>(
+        &self,
+        lanes: V,
+        (slots, rules): (&[f64], Rules),
+        ts: &[f32],
+        out: &mut [f32],
+    ) {
+        let block = BLOCK_VECTORS * V::WIDTH;
+        let count = self.scalars.len();
+        let size = count + (count + self.registers) * block;
+        // Taken out of the thread-local and put back, not used inside `with`: a closure is
+        // compiled without the level's features, and every intrinsic in it would be a call.
+        let mut storage = FILE.with(core::cell::RefCell::take);
+        if storage.len() < size {
+            storage.resize(size, 0.0);
+        }
+        let (values, file) = storage.split_at_mut(count);
+        for (value, scalar) in values.iter_mut().zip(&self.scalars) {
+            *value = match *scalar {
+                Scalar::Slot(k) => slots[k] as f32,
+                Scalar::Constant(c) => c as f32,
+            };
+        }
+        if self.steps.iter().any(|s| !matches!(s, Step::Chain(..))) {
+            for (s, &value) in values.iter().enumerate() {
+                file[s * block..(s + 1) * block].fill(value);
+            }
+        }
+        let mut whole_ts = ts.chunks_exact(block);
+        let mut whole_out = out.chunks_exact_mut(block);
+        for (t_block, out_block) in (&mut whole_ts).zip(&mut whole_out) {
+            self.run_block(lanes, (values, rules), file, t_block, out_block);
+        }
+        let (t_rest, out_rest) = (whole_ts.remainder(), whole_out.into_remainder());
+        if !t_rest.is_empty() {
+            let mut padded = [1.0_f32; BLOCK_VECTORS * MAX_WIDTH];
+            padded[..t_rest.len()].copy_from_slice(t_rest);
+            let mut result = [0.0_f32; BLOCK_VECTORS * MAX_WIDTH];
+            self.run_block(
+                lanes,
+                (values, rules),
+                file,
+                &padded[..block],
+                &mut result[..block],
+            );
+            out_rest.copy_from_slice(&result[..out_rest.len()]);
+        }
+        FILE.with(|cell| cell.replace(storage));
+    }
+
+    /// One whole block.
+    #[inline(always)]
+    fn run_block<V: Lanes>(
+        &self,
+        lanes: V,
+        (values, rules): (&[f32], Rules),
+        file: &mut [f32],
+        ts: &[f32],
+        out: &mut [f32],
+    ) {
+        let (width, block) = (V::WIDTH, BLOCK_VECTORS * V::WIDTH);
+        let base = self.scalars.len() * block;
+        let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
+        if self.needs_t {
+            let mut at = 0;
+            while at < block {
+                let clamped = one.min(lanes.load(&ts[at..at + width])).max(zero);
+                clamped.store(&mut file[base + at..base + at + width]);
+                at += width;
+            }
+        }
+        for step in &self.steps {
+            match step {
+                Step::Chain(chain, input, output) => {
+                    let offset = |end: End| match end {
+                        End::Register(r) => End::Register(base + r * block),
+                        End::Batch => End::Batch,
+                    };
+                    let mut buffers = chain::Buffers {
+                        rules,
+                        values,
+                        file,
+                        ts,
+                        out,
+                    };
+                    chain::run(
+                        lanes,
+                        chain,
+                        &mut buffers,
+                        (offset(*input), offset(*output)),
+                        block,
+                    );
+                }
+                step => run_step(lanes, step, file, base, block),
+            }
+        }
+        let Some(result) = self.result else {
+            return;
+        };
+        let result = match result {
+            Source::Register(r) => base + r * block,
+            Source::Scalar(s) => s * block,
+        };
+        let mut at = 0;
+        while at < block {
+            let t = lanes.load(&ts[at..at + width]);
+            let value = lanes.load(&file[result + at..result + at + width]);
+            value
+                .max(zero)
+                .min(one)
+                .keep(t.gt(zero))
+                .store(&mut out[at..at + width]);
+            at += width;
+        }
+    }
+}
+
+/// A chain's input register (its head's source is never a scalar: a link has one varying
+/// operand).
+fn register_of(source: Source) -> usize {
+    match source {
+        Source::Register(r) => r,
+        Source::Scalar(_) => 0,
+    }
+}
+
+/// Appends `link`, fusing it with the last one where a superinstruction does both: each
+/// link is a dispatch and a trip of the group through memory, so the common shapes of
+/// lobes (a multiply-add of a difference, a power of two) are one link each.
+fn push_fused(links: &mut Vec<Link>, link: Link) {
+    let fused = match (links.last(), link) {
+        (Some(&Link::Mul(a)), Link::Add(b)) => Some(Link::Fma(a, b)),
+        (Some(&Link::Sub(c)), Link::Fma(a, b)) => Some(Link::Affine(c, a, b)),
+        (Some(&Link::Squarings(m)), Link::Powi(k)) if k > 0 && k.count_ones() == 1 => {
+            Some(Link::Squarings(m + k.trailing_zeros()))
+        }
+        _ => None,
+    };
+    match fused {
+        Some(fused) => {
+            links.pop();
+            // The fused link may fuse again with the one before (`Sub` then `Mul`, `Add`).
+            push_fused(links, fused);
+        }
+        None => match link {
+            // A positive power of two is squarings, as `cosquad` computes it.
+            Link::Powi(k) if k > 0 && k.count_ones() == 1 => {
+                links.push(Link::Squarings(k.trailing_zeros()));
+            }
+            link => links.push(link),
+        },
+    }
+}
+
+/// `op` as a link: its one varying operand and the link, when its other operands are
+/// scalars and it has one.
+fn link(op: Op, roles: &[Role]) -> Option<(usize, Link)> {
+    let scalar = |i: usize| match roles[i] {
+        Role::Scalar(s) => Some(s),
+        _ => None,
+    };
+    let varying = |i: usize| scalar(i).is_none();
+    Some(match op {
+        Op::Add(a, b) if varying(a) => (a, Link::Add(scalar(b)?)),
+        Op::Add(a, b) => (b, Link::Add(scalar(a)?)),
+        Op::Sub(a, b) if varying(a) => {
+            // x - s as x + (-s) would round the constant: keep a subtraction.
+            (a, Link::Sub(scalar(b)?))
+        }
+        Op::Sub(a, b) => (b, Link::SubFrom(scalar(a)?)),
+        Op::Mul(a, b) if varying(a) => (a, Link::Mul(scalar(b)?)),
+        Op::Mul(a, b) => (b, Link::Mul(scalar(a)?)),
+        Op::Div(a, b) if varying(a) => (a, Link::Div(scalar(b)?)),
+        Op::Div(a, b) => (b, Link::DivInto(scalar(a)?)),
+        Op::Min(a, b) if varying(a) => (a, Link::Min(scalar(b)?)),
+        Op::Min(a, b) => (b, Link::Min(scalar(a)?)),
+        Op::Max(a, b) if varying(a) => (a, Link::Max(scalar(b)?)),
+        Op::Max(a, b) => (b, Link::Max(scalar(a)?)),
+        Op::Pow(a, b) if varying(a) => (a, Link::Pow(scalar(b)?)),
+        Op::Powi(a, k) => (a, Link::Powi(k)),
+        Op::Neg(a) => (a, Link::Neg),
+        Op::Abs(a) => (a, Link::Abs),
+        Op::Sqrt(a) => (a, Link::Sqrt),
+        Op::Log2(a) => (a, Link::Log2),
+        Op::Ln(a) => (a, Link::Ln),
+        Op::Exp2(a) => (a, Link::Exp2(1.0)),
+        Op::Exp(a) => (a, Link::Exp2(core::f32::consts::LOG2_E)),
+        Op::Acos(a) => (a, Link::Acos),
+        Op::Cos(a) => (a, Link::Lane(LaneFunction::Cos)),
+        Op::Sin(a) => (a, Link::Lane(LaneFunction::Sin)),
+        Op::Floor(a) => (a, Link::Lane(LaneFunction::Floor)),
+        Op::Ceil(a) => (a, Link::Lane(LaneFunction::Ceil)),
+        _ => return None,
+    })
+}
+
+/// The widest level's lanes (AVX2's 8).
+const MAX_WIDTH: usize = 8;
+
+thread_local! {
+    static FILE: core::cell::RefCell<Vec<f32>> = const { core::cell::RefCell::new(Vec::new()) };
+}
+
+fn unary(op: Op) -> Option<Unary> {
+    Some(match op {
+        Op::Neg(_) => Unary::Neg,
+        Op::Sqrt(_) => Unary::Sqrt,
+        Op::Log2(_) => Unary::Log2,
+        Op::Exp2(_) => Unary::Exp2,
+        Op::Exp(_) => Unary::Exp,
+        Op::Ln(_) => Unary::Ln,
+        Op::Acos(_) => Unary::Acos,
+        Op::Abs(_) => Unary::Abs,
+        Op::Cos(_) => Unary::Scalar(LaneFunction::Cos),
+        Op::Sin(_) => Unary::Scalar(LaneFunction::Sin),
+        Op::Floor(_) => Unary::Scalar(LaneFunction::Floor),
+        Op::Ceil(_) => Unary::Scalar(LaneFunction::Ceil),
+        _ => return None,
+    })
+}
+
+fn binary(op: Op) -> Option<Binary> {
+    Some(match op {
+        Op::Add(..) => Binary::Add,
+        Op::Sub(..) => Binary::Sub,
+        Op::Mul(..) => Binary::Mul,
+        Op::Div(..) => Binary::Div,
+        Op::Min(..) => Binary::Min,
+        Op::Max(..) => Binary::Max,
+        Op::Pow(..) => Binary::Pow,
+        _ => None?,
+    })
+}
+
+/// An operation on `N` vectors, as a type: called from the level's target-feature function
+/// and `#[inline(always)]`, so that its intrinsics are inlined (a closure here would be a
+/// function of its own, compiled without the features, and every intrinsic in it a call).
+trait Map<const N: usize>: Copy {
+    fn apply<V: Lanes>(self, x: [V; N]) -> V;
+}
+
+macro_rules! map {
+    ($name:ident, $n:literal, |$x:ident $(, $field:ident: $ty:ty)*| $body:expr) => {
+        #[derive(Clone, Copy)]
+        struct $name { $($field: $ty),* }
+        impl Map<$n> for $name {
+            #[inline(always)]
+            #[allow(unused_variables)]
+            fn apply<V: Lanes>(self, $x: [V; $n]) -> V {
+                $(let $field = self.$field;)*
+                $body
+            }
+        }
+    };
+}
+
+map!(AddOp, 2, |x| x[0] + x[1]);
+map!(SubOp, 2, |x| x[0] - x[1]);
+map!(MulOp, 2, |x| x[0] * x[1]);
+map!(DivOp, 2, |x| x[0] / x[1]);
+map!(MinOp, 2, |x| x[0].min(x[1]));
+map!(MaxOp, 2, |x| x[0].max(x[1]));
+map!(FmaOp, 3, |x| x[0].mul_add(x[1], x[2]));
+map!(SelectOp, 4, |x| x[2].select(x[0].lt(x[1]), x[3]));
+map!(PowiOp, 1, |x, k: i32| powi(x[0], k));
+map!(ScaleOp, 1, |x, by: f32| x[0] * x[0].splat(by));
+map!(AbsOp, 1, |x| x[0].max(x[0] * x[0].splat(-1.0)));
+map!(SqrtOp, 1, |x| x[0].sqrt());
+map!(Log2Op, 1, |x| math::log2(x[0]));
+map!(LnOp, 1, |x| math::log2(x[0])
+    * x[0].splat(core::f32::consts::LN_2));
+map!(PowLogOp, 2, |x| x[1] * math::log2(x[0]));
+map!(Exp2Op, 1, |x, scale: f32| math::exp2(
+    x[0] * x[0].splat(scale)
+));
+map!(AcosOp, 1, |x| math::acos(x[0]));
+// 1 where `low < scale x < high` (NaN fails both), else 0.
+map!(Inside, 1, |x, scale: f32, low: f32, high: f32| {
+    let (zero, one) = (x[0].splat(0.0), x[0].splat(1.0));
+    let y = x[0] * x[0].splat(scale);
+    one.select(y.gt(y.splat(low)), zero)
+        .select(y.lt(y.splat(high)), zero)
+});
+
+/// `op` over every vector of the block: reads the operand columns, writes column `out`
+/// (never one of them: the planner gives every result a register of its own at that step).
+#[inline(always)]
+fn columns<V: Lanes, const N: usize, M: Map<N>>(
+    lanes: V,
+    file: &mut [f32],
+    operands: [usize; N],
+    out: usize,
+    block: usize,
+    op: M,
+) {
+    let (before, rest) = file.split_at_mut(out);
+    let (target, after) = rest.split_at_mut(block);
+    let read = |column: usize| -> &[f32] {
+        if column < out {
+            &before[column..column + block]
+        } else {
+            &after[column - out - block..column - out]
+        }
+    };
+    let mut sources: [&[f32]; N] = [&[]; N];
+    for (source, &column) in sources.iter_mut().zip(&operands) {
+        *source = read(column);
+    }
+    let width = V::WIDTH;
+    for (i, chunk) in target.chunks_exact_mut(width).enumerate() {
+        let mut values = [lanes; N];
+        for (value, source) in values.iter_mut().zip(&sources) {
+            *value = lanes.load(&source[i * width..(i + 1) * width]);
+        }
+        op.apply(values).store(chunk);
+    }
+}
+
+/// `op` over column `column`, in place.
+#[inline(always)]
+fn in_place<V: Lanes, M: Map<1>>(lanes: V, file: &mut [f32], column: usize, block: usize, op: M) {
+    for chunk in file[column..column + block].chunks_exact_mut(V::WIDTH) {
+        op.apply([lanes.load(chunk)]).store(chunk);
+    }
+}
+
+/// A lane-by-lane pass with the standard library, for what the polynomials do not cover.
+fn lane_by_lane(file: &mut [f32], operand: usize, out: usize, block: usize, f: fn(f32) -> f32) {
+    for i in 0..block {
+        file[out + i] = f(file[operand + i]);
+    }
+}
+
+/// Whether every lane of the block's column passes `inside` (which gives 1 or 0 per lane).
+#[inline(always)]
+fn all_inside<V: Lanes>(
+    lanes: V,
+    file: &[f32],
+    column: usize,
+    block: usize,
+    inside: Inside,
+) -> bool {
+    let width = V::WIDTH;
+    let mut worst = lanes.splat(1.0);
+    let mut at = 0;
+    while at < block {
+        worst = worst.min(inside.apply([lanes.load(&file[column + at..column + at + width])]));
+        at += width;
+    }
+    let mut lanes_out = [0.0_f32; 64];
+    worst.store(&mut lanes_out[..width]);
+    lanes_out[..width].iter().all(|&v| v == 1.0)
+}
+
+/// Positive, finite and normal: where the `log2` polynomial holds.
+const LOG2_DOMAIN: Inside = Inside {
+    scale: 1.0,
+    low: f32::MIN_POSITIVE,
+    high: f32::MAX,
+};
+
+/// `[0, 1]` and a rounding either side: where the `acos` polynomial holds.
+const ACOS_DOMAIN: Inside = Inside {
+    scale: 1.0,
+    low: -f32::MIN_POSITIVE,
+    high: 1.0 + f32::EPSILON,
+};
+
+#[inline(always)]
+fn log2_column<V: Lanes>(lanes: V, file: &mut [f32], a: usize, r: usize, block: usize) {
+    if all_inside(lanes, file, a, block, LOG2_DOMAIN) {
+        columns(lanes, file, [a], r, block, Log2Op {});
+    } else {
+        lane_by_lane(file, a, r, block, f32::log2);
+    }
+}
+
+#[inline(always)]
+fn run_step<V: Lanes>(lanes: V, step: &Step, file: &mut [f32], base: usize, block: usize) {
+    let column = |source: Source| match source {
+        Source::Register(r) => base + r * block,
+        Source::Scalar(s) => s * block,
+    };
+    let out = |r: usize| base + r * block;
+    match *step {
+        Step::Chain(..) => unreachable!("chains run in run_block"),
+        Step::Fma(a, b, c, r) => columns(
+            lanes,
+            file,
+            [column(a), column(b), column(c)],
+            out(r),
+            block,
+            FmaOp {},
+        ),
+        Step::Powi(a, k, r) => columns(lanes, file, [column(a)], out(r), block, PowiOp { k }),
+        Step::SelectLess([a, b, then, otherwise], r) => {
+            let operands = [column(a), column(b), column(then), column(otherwise)];
+            columns(lanes, file, operands, out(r), block, SelectOp {});
+        }
+        Step::Binary(op, a, b, r) => {
+            let (operands, r) = ([column(a), column(b)], out(r));
+            match op {
+                Binary::Add => columns(lanes, file, operands, r, block, AddOp {}),
+                Binary::Sub => columns(lanes, file, operands, r, block, SubOp {}),
+                Binary::Mul => columns(lanes, file, operands, r, block, MulOp {}),
+                Binary::Div => columns(lanes, file, operands, r, block, DivOp {}),
+                Binary::Min => columns(lanes, file, operands, r, block, MinOp {}),
+                Binary::Max => columns(lanes, file, operands, r, block, MaxOp {}),
+                Binary::Pow => {
+                    // exp2(b log2 a), each half checked against its polynomial's range.
+                    if all_inside(lanes, file, operands[0], block, LOG2_DOMAIN) {
+                        columns(lanes, file, operands, r, block, PowLogOp {});
+                    } else {
+                        for i in 0..block {
+                            file[r + i] = file[operands[1] + i] * file[operands[0] + i].log2();
+                        }
+                    }
+                    exp2_column(lanes, file, r, r, block, 1.0);
+                }
+            }
+        }
+        Step::Unary(op, a, r) => {
+            let (a, r) = (column(a), out(r));
+            match op {
+                Unary::Neg => columns(lanes, file, [a], r, block, ScaleOp { by: -1.0 }),
+                Unary::Abs => columns(lanes, file, [a], r, block, AbsOp {}),
+                Unary::Sqrt => columns(lanes, file, [a], r, block, SqrtOp {}),
+                Unary::Log2 => log2_column(lanes, file, a, r, block),
+                Unary::Ln => {
+                    if all_inside(lanes, file, a, block, LOG2_DOMAIN) {
+                        columns(lanes, file, [a], r, block, LnOp {});
+                    } else {
+                        lane_by_lane(file, a, r, block, |x| x.log2() * core::f32::consts::LN_2);
+                    }
+                }
+                Unary::Exp2 => exp2_column(lanes, file, a, r, block, 1.0),
+                Unary::Exp => exp2_column(lanes, file, a, r, block, core::f32::consts::LOG2_E),
+                Unary::Acos => {
+                    if all_inside(lanes, file, a, block, ACOS_DOMAIN) {
+                        columns(lanes, file, [a], r, block, AcosOp {});
+                    } else {
+                        lane_by_lane(file, a, r, block, f32::acos);
+                    }
+                }
+                Unary::Scalar(f) => lane_by_lane(file, a, r, block, f.get()),
+            }
+        }
+    }
+}
+
+/// `exp2(scale x)`: the polynomial on `(-inf, 0]` (0 below -127), the standard library
+/// elsewhere.
+#[inline(always)]
+fn exp2_column<V: Lanes>(lanes: V, file: &mut [f32], a: usize, r: usize, block: usize, scale: f32) {
+    let domain = Inside {
+        scale,
+        low: -f32::MAX,
+        high: f32::MIN_POSITIVE,
+    };
+    if all_inside(lanes, file, a, block, domain) {
+        if a == r {
+            in_place(lanes, file, r, block, Exp2Op { scale });
+        } else {
+            columns(lanes, file, [a], r, block, Exp2Op { scale });
+        }
+    } else {
+        for i in 0..block {
+            file[r + i] = (file[a + i] * scale).exp2();
+        }
+    }
+}
+
+/// `x^k` in [`super::program::powi`]'s order (so `x^16` is the four squarings `cosquad`'s
+/// kernel computes).
+#[inline(always)]
+fn powi<V: Lanes>(x: V, k: i32) -> V {
+    super::program::by_squaring(OfLanes(x), k).0
+}
+
+#[derive(Clone, Copy)]
+struct OfLanes<V>(V);
+
+impl<V: Lanes> super::program::Multiplies for OfLanes<V> {
+    #[inline(always)]
+    fn times(self, other: Self) -> Self {
+        Self(self.0 * other.0)
+    }
+    #[inline(always)]
+    fn squared(self) -> Self {
+        Self(self.0 * self.0)
+    }
+    #[inline(always)]
+    fn reciprocal(self) -> Self {
+        Self(self.0.splat(1.0) / self.0)
+    }
+    #[inline(always)]
+    fn one(self) -> Self {
+        Self(self.0.splat(1.0))
+    }
+}
