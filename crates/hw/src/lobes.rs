@@ -79,6 +79,15 @@ pub enum HwError {
     /// Not a datapath id.
     #[error("unknown hardware datapath `{0}`; valid: {valid}{hint}", valid = HwLobe::valid_ids(), hint = specula::did_you_mean(.0, HwLobe::ALL.map(HwLobe::id)))]
     UnknownLobe(String),
+    /// A user's lobe (a lobe file or a formula): no datapath is generated from a formula.
+    #[error(
+        "`{}` is a lobe of yours; the fixed-point datapaths are designed per model (word \
+         lengths, tables, shifts), not generated from a formula, so a user lobe has none; \
+         valid: {valid}",
+        specula::excerpt(.0),
+        valid = HwLobe::valid_ids()
+    )]
+    UserLobe(String),
     /// A word length outside [`BITS`].
     #[error("word length {0} is out of range; valid: 8 to 24 bits")]
     Bits(u32),
@@ -126,7 +135,17 @@ impl HwLobe {
         Self::ALL
             .into_iter()
             .find(|lobe| lobe.id() == text)
-            .ok_or_else(|| HwError::UnknownLobe(specula::excerpt(text)))
+            .ok_or_else(|| {
+                let text = text.trim();
+                let user = text.starts_with('@')
+                    || text.starts_with('=')
+                    || matches!(LobeKind::parse(text), Ok(LobeKind::Formula(_)));
+                if user {
+                    HwError::UserLobe(text.to_owned())
+                } else {
+                    HwError::UnknownLobe(specula::excerpt(text))
+                }
+            })
     }
 
     /// The float model it implements.

@@ -65,6 +65,11 @@ pub struct Args {
     /// the BRDF energy-conserving).
     #[arg(long)]
     energy_conserving: bool,
+    /// Also consider these lobes: your own (`@FILE.toml`, `=FORMULA`), or a built-in with
+    /// other parameters (`cosquad:v=5`); comma separated. On `fpga` a lobe without a
+    /// fixed-point datapath is listed as unavailable.
+    #[arg(long, value_parser = crate::args::LobeParser, value_delimiter = ',')]
+    lobe: Vec<LobeKind>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
     format: crate::args::Format,
@@ -337,13 +342,20 @@ pub(crate) fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
 /// Measures, ranks and prints.
 pub fn run(args: &Args) -> CommandResult {
     let exponents = &args.n.0;
+    crate::args::check_lobes(&args.lobe, exponents)?;
+    let mut kinds = LobeKind::ALL.to_vec();
+    for &kind in &args.lobe {
+        if !kinds.contains(&kind) {
+            kinds.push(kind);
+        }
+    }
     let costing = Costing::new(args.target, exponents)?;
-    let progress = ProgressBar::new(LobeKind::ALL.len() as u64).with_style(
+    let progress = ProgressBar::new(kinds.len() as u64).with_style(
         ProgressStyle::with_template("measuring {bar:30} {pos}/{len} lobes {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut candidates = Vec::new();
-    for kind in LobeKind::ALL {
+    for kind in kinds {
         progress.set_message(kind.to_string());
         let mut error = 0.0_f64;
         let mut energy = 0.0_f64;

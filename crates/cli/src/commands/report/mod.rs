@@ -14,6 +14,7 @@ mod renders;
 mod sections;
 mod verdict;
 mod volumes;
+mod yours;
 
 use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
@@ -22,6 +23,7 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use specula::claims::ClaimOptions;
+use specula::{Exponent, LobeKind};
 use specula_hw::analysis::WidthSweep;
 use specula_hw::{HwLobe, BITS};
 use specula_render::{write_atomically, write_png_srgb8, Display, Image, Scene};
@@ -40,6 +42,9 @@ pub struct Args {
     /// Also measure each lobe's throughput and plot error against speed.
     #[arg(long)]
     bench: bool,
+    /// Add your own lobes to every section (`@FILE.toml`, `=FORMULA`; comma separated).
+    #[arg(long, value_parser = crate::args::LobeParser, value_delimiter = ',')]
+    lobe: Vec<LobeKind>,
 }
 
 /// How much each section computes.
@@ -74,6 +79,8 @@ pub struct Context {
     bench: bool,
     files: Vec<String>,
     shared: Arc<Shared>,
+    /// Every lobe the sections show: the built-in ones, then the user's.
+    lobes: Vec<LobeKind>,
 }
 
 /// Every datapath's sweeps over word lengths, per hardware exponent.
@@ -211,8 +218,26 @@ pub fn run(args: &Args) -> CommandResult {
             args.out.display()
         )
     })?;
+    let mut lobes = LobeKind::ALL.to_vec();
+    for &kind in &args.lobe {
+        if !lobes.contains(&kind) {
+            lobes.push(kind);
+        }
+    }
+    // Every exponent a section uses lies on the plots' grid or among these.
+    let sizes = sections::sizes(args.quick);
+    let mut checked = sections::exponents(sizes.n_steps);
+    checked.extend([8.0, 64.0, 100.0, 512.0].map(Exponent::new));
+    checked.extend(
+        sizes
+            .hardware_exponents
+            .iter()
+            .map(|&n| Exponent::new(f64::from(n))),
+    );
+    crate::args::check_lobes(&args.lobe, &checked)?;
     let shared = Arc::new(Shared::default());
     let context = || Context {
+        lobes: lobes.clone(),
         directory: args.out.clone(),
         sizes: sections::sizes(args.quick),
         bench: args.bench,

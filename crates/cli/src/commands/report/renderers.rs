@@ -29,10 +29,11 @@ fn bit_exact(lobe: &Lobe, expression: &Expression, cosines: &[f32]) -> (usize, u
     (same(expression), same(&lowered))
 }
 
-pub fn renderers(_: &mut Context) -> Result<String, String> {
+pub fn renderers(context: &mut Context) -> Result<String, String> {
     let cosines: Vec<f32> = (1..=20_000).map(|k| k as f32 / 20_000.0).collect();
     let lobe = |kind: LobeKind, n: f64| Lobe::try_new(kind, n).map_err(|e| e.to_string());
-    let description = LobeKind::ALL
+    let description = context
+        .lobes
         .par_iter()
         .map(|&kind| {
             let lobe = lobe(kind, DESCRIPTION_EXPONENT)?;
@@ -52,7 +53,8 @@ pub fn renderers(_: &mut Context) -> Result<String, String> {
             ])
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let fits = LobeKind::ALL
+    let fits = context
+        .lobes
         .par_iter()
         .map(|&kind| {
             let mut row = vec![kind.id().to_owned()];

@@ -43,7 +43,7 @@ fn lobe_table(
     draw: &dyn Fn(&Scene) -> Result<Image, String>,
 ) -> Result<(String, Vec<Option<Image>>), String> {
     let options = GridOptions {
-        lobes: LobeKind::ALL.to_vec(),
+        lobes: context.lobes.clone(),
         reference: LobeKind::Pow,
     };
     // The grid draws the reference as render 0 and each other lobe as render `column + 1`;

@@ -20,7 +20,7 @@ use crate::output::sig;
 type Pick = fn(&ErrorFigures) -> f64;
 
 /// Exponents from 1 to 1000, log-spaced, `steps + 1` of them.
-fn exponents(steps: usize) -> Vec<Exponent> {
+pub(super) fn exponents(steps: usize) -> Vec<Exponent> {
     (0..=steps)
         .map(|k| Exponent::new(1000f64.powf(k as f64 / steps as f64).clamp(1.0, 1000.0)))
         .collect()
@@ -43,9 +43,10 @@ pub(super) fn series(kind: LobeKind, points: Vec<(f64, f64)>) -> Series {
     }
 }
 
-pub fn models(_: &mut Context) -> Result<String, String> {
+pub fn models(context: &mut Context) -> Result<String, String> {
     let n = Exponent::new(100.0);
-    let rows: Vec<Vec<String>> = LobeKind::ALL
+    let rows: Vec<Vec<String>> = context
+        .lobes
         .iter()
         .map(|&kind| {
             let info = kind.info();
@@ -88,7 +89,8 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
             bloom_angle(exponent).to_degrees(),
         );
         let right = (2.0 * bloom).min(90.0);
-        let curves: Vec<Series> = LobeKind::ALL
+        let curves: Vec<Series> = context
+            .lobes
             .iter()
             .map(|&kind| {
                 let lobe = Lobe::new(kind, exponent);
@@ -147,7 +149,12 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
 
 pub fn errors(context: &mut Context) -> Result<String, String> {
     let mut html = paragraph("Signed error lobe - t^n against the angle, scaled by the bloom's edge so that every n fits one axis, for n = 8, 64 and 512.");
-    for kind in LobeKind::ALL.into_iter().filter(|&k| k != LobeKind::Pow) {
+    for kind in context
+        .lobes
+        .clone()
+        .into_iter()
+        .filter(|&k| k != LobeKind::Pow)
+    {
         let mut low: f64 = -1e-3;
         let mut high: f64 = 1e-3;
         let curves: Vec<Series> = [8.0, 64.0, 512.0]
@@ -198,8 +205,10 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
     }
     let sizes = context.sizes.clone();
     let grid = exponents(sizes.n_steps);
-    let kinds: Vec<LobeKind> = LobeKind::ALL
-        .into_iter()
+    let kinds: Vec<LobeKind> = context
+        .lobes
+        .iter()
+        .copied()
         .filter(|&k| k != LobeKind::Pow)
         .collect();
     let figures: Vec<Vec<(f64, ErrorFigures)>> = kinds
@@ -294,7 +303,7 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
 
 pub fn energy(context: &mut Context) -> Result<String, String> {
     let grid = exponents(context.sizes.n_steps);
-    let kinds: Vec<LobeKind> = LobeKind::ALL.to_vec();
+    let kinds: Vec<LobeKind> = context.lobes.clone();
     let ratios: Vec<Vec<(f64, f64)>> = kinds
         .par_iter()
         .map(|&kind| {
@@ -388,7 +397,8 @@ pub fn reciprocity(context: &mut Context) -> Result<String, String> {
     use rand::SeedableRng;
     let pairs = context.sizes.reciprocity_pairs;
     let exponents = [8.0, 64.0, 512.0].map(Exponent::new);
-    let rows: Vec<Vec<String>> = LobeKind::ALL
+    let rows: Vec<Vec<String>> = context
+        .lobes
         .par_iter()
         .map(|&kind| {
             let mut row = vec![kind.to_string()];
@@ -473,6 +483,7 @@ pub fn claims(context: &mut Context) -> Result<String, String> {
         .collect();
     html += &paragraph("The figures behind the verdicts:");
     html += &table(&["claim", "figure", "value"], &figure_rows);
+    html += &super::yours::claims_figures(context);
     Ok(html)
 }
 
@@ -486,7 +497,7 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
     });
     let mut rows = Vec::new();
     let mut points = Vec::new();
-    for (k, kind) in LobeKind::ALL.into_iter().enumerate() {
+    for (k, kind) in context.lobes.clone().into_iter().enumerate() {
         let lobe = Lobe::new(kind, n);
         let error = error_figures(&lobe, &mut Precision::F64, context.sizes.samples_per_zone)
             .epicentre_max_rel;

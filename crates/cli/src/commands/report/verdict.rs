@@ -24,9 +24,14 @@ const PLOTTED: f64 = 64.0;
 const EXACT_FLOOR: f64 = 1e-6;
 
 /// Every lobe at `n`: its epicentre error and its shader's instructions.
-fn measure(n: f64, samples: usize) -> Result<Vec<(LobeKind, f64, ShaderOps)>, String> {
-    LobeKind::ALL
-        .into_iter()
+fn measure(
+    lobes: &[LobeKind],
+    n: f64,
+    samples: usize,
+) -> Result<Vec<(LobeKind, f64, ShaderOps)>, String> {
+    lobes
+        .iter()
+        .copied()
         .map(|kind| {
             let lobe = Lobe::new(kind, Exponent::new(n));
             let error = error_figures(&lobe, &mut Precision::F64, samples).epicentre_max_rel;
@@ -57,9 +62,21 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
          (crates/specula/src/gpu_cost.rs). The ratio is its modelled rate over pow's. For \
          the CPU, run specula recommend --target cpu: its costs are measured.",
     );
+    let yours: Vec<String> = context
+        .lobes
+        .iter()
+        .filter(|kind| matches!(kind, LobeKind::Formula(_)))
+        .map(LobeKind::to_string)
+        .collect();
+    if !yours.is_empty() {
+        html += &paragraph(&format!(
+            "Your lobes are candidates too: {}.",
+            yours.join(", ")
+        ));
+    }
     let by_n = EXPONENTS
         .into_iter()
-        .map(|n| Ok((n, measure(n, samples)?)))
+        .map(|n| Ok((n, measure(&context.lobes, n, samples)?)))
         .collect::<Result<Vec<_>, String>>()?;
     let mut rows = Vec::new();
     for (id, name) in FAMILIES {
@@ -88,8 +105,10 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
     for (n, sweeps) in context.hardware_sweeps()? {
         let mut row = vec!["FPGA (estimated)".to_owned(), n.to_string()];
         for bound in ACCURACIES {
-            let best = LobeKind::ALL
-                .into_iter()
+            let best = context
+                .lobes
+                .iter()
+                .copied()
                 .filter_map(|kind| cheapest_datapath(sweeps, kind, ZoneChoice::Epicentre, bound))
                 .filter(|chosen| chosen.error <= bound)
                 .min_by_key(|chosen| chosen.cells);

@@ -61,7 +61,7 @@ pub fn volumes(context: &mut Context) -> Result<String, String> {
     let mut rows = Vec::new();
     let mut figures = String::new();
     let mut reference: Option<Image> = None;
-    for kind in LobeKind::ALL {
+    for kind in context.lobes.clone() {
         let settings = DvrSettings::new(pixels, pixels, View::Coronal, Some(shading(kind)?));
         let (cpu_ms, image) = timed(runs, || {
             render_dvr(&volume, &transfer, &settings, &|| {}).map_err(|e| e.to_string())
@@ -136,14 +136,14 @@ pub fn volumes(context: &mut Context) -> Result<String, String> {
         &bytes,
         &format!("the isosurface at {iso} (marching cubes, Phong shading, pow), seen from (300, -400, 200) mm"),
     )?;
-    html += &marschner_lobb_errors()?;
+    html += &marschner_lobb_errors(&context.lobes)?;
     Ok(html)
 }
 
 /// Shading errors on the Marschner-Lobb signal at 41³ (the test's usual size): normals from
 /// the volume's central differences against the analytic gradient, and what each lobe's
 /// specular term makes of the difference.
-fn marschner_lobb_errors() -> Result<String, String> {
+fn marschner_lobb_errors(lobes: &[LobeKind]) -> Result<String, String> {
     const SIDE: usize = 41;
     let volume: Volume = phantom::marschner_lobb(SIDE).map_err(|e| e.to_string())?;
     let camera = RayCamera::new(View::Coronal, &volume).map_err(|e| e.to_string())?;
@@ -172,7 +172,7 @@ fn marschner_lobb_errors() -> Result<String, String> {
     let max_angle = angles.iter().copied().fold(0.0, f64::max);
     let pow = shading(LobeKind::Pow)?;
     let mut rows = Vec::new();
-    for kind in LobeKind::ALL {
+    for &kind in lobes {
         let lobe = shading(kind)?.lobe;
         let specular =
             |n: Vec3, lobe: &Lobe| f64::from(lobe.eval(Geometry::Blinn.cos_lobe_f32(n, wo, wi)));
