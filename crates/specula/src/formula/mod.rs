@@ -389,7 +389,12 @@ fn check_tail(formula: &Formula, slots: &[f64; MAX_SLOTS], lobe: &Lobe) -> Resul
     // Pieces closing in on the peak geometrically: a narrow lobe lives in the last few.
     let integral = |from: f64| {
         let mut points = vec![from];
-        points.extend((1..=52).rev().map(|k| 1.0 - 2f64.powi(-k)).filter(|&p| p > from));
+        points.extend(
+            (1..=52)
+                .rev()
+                .map(|k| 1.0 - 2f64.powi(-k))
+                .filter(|&p| p > from),
+        );
         points.push(1.0);
         crate::quadrature::integrate_pieces(|t| lobe.eval(t), &points, 1e-13)
     };

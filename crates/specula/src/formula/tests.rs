@@ -241,6 +241,11 @@ fn columns_match_the_scalar_path_for_every_function() {
         ("col-grows", "exp(t * 2) / exp(2) * t ^ -2 * t ^ 2"),
         ("col-sin", "sin(t * pi / 2) ^ n"),
         ("col-neg", "-(-t) ^ 2 * -1 * t ^ n / e * e"),
+        // Whole chains whose rules the range analysis drops (the first) or keeps (the mask
+        // for the second, which is not 0 at t = 0; the clamp for the third, above 1).
+        ("col-rules-dropped", "max(0, 2 * t - 1) ^ 2"),
+        ("col-rules-mask", "(1 - t) ^ 2 * 0.5 + 0.25"),
+        ("col-rules-clamp", "min(1, t * 1.5)"),
     ];
     let ts = cosines();
     for (name, text) in formulas {

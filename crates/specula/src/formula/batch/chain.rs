@@ -3,7 +3,7 @@
 //! runs a group of [`GROUP`] vectors through all its links in registers, so the value never
 //! goes through memory between operations and a link's choice is paid once per group.
 
-use super::{Inside, LaneFunction, Map, ACOS_DOMAIN, LOG2_DOMAIN};
+use super::{Inside, LaneFunction, Map, ACOS_DOMAIN, LOG2_DOMAIN, MAX_WIDTH};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{math, Lanes};
 
@@ -259,6 +259,86 @@ pub(super) fn run<V: Lanes>(
             store_group(lanes, buffers, ends.1, at, x);
             at += GROUP * V::WIDTH;
         }
+    }
+}
+
+/// A whole formula that is one arithmetic chain, over the whole batch: no blocks and no
+/// register file, the shared rules picked once (as `cosquad`'s kernel picks its mask).
+#[inline(always)]
+pub(super) fn run_whole<V: Lanes>(
+    lanes: V,
+    chain: &Chain,
+    values: &[f32],
+    rules: Rules,
+    ts: &[f32],
+    out: &mut [f32],
+) {
+    match (rules.clamp, rules.mask) {
+        (false, false) => whole::<V, false, false>(lanes, &chain.links, values, ts, out),
+        (false, true) => whole::<V, false, true>(lanes, &chain.links, values, ts, out),
+        (true, false) => whole::<V, true, false>(lanes, &chain.links, values, ts, out),
+        (true, true) => whole::<V, true, true>(lanes, &chain.links, values, ts, out),
+    }
+}
+
+/// Whether a chain can run as [`run_whole`]: arithmetic links only.
+pub(super) fn is_arithmetic(chain: &Chain) -> bool {
+    !chain.checked && !chain.lane_only
+}
+
+#[inline(always)]
+fn whole<V: Lanes, const CLAMP: bool, const MASK: bool>(
+    lanes: V,
+    links: &[Link],
+    values: &[f32],
+    ts: &[f32],
+    out: &mut [f32],
+) {
+    let step = GROUP * V::WIDTH;
+    let mut t_groups = ts.chunks_exact(step);
+    let mut o_groups = out.chunks_exact_mut(step);
+    for (t, o) in (&mut t_groups).zip(&mut o_groups) {
+        whole_group::<V, CLAMP, MASK>(lanes, links, values, t, o);
+    }
+    let (t, o) = (t_groups.remainder(), o_groups.into_remainder());
+    if !t.is_empty() {
+        let mut padded = [1.0_f32; GROUP * MAX_WIDTH];
+        padded[..t.len()].copy_from_slice(t);
+        let mut result = [0.0_f32; GROUP * MAX_WIDTH];
+        whole_group::<V, CLAMP, MASK>(lanes, links, values, &padded[..step], &mut result[..step]);
+        o.copy_from_slice(&result[..o.len()]);
+    }
+}
+
+/// One group of [`whole`] (a function, not a closure: see [`super::Map`]).
+#[inline(always)]
+fn whole_group<V: Lanes, const CLAMP: bool, const MASK: bool>(
+    lanes: V,
+    links: &[Link],
+    values: &[f32],
+    t: &[f32],
+    o: &mut [f32],
+) {
+    let width = V::WIDTH;
+    let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
+    let mut x = [zero; GROUP];
+    for (k, value) in x.iter_mut().enumerate() {
+        *value = one
+            .min(lanes.load(&t[k * width..(k + 1) * width]))
+            .max(zero);
+    }
+    for &link in links {
+        apply_arithmetic(lanes, link, values, &mut x);
+    }
+    for (k, value) in x.into_iter().enumerate() {
+        let mut value = value;
+        if CLAMP {
+            value = value.max(zero).min(one);
+        }
+        if MASK {
+            value = value.keep(lanes.load(&t[k * width..(k + 1) * width]).gt(zero));
+        }
+        value.store(&mut o[k * width..(k + 1) * width]);
     }
 }
 

@@ -354,6 +354,13 @@ impl Plan {
                 Scalar::Constant(c) => c as f32,
             };
         }
+        if let [Step::Chain(chain, End::Batch, End::Batch)] = self.steps.as_slice() {
+            if chain::is_arithmetic(chain) {
+                chain::run_whole(lanes, chain, values, rules, ts, out);
+                FILE.with(|cell| cell.replace(storage));
+                return;
+            }
+        }
         if self.steps.iter().any(|s| !matches!(s, Step::Chain(..))) {
             for (s, &value) in values.iter().enumerate() {
                 file[s * block..(s + 1) * block].fill(value);
