@@ -45,6 +45,12 @@ enum Command {
                             specula analyze --lobe schlick,schlick-mod --n 16,256\n  \
                             specula analyze --format json --backend f32 > errors.json")]
     Analyze(commands::analyze::Args),
+    /// Your own lobe: write a lobe file to start from, or check one (a file or a formula) over
+    /// a range of n.
+    #[command(after_help = "Examples:\n  specula lobe new mine.toml\n  \
+                            specula lobe check @mine.toml\n  \
+                            specula lobe check '=exp2(n * (t - 1) * 1.4427)' --n 1..1000")]
+    Lobe(commands::lobe::Args),
     /// Test the thesis's claims (SPEC section 9) with measured figures and verdicts.
     #[command(after_help = "Examples:\n  specula claims\n  specula claims --format json")]
     Claims(commands::claims::Args),
@@ -208,6 +214,7 @@ fn main() -> ExitCode {
         Command::Eval(args) => commands::eval::run(&args),
         Command::Analyze(args) => commands::analyze::run(&args),
         Command::Claims(args) => commands::claims::run(&args),
+        Command::Lobe(args) => commands::lobe::run(&args),
         Command::Report(args) => commands::report::run(&args),
         Command::Render(args) => commands::render::run(&args),
         Command::Volume(args) => commands::volume::run(&args),

@@ -47,6 +47,15 @@ pub fn parse_lobe(text: &str, base: Option<&Path>) -> Result<LobeKind, String> {
 /// Reads and parses a lobe file (a regular file within [`MAX_LOBE_FILE_BYTES`]).
 pub fn read_definition(path: &Path) -> Result<Definition, String> {
     let shown = path.display();
+    if let Ok(meta) = std::fs::metadata(path) {
+        if meta.is_file() && meta.len() > MAX_LOBE_FILE_BYTES {
+            return Err(format!(
+                "lobe file {shown}: is {} bytes; a lobe file is at most {MAX_LOBE_FILE_BYTES} \
+                 bytes (a formula at most {MAX_SOURCE_BYTES})",
+                meta.len()
+            ));
+        }
+    }
     let bytes = crate::input::read_within(path, MAX_LOBE_FILE_BYTES)
         .map_err(|e| format!("lobe file {shown}: {e}"))?;
     let text = String::from_utf8(bytes)

@@ -7,6 +7,7 @@ pub mod diff;
 pub mod eval;
 pub mod fpga_estimate;
 pub mod hw;
+pub mod lobe;
 pub mod models;
 pub mod recommend;
 pub mod render;

@@ -173,6 +173,10 @@ impl Kernel for FormulaKernel {
 
 impl LobeKernel for FormulaKernel {
     fn instructions(self) -> Instructions {
-        self.lobe.instance.formula().plan().instructions()
+        self.lobe
+            .instance
+            .formula()
+            .plan()
+            .instructions(self.lobe.rules)
     }
 }

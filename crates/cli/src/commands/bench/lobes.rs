@@ -319,7 +319,8 @@ pub fn run(n: Exponent, format: Format) -> Result<(), String> {
         rate_of(LobeKind::CosQuad { v: 4 }),
     );
     println!(
-        "cosquad written as a formula ({}, docs/lobes/k4.toml) runs at {} of the built-in          cosquad's kernel (the user-lobe floor is 50 %)",
+        "cosquad written as a formula ({}, docs/lobes/k4.toml) runs at {} of the built-in \
+         cosquad's kernel (the user-lobe floor is 50 %)",
         cosquad_formula(),
         percent(mine / built_in)
     );

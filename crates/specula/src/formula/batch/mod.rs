@@ -293,8 +293,15 @@ impl Plan {
 
     /// The instructions one vector costs (the loads and stores between steps aside), with
     /// the shared rules.
-    pub(crate) fn instructions(&self) -> Instructions {
-        let rules = Instructions::of(&[(Class::MinMax, 4), (Class::Compare, 1), (Class::Logic, 1)]);
+    pub(crate) fn instructions(&self, applied: Rules) -> Instructions {
+        // The clamp of t, and the rules applied on the way out.
+        let mut rules = Instructions::of(&[(Class::MinMax, 2)]);
+        if applied.clamp {
+            rules = rules.plus(Class::MinMax, 2);
+        }
+        if applied.mask {
+            rules = rules.plus(Class::Compare, 1).plus(Class::Logic, 1);
+        }
         self.steps.iter().fold(rules, |total, step| {
             total.and(match step {
                 Step::Chain(chain, ..) => chain
