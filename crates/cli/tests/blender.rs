@@ -240,6 +240,25 @@ fn cycles_renders_every_lobe_as_specula_does() {
     )));
 }
 
+/// A lobe of the user's (`docs/lobes/quartic.toml`, in the scene's folder) compiles in
+/// Blender's OSL compiler and renders in Cycles as specula renders it.
+#[test]
+fn cycles_renders_a_user_lobe_as_specula_does() {
+    if !have_python_module("bpy", "bpy") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("sphere.obj"), sphere_obj(1.0, 96, 48)).unwrap();
+    std::fs::copy(
+        common::docs_lobe("quartic.toml"),
+        dir.path().join("quartic.toml"),
+    )
+    .unwrap();
+    let [ours, theirs] = render_both(dir.path(), "@quartic.toml", "phong", 48.0, 48.0);
+    let measured = difference(&ours, &theirs);
+    assert!(agrees(measured), "Cycles and specula differ: {measured:?}");
+}
+
 /// The node's `n` is a live input: exported for one `n` and set to another in Blender, it
 /// renders the lobe at the other, its constants computed in the shader.
 #[test]

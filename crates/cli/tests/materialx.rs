@@ -12,7 +12,8 @@ const TARGETS: [&str; 5] = ["glsl", "essl", "msl", "osl", "mdl"];
 
 fn check(lobe: &str, geometry: &str) {
     let dir = tempfile::tempdir().unwrap();
-    let file = format!("{lobe}-{geometry}.mtlx");
+    let stem = lobe.replace(|c: char| !c.is_ascii_alphanumeric() && c != '-', "_");
+    let file = format!("{stem}-{geometry}.mtlx");
     export_lobe(dir.path(), lobe, 100.0, geometry, "mtlx", &file);
     let args = [
         file.as_str(),
@@ -66,6 +67,11 @@ fn every_lobes_document_validates_and_generates_every_language() {
     for lobe in ["pow", "fastpow"] {
         check(lobe, "blinn");
     }
+    // A lobe of the user's (docs/lobes/quartic.toml) is generated from the same description.
+    check(
+        &format!("@{}", common::docs_lobe("quartic.toml").display()),
+        "phong",
+    );
 }
 
 /// The lobe's node graph, evaluated as MaterialX defines its nodes (an independent reader,
@@ -81,9 +87,16 @@ fn every_lobes_node_graph_evaluates_to_the_lobe() {
     let cosines: Vec<f64> = (0..400)
         .map(|k| -0.05 + 1.1 * f64::from(k) / 399.0)
         .collect();
-    for kind in LobeKind::ALL {
+    // The built-in lobes, and a lobe of the user's (its file's formula, n an input).
+    let quartic = format!("@{}", common::docs_lobe("quartic.toml").display());
+    let user = specula_render::lobe_file::parse_lobe(&quartic, None).unwrap();
+    let cases = LobeKind::ALL
+        .map(|kind| (kind.id().to_owned(), kind))
+        .into_iter()
+        .chain([(quartic, user)]);
+    for (argument, kind) in cases {
         let file = format!("{}.mtlx", kind.id());
-        export_lobe(dir.path(), kind.id(), 100.0, "phong", "mtlx", &file);
+        export_lobe(dir.path(), &argument, 100.0, "phong", "mtlx", &file);
         let exported = Lobe::try_new(kind, 100.0).unwrap();
         let takes_n = exported.structural_range() != [100.0, 100.0];
         let n = if takes_n { 80.0 } else { 100.0 };

@@ -81,6 +81,37 @@ fn every_lobe_passes_mitsubas_chi_square_test() {
     }
 }
 
+/// Lobes of the user's pass too: one sampled by Newton on its own tail
+/// (`docs/lobes/quartic.toml`) and one from specula's table (a formula without a tail).
+#[test]
+fn user_lobes_pass_mitsubas_chi_square_test() {
+    if !have_python_module("mitsuba", "mitsuba") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let quartic = format!("@{}", common::docs_lobe("quartic.toml").display());
+    for (lobe, name) in [
+        (quartic.as_str(), "specula_quartic"),
+        ("=exp2(n * (t - 1) * 1.4427)", "specula_formula"),
+    ] {
+        let file = format!("{name}.py");
+        export(dir.path(), lobe, 64.0, &file);
+        let output = chi2(
+            dir.path(),
+            &file,
+            name,
+            "llvm_ad_rgb",
+            &["--n", "8", "64", "512"],
+        );
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(
+            output.status.success() && stdout.contains("18 passed, 0 failed"),
+            "{lobe}:\n{stdout}\n{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+}
+
 /// The same files in `scalar_rgb`: a closed-form lobe (`cosquad`), a Newton one (`schlick`)
 /// and a tabulated one (`schlick-mod`, Mitsuba's distribution given Python lists there).
 #[test]

@@ -157,6 +157,13 @@ pub fn sphere_obj(radius: f64, segments: u32, rings: u32) -> String {
     obj
 }
 
+/// The path of one of `docs/lobes/`'s lobe files (`quartic.toml`, ...).
+pub fn docs_lobe(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../docs/lobes")
+        .join(name)
+}
+
 /// `specula shader --lobe LOBE --n N --geometry GEOMETRY --lang LANG -o FILE` in `directory`,
 /// requiring success: a lobe exported for a renderer test.
 pub fn export_lobe(directory: &Path, lobe: &str, n: f64, geometry: &str, lang: &str, file: &str) {
