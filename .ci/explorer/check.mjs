@@ -130,6 +130,42 @@ try {
   if (afterV.plots[0] === beforeV.plots[0]) failures.push("changing cosquad's v did not change the lobe plot");
   if (!afterV.address.includes("cosquad%3Av%3D2")) failures.push(`v is not in the address: ${afterV.address}`);
 
+  // The formula box: a formula typed there is drawn beside the lobes and becomes the renders'
+  // and the volume's lobe; a refused one gets its one-line error beside the box, is drawn
+  // nowhere, and the rest of the page is drawn all the same.
+  const K4 = "let a = (n + 1) / 17; max(0, a * (t - 1) + 1) ^ 16";
+  const beforeFormula = await snapshot();
+  await page.locator("#formula").fill(K4);
+  await drawn("formula", K4);
+  const typed = await snapshot();
+  // Every plot but the slice (the first lobe's) draws the formula's curve too.
+  typed.plots.slice(0, 4).forEach((plot, k) => { if (plot === beforeFormula.plots[k]) failures.push(`typing a formula: plot ${k} did not change`); });
+  if (typed.sphere === beforeFormula.sphere) failures.push("typing a formula: the sphere was not re-rendered");
+  if (typed.volume === beforeFormula.volume) failures.push("typing a formula did not re-render the volume with it");
+  const labels = () => page.evaluate(() => ({
+    error: document.getElementById("formula-error").textContent,
+    legend: document.getElementById("legend-cartesian").textContent,
+    render: document.getElementById("render-lobe").textContent,
+    volume: document.getElementById("volume-lobe-name").textContent,
+    status: document.getElementById("status").textContent,
+  }));
+  const good = await labels();
+  if (good.error || good.status || !good.legend.includes("formula") || good.render !== "formula" || good.volume !== "formula") failures.push(`a good formula: ${JSON.stringify(good)}`);
+  // A refusal's console line ("Failed to load resource: ... 400") is the browser's, expected here.
+  const quiet = messages.length;
+  for (const [text, expected] of [["max(0, tt)", "column 8: unknown name 'tt'; did you mean 't'?"], ["2 * t", "(above 1)"]]) {
+    await page.locator("#formula").fill(text);
+    await drawn("formula", text);
+    const bad = await labels();
+    if (!bad.error.includes(expected) || bad.error.includes("\n")) failures.push(`the formula '${text}' shows '${bad.error}', not '${expected}'`);
+    if (bad.legend.includes("formula") || bad.render === "formula" || bad.volume === "formula" || bad.status) failures.push(`a refused formula is drawn: ${JSON.stringify(bad)}`);
+  }
+  messages.push(...messages.splice(quiet).filter((m) => !/status of 400/.test(m)));
+  await page.locator("#formula").fill("");
+  await drawn("formula", "");
+  const cleared = await labels();
+  if (cleared.error || cleared.legend.includes("formula")) failures.push(`clearing the formula: ${JSON.stringify(cleared)}`);
+
   // Axis ticks are round numbers, counted by hand: 1, 2 or 5 times a power of ten.
   const ticks = await page.evaluate(() => [[0, 21.4], [-0.129, 0.129], [0, 1.05], [0, 90]].map(([lo, hi]) => niceTicks(lo, hi).map(([, label]) => label).join(" ")));
   const expected = ["0 5 10 15 20", "-0.10 -0.05 0.00 0.05 0.10", "0.0 0.2 0.4 0.6 0.8 1.0", "0 20 40 60 80"];
@@ -145,4 +181,4 @@ if (failures.length) {
   console.error("explorer check failed:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`explorer check: loaded, moved n, changed lobes (and the environment view), changed the volume's lobe and volume, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, round ticks; no console message; screenshot ${screenshot}`);
+console.log(`explorer check: loaded, moved n, changed lobes (and the environment view), changed the volume's lobe and volume, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, typed a formula (drawn and rendered) and two refused ones (their errors beside the box), round ticks; no console message; screenshot ${screenshot}`);

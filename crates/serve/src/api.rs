@@ -1,7 +1,15 @@
 //! The JSON API: parameters parsed with the library's registries, every refusal a 400 with a
 //! JSON body naming the parameter and its valid range or choices.
 //!
-//! - `GET /api/models`: the lobes, geometries, normalisations, shadings, objects and limits;
+//! Every `lobe` is a built-in id (`cosquad:v=2`) or, as on the command line, `=FORMULA`: a
+//! formula of `t` and `n` (`lobe==exp2(n * (t - 1) * 1.4427)`, percent-encoded). A formula is
+//! refused with a 400 whose `error` is the library's one-line message (the position and the
+//! problem) when it does not parse, when it is longer than
+//! [`MAX_SOURCE_BYTES`](specula::formula::MAX_SOURCE_BYTES) (before any work), or when
+//! [`Lobe::checked`] finds it outside `[0, 1]` at the request's `n`.
+//!
+//! - `GET /api/models`: the lobes, geometries, normalisations, shadings, objects and limits,
+//!   and the formula language's functions and length limit (the page's text box);
 //! - `GET /api/evaluate?lobe&n&geometry&normalisation&theta_in`: every plot's data;
 //! - `GET /api/analyze?lobe&n`: the error, energy and albedo figures (`specula analyze`'s),
 //!   and `costs`, the lobe's cost on every target the server's cost model knows;
@@ -23,6 +31,7 @@ use axum::Json;
 use serde::Serialize;
 use serde_json::json;
 use specula::analysis::{analyze, Precision};
+use specula::formula::MAX_SOURCE_BYTES;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use specula_render::volume::raymarch::View;
 use specula_render::{IlluminationModel, Shading};
@@ -237,14 +246,24 @@ impl Params {
         }
     }
 
+    /// The lobe: an id, with parameters (`cosquad:v=2`), or `=FORMULA`.
     fn lobe(&self) -> Result<LobeKind, ApiError> {
         let text = self.text("lobe").unwrap_or("pow");
-        LobeKind::parse(text).map_err(|_| {
-            ApiError::bad(
-                "lobe",
-                format!("unknown lobe `{text}`"),
-                LobeKind::valid_ids(),
-            )
+        if let Some(formula) = text.trim_start().strip_prefix('=') {
+            // Refused before the text is copied or read: the parser's own limit, said here.
+            if formula.len() > MAX_SOURCE_BYTES {
+                return Err(bad_lobe(format!(
+                    "the formula is {} bytes long; the limit is {MAX_SOURCE_BYTES}",
+                    formula.len()
+                )));
+            }
+        }
+        LobeKind::parse(text).map_err(|error| match error {
+            // The position and the problem, in a line; the lobe's name is the server's
+            // numbering (`formula-7`), not the user's, so it is left out.
+            specula::Error::Formula { message, .. } => bad_lobe(message),
+            specula::Error::InvalidLobeParameter { .. } => bad_lobe(error.to_string()),
+            _ => bad_lobe(format!("unknown lobe `{}`", specula::excerpt(text))),
         })
     }
 
@@ -268,6 +287,28 @@ impl Params {
     }
 }
 
+/// A refused `lobe`: `error` and the valid forms.
+fn bad_lobe(error: String) -> ApiError {
+    ApiError::bad(
+        "lobe",
+        error,
+        format!(
+            "{}, with parameters as ID:NAME=VALUE (cosquad:v=2), or =FORMULA: a formula of t and n",
+            LobeKind::valid_ids()
+        ),
+    )
+}
+
+/// `kind` prepared for `n`, refusing a formula whose values leave `[0, 1]` there or are not
+/// finite ([`Lobe::checked`]). Run inside [`compute`]: a long formula's check takes a tenth of
+/// a second.
+fn checked(kind: LobeKind, n: Exponent) -> Result<Lobe, ApiError> {
+    Lobe::checked(kind, n).map_err(|error| match error {
+        specula::Error::Formula { message, .. } => bad_lobe(message),
+        error => bad_lobe(error.to_string()),
+    })
+}
+
 /// Runs `work` on the blocking pool once a worker is free, or answers the full queue's 503; a
 /// panic inside becomes a 500, never a dropped server.
 async fn compute<T: Send + 'static>(
@@ -278,6 +319,19 @@ async fn compute<T: Send + 'static>(
     tokio::task::spawn_blocking(work)
         .await
         .map_err(|e| ApiError::internal(format!("the computation failed: {e}")).into())
+}
+
+/// [`compute`] for a request's lobe: `work` is given the lobe once [`checked`] accepts it, in
+/// the same turn.
+async fn compute_with<T: Send + 'static>(
+    state: &AppState,
+    kind: LobeKind,
+    n: Exponent,
+    work: impl FnOnce(Lobe) -> T + Send + 'static,
+) -> Result<T, Response> {
+    compute(state, move || checked(kind, n).map(work))
+        .await?
+        .map_err(Response::from)
 }
 
 /// Any other path.
@@ -336,6 +390,11 @@ pub async fn models() -> impl IntoResponse {
         "max_volume_size": MAX_VOLUME_SIZE,
         "max_environment_size": MAX_ENVIRONMENT_SIZE,
         "max_environment_spp": MAX_ENVIRONMENT_SPP,
+        // The text box's language and limit (a formula is sent as `lobe==FORMULA`).
+        "formula": {
+            "max_bytes": MAX_SOURCE_BYTES,
+            "functions": specula::formula::FUNCTIONS.map(|(_, signature)| signature),
+        },
     }))
 }
 
@@ -353,7 +412,7 @@ pub async fn evaluate(
         params.normalisation(Normalisation::Lobe)?,
     );
     let theta_in = params.number("theta_in", 0.0..=89.0, 30.0)?.to_radians();
-    let data = compute(&state, move || {
+    let data = compute_with(&state, kind, n, move |_| {
         curves(kind, n, geometry, normalisation, theta_in)
     })
     .await?;
@@ -367,9 +426,8 @@ pub async fn analyze_lobe(
     let params = Params::new(pairs(query)?, &["lobe", "n"])?;
     let (kind, n) = (params.lobe()?, params.exponent()?);
     let costs = state.costs.clone();
-    let (report, costs) = compute(&state, move || {
-        let report = analyze(kind, n, &mut Precision::F64);
-        (report, costs(&Lobe::new(kind, n)))
+    let (report, costs) = compute_with(&state, kind, n, move |lobe| {
+        (analyze(kind, n, &mut Precision::F64), costs(&lobe))
     })
     .await?;
     let costs = costs.map_err(ApiError::internal)?;
@@ -397,10 +455,11 @@ pub async fn render(
             "size",
         ],
     )?;
+    let (kind, n) = (params.lobe()?, params.exponent()?);
     let request = RenderRequest {
         object: params.choice("object", &Object::ALL, Object::id, Object::Sphere)?,
-        kind: params.lobe()?,
-        n: params.exponent()?,
+        kind,
+        n,
         geometry: params.geometry()?,
         normalisation: params.normalisation(Normalisation::None)?,
         shading: params.choice("shading", &Shading::ALL, Shading::id, Shading::Phong)?,
@@ -416,7 +475,7 @@ pub async fn render(
             .to_radians(),
         size: params.number("size", 16.0..=f64::from(MAX_RENDER_SIZE), 512.0)? as u32,
     };
-    let encoded = compute(&state, move || render_png(&request)).await?;
+    let encoded = compute_with(&state, kind, n, move |_| render_png(&request)).await?;
     Ok(png(encoded.map_err(ApiError::internal)?))
 }
 
@@ -436,16 +495,17 @@ pub async fn volume(
             "size",
         ],
     )?;
+    let (kind, n) = (params.lobe()?, params.exponent()?);
     let request = VolumeRequest {
         volume: params.choice("volume", &BuiltIn::ALL, BuiltIn::id, BuiltIn::SheppLogan)?,
         view: params.choice("view", &View::STANDARD, View::id, View::Coronal)?,
-        kind: params.lobe()?,
-        n: params.exponent()?,
+        kind,
+        n,
         geometry: params.geometry()?,
         normalisation: params.normalisation(Normalisation::ThesisPhong)?,
         size: params.number("size", 16.0..=f64::from(MAX_VOLUME_SIZE), 256.0)? as u32,
     };
-    let encoded = compute(&state, move || volume_png(&request)).await?;
+    let encoded = compute_with(&state, kind, n, move |_| volume_png(&request)).await?;
     Ok(png(encoded.map_err(ApiError::internal)?))
 }
 
@@ -457,15 +517,16 @@ pub async fn environment(
         pairs(query)?,
         &["lobe", "n", "geometry", "normalisation", "size", "spp"],
     )?;
+    let (kind, n) = (params.lobe()?, params.exponent()?);
     let request = EnvironmentRequest {
-        kind: params.lobe()?,
-        n: params.exponent()?,
+        kind,
+        n,
         geometry: params.geometry()?,
         normalisation: params.normalisation(Normalisation::Lobe)?,
         size: params.number("size", 16.0..=f64::from(MAX_ENVIRONMENT_SIZE), 384.0)? as u32,
         spp: params.number("spp", 1.0..=f64::from(MAX_ENVIRONMENT_SPP), 16.0)? as u32,
     };
-    let encoded = compute(&state, move || environment_png(&request)).await?;
+    let encoded = compute_with(&state, kind, n, move |_| environment_png(&request)).await?;
     Ok(png(encoded.map_err(ApiError::internal)?))
 }
 
@@ -479,4 +540,28 @@ fn png(encoded: Vec<u8>) -> Response {
         encoded,
     )
         .into_response()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A formula over the parser's limit (which HTTP's address limit already keeps out) is
+    /// refused by its length alone, at once, without echoing it.
+    #[test]
+    fn an_oversize_formula_is_refused_by_its_length() {
+        let text = format!("={}", "t+".repeat(1 << 19));
+        let params = Params::new(vec![("lobe".into(), text)], &["lobe"]).expect("known");
+        let started = std::time::Instant::now();
+        let error = params.lobe().expect_err("too long");
+        assert!(started.elapsed() < std::time::Duration::from_millis(100));
+        assert_eq!(error.status, StatusCode::BAD_REQUEST);
+        assert_eq!(
+            error.error,
+            format!(
+                "the formula is {} bytes long; the limit is {MAX_SOURCE_BYTES}",
+                1 << 20
+            )
+        );
+    }
 }

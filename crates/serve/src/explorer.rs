@@ -226,7 +226,9 @@ normalisation = "{normalisation}"
         x = towards[0],
         y = towards[1],
         z = towards[2],
-        lobe = request.kind.id(),
+        // With its parameters (`cosquad:v=2`); a formula by the name the registry gave it
+        // (`formula-3`), which the scene parser resolves to the same lobe.
+        lobe = request.kind,
         n = request.n.get(),
         geometry = request.geometry.id(),
         normalisation = request.normalisation.id(),

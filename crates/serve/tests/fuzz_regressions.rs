@@ -1,17 +1,20 @@
-//! Replays the API fuzzer's seeds and every crash input it found (`fuzz/regressions/api/`)
-//! through the fuzz target's own check, so that CI needs no fuzzer.
+//! Replays the API and formula fuzzers' seeds and every crash input they found
+//! (`fuzz/regressions/{api,formula}/`) through the fuzz targets' own checks, so that CI needs
+//! no fuzzer.
 
 use std::path::Path;
 
 #[path = "../../../fuzz/fuzz_targets/checks/api.rs"]
-mod checks;
+mod api;
+#[path = "../../../fuzz/fuzz_targets/checks/formula.rs"]
+mod formula;
 
-#[test]
-fn fuzz_inputs_get_200_or_a_json_400() {
+/// Every seed and regression input of `target`, run through `check`; how many there were.
+fn replay(target: &str, check: fn(&[u8])) -> usize {
     let fuzz = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
     let mut count = 0;
     for kind in ["seeds", "regressions"] {
-        for entry in std::fs::read_dir(fuzz.join(kind).join("api"))
+        for entry in std::fs::read_dir(fuzz.join(kind).join(target))
             .into_iter()
             .flatten()
         {
@@ -19,9 +22,25 @@ fn fuzz_inputs_get_200_or_a_json_400() {
             if path.file_name().is_some_and(|name| name == ".gitkeep") {
                 continue;
             }
-            checks::check_api(&std::fs::read(&path).expect("read"));
+            check(&std::fs::read(&path).expect("read"));
             count += 1;
         }
     }
-    assert!(count >= 2, "the API seeds are missing");
+    count
+}
+
+#[test]
+fn fuzz_inputs_get_200_or_a_json_400() {
+    assert!(
+        replay("api", api::check_api) >= 2,
+        "the API seeds are missing"
+    );
+}
+
+#[test]
+fn fuzz_formulas_are_lobes_in_range_or_one_line_refusals() {
+    assert!(
+        replay("formula", formula::check_formula) >= 5,
+        "the formula seeds are missing"
+    );
 }

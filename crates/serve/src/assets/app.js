@@ -6,12 +6,22 @@
 const DASH = [7, 4];
 // Phong geometry with the lobe's own normalisation: energy-conserving (albedo <= 1) for every
 // lobe, so the first view is physically sensible.
-const DEFAULTS = { lobes: "pow,schlick,schlick-mod", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "", volume: "phantom", view: "coronal", volume_lobe: "cosquad" };
+const DEFAULTS = { lobes: "pow,schlick,schlick-mod", formula: "", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "", volume: "phantom", view: "coronal", volume_lobe: "cosquad" };
 const $ = (id) => document.getElementById(id);
 let registry = null;
 let generation = 0;
 // The lobe the renders show: the one the user chose last.
 let renderLobe = "";
+// The text box's lobe, as the page names it; the API gets its text as `lobe==FORMULA`.
+const FORMULA = "formula";
+// Paul Tol's wine: a user's lobe never looks like a built-in one (the library's first user colour).
+const FORMULA_STYLE = { colour: "#882255", dashed: false };
+// Typing pauses this long before the formula is sent.
+const FORMULA_DEBOUNCE_MS = 300;
+// The longest request target the server reads (hyper's), in bytes, and the room the
+// longest request (a render's) needs beside the formula.
+const MAX_ADDRESS = 65534;
+const ADDRESS_ROOM = 512;
 
 function readState() {
   const query = new URLSearchParams(location.search);
@@ -35,13 +45,24 @@ function lobeName(box) {
   return given.length ? `${lobe.id}:${given.join(",")}` : lobe.id;
 }
 
+// The formula in the text box, if any (blank counts as none).
+function formulaText() { return $("formula").value.trim() ? $("formula").value : ""; }
+
+// A lobe's name as the API takes it: the page's `formula` is the text box's text.
+function apiLobe(name) { return name === FORMULA ? "=" + formulaText() : name; }
+
 function currentState() {
   const boxes = [...document.querySelectorAll("#lobes input[type=checkbox]:checked")];
   const lobes = boxes.map(lobeName);
   const ids = boxes.map((box) => box.value);
+  const formula = formulaText();
+  // The formula's lobe comes after the boxes' and may be the one the renders show.
+  const names = formula ? [...lobes, FORMULA] : lobes;
+  if (formula) ids.push(FORMULA);
   if (!ids.includes(renderLobe)) renderLobe = ids.length ? ids[ids.length - 1] : "";
   return {
     lobes: lobes.join(","),
+    formula,
     n: $("n-box").value,
     geometry: $("geometry").value,
     normalisation: $("normalisation").value,
@@ -51,10 +72,10 @@ function currentState() {
     light_theta: $("light_theta").value,
     light_phi: $("light_phi").value,
     log: $("log").checked ? "1" : "0",
-    render: lobes[ids.indexOf(renderLobe)] ?? "",
+    render: names[ids.indexOf(renderLobe)] ?? "",
     volume: $("volume").value,
     view: $("view").value,
-    volume_lobe: lobeName({ value: $("volume_lobe").value }),
+    volume_lobe: $("volume_lobe").value === FORMULA ? FORMULA : lobeName({ value: $("volume_lobe").value }),
   };
 }
 
@@ -110,8 +131,13 @@ function buildControls(state) {
   select("volume", registry.volumes);
   select("view", registry.views);
   const volumeLobe = state.volume_lobe.split(":")[0];
-  if (!known.has(volumeLobe)) notes.push(`volume_lobe '${state.volume_lobe}' is not a lobe; using ${DEFAULTS.volume_lobe}`);
-  fillSelect("volume_lobe", [...known], known.has(volumeLobe) ? volumeLobe : DEFAULTS.volume_lobe);
+  const volumeKnown = known.has(volumeLobe) || volumeLobe === FORMULA;
+  if (!volumeKnown) notes.push(`volume_lobe '${state.volume_lobe}' is not a lobe; using ${DEFAULTS.volume_lobe}`);
+  fillSelect("volume_lobe", [...known, FORMULA], volumeKnown ? volumeLobe : DEFAULTS.volume_lobe);
+  $("volume_lobe").lastElementChild.textContent = "formula (the text box)";
+  $("formula").value = state.formula;
+  const limits = registry.formula;
+  $("formula-help").textContent = `An expression of t (the cosine, 0 to 1) and n (the exponent), after any "let NAME = ...;". Operators + - * / ^; comparisons < <= > >= as the condition of select or if; # starts a comment. Functions: ${limits.functions.join(", ")}; constants pi, e. Its value must stay in [0, 1]; up to ${limits.max_bytes} bytes.`;
   let n = Number(state.n);
   if (!(n >= 1 && n <= 1000)) {
     notes.push(`n = '${state.n}' is outside [1, 1000]; using ${DEFAULTS.n}`);
@@ -119,34 +145,60 @@ function buildControls(state) {
   }
   $("n-box").value = String(n);
   $("n").value = sliderFromN(n);
-  renderLobe = [...chosen.keys()].includes(idOf(state.render)) ? idOf(state.render) : "";
+  renderLobe = [...chosen.keys()].includes(idOf(state.render)) ? idOf(state.render)
+    : state.render === FORMULA && formulaText() ? FORMULA : "";
   for (const id of ["theta_in", "light_theta", "light_phi"]) $(id).value = state[id];
   $("log").checked = state.log === "1";
   $("notes").textContent = notes.length ? "From the address: " + notes.join("; ") + "." : "";
 }
 
-function showValues(state) {
-  $("render-lobe").textContent = state.render || "no lobe";
-  $("environment-lobe").textContent = state.render || "no lobe";
-  $("environment-image").style.borderColor = colourOf(state.render);
+// `shown` has the lobes the renders draw: the state's, unless the formula is refused.
+function showValues(state, shown) {
+  $("render-lobe").textContent = shown.render || "no lobe";
+  $("environment-lobe").textContent = shown.render || "no lobe";
+  $("environment-image").style.borderColor = colourOf(shown.render);
   $("environment-pow").style.borderColor = colourOf("pow");
-  $("volume-lobe-name").textContent = state.volume_lobe;
-  $("volume-image").style.borderColor = colourOf(state.volume_lobe);
+  $("volume-lobe-name").textContent = shown.volume_lobe;
+  $("volume-image").style.borderColor = colourOf(shown.volume_lobe);
   $("volume-pow").style.borderColor = colourOf("pow");
   $("theta_in-value").textContent = state.theta_in + "°";
   $("light_theta-value").textContent = state.light_theta + "°";
   $("light_phi-value").textContent = state.light_phi + "°";
 }
 
-function lobeOf(name) { return registry.lobes.find((l) => l.id === name.split(":")[0]) ?? { colour: "#000", dashed: false }; }
+function lobeOf(name) {
+  if (name === FORMULA) return FORMULA_STYLE;
+  return registry.lobes.find((l) => l.id === name.split(":")[0]) ?? { colour: "#000", dashed: false };
+}
 function colourOf(id) { return lobeOf(id).colour; }
 function dashOf(id) { return lobeOf(id).dashed ? DASH : []; }
 
+// The API's JSON; a refusal throws an Error whose `refusal` is the API's one-line `error`.
 async function getJson(url) {
   const response = await fetch(url);
-  const body = await response.json();
-  if (!response.ok) throw new Error(body.error + (body.valid ? " (valid: " + body.valid + ")" : ""));
+  const text = await response.text();
+  let body = null;
+  try { body = JSON.parse(text); } catch { /* not JSON: an HTTP-level refusal (414) */ }
+  if (!response.ok || body === null) {
+    const refusal = body?.error ?? `the server answered ${response.status} ${response.statusText}`.trim();
+    throw Object.assign(new Error(refusal + (body?.valid ? " (valid: " + body.valid + ")" : "")), { refusal });
+  }
   return body;
+}
+
+// Why the formula cannot be sent in `url`, or "" if it can: the API's length limit, said
+// before the server refuses it, and the longest address the server reads.
+function formulaTooLong(url) {
+  const bytes = new TextEncoder().encode(formulaText()).length;
+  if (bytes > registry.formula.max_bytes) return `the formula is ${bytes} bytes long; the limit is ${registry.formula.max_bytes}`;
+  if (url.length + ADDRESS_ROOM > MAX_ADDRESS) return `the formula is too long to send: ${url.length} characters once percent-encoded, and the server reads addresses of up to ${MAX_ADDRESS}`;
+  return "";
+}
+
+// The formula's refusal beside the text box (empty: none).
+function showFormulaError(message) {
+  $("formula-error").textContent = message;
+  $("formula").setAttribute("aria-invalid", message ? "true" : "false");
 }
 
 // A line plot: axes with ticks, optional shaded bands, one polyline per series.
@@ -313,36 +365,54 @@ function loadImage(img, url) {
   if (img.getAttribute("src") === url && img.complete && img.naturalWidth > 0) return Promise.resolve();
   return new Promise((resolve, reject) => {
     img.onload = () => resolve();
-    img.onerror = () => reject(new Error("render failed: " + url));
+    img.onerror = () => reject(new Error("render failed: " + url.split("?")[0]));
     img.src = url;
   });
 }
 
 async function update() {
   const state = currentState();
-  showValues(state);
+  showValues(state, state);
   const query = "?" + new URLSearchParams(state).toString();
   history.replaceState(null, "", query);
   const mine = ++generation;
-  const lobes = state.lobes ? state.lobes.split(",") : [];
+  const boxes = state.lobes ? state.lobes.split(",") : [];
   const common = { n: state.n, geometry: state.geometry, normalisation: state.normalisation };
+  const evaluate = (name) => "/api/evaluate?" + new URLSearchParams({ lobe: apiLobe(name), ...common, theta_in: state.theta_in });
   try {
-    const data = await Promise.all(lobes.map((lobe) => getJson("/api/evaluate?" + new URLSearchParams({ lobe, ...common, theta_in: state.theta_in }))));
-    const reports = await Promise.all(lobes.map((lobe) => getJson("/api/analyze?" + new URLSearchParams({ lobe, n: state.n }))));
+    // The formula's own request settles apart: its refusal is shown beside the text box, and
+    // the other lobes are drawn all the same.
+    const tooLong = state.formula ? formulaTooLong(evaluate(FORMULA)) : "";
+    const formula = !state.formula ? Promise.resolve({})
+      : tooLong ? Promise.resolve({ refusal: tooLong })
+      : getJson(evaluate(FORMULA)).then((data) => ({ data }), (error) => ({ refusal: error.refusal ?? error.message }));
+    const [builtIn, typed] = await Promise.all([Promise.all(boxes.map((lobe) => getJson(evaluate(lobe)))), formula]);
     if (mine !== generation) return;
+    showFormulaError(typed.refusal ?? "");
+    const lobes = typed.data ? [...boxes, FORMULA] : boxes;
+    // The page names the formula's lobe `formula`, whatever the server numbered it.
+    const data = typed.data ? [...builtIn, { ...typed.data, lobe: FORMULA }] : builtIn;
+    const reports = await Promise.all(lobes.map((lobe) => getJson("/api/analyze?" + new URLSearchParams({ lobe: apiLobe(lobe), n: state.n })).then((r) => ({ ...r, lobe }))));
+    if (mine !== generation) return;
+    // A refused formula is drawn nowhere: the renders show the last box's lobe, the volume its default.
+    const shown = {
+      render: state.render === FORMULA && !typed.data ? boxes[boxes.length - 1] ?? "" : state.render,
+      volume_lobe: state.volume_lobe === FORMULA && !typed.data ? DEFAULTS.volume_lobe : state.volume_lobe,
+    };
+    showValues(state, shown);
     draw(data, state);
     warnAboutAlbedo(data, state);
     $("analysis").innerHTML = lobes.length ? analysisTable(reports) : "<p>Choose a lobe.</p>";
-    if (lobes.length) {
-      const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: state.render, ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
+    if (shown.render) {
+      const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: apiLobe(shown.render), ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
       await Promise.all([loadImage($("sphere"), render("sphere")), loadImage($("teapot"), render("teapot"))]);
       const environment = (lobe) => "/api/environment?" + new URLSearchParams({ lobe, ...common, size: "384", spp: "16" });
-      await Promise.all([loadImage($("environment-image"), environment(state.render)), loadImage($("environment-pow"), environment("pow"))]);
+      await Promise.all([loadImage($("environment-image"), environment(apiLobe(shown.render))), loadImage($("environment-pow"), environment("pow"))]);
       if (mine !== generation) return;
       drawDifference($("environment-image"), $("environment-pow"), $("environment-diff"), $("environment-psnr"));
     }
     const volume = (lobe) => "/api/volume?" + new URLSearchParams({ volume: state.volume, view: state.view, lobe, ...common, size: "256" });
-    await Promise.all([loadImage($("volume-image"), volume(state.volume_lobe)), loadImage($("volume-pow"), volume("pow"))]);
+    await Promise.all([loadImage($("volume-image"), volume(apiLobe(shown.volume_lobe))), loadImage($("volume-pow"), volume("pow"))]);
     if (mine !== generation) return;
     drawDifference($("volume-image"), $("volume-pow"), $("volume-diff"), $("volume-psnr"));
     $("status").textContent = "";
@@ -434,6 +504,17 @@ async function start() {
   });
   document.querySelectorAll("#controls input, #controls select, #volume-controls select").forEach((el) => el.addEventListener("input", schedule));
   $("lobes").addEventListener("change", schedule);
+  // Typing in the formula makes it the lobe the renders and the volume show; a pause sends it.
+  $("formula").addEventListener("input", () => {
+    if (formulaText()) {
+      renderLobe = FORMULA;
+      $("volume_lobe").value = FORMULA;
+    } else if ($("volume_lobe").value === FORMULA) {
+      $("volume_lobe").value = DEFAULTS.volume_lobe;
+    }
+    clearTimeout(pending);
+    pending = setTimeout(update, FORMULA_DEBOUNCE_MS);
+  });
   await update();
 }
 

@@ -106,28 +106,44 @@ pub fn define(mut definition: Definition, naming: Naming) -> Result<&'static For
         lobe: crate::excerpt(&definition.name),
         message,
     })?;
+    // One pass over the defined formulas: the same definition under this name or a
+    // numbered one is found again; otherwise the name, or the next free number, is taken.
     let base = definition.name.clone();
-    for attempt in 1.. {
-        if attempt > 1 {
-            definition.name = format!("{base}-{attempt}");
+    let numbered = |name: &str| -> Option<u64> {
+        match name.strip_prefix(base.as_str()) {
+            Some("") => Some(1),
+            Some(rest) => rest.strip_prefix('-')?.parse().ok().filter(|&k| k > 1),
+            None => None,
         }
-        let taken = read()
-            .formulas
-            .iter()
-            .find(|(f, _)| f.name() == definition.name)
-            .map(|(f, _)| *f);
-        match taken {
-            Some(formula) if *formula.definition() == definition => return Ok(formula),
-            Some(_) if naming == Naming::Exact => {
-                return Err(Error::Formula {
-                    lobe: definition.name,
-                    message: "a different lobe of that name is already defined; rename one"
-                        .to_owned(),
-                })
-            }
-            Some(_) => continue,
-            None => break,
+    };
+    let same = |other: &Definition| {
+        other.formula == definition.formula
+            && other.tail == definition.tail
+            && other.parameters == definition.parameters
+            && other.description == definition.description
+    };
+    let mut highest = 0;
+    for (formula, _) in &read().formulas {
+        let Some(number) = numbered(formula.name()) else {
+            continue;
+        };
+        if naming == Naming::Exact && number > 1 {
+            continue;
         }
+        if same(formula.definition()) {
+            return Ok(formula);
+        }
+        if naming == Naming::Exact {
+            return Err(Error::Formula {
+                lobe: base,
+                message: "a different lobe of that name is already defined; rename one"
+                    .to_owned(),
+            });
+        }
+        highest = highest.max(number);
+    }
+    if highest > 0 {
+        definition.name = format!("{base}-{}", highest + 1);
     }
     let formula = Formula::compile(definition)?;
     let mut registry = write();

@@ -7,6 +7,8 @@ use tower::ServiceExt as _;
 
 use super::router;
 
+mod formula;
+
 async fn get(uri: &str) -> (StatusCode, Vec<u8>) {
     let response = router()
         .oneshot(Request::get(uri).body(Body::empty()).expect("request"))
