@@ -136,8 +136,7 @@ pub fn define(mut definition: Definition, naming: Naming) -> Result<&'static For
         if naming == Naming::Exact {
             return Err(Error::Formula {
                 lobe: base,
-                message: "a different lobe of that name is already defined; rename one"
-                    .to_owned(),
+                message: "a different lobe of that name is already defined; rename one".to_owned(),
             });
         }
         highest = highest.max(number);
