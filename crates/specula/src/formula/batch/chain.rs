@@ -507,7 +507,7 @@ fn apply_arithmetic<V: Lanes>(lanes: V, link: Link, values: &[f32], x: &mut [V; 
             each!(x, |v| v.mul_add(a, b));
         }
         Link::Powi(k) => {
-            each!(x, |v| super::powi(v, k));
+            each!(x, |v| super::columns::powi(v, k));
         }
         Link::Squarings(m) => {
             for _ in 0..m {
