@@ -31,6 +31,43 @@ impl TypedValueParser for LobeParser {
     }
 }
 
+/// A comma-separated list of lobes, parsed whole so that a formula's commas and a lobe's
+/// parameter values stay with it (`specula_render::lobe_file::parse_lobe_list`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LobeList(pub Vec<LobeKind>);
+
+/// Parses a [`LobeList`], listing the registry's ids as the possible values in `--help`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LobeListParser;
+
+impl TypedValueParser for LobeListParser {
+    type Value = LobeList;
+
+    fn parse_ref(
+        &self,
+        cmd: &Command,
+        arg: Option<&Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<LobeList, clap::Error> {
+        specula_render::lobe_file::parse_lobe_list(&value.to_string_lossy(), None)
+            .map(LobeList)
+            .map_err(|error| invalid_value(cmd, arg, &error))
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        LobeParser.possible_values()
+    }
+}
+
+/// Every lobe of repeated `--lobe` lists, in order.
+#[must_use]
+pub fn flatten(lists: &[LobeList]) -> Vec<LobeKind> {
+    lists
+        .iter()
+        .flat_map(|list| list.0.iter().copied())
+        .collect()
+}
+
 /// Parses a specular exponent in `[1, 1000]`.
 pub fn parse_exponent(text: &str) -> Result<Exponent, String> {
     let value: f64 = text

@@ -44,6 +44,42 @@ pub fn parse_lobe(text: &str, base: Option<&Path>) -> Result<LobeKind, String> {
     instance(formula, &given).map_err(|e| e.to_string())
 }
 
+/// A comma-separated list of lobe arguments (`pow,@mine.toml:k=2,m=1,=max(0, t - 0.5)`):
+/// commas inside parentheses belong to a formula, and `NAME=VALUE` items after a lobe with
+/// parameter values (`@FILE:k=2` or `id:k=2`) are more of its values.
+pub fn parse_lobe_list(text: &str, base: Option<&Path>) -> Result<Vec<LobeKind>, String> {
+    let mut items: Vec<String> = Vec::new();
+    let mut depth = 0_i32;
+    let mut current = String::new();
+    for c in text.chars() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth -= 1,
+            _ => {}
+        }
+        if c == ',' && depth <= 0 {
+            items.push(core::mem::take(&mut current));
+        } else {
+            current.push(c);
+        }
+    }
+    items.push(current);
+    let mut merged: Vec<String> = Vec::new();
+    for item in items {
+        let item = item.trim();
+        let is_value = !item.starts_with(['@', '=']) && item.contains('=') && !item.contains(':');
+        match merged.last_mut() {
+            Some(last) if is_value && last.contains(':') && last.contains('=') => {
+                last.push(',');
+                last.push_str(item);
+            }
+            _ if item.is_empty() => {}
+            _ => merged.push(item.to_owned()),
+        }
+    }
+    merged.iter().map(|item| parse_lobe(item, base)).collect()
+}
+
 /// Reads and parses a lobe file (a regular file within [`MAX_LOBE_FILE_BYTES`]).
 pub fn read_definition(path: &Path) -> Result<Definition, String> {
     let shown = path.display();
@@ -104,6 +140,27 @@ mod tests {
                 .to_string(),
             "file-sharp"
         );
+    }
+
+    #[test]
+    fn lists_keep_formulas_and_values_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("two.toml"),
+            "name = \"list-two\"\nformula = \"t ^ (n * k * m)\"\n[parameters.k]\ndefault = 1\nmin = 1\nmax = 4\n[parameters.m]\ndefault = 1\nmin = 1\nmax = 4\n",
+        )
+        .unwrap();
+        let kinds = parse_lobe_list(
+            "pow, @two.toml:k=2,m=3, =max(0, 1 - n * (1 - t)), cosquad:v=2",
+            Some(dir.path()),
+        )
+        .unwrap();
+        let shown: Vec<String> = kinds.iter().map(ToString::to_string).collect();
+        assert_eq!(shown[0], "pow");
+        assert_eq!(shown[1], "list-two:k=2,m=3");
+        assert!(shown[2].starts_with("formula"), "{shown:?}");
+        assert_eq!(shown[3], "cosquad:v=2");
+        assert_eq!(kinds.len(), 4);
     }
 
     #[test]

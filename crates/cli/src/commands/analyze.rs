@@ -7,15 +7,15 @@ use specula::{Exponent, LobeKind};
 use specula_gpu::{Gpu, GpuEvaluator, LobeEvaluator};
 
 use super::{print_json, CommandResult};
-use crate::args::{parse_exponent, BackendArg, Format, LobeParser};
+use crate::args::{parse_exponent, BackendArg, Format};
 use crate::output::{percent, sig, Table};
 
 /// Arguments of `specula analyze`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Lobes to analyse, comma separated (default: all).
-    #[arg(long, value_parser = LobeParser, value_delimiter = ',')]
-    lobe: Vec<LobeKind>,
+    #[arg(long, value_parser = crate::args::LobeListParser)]
+    lobe: Vec<crate::args::LobeList>,
     /// Exponents, comma separated (default: 1,2,4,8,16,32,64,128,256,512,1000).
     #[arg(long, value_parser = parse_exponent, value_delimiter = ',', allow_hyphen_values = true)]
     n: Vec<Exponent>,
@@ -33,7 +33,7 @@ pub fn run(args: &Args) -> CommandResult {
     let lobes = if args.lobe.is_empty() {
         LobeKind::ALL.to_vec()
     } else {
-        args.lobe.clone()
+        crate::args::flatten(&args.lobe)
     };
     let exponents: Vec<Exponent> = if args.n.is_empty() {
         DEFAULT_EXPONENTS

@@ -65,11 +65,14 @@ fn new(args: &NewArgs) -> CommandResult {
         .chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
         .collect();
-    let name = if name.starts_with(|c: char| c.is_ascii_lowercase()) {
+    // An id: a lowercase letter first, at most 32 characters, not a built-in lobe's id.
+    let builtin = LobeKind::ALL.iter().any(|kind| kind.id() == name);
+    let name = if name.starts_with(|c: char| c.is_ascii_lowercase()) && !builtin {
         name
     } else {
-        format!("lobe-{name}")
+        format!("my-{name}")
     };
+    let name: String = name.chars().take(32).collect();
     let text = TEMPLATE
         .replace("name = \"k4-by-hand\"", &format!("name = \"{name}\""))
         .replace(

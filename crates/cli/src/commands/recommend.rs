@@ -68,8 +68,8 @@ pub struct Args {
     /// Also consider these lobes: your own (`@FILE.toml`, `=FORMULA`), or a built-in with
     /// other parameters (`cosquad:v=5`); comma separated. On `fpga` a lobe without a
     /// fixed-point datapath is listed as unavailable.
-    #[arg(long, value_parser = crate::args::LobeParser, value_delimiter = ',')]
-    lobe: Vec<LobeKind>,
+    #[arg(long, value_parser = crate::args::LobeListParser)]
+    lobe: Vec<crate::args::LobeList>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
     format: crate::args::Format,
@@ -342,9 +342,10 @@ pub(crate) fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
 /// Measures, ranks and prints.
 pub fn run(args: &Args) -> CommandResult {
     let exponents = &args.n.0;
-    crate::args::check_lobes(&args.lobe, exponents)?;
+    let yours = crate::args::flatten(&args.lobe);
+    crate::args::check_lobes(&yours, exponents)?;
     let mut kinds = LobeKind::ALL.to_vec();
-    for &kind in &args.lobe {
+    for &kind in &yours {
         if !kinds.contains(&kind) {
             kinds.push(kind);
         }

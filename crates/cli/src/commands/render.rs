@@ -87,11 +87,7 @@ fn parse_grid(text: &str) -> Result<LobeList, String> {
     let list = text.strip_prefix("lobes=").ok_or_else(|| {
         format!("'{text}' must have the form lobes=ID,ID,... (e.g. lobes=pow,schlick)")
     })?;
-    list.split(',')
-        .filter(|id| !id.is_empty())
-        .map(|id| specula_render::lobe_file::parse_lobe(id.trim(), None))
-        .collect::<Result<_, _>>()
-        .map(LobeList)
+    specula_render::lobe_file::parse_lobe_list(list, None).map(LobeList)
 }
 
 fn progress_bar(label: &str) -> ProgressBar {

@@ -125,23 +125,18 @@ pub const FUNCTIONS: [(&str, &str); 18] = [
     ("mix", "mix(x, y, s)"),
 ];
 
-/// Names a user may not bind: the formula's own, the functions, and the keywords and
-/// built-ins of the languages the lobe is generated in (WGSL, GLSL, HLSL, MSL, OSL, Python).
-const RESERVED: [&str; 58] = [
-    "t", "n", "pi", "e", "let", "if", "else", "for", "while", "do", "return", "var", "fn", "const",
-    "struct", "true", "false", "in", "out", "inout", "int", "uint", "float", "double", "bool",
-    "void", "half", "color", "point", "vector", "normal", "matrix", "string", "closure", "output",
-    "shader", "surface", "def", "lambda", "and", "or", "not", "is", "none", "pass", "class",
-    "import", "from", "with", "as", "switch", "case", "default", "break", "continue", "discard",
-    "dr", "mi",
-];
+/// Names a user may not bind: the formula's own. (The generated languages' words need no
+/// list: a per-material constant is written as `c_` and its name in every target, which no
+/// keyword of WGSL, GLSL, HLSL, MSL, OSL or Python begins with.)
+const RESERVED: [&str; 5] = ["t", "n", "pi", "e", "let"];
 
 /// Whether `name` may be bound by a `let` or declared as a parameter, and why not.
 pub(crate) fn check_user_name(name: &str) -> Result<(), String> {
     let bytes = name.as_bytes();
-    let generated = |prefix: u8| {
-        bytes.len() > 1 && bytes[0] == prefix && bytes[1..].iter().all(u8::is_ascii_digit)
-    };
+    // The generators name a constant's intermediate values `<constant>_v<digits>`.
+    let generated_suffix = name
+        .match_indices("_v")
+        .any(|(at, _)| bytes.get(at + 2).is_some_and(u8::is_ascii_digit));
     if name.is_empty()
         || name.len() > 32
         || !bytes[0].is_ascii_lowercase()
@@ -156,13 +151,11 @@ pub(crate) fn check_user_name(name: &str) -> Result<(), String> {
         ))
     } else if RESERVED.contains(&name)
         || FUNCTIONS.iter().any(|(f, _)| *f == name)
-        || generated(b'v')
-        || generated(b'k')
-        || name.contains("_v")
+        || generated_suffix
     {
         Err(format!(
-            "'{name}' is reserved (a name of the formula language or of a language the lobe \
-             is generated in, or of the form v<digits>, k<digits>, *_v*)"
+            "'{name}' is reserved (t, n, pi, e, let, the functions, and names with _v and a \
+             digit, which the generated code uses)"
         ))
     } else {
         Ok(())
@@ -393,12 +386,14 @@ pub(crate) fn compile(
     }
     let tail = match tail {
         Some(ast) => {
-            let index = compiler.expression(ast)?;
+            let index = compiler
+                .expression(ast)
+                .map_err(|e| FormulaError { in_tail: true, ..e })?;
             if !compiler.varying[index] {
-                return Err(FormulaError::at(
-                    ast.at,
-                    "the tail does not depend on t".to_owned(),
-                ));
+                return Err(FormulaError {
+                    in_tail: true,
+                    ..FormulaError::at(ast.at, "the tail does not depend on t".to_owned())
+                });
             }
             Some(index)
         }
@@ -414,8 +409,9 @@ pub(crate) fn compile(
     })
 }
 
-/// The uniform operations the varying ones read, each named: `n`, a parameter's name, a
-/// `let`'s name, or `k0`, `k1`, ... for an unnamed sub-expression.
+/// The uniform operations the varying ones read, each named: `n`, or `c_` and a parameter's
+/// or a `let`'s name, or `c_0`, `c_1`, ... for an unnamed sub-expression (the prefix keeps
+/// every name clear of every generated language's keywords).
 fn slots(compiler: &Compiler) -> Result<Vec<Slot>, FormulaError> {
     let mut slots: Vec<Slot> = Vec::new();
     for (index, op) in compiler.ops.iter().enumerate() {
@@ -428,12 +424,15 @@ fn slots(compiler: &Compiler) -> Result<Vec<Slot>, FormulaError> {
             if uniform && !folded && slots.iter().all(|s| s.op != operand) {
                 let name = match compiler.ops[operand] {
                     Op::N => "n".to_owned(),
-                    Op::Param(p) => compiler.parameters[p].clone(),
+                    Op::Param(p) => format!("c_{}", compiler.parameters[p]),
                     _ => compiler
                         .lets
                         .iter()
                         .find(|(_, op)| *op == operand)
-                        .map_or_else(|| format!("k{}", slots.len()), |(name, _)| name.clone()),
+                        .map_or_else(
+                            || format!("c_{}", slots.len()),
+                            |(name, _)| format!("c_{name}"),
+                        ),
                 };
                 slots.push(Slot { name, op: operand });
             }

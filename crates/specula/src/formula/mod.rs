@@ -89,11 +89,17 @@ pub struct FormulaError {
     pub at: usize,
     /// What is wrong, and what is valid.
     pub message: String,
+    /// Whether the offset is in the tail's text rather than the formula's.
+    pub in_tail: bool,
 }
 
 impl FormulaError {
     pub(crate) fn at(at: usize, message: String) -> Self {
-        Self { at, message }
+        Self {
+            at,
+            message,
+            in_tail: false,
+        }
     }
 
     /// `field`, line and column (or column alone for one line), then the message: one line.
@@ -183,15 +189,13 @@ impl Formula {
             }
             None => None,
         };
-        let compiled = compile::compile(&program, tail_program.as_ref(), &names).map_err(|e| {
-            // An error in the tail's expression points into the tail's text.
-            match (&tail_program, &definition.tail) {
-                (Some(_), Some(text)) if e.message.contains("tail") => {
-                    refuse(e.locate("tail", text))
+        let compiled =
+            compile::compile(&program, tail_program.as_ref(), &names).map_err(|e| {
+                match (&definition.tail, e.in_tail) {
+                    (Some(text), true) => refuse(e.locate("tail", text)),
+                    _ => refuse(e.locate("formula", &definition.formula)),
                 }
-                _ => refuse(e.locate("formula", &definition.formula)),
-            }
-        })?;
+            })?;
         let slot_of = |index: usize| compiled.slots.iter().position(|s| s.op == index);
         let leaf = |index: usize| match compiled.ops[index] {
             Op::Const(c) => Some(Op::Const(c)),
@@ -202,6 +206,19 @@ impl Formula {
         let tail = compiled
             .tail
             .map(|root| program::extract(&compiled.ops, root, leaf));
+        // A constant folded to NaN or infinity would make every value of the lobe depend on
+        // how each backend's min and max treat it.
+        for (field, tape) in [("formula", Some(&body)), ("tail", tail.as_ref())] {
+            if tape.is_some_and(|ops| {
+                ops.iter()
+                    .any(|op| matches!(op, Op::Const(c) if !c.is_finite()))
+            }) {
+                return Err(refuse(format!(
+                    "{field}: a sub-expression of numbers alone is NaN or infinite (as 0/0 or \
+                     log(0)); write a finite number"
+                )));
+            }
+        }
         let slot_tapes = compiled
             .slots
             .iter()

@@ -112,7 +112,12 @@ pub fn define(mut definition: Definition, naming: Naming) -> Result<&'static For
     let numbered = |name: &str| -> Option<u64> {
         match name.strip_prefix(base.as_str()) {
             Some("") => Some(1),
-            Some(rest) => rest.strip_prefix('-')?.parse().ok().filter(|&k| k > 1),
+            Some(rest) => rest
+                .strip_prefix('-')?
+                .parse::<u32>()
+                .ok()
+                .filter(|&k| k > 1)
+                .map(u64::from),
             None => None,
         }
     };
@@ -144,6 +149,15 @@ pub fn define(mut definition: Definition, naming: Naming) -> Result<&'static For
     if highest > 0 {
         definition.name = format!("{base}-{}", highest + 1);
     }
+    // Refused before compiling, so that a full registry costs a request nothing it keeps.
+    if read().formulas.len() >= MAX_FORMULAS {
+        return Err(Error::Formula {
+            lobe: definition.name,
+            message: format!(
+                "this process has defined its limit of {MAX_FORMULAS} lobes; restart it"
+            ),
+        });
+    }
     let formula = Formula::compile(definition)?;
     let mut registry = write();
     if let Some((existing, _)) = registry
@@ -151,9 +165,14 @@ pub fn define(mut definition: Definition, naming: Naming) -> Result<&'static For
         .iter()
         .find(|(f, _)| f.name() == formula.name())
     {
-        // Defined by another thread meanwhile: the same text, or a refusal.
+        // Defined by another thread meanwhile: the same text, another number, or a refusal.
         return if existing.definition() == formula.definition() {
             Ok(existing)
+        } else if naming == Naming::Unique {
+            drop(registry);
+            let mut again = formula.definition.clone();
+            again.name = base;
+            define(again, naming)
         } else {
             Err(Error::Formula {
                 lobe: formula.name().to_owned(),

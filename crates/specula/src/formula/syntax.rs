@@ -21,8 +21,9 @@ use super::FormulaError;
 
 /// The longest formula text, in bytes (a pasted file of 64 KiB is far beyond any lobe).
 pub const MAX_SOURCE_BYTES: usize = 64 * 1024;
-/// The deepest nesting of parentheses, calls and operators.
-pub const MAX_DEPTH: usize = 64;
+/// The deepest nesting of the grammar's levels: a parenthesis or a call takes two (the
+/// expression inside, and the sign before it), so 64 parentheses fit.
+pub const MAX_DEPTH: usize = 128;
 /// The most nodes a formula's tree may have.
 pub const MAX_NODES: usize = 4096;
 /// The most `let` bindings.

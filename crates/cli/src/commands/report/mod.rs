@@ -43,8 +43,8 @@ pub struct Args {
     #[arg(long)]
     bench: bool,
     /// Add your own lobes to every section (`@FILE.toml`, `=FORMULA`; comma separated).
-    #[arg(long, value_parser = crate::args::LobeParser, value_delimiter = ',')]
-    lobe: Vec<LobeKind>,
+    #[arg(long, value_parser = crate::args::LobeListParser)]
+    lobe: Vec<crate::args::LobeList>,
 }
 
 /// How much each section computes.
@@ -218,8 +218,9 @@ pub fn run(args: &Args) -> CommandResult {
             args.out.display()
         )
     })?;
+    let yours = crate::args::flatten(&args.lobe);
     let mut lobes = LobeKind::ALL.to_vec();
-    for &kind in &args.lobe {
+    for &kind in &yours {
         if !lobes.contains(&kind) {
             lobes.push(kind);
         }
@@ -234,7 +235,7 @@ pub fn run(args: &Args) -> CommandResult {
             .iter()
             .map(|&n| Exponent::new(f64::from(n))),
     );
-    crate::args::check_lobes(&args.lobe, &checked)?;
+    crate::args::check_lobes(&yours, &checked)?;
     let shared = Arc::new(Shared::default());
     let context = || Context {
         lobes: lobes.clone(),

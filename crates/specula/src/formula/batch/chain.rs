@@ -155,6 +155,11 @@ impl Chain {
     /// range by evaluating monotone links at the interval's ends in `f32` (each rounded
     /// monotone operation keeps the order of its inputs), any other link needing both.
     pub(super) fn rules(&self, values: &[f32]) -> Rules {
+        // Rust's min and max ignore a NaN that the vector instructions return: with one
+        // among the constants, the scalar ends prove nothing.
+        if values.iter().any(|v| !v.is_finite()) {
+            return Rules::ALL;
+        }
         let (mut low, mut high) = (0.0_f32, 1.0_f32);
         for &link in &self.links {
             let monotone = match link {
@@ -172,6 +177,9 @@ impl Chain {
                 return Rules::ALL;
             }
             let (a, b) = (link.scalar(low, values), link.scalar(high, values));
+            if a.is_nan() || b.is_nan() {
+                return Rules::ALL;
+            }
             (low, high) = (a.min(b), a.max(b));
             if !(low.is_finite() && high.is_finite()) {
                 return Rules::ALL;

@@ -10,20 +10,6 @@ use super::{Source, Step};
 use crate::formula::compile::Op;
 use crate::simd::{math, Lanes};
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Unary {
-    Neg,
-    Sqrt,
-    Log2,
-    Exp2,
-    Exp,
-    Ln,
-    Acos,
-    Abs,
-    /// Lane by lane with the standard library.
-    Scalar(LaneFunction),
-}
-
 /// A function the columns compute lane by lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum LaneFunction {
@@ -53,24 +39,6 @@ pub(super) enum Binary {
     Min,
     Max,
     Pow,
-}
-
-pub(super) fn unary(op: Op) -> Option<Unary> {
-    Some(match op {
-        Op::Neg(_) => Unary::Neg,
-        Op::Sqrt(_) => Unary::Sqrt,
-        Op::Log2(_) => Unary::Log2,
-        Op::Exp2(_) => Unary::Exp2,
-        Op::Exp(_) => Unary::Exp,
-        Op::Ln(_) => Unary::Ln,
-        Op::Acos(_) => Unary::Acos,
-        Op::Abs(_) => Unary::Abs,
-        Op::Cos(_) => Unary::Scalar(LaneFunction::Cos),
-        Op::Sin(_) => Unary::Scalar(LaneFunction::Sin),
-        Op::Floor(_) => Unary::Scalar(LaneFunction::Floor),
-        Op::Ceil(_) => Unary::Scalar(LaneFunction::Ceil),
-        _ => return None,
-    })
 }
 
 pub(super) fn binary(op: Op) -> Option<Binary> {
@@ -116,18 +84,10 @@ map!(MinOp, 2, |x| x[0].min(x[1]));
 map!(MaxOp, 2, |x| x[0].max(x[1]));
 map!(FmaOp, 3, |x| x[0].mul_add(x[1], x[2]));
 map!(SelectOp, 4, |x| x[2].select(x[0].lt(x[1]), x[3]));
-map!(PowiOp, 1, |x, k: i32| powi(x[0], k));
-map!(ScaleOp, 1, |x, by: f32| x[0] * x[0].splat(by));
-map!(AbsOp, 1, |x| x[0].max(x[0] * x[0].splat(-1.0)));
-map!(SqrtOp, 1, |x| x[0].sqrt());
-map!(Log2Op, 1, |x| math::log2(x[0]));
-map!(LnOp, 1, |x| math::log2(x[0])
-    * x[0].splat(core::f32::consts::LN_2));
 map!(PowLogOp, 2, |x| x[1] * math::log2(x[0]));
 map!(Exp2Op, 1, |x, scale: f32| math::exp2(
     x[0] * x[0].splat(scale)
 ));
-map!(AcosOp, 1, |x| math::acos(x[0]));
 // 1 where `low < scale x < high` (NaN fails both), else 0.
 map!(Inside, 1, |x, scale: f32, low: f32, high: f32| {
     let (zero, one) = (x[0].splat(0.0), x[0].splat(1.0));
@@ -178,13 +138,6 @@ fn in_place<V: Lanes, M: Map<1>>(lanes: V, file: &mut [f32], column: usize, bloc
     }
 }
 
-/// A lane-by-lane pass with the standard library, for what the polynomials do not cover.
-fn lane_by_lane(file: &mut [f32], operand: usize, out: usize, block: usize, f: fn(f32) -> f32) {
-    for i in 0..block {
-        file[out + i] = f(file[operand + i]);
-    }
-}
-
 /// Whether every lane of the block's column passes `inside` (which gives 1 or 0 per lane).
 #[inline(always)]
 fn all_inside<V: Lanes>(
@@ -221,15 +174,6 @@ pub(super) const ACOS_DOMAIN: Inside = Inside {
 };
 
 #[inline(always)]
-fn log2_column<V: Lanes>(lanes: V, file: &mut [f32], a: usize, r: usize, block: usize) {
-    if all_inside(lanes, file, a, block, LOG2_DOMAIN) {
-        columns(lanes, file, [a], r, block, Log2Op {});
-    } else {
-        lane_by_lane(file, a, r, block, f32::log2);
-    }
-}
-
-#[inline(always)]
 pub(super) fn run_step<V: Lanes>(
     lanes: V,
     step: &Step,
@@ -252,7 +196,6 @@ pub(super) fn run_step<V: Lanes>(
             block,
             FmaOp {},
         ),
-        Step::Powi(a, k, r) => columns(lanes, file, [column(a)], out(r), block, PowiOp { k }),
         Step::SelectLess([a, b, then, otherwise], r) => {
             let operands = [column(a), column(b), column(then), column(otherwise)];
             columns(lanes, file, operands, out(r), block, SelectOp {});
@@ -277,32 +220,6 @@ pub(super) fn run_step<V: Lanes>(
                     }
                     exp2_column(lanes, file, r, r, block, 1.0);
                 }
-            }
-        }
-        Step::Unary(op, a, r) => {
-            let (a, r) = (column(a), out(r));
-            match op {
-                Unary::Neg => columns(lanes, file, [a], r, block, ScaleOp { by: -1.0 }),
-                Unary::Abs => columns(lanes, file, [a], r, block, AbsOp {}),
-                Unary::Sqrt => columns(lanes, file, [a], r, block, SqrtOp {}),
-                Unary::Log2 => log2_column(lanes, file, a, r, block),
-                Unary::Ln => {
-                    if all_inside(lanes, file, a, block, LOG2_DOMAIN) {
-                        columns(lanes, file, [a], r, block, LnOp {});
-                    } else {
-                        lane_by_lane(file, a, r, block, |x| x.log2() * core::f32::consts::LN_2);
-                    }
-                }
-                Unary::Exp2 => exp2_column(lanes, file, a, r, block, 1.0),
-                Unary::Exp => exp2_column(lanes, file, a, r, block, core::f32::consts::LOG2_E),
-                Unary::Acos => {
-                    if all_inside(lanes, file, a, block, ACOS_DOMAIN) {
-                        columns(lanes, file, [a], r, block, AcosOp {});
-                    } else {
-                        lane_by_lane(file, a, r, block, f32::acos);
-                    }
-                }
-                Unary::Scalar(f) => lane_by_lane(file, a, r, block, f.get()),
             }
         }
     }

@@ -21,9 +21,7 @@ use crate::simd::tally::{Class, Instructions};
 use crate::simd::Lanes;
 pub(crate) use chain::Rules;
 use chain::{Chain, End, Link};
-use columns::{
-    binary, run_step, unary, Binary, Inside, LaneFunction, Map, Unary, ACOS_DOMAIN, LOG2_DOMAIN,
-};
+use columns::{binary, run_step, Binary, Inside, LaneFunction, Map, ACOS_DOMAIN, LOG2_DOMAIN};
 
 /// Vectors per block: 16 vectors of 8 lanes keep a register in 512 bytes, so a formula's
 /// live registers stay in L1.
@@ -49,10 +47,8 @@ enum Scalar {
 #[derive(Clone, Debug, PartialEq)]
 enum Step {
     Chain(Chain, End, End),
-    Unary(Unary, Source, usize),
     Binary(Binary, Source, Source, usize),
     Fma(Source, Source, Source, usize),
-    Powi(Source, i32, usize),
     SelectLess([Source; 4], usize),
 }
 
@@ -110,21 +106,49 @@ impl Plan {
         let continues = |index: usize| {
             uses[index] == 1 && matches!(roles[last_use[index]], Role::Link(x, _) if x == index)
         };
-        // A multiply read only by the add that follows it is fused into that add.
-        let fused_into_add = |index: usize| {
+        // A multiply read only by an add is fused into it: the add's first such operand.
+        let fusible = |index: usize| {
             matches!(roles[index], Role::Column)
                 && matches!(tape[index], Op::Mul(..))
                 && uses[index] == 1
                 && matches!(roles[last_use[index]], Role::Column)
-                && matches!(tape[last_use[index]], Op::Add(a, b) if a == index || b == index)
         };
+        let fused_into_add = |index: usize| {
+            fusible(index)
+                && match tape[last_use[index]] {
+                    Op::Add(a, _) if a == index => true,
+                    Op::Add(a, b) if b == index => !fusible(a),
+                    _ => false,
+                }
+        };
+        // Where each operation's step runs: a link with its chain's last link, a fused
+        // multiply with its add, the others in place; a value's register is free once the
+        // last step reading it has run (not its last reader's own index, which for a chain's
+        // head or a fused multiply's operands comes earlier).
+        let emitted = |index: usize| {
+            let mut at = index;
+            if matches!(roles[at], Role::Link(..)) {
+                while continues(at) {
+                    at = last_use[at];
+                }
+            } else if fused_into_add(at) {
+                at = last_use[at];
+            }
+            at
+        };
+        let mut freed_after = vec![0usize; tape.len()];
+        for (index, op) in tape.iter().enumerate() {
+            for operand in op.operands() {
+                freed_after[operand] = freed_after[operand].max(emitted(index));
+            }
+        }
         let last = tape.len() - 1;
         let mut source: Vec<Option<Source>> = vec![None; tape.len()];
         let mut free: Vec<usize> = Vec::new();
         let mut registers = 1;
         let mut steps = Vec::new();
         let mut needs_t = false;
-        let mut chains: Vec<Option<(usize, usize, Vec<Link>)>> = vec![None; tape.len()];
+        let mut chains: Vec<Option<(usize, Vec<Link>)>> = vec![None; tape.len()];
         for index in 0..tape.len() {
             let at = |i: usize| match roles[i] {
                 Role::Scalar(s) => Source::Scalar(s),
@@ -137,8 +161,8 @@ impl Plan {
                     registers - 1
                 })
             };
-            let release = |i: usize, reader: usize, free: &mut Vec<usize>| {
-                if last_use[i] == reader && matches!(roles[i], Role::Link(..) | Role::Column) {
+            let release = |i: usize, step: usize, free: &mut Vec<usize>| {
+                if freed_after[i] == step && matches!(roles[i], Role::Link(..) | Role::Column) {
                     if let Some(Source::Register(r)) = source[i] {
                         if r != 0 && !free.contains(&r) {
                             free.push(r);
@@ -150,18 +174,17 @@ impl Plan {
                 Role::Scalar(_) | Role::T => {}
                 Role::Link(x, l) => {
                     // Extend the chain ending at `x`, or start one from `x`.
-                    let (head, first, mut links) =
-                        chains[x].take().unwrap_or((x, index, Vec::new()));
+                    let (head, mut links) = chains[x].take().unwrap_or((x, Vec::new()));
                     push_fused(&mut links, l);
                     if continues(index) {
-                        chains[index] = Some((head, first, links));
+                        chains[index] = Some((head, links));
                         continue;
                     }
                     let input = match roles[head] {
                         Role::T => End::Batch,
                         _ => End::Register(register_of(at(head))),
                     };
-                    release(head, first, &mut free);
+                    release(head, index, &mut free);
                     let output = if index == last {
                         End::Batch
                     } else {
@@ -186,10 +209,9 @@ impl Plan {
                                 unreachable!("fused_into_add holds multiplies")
                             };
                             needs_t |= [x, y].iter().any(|&i| roles[i] == Role::T);
-                            for i in [x, y] {
-                                release(i, product, &mut free);
+                            for i in [x, y, addend] {
+                                release(i, index, &mut free);
                             }
-                            release(addend, index, &mut free);
                             Step::Fma(at(x), at(y), at(addend), out)
                         }
                         Op::SelectLess {
@@ -198,11 +220,10 @@ impl Plan {
                             then,
                             otherwise,
                         } => Step::SelectLess([at(a), at(b), at(then), at(otherwise)], out),
-                        Op::Powi(a, k) => Step::Powi(at(a), k, out),
-                        op => match (unary(op), binary(op)) {
-                            (Some(u), _) => Step::Unary(u, at(operands[0]), out),
-                            (_, Some(b)) => Step::Binary(b, at(operands[0]), at(operands[1]), out),
-                            _ => unreachable!("every operation of a tape is a step: {op:?}"),
+                        // Every operation of one varying operand is a link; of two, a binary.
+                        op => match binary(op) {
+                            Some(b) => Step::Binary(b, at(operands[0]), at(operands[1]), out),
+                            None => unreachable!("every operation of a tape is a step: {op:?}"),
                         },
                     };
                     for &i in &operands {
@@ -266,7 +287,6 @@ impl Plan {
                     .iter()
                     .fold(Instructions::NONE, |sum, link| sum.and(link.instructions())),
                 Step::Fma(..) => Instructions::of(&[(Class::Fma, 1)]),
-                Step::Powi(_, k, _) => Link::Powi(*k).instructions(),
                 Step::SelectLess(..) => Instructions::of(&[(Class::Compare, 1), (Class::Blend, 1)]),
                 Step::Binary(b, ..) => match b {
                     Binary::Add | Binary::Sub => Instructions::of(&[(Class::Add, 1)]),
@@ -274,16 +294,6 @@ impl Plan {
                     Binary::Div => Instructions::of(&[(Class::Div, 1)]),
                     Binary::Min | Binary::Max => Instructions::of(&[(Class::MinMax, 1)]),
                     Binary::Pow => Link::Pow(0).instructions(),
-                },
-                Step::Unary(u, ..) => match u {
-                    Unary::Neg => Link::Neg.instructions(),
-                    Unary::Abs => Link::Abs.instructions(),
-                    Unary::Sqrt => Link::Sqrt.instructions(),
-                    Unary::Log2 => Link::Log2.instructions(),
-                    Unary::Exp2 | Unary::Exp => Link::Exp2(1.0).instructions(),
-                    Unary::Ln => Link::Ln.instructions(),
-                    Unary::Acos => Link::Acos.instructions(),
-                    Unary::Scalar(f) => Link::Lane(*f).instructions(),
                 },
             })
         })
