@@ -6,6 +6,7 @@
 //! is written atomically, and the page last, so an interrupted run never leaves a page that
 //! points at missing images.
 
+mod energy;
 mod hardware;
 mod html;
 mod plot;
@@ -197,8 +198,8 @@ const SECTIONS: [Section; 12] = [
     ("Models", sections::models),
     ("Lobe shapes", sections::shapes),
     ("Error against the angle and against n", sections::errors),
-    ("Energy and normalisation", sections::energy),
-    ("Reciprocity and white furnace", sections::reciprocity),
+    ("Energy and normalisation", energy::energy),
+    ("Reciprocity and white furnace", energy::reciprocity),
     ("Renders", renders::renders),
     ("Medical volumes", volumes::volumes),
     ("Into other renderers", renderers::renderers),

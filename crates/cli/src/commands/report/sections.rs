@@ -1,14 +1,11 @@
-//! The report's analysis sections: models, lobe shapes, errors, energy, reciprocity, claims
-//! and cost. Every figure is computed here, during the run.
+//! The report's analysis sections: models, lobe shapes, errors, claims and cost (energy
+//! and reciprocity are `energy.rs`). Every figure is computed here, during the run.
 
 use rayon::prelude::*;
-use specula::analysis::{
-    error_figures, max_directional_albedo, max_reciprocity_error, ErrorFigures, Precision,
-};
+use specula::analysis::{error_figures, ErrorFigures, Precision};
 use specula::claims::{evaluate_all, ClaimOptions, Verdict};
-use specula::normalisation::lobe_constant;
 use specula::zones::{bloom_angle, epicentre_angle};
-use specula::{Brdf, ClassicModel, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
+use specula::{Exponent, Lobe, LobeKind};
 use specula_synth::OnMiss;
 
 use super::html::{escape, paragraph, table};
@@ -299,152 +296,6 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
         &rows,
     );
     Ok(html)
-}
-
-pub fn energy(context: &mut Context) -> Result<String, String> {
-    let grid = exponents(context.sizes.n_steps);
-    let kinds: Vec<LobeKind> = context.lobes.clone();
-    let ratios: Vec<Vec<(f64, f64)>> = kinds
-        .par_iter()
-        .map(|&kind| {
-            grid.iter()
-                .map(|&n| {
-                    (
-                        n.get(),
-                        specula::analysis::energy_ratio(&Lobe::new(kind, n)),
-                    )
-                })
-                .collect()
-        })
-        .collect();
-    let high = ratios.iter().flatten().map(|p| p.1).fold(1.2, f64::max);
-    let chart = Chart {
-        title: "energy relative to t^n".into(),
-        x_label: "n".into(),
-        y_label: "(n + 1) int lobe(cos g) sin g dg".into(),
-        x: (1.0, 1000.0),
-        y: (0.0, high * 1.05),
-        log_x: true,
-        log_y: false,
-        series: kinds
-            .iter()
-            .zip(ratios)
-            .map(|(&k, points)| series(k, points))
-            .collect(),
-        bands: Vec::new(),
-        legend_below: false,
-    };
-    let mut html = paragraph("Energy ratio 1 means the lobe reflects what t^n reflects; the analytic (n+1)/(2 pi) applied to an approximation scales its energy by exactly this ratio.");
-    html += &context.svg("energy-ratio.svg", &chart, "energy ratio against n: 1 reflects what t^n reflects; above 1 a lobe with t^n's normalisation creates energy, below it darkens")?;
-    let coef1 = Chart {
-        title: "the thesis's coef1 = 1.063 n / (2 pi) against the exact (n + 1) / (2 pi)".into(),
-        x_label: "n".into(),
-        y_label: "coef1 / exact".into(),
-        x: (1.0, 1000.0),
-        y: (0.4, 1.2),
-        log_x: true,
-        log_y: false,
-        series: vec![
-            Series {
-                name: "coef1 / exact".into(),
-                points: grid
-                    .iter()
-                    .map(|n| (n.get(), 1.063 * n.get() / (n.get() + 1.0)))
-                    .collect(),
-                colour: SEQUENCE[1],
-                width: 2,
-                markers: false,
-                dashed: false,
-            },
-            Series {
-                name: "1".into(),
-                points: vec![(1.0, 1.0), (1000.0, 1.0)],
-                colour: plotters::style::RGBColor(0, 0, 0),
-                width: 1,
-                markers: false,
-                dashed: true,
-            },
-        ],
-        bands: Vec::new(),
-        legend_below: false,
-    };
-    html += &context.svg("coef1.svg", &coef1, "coef1 against the exact normalisation: it crosses 1 at a single n, so the thesis's coefficient is right only there")?;
-    let table_n = [1.0, 8.0, 64.0, 512.0, 1000.0].map(Exponent::new);
-    let rows: Vec<Vec<String>> = kinds
-        .iter()
-        .map(|&kind| {
-            let mut row = vec![kind.to_string()];
-            row.extend(table_n.iter().map(|&n| {
-                let numeric = lobe_constant(&Lobe::new(kind, n));
-                format!(
-                    "{} ({:+.2}%)",
-                    sig(numeric),
-                    100.0 * (numeric / Normalisation::Lobe.analytic(n) - 1.0)
-                )
-            }));
-            row
-        })
-        .collect();
-    html += &paragraph("Each lobe's own normalisation constant (computed numerically), and how far it is from the analytic (n+1)/(2 pi):");
-    html += &table(
-        &["lobe", "n = 1", "n = 8", "n = 64", "n = 512", "n = 1000"],
-        &rows,
-    );
-    Ok(html)
-}
-
-pub fn reciprocity(context: &mut Context) -> Result<String, String> {
-    use rand::SeedableRng;
-    let pairs = context.sizes.reciprocity_pairs;
-    let exponents = [8.0, 64.0, 512.0].map(Exponent::new);
-    let rows: Vec<Vec<String>> = context
-        .lobes
-        .par_iter()
-        .map(|&kind| {
-            let mut row = vec![kind.to_string()];
-            for n in exponents {
-                let lobe = Lobe::new(kind, n);
-                let brdf = Brdf::new(
-                    Rgb::ZERO,
-                    Rgb::ONE,
-                    lobe,
-                    Geometry::Phong,
-                    Normalisation::Lobe,
-                );
-                row.push(format!("{:.5}", max_directional_albedo(&brdf).1));
-            }
-            let mut rng = rand_pcg::Pcg64::seed_from_u64(0x5eed);
-            let worst = Geometry::ALL
-                .iter()
-                .map(|&geometry| {
-                    let brdf = Brdf::new(
-                        Rgb::splat(0.2),
-                        Rgb::splat(0.8),
-                        Lobe::new(kind, exponents[1]),
-                        geometry,
-                        Normalisation::Lobe,
-                    );
-                    max_reciprocity_error(|wo, wi| brdf.f(wo, wi), pairs, &mut rng)
-                })
-                .fold(0.0, f64::max);
-            let classic = ClassicModel {
-                ka: Rgb::ZERO,
-                kd: Rgb::splat(0.2),
-                ks: Rgb::splat(0.8),
-                lobe: Lobe::new(kind, exponents[1]),
-                geometry: Geometry::Phong,
-            };
-            let classic_error =
-                max_reciprocity_error(|wo, wi| classic.implied_brdf(wo, wi), pairs, &mut rng);
-            row.push(sig(worst));
-            row.push(sig(classic_error));
-            row
-        })
-        .collect();
-    Ok(paragraph(&format!("White furnace: the largest directional albedo of the lobe-normalised BRDF (kd = 0, ks = 1, Phong geometry) over all outgoing angles; at most 1 conserves energy. Reciprocity: the largest |f(wo, wi) - f(wi, wo)| over {pairs} random direction pairs at n = 64 (Phong and Blinn), and the same for the BRDF the classic model implies (kd + ks lobe / cos theta_i).")) + &table(
-        &["lobe", "max albedo n = 8", "n = 64", "n = 512", "reciprocity error", "classic model's implied BRDF"],
-        &rows,
-    ))
 }
 
 pub fn claims(context: &mut Context) -> Result<String, String> {
