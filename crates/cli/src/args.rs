@@ -204,6 +204,22 @@ impl InputLimit {
     }
 }
 
+/// One exponent, or `LOW..HIGH` as `steps + 1` log-spaced ones.
+pub fn parse_exponent_range(text: &str, steps: u32) -> Result<Vec<Exponent>, String> {
+    let Some((low, high)) = text.split_once("..") else {
+        return Ok(vec![parse_exponent(text)?]);
+    };
+    let (low, high) = (parse_exponent(low)?.get(), parse_exponent(high)?.get());
+    if low >= high {
+        return Err(format!(
+            "'{text}': a range needs LOW < HIGH, both in [1, 1000]"
+        ));
+    }
+    Ok((0..=steps)
+        .map(|k| Exponent::new(low * (high / low).powf(f64::from(k) / f64::from(steps))))
+        .collect())
+}
+
 /// Refuses, before any work, a user's lobe whose formula is not a lobe at one of `exponents`
 /// (see [`specula::Lobe::checked`]); built-in lobes pass.
 pub fn check_lobes(kinds: &[LobeKind], exponents: &[Exponent]) -> Result<(), String> {

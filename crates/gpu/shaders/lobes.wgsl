@@ -155,6 +155,7 @@ fn lobe_eval(lobe: Lobe, t: f32) -> f32 {
         case 10u: { return lobe_sg_karis(lobe, c); }
         case 11u: { return lobe_fastpow(lobe, c); }
         case 12u: { return lobe_fasterpow(lobe, c); }
-        default: { return 0.0; }
+        // The user's lobes: generated per module (specula_gpu::wgsl::lobes).
+        default: { return lobe_formula(lobe, c); }
     }
 }

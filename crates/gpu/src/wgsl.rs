@@ -8,7 +8,8 @@
 
 use specula::LobeKind;
 
-/// The lobe library.
+/// The lobe library's built-in lobes (`lobe_eval`'s default case calls `lobe_formula`,
+/// which [`lobes`] appends).
 pub const LOBES: &str = include_str!("../shaders/lobes.wgsl");
 /// The lobe's cosine from the directions (Phong or Blinn).
 pub const GEOMETRY: &str = include_str!("../shaders/geometry.wgsl");
@@ -56,11 +57,7 @@ fn lobe_formula(lobe: Lobe, t: f32) -> f32 {{
 }}
 "
     );
-    LOBES.replace(
-        "default: { return 0.0; }",
-        "default: { return lobe_formula(lobe, c); }",
-    ) + &functions
-        + &dispatch
+    [LOBES, &functions, &dispatch].concat()
 }
 
 /// The render module's source.

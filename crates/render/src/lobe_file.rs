@@ -104,9 +104,7 @@ pub fn parse_definition(text: &str, label: &str) -> Result<Definition, String> {
     let shown = label;
     toml::from_str(text).map_err(|e| {
         let place = e.span().map_or_else(String::new, |span| {
-            let before = &text[..span.start.min(text.len())];
-            let line = before.matches('\n').count() + 1;
-            let column = before.chars().rev().take_while(|&c| c != '\n').count() + 1;
+            let (line, column) = specula::line_column(text, span.start);
             format!(":{line}:{column}")
         });
         format!(

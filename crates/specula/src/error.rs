@@ -80,6 +80,20 @@ pub fn excerpt(text: &str) -> String {
     }
 }
 
+/// The 1-based line and column (in characters) of byte offset `at` in `text`, as messages
+/// about a file or a formula name a position.
+#[must_use]
+pub fn line_column(text: &str, at: usize) -> (usize, usize) {
+    let mut at = at.min(text.len());
+    while !text.is_char_boundary(at) {
+        at -= 1;
+    }
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let column = before.chars().rev().take_while(|&c| c != '\n').count() + 1;
+    (line, column)
+}
+
 /// The longest text a "did you mean" is computed for: identifiers, not pasted files.
 const SUGGESTED_UP_TO: usize = 40;
 

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use specula::{Exponent, Lobe, LobeKind};
+use specula::{Lobe, LobeKind};
 
 use super::CommandResult;
 use crate::output::Table;
@@ -87,26 +87,8 @@ fn new(args: &NewArgs) -> CommandResult {
     Ok(())
 }
 
-fn exponents(text: &str) -> Result<Vec<Exponent>, String> {
-    let Some((low, high)) = text.split_once("..") else {
-        return Ok(vec![crate::args::parse_exponent(text)?]);
-    };
-    let (low, high) = (
-        crate::args::parse_exponent(low)?.get(),
-        crate::args::parse_exponent(high)?.get(),
-    );
-    if low > high {
-        return Err(format!(
-            "--n {text}: the range's low end is above its high end"
-        ));
-    }
-    Ok((0..=30)
-        .map(|k| Exponent::new(low * (high / low).powf(f64::from(k) / 30.0)))
-        .collect())
-}
-
 fn check(args: &CheckArgs) -> CommandResult {
-    let exponents = exponents(&args.n)?;
+    let exponents = crate::args::parse_exponent_range(&args.n, 30)?;
     let LobeKind::Formula(_) = args.lobe else {
         return Err(format!(
             "'{}' is a built-in lobe; check takes a lobe of yours (@FILE.toml or =FORMULA)",

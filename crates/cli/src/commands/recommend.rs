@@ -80,20 +80,12 @@ pub struct Args {
 pub struct Exponents(Vec<Exponent>);
 
 fn parse_exponents(text: &str) -> Result<Exponents, String> {
-    let Some((low, high)) = text.split_once("..") else {
-        return Ok(Exponents(vec![crate::args::parse_exponent(text)?]));
-    };
-    let (low, high) = (
-        crate::args::parse_exponent(low)?.get(),
-        crate::args::parse_exponent(high)?.get(),
-    );
-    if low >= high {
-        return Err(format!(
-            "'{text}': a range needs LOW < HIGH, both in [1, 1000]"
-        ));
-    }
-    let mut values: Vec<f64> = (0..=8)
-        .map(|k| low * (high / low).powf(f64::from(k) / 8.0))
+    let sampled = crate::args::parse_exponent_range(text, 8)?;
+    let (low, high) = (sampled[0].get(), sampled[sampled.len() - 1].get());
+    // The powers of two inside the range too: schlick-mod and cosquad change shape there.
+    let mut values: Vec<f64> = sampled
+        .iter()
+        .map(|n| n.get())
         .chain(
             (0..10)
                 .map(|p| f64::from(1u32 << p))

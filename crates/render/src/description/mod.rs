@@ -99,9 +99,7 @@ struct Locator<'a> {
 
 impl Locator<'_> {
     fn error(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
-        let before = &self.source[..span.start.min(self.source.len())];
-        let line = before.matches('\n').count() + 1;
-        let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+        let (line, column) = specula::line_column(self.source, span.start);
         SceneError {
             file: self.file.to_owned(),
             line,

@@ -105,10 +105,7 @@ impl FormulaError {
     /// `field`, line and column (or column alone for one line), then the message: one line.
     #[must_use]
     pub fn locate(&self, field: &str, source: &str) -> String {
-        let at = self.at.min(source.len());
-        let before = source.get(..at).unwrap_or_default();
-        let line = before.matches('\n').count() + 1;
-        let column = before.chars().rev().take_while(|&c| c != '\n').count() + 1;
+        let (line, column) = crate::line_column(source, self.at);
         if source.contains('\n') {
             format!("{field}, line {line}, column {column}: {}", self.message)
         } else {

@@ -194,19 +194,31 @@ pub(crate) struct Leaves<'a, R> {
 }
 
 /// Runs `tape`; its result.
+///
+/// A lobe's scalar path runs this per evaluation (per sample of a volume, per path of an
+/// environment render), so tapes of the usual size keep their values on the stack.
 pub(crate) fn run<R: Real>(tape: &[Op], leaves: &Leaves<'_, R>) -> R {
-    let mut values: Vec<R> = Vec::with_capacity(tape.len());
-    for &op in tape {
-        let value = match op {
+    const ON_STACK: usize = 64;
+    if tape.len() <= ON_STACK {
+        run_in(tape, leaves, &mut [leaves.t; ON_STACK])
+    } else {
+        run_in(tape, leaves, &mut vec![leaves.t; tape.len()])
+    }
+}
+
+/// [`run`] with `values` (at least the tape's length) holding each entry's value.
+#[inline]
+fn run_in<R: Real>(tape: &[Op], leaves: &Leaves<'_, R>, values: &mut [R]) -> R {
+    for (index, &op) in tape.iter().enumerate() {
+        values[index] = match op {
             Op::T => leaves.t,
             Op::N => leaves.n,
             Op::Param(p) => (leaves.parameter)(p),
             Op::Slot(s) => (leaves.slot)(s),
             op => apply(op, |i| values[i]),
         };
-        values.push(value);
     }
-    values[values.len() - 1]
+    values[tape.len() - 1]
 }
 
 #[cfg(test)]

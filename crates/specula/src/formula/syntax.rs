@@ -332,31 +332,30 @@ impl Parser {
     }
 
     fn sum(&mut self) -> Result<Ast, FormulaError> {
-        let mut left = self.product()?;
-        loop {
-            let op = match self.peek() {
-                Token::Symbol("+") => BinaryOp::Add,
-                Token::Symbol("-") => BinaryOp::Sub,
-                _ => return Ok(left),
-            };
-            let at = self.at();
-            self.advance();
-            let right = self.product()?;
-            left = self.node(at, AstKind::Binary(op, Box::new(left), Box::new(right)))?;
-        }
+        self.left_associative(&[("+", BinaryOp::Add), ("-", BinaryOp::Sub)], Self::product)
     }
 
     fn product(&mut self) -> Result<Ast, FormulaError> {
-        let mut left = self.unary()?;
+        self.left_associative(&[("*", BinaryOp::Mul), ("/", BinaryOp::Div)], Self::unary)
+    }
+
+    /// `operand { op operand }` for the operators `ops`, grouped from the left.
+    fn left_associative(
+        &mut self,
+        ops: &[(&str, BinaryOp)],
+        operand: fn(&mut Self) -> Result<Ast, FormulaError>,
+    ) -> Result<Ast, FormulaError> {
+        let mut left = operand(self)?;
         loop {
-            let op = match self.peek() {
-                Token::Symbol("*") => BinaryOp::Mul,
-                Token::Symbol("/") => BinaryOp::Div,
-                _ => return Ok(left),
+            let Token::Symbol(symbol) = self.peek() else {
+                return Ok(left);
+            };
+            let Some(&(_, op)) = ops.iter().find(|(s, _)| s == symbol) else {
+                return Ok(left);
             };
             let at = self.at();
             self.advance();
-            let right = self.unary()?;
+            let right = operand(self)?;
             left = self.node(at, AstKind::Binary(op, Box::new(left), Box::new(right)))?;
         }
     }

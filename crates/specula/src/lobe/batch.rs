@@ -70,7 +70,10 @@ impl Lobe {
             Model::Sg(m) => f.call(m.kernel()),
             Model::FastPow(m) => f.call(m.kernel()),
             Model::FasterPow(m) => f.call(m.kernel()),
-            Model::Formula(m) => f.call(m.kernel()),
+            Model::Formula(m) => f.call(super::formula::FormulaKernel {
+                lobe: *self,
+                stated: m.instructions(),
+            }),
         }
     }
 }
@@ -137,8 +140,8 @@ impl Lobe {
         out: &mut [f32],
     ) {
         assert_eq!(ts.len(), out.len(), "eval_batch: one output per cosine");
-        if let Model::Formula(m) = &self.model {
-            return m.eval_batch(level, batch_loop, ts, out);
+        if let (Model::Formula(m), BatchLoop::Explicit) = (&self.model, batch_loop) {
+            return m.eval_compiled(level, ts, out);
         }
         self.with_kernel(Run {
             level,

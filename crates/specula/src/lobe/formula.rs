@@ -17,7 +17,7 @@ use crate::formula::batch::Rules;
 use crate::formula::{registry, Instance, MAX_SLOTS};
 use crate::real::Real;
 use crate::simd::tally::Instructions;
-use crate::simd::{BatchLoop, Job, Kernel, Lanes, Level};
+use crate::simd::{Job, Kernel, Lanes, Level};
 use crate::Exponent;
 
 /// The prepared formula.
@@ -104,30 +104,21 @@ impl FormulaLobe {
             .preparation_of(name, n, self.instance.values())
     }
 
-    /// The batch: the compiled columns, or the plain loop of the scalar `f32` formula.
-    pub(crate) fn eval_batch(
-        &self,
-        level: Level,
-        batch_loop: BatchLoop,
-        ts: &[f32],
-        out: &mut [f32],
-    ) {
-        match batch_loop {
-            BatchLoop::Explicit => crate::simd::dispatch(
-                level,
-                Columns {
-                    lobe: self,
-                    ts,
-                    out,
-                },
-            ),
-            BatchLoop::Plain => crate::simd::plain_loop(self.kernel(), ts, out),
-        }
+    /// The batch through the compiled chains and columns.
+    pub(crate) fn eval_compiled(&self, level: Level, ts: &[f32], out: &mut [f32]) {
+        crate::simd::dispatch(
+            level,
+            Columns {
+                lobe: self,
+                ts,
+                out,
+            },
+        );
     }
 
-    /// The lane-at-a-time kernel (the plain loop's formula).
-    pub(crate) fn kernel(&self) -> FormulaKernel {
-        FormulaKernel { lobe: *self }
+    /// What the compiled batch executes per vector, with the rules it applies.
+    pub(crate) fn instructions(&self) -> Instructions {
+        self.instance.formula().plan().instructions(self.rules)
     }
 }
 
@@ -150,10 +141,12 @@ impl Job for Columns<'_> {
     }
 }
 
-/// The formula one lane at a time in scalar `f32`, with the shared rules.
+/// The formula one lane at a time in scalar `f32`, through [`Lobe::eval`] and so its rules:
+/// the plain loop the compiled batch is measured against.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct FormulaKernel {
-    lobe: FormulaLobe,
+    pub(crate) lobe: super::Lobe,
+    pub(crate) stated: Instructions,
 }
 
 impl Kernel for FormulaKernel {
@@ -161,11 +154,7 @@ impl Kernel for FormulaKernel {
         let mut lanes = [0.0_f32; 64];
         t.store(&mut lanes[..V::WIDTH]);
         for value in &mut lanes[..V::WIDTH] {
-            *value = if *value > 0.0 {
-                self.lobe.eval(value.min(1.0))
-            } else {
-                0.0
-            };
+            *value = self.lobe.eval(*value);
         }
         t.load(&lanes[..V::WIDTH])
     }
@@ -173,10 +162,6 @@ impl Kernel for FormulaKernel {
 
 impl LobeKernel for FormulaKernel {
     fn instructions(self) -> Instructions {
-        self.lobe
-            .instance
-            .formula()
-            .plan()
-            .instructions(self.lobe.rules)
+        self.stated
     }
 }

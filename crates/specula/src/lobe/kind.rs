@@ -424,16 +424,12 @@ impl core::fmt::Display for LobeKind {
             LobeKind::CosQuad { v } if *v != CosQuad::DEFAULT_V => write!(f, "cosquad:v={v}"),
             LobeKind::Formula(id) => {
                 let instance = crate::formula::registry::get(*id);
-                f.write_str(kind_name(instance))
+                f.write_str(instance.info().id)
                     .and_then(|()| write_values(f, instance))
             }
             kind => f.write_str(kind.id()),
         }
     }
-}
-
-fn kind_name(instance: &crate::formula::Instance) -> &'static str {
-    instance.info().id
 }
 
 /// `:k=1.5,m=2` for the parameters that differ from their defaults.

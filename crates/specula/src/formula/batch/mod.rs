@@ -180,9 +180,10 @@ impl Plan {
                         chains[index] = Some((head, links));
                         continue;
                     }
-                    let input = match roles[head] {
-                        Role::T => End::Batch,
-                        _ => End::Register(register_of(at(head))),
+                    let input = match (roles[head], source[head]) {
+                        (Role::T, _) => End::Batch,
+                        (_, Some(Source::Register(r))) => End::Register(r),
+                        _ => unreachable!("a chain starts from t or from a step's register"),
                     };
                     release(head, index, &mut free);
                     let output = if index == last {
@@ -426,15 +427,6 @@ impl Plan {
                 .store(&mut out[at..at + width]);
             at += width;
         }
-    }
-}
-
-/// A chain's input register (its head's source is never a scalar: a link has one varying
-/// operand).
-fn register_of(source: Source) -> usize {
-    match source {
-        Source::Register(r) => r,
-        Source::Scalar(_) => 0,
     }
 }
 
