@@ -197,6 +197,13 @@ pub struct InputLimit {
     max_input_mib: u64,
 }
 
+impl Default for InputLimit {
+    /// The flag's default, 512 MiB.
+    fn default() -> Self {
+        Self { max_input_mib: 512 }
+    }
+}
+
 impl InputLimit {
     /// Makes it the process's limit.
     pub fn apply(&self) {

@@ -35,9 +35,9 @@ fn gpu_ray_marching_matches_the_cpu_for_every_lobe() {
     let mut parity = Parity::new(MAX_MEAN_FLIP, MIN_PSNR_DB);
     for (kind, view) in LobeKind::ALL.into_iter().zip(
         [
-            View::Coronal,
-            View::Axial,
-            View::Sagittal,
+            View::Anterior,
+            View::Inferior,
+            View::Left,
             View::Eye(glam::Vec3::new(300.0, -200.0, 150.0)),
         ]
         .into_iter()
@@ -51,9 +51,9 @@ fn gpu_ray_marching_matches_the_cpu_for_every_lobe() {
     }
     parity.report();
     // Not vacuous: the unshaded image is further from the CPU's pow image than the GPU's is.
-    let settings = DvrSettings::new(96, 80, View::Coronal, Some(shading(LobeKind::Pow)));
+    let settings = DvrSettings::new(96, 80, View::Anterior, Some(shading(LobeKind::Pow)));
     let cpu = render_dvr(&volume, &transfer, &settings, &|| {}).unwrap();
-    let unshaded = DvrSettings::new(96, 80, View::Coronal, None);
+    let unshaded = DvrSettings::new(96, 80, View::Anterior, None);
     let other = render_dvr(&volume, &transfer, &unshaded, &|| {}).unwrap();
     let gpu_image = renderer.render(&volume, &transfer, &settings).unwrap();
     let apart = compare(&cpu, &other, Display::default()).unwrap().mean_flip;
@@ -72,7 +72,7 @@ fn gpu_isosurfaces_match_the_cpu() {
         let settings = IsoSettings {
             width: 96,
             height: 80,
-            view: View::Coronal,
+            view: View::Anterior,
             iso: 0.5,
             shading: shading(kind),
             method: specula_render::Shading::Phong,

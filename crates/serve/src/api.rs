@@ -498,7 +498,7 @@ pub async fn volume(
     let (kind, n) = (params.lobe()?, params.exponent()?);
     let request = VolumeRequest {
         volume: params.choice("volume", &BuiltIn::ALL, BuiltIn::id, BuiltIn::SheppLogan)?,
-        view: params.choice("view", &View::STANDARD, View::id, View::Coronal)?,
+        view: params.choice("view", &View::STANDARD, View::id, View::Anterior)?,
         kind,
         n,
         geometry: params.geometry()?,

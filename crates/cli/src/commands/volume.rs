@@ -13,7 +13,7 @@ use specula_render::volume::isosurface::{
     default_isovalue, iso_scene, marching_cubes, IsoSettings,
 };
 use specula_render::volume::phantom::BuiltIn;
-use specula_render::volume::raymarch::{render_dvr, DvrSettings, Shading, View};
+use specula_render::volume::raymarch::{render_dvr, DvrSettings, Light, Shading, View};
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::{self, Volume};
 use specula_render::{check_output_path, render, write_image, Display, Image};
@@ -48,6 +48,33 @@ pub struct Args {
     /// default surface for marschner-lobb, ct-bone for CT and mr otherwise.
     #[arg(long)]
     transfer: Option<String>,
+    /// Place the transfer function's ramp as a radiologist's window (its first control point at
+    /// level - window/2, its last at level + window/2), in the volume's values (HU for CT).
+    #[arg(long, requires = "level", value_parser = parse_finite)]
+    window: Option<f32>,
+    /// The window's centre (see --window).
+    #[arg(long, requires = "window", allow_hyphen_values = true, value_parser = parse_finite)]
+    level: Option<f32>,
+    /// Segment length along a ray in millimetres (VTK's sample distance); by default half the
+    /// smallest voxel spacing. At most 4 voxels.
+    #[arg(long, value_parser = parse_finite)]
+    step: Option<f32>,
+    /// The light: key (at the eye, up and to the left) or headlight (along the view).
+    #[arg(long, value_parser = choice(&Light::ALL, Light::id), default_value = "key")]
+    light: Light,
+    /// Ambient, diffuse and specular weights of the volume's shading.
+    #[arg(long, value_parser = parse_weight, default_value = "0.25")]
+    ambient: f32,
+    /// Diffuse weight (see --ambient).
+    #[arg(long, value_parser = parse_weight, default_value = "0.7")]
+    diffuse: f32,
+    /// Specular weight (see --ambient).
+    #[arg(long, value_parser = parse_weight, default_value = "0.5")]
+    specular: f32,
+    /// Shade every sample with a gradient fully, as VTK does (by default a sample fades to its
+    /// unshaded colour where its gradient is weak, inside uniform tissue).
+    #[arg(long)]
+    full_shading: bool,
     /// The specular lobe.
     #[arg(long, value_parser = LobeParser, default_value = "pow")]
     lobe: LobeKind,
@@ -60,8 +87,9 @@ pub struct Args {
     /// The specular normalisation (the thesis's is thesis-phong).
     #[arg(long, value_parser = choice(&Normalisation::ALL, Normalisation::id), default_value = "none")]
     normalisation: Normalisation,
-    /// The view: axial (from the feet), sagittal (from the left) or coronal (from the front).
-    #[arg(long, value_parser = choice(&View::STANDARD, View::id), default_value = "coronal", conflicts_with = "eye")]
+    /// The side the camera stands on: anterior (the face), posterior, left, right, superior or
+    /// inferior (also coronal = anterior, sagittal = left, axial = inferior).
+    #[arg(long, value_parser = View::parse, default_value = "anterior", conflicts_with = "eye")]
     view: View,
     /// A perspective view from this point (millimetres, `x,y,z`) towards the volume's centre.
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
@@ -84,7 +112,8 @@ pub struct Args {
 #[derive(Debug, clap::Args)]
 pub struct Source {
     /// The volume: `phantom` (the 3D Shepp-Logan head), `marschner-lobb` (the test signal), a
-    /// NIfTI-1 file (.nii, .nii.gz) or a folder holding one DICOM series.
+    /// NIfTI-1 file (.nii, .nii.gz), a folder holding one DICOM series, or a multi-frame
+    /// (enhanced) DICOM file.
     #[arg(long, default_value = "phantom")]
     input: String,
     /// Voxels along each side of a built-in volume.
@@ -92,6 +121,17 @@ pub struct Source {
     size: u32,
     #[command(flatten)]
     input_limit: InputLimit,
+}
+
+impl Source {
+    /// The volume at `input`, with the default size and input limit.
+    pub(crate) fn new(input: &str) -> Self {
+        Self {
+            input: input.to_owned(),
+            size: 128,
+            input_limit: InputLimit::default(),
+        }
+    }
 }
 
 /// Arguments of `specula volume-convert`.
@@ -109,6 +149,16 @@ fn parse_finite(text: &str) -> Result<f32, String> {
         Ok(value) if value.is_finite() => Ok(value),
         _ => Err(format!(
             "'{}' must be a finite number",
+            specula::excerpt(text)
+        )),
+    }
+}
+
+fn parse_weight(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(value) if (0.0..=10.0).contains(&value) => Ok(value),
+        _ => Err(format!(
+            "'{}' must be a weight from 0 to 10",
             specula::excerpt(text)
         )),
     }
@@ -135,7 +185,7 @@ fn parse_point(text: &str) -> Result<Vec3, String> {
 }
 
 /// The volume `--input` names.
-fn load(source: &Source) -> Result<Volume, String> {
+pub(crate) fn load(source: &Source) -> Result<Volume, String> {
     source.input_limit.apply();
     let side = source.size as usize;
     let input = source.input.as_str();
@@ -167,7 +217,11 @@ fn transfer(args: &Args, volume: &Volume) -> Result<TransferFunction, String> {
         }
         Some(name) => TransferFunction::preset(name).map_err(|e| e.to_string())?,
     };
-    Ok(function.for_volume(volume))
+    let function = function.for_volume(volume);
+    match (args.window, args.level) {
+        (Some(window), Some(level)) => function.windowed(window, level).map_err(|e| e.to_string()),
+        _ => Ok(function),
+    }
 }
 
 /// Renders and writes the image.
@@ -175,11 +229,18 @@ pub fn run(args: &Args) -> CommandResult {
     check_output_path(&args.output).map_err(|e| e.to_string())?;
     let started = Instant::now();
     let volume = load(&args.source)?;
-    let shading = Shading::new(
-        Lobe::checked(args.lobe, args.n).map_err(|e| e.to_string())?,
-        args.geometry,
-        args.normalisation,
-    );
+    let shading = Shading {
+        ka: args.ambient,
+        kd: args.diffuse,
+        ks: args.specular,
+        light: args.light,
+        fade_weak_gradients: !args.full_shading,
+        ..Shading::new(
+            Lobe::checked(args.lobe, args.n).map_err(|e| e.to_string())?,
+            args.geometry,
+            args.normalisation,
+        )
+    };
     let view = args.eye.map_or(args.view, View::Eye);
     let gpu = match args.backend {
         RendererArg::Cpu => None,
@@ -192,7 +253,17 @@ pub fn run(args: &Args) -> CommandResult {
     let (image, drawn) = match args.mode {
         Mode::Dvr => {
             let transfer = transfer(args, &volume)?;
-            let settings = DvrSettings::new(args.width, args.height, view, Some(shading));
+            let mut settings = DvrSettings::new(args.width, args.height, view, Some(shading));
+            if let Some(step) = args.step {
+                let voxel = volume.spacing().min_element();
+                if !(step > 0.0 && step <= 4.0 * voxel) {
+                    return Err(format!(
+                        "--step {step} mm: the step must be more than 0 and at most 4 voxels ({} mm here)",
+                        4.0 * voxel
+                    ));
+                }
+                settings.step_fraction = step / voxel;
+            }
             let image = match &gpu {
                 Some(gpu) => GpuVolumeRenderer::new(gpu)
                     .and_then(|renderer| renderer.render(&volume, &transfer, &settings))

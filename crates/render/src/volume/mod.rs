@@ -19,10 +19,12 @@ use thiserror::Error;
 
 pub mod dicom;
 pub mod isosurface;
+pub mod march;
 pub mod nifti;
 pub mod phantom;
 pub mod raymarch;
 pub mod transfer;
+pub mod vtk;
 
 /// The most voxels a volume may hold: 2^28 (a 1 GiB `f32` grid, 512 x 512 x 1024).
 pub const MAX_VOXELS: usize = 1 << 28;
@@ -56,6 +58,30 @@ pub enum Units {
     /// the volume's range.
     #[default]
     Arbitrary,
+}
+
+impl Units {
+    /// What a volume's values are when its file does not say: Hounsfield units when the
+    /// smallest value is that of air or of a scanner's padding outside its field of view
+    /// (-3100 to -900: air is -1000 HU, padding -1024, -2048 or -3024) and at least 1 % of
+    /// the voxels are air (within 100 of -1000); otherwise arbitrary. MR magnitudes and the
+    /// built-in volumes are never negative, so they are never taken for CT.
+    #[must_use]
+    pub fn from_values(samples: &[f32]) -> Self {
+        let smallest = samples.iter().copied().fold(f32::INFINITY, f32::min);
+        if !(-3100.0..=-900.0).contains(&smallest) {
+            return Units::Arbitrary;
+        }
+        let air = samples
+            .iter()
+            .filter(|&&v| (-1100.0..=-900.0).contains(&v))
+            .count();
+        if air * 100 >= samples.len() {
+            Units::Hounsfield
+        } else {
+            Units::Arbitrary
+        }
+    }
 }
 
 impl Volume {
@@ -277,15 +303,18 @@ impl Volume {
 }
 
 /// Reads the volume at `path`: a folder is a DICOM series, a `.nii` or `.nii.gz` file is
-/// NIfTI-1.
+/// NIfTI-1, a `.dcm` file (or one with DICOM's preamble) an enhanced, multi-frame DICOM
+/// object.
 pub fn read(path: &Path) -> Result<Volume, VolumeError> {
     if path.is_dir() {
         dicom::read_series(path)
     } else if nifti::is_nifti_path(path) {
         nifti::read(path)
+    } else if dicom::is_dicom_file(path) {
+        dicom::read_file(path)
     } else {
         Err(VolumeError(format!(
-            "{}: not a volume; give a .nii or .nii.gz file or a folder holding a DICOM series",
+            "{}: not a volume; give a .nii or .nii.gz file, a folder holding a DICOM series, or a multi-frame DICOM file",
             path.display()
         )))
     }

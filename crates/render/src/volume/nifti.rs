@@ -43,7 +43,28 @@ pub fn read(path: &Path) -> Result<Volume, VolumeError> {
         .map_err(|e| fail(read_error(&e)))?;
     // The array is indexed `[i, j, k]`; its transpose, read in logical order, runs `i` fastest.
     let samples: Vec<f32> = array.t().iter().copied().collect();
-    Volume::try_new(dims, to_world, origin, samples, Units::Arbitrary).map_err(|e| fail(e.0))
+    let units = stated_units(&header).unwrap_or_else(|| Units::from_values(&samples));
+    Volume::try_new(dims, to_world, origin, samples, units).map_err(|e| fail(e.0))
+}
+
+/// What the header says the values are: Hounsfield units when its description or intent
+/// name says so ("Hounsfield", or "HU" as a word, as converters write it). NIfTI-1 has no
+/// field for value units, so a header that says nothing leaves it to
+/// [`Units::from_values`].
+fn stated_units(header: &NiftiHeader) -> Option<Units> {
+    let text = |bytes: &[u8]| {
+        String::from_utf8_lossy(bytes)
+            .trim_end_matches('\0')
+            .to_ascii_lowercase()
+    };
+    let said = [text(&header.descrip), text(&header.intent_name)];
+    said.iter()
+        .any(|s| {
+            s.contains("hounsfield")
+                || s.split(|c: char| !c.is_ascii_alphanumeric())
+                    .any(|word| word == "hu")
+        })
+        .then_some(Units::Hounsfield)
 }
 
 /// Whether `path` names a NIfTI file by its extension.
@@ -215,7 +236,14 @@ pub fn write(volume: &Volume, path: &Path) -> Result<(), VolumeError> {
         [axis.x, axis.y, axis.z, origin[r]]
     };
     let spacing = volume.spacing();
+    // NIfTI's description is 80 bytes, zero-padded.
+    let mut descrip = vec![0_u8; 80];
+    if volume.units() == Units::Hounsfield {
+        let said = b"Hounsfield units";
+        descrip[..said.len()].copy_from_slice(said);
+    }
     let header = NiftiHeader {
+        descrip,
         pixdim: [1.0, spacing.x, spacing.y, spacing.z, 1.0, 1.0, 1.0, 1.0],
         sform_code: 2,
         srow_x: row(0),

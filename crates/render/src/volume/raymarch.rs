@@ -17,36 +17,103 @@ use glam::Vec3;
 use rayon::prelude::*;
 use specula::{Geometry, Lobe, Normalisation};
 
+use super::march::ray::{march_together, Highlights, Ray, Shade, HIGHLIGHTS};
+use super::march::{Classification, PreparedVolume};
 use super::transfer::TransferFunction;
 use super::{Volume, VolumeError};
 use crate::image::Image;
 use crate::{Camera, Projection};
 
-/// Where the volume is seen from.
+/// Where the volume is seen from: named by anatomy, as a radiologist names the side the
+/// camera stands on, with parallel rays; or a perspective eye.
+///
+/// Front and back views have superior up; a view from above or below has anterior up. The
+/// patient's left is on the image's right from the front (anterior) and from the feet
+/// (inferior), as radiology displays a patient facing the viewer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum View {
-    /// From the feet, anterior up (radiological convention: the patient's left on the right).
-    Axial,
-    /// From the patient's left, superior up (anterior on the left).
-    Sagittal,
-    /// From the front, superior up (the patient's left on the right).
-    Coronal,
+    /// From the front: the face, the patient's left on the image's right.
+    Anterior,
+    /// From behind: the back of the head, the patient's left on the image's left.
+    Posterior,
+    /// From the patient's left: anterior on the image's left.
+    Left,
+    /// From the patient's right: anterior on the image's right.
+    Right,
+    /// From above (the vertex), anterior up: the patient's right on the image's right.
+    Superior,
+    /// From the feet, anterior up: the patient's left on the image's right (an axial slice's
+    /// orientation).
+    Inferior,
     /// A perspective view from this world position towards the volume's centre, `z` up.
     Eye(Vec3),
 }
 
 impl View {
-    /// The standard views, as the command line names them.
-    pub const STANDARD: [View; 3] = [View::Axial, View::Sagittal, View::Coronal];
+    /// The anatomical views, as the command line names them.
+    pub const STANDARD: [View; 6] = [
+        View::Anterior,
+        View::Posterior,
+        View::Left,
+        View::Right,
+        View::Superior,
+        View::Inferior,
+    ];
+
+    /// The slice planes' names that earlier versions used, and the views they name.
+    pub const ALIASES: [(&'static str, View); 3] = [
+        ("coronal", View::Anterior),
+        ("sagittal", View::Left),
+        ("axial", View::Inferior),
+    ];
 
     /// The view's name (`eye` for a perspective view).
     #[must_use]
     pub fn id(self) -> &'static str {
         match self {
-            View::Axial => "axial",
-            View::Sagittal => "sagittal",
-            View::Coronal => "coronal",
+            View::Anterior => "anterior",
+            View::Posterior => "posterior",
+            View::Left => "left",
+            View::Right => "right",
+            View::Superior => "superior",
+            View::Inferior => "inferior",
             View::Eye(_) => "eye",
+        }
+    }
+
+    /// A view by name (or by an alias), or the reason naming the choices.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let name = text.trim().to_ascii_lowercase();
+        Self::STANDARD
+            .into_iter()
+            .find(|view| view.id() == name)
+            .or_else(|| {
+                Self::ALIASES
+                    .iter()
+                    .find(|(alias, _)| *alias == name)
+                    .map(|&(_, view)| view)
+            })
+            .ok_or_else(|| {
+                let names = Self::STANDARD.map(View::id);
+                format!(
+                    "unknown view '{}'; views: {} (or coronal, sagittal, axial){}",
+                    specula::excerpt(text),
+                    names.join(", "),
+                    specula::did_you_mean(text, names)
+                )
+            })
+    }
+
+    /// The direction the camera looks along and the image's up, in RAS world axes (an eye's
+    /// are found from its position: [`RayCamera::new`]).
+    fn axes(self) -> (Vec3, Vec3) {
+        match self {
+            View::Anterior => (Vec3::NEG_Y, Vec3::Z),
+            View::Posterior => (Vec3::Y, Vec3::Z),
+            View::Left => (Vec3::X, Vec3::Z),
+            View::Right => (Vec3::NEG_X, Vec3::Z),
+            View::Superior => (Vec3::NEG_Z, Vec3::Y),
+            View::Inferior | View::Eye(_) => (Vec3::Z, Vec3::Y),
         }
     }
 }
@@ -78,9 +145,6 @@ impl RayCamera {
             .map(|c| c.distance(centre))
             .fold(0.0, f32::max);
         let (forward, up) = match view {
-            View::Axial => (Vec3::Z, Vec3::Y),
-            View::Sagittal => (Vec3::X, Vec3::Z),
-            View::Coronal => (Vec3::NEG_Y, Vec3::Z),
             View::Eye(eye) => {
                 let distance = eye.distance(centre);
                 if !(eye.is_finite() && distance > 1.01 * radius) {
@@ -104,6 +168,7 @@ impl RayCamera {
                     parallel: false,
                 });
             }
+            anatomical => anatomical.axes(),
         };
         let right = forward.cross(up);
         // The view fits the grid's projected extent (the image's aspect is applied per ray,
@@ -124,8 +189,10 @@ impl RayCamera {
         })
     }
 
-    /// The ray through the centre of pixel `(x, y)` of a `width x height` image.
-    fn ray(&self, x: u32, y: u32, width: u32, height: u32) -> (Vec3, Vec3) {
+    /// The ray through the centre of pixel `(x, y)` of a `width x height` image: its origin
+    /// and unit direction in the world.
+    #[must_use]
+    pub fn ray(&self, x: u32, y: u32, width: u32, height: u32) -> (Vec3, Vec3) {
         let aspect = width as f32 / height as f32;
         let sx = ((x as f32 + 0.5) / width as f32 * 2.0 - 1.0) * aspect * self.half_height;
         let sy = (1.0 - (y as f32 + 0.5) / height as f32 * 2.0) * self.half_height;
@@ -189,11 +256,42 @@ pub struct Shading {
     pub kd: f32,
     /// Specular weight.
     pub ks: f32,
+    /// Where the light is.
+    pub light: Light,
+    /// Whether a sample fades to its unshaded colour as its gradient weakens (below 2 % of the
+    /// value range per voxel), since a normal means little inside uniform tissue; without it
+    /// every sample with a gradient is fully shaded, as VTK's ray casters shade.
+    pub fade_weak_gradients: bool,
+}
+
+/// Where a volume's light is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Light {
+    /// At the eye, offset up and to the left (the default: surfaces facing the viewer keep
+    /// some modelling).
+    Key,
+    /// Along the view direction, as a viewer's headlight (VTK's default light).
+    Headlight,
+}
+
+impl Light {
+    /// Both lights.
+    pub const ALL: [Light; 2] = [Light::Key, Light::Headlight];
+
+    /// The name the command line uses.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            Light::Key => "key",
+            Light::Headlight => "headlight",
+        }
+    }
 }
 
 impl Shading {
     /// `lobe` with the weights every volume view uses: ambient 0.25, diffuse 0.7, specular
-    /// 0.5, so that a highlight on a lit surface saturates only near its peak.
+    /// 0.5, so that a highlight on a lit surface saturates only near its peak; the key light;
+    /// weak gradients faded.
     #[must_use]
     pub fn new(lobe: Lobe, geometry: Geometry, normalisation: Normalisation) -> Self {
         Self {
@@ -203,6 +301,8 @@ impl Shading {
             ka: 0.25,
             kd: 0.7,
             ks: 0.5,
+            light: Light::Key,
+            fade_weak_gradients: true,
         }
     }
 }
@@ -243,7 +343,7 @@ impl DvrSettings {
 }
 
 /// Where a ray (in grid coordinates, advancing `direction` per millimetre) is inside the grid.
-fn inside_grid(volume: &Volume, origin: Vec3, direction: Vec3) -> Option<(f32, f32)> {
+pub(super) fn inside_grid(volume: &Volume, origin: Vec3, direction: Vec3) -> Option<(f32, f32)> {
     let high = volume.last_index();
     let (mut near, mut far) = (0.0_f32, f32::INFINITY);
     for axis in 0..3 {
@@ -289,9 +389,13 @@ impl DvrPlan {
         Ok(Self {
             camera,
             step: settings.step_fraction * volume.spacing().min_element(),
-            lighting: settings
-                .shading
-                .map(|shading| Lighting::new(shading, volume, camera.light())),
+            lighting: settings.shading.map(|shading| {
+                let light = match shading.light {
+                    Light::Key => camera.light(),
+                    Light::Headlight => -camera.forward,
+                };
+                Lighting::new(shading, volume, light)
+            }),
         })
     }
 }
@@ -304,56 +408,111 @@ pub fn render_dvr(
     settings: &DvrSettings,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Image, VolumeError> {
+    DvrPlan::new(volume, settings)?;
+    let prepared = PreparedVolume::new(volume);
+    render_dvr_prepared(volume, &prepared, transfer, settings, progress)
+}
+
+/// [`render_dvr`] with the volume's gradients and bricks computed beforehand (once for every
+/// frame of one volume). `prepared` must be `volume`'s.
+pub fn render_dvr_prepared(
+    volume: &Volume,
+    prepared: &PreparedVolume,
+    transfer: &TransferFunction,
+    settings: &DvrSettings,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Image, VolumeError> {
+    if prepared.dims() != volume.dims() {
+        return Err(VolumeError(
+            "the prepared volume is another volume's (its grid differs)".into(),
+        ));
+    }
     let (width, height) = (settings.width, settings.height);
     let DvrPlan {
         camera,
         step,
         lighting,
     } = DvrPlan::new(volume, settings)?;
+    let classification = Classification::new(prepared, transfer, step);
+    let arch = pulp::Arch::new();
     let mut pixels = vec![settings.background; width as usize * height as usize];
+    // Bands of TILE rows, drawn tile by tile: a tile's rays cross the same few columns of
+    // voxels, which then stay in cache from one ray to the next.
+    let band = TILE * width as usize;
     pixels
-        .par_chunks_mut(width as usize)
+        .par_chunks_mut(band)
         .enumerate()
-        .for_each(|(y, row)| {
-            for (x, pixel) in row.iter_mut().enumerate() {
-                let (origin, direction) = camera.ray(x as u32, y as u32, width, height);
-                let wo = -direction;
-                let (grid_origin, grid_direction) =
-                    (volume.index(origin), volume.index_direction(direction));
-                let Some((start, end)) = inside_grid(volume, grid_origin, grid_direction) else {
-                    continue;
-                };
-                let (mut colour, mut transmittance) = (Vec3::ZERO, 1.0_f32);
-                let mut t = start;
-                // The first segment's length varies from pixel to pixel, so the steps do not
-                // line up with a sharp boundary in the same way across the image (which draws
-                // wood-grain rings); the segments still sum to the ray's length exactly.
-                let mut segment = step * pixel_jitter(x as u32, y as u32);
-                while t < end && 1.0 - transmittance < settings.opacity_cutoff {
-                    segment = segment.min(end - t);
-                    let index = grid_origin + grid_direction * (t + 0.5 * segment);
-                    t += segment;
-                    let length = segment;
-                    segment = step;
-                    let (sigma, base) = transfer.at(volume.sample(index));
-                    if sigma <= 0.0 {
-                        continue;
+        .for_each(|(index, band)| {
+            let rows = band.len() / width as usize;
+            let mut buffers = [Highlights::EMPTY; TOGETHER];
+            for x0 in (0..width as usize).step_by(TILE) {
+                for row in 0..rows {
+                    let y = (index * TILE + row) as u32;
+                    let line = &mut band[row * width as usize..(row + 1) * width as usize];
+                    let tile = &mut line[x0..(x0 + TILE).min(width as usize)];
+                    for (group, pixels) in tile.chunks_mut(TOGETHER).enumerate() {
+                        let first = x0 + group * TOGETHER;
+                        let rays: [Option<(Ray, Vec3)>; TOGETHER] = core::array::from_fn(|k| {
+                            if k >= pixels.len() {
+                                return None;
+                            }
+                            let x = (first + k) as u32;
+                            let (origin, direction) = camera.ray(x, y, width, height);
+                            let (grid_origin, grid_direction) =
+                                (volume.index(origin), volume.index_direction(direction));
+                            let (start, end) = inside_grid(volume, grid_origin, grid_direction)?;
+                            // The first segment's length varies from pixel to pixel, so the
+                            // steps do not line up with a sharp boundary in the same way
+                            // across the image (which draws wood-grain rings); the segments
+                            // still sum to the ray's length exactly.
+                            let ray = Ray {
+                                origin: grid_origin,
+                                direction: grid_direction,
+                                start,
+                                end,
+                                first: step * pixel_jitter(x, y),
+                            };
+                            Some((ray, direction))
+                        });
+                        let lits = rays.map(|ray| {
+                            let (_, direction) = ray?;
+                            lighting.as_ref().map(|lighting| Lit {
+                                lighting,
+                                view: RayView::new(lighting, -direction),
+                            })
+                        });
+                        let marched = march_together::<_, TOGETHER>(
+                            arch,
+                            prepared,
+                            &classification,
+                            core::array::from_fn(|k| {
+                                rays[k].map(|(ray, _)| (ray, lits[k].as_ref()))
+                            }),
+                            step,
+                            settings.opacity_cutoff,
+                            &mut buffers,
+                        );
+                        for (pixel, marched) in pixels.iter_mut().zip(marched) {
+                            if let Some((colour, transmittance)) = marched {
+                                *pixel = colour + transmittance * settings.background;
+                            }
+                        }
                     }
-                    let alpha = 1.0 - (-sigma * length).exp();
-                    let shaded = match &lighting {
-                        None => base,
-                        Some(lighting) => lighting.shade(volume, index, base, wo),
-                    };
-                    colour += transmittance * alpha * shaded;
-                    transmittance *= 1.0 - alpha;
                 }
-                *pixel = colour + transmittance * settings.background;
             }
-            progress();
+            for _ in 0..rows {
+                progress();
+            }
         });
     Image::from_pixels(width, height, pixels)
         .ok_or_else(|| VolumeError("the image could not be assembled".into()))
 }
+
+/// Neighbouring rays marched side by side (see [`march_together`]).
+const TOGETHER: usize = 4;
+
+/// Pixels along each side of the square tiles drawn one at a time.
+const TILE: usize = 8;
 
 /// A fraction in `(0, 1]` that is fixed per pixel (a hash of its coordinates).
 #[must_use]
@@ -377,38 +536,132 @@ pub struct Lighting {
     /// The gradient magnitude at which a sample is fully shaded: 2 % of the value range per
     /// voxel.
     pub gradient_reference: f32,
+    /// Its reciprocal (infinite without the fade).
+    per_gradient_reference: f32,
 }
 
 impl Lighting {
     fn new(shading: Shading, volume: &Volume, light: Vec3) -> Self {
         let (lo, hi) = volume.range();
         let voxel = volume.spacing().min_element();
+        // Without the fade, any gradient shades fully (the GPU reads the same field).
+        let gradient_reference = if shading.fade_weak_gradients {
+            (0.02 * (hi - lo) / voxel).max(f32::MIN_POSITIVE)
+        } else {
+            f32::MIN_POSITIVE
+        };
         Self {
             shading,
             normalisation: shading.normalisation.constant_for(&shading.lobe) as f32,
             light,
-            gradient_reference: (0.02 * (hi - lo) / voxel).max(f32::MIN_POSITIVE),
+            gradient_reference,
+            per_gradient_reference: 1.0 / gradient_reference,
         }
     }
 
-    /// A sample's colour `base` lit by the classic model, with the gradient as the normal,
-    /// seen along `wo`.
-    fn shade(&self, volume: &Volume, index: Vec3, base: Vec3, wo: Vec3) -> Vec3 {
-        let gradient = volume.gradient(index);
-        let strength = gradient.length();
-        if !(strength > 0.0 && strength.is_finite()) {
-            return base;
+    /// A sample's colour `base` lit by the classic model, with its `gradient` (value per mm)
+    /// as the normal, seen along `wo`.
+    #[must_use]
+    pub fn shade(&self, gradient: Vec3, base: Vec3, wo: Vec3) -> Vec3 {
+        let lit = self.light(gradient, base, &RayView::new(self, wo));
+        lit.colour + Vec3::splat(lit.highlight * self.shading.lobe.eval(lit.t))
+    }
+
+    /// [`Lighting::shade`] in parts, the lobe left unevaluated (a ray gathers its cosines
+    /// and evaluates them together).
+    #[inline(always)]
+    #[must_use]
+    pub fn light(&self, gradient: Vec3, base: Vec3, view: &RayView) -> LitSample {
+        let squared = gradient.length_squared();
+        if !(squared > 0.0 && squared.is_finite()) {
+            return LitSample {
+                colour: base,
+                highlight: 0.0,
+                t: 0.0,
+            };
         }
-        let mut normal = -gradient / strength;
-        if normal.dot(wo) < 0.0 {
-            normal = -normal;
+        let inverse = squared.sqrt().recip();
+        // The normal is the gradient's opposite turned to face the viewer: `k g` with
+        // `|k| = 1 / |g|`, so its dot products are those of the gradient, scaled.
+        let towards_viewer = gradient.dot(view.wo);
+        let k = if towards_viewer > 0.0 {
+            inverse
+        } else {
+            -inverse
+        };
+        let shading = &self.shading;
+        let along_light = k * gradient.dot(self.light);
+        let diffuse = along_light.max(0.0);
+        let t = match shading.geometry {
+            Geometry::Phong => 2.0 * along_light * (k * towards_viewer) - view.wi_dot_wo,
+            Geometry::Blinn => k * gradient.dot(view.half),
+        };
+        // base.lerp(lit, weight), the highlight's share kept apart.
+        let weight = (squared * inverse * self.per_gradient_reference).min(1.0);
+        LitSample {
+            colour: base * (1.0 + weight * (shading.ka + shading.kd * diffuse - 1.0)),
+            highlight: weight * shading.ks * self.normalisation,
+            t,
         }
-        let (shading, wi) = (&self.shading, self.light);
-        let diffuse = normal.dot(wi).max(0.0);
-        let t = shading.geometry.cos_lobe_f32(normal, wo, wi);
-        let specular = shading.ks * self.normalisation * shading.lobe.eval(t);
-        let lit = base * (shading.ka + shading.kd * diffuse) + Vec3::splat(specular);
-        base.lerp(lit, (strength / self.gradient_reference).min(1.0))
+    }
+}
+
+/// A sample lit, its highlight apart: the sample is `colour + highlight * lobe(t)` in every
+/// channel (the highlight is white).
+#[derive(Clone, Copy, Debug)]
+pub struct LitSample {
+    /// Ambient and diffuse.
+    pub colour: Vec3,
+    /// The lobe's weight.
+    pub highlight: f32,
+    /// The lobe's cosine.
+    pub t: f32,
+}
+
+/// What one ray's samples share: the view direction and, for Blinn, the half vector.
+#[derive(Clone, Copy, Debug)]
+pub struct RayView {
+    wo: Vec3,
+    half: Vec3,
+    wi_dot_wo: f32,
+}
+
+impl RayView {
+    /// The view `wo` under `lighting`'s light.
+    #[must_use]
+    pub fn new(lighting: &Lighting, wo: Vec3) -> Self {
+        let sum = lighting.light + wo;
+        let length = sum.length();
+        Self {
+            wo,
+            // Light and view opposite: no half vector, and Blinn's cosine is 0.
+            half: if length > 0.0 {
+                sum / length
+            } else {
+                Vec3::ZERO
+            },
+            wi_dot_wo: lighting.light.dot(wo),
+        }
+    }
+}
+
+/// The lighting as one ray sees it.
+struct Lit<'a> {
+    lighting: &'a Lighting,
+    view: RayView,
+}
+
+impl Shade for Lit<'_> {
+    #[inline(always)]
+    fn light(&self, gradient: Vec3, base: Vec3) -> LitSample {
+        self.lighting.light(gradient, base, &self.view)
+    }
+
+    fn highlights(&self, ts: &[f32], weights: &[f32]) -> f32 {
+        let mut lobes = [0.0_f32; HIGHLIGHTS];
+        let lobes = &mut lobes[..ts.len()];
+        self.lighting.shading.lobe.eval_batch(ts, lobes);
+        lobes.iter().zip(weights).map(|(l, w)| l * w).sum()
     }
 }
 
@@ -449,7 +702,7 @@ mod tests {
         // 40 x 40 x 11 voxels of 2 x 2 x 3 mm: 30 mm thick along z.
         let volume = constant([40, 40, 11], Vec3::new(2.0, 2.0, 3.0), 1.0);
         for (sigma, step_fraction) in [(0.01, 0.5), (0.05, 0.37), (0.2, 1.3)] {
-            let mut settings = DvrSettings::new(32, 32, View::Axial, None);
+            let mut settings = DvrSettings::new(32, 32, View::Inferior, None);
             settings.step_fraction = step_fraction;
             settings.opacity_cutoff = 1.0;
             settings.background = background;
@@ -467,7 +720,7 @@ mod tests {
     #[test]
     fn early_termination_stops_within_its_cutoff() {
         let volume = constant([20, 20, 20], Vec3::ONE, 1.0);
-        let settings = DvrSettings::new(8, 8, View::Coronal, None);
+        let settings = DvrSettings::new(8, 8, View::Anterior, None);
         let image = render_dvr(&volume, &flat(0.5, Vec3::ONE), &settings, &|| {}).unwrap();
         let centre = image.get(4, 4).x;
         assert!((0.99..=1.0).contains(&centre), "{centre}");
@@ -477,9 +730,9 @@ mod tests {
     fn rays_that_miss_see_the_background_and_views_frame_the_volume() {
         let volume = constant([10, 10, 10], Vec3::ONE, 1.0);
         for view in [
-            View::Axial,
-            View::Sagittal,
-            View::Coronal,
+            View::Inferior,
+            View::Left,
+            View::Anterior,
             View::Eye(Vec3::new(40.0, -30.0, 20.0)),
         ] {
             let mut settings = DvrSettings::new(40, 40, view, None);

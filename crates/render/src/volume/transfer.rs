@@ -219,6 +219,40 @@ impl TransferFunction {
         }
     }
 
+    /// This function (in the volume's values) with its control points moved so that the first
+    /// lies at `level - window / 2` and the last at `level + window / 2`, those between in
+    /// proportion: how a radiologist's window and level drag a volume's ramp. A function of
+    /// one point moves it to `level`.
+    pub fn windowed(&self, window: f32, level: f32) -> Result<Self, VolumeError> {
+        if !(window.is_finite() && window > 0.0 && level.is_finite()) {
+            return Err(VolumeError(format!(
+                "--window {window} --level {level}: the window must be a positive width and the level a finite centre, in the volume's values"
+            )));
+        }
+        let (first, last) = (
+            self.points[0].value,
+            self.points[self.points.len() - 1].value,
+        );
+        let span = last - first;
+        let points = self
+            .points
+            .iter()
+            .map(|p| ControlPoint {
+                value: if span > 0.0 {
+                    level - 0.5 * window + (p.value - first) / span * window
+                } else {
+                    level
+                },
+                ..*p
+            })
+            .collect();
+        Self::try_new(points, self.scale).map_err(|e| {
+            VolumeError(format!(
+                "--window {window} --level {level} squeezes the transfer function's points together ({e}); widen the window"
+            ))
+        })
+    }
+
     /// The control points, by increasing value.
     #[must_use]
     pub fn points(&self) -> &[ControlPoint] {

@@ -6,7 +6,7 @@
 const DASH = [7, 4];
 // Phong geometry with the lobe's own normalisation: energy-conserving (albedo <= 1) for every
 // lobe, so the first view is physically sensible.
-const DEFAULTS = { lobes: "pow,schlick,schlick-mod", formula: "", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "", volume: "phantom", view: "coronal", volume_lobe: "cosquad" };
+const DEFAULTS = { lobes: "pow,schlick,schlick-mod", formula: "", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "", volume: "phantom", view: "anterior", volume_lobe: "cosquad" };
 const $ = (id) => document.getElementById(id);
 let registry = null;
 let generation = 0;

@@ -102,7 +102,7 @@ async fn volume_renders_the_named_volume_view_and_lobe() {
     use specula_render::volume::raymarch::{render_dvr, DvrSettings, Shading, View};
     use specula_render::volume::{phantom, transfer::TransferFunction};
 
-    let uri = "/api/volume?volume=phantom&view=axial&lobe=cosquad&n=40&geometry=phong&normalisation=lobe&size=48";
+    let uri = "/api/volume?volume=phantom&view=inferior&lobe=cosquad&n=40&geometry=phong&normalisation=lobe&size=48";
     let served = served_png(uri, (48, 48)).await;
 
     let volume = phantom::shepp_logan(64).expect("phantom");
@@ -114,7 +114,7 @@ async fn volume_renders_the_named_volume_view_and_lobe() {
         Geometry::Phong,
         Normalisation::Lobe,
     );
-    let settings = DvrSettings::new(48, 48, View::Axial, Some(shading));
+    let settings = DvrSettings::new(48, 48, View::Inferior, Some(shading));
     let transfer = TransferFunction::preset("mr")
         .expect("a preset")
         .for_volume(&volume);
@@ -129,7 +129,7 @@ async fn volume_renders_the_named_volume_view_and_lobe() {
     for other in [
         uri.replace("lobe=cosquad", "lobe=schlick"),
         uri.replace("n=40", "n=400"),
-        uri.replace("view=axial", "view=sagittal"),
+        uri.replace("view=inferior", "view=left"),
         uri.replace("volume=phantom", "volume=marschner-lobb"),
         uri.replace("normalisation=lobe", "normalisation=none"),
     ] {
@@ -223,7 +223,7 @@ async fn bad_parameters_get_400_naming_the_parameter_and_the_valid_values() {
         (
             "/api/volume?view=oblique",
             "view",
-            "axial, sagittal, coronal",
+            "anterior, posterior, left, right, superior, inferior",
         ),
         ("/api/volume?size=2048", "size", "[16, 512]"),
         ("/api/volume?lobe=gauss", "lobe", "cosquad"),

@@ -26,6 +26,15 @@ pub(crate) mod x86;
 
 use core::ops::{Add, Div, Mul, Sub};
 
+/// `2^x` for one `x` in `[-126, 0]` (within 2 ulp), 0 at or below `-127`: the kernels'
+/// polynomial on one lane, for scalar code that needs `exp` of a non-positive argument
+/// (an opacity's `exp(-sigma d)`) without a library call.
+#[inline(always)]
+#[must_use]
+pub fn exp2_nonpositive(x: f32) -> f32 {
+    math::exp2(scalar::Scalar(x)).0
+}
+
 /// Independent vectors the driver evaluates per step: enough to cover a 4-cycle FMA latency
 /// on two FMA pipes with the out-of-order window's help (`drive` writes the four out).
 pub const UNROLL: usize = 4;

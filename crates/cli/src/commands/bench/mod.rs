@@ -11,6 +11,7 @@ use super::CommandResult;
 use crate::output::Table;
 
 pub mod lobes;
+pub mod volume;
 
 /// What to measure.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -25,6 +26,10 @@ pub enum Target {
     Gpu,
     /// Every lobe in a GPU compute shader: G evaluations/s and the ratio to pow.
     GpuLobes,
+    /// The volume renderer on the CPU: frames per second of `--input` (512 x 512 unless
+    /// `--width`/`--height` say otherwise), beside VTK's CPU ray caster when the `vtk` wheel
+    /// is present.
+    Volume,
 }
 
 /// Arguments of `specula bench`.
@@ -33,21 +38,47 @@ pub struct Args {
     /// What to measure.
     #[arg(value_enum)]
     target: Target,
-    /// Frame width.
-    #[arg(long, default_value_t = 1920, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    width: u32,
-    /// Frame height.
-    #[arg(long, default_value_t = 1080, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    height: u32,
+    /// Frame width (1920, or 512 for `bench volume`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    width: Option<u32>,
+    /// Frame height (1080, or 512 for `bench volume`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    height: Option<u32>,
     /// Timed frames per method (after one untimed warm-up frame).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     frames: u32,
-    /// The exponent the lobes are prepared for (`bench lobes`).
+    /// The exponent the lobes are prepared for (`bench lobes`; VTK's specular power in
+    /// `bench volume`).
     #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = crate::args::parse_exponent)]
     n: specula::Exponent,
     /// Output format (`bench lobes`, `bench gpu-lobes`).
     #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
     format: crate::args::Format,
+    /// The volume `bench volume` renders: built-in (phantom, marschner-lobb), NIfTI or DICOM.
+    #[arg(long, default_value = "phantom")]
+    input: String,
+    /// The transfer function of `bench volume` (a preset); by default the volume's own.
+    #[arg(long)]
+    transfer: Option<String>,
+    /// The view of `bench volume` (anterior, posterior, left, right, superior, inferior).
+    #[arg(long, value_parser = specula_render::volume::raymarch::View::parse, default_value = "anterior")]
+    view: specula_render::volume::raymarch::View,
+    /// Millimetres between samples along a ray (`bench volume`; VTK's sample distance).
+    #[arg(long, default_value_t = 0.5, value_parser = parse_distance)]
+    sample_distance: f32,
+    /// Also write the last frame of each renderer into this folder (`bench volume`).
+    #[arg(long)]
+    images: Option<std::path::PathBuf>,
+}
+
+fn parse_distance(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(value) if value > 0.0 && value.is_finite() => Ok(value),
+        _ => Err(format!(
+            "'{}' must be a positive distance in millimetres",
+            specula::excerpt(text)
+        )),
+    }
 }
 
 /// Measures and prints.
@@ -58,15 +89,28 @@ pub fn run(args: &Args) -> CommandResult {
         Target::Render => bench_render(args),
         Target::Gpu => bench_gpu(args),
         Target::GpuLobes => bench_gpu_lobes(args),
+        Target::Volume => volume::run(args),
+    }
+}
+
+impl Args {
+    /// The frame's size: the target's default unless given.
+    fn size(&self) -> (u32, u32) {
+        let (width, height) = match self.target {
+            Target::Volume => (512, 512),
+            _ => (1920, 1080),
+        };
+        (self.width.unwrap_or(width), self.height.unwrap_or(height))
     }
 }
 
 /// The default scene at the requested size, one sample per pixel, with these overrides.
 fn bench_scene(args: &Args, overrides: Overrides) -> Scene {
     let mut scene = Scene::default_scene();
+    let (width, height) = args.size();
     scene.apply(&Overrides {
-        width: Some(args.width),
-        height: Some(args.height),
+        width: Some(width),
+        height: Some(height),
         samples: Some(1),
         ..overrides
     });
@@ -129,8 +173,8 @@ fn bench_frame(args: &Args) -> CommandResult {
         "default scene, {}x{}, 1 sample per pixel, {} frames per method; CPU: {} threads; GPU: {}\n\
          GPU frames are drawn from buffers uploaded once; 'GPU pass' is the scene pass by the \
          GPU's own timestamps",
-        args.width,
-        args.height,
+        args.size().0,
+        args.size().1,
         args.frames,
         rayon::current_num_threads(),
         gpu.adapter_name()
@@ -174,8 +218,8 @@ fn bench_gpu(args: &Args) -> CommandResult {
          drawn from buffers uploaded once (draw and wait; then with the image copied back); \
          'pass' is the scene pass by the GPU's own timestamps",
         gpu.adapter_name(),
-        args.width,
-        args.height,
+        args.size().0,
+        args.size().1,
         args.frames
     );
     let mut table = Table::new(&[
@@ -285,7 +329,9 @@ fn bench_render(args: &Args) -> CommandResult {
     let cores = rayon::current_num_threads();
     println!(
         "default scene, {}x{}, 1 sample per pixel, {} frames per method, {cores} threads",
-        args.width, args.height, args.frames
+        args.size().0,
+        args.size().1,
+        args.frames
     );
     let mut table = Table::new(&["shading", "best ms/frame", "mean ms/frame", "vs flat"]);
     let mut flat_best = None;

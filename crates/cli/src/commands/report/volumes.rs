@@ -62,7 +62,7 @@ pub fn volumes(context: &mut Context) -> Result<String, String> {
     let mut figures = String::new();
     let mut reference: Option<Image> = None;
     for kind in context.lobes.clone() {
-        let settings = DvrSettings::new(pixels, pixels, View::Coronal, Some(shading(kind)?));
+        let settings = DvrSettings::new(pixels, pixels, View::Anterior, Some(shading(kind)?));
         let (cpu_ms, image) = timed(runs, || {
             render_dvr(&volume, &transfer, &settings, &|| {}).map_err(|e| e.to_string())
         })?;
@@ -146,7 +146,7 @@ pub fn volumes(context: &mut Context) -> Result<String, String> {
 fn marschner_lobb_errors(lobes: &[LobeKind]) -> Result<String, String> {
     const SIDE: usize = 41;
     let volume: Volume = phantom::marschner_lobb(SIDE).map_err(|e| e.to_string())?;
-    let camera = RayCamera::new(View::Coronal, &volume).map_err(|e| e.to_string())?;
+    let camera = RayCamera::new(View::Anterior, &volume).map_err(|e| e.to_string())?;
     let (wo, wi) = (-camera.forward, camera.light());
     // Cell centres away from the boundary, where the gradient is not negligible.
     let mut normals = Vec::new();

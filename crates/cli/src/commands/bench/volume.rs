@@ -1,0 +1,187 @@
+//! `specula bench volume`: the CPU ray marcher's frames per second on one volume, beside
+//! VTK's CPU ray caster set up alike ([`specula_render::volume::vtk`]) when Python has the
+//! `vtk` and `nibabel` packages.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use specula_render::volume::march::PreparedVolume;
+use specula_render::volume::raymarch::render_dvr_prepared;
+use specula_render::volume::transfer::TransferFunction;
+use specula_render::volume::{self, nifti, vtk, Volume};
+use specula_render::{write_image, Display};
+
+use super::Args;
+use crate::commands::volume::{load, Source};
+use crate::commands::CommandResult;
+use crate::output::Table;
+
+/// The VTK side of the comparison: `vtk_volume.py`, run by the Python that has VTK.
+const VTK_SCRIPT: &str = include_str!("vtk_volume.py");
+
+/// Median of `values` (sorted in place).
+fn median(values: &mut [f64]) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let middle = values.len() / 2;
+    if values.len() % 2 == 1 {
+        values[middle]
+    } else {
+        0.5 * (values[middle - 1] + values[middle])
+    }
+}
+
+/// The Python that runs VTK: `$SPECULA_PYTHON`, else `python3`.
+fn python() -> PathBuf {
+    std::env::var_os("SPECULA_PYTHON").map_or_else(|| PathBuf::from("python3"), PathBuf::from)
+}
+
+/// What VTK measured.
+struct VtkTimes {
+    median_draw: f64,
+    version: String,
+}
+
+/// Renders `job` with VTK; `Err` says why VTK could not run (reported, not fatal).
+fn run_vtk(job: &vtk::VtkJob, scratch: &Path) -> Result<VtkTimes, String> {
+    let script = scratch.join("vtk_volume.py");
+    std::fs::write(&script, VTK_SCRIPT).map_err(|e| e.to_string())?;
+    let job_file = scratch.join("job.json");
+    std::fs::write(
+        &job_file,
+        serde_json::to_vec(job).map_err(|e| e.to_string())?,
+    )
+    .map_err(|e| e.to_string())?;
+    let output = Command::new(python())
+        .arg(&script)
+        .arg(&job_file)
+        .output()
+        .map_err(|e| format!("{}: {e}", python().display()))?;
+    if !output.status.success() {
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        let last = stderr.lines().last().unwrap_or("no message");
+        return Err(last.to_owned());
+    }
+    let report: serde_json::Value = serde_json::from_slice(&output.stdout)
+        .map_err(|e| format!("vtk_volume.py printed no JSON ({e})"))?;
+    Ok(VtkTimes {
+        median_draw: report["median_draw"]
+            .as_f64()
+            .ok_or("vtk_volume.py reported no median_draw")?,
+        version: report["vtk"].as_str().unwrap_or("?").to_owned(),
+    })
+}
+
+/// The volume as a NIfTI file VTK can read: the input itself, or a copy in `scratch`.
+fn nifti_file(input: &str, volume: &Volume, scratch: &Path) -> Result<PathBuf, String> {
+    let path = Path::new(input);
+    if nifti::is_nifti_path(path) && path.is_file() {
+        return Ok(path.to_owned());
+    }
+    let copy = scratch.join("volume.nii");
+    volume::write(volume, &copy).map_err(|e| e.to_string())?;
+    Ok(copy)
+}
+
+/// Measures and prints.
+pub fn run(args: &Args) -> CommandResult {
+    let source = Source::new(&args.input);
+    let volume = load(&source)?;
+    let transfer = match &args.transfer {
+        Some(name) => TransferFunction::preset(name).map_err(|e| e.to_string())?,
+        None => TransferFunction::default_for(&volume),
+    }
+    .for_volume(&volume);
+    let (width, height) = args.size();
+    let view = args.view;
+    let settings = vtk::alike_settings(&volume, width, height, view, args.n, args.sample_distance)
+        .map_err(|e| e.to_string())?;
+    let started = Instant::now();
+    let prepared = PreparedVolume::new(&volume);
+    let preparation = started.elapsed().as_secs_f64();
+    let mut image = None;
+    let mut frame = || -> Result<f64, String> {
+        let started = Instant::now();
+        let drawn = render_dvr_prepared(&volume, &prepared, &transfer, &settings, &|| {})
+            .map_err(|e| e.to_string())?;
+        let seconds = started.elapsed().as_secs_f64();
+        image = Some(drawn);
+        Ok(seconds)
+    };
+    frame()?;
+    let mut times = (0..args.frames)
+        .map(|_| frame())
+        .collect::<Result<Vec<_>, _>>()?;
+    let specula = median(&mut times);
+    let threads = rayon::current_num_threads();
+    let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let vtk_output = scratch.path().join("vtk.png");
+    let vtk = nifti_file(&args.input, &volume, scratch.path()).and_then(|file| {
+        let job = vtk::job(
+            &volume,
+            &file,
+            &transfer,
+            &settings,
+            &vtk_output,
+            threads,
+            args.frames,
+        )
+        .map_err(|e| e.to_string())?;
+        run_vtk(&job, scratch.path())
+    });
+    let [nx, ny, nz] = volume.dims();
+    println!(
+        "{} ({nx} x {ny} x {nz}), {} view, {width} x {height}, {} mm between samples, {threads} threads; \
+         median of {} frames after one warm-up; specula's gradients and bricks took {:.0} ms once",
+        args.input,
+        view.id(),
+        args.sample_distance,
+        args.frames,
+        preparation * 1e3
+    );
+    let mut table = Table::new(&["renderer", "median ms/frame", "frames/s", "specula vs VTK"]);
+    let row = |name: String, seconds: f64, ratio: String| {
+        vec![
+            name,
+            format!("{:.1}", seconds * 1e3),
+            format!("{:.2}", 1.0 / seconds),
+            ratio,
+        ]
+    };
+    match &vtk {
+        Ok(times) => {
+            table.push(row(
+                "specula (CPU)".into(),
+                specula,
+                format!("{:.2}x", times.median_draw / specula),
+            ));
+            table.push(row(
+                format!("VTK {} vtkFixedPointVolumeRayCastMapper", times.version),
+                times.median_draw,
+                "1.00x".into(),
+            ));
+        }
+        Err(why) => {
+            table.push(row("specula (CPU)".into(), specula, "-".into()));
+            println!(
+                "VTK not measured: {why} (install the vtk and nibabel wheels for {})",
+                python().display()
+            );
+        }
+    }
+    table.print(crate::args::Format::Table);
+    if let (Some(dir), Some(image)) = (&args.images, &image) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        write_image(&dir.join("specula.exr"), image, Display::default())
+            .map_err(|e| e.to_string())?;
+        if vtk.is_ok() {
+            std::fs::copy(&vtk_output, dir.join("vtk.png"))
+                .map_err(|e| format!("{}: {e}", dir.display()))?;
+        }
+        println!(
+            "wrote {} (linear) and, from VTK, vtk.png (8-bit linear values, as VTK composites them)",
+            dir.join("specula.exr").display()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,306 @@
+//! What makes the CPU ray marcher fast without changing what it computes.
+//!
+//! - **Gradients once per volume.** Central differences one voxel apart of the trilinear field
+//!   are the trilinear interpolation of the voxels' own central differences (interpolation is
+//!   linear in the data and commutes with a whole-voxel shift), so [`PreparedVolume`] stores
+//!   each voxel's value and world gradient side by side (16 bytes) and a sample reads 8
+//!   neighbours instead of 48. Only the last voxel layer differs: there the reference clamps
+//!   the outer sample of the difference, the prepared field the voxel's.
+//! - **Empty space skipped exactly.** The grid is cut into bricks of [`BRICK`]^3 cells with
+//!   each brick's smallest and largest value; a render marks the bricks whose whole value
+//!   range has no extinction, and a ray inside such a brick jumps to its exit along its own
+//!   lattice of segments, so every sample it still takes is one it would have taken.
+//! - **Classification without a search.** A table over the volume's range finds the piece
+//!   of the transfer function a value falls in, whose line then gives extinction and colour
+//!   exactly as the function does.
+
+use glam::{IVec3, Vec3, Vec4};
+use rayon::prelude::*;
+
+use super::transfer::TransferFunction;
+use super::Volume;
+
+pub(super) mod ray;
+#[cfg(test)]
+mod tests;
+
+/// The flag of a table entry within which a control point lies.
+const HOLDS_A_BOUND: u16 = 1 << 15;
+
+/// Cells along each side of a brick: `2^BRICK_SHIFT`.
+pub const BRICK: usize = 1 << BRICK_SHIFT;
+
+const BRICK_SHIFT: i32 = 2;
+
+/// Entries of the table that finds a value's piece of the transfer function.
+pub const CLASSIFICATION_ENTRIES: usize = 4096;
+
+/// A volume laid out for marching: value and world gradient per voxel, and the bricks'
+/// value ranges. Built once and shared by every frame of that volume.
+#[derive(Clone, Debug)]
+pub struct PreparedVolume {
+    dims: [usize; 3],
+    /// `(value, gradient in value per mm)` per voxel, `i` fastest.
+    voxels: Vec<Vec4>,
+    /// The largest cell index along each axis (`dims - 2`).
+    last_cell: IVec3,
+    last_index: Vec3,
+    bricks: [usize; 3],
+    /// Smallest and largest value of each brick's voxels (its cells' corners).
+    brick_ranges: Vec<(f32, f32)>,
+    range: (f32, f32),
+}
+
+impl PreparedVolume {
+    /// Computes the gradients and the bricks' ranges (in parallel over slices).
+    #[must_use]
+    pub fn new(volume: &Volume) -> Self {
+        let dims = volume.dims();
+        let [nx, ny, nz] = dims;
+        let samples = volume.samples();
+        let to_world_gradient = volume.to_index().transpose();
+        let at = |i: usize, j: usize, k: usize| samples[i + nx * (j + ny * k)];
+        let mut voxels = vec![Vec4::ZERO; samples.len()];
+        voxels
+            .par_chunks_mut(nx * ny)
+            .enumerate()
+            .for_each(|(k, slice)| {
+                let (k0, k1) = (k.saturating_sub(1), (k + 1).min(nz - 1));
+                for j in 0..ny {
+                    let (j0, j1) = (j.saturating_sub(1), (j + 1).min(ny - 1));
+                    for i in 0..nx {
+                        let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nx - 1));
+                        let along_index = 0.5
+                            * Vec3::new(
+                                at(i1, j, k) - at(i0, j, k),
+                                at(i, j1, k) - at(i, j0, k),
+                                at(i, j, k1) - at(i, j, k0),
+                            );
+                        let g = to_world_gradient * along_index;
+                        slice[i + nx * j] = Vec4::new(at(i, j, k), g.x, g.y, g.z);
+                    }
+                }
+            });
+        let bricks = dims.map(|d| (d - 1).div_ceil(BRICK));
+        let brick_ranges = (0..bricks[0] * bricks[1] * bricks[2])
+            .into_par_iter()
+            .map(|b| {
+                let (bi, bj, bk) = (
+                    b % bricks[0],
+                    b / bricks[0] % bricks[1],
+                    b / (bricks[0] * bricks[1]),
+                );
+                let span =
+                    |brick: usize, d: usize| brick * BRICK..=((brick + 1) * BRICK).min(d - 1);
+                let mut range = (f32::INFINITY, f32::NEG_INFINITY);
+                for k in span(bk, nz) {
+                    for j in span(bj, ny) {
+                        for i in span(bi, nx) {
+                            let v = at(i, j, k);
+                            range = (range.0.min(v), range.1.max(v));
+                        }
+                    }
+                }
+                range
+            })
+            .collect();
+        Self {
+            dims,
+            voxels,
+            last_cell: IVec3::from(dims.map(|d| (d - 2) as i32)),
+            last_index: volume.last_index(),
+            bricks,
+            brick_ranges,
+            range: volume.range(),
+        }
+    }
+
+    /// The grid's size.
+    #[must_use]
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
+    /// The cell holding grid index `p` (already within the grid), and `p`'s place in it.
+    #[inline(always)]
+    fn cell(&self, p: Vec3) -> (IVec3, Vec3) {
+        // p >= 0, so truncation is floor (to i32, where u32's conversions take several
+        // instructions); the last layer of voxels belongs to the last cell.
+        let cell = p.as_ivec3().min(self.last_cell);
+        (cell, p - cell.as_vec3())
+    }
+
+    /// Value and world gradient at grid index `p` (clamped to the grid), interpolated
+    /// trilinearly.
+    #[inline(always)]
+    #[must_use]
+    pub fn sample(&self, p: Vec3) -> Vec4 {
+        let (cell, f) = self.cell(p.clamp(Vec3::ZERO, self.last_index));
+        self.sample_in(cell, f)
+    }
+
+    #[inline(always)]
+    fn sample_in(&self, cell: IVec3, f: Vec3) -> Vec4 {
+        let (nx, nxy) = (self.dims[0], self.dims[0] * self.dims[1]);
+        let at = cell.x as usize + nx * cell.y as usize + nxy * cell.z as usize;
+        let v = &self.voxels[at..=at + nxy + nx + 1];
+        let row = |o: usize| v[o].lerp(v[o + 1], f.x);
+        let plane = |o: usize| row(o).lerp(row(o + nx), f.y);
+        plane(0).lerp(plane(nxy), f.z)
+    }
+
+    /// The index of the brick holding `cell`.
+    #[inline(always)]
+    fn brick(&self, cell: IVec3) -> usize {
+        let b = cell >> BRICK_SHIFT;
+        b.x as usize + self.bricks[0] * (b.y as usize + self.bricks[1] * b.z as usize)
+    }
+
+    /// Where a ray (grid index `origin + direction * t`) leaves the brick holding `cell`.
+    #[inline(always)]
+    fn brick_exit(&self, cell: IVec3, origin: Vec3, inverse_direction: Vec3) -> f32 {
+        let low = (cell >> BRICK_SHIFT << BRICK_SHIFT).as_vec3();
+        let high = low + BRICK as f32;
+        let a = (low - origin) * inverse_direction;
+        let c = (high - origin) * inverse_direction;
+        a.max(c).min_element()
+    }
+}
+
+/// A transfer function arranged for one volume: its pieces as `value -> (sigma, r, g, b)`
+/// lines, a table that finds a value's piece, and the bricks it leaves empty.
+#[derive(Clone, Debug)]
+pub struct Classification {
+    /// The control points' values: piece `s` holds the values in `(bounds[s - 1], bounds[s]]`
+    /// (piece 0 those up to the first point, the last those beyond the last point).
+    bounds: Vec<f32>,
+    /// Per piece: where its line starts (a value), its `(sigma, r, g, b)` there, and its
+    /// slope per unit of value.
+    pieces: Vec<(f32, Vec4, Vec4)>,
+    /// The piece of the smallest value each table entry can hold, with [`HOLDS_A_BOUND`] set
+    /// when a control point lies within the entry (so that a value may be in a later piece).
+    first_piece: Vec<u16>,
+    lowest: f32,
+    per_entry: f32,
+    /// Whether each brick holds any value with extinction.
+    occupied: Vec<bool>,
+    /// A full segment's opacity `1 - exp(-u)` at `u = sigma step`, evenly spaced from 0 to
+    /// the densest segment's (at most [`OPAQUE`]).
+    opacity: Vec<f32>,
+    /// Entries of `opacity` per unit of `sigma`.
+    opacity_per_sigma: f32,
+    /// The last entry's index.
+    opacity_last: f32,
+}
+
+/// Entries of the opacity table. Interpolated linearly, `1 - exp(-u)` is off by at most
+/// `du^2 / 8` (its curvature is at most 1): `1.2e-5` at the widest spacing, `40 / 4095`.
+const OPACITY_ENTRIES: usize = 4096;
+
+/// Where the opacity table ends: `1 - exp(-40)` is 1 in `f32`.
+const OPAQUE: f32 = 40.0;
+
+impl Classification {
+    /// Arranges `transfer` (in `volume`'s values) for segments of `step` mm.
+    #[must_use]
+    pub fn new(volume: &PreparedVolume, transfer: &TransferFunction, step: f32) -> Self {
+        let points = transfer.points();
+        let bounds: Vec<f32> = points.iter().map(|p| p.value).collect();
+        let entry = |p: &super::transfer::ControlPoint| {
+            Vec4::new(p.sigma, p.colour.x, p.colour.y, p.colour.z)
+        };
+        let mut pieces = vec![(points[0].value, entry(&points[0]), Vec4::ZERO)];
+        for pair in points.windows(2) {
+            let (a, b) = (&pair[0], &pair[1]);
+            let slope = (entry(b) - entry(a)) / (b.value - a.value);
+            pieces.push((a.value, entry(a), slope));
+        }
+        let last = &points[points.len() - 1];
+        pieces.push((last.value, entry(last), Vec4::ZERO));
+        let (lowest, highest) = volume.range;
+        let span = highest - lowest;
+        let entries = CLASSIFICATION_ENTRIES;
+        // A flat volume has one value: every lookup reads the first entry.
+        let per_entry = if span > 0.0 {
+            entries as f32 / span
+        } else {
+            0.0
+        };
+        // Half an entry below its start, so that rounding in the lookup never lands past
+        // a value's piece; the march then steps forward over the bounds it passes.
+        let below = |value: f32| bounds.iter().filter(|&&b| b < value).count() as u16;
+        let first_piece = (0..entries)
+            .map(|e| {
+                let start = lowest + (e as f32 - 0.5) / per_entry.max(f32::MIN_POSITIVE);
+                let end = lowest + (e as f32 + 1.5) / per_entry.max(f32::MIN_POSITIVE);
+                let piece = below(start);
+                if below(end) == piece && per_entry > 0.0 {
+                    piece
+                } else {
+                    piece | HOLDS_A_BOUND
+                }
+            })
+            .collect();
+        let occupied = volume
+            .brick_ranges
+            .iter()
+            .map(|&(lo, hi)| {
+                transfer.at(lo).0 > 0.0
+                    || transfer.at(hi).0 > 0.0
+                    || points
+                        .iter()
+                        .any(|p| p.sigma > 0.0 && p.value > lo && p.value < hi)
+            })
+            .collect();
+        let densest = points.iter().map(|p| p.sigma).fold(0.0, f32::max);
+        let reach = (densest * step).clamp(f32::MIN_POSITIVE, OPAQUE);
+        let last = (OPACITY_ENTRIES - 1) as f32;
+        let opacity = (0..OPACITY_ENTRIES)
+            .map(|e| 1.0 - (-(reach * e as f32 / last)).exp())
+            .collect();
+        Self {
+            bounds,
+            pieces,
+            first_piece,
+            lowest,
+            per_entry,
+            occupied,
+            opacity,
+            opacity_per_sigma: step * last / reach,
+            opacity_last: last,
+        }
+    }
+
+    /// A full segment's opacity at extinction `sigma` (`>= 0`), from the table.
+    #[inline(always)]
+    fn full_segment_opacity(&self, sigma: f32) -> f32 {
+        let x = sigma * self.opacity_per_sigma;
+        if x >= self.opacity_last {
+            return self.opacity[OPACITY_ENTRIES - 1];
+        }
+        let e = x as i32 as usize;
+        let f = x - e as f32;
+        let (a, b) = (
+            self.opacity[e],
+            self.opacity[(e + 1).min(OPACITY_ENTRIES - 1)],
+        );
+        a + (b - a) * f
+    }
+
+    /// Extinction and colour `(sigma, r, g, b)` at `value`: the transfer function's own
+    /// interpolation.
+    #[inline(always)]
+    fn at(&self, value: f32) -> Vec4 {
+        let x = ((value - self.lowest) * self.per_entry)
+            .clamp(0.0, (CLASSIFICATION_ENTRIES - 1) as f32);
+        let entry = self.first_piece[x as i32 as usize];
+        let mut piece = usize::from(entry & !HOLDS_A_BOUND);
+        if entry & HOLDS_A_BOUND != 0 {
+            while piece < self.bounds.len() && value > self.bounds[piece] {
+                piece += 1;
+            }
+        }
+        let (start, at_start, slope) = self.pieces[piece];
+        at_start + slope * (value - start)
+    }
+}

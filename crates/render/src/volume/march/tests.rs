@@ -1,0 +1,265 @@
+use super::ray::{march_together, Highlights, Ray, Shade};
+use super::*;
+use crate::volume::phantom::BuiltIn;
+use crate::volume::raymarch::LitSample;
+use crate::volume::raymarch::{
+    inside_grid, pixel_jitter, render_dvr, DvrPlan, DvrSettings, Light, Shading, View,
+};
+use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+
+/// The march as the model states it, sample by sample from the volume and the transfer
+/// function themselves (no table, no bricks, gradients from six trilinear samples).
+fn reference(volume: &Volume, transfer: &TransferFunction, settings: &DvrSettings) -> Vec<Vec3> {
+    let plan = DvrPlan::new(volume, settings).unwrap();
+    let (width, height) = (settings.width, settings.height);
+    let mut pixels = Vec::new();
+    for y in 0..height {
+        for x in 0..width {
+            let (origin, direction) = plan.camera.ray(x, y, width, height);
+            let (o, d) = (volume.index(origin), volume.index_direction(direction));
+            let Some((start, end)) = inside_grid(volume, o, d) else {
+                pixels.push(settings.background);
+                continue;
+            };
+            let (mut colour, mut transmittance) = (Vec3::ZERO, 1.0_f32);
+            // The segments' ends: the first a fraction of a step in, then whole steps.
+            let first = start + plan.step * pixel_jitter(x, y);
+            let ends = std::iter::once(first)
+                .chain((1..).map(|j| first - plan.step + (j + 1) as f32 * plan.step));
+            let mut t = start;
+            for next in ends {
+                if !(t < end && 1.0 - transmittance < settings.opacity_cutoff) {
+                    break;
+                }
+                let segment = next.min(end) - t;
+                let index = o + d * (t + 0.5 * segment);
+                t = next;
+                let (sigma, base) = transfer.at(volume.sample(index));
+                let alpha = 1.0 - (-sigma * segment).exp();
+                let shaded = plan.lighting.as_ref().map_or(base, |lighting| {
+                    lighting.shade(volume.gradient(index), base, -direction)
+                });
+                colour += transmittance * alpha * shaded;
+                transmittance *= 1.0 - alpha;
+            }
+            pixels.push(colour + transmittance * settings.background);
+        }
+    }
+    pixels
+}
+
+/// The Shepp-Logan head of `side` voxels inside a margin of 4 empty voxels, so that the
+/// last layer (where the two gradients differ by definition) is uniform.
+fn padded_head(side: usize) -> Volume {
+    let head = BuiltIn::SheppLogan.make(side).unwrap();
+    let n = side + 8;
+    let samples = (0..n * n * n)
+        .map(|v| {
+            let [i, j, k] = [v % n, v / n % n, v / (n * n)].map(|c| c as isize - 4);
+            head.at(i, j, k)
+                * f32::from(u8::from(
+                    [i, j, k].iter().all(|&c| (0..side as isize).contains(&c)),
+                ))
+        })
+        .collect();
+    Volume::centred(
+        [n; 3],
+        head.spacing(),
+        samples,
+        crate::volume::Units::Arbitrary,
+    )
+    .unwrap()
+}
+
+#[test]
+fn the_prepared_march_is_the_reference_march() {
+    let volume = padded_head(36);
+    let lobe = Lobe::new(LobeKind::Pow, Exponent::new(24.0));
+    for (view, transfer, light) in [
+        (View::Anterior, "mr", Light::Key),
+        (View::Left, "surface", Light::Headlight),
+        (
+            View::Eye(Vec3::new(400.0, -300.0, 200.0)),
+            "mr",
+            Light::Headlight,
+        ),
+    ] {
+        let transfer = TransferFunction::preset(transfer)
+            .unwrap()
+            .for_volume(&volume);
+        let shading = Shading {
+            light,
+            ..Shading::new(lobe, Geometry::Blinn, Normalisation::None)
+        };
+        let mut settings = DvrSettings::new(48, 40, view, Some(shading));
+        settings.background = Vec3::new(0.1, 0.2, 0.3);
+        let fast = render_dvr(&volume, &transfer, &settings, &|| {}).unwrap();
+        let expected = reference(&volume, &transfer, &settings);
+        let errors: Vec<f32> = expected
+            .iter()
+            .enumerate()
+            .map(|(p, e)| {
+                (fast.get(p as u32 % 48, p as u32 / 48) - *e)
+                    .abs()
+                    .max_element()
+            })
+            .collect();
+        let worst = errors.iter().copied().fold(0.0, f32::max);
+        let mean = errors.iter().sum::<f32>() / errors.len() as f32;
+        assert!(
+            worst < 2e-3 && mean < 2e-4,
+            "{view:?}: worst {worst}, mean {mean}"
+        );
+    }
+}
+
+#[test]
+fn empty_bricks_are_skipped_without_changing_a_pixel() {
+    // A ball in a large empty grid: most bricks are empty, and the image with bricks is
+    // the image without them (every brick marked occupied) bit for bit.
+    let n = 64;
+    let samples = (0..n * n * n)
+        .map(|v| {
+            let p = Vec3::new((v % n) as f32, (v / n % n) as f32, (v / (n * n)) as f32);
+            if p.distance(Vec3::new(40.0, 30.0, 25.0)) < 9.0 {
+                1.0
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let volume =
+        Volume::centred([n; 3], Vec3::ONE, samples, crate::volume::Units::Arbitrary).unwrap();
+    let prepared = PreparedVolume::new(&volume);
+    let transfer = TransferFunction::preset("surface")
+        .unwrap()
+        .for_volume(&volume);
+    let step = 0.37;
+    let skipping = Classification::new(&prepared, &transfer, step);
+    let occupied = skipping.occupied.iter().filter(|&&o| o).count();
+    assert!(
+        occupied * 4 < skipping.occupied.len(),
+        "{occupied} bricks occupied"
+    );
+    let mut everything = skipping.clone();
+    everything.occupied.iter_mut().for_each(|o| *o = true);
+    let direction = Vec3::new(0.3, 0.8, 0.52).normalize();
+    for (k, first) in [0.1_f32, 0.5, 1.0].into_iter().enumerate() {
+        for start in 0..16 {
+            let origin = Vec3::new(2.0 + start as f32 * 3.0, 0.5 * k as f32, 0.0);
+            let Some((start, end)) = inside_grid(&volume, origin, direction) else {
+                continue;
+            };
+            let ray = Ray {
+                origin,
+                direction,
+                start,
+                end,
+                first: step * first,
+            };
+            let march_with = |c: &Classification| {
+                march_together::<Unlit, 1>(
+                    pulp::Arch::new(),
+                    &prepared,
+                    c,
+                    [Some((ray, None))],
+                    step,
+                    0.99,
+                    &mut [Highlights::EMPTY],
+                )[0]
+            };
+            assert_eq!(march_with(&skipping), march_with(&everything));
+        }
+    }
+}
+
+#[test]
+fn prepared_samples_are_the_volumes_trilinear_values_and_gradients() {
+    let volume = BuiltIn::SheppLogan.make(24).unwrap();
+    let prepared = PreparedVolume::new(&volume);
+    let last = volume.last_index();
+    for k in 0..500 {
+        // Points at least a voxel inside the grid, where both gradients see the same
+        // neighbours.
+        let fraction = Vec3::new(
+            (k as f32 * 0.618_034).fract(),
+            (k as f32 * 0.414_214).fract(),
+            (k as f32 * 0.732_051).fract(),
+        );
+        let p = Vec3::ONE + fraction * (last - 2.0);
+        let sample = prepared.sample(p);
+        assert!((sample.x - volume.sample(p)).abs() < 1e-5, "{p}");
+        let gradient = Vec3::new(sample.y, sample.z, sample.w);
+        assert!(
+            (gradient - volume.gradient(p)).length() <= 1e-4 * (1.0 + gradient.length()),
+            "{p}: {gradient} against {}",
+            volume.gradient(p)
+        );
+    }
+}
+
+#[test]
+fn a_full_segments_tabulated_opacity_is_beer_lamberts() {
+    let volume = BuiltIn::SheppLogan.make(16).unwrap();
+    let prepared = PreparedVolume::new(&volume);
+    for (name, step) in [("surface", 0.8), ("mr", 0.5), ("surface", 0.05)] {
+        let transfer = TransferFunction::preset(name).unwrap().for_volume(&volume);
+        let classification = Classification::new(&prepared, &transfer, step);
+        let densest = transfer
+            .points()
+            .iter()
+            .map(|p| p.sigma)
+            .fold(0.0, f32::max);
+        for k in 0..=5000 {
+            let sigma = densest * k as f32 / 5000.0;
+            let exact = 1.0 - f64::exp(-f64::from(sigma) * f64::from(step));
+            let tabulated = f64::from(classification.full_segment_opacity(sigma));
+            // The table's bound (du^2 / 8 at du = 40 / 4095) and f32 rounding.
+            assert!(
+                (tabulated - exact).abs() < 1.3e-5,
+                "{name}: sigma {sigma}: {tabulated} against {exact}"
+            );
+        }
+    }
+}
+
+#[test]
+fn classification_is_the_transfer_function() {
+    let volume = BuiltIn::SheppLogan.make(16).unwrap();
+    let prepared = PreparedVolume::new(&volume);
+    for name in crate::volume::transfer::PRESETS {
+        let transfer = TransferFunction::preset(name).unwrap().for_volume(&volume);
+        let step = 0.43;
+        let classification = Classification::new(&prepared, &transfer, step);
+        let (lo, hi) = volume.range();
+        for k in 0..=20_000 {
+            let value = lo - 0.1 + (hi - lo + 0.2) * k as f32 / 20_000.0;
+            let (sigma, colour) = transfer.at(value);
+            let got = classification.at(value);
+            assert!(
+                (got.x - sigma).abs() <= 1e-4 * (1.0 + sigma)
+                    && (Vec3::new(got.y, got.z, got.w) - colour)
+                        .abs()
+                        .max_element()
+                        < 1e-5,
+                "{name} at {value}: {got} against {sigma} {colour}"
+            );
+        }
+    }
+}
+
+struct Unlit;
+
+impl Shade for Unlit {
+    fn light(&self, _: Vec3, base: Vec3) -> LitSample {
+        LitSample {
+            colour: base,
+            highlight: 0.0,
+            t: 0.0,
+        }
+    }
+
+    fn highlights(&self, _: &[f32], _: &[f32]) -> f32 {
+        0.0
+    }
+}
