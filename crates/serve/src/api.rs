@@ -15,8 +15,8 @@
 //!   and `costs`, the lobe's cost on every target the server's cost model knows;
 //! - `GET /api/render?object&lobe&n&geometry&normalisation&shading&model&light_theta&light_phi&size`:
 //!   a PNG from the CPU renderer;
-//! - `GET /api/volume?volume&view&lobe&n&geometry&normalisation&size`: a built-in volume ray
-//!   marched on the CPU, as a PNG;
+//! - `GET /api/volume?volume&view&lobe&n&geometry&normalisation&size`: a volume (a built-in
+//!   one, or a real scan while its file is installed) ray marched on the CPU, as a PNG;
 //! - `GET /api/environment?lobe&n&geometry&normalisation&size&spp`: the environment scene lit
 //!   by the procedural sky (Monte Carlo, CPU), as a PNG.
 
@@ -43,7 +43,7 @@ use specula_render::volume::phantom::BuiltIn;
 use super::environment::{
     environment_png, EnvironmentRequest, MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP,
 };
-use super::volume::{volume_png, VolumeRequest, MAX_VOLUME_SIZE};
+use super::volume::{volume_png, Choice, VolumeRequest, MAX_VOLUME_SIZE};
 
 /// The largest render side, in pixels.
 pub const MAX_RENDER_SIZE: u32 = 1024;
@@ -385,7 +385,8 @@ pub async fn models() -> impl IntoResponse {
         "objects": Object::ALL.map(Object::id),
         "n": [1.0, 1000.0],
         "max_render_size": MAX_RENDER_SIZE,
-        "volumes": BuiltIn::ALL.map(BuiltIn::id),
+        // The built-in volumes, then the real scans whose files are installed.
+        "volumes": Choice::available().into_iter().map(Choice::id).collect::<Vec<_>>(),
         "views": View::STANDARD.map(View::id),
         "max_volume_size": MAX_VOLUME_SIZE,
         "max_environment_size": MAX_ENVIRONMENT_SIZE,
@@ -497,7 +498,12 @@ pub async fn volume(
     )?;
     let (kind, n) = (params.lobe()?, params.exponent()?);
     let request = VolumeRequest {
-        volume: params.choice("volume", &BuiltIn::ALL, BuiltIn::id, BuiltIn::SheppLogan)?,
+        volume: params.choice(
+            "volume",
+            &Choice::available(),
+            Choice::id,
+            Choice::BuiltIn(BuiltIn::SheppLogan),
+        )?,
         view: params.choice("view", &View::STANDARD, View::id, View::Anterior)?,
         kind,
         n,

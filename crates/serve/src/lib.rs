@@ -25,7 +25,7 @@ pub use api::{cpu_cost, AppState, CostModel, TargetCost, MAX_RENDER_SIZE};
 pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
 pub use listen::{CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT, MAX_CONNECTIONS};
-pub use volume::MAX_VOLUME_SIZE;
+pub use volume::{Scan, MAX_VOLUME_SIZE};
 
 use axum::extract::DefaultBodyLimit;
 use axum::http::header;

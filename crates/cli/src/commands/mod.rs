@@ -17,6 +17,7 @@ pub mod serve;
 pub mod shader;
 pub mod synth;
 pub mod volume;
+pub mod vtk_peer;
 
 /// What a command reports when it fails: a one-line message.
 pub type CommandResult = Result<(), String>;

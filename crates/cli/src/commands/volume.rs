@@ -112,8 +112,8 @@ pub struct Args {
 #[derive(Debug, clap::Args)]
 pub struct Source {
     /// The volume: `phantom` (the 3D Shepp-Logan head), `marschner-lobb` (the test signal), a
-    /// NIfTI-1 file (.nii, .nii.gz), a folder holding one DICOM series, or a multi-frame
-    /// (enhanced) DICOM file.
+    /// NIfTI-1 file (.nii, .nii.gz), a folder holding one DICOM series, a multi-frame
+    /// (enhanced) DICOM file, or an InVesalius project (.inv3).
     #[arg(long, default_value = "phantom")]
     input: String,
     /// Voxels along each side of a built-in volume.

@@ -7,8 +7,10 @@
 //! field, one voxel apart, taken to world units by the inverse transpose of the map.
 //!
 //! - [`phantom`]: the built-in volumes (the 3D Shepp-Logan head, the Marschner-Lobb signal);
-//! - [`nifti`] and [`dicom`]: the files scanners and research tools write ([`read`] and
-//!   [`write`] choose by path);
+//! - [`nifti`], [`dicom`] (series and enhanced multi-frame objects) and [`invesalius`]: the
+//!   files scanners and research tools write ([`read`] and [`write`] choose by path);
+//! - [`march`]: what makes the CPU ray marcher fast without changing what it computes;
+//! - [`vtk`]: VTK's CPU ray caster set up as specula's, the yardstick;
 //! - [`transfer`]: transfer functions (extinction and colour by value) and their presets;
 //! - [`raymarch`]: direct volume rendering with any lobe as the specular term.
 
@@ -18,6 +20,7 @@ use glam::{Mat3, Vec3};
 use thiserror::Error;
 
 pub mod dicom;
+pub mod invesalius;
 pub mod isosurface;
 pub mod march;
 pub mod nifti;
@@ -303,18 +306,20 @@ impl Volume {
 }
 
 /// Reads the volume at `path`: a folder is a DICOM series, a `.nii` or `.nii.gz` file is
-/// NIfTI-1, a `.dcm` file (or one with DICOM's preamble) an enhanced, multi-frame DICOM
-/// object.
+/// NIfTI-1, an `.inv3` file an InVesalius 3 project ([`invesalius`]), a `.dcm` file (or one
+/// with DICOM's preamble) an enhanced, multi-frame DICOM object.
 pub fn read(path: &Path) -> Result<Volume, VolumeError> {
     if path.is_dir() {
         dicom::read_series(path)
     } else if nifti::is_nifti_path(path) {
         nifti::read(path)
+    } else if invesalius::is_invesalius_path(path) {
+        invesalius::read(path)
     } else if dicom::is_dicom_file(path) {
         dicom::read_file(path)
     } else {
         Err(VolumeError(format!(
-            "{}: not a volume; give a .nii or .nii.gz file, a folder holding a DICOM series, or a multi-frame DICOM file",
+            "{}: not a volume; give a .nii or .nii.gz file, an InVesalius .inv3 project, a folder holding a DICOM series, or a multi-frame DICOM file",
             path.display()
         )))
     }

@@ -2,23 +2,20 @@
 //! VTK's CPU ray caster set up alike ([`specula_render::volume::vtk`]) when Python has the
 //! `vtk` and `nibabel` packages.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 use std::time::Instant;
 
 use specula_render::volume::march::PreparedVolume;
 use specula_render::volume::raymarch::render_dvr_prepared;
 use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::{self, nifti, vtk, Volume};
+use specula_render::volume::vtk;
 use specula_render::{write_image, Display};
 
 use super::Args;
 use crate::commands::volume::{load, Source};
+use crate::commands::vtk_peer;
 use crate::commands::CommandResult;
 use crate::output::Table;
-
-/// The VTK side of the comparison: `vtk_volume.py`, run by the Python that has VTK.
-const VTK_SCRIPT: &str = include_str!("vtk_volume.py");
 
 /// Median of `values` (sorted in place).
 fn median(values: &mut [f64]) -> f64 {
@@ -29,58 +26,6 @@ fn median(values: &mut [f64]) -> f64 {
     } else {
         0.5 * (values[middle - 1] + values[middle])
     }
-}
-
-/// The Python that runs VTK: `$SPECULA_PYTHON`, else `python3`.
-fn python() -> PathBuf {
-    std::env::var_os("SPECULA_PYTHON").map_or_else(|| PathBuf::from("python3"), PathBuf::from)
-}
-
-/// What VTK measured.
-struct VtkTimes {
-    median_draw: f64,
-    version: String,
-}
-
-/// Renders `job` with VTK; `Err` says why VTK could not run (reported, not fatal).
-fn run_vtk(job: &vtk::VtkJob, scratch: &Path) -> Result<VtkTimes, String> {
-    let script = scratch.join("vtk_volume.py");
-    std::fs::write(&script, VTK_SCRIPT).map_err(|e| e.to_string())?;
-    let job_file = scratch.join("job.json");
-    std::fs::write(
-        &job_file,
-        serde_json::to_vec(job).map_err(|e| e.to_string())?,
-    )
-    .map_err(|e| e.to_string())?;
-    let output = Command::new(python())
-        .arg(&script)
-        .arg(&job_file)
-        .output()
-        .map_err(|e| format!("{}: {e}", python().display()))?;
-    if !output.status.success() {
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        let last = stderr.lines().last().unwrap_or("no message");
-        return Err(last.to_owned());
-    }
-    let report: serde_json::Value = serde_json::from_slice(&output.stdout)
-        .map_err(|e| format!("vtk_volume.py printed no JSON ({e})"))?;
-    Ok(VtkTimes {
-        median_draw: report["median_draw"]
-            .as_f64()
-            .ok_or("vtk_volume.py reported no median_draw")?,
-        version: report["vtk"].as_str().unwrap_or("?").to_owned(),
-    })
-}
-
-/// The volume as a NIfTI file VTK can read: the input itself, or a copy in `scratch`.
-fn nifti_file(input: &str, volume: &Volume, scratch: &Path) -> Result<PathBuf, String> {
-    let path = Path::new(input);
-    if nifti::is_nifti_path(path) && path.is_file() {
-        return Ok(path.to_owned());
-    }
-    let copy = scratch.join("volume.nii");
-    volume::write(volume, &copy).map_err(|e| e.to_string())?;
-    Ok(copy)
 }
 
 /// Measures and prints.
@@ -116,19 +61,20 @@ pub fn run(args: &Args) -> CommandResult {
     let threads = rayon::current_num_threads();
     let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
     let vtk_output = scratch.path().join("vtk.png");
-    let vtk = nifti_file(&args.input, &volume, scratch.path()).and_then(|file| {
-        let job = vtk::job(
-            &volume,
-            &file,
-            &transfer,
-            &settings,
-            &vtk_output,
-            threads,
-            args.frames,
-        )
-        .map_err(|e| e.to_string())?;
-        run_vtk(&job, scratch.path())
-    });
+    let vtk =
+        vtk_peer::nifti_file(Path::new(&args.input), &volume, scratch.path()).and_then(|file| {
+            let job = vtk::job(
+                &volume,
+                &file,
+                &transfer,
+                &settings,
+                &vtk_output,
+                threads,
+                args.frames,
+            )
+            .map_err(|e| e.to_string())?;
+            vtk_peer::run(&job, scratch.path())
+        });
     let [nx, ny, nz] = volume.dims();
     println!(
         "{} ({nx} x {ny} x {nz}), {} view, {width} x {height}, {} mm between samples, {threads} threads; \
@@ -165,7 +111,7 @@ pub fn run(args: &Args) -> CommandResult {
             table.push(row("specula (CPU)".into(), specula, "-".into()));
             println!(
                 "VTK not measured: {why} (install the vtk and nibabel wheels for {})",
-                python().display()
+                vtk_peer::python().display()
             );
         }
     }

@@ -10,6 +10,7 @@ mod energy;
 mod hardware;
 mod html;
 mod plot;
+mod real_scans;
 mod renderers;
 mod renders;
 mod sections;
@@ -66,6 +67,9 @@ pub struct Sizes {
     /// The medical section's phantom side (voxels), image side (pixels) and frames timed per
     /// lobe and backend.
     pub volume: (usize, u32, usize),
+    /// The real scans' image side (pixels), frames timed against VTK, and whether every lobe
+    /// renders them (else pow, schlick and cosquad).
+    pub real_scans: (u32, usize, bool),
     /// The (integer) exponents the hardware section sweeps word lengths at.
     pub hardware_exponents: &'static [u32],
     /// Whether the hardware claim's designs are synthesized when the cache lacks them (the

@@ -443,6 +443,7 @@ pub fn sizes(quick: bool) -> Sizes {
             render: (240, 135, 1),
             environment: (240, 135, 16),
             volume: (32, 96, 1),
+            real_scans: (64, 1, false),
             hardware_exponents: &[64],
             synthesis: OnMiss::Skip,
         }
@@ -455,6 +456,7 @@ pub fn sizes(quick: bool) -> Sizes {
             render: (480, 270, 2),
             environment: (480, 270, 128),
             volume: (64, 192, 2),
+            real_scans: (128, 3, true),
             hardware_exponents: &[8, 64, 512],
             synthesis: OnMiss::Synthesize,
         }

@@ -1,7 +1,7 @@
 //! The report's medical section: the head phantom ray-marched with every lobe (FLIP and PSNR
 //! against `pow`, time per frame on the CPU and the GPU), its isosurface, and on the
 //! Marschner-Lobb signal the shading error that central-difference gradients cause, set
-//! beside each lobe's own error.
+//! beside each lobe's own error; then the real scans and VTK (`real_scans.rs`).
 
 use std::time::Instant;
 
@@ -20,9 +20,11 @@ use super::html::{paragraph, table};
 use super::Context;
 use crate::output::sig;
 
-const EXPONENT: f64 = 32.0;
+/// The exponent of every lobe in the section (VTK's specular power in the comparison).
+pub(super) const EXPONENT: f64 = 32.0;
 
-fn shading(kind: LobeKind) -> Result<Shading, String> {
+/// The section's shading with `kind` as the specular term.
+pub(super) fn shading(kind: LobeKind) -> Result<Shading, String> {
     let n = Exponent::try_new(EXPONENT).map_err(|e| e.to_string())?;
     Ok(Shading::new(
         Lobe::new(kind, n),
@@ -46,7 +48,26 @@ fn timed(
     Ok((best, image.ok_or("no run")?))
 }
 
+/// The phantom and, beside it (concurrently: reading the scans and VTK's run wait on one core
+/// each), the real scans.
 pub fn volumes(context: &mut Context) -> Result<String, String> {
+    let mut real = Context {
+        directory: context.directory.clone(),
+        sizes: context.sizes.clone(),
+        bench: context.bench,
+        files: Vec::new(),
+        shared: std::sync::Arc::clone(&context.shared),
+        lobes: context.lobes.clone(),
+    };
+    let (phantom, real_scans) = rayon::join(
+        || phantom(context),
+        || super::real_scans::real_scans(&mut real),
+    );
+    context.files.append(&mut real.files);
+    Ok(phantom? + &real_scans?)
+}
+
+fn phantom(context: &mut Context) -> Result<String, String> {
     let (side, pixels, runs) = context.sizes.volume;
     let volume = phantom::shepp_logan(side).map_err(|e| e.to_string())?;
     let transfer = TransferFunction::default_for(&volume).for_volume(&volume);

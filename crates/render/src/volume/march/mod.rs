@@ -32,6 +32,12 @@ pub const BRICK: usize = 1 << BRICK_SHIFT;
 
 const BRICK_SHIFT: i32 = 2;
 
+/// Bricks along each side of a region, the coarser level a ray skips by in empty space:
+/// `2^REGION_SHIFT`.
+pub const REGION: usize = 1 << REGION_SHIFT;
+
+const REGION_SHIFT: i32 = 2;
+
 /// Entries of the table that finds a value's piece of the transfer function.
 pub const CLASSIFICATION_ENTRIES: usize = 4096;
 
@@ -46,6 +52,7 @@ pub struct PreparedVolume {
     last_cell: IVec3,
     last_index: Vec3,
     bricks: [usize; 3],
+    regions: [usize; 3],
     /// Smallest and largest value of each brick's voxels (its cells' corners).
     brick_ranges: Vec<(f32, f32)>,
     range: (f32, f32),
@@ -110,6 +117,7 @@ impl PreparedVolume {
             last_cell: IVec3::from(dims.map(|d| (d - 2) as i32)),
             last_index: volume.last_index(),
             bricks,
+            regions: bricks.map(|b| b.div_ceil(REGION)),
             brick_ranges,
             range: volume.range(),
         }
@@ -124,9 +132,16 @@ impl PreparedVolume {
     /// The cell holding grid index `p` (already within the grid), and `p`'s place in it.
     #[inline(always)]
     fn cell(&self, p: Vec3) -> (IVec3, Vec3) {
-        // p >= 0, so truncation is floor (to i32, where u32's conversions take several
-        // instructions); the last layer of voxels belongs to the last cell.
-        let cell = p.as_ivec3().min(self.last_cell);
+        // Adding 1.5 * 2^23 to p - 1/2 rounds it to an integer held in the low mantissa bits
+        // (the sum lies in [2^23, 2^24), where the spacing is 1): floor of p, or p - 1 where p
+        // is an odd whole number (a tie rounded to even), whose cell then holds p at its far
+        // corner (f = 1). Two instructions a lane, where `as i32` (saturating) takes several;
+        // p lies in [0, 4096). The last layer of voxels belongs to the last cell.
+        const ROUND: f32 = 12_582_912.0;
+        let rounded = (p - 0.5) + ROUND;
+        let bits = |x: f32| x.to_bits() as i32 - ROUND.to_bits() as i32;
+        let cell =
+            IVec3::new(bits(rounded.x), bits(rounded.y), bits(rounded.z)).min(self.last_cell);
         (cell, p - cell.as_vec3())
     }
 
@@ -144,9 +159,11 @@ impl PreparedVolume {
         let (nx, nxy) = (self.dims[0], self.dims[0] * self.dims[1]);
         let at = cell.x as usize + nx * cell.y as usize + nxy * cell.z as usize;
         let v = &self.voxels[at..=at + nxy + nx + 1];
-        let row = |o: usize| v[o].lerp(v[o + 1], f.x);
-        let plane = |o: usize| row(o).lerp(row(o + nx), f.y);
-        plane(0).lerp(plane(nxy), f.z)
+        // `a + (b - a) t` along x, then y, then z: the reference's order of operations.
+        let lerp = |a: Vec4, b: Vec4, t: f32| a + (b - a) * t;
+        let row = |o: usize| lerp(v[o], v[o + 1], f.x);
+        let plane = |o: usize| lerp(row(o), row(o + nx), f.y);
+        lerp(plane(0), plane(nxy), f.z)
     }
 
     /// The index of the brick holding `cell`.
@@ -159,8 +176,27 @@ impl PreparedVolume {
     /// Where a ray (grid index `origin + direction * t`) leaves the brick holding `cell`.
     #[inline(always)]
     fn brick_exit(&self, cell: IVec3, origin: Vec3, inverse_direction: Vec3) -> f32 {
-        let low = (cell >> BRICK_SHIFT << BRICK_SHIFT).as_vec3();
-        let high = low + BRICK as f32;
+        Self::exit(cell, BRICK_SHIFT, origin, inverse_direction)
+    }
+
+    /// The index of the region of [`REGION`] bricks a side holding `cell`.
+    #[inline(always)]
+    fn region(&self, cell: IVec3) -> usize {
+        let r = cell >> (BRICK_SHIFT + REGION_SHIFT);
+        r.x as usize + self.regions[0] * (r.y as usize + self.regions[1] * r.z as usize)
+    }
+
+    /// Where a ray leaves the region holding `cell`.
+    #[inline(always)]
+    fn region_exit(&self, cell: IVec3, origin: Vec3, inverse_direction: Vec3) -> f32 {
+        Self::exit(cell, BRICK_SHIFT + REGION_SHIFT, origin, inverse_direction)
+    }
+
+    /// Where a ray leaves the aligned cube of `2^shift` cells a side holding `cell`.
+    #[inline(always)]
+    fn exit(cell: IVec3, shift: i32, origin: Vec3, inverse_direction: Vec3) -> f32 {
+        let low = (cell >> shift << shift).as_vec3();
+        let high = low + (1 << shift) as f32;
         let a = (low - origin) * inverse_direction;
         let c = (high - origin) * inverse_direction;
         a.max(c).min_element()
@@ -184,6 +220,8 @@ pub struct Classification {
     per_entry: f32,
     /// Whether each brick holds any value with extinction.
     occupied: Vec<bool>,
+    /// Whether each region holds an occupied brick.
+    occupied_regions: Vec<bool>,
     /// A full segment's opacity `1 - exp(-u)` at `u = sigma step`, evenly spaced from 0 to
     /// the densest segment's (at most [`OPAQUE`]).
     opacity: Vec<f32>,
@@ -241,7 +279,7 @@ impl Classification {
                 }
             })
             .collect();
-        let occupied = volume
+        let occupied: Vec<bool> = volume
             .brick_ranges
             .iter()
             .map(|&(lo, hi)| {
@@ -252,6 +290,13 @@ impl Classification {
                         .any(|p| p.sigma > 0.0 && p.value > lo && p.value < hi)
             })
             .collect();
+        let mut occupied_regions = vec![false; volume.regions.iter().product()];
+        for (b, _) in occupied.iter().enumerate().filter(|(_, &o)| o) {
+            let [bx, by] = [volume.bricks[0], volume.bricks[1]];
+            let brick = [b % bx, b / bx % by, b / (bx * by)].map(|c| c / REGION);
+            let [rx, ry] = [volume.regions[0], volume.regions[1]];
+            occupied_regions[brick[0] + rx * (brick[1] + ry * brick[2])] = true;
+        }
         let densest = points.iter().map(|p| p.sigma).fold(0.0, f32::max);
         let reach = (densest * step).clamp(f32::MIN_POSITIVE, OPAQUE);
         let last = (OPACITY_ENTRIES - 1) as f32;
@@ -265,6 +310,7 @@ impl Classification {
             lowest,
             per_entry,
             occupied,
+            occupied_regions,
             opacity,
             opacity_per_sigma: step * last / reach,
             opacity_last: last,

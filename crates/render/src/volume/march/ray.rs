@@ -121,9 +121,14 @@ impl Marching {
         self.j += 1;
         if !classification.occupied[volume.brick(cell)] {
             // Every sample whose midpoint lies in this brick has no extinction: skip the
-            // segments whose midpoints come before the brick's exit (a margin keeps the one
-            // that rounding could place across it).
-            let exit = volume.brick_exit(cell, self.ray.origin, self.inverse_direction);
+            // segments whose midpoints come before its exit (a margin keeps the one that
+            // rounding could place across it).
+            // Out of the whole region when it is empty too.
+            let exit = if classification.occupied_regions[volume.region(cell)] {
+                volume.brick_exit(cell, self.ray.origin, self.inverse_direction)
+            } else {
+                volume.region_exit(cell, self.ray.origin, self.inverse_direction)
+            };
             let beyond = (exit - self.t) * self.per_step - 0.5 - 1e-3;
             if beyond > 0.0 {
                 // ceil without a library call (beyond > 0).

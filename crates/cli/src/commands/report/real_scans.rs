@@ -1,0 +1,453 @@
+//! The medical section's real scans: a head CT and a head MRI from Debian's packages,
+//! ray-marched with every lobe (FLIP and PSNR against `pow`), and VTK's CPU ray caster
+//! (`vtkFixedPointVolumeRayCastMapper`) set up alike beside specula ([`vtk::alike_settings`],
+//! [`vtk::job`]): both images, their agreement and both frame rates.
+
+use std::path::Path;
+use std::time::Instant;
+
+use glam::Vec3;
+use specula::{Exponent, LobeKind};
+use specula_render::metrics::compare;
+use specula_render::volume::march::PreparedVolume;
+use specula_render::volume::raymarch::{render_dvr_prepared, DvrSettings, View};
+use specula_render::volume::transfer::TransferFunction;
+use specula_render::volume::{self, vtk, Units, Volume};
+use specula_render::{read_image, srgb_encode, Display, Image};
+
+use super::html::{paragraph, table};
+use super::volumes::{shading, EXPONENT};
+use super::Context;
+use crate::commands::vtk_peer;
+
+/// A real scan a Debian package installs.
+struct Scan {
+    /// File names start `real-KEY-`.
+    key: &'static str,
+    /// "CT" or "MRI".
+    name: &'static str,
+    /// What it is.
+    what: &'static str,
+    path: &'static str,
+    package: &'static str,
+    /// Its default transfer function.
+    transfer: &'static str,
+}
+
+const SCANS: [Scan; 2] = [
+    Scan {
+        key: "ct",
+        name: "CT",
+        what: "InVesalius' example head CT Cranium.inv3",
+        path: "/usr/share/doc/invesalius-examples/examples/Cranium.inv3",
+        package: "invesalius-examples",
+        transfer: "ct-bone",
+    },
+    Scan {
+        key: "mri",
+        name: "MRI",
+        what: "the Colin27 T1-weighted head MRI with skull ch2.nii.gz",
+        path: "/usr/share/mricron/templates/ch2-missing.nii.gz",
+        package: "mricron-data",
+        transfer: "mr",
+    },
+];
+
+/// Millimetres between samples in the VTK comparison (`specula bench volume`'s default).
+const SAMPLE_DISTANCE: f32 = 0.5;
+
+/// The lobes `--quick` renders the real scans with (and any of the user's): the reference,
+/// the classic cheap approximation and the thesis's cosine-quadratic.
+const QUICK_LOBES: [LobeKind; 3] = [
+    LobeKind::Pow,
+    LobeKind::Schlick,
+    LobeKind::CosQuad {
+        v: specula::lobe::CosQuad::DEFAULT_V,
+    },
+];
+
+/// A scan read, with its transfer function.
+struct Loaded<'a> {
+    scan: &'a Scan,
+    volume: Volume,
+    transfer: TransferFunction,
+    read_ms: f64,
+}
+
+fn milliseconds(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
+
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let middle = values.len() / 2;
+    if values.len() % 2 == 1 {
+        values[middle]
+    } else {
+        0.5 * (values[middle - 1] + values[middle])
+    }
+}
+
+fn load(scan: &Scan) -> Result<Loaded<'_>, String> {
+    let started = Instant::now();
+    let volume = volume::read(Path::new(scan.path)).map_err(|e| e.to_string())?;
+    let read_ms = milliseconds(started);
+    let transfer = TransferFunction::preset(scan.transfer)
+        .map_err(|e| e.to_string())?
+        .for_volume(&volume);
+    Ok(Loaded {
+        scan,
+        volume,
+        transfer,
+        read_ms,
+    })
+}
+
+/// The real scans' part of the medical section.
+pub fn real_scans(context: &mut Context) -> Result<String, String> {
+    let (side, frames, every_lobe) = context.sizes.real_scans;
+    let mut html = String::from("<h3>Real scans</h3>\n");
+    let present: Vec<&Scan> = SCANS
+        .iter()
+        .filter(|scan| Path::new(scan.path).is_file())
+        .collect();
+    for scan in SCANS.iter().filter(|scan| !Path::new(scan.path).is_file()) {
+        html += &paragraph(&format!(
+            "The real {} is not here: it is {} at {}, which the Debian package {} installs (apt-get install {}).",
+            scan.name, scan.what, scan.path, scan.package, scan.package
+        ));
+    }
+    let loaded: Vec<Result<Loaded, String>> = {
+        use rayon::prelude::*;
+        present.par_iter().map(|scan| load(scan)).collect()
+    };
+    let mut scans = Vec::new();
+    for (scan, loaded) in present.iter().zip(loaded) {
+        match loaded {
+            Ok(loaded) => scans.push(loaded),
+            Err(error) => {
+                html += &paragraph(&format!(
+                    "The real {} ({}) is here but could not be read: {error}",
+                    scan.name, scan.path
+                ));
+            }
+        }
+    }
+    if scans.is_empty() {
+        return Ok(html);
+    }
+    let lobes: Vec<LobeKind> = context
+        .lobes
+        .iter()
+        .copied()
+        .filter(|kind| every_lobe || QUICK_LOBES.contains(kind) || !LobeKind::ALL.contains(kind))
+        .collect();
+    let which = if every_lobe {
+        "every lobe".to_owned()
+    } else {
+        format!(
+            "{} (--quick; the full report renders every lobe)",
+            lobes
+                .iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
+    html += &paragraph(&format!(
+        "Each scan as read from the file its Debian package installs, ray-marched at {side}x{side} from the front (anterior view) through its default transfer function (ct-bone for the CT, mr for the MRI), with the phantom's shading (thesis normalisation, Blinn geometry, n = {EXPONENT}, the key light) and {which} as the specular term (specula volume --input FILE --lobe L --normalisation thesis-phong). FLIP and PSNR are against the pow image; the time is one frame on all CPU cores, while the report's other sections run, after the volume's gradients and bricks were computed once."
+    ));
+    // VTK starts first and renders while specula does: one Python process for every scan.
+    let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let setups = scans
+        .iter()
+        .map(|loaded| alike_setup(loaded, side, frames, scratch.path()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let jobs: Vec<vtk::VtkJob> = setups.iter().map(|(_, job)| job.clone()).collect();
+    let running = vtk_peer::start_each(&jobs, scratch.path());
+    let prepared: Vec<PreparedVolume> = scans
+        .iter()
+        .map(|loaded| PreparedVolume::new(&loaded.volume))
+        .collect();
+    for (loaded, prepared) in scans.iter().zip(&prepared) {
+        html += &lobe_table(context, loaded, prepared, &lobes, side)?;
+    }
+    // specula's frames are timed once VTK is done, so that neither times the other's work.
+    let theirs = running.and_then(vtk_peer::Running::finish);
+    let ours = scans
+        .iter()
+        .zip(&prepared)
+        .zip(&setups)
+        .map(|((loaded, prepared), (settings, _))| {
+            specula_alike(loaded, prepared, settings, frames)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    html += &against_vtk(context, &scans, &ours, &jobs, theirs, side, frames)?;
+    Ok(html)
+}
+
+/// One scan with every lobe: a table and the images.
+fn lobe_table(
+    context: &mut Context,
+    loaded: &Loaded,
+    prepared: &PreparedVolume,
+    lobes: &[LobeKind],
+    side: u32,
+) -> Result<String, String> {
+    let Loaded {
+        scan,
+        volume,
+        transfer,
+        read_ms,
+    } = loaded;
+    let [nx, ny, nz] = volume.dims();
+    let spacing = volume.spacing();
+    let (low, high) = volume.range();
+    let units = match volume.units() {
+        Units::Hounsfield => "Hounsfield units",
+        Units::Arbitrary => "arbitrary units",
+    };
+    let mut html = paragraph(&format!(
+        "The real {}: {} ({}, Debian {}), {nx} x {ny} x {nz} voxels of {:.3} x {:.3} x {:.3} mm, values {low} to {high} read as {units}, read in {read_ms:.0} ms; the {} transfer function.",
+        scan.name, scan.what, scan.path, scan.package, spacing.x, spacing.y, spacing.z, scan.transfer
+    ));
+    let mut rows = Vec::new();
+    let mut figures = String::new();
+    let mut reference: Option<Image> = None;
+    for &kind in lobes {
+        let settings = DvrSettings::new(side, side, View::Anterior, Some(shading(kind)?));
+        let started = Instant::now();
+        let image = render_dvr_prepared(volume, prepared, transfer, &settings, &|| {})
+            .map_err(|e| e.to_string())?;
+        let ms = milliseconds(started);
+        let name = format!("real-{}-{}.png", scan.key, kind.id());
+        let bytes = image.to_srgb8(Display::default());
+        figures += &context.png_srgb8(
+            &name,
+            side,
+            side,
+            &bytes,
+            &format!("real {}, {kind}", scan.name),
+        )?;
+        // Compared as written (8-bit sRGB), so `specula diff` on the files prints the same.
+        let written = Image::from_srgb8(side, side, &bytes).ok_or("inconsistent image size")?;
+        let reference_image = reference.get_or_insert_with(|| written.clone());
+        let against_pow =
+            compare(reference_image, &written, Display::default()).map_err(|e| e.to_string())?;
+        rows.push(vec![
+            kind.to_string(),
+            name,
+            format!("{:.1}", against_pow.psnr_db.min(999.0)),
+            format!("{:.5}", against_pow.mean_flip),
+            format!("{ms:.1}"),
+        ]);
+    }
+    html += &table(
+        &[
+            "lobe",
+            "image",
+            &format!("PSNR vs pow on the real {} (dB)", scan.name),
+            "mean FLIP vs the pow image",
+            "CPU ms",
+        ],
+        &rows,
+    );
+    html += &figures;
+    Ok(html)
+}
+
+/// VTK's PNG (8-bit linear values, as VTK composites them) as a linear image.
+fn read_vtk_png(path: &Path) -> Result<Image, String> {
+    let decoded = read_image(path).map_err(|e| e.to_string())?;
+    // `read_image` decodes sRGB; VTK wrote linear values, so encode them back.
+    let pixels = decoded
+        .pixels()
+        .iter()
+        .map(|p| Vec3::new(srgb_encode(p.x), srgb_encode(p.y), srgb_encode(p.z)))
+        .map(|p| (p * 255.0).round() / 255.0)
+        .collect();
+    Image::from_pixels(decoded.width(), decoded.height(), pixels)
+        .ok_or_else(|| "VTK's image has an inconsistent size".to_owned())
+}
+
+/// specula's settings for a render VTK can match, and VTK's job for it.
+fn alike_setup(
+    loaded: &Loaded,
+    side: u32,
+    frames: usize,
+    scratch: &Path,
+) -> Result<(DvrSettings, vtk::VtkJob), String> {
+    let Loaded {
+        scan,
+        volume,
+        transfer,
+        ..
+    } = loaded;
+    let settings = vtk::alike_settings(
+        volume,
+        side,
+        side,
+        View::Anterior,
+        Exponent::new(EXPONENT),
+        SAMPLE_DISTANCE,
+    )
+    .map_err(|e| e.to_string())?;
+    let folder = scratch.join(scan.key);
+    std::fs::create_dir_all(&folder).map_err(|e| e.to_string())?;
+    let file = vtk_peer::nifti_file(Path::new(scan.path), volume, &folder)?;
+    let job = vtk::job(
+        volume,
+        &file,
+        transfer,
+        &settings,
+        &folder.join("vtk.png"),
+        rayon::current_num_threads(),
+        frames as u32,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok((settings, job))
+}
+
+/// specula's image set up as VTK, and the median seconds of `frames` frames (the volume's
+/// gradients and bricks, which VTK computes in its untimed first frame, are `prepared`).
+fn specula_alike(
+    loaded: &Loaded,
+    prepared: &PreparedVolume,
+    settings: &DvrSettings,
+    frames: usize,
+) -> Result<(Image, f64), String> {
+    let draw = || {
+        render_dvr_prepared(&loaded.volume, prepared, &loaded.transfer, settings, &|| {})
+            .map_err(|e| e.to_string())
+    };
+    let mut image = None;
+    let mut times = Vec::new();
+    for _ in 0..frames.max(1) {
+        let started = Instant::now();
+        image = Some(draw()?);
+        times.push(started.elapsed().as_secs_f64());
+    }
+    Ok((image.ok_or("no frame")?, median(times)))
+}
+
+/// The comparison with VTK: what is alike, what differs, the images, their agreement and
+/// both frame rates.
+#[allow(clippy::too_many_arguments)]
+fn against_vtk(
+    context: &mut Context,
+    scans: &[Loaded],
+    ours: &[(Image, f64)],
+    jobs: &[vtk::VtkJob],
+    theirs: Result<Vec<Result<vtk_peer::VtkTimes, String>>, String>,
+    side: u32,
+    frames: usize,
+) -> Result<String, String> {
+    let mut html = String::from("<h3>Against VTK's CPU ray caster</h3>\n");
+    html += &paragraph(&format!(
+        "VTK's vtkFixedPointVolumeRayCastMapper (the CPU ray caster 3D Slicer and ParaView build on) and specula set up alike, as specula bench volume does: the same voxels and placement (VTK reads a NIfTI file: ch2.nii.gz itself, 8-bit, for the CT a float32 copy that specula writes, so VTK takes its general gradient path there rather than its 8- and 16-bit one), anterior view with a parallel projection, {side}x{side} pixels, one ray per pixel, trilinear interpolation, a sample every {SAMPLE_DISTANCE} mm, the same transfer function (VTK's opacity per millimetre 1 - exp(-sigma), which its sample-distance correction turns into specula's 1 - exp(-sigma d)), VTK's headlight (a white ambient colour given to it, so that both count ambient 0.25), diffuse 0.7, specular 0.5 with VTK's Blinn-Phong power {EXPONENT} as the pow lobe without normalisation, every sample fully shaded and rays stopped at VTK's 99.22 % opacity. What differs is how each computes: VTK lights each voxel's central-difference normal quantised to 65,280 directions and interpolates the 8 corners' lit values (a voxel whose difference is exactly zero is lit black but stays opaque; in integer data that is uniform tissue and saturated bone), where specula shades the gradient of the trilinear field at the sample; VTK's samples lie on a lattice anchored at the near clipping plane, the same depths for every ray, where specula jitters each ray's first segment; VTK's arithmetic is 15-bit fixed point (docs/vtk-notes.md). So the images agree in shape and colour, and differ most on smooth surfaces (VTK's quantised normals band the highlights) and in uniform regions."
+    ));
+    let vtk_runs = match theirs {
+        Ok(runs) => runs,
+        Err(why) => {
+            html += &paragraph(&format!(
+                "VTK was not run ({why}): the comparison needs the vtk wheel, with nibabel, in {} (pip install vtk nibabel; SPECULA_PYTHON names another Python).",
+                vtk_peer::python().display()
+            ));
+            return Ok(html);
+        }
+    };
+    let mut rows = Vec::new();
+    let mut figures = String::new();
+    let mut version = String::new();
+    for (((loaded, (ours, seconds)), job), run) in scans.iter().zip(ours).zip(jobs).zip(vtk_runs) {
+        let scan = loaded.scan;
+        let times = match run {
+            Ok(times) => times,
+            Err(why) => {
+                html += &paragraph(&format!("VTK refused the real {}: {why}", scan.name));
+                continue;
+            }
+        };
+        version = times.version.clone();
+        let theirs = read_vtk_png(&job.output)?;
+        if (theirs.width(), theirs.height()) != (ours.width(), ours.height()) {
+            return Err(format!(
+                "VTK drew {}x{} pixels, specula {side}x{side}",
+                theirs.width(),
+                theirs.height()
+            ));
+        }
+        let (mut total, mut off) = (0.0_f64, 0_usize);
+        for (a, b) in ours.pixels().iter().zip(theirs.pixels()) {
+            let d = (a.clamp(Vec3::ZERO, Vec3::ONE) - *b).abs();
+            total += f64::from(d.x + d.y + d.z);
+            off += usize::from(d.max_element() > 0.1);
+        }
+        let count = ours.pixels().len().max(1);
+        let difference = compare(ours, &theirs, Display::default()).map_err(|e| e.to_string())?;
+        let names = ["specula", "vtk", "flip"].map(|k| format!("real-{}-{k}.png", scan.key));
+        figures += &context.png_srgb8(
+            &names[0],
+            side,
+            side,
+            &ours.to_srgb8(Display::default()),
+            &format!("real {}, specula set up as VTK", scan.name),
+        )?;
+        figures += &context.png_srgb8(
+            &names[1],
+            side,
+            side,
+            &theirs.to_srgb8(Display::default()),
+            &format!(
+                "real {}, VTK {} (its linear values shown in sRGB)",
+                scan.name, times.version
+            ),
+        )?;
+        figures += &context.png_srgb8(
+            &names[2],
+            side,
+            side,
+            &difference.heatmap_srgb8(),
+            &format!(
+                "real {}, FLIP between the two (magma: black 0, white 1)",
+                scan.name
+            ),
+        )?;
+        let (ours_fps, theirs_fps) = (1.0 / seconds, 1.0 / times.median_draw);
+        rows.push(vec![
+            format!("real {}", scan.name),
+            names[0].clone(),
+            names[1].clone(),
+            format!("{:.4}", total / (3 * count) as f64),
+            format!("{:.2} %", 100.0 * off as f64 / count as f64),
+            format!("{:.5}", difference.mean_flip),
+            format!("{ours_fps:.1}"),
+            format!("{theirs_fps:.1}"),
+            format!("{:.2}x", ours_fps / theirs_fps),
+        ]);
+    }
+    if rows.is_empty() {
+        return Ok(html);
+    }
+    html += &table(
+        &[
+            "scan",
+            "specula image",
+            "VTK image",
+            "mean |specula - VTK| (linear)",
+            "pixels off by more than 0.1",
+            "mean FLIP, specula vs VTK",
+            "specula frames/s",
+            "VTK frames/s",
+            "specula vs VTK",
+        ],
+        &rows,
+    );
+    html += &paragraph(&format!(
+        "VTK {}. The differences are of linear values in [0, 1] per channel over the whole image (background included); a pixel is off when any channel differs by more than 0.1; FLIP is of the images as shown (sRGB). Frames per second are the median of {frames} frame(s) ({} threads each; VTK's own time to draw after an untimed first frame, in which it computes its gradients; specula's whole frame, its gradients and bricks computed once before), specula's taken after VTK's, both while the report's other sections run and on small images, where a frame's fixed costs weigh more: a rough guide, not a benchmark (specula bench volume --input FILE measures on a quiet machine at 512x512). Timings are printed, never asserted.",
+        version,
+        rayon::current_num_threads()
+    ));
+    html += &figures;
+    Ok(html)
+}

@@ -1,0 +1,178 @@
+//! VTK's CPU ray caster (`vtkFixedPointVolumeRayCastMapper`) as a peer: the embedded
+//! `vtk_volume.py` run by the Python that has the `vtk` and `nibabel` wheels, on jobs made by
+//! [`specula_render::volume::vtk::job`]. Used by `specula bench volume` and the report's
+//! medical section.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use specula_render::volume::{self, nifti, vtk, Volume};
+
+/// The VTK side of a comparison: `vtk_volume.py`, run by the Python that has VTK.
+const VTK_SCRIPT: &str = include_str!("bench/vtk_volume.py");
+
+/// Runs several jobs in one Python process (VTK is imported once): the script's own
+/// `read_job` and `render`, one JSON line per job (`{"error": ...}` for a job it refused).
+const DRIVER: &str = "\
+import importlib.util, json, sys
+spec = importlib.util.spec_from_file_location('vtk_volume', sys.argv[1])
+peer = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(peer)
+for path in sys.argv[2:]:
+    try:
+        print(json.dumps(peer.render(peer.read_job(path))), flush=True)
+    except peer.Failure as e:
+        print(json.dumps({'error': str(e)}), flush=True)
+";
+
+/// The Python that runs VTK: `$SPECULA_PYTHON`, else `python3`.
+pub fn python() -> PathBuf {
+    std::env::var_os("SPECULA_PYTHON").map_or_else(|| PathBuf::from("python3"), PathBuf::from)
+}
+
+/// What VTK measured.
+pub struct VtkTimes {
+    /// The median of the timed frames' ray casts (the mapper's own time to draw), seconds.
+    pub median_draw: f64,
+    /// VTK's version.
+    pub version: String,
+}
+
+fn times(report: &serde_json::Value) -> Result<VtkTimes, String> {
+    if let Some(error) = report["error"].as_str() {
+        return Err(error.to_owned());
+    }
+    Ok(VtkTimes {
+        median_draw: report["median_draw"]
+            .as_f64()
+            .ok_or("vtk_volume.py reported no median_draw")?,
+        version: report["vtk"].as_str().unwrap_or("?").to_owned(),
+    })
+}
+
+/// The last line a failed run printed (on stderr, else on stdout: the script says there that
+/// it skipped because VTK is missing).
+fn last_line(output: &std::process::Output) -> String {
+    [&output.stderr, &output.stdout]
+        .into_iter()
+        .find_map(|bytes| {
+            String::from_utf8_lossy(bytes)
+                .lines()
+                .rev()
+                .find(|line| !line.trim().is_empty())
+                .map(str::to_owned)
+        })
+        .unwrap_or_else(|| "no message".to_owned())
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Renders `job` with VTK; `Err` says why VTK could not run (reported, not fatal).
+pub fn run(job: &vtk::VtkJob, scratch: &Path) -> Result<VtkTimes, String> {
+    let script = scratch.join("vtk_volume.py");
+    write(&script, VTK_SCRIPT.as_bytes())?;
+    let job_file = scratch.join("job.json");
+    write(
+        &job_file,
+        &serde_json::to_vec(job).map_err(|e| e.to_string())?,
+    )?;
+    let output = Command::new(python())
+        .arg(&script)
+        .arg(&job_file)
+        .output()
+        .map_err(|e| format!("{}: {e}", python().display()))?;
+    if !output.status.success() {
+        return Err(last_line(&output));
+    }
+    let report: serde_json::Value = serde_json::from_slice(&output.stdout)
+        .map_err(|e| format!("vtk_volume.py printed no JSON ({e})"))?;
+    times(&report)
+}
+
+/// VTK at work on several jobs (see [`start_each`]).
+pub struct Running {
+    /// `None` once waited for.
+    child: Option<std::process::Child>,
+    jobs: usize,
+}
+
+impl Drop for Running {
+    /// A run given up on (an error elsewhere) is stopped, not left behind.
+    fn drop(&mut self) {
+        if let Some(mut child) = self.child.take() {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+/// Starts VTK on every job, in one Python process (VTK is imported once) that renders them
+/// one after another, and returns at once. `Err` says why VTK could not start.
+pub fn start_each(jobs: &[vtk::VtkJob], scratch: &Path) -> Result<Running, String> {
+    let script = scratch.join("vtk_volume.py");
+    write(&script, VTK_SCRIPT.as_bytes())?;
+    let mut command = Command::new(python());
+    command.arg("-c").arg(DRIVER).arg(&script);
+    for (k, job) in jobs.iter().enumerate() {
+        let job_file = scratch.join(format!("job-{k}.json"));
+        write(
+            &job_file,
+            &serde_json::to_vec(job).map_err(|e| e.to_string())?,
+        )?;
+        command.arg(job_file);
+    }
+    let child = command
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("{}: {e}", python().display()))?;
+    Ok(Running {
+        child: Some(child),
+        jobs: jobs.len(),
+    })
+}
+
+impl Running {
+    /// Waits for VTK. The outer `Err` says why VTK could not run at all; an inner one why it
+    /// refused that job.
+    pub fn finish(mut self) -> Result<Vec<Result<VtkTimes, String>>, String> {
+        let child = self.child.take().ok_or("VTK was already waited for")?;
+        let output = child.wait_with_output().map_err(|e| e.to_string())?;
+        if !output.status.success() {
+            return Err(last_line(&output));
+        }
+        let lines: Vec<&[u8]> = output
+            .stdout
+            .split(|&b| b == b'\n')
+            .filter(|line| !line.is_empty())
+            .collect();
+        if lines.len() != self.jobs {
+            return Err(format!(
+                "vtk_volume.py answered {} of {} jobs",
+                lines.len(),
+                self.jobs
+            ));
+        }
+        Ok(lines
+            .into_iter()
+            .map(|line| {
+                serde_json::from_slice(line)
+                    .map_err(|e| format!("vtk_volume.py printed no JSON ({e})"))
+                    .and_then(|report| times(&report))
+            })
+            .collect())
+    }
+}
+
+/// The volume as a NIfTI file VTK can read: `input` itself, or a copy in `scratch`.
+pub fn nifti_file(input: &Path, volume: &Volume, scratch: &Path) -> Result<PathBuf, String> {
+    if nifti::is_nifti_path(input) && input.is_file() {
+        return Ok(input.to_owned());
+    }
+    let copy = scratch.join("volume.nii");
+    volume::write(volume, &copy).map_err(|e| e.to_string())?;
+    Ok(copy)
+}
