@@ -11,14 +11,26 @@ use specula_render::volume::{self, nifti, vtk, Volume};
 /// The VTK side of a comparison: `vtk_volume.py`, run by the Python that has VTK.
 const VTK_SCRIPT: &str = include_str!("bench/vtk_volume.py");
 
-/// Runs several jobs in one Python process (VTK is imported once): the script's own
-/// `read_job` and `render`, one JSON line per job (`{"error": ...}` for a job it refused).
+/// Renders several jobs in one Python process started ahead of them (VTK imported while the
+/// caller prepares the jobs): the script's own `read_job` and `render` on each job file whose
+/// path arrives on standard input, one JSON line per job (`{"error": ...}` for a job it
+/// refused). VTK is imported as the script does, after the same environment defaults (argv:
+/// the script, the threads).
 const DRIVER: &str = "\
-import importlib.util, json, sys
+import importlib.util, json, os, sys
+os.environ.setdefault('VTK_DEFAULT_OPENGL_WINDOW', 'vtkEGLRenderWindow')
+os.environ.setdefault('LP_NUM_THREADS', sys.argv[2])
 spec = importlib.util.spec_from_file_location('vtk_volume', sys.argv[1])
 peer = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(peer)
-for path in sys.argv[2:]:
+try:
+    import vtk, nibabel
+except ImportError:
+    pass
+for line in sys.stdin:
+    path = line.strip()
+    if not path:
+        continue
     try:
         print(json.dumps(peer.render(peer.read_job(path))), flush=True)
     except peer.Failure as e:
@@ -91,10 +103,11 @@ pub fn run(job: &vtk::VtkJob, scratch: &Path) -> Result<VtkTimes, String> {
     times(&report)
 }
 
-/// VTK at work on several jobs (see [`start_each`]).
+/// VTK started ahead of its jobs ([`start`]).
 pub struct Running {
     /// `None` once waited for.
     child: Option<std::process::Child>,
+    scratch: PathBuf,
     jobs: usize,
 }
 
@@ -108,38 +121,53 @@ impl Drop for Running {
     }
 }
 
-/// Starts VTK on every job, in one Python process (VTK is imported once) that renders them
-/// one after another, and returns at once. `Err` says why VTK could not start.
-pub fn start_each(jobs: &[vtk::VtkJob], scratch: &Path) -> Result<Running, String> {
+/// Starts the Python that will render jobs with VTK on `threads` threads, and returns at once
+/// (VTK is imported meanwhile). `scratch` holds the script and the jobs. `Err` says why
+/// Python could not start.
+pub fn start(threads: usize, scratch: &Path) -> Result<Running, String> {
     let script = scratch.join("vtk_volume.py");
     write(&script, VTK_SCRIPT.as_bytes())?;
-    let mut command = Command::new(python());
-    command.arg("-c").arg(DRIVER).arg(&script);
-    for (k, job) in jobs.iter().enumerate() {
-        let job_file = scratch.join(format!("job-{k}.json"));
-        write(
-            &job_file,
-            &serde_json::to_vec(job).map_err(|e| e.to_string())?,
-        )?;
-        command.arg(job_file);
-    }
-    let child = command
-        .stdin(Stdio::null())
+    let child = Command::new(python())
+        .arg("-c")
+        .arg(DRIVER)
+        .arg(&script)
+        .arg(threads.to_string())
+        .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .map_err(|e| format!("{}: {e}", python().display()))?;
     Ok(Running {
         child: Some(child),
-        jobs: jobs.len(),
+        scratch: scratch.to_owned(),
+        jobs: 0,
     })
 }
 
 impl Running {
+    /// Hands VTK every job (rendered one after another, in order); no more can follow.
+    pub fn submit(&mut self, jobs: &[vtk::VtkJob]) -> Result<(), String> {
+        let mut paths = String::new();
+        for job in jobs {
+            let file = self.scratch.join(format!("job-{}.json", self.jobs));
+            write(&file, &serde_json::to_vec(job).map_err(|e| e.to_string())?)?;
+            paths += &format!("{}\n", file.display());
+            self.jobs += 1;
+        }
+        let child = self.child.as_mut().ok_or("VTK was already waited for")?;
+        // Closing standard input ends the driver's loop. A Python that stopped early (VTK
+        // missing) has closed its end: what it said is read in `finish`.
+        if let Some(mut stdin) = child.stdin.take() {
+            let _ = std::io::Write::write_all(&mut stdin, paths.as_bytes());
+        }
+        Ok(())
+    }
+
     /// Waits for VTK. The outer `Err` says why VTK could not run at all; an inner one why it
     /// refused that job.
     pub fn finish(mut self) -> Result<Vec<Result<VtkTimes, String>>, String> {
-        let child = self.child.take().ok_or("VTK was already waited for")?;
+        let mut child = self.child.take().ok_or("VTK was already waited for")?;
+        drop(child.stdin.take());
         let output = child.wait_with_output().map_err(|e| e.to_string())?;
         if !output.status.success() {
             return Err(last_line(&output));

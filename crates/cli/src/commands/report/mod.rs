@@ -67,14 +67,26 @@ pub struct Sizes {
     /// The medical section's phantom side (voxels), image side (pixels) and frames timed per
     /// lobe and backend.
     pub volume: (usize, u32, usize),
-    /// The real scans' image side (pixels), frames timed against VTK, and whether every lobe
-    /// renders them (else pow, schlick and cosquad).
-    pub real_scans: (u32, usize, bool),
+    /// What the medical section does with the real scans.
+    pub real_scans: RealScanSizes,
     /// The (integer) exponents the hardware section sweeps word lengths at.
     pub hardware_exponents: &'static [u32],
     /// Whether the hardware claim's designs are synthesized when the cache lacks them (the
     /// first time, minutes) or only read from it.
     pub synthesis: specula_synth::OnMiss,
+}
+
+/// How much the medical section does with the real scans.
+#[derive(Clone, Copy, Debug)]
+pub struct RealScanSizes {
+    /// Image side in pixels.
+    pub side: u32,
+    /// Frames timed against VTK.
+    pub frames: usize,
+    /// Whether every lobe renders them (else pow, schlick and cosquad).
+    pub every_lobe: bool,
+    /// Whether every scan is compared with VTK (else the first: one VTK job).
+    pub every_scan_against_vtk: bool,
 }
 
 /// What a section works with: where files go, how much to compute, and what it wrote.

@@ -10,7 +10,7 @@ use specula_synth::OnMiss;
 
 use super::html::{escape, paragraph, table};
 use super::plot::{Chart, Series, SEQUENCE};
-use super::{Context, Sizes};
+use super::{Context, RealScanSizes, Sizes};
 use crate::output::sig;
 
 /// Chooses one figure.
@@ -443,7 +443,12 @@ pub fn sizes(quick: bool) -> Sizes {
             render: (240, 135, 1),
             environment: (240, 135, 16),
             volume: (32, 96, 1),
-            real_scans: (64, 1, false),
+            real_scans: RealScanSizes {
+                side: 64,
+                frames: 1,
+                every_lobe: false,
+                every_scan_against_vtk: false,
+            },
             hardware_exponents: &[64],
             synthesis: OnMiss::Skip,
         }
@@ -456,7 +461,12 @@ pub fn sizes(quick: bool) -> Sizes {
             render: (480, 270, 2),
             environment: (480, 270, 128),
             volume: (64, 192, 2),
-            real_scans: (128, 3, true),
+            real_scans: RealScanSizes {
+                side: 128,
+                frames: 3,
+                every_lobe: true,
+                every_scan_against_vtk: true,
+            },
             hardware_exponents: &[8, 64, 512],
             synthesis: OnMiss::Synthesize,
         }

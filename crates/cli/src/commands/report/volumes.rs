@@ -48,8 +48,7 @@ fn timed(
     Ok((best, image.ok_or("no run")?))
 }
 
-/// The phantom and, beside it (concurrently: reading the scans and VTK's run wait on one core
-/// each), the real scans.
+/// The phantom and, beside it, the real scans.
 pub fn volumes(context: &mut Context) -> Result<String, String> {
     let mut real = Context {
         directory: context.directory.clone(),
@@ -59,10 +58,24 @@ pub fn volumes(context: &mut Context) -> Result<String, String> {
         shared: std::sync::Arc::clone(&context.shared),
         lobes: context.lobes.clone(),
     };
-    let (phantom, real_scans) = rayon::join(
-        || phantom(context),
-        || super::real_scans::real_scans(&mut real),
-    );
+    // The real scans wait on files and on VTK's process, and time specula beside VTK's
+    // threads: on threads of their own (as many as the sections share) they hold none of the
+    // sections' workers, and their parallel work does not queue behind the other sections'.
+    let threads = rayon::current_num_threads();
+    let (phantom, real_scans) = std::thread::scope(|scope| {
+        let real_scans = scope.spawn(|| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .map_err(|e| e.to_string())?
+                .install(|| super::real_scans::real_scans(&mut real))
+        });
+        let phantom = phantom(context);
+        let real_scans = real_scans
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (phantom, real_scans)
+    });
     context.files.append(&mut real.files);
     Ok(phantom? + &real_scans?)
 }
