@@ -5,8 +5,13 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+use std::time::Instant;
 
+use specula_render::volume::march::PreparedVolume;
+use specula_render::volume::raymarch::{render_dvr_prepared, DvrSettings};
+use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::{self, nifti, vtk, Volume};
+use specula_render::Image;
 
 /// The VTK side of a comparison: `vtk_volume.py`, run by the Python that has VTK.
 const VTK_SCRIPT: &str = include_str!("bench/vtk_volume.py");
@@ -203,4 +208,38 @@ pub fn nifti_file(input: &Path, volume: &Volume, scratch: &Path) -> Result<PathB
     let copy = scratch.join("volume.nii");
     volume::write(volume, &copy).map_err(|e| e.to_string())?;
     Ok(copy)
+}
+
+/// specula's side of a comparison: the last of `frames` frames of `volume` (whose gradients
+/// and bricks, which VTK computes in its untimed first frame, are `prepared`) after one untimed
+/// warm-up, and the median seconds a frame took.
+pub fn time_specula(
+    volume: &Volume,
+    prepared: &PreparedVolume,
+    transfer: &TransferFunction,
+    settings: &DvrSettings,
+    frames: usize,
+) -> Result<(Image, f64), String> {
+    let draw = || {
+        render_dvr_prepared(volume, prepared, transfer, settings, &|| {}).map_err(|e| e.to_string())
+    };
+    let mut image = draw()?;
+    let mut times = Vec::new();
+    for _ in 0..frames.max(1) {
+        let started = Instant::now();
+        image = draw()?;
+        times.push(started.elapsed().as_secs_f64());
+    }
+    Ok((image, median(times)))
+}
+
+/// The median of `values` (at least one).
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let middle = values.len() / 2;
+    if values.len() % 2 == 1 {
+        values[middle]
+    } else {
+        0.5 * (values[middle - 1] + values[middle])
+    }
 }

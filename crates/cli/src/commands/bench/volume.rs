@@ -6,7 +6,6 @@ use std::path::Path;
 use std::time::Instant;
 
 use specula_render::volume::march::PreparedVolume;
-use specula_render::volume::raymarch::render_dvr_prepared;
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::vtk;
 use specula_render::{write_image, Display};
@@ -16,17 +15,6 @@ use crate::commands::volume::{load, Source};
 use crate::commands::vtk_peer;
 use crate::commands::CommandResult;
 use crate::output::Table;
-
-/// Median of `values` (sorted in place).
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let middle = values.len() / 2;
-    if values.len() % 2 == 1 {
-        values[middle]
-    } else {
-        0.5 * (values[middle - 1] + values[middle])
-    }
-}
 
 /// Measures and prints.
 pub fn run(args: &Args) -> CommandResult {
@@ -44,20 +32,13 @@ pub fn run(args: &Args) -> CommandResult {
     let started = Instant::now();
     let prepared = PreparedVolume::new(&volume);
     let preparation = started.elapsed().as_secs_f64();
-    let mut image = None;
-    let mut frame = || -> Result<f64, String> {
-        let started = Instant::now();
-        let drawn = render_dvr_prepared(&volume, &prepared, &transfer, &settings, &|| {})
-            .map_err(|e| e.to_string())?;
-        let seconds = started.elapsed().as_secs_f64();
-        image = Some(drawn);
-        Ok(seconds)
-    };
-    frame()?;
-    let mut times = (0..args.frames)
-        .map(|_| frame())
-        .collect::<Result<Vec<_>, _>>()?;
-    let specula = median(&mut times);
+    let (image, specula) = vtk_peer::time_specula(
+        &volume,
+        &prepared,
+        &transfer,
+        &settings,
+        args.frames as usize,
+    )?;
     let threads = rayon::current_num_threads();
     let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
     let vtk_output = scratch.path().join("vtk.png");
@@ -116,9 +97,9 @@ pub fn run(args: &Args) -> CommandResult {
         }
     }
     table.print(crate::args::Format::Table);
-    if let (Some(dir), Some(image)) = (&args.images, &image) {
+    if let Some(dir) = &args.images {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        write_image(&dir.join("specula.exr"), image, Display::default())
+        write_image(&dir.join("specula.exr"), &image, Display::default())
             .map_err(|e| e.to_string())?;
         if vtk.is_ok() {
             std::fs::copy(&vtk_output, dir.join("vtk.png"))

@@ -82,16 +82,6 @@ fn milliseconds(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
 
-fn median(mut values: Vec<f64>) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let middle = values.len() / 2;
-    if values.len() % 2 == 1 {
-        values[middle]
-    } else {
-        0.5 * (values[middle - 1] + values[middle])
-    }
-}
-
 fn load(scan: &Scan) -> Result<Loaded<'_>, String> {
     let started = Instant::now();
     let volume = volume::read(Path::new(scan.path)).map_err(|e| e.to_string())?;
@@ -353,26 +343,14 @@ fn alike_setup(
     Ok((settings, job))
 }
 
-/// specula's image set up as VTK, and the median seconds of `frames` frames (the volume's
-/// gradients and bricks, which VTK computes in its untimed first frame, are `prepared`).
+/// specula's image set up as VTK, and the median seconds of `frames` frames.
 fn specula_alike(
     loaded: &Loaded,
     prepared: &PreparedVolume,
     settings: &DvrSettings,
     frames: usize,
 ) -> Result<(Image, f64), String> {
-    let draw = || {
-        render_dvr_prepared(&loaded.volume, prepared, &loaded.transfer, settings, &|| {})
-            .map_err(|e| e.to_string())
-    };
-    let mut image = None;
-    let mut times = Vec::new();
-    for _ in 0..frames.max(1) {
-        let started = Instant::now();
-        image = Some(draw()?);
-        times.push(started.elapsed().as_secs_f64());
-    }
-    Ok((image.ok_or("no frame")?, median(times)))
+    vtk_peer::time_specula(&loaded.volume, prepared, &loaded.transfer, settings, frames)
 }
 
 /// The comparison with VTK: what is alike, what differs, the images, their agreement and
