@@ -50,6 +50,9 @@ pub struct Volume {
     to_index: Mat3,
     samples: Vec<f32>,
     units: Units,
+    /// The smallest and largest sample, found once: every render's transfer function and
+    /// lighting read it.
+    range: (f32, f32),
 }
 
 /// What a volume's values mean.
@@ -140,6 +143,11 @@ impl Volume {
                 "the voxel spacing and orientation must be finite and non-degenerate (a zero spacing or parallel axes cannot place the voxels)".into(),
             ));
         }
+        let range = samples
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
         Ok(Self {
             dims,
             to_world,
@@ -147,6 +155,7 @@ impl Volume {
             to_index: to_world.inverse(),
             samples,
             units,
+            range,
         })
     }
 
@@ -258,11 +267,7 @@ impl Volume {
     /// The smallest and largest sample.
     #[must_use]
     pub fn range(&self) -> (f32, f32) {
-        self.samples
-            .iter()
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
-                (lo.min(v), hi.max(v))
-            })
+        self.range
     }
 
     /// The sample at a whole index, clamped to the grid.

@@ -3,9 +3,28 @@ use super::*;
 use crate::volume::phantom::BuiltIn;
 use crate::volume::raymarch::LitSample;
 use crate::volume::raymarch::{
-    inside_grid, pixel_jitter, render_dvr, DvrPlan, DvrSettings, Light, Shading, View,
+    inside_grid, pixel_jitter, render_dvr, DvrPlan, DvrSettings, Light, Lighting, Shading, View,
 };
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+
+/// The classic model as the module states it, written here apart from `Lighting::light`'s
+/// rearranged arithmetic: the gradient's opposite, turned to the viewer, as the normal; the
+/// geometry's own cosine; lit blended with unlit by the gradient's strength.
+fn classic(lighting: &Lighting, gradient: Vec3, base: Vec3, wo: Vec3) -> Vec3 {
+    let strength = gradient.length();
+    if strength == 0.0 {
+        return base;
+    }
+    let mut normal = -gradient / strength;
+    if normal.dot(wo) < 0.0 {
+        normal = -normal;
+    }
+    let (shading, wi) = (&lighting.shading, lighting.light);
+    let t = shading.geometry.cos_lobe_f32(normal, wo, wi);
+    let specular = shading.ks * lighting.normalisation * shading.lobe.eval(t);
+    let lit = base * (shading.ka + shading.kd * normal.dot(wi).max(0.0)) + Vec3::splat(specular);
+    base.lerp(lit, (strength / lighting.gradient_reference).min(1.0))
+}
 
 /// The march as the model states it, sample by sample from the volume and the transfer
 /// function themselves (no table, no bricks, gradients from six trilinear samples).
@@ -37,7 +56,7 @@ fn reference(volume: &Volume, transfer: &TransferFunction, settings: &DvrSetting
                 let (sigma, base) = transfer.at(volume.sample(index));
                 let alpha = 1.0 - (-sigma * segment).exp();
                 let shaded = plan.lighting.as_ref().map_or(base, |lighting| {
-                    lighting.shade(volume.gradient(index), base, -direction)
+                    classic(lighting, volume.gradient(index), base, -direction)
                 });
                 colour += transmittance * alpha * shaded;
                 transmittance *= 1.0 - alpha;
@@ -75,21 +94,31 @@ fn padded_head(side: usize) -> Volume {
 fn the_prepared_march_is_the_reference_march() {
     let volume = padded_head(36);
     let lobe = Lobe::new(LobeKind::Pow, Exponent::new(24.0));
-    for (view, transfer, light) in [
-        (View::Anterior, "mr", Light::Key),
-        (View::Left, "surface", Light::Headlight),
+    for (view, transfer, light, geometry, fade) in [
+        (View::Anterior, "mr", Light::Key, Geometry::Blinn, true),
+        (
+            View::Left,
+            "surface",
+            Light::Headlight,
+            Geometry::Phong,
+            true,
+        ),
         (
             View::Eye(Vec3::new(400.0, -300.0, 200.0)),
             "mr",
             Light::Headlight,
+            Geometry::Blinn,
+            false,
         ),
+        (View::Superior, "mr", Light::Key, Geometry::Phong, false),
     ] {
         let transfer = TransferFunction::preset(transfer)
             .unwrap()
             .for_volume(&volume);
         let shading = Shading {
             light,
-            ..Shading::new(lobe, Geometry::Blinn, Normalisation::None)
+            fade_weak_gradients: fade,
+            ..Shading::new(lobe, geometry, Normalisation::None)
         };
         let mut settings = DvrSettings::new(48, 40, view, Some(shading));
         settings.background = Vec3::new(0.1, 0.2, 0.3);
