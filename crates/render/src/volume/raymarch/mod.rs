@@ -129,6 +129,7 @@ pub fn render_dvr(
     settings: &DvrSettings,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Image, VolumeError> {
+    // A request the plan refuses is refused before the volume is prepared (16 bytes a voxel).
     DvrPlan::new(volume, settings)?;
     let prepared = PreparedVolume::new(volume);
     render_dvr_prepared(volume, &prepared, transfer, settings, progress)
