@@ -222,26 +222,12 @@ pub struct Classification {
     occupied: Vec<bool>,
     /// Whether each region holds an occupied brick.
     occupied_regions: Vec<bool>,
-    /// A full segment's opacity `1 - exp(-u)` at `u = sigma step`, evenly spaced from 0 to
-    /// the densest segment's (at most [`OPAQUE`]).
-    opacity: Vec<f32>,
-    /// Entries of `opacity` per unit of `sigma`.
-    opacity_per_sigma: f32,
-    /// The last entry's index.
-    opacity_last: f32,
 }
 
-/// Entries of the opacity table. Interpolated linearly, `1 - exp(-u)` is off by at most
-/// `du^2 / 8` (its curvature is at most 1): `1.2e-5` at the widest spacing, `40 / 4095`.
-const OPACITY_ENTRIES: usize = 4096;
-
-/// Where the opacity table ends: `1 - exp(-40)` is 1 in `f32`.
-const OPAQUE: f32 = 40.0;
-
 impl Classification {
-    /// Arranges `transfer` (in `volume`'s values) for segments of `step` mm.
+    /// Arranges `transfer` (in `volume`'s values).
     #[must_use]
-    pub fn new(volume: &PreparedVolume, transfer: &TransferFunction, step: f32) -> Self {
+    pub fn new(volume: &PreparedVolume, transfer: &TransferFunction) -> Self {
         let points = transfer.points();
         let bounds: Vec<f32> = points.iter().map(|p| p.value).collect();
         let entry = |p: &super::transfer::ControlPoint| {
@@ -297,12 +283,6 @@ impl Classification {
             let [rx, ry] = [volume.regions[0], volume.regions[1]];
             occupied_regions[brick[0] + rx * (brick[1] + ry * brick[2])] = true;
         }
-        let densest = points.iter().map(|p| p.sigma).fold(0.0, f32::max);
-        let reach = (densest * step).clamp(f32::MIN_POSITIVE, OPAQUE);
-        let last = (OPACITY_ENTRIES - 1) as f32;
-        let opacity = (0..OPACITY_ENTRIES)
-            .map(|e| 1.0 - (-(reach * e as f32 / last)).exp())
-            .collect();
         Self {
             bounds,
             pieces,
@@ -311,26 +291,7 @@ impl Classification {
             per_entry,
             occupied,
             occupied_regions,
-            opacity,
-            opacity_per_sigma: step * last / reach,
-            opacity_last: last,
         }
-    }
-
-    /// A full segment's opacity at extinction `sigma` (`>= 0`), from the table.
-    #[inline(always)]
-    fn full_segment_opacity(&self, sigma: f32) -> f32 {
-        let x = sigma * self.opacity_per_sigma;
-        if x >= self.opacity_last {
-            return self.opacity[OPACITY_ENTRIES - 1];
-        }
-        let e = x as i32 as usize;
-        let f = x - e as f32;
-        let (a, b) = (
-            self.opacity[e],
-            self.opacity[(e + 1).min(OPACITY_ENTRIES - 1)],
-        );
-        a + (b - a) * f
     }
 
     /// Extinction and colour `(sigma, r, g, b)` at `value`: the transfer function's own

@@ -1,7 +1,6 @@
-use super::ray::{march_together, Highlights, Ray, Shade};
+use super::ray::{march_rays, Marched, Ray};
 use super::*;
 use crate::volume::phantom::BuiltIn;
-use crate::volume::raymarch::LitSample;
 use crate::volume::raymarch::{
     inside_grid, pixel_jitter, render_dvr, DvrPlan, DvrSettings, Light, Lighting, Shading, View,
 };
@@ -164,7 +163,7 @@ fn empty_bricks_are_skipped_without_changing_a_pixel() {
         .unwrap()
         .for_volume(&volume);
     let step = 0.37;
-    let skipping = Classification::new(&prepared, &transfer, step);
+    let skipping = Classification::new(&prepared, &transfer);
     let occupied = skipping.occupied.iter().filter(|&&o| o).count();
     assert!(
         occupied * 4 < skipping.occupied.len(),
@@ -173,33 +172,48 @@ fn empty_bricks_are_skipped_without_changing_a_pixel() {
     let mut everything = skipping.clone();
     everything.occupied.iter_mut().for_each(|o| *o = true);
     let direction = Vec3::new(0.3, 0.8, 0.52).normalize();
+    let mut rays = Vec::new();
     for (k, first) in [0.1_f32, 0.5, 1.0].into_iter().enumerate() {
         for start in 0..16 {
             let origin = Vec3::new(2.0 + start as f32 * 3.0, 0.5 * k as f32, 0.0);
-            let Some((start, end)) = inside_grid(&volume, origin, direction) else {
-                continue;
-            };
-            let ray = Ray {
-                origin,
-                direction,
-                start,
-                end,
-                first: step * first,
-            };
-            let march_with = |c: &Classification| {
-                march_together::<Unlit, 1>(
-                    pulp::Arch::new(),
-                    &prepared,
-                    c,
-                    [Some((ray, None))],
-                    step,
-                    0.99,
-                    &mut [Highlights::EMPTY],
-                )[0]
-            };
-            assert_eq!(march_with(&skipping), march_with(&everything));
+            if let Some((start, end)) = inside_grid(&volume, origin, direction) {
+                rays.push(Ray {
+                    origin,
+                    direction,
+                    start,
+                    end,
+                    first: step * first,
+                });
+            }
         }
     }
+    let march_with = |c: &Classification, rays: &[Ray]| {
+        let mut out = vec![(Vec3::ZERO, 1.0); rays.len()];
+        march_rays(
+            pulp::Arch::new(),
+            &prepared,
+            c,
+            None,
+            rays,
+            step,
+            0.99,
+            &mut out,
+        );
+        out
+    };
+    // More rays than a packet has lanes, so lanes take new rays as theirs end; each ray's
+    // result is its march on its own.
+    assert!(rays.len() > 2 * super::ray::LANES, "{} rays", rays.len());
+    let together = march_with(&skipping, &rays);
+    assert_eq!(together, march_with(&everything, &rays));
+    for (ray, marched) in rays.iter().zip(&together) {
+        let alone: Marched = march_with(&skipping, std::slice::from_ref(ray))[0];
+        assert_eq!(alone, *marched);
+    }
+    assert!(
+        together.iter().any(|(colour, _)| colour.x > 0.1),
+        "some rays cross the ball"
+    );
 }
 
 #[test]
@@ -228,38 +242,12 @@ fn prepared_samples_are_the_volumes_trilinear_values_and_gradients() {
 }
 
 #[test]
-fn a_full_segments_tabulated_opacity_is_beer_lamberts() {
-    let volume = BuiltIn::SheppLogan.make(16).unwrap();
-    let prepared = PreparedVolume::new(&volume);
-    for (name, step) in [("surface", 0.8), ("mr", 0.5), ("surface", 0.05)] {
-        let transfer = TransferFunction::preset(name).unwrap().for_volume(&volume);
-        let classification = Classification::new(&prepared, &transfer, step);
-        let densest = transfer
-            .points()
-            .iter()
-            .map(|p| p.sigma)
-            .fold(0.0, f32::max);
-        for k in 0..=5000 {
-            let sigma = densest * k as f32 / 5000.0;
-            let exact = 1.0 - f64::exp(-f64::from(sigma) * f64::from(step));
-            let tabulated = f64::from(classification.full_segment_opacity(sigma));
-            // The table's bound (du^2 / 8 at du = 40 / 4095) and f32 rounding.
-            assert!(
-                (tabulated - exact).abs() < 1.3e-5,
-                "{name}: sigma {sigma}: {tabulated} against {exact}"
-            );
-        }
-    }
-}
-
-#[test]
 fn classification_is_the_transfer_function() {
     let volume = BuiltIn::SheppLogan.make(16).unwrap();
     let prepared = PreparedVolume::new(&volume);
     for name in crate::volume::transfer::PRESETS {
         let transfer = TransferFunction::preset(name).unwrap().for_volume(&volume);
-        let step = 0.43;
-        let classification = Classification::new(&prepared, &transfer, step);
+        let classification = Classification::new(&prepared, &transfer);
         let (lo, hi) = volume.range();
         for k in 0..=20_000 {
             let value = lo - 0.1 + (hi - lo + 0.2) * k as f32 / 20_000.0;
@@ -274,21 +262,5 @@ fn classification_is_the_transfer_function() {
                 "{name} at {value}: {got} against {sigma} {colour}"
             );
         }
-    }
-}
-
-struct Unlit;
-
-impl Shade for Unlit {
-    fn light(&self, _: Vec3, base: Vec3) -> LitSample {
-        LitSample {
-            colour: base,
-            highlight: 0.0,
-            t: 0.0,
-        }
-    }
-
-    fn highlights(&self, _: &[f32], _: &[f32]) -> f32 {
-        0.0
     }
 }

@@ -4,7 +4,6 @@
 use glam::Vec3;
 use specula::{Geometry, Lobe, Normalisation};
 
-use crate::volume::march::ray::{Shade, HIGHLIGHTS};
 use crate::volume::Volume;
 
 /// The specular material every sample shares.
@@ -121,18 +120,32 @@ impl Lighting {
     #[inline(always)]
     #[must_use]
     pub fn light(&self, gradient: Vec3, base: Vec3, view: &RayView) -> LitSample {
-        let squared = gradient.length_squared();
-        if !(squared > 0.0 && squared.is_finite()) {
-            return LitSample {
-                colour: base,
-                highlight: 0.0,
-                t: 0.0,
-            };
+        let parts = self.lit_parts(gradient, view.wo, view.half, view.wi_dot_wo);
+        LitSample {
+            colour: base * parts.colour_scale,
+            highlight: parts.highlight,
+            t: parts.t,
         }
-        let inverse = squared.sqrt().recip();
+    }
+
+    /// [`Lighting::light`] without a branch on the sample (the ray marcher lights several
+    /// rays' samples at once, lane by lane): the view is `wo`, its `half` vector and
+    /// `wi . wo`.
+    #[inline(always)]
+    pub(crate) fn lit_parts(
+        &self,
+        gradient: Vec3,
+        wo: Vec3,
+        half: Vec3,
+        wi_dot_wo: f32,
+    ) -> LitParts {
+        let squared = gradient.length_squared();
+        // No gradient (or an infinite one): unlit, as a sample inside uniform tissue.
+        let lit = squared > 0.0 && squared < f32::INFINITY;
+        let inverse = if lit { squared } else { 1.0 }.sqrt().recip();
         // The normal is the gradient's opposite turned to face the viewer: `k g` with
         // `|k| = 1 / |g|`, so its dot products are those of the gradient, scaled.
-        let towards_viewer = gradient.dot(view.wo);
+        let towards_viewer = gradient.dot(wo);
         let k = if towards_viewer > 0.0 {
             inverse
         } else {
@@ -142,17 +155,34 @@ impl Lighting {
         let along_light = k * gradient.dot(self.light);
         let diffuse = along_light.max(0.0);
         let t = match shading.geometry {
-            Geometry::Phong => 2.0 * along_light * (k * towards_viewer) - view.wi_dot_wo,
-            Geometry::Blinn => k * gradient.dot(view.half),
+            Geometry::Phong => 2.0 * along_light * (k * towards_viewer) - wi_dot_wo,
+            Geometry::Blinn => k * gradient.dot(half),
         };
         // base.lerp(lit, weight), the highlight's share kept apart.
         let weight = (squared * inverse * self.per_gradient_reference).min(1.0);
-        LitSample {
-            colour: base * (1.0 + weight * (shading.ka + shading.kd * diffuse - 1.0)),
-            highlight: weight * shading.ks * self.normalisation,
-            t,
+        LitParts {
+            colour_scale: if lit {
+                1.0 + weight * (shading.ka + shading.kd * diffuse - 1.0)
+            } else {
+                1.0
+            },
+            highlight: if lit {
+                weight * shading.ks * self.normalisation
+            } else {
+                0.0
+            },
+            t: if lit { t } else { 0.0 },
         }
     }
+}
+
+/// A sample's lighting, its colour apart: the sample is `colour_scale * base + highlight *
+/// lobe(t)` in every channel.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LitParts {
+    pub colour_scale: f32,
+    pub highlight: f32,
+    pub t: f32,
 }
 
 /// A sample lit, its highlight apart: the sample is `colour + highlight * lobe(t)` in every
@@ -170,9 +200,9 @@ pub struct LitSample {
 /// What one ray's samples share: the view direction and, for Blinn, the half vector.
 #[derive(Clone, Copy, Debug)]
 pub struct RayView {
-    wo: Vec3,
-    half: Vec3,
-    wi_dot_wo: f32,
+    pub(crate) wo: Vec3,
+    pub(crate) half: Vec3,
+    pub(crate) wi_dot_wo: f32,
 }
 
 impl RayView {
@@ -191,25 +221,5 @@ impl RayView {
             },
             wi_dot_wo: lighting.light.dot(wo),
         }
-    }
-}
-
-/// The lighting as one ray sees it.
-pub(super) struct Lit<'a> {
-    pub(super) lighting: &'a Lighting,
-    pub(super) view: RayView,
-}
-
-impl Shade for Lit<'_> {
-    #[inline(always)]
-    fn light(&self, gradient: Vec3, base: Vec3) -> LitSample {
-        self.lighting.light(gradient, base, &self.view)
-    }
-
-    fn highlights(&self, ts: &[f32], weights: &[f32]) -> f32 {
-        let mut lobes = [0.0_f32; HIGHLIGHTS];
-        let lobes = &mut lobes[..ts.len()];
-        self.lighting.shading.lobe.eval_batch(ts, lobes);
-        lobes.iter().zip(weights).map(|(l, w)| l * w).sum()
     }
 }

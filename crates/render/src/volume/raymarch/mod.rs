@@ -21,12 +21,11 @@ use rayon::prelude::*;
 pub use lighting::{Light, Lighting, LitSample, RayView, Shading};
 pub use view::{surface_camera, RayCamera, View};
 
-use super::march::ray::{march_together, Highlights, Ray};
+use super::march::ray::{march_rays, Lit, Ray};
 use super::march::{Classification, PreparedVolume};
 use super::transfer::TransferFunction;
 use super::{Volume, VolumeError};
 use crate::image::Image;
-use lighting::Lit;
 
 /// What to render.
 #[derive(Clone, Copy, Debug)]
@@ -155,7 +154,7 @@ pub fn render_dvr_prepared(
         step,
         lighting,
     } = DvrPlan::new(volume, settings)?;
-    let classification = Classification::new(prepared, transfer, step);
+    let classification = Classification::new(prepared, transfer);
     let arch = pulp::Arch::new();
     let mut pixels = vec![settings.background; width as usize * height as usize];
     // Bands of TILE rows, drawn tile by tile: a tile's rays cross the same few columns of
@@ -166,60 +165,58 @@ pub fn render_dvr_prepared(
         .enumerate()
         .for_each(|(index, band)| {
             let rows = band.len() / width as usize;
-            let mut buffers = [Highlights::EMPTY; TOGETHER];
+            let mut rays = Vec::with_capacity(TILE * TILE);
+            let mut views = Vec::with_capacity(TILE * TILE);
+            let mut places = Vec::with_capacity(TILE * TILE);
+            let mut marched = Vec::with_capacity(TILE * TILE);
             for x0 in (0..width as usize).step_by(TILE) {
+                rays.clear();
+                views.clear();
+                places.clear();
                 for row in 0..rows {
                     let y = (index * TILE + row) as u32;
-                    let line = &mut band[row * width as usize..(row + 1) * width as usize];
-                    let tile = &mut line[x0..(x0 + TILE).min(width as usize)];
-                    for (group, pixels) in tile.chunks_mut(TOGETHER).enumerate() {
-                        let first = x0 + group * TOGETHER;
-                        let rays: [Option<(Ray, Vec3)>; TOGETHER] = core::array::from_fn(|k| {
-                            if k >= pixels.len() {
-                                return None;
-                            }
-                            let x = (first + k) as u32;
-                            let (origin, direction) = camera.ray(x, y, width, height);
-                            let (grid_origin, grid_direction) =
-                                (volume.index(origin), volume.index_direction(direction));
-                            let (start, end) = inside_grid(volume, grid_origin, grid_direction)?;
-                            // The first segment's length varies from pixel to pixel, so the
-                            // steps do not line up with a sharp boundary in the same way
-                            // across the image (which draws wood-grain rings); the segments
-                            // still sum to the ray's length exactly.
-                            let ray = Ray {
-                                origin: grid_origin,
-                                direction: grid_direction,
-                                start,
-                                end,
-                                first: step * pixel_jitter(x, y),
-                            };
-                            Some((ray, direction))
+                    for x in x0..(x0 + TILE).min(width as usize) {
+                        let (origin, direction) = camera.ray(x as u32, y, width, height);
+                        let (grid_origin, grid_direction) =
+                            (volume.index(origin), volume.index_direction(direction));
+                        let Some((start, end)) = inside_grid(volume, grid_origin, grid_direction)
+                        else {
+                            continue;
+                        };
+                        // The first segment's length varies from pixel to pixel, so the steps
+                        // do not line up with a sharp boundary in the same way across the
+                        // image (which draws wood-grain rings); the segments still sum to the
+                        // ray's length exactly.
+                        rays.push(Ray {
+                            origin: grid_origin,
+                            direction: grid_direction,
+                            start,
+                            end,
+                            first: step * pixel_jitter(x as u32, y),
                         });
-                        let lits = rays.map(|ray| {
-                            let (_, direction) = ray?;
-                            lighting.as_ref().map(|lighting| Lit {
-                                lighting,
-                                view: RayView::new(lighting, -direction),
-                            })
-                        });
-                        let marched = march_together::<_, TOGETHER>(
-                            arch,
-                            prepared,
-                            &classification,
-                            core::array::from_fn(|k| {
-                                rays[k].map(|(ray, _)| (ray, lits[k].as_ref()))
-                            }),
-                            step,
-                            settings.opacity_cutoff,
-                            &mut buffers,
-                        );
-                        for (pixel, marched) in pixels.iter_mut().zip(marched) {
-                            if let Some((colour, transmittance)) = marched {
-                                *pixel = colour + transmittance * settings.background;
-                            }
+                        if let Some(lighting) = &lighting {
+                            views.push(RayView::new(lighting, -direction));
                         }
+                        places.push(row * width as usize + x);
                     }
+                }
+                marched.clear();
+                marched.resize(rays.len(), (Vec3::ZERO, 1.0));
+                march_rays(
+                    arch,
+                    prepared,
+                    &classification,
+                    lighting.as_ref().map(|lighting| Lit {
+                        lighting,
+                        views: &views,
+                    }),
+                    &rays,
+                    step,
+                    settings.opacity_cutoff,
+                    &mut marched,
+                );
+                for (&place, &(colour, transmittance)) in places.iter().zip(&marched) {
+                    band[place] = colour + transmittance * settings.background;
                 }
             }
             for _ in 0..rows {
@@ -229,9 +226,6 @@ pub fn render_dvr_prepared(
     Image::from_pixels(width, height, pixels)
         .ok_or_else(|| VolumeError("the image could not be assembled".into()))
 }
-
-/// Neighbouring rays marched side by side (see [`march_together`]).
-const TOGETHER: usize = 4;
 
 /// Pixels along each side of the square tiles drawn one at a time.
 const TILE: usize = 8;
