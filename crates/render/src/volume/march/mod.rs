@@ -46,8 +46,9 @@ pub const CLASSIFICATION_ENTRIES: usize = 4096;
 #[derive(Clone, Debug)]
 pub struct PreparedVolume {
     dims: [usize; 3],
-    /// `(value, gradient in value per mm)` per voxel, `i` fastest.
-    voxels: Vec<Vec4>,
+    /// `(value, gradient in value per mm)` per voxel, four numbers each, `i` fastest: a
+    /// voxel and its neighbour along `i` are eight numbers in a row (one 256-bit load).
+    voxels: Vec<[f32; 4]>,
     /// The largest cell index along each axis (`dims - 2`).
     last_cell: IVec3,
     last_index: Vec3,
@@ -67,7 +68,7 @@ impl PreparedVolume {
         let samples = volume.samples();
         let to_world_gradient = volume.to_index().transpose();
         let at = |i: usize, j: usize, k: usize| samples[i + nx * (j + ny * k)];
-        let mut voxels = vec![Vec4::ZERO; samples.len()];
+        let mut voxels = vec![[0.0; 4]; samples.len()];
         voxels
             .par_chunks_mut(nx * ny)
             .enumerate()
@@ -84,7 +85,7 @@ impl PreparedVolume {
                                 at(i, j, k1) - at(i, j, k0),
                             );
                         let g = to_world_gradient * along_index;
-                        slice[i + nx * j] = Vec4::new(at(i, j, k), g.x, g.y, g.z);
+                        slice[i + nx * j] = [at(i, j, k), g.x, g.y, g.z];
                     }
                 }
             });
@@ -154,16 +155,25 @@ impl PreparedVolume {
         self.sample_in(cell, f)
     }
 
+    /// The cell's corners are four pairs of neighbours along `i`, each pair eight numbers in
+    /// a row: they are interpolated pairwise along `y`, then `z` (eight lanes at a time), and
+    /// the pair's two ends along `x` last.
     #[inline(always)]
     fn sample_in(&self, cell: IVec3, f: Vec3) -> Vec4 {
         let (nx, nxy) = (self.dims[0], self.dims[0] * self.dims[1]);
         let at = cell.x as usize + nx * cell.y as usize + nxy * cell.z as usize;
-        let v = &self.voxels[at..=at + nxy + nx + 1];
-        // `a + (b - a) t` along x, then y, then z: the reference's order of operations.
-        let lerp = |a: Vec4, b: Vec4, t: f32| a + (b - a) * t;
-        let row = |o: usize| lerp(v[o], v[o + 1], f.x);
-        let plane = |o: usize| lerp(row(o), row(o + nx), f.y);
-        lerp(plane(0), plane(nxy), f.z)
+        let pair = |voxel: usize| -> [f32; 8] {
+            *self.voxels[voxel..]
+                .as_flattened()
+                .first_chunk()
+                .expect("a cell's corners lie inside the grid")
+        };
+        let near = lerp8(pair(at), pair(at + nx), f.y);
+        let far = lerp8(pair(at + nxy), pair(at + nxy + nx), f.y);
+        let ends = lerp8(near, far, f.z);
+        let low = Vec4::from_slice(&ends[..4]);
+        let high = Vec4::from_slice(&ends[4..]);
+        low + (high - low) * f.x
     }
 
     /// The index of the brick holding `cell`.
@@ -201,6 +211,16 @@ impl PreparedVolume {
         let c = (high - origin) * inverse_direction;
         a.max(c).min_element()
     }
+}
+
+/// `a + (b - a) t`, lane by lane.
+#[inline(always)]
+fn lerp8(a: [f32; 8], b: [f32; 8], t: f32) -> [f32; 8] {
+    let mut out = a;
+    for lane in 0..8 {
+        out[lane] = a[lane] + (b[lane] - a[lane]) * t;
+    }
+    out
 }
 
 /// A transfer function arranged for one volume: its pieces as `value -> (sigma, r, g, b)`

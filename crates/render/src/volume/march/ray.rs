@@ -1,26 +1,27 @@
 //! Rays marched as a packet: [`LANES`] rays side by side in structure-of-arrays form, every
 //! lane advanced by one segment per turn of the loop.
 //!
-//! Each turn has three phases. Where the lanes' segments lie and which voxel cell each
-//! midpoint falls in is lane-wise arithmetic on arrays, which the compiler turns into vector
-//! instructions; reading the voxels and the tables is a loop over the lanes (the loads differ
-//! per lane); lighting and compositing are lane-wise arithmetic again, with no branch on a
-//! sample's value (whether a noisy sample faces the light is a coin toss a branch would
-//! mispredict). A lane whose ray ends takes the next ray of the list, so the packet stays full
-//! until the list runs out. Highlights are gathered across lanes and their lobe evaluated
-//! together by the lobe's vector kernel ([`specula::Lobe::eval_batch`]).
+//! A turn has three phases. Where each lane's segment lies and which voxel cell its midpoint
+//! falls in is lane-wise arithmetic on arrays (which the compiler vectorises); reading the
+//! voxels and the transfer function is a loop over the lanes, since each lane reads elsewhere;
+//! opacity, lighting and compositing are written in the core's vectors ([`Lanes`]), with no
+//! branch on a sample's value (whether a noisy sample faces the light is a coin toss that a
+//! branch would mispredict). A lane whose ray ends takes the next ray of the list, so the
+//! packet stays full until the list runs out. Highlights are gathered across lanes and their
+//! lobe evaluated together by the lobe's vector kernel ([`specula::Lobe::eval_batch`]).
 //!
-//! Every ray gets exactly the samples, opacities and lighting of a march on its own, front to
-//! back; only the order in which its highlights are summed differs.
+//! Every ray gets exactly the samples of a march on its own, front to back; only the order in
+//! which its highlights are summed differs.
 
 // A lane loop reads and writes several arrays at the lane's index: written as one index, it
 // is the shape the compiler vectorises.
 #![allow(clippy::needless_range_loop)]
 
 use glam::{IVec3, Vec3};
-use specula::simd::exp2_nonpositive;
+use specula::simd::{dispatch, exp2_nonpositive, Job, Lanes, Level};
 
 use super::{Classification, PreparedVolume};
+use crate::volume::raymarch::lighting::LanesView;
 use crate::volume::raymarch::{Lighting, RayView};
 
 /// One ray's march, in grid units: `origin + direction * t` for `t` (mm) in `[start, end]`.
@@ -34,7 +35,8 @@ pub(crate) struct Ray {
     pub first: f32,
 }
 
-/// Rays a packet marches side by side: one 256-bit vector of `f32`.
+/// Rays a packet marches side by side: one AVX2 vector of `f32` (a multiple of every
+/// level's width).
 pub(crate) const LANES: usize = 8;
 
 /// Highlights gathered before their lobe is evaluated together.
@@ -54,16 +56,13 @@ pub(crate) struct Lit<'a> {
 }
 
 /// Marches `rays` (with `lit`, or emission and absorption only) through `volume`, writing ray
-/// `r`'s result to `out[r]`.
-///
-/// The loop is compiled for the best instruction set the CPU has (`arch` dispatches it), with
-/// everything it calls inlined into it.
+/// `r`'s result to `out[r]`, compiled for `level`.
 ///
 /// # Panics
 /// If `out` (or `lit`'s views) and `rays` differ in length.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn march_rays(
-    arch: pulp::Arch,
+    level: Level,
     volume: &PreparedVolume,
     classification: &Classification,
     lit: Option<Lit<'_>>,
@@ -76,15 +75,18 @@ pub(crate) fn march_rays(
     if let Some(lit) = lit {
         assert_eq!(rays.len(), lit.views.len(), "march_rays: one view per ray");
     }
-    arch.dispatch(Packet {
-        volume,
-        classification,
-        lit,
-        rays,
-        step,
-        opacity_cutoff,
-        out,
-    });
+    dispatch(
+        level,
+        Packet {
+            volume,
+            classification,
+            lit,
+            rays,
+            step,
+            opacity_cutoff,
+            out,
+        },
+    );
 }
 
 /// [`march_rays`]'s work, as the instruction-set dispatch takes it.
@@ -99,9 +101,10 @@ struct Packet<'a> {
 }
 
 /// The lanes' rays partway through their marches.
-struct Lanes {
-    /// The ray each lane marches (an index into the list), or none.
-    ray: Lane<Option<usize>>,
+struct Marching {
+    /// The ray each lane marches (an index into the list); `live` says whether it has one.
+    ray: Lane<usize>,
+    live: Lane<bool>,
     origin: [Lane<f32>; 3],
     direction: [Lane<f32>; 3],
     /// Per axis, `1 / direction` (huge along a grid plane), for leaving empty bricks.
@@ -116,15 +119,19 @@ struct Lanes {
     t: Lane<f32>,
     colour: [Lane<f32>; 3],
     transmittance: Lane<f32>,
-    /// The ray's view: `wo`, the half vector, `wi . wo`.
+    /// The rays' views: `wo`, the half vector and `wi . wo`.
     wo: [Lane<f32>; 3],
     half: [Lane<f32>; 3],
     wi_dot_wo: Lane<f32>,
 }
 
-/// One turn's samples, lane by lane.
-struct Samples {
-    /// The extinction there (0 where a lane took no sample).
+/// One turn's segments and samples, lane by lane.
+struct Turn {
+    cell: [Lane<i32>; 3],
+    /// The midpoint's place in its cell.
+    fraction: [Lane<f32>; 3],
+    length: Lane<f32>,
+    /// The extinction at the midpoint (0 where a lane took no sample).
     sigma: Lane<f32>,
     /// The transfer function's colour there.
     base: [Lane<f32>; 3],
@@ -157,59 +164,31 @@ impl Highlights {
     }
 }
 
-impl Lanes {
-    /// Lane `k` takes ray `r` of `rays` (or none), its result in `out[r]` cleared.
-    #[inline(always)]
-    fn start(&mut self, k: usize, r: Option<usize>, packet: &mut Packet<'_>) {
-        self.ray[k] = r;
-        let Some(r) = r else {
-            // An idle lane: no segment left, no light to carry.
-            self.end[k] = f32::NEG_INFINITY;
-            self.t[k] = 0.0;
-            self.transmittance[k] = 0.0;
-            return;
-        };
-        let ray = packet.rays[r];
-        for axis in 0..3 {
-            self.origin[axis][k] = ray.origin[axis];
-            self.direction[axis][k] = ray.direction[axis];
-        }
-        // A direction along a grid plane never leaves a brick across it: a huge inverse keeps
-        // that axis's exit out of the minimum (and away from 0 * infinity).
-        self.inverse_direction[k] = Vec3::select(
-            ray.direction.abs().cmplt(Vec3::splat(1e-12)),
-            Vec3::splat(1e30),
-            ray.direction.recip(),
-        );
-        self.end[k] = ray.end;
-        self.first_end[k] = ray.start + ray.first;
-        self.lattice[k] = ray.start + ray.first - packet.step;
-        self.j[k] = 0;
-        self.t[k] = ray.start;
-        self.transmittance[k] = 1.0;
-        for c in 0..3 {
-            self.colour[c][k] = 0.0;
-        }
-        if let Some(lit) = packet.lit {
-            let view = lit.views[r];
-            for axis in 0..3 {
-                self.wo[axis][k] = view.wo[axis];
-                self.half[axis][k] = view.half[axis];
-            }
-            self.wi_dot_wo[k] = view.wi_dot_wo;
-        }
-        packet.out[r] = (Vec3::ZERO, 1.0);
-    }
+/// The `W` lanes of `array` from `at`.
+#[inline(always)]
+fn load<V: Lanes>(lanes: V, array: &Lane<f32>, at: usize) -> V {
+    lanes.load(&array[at..at + V::WIDTH])
 }
 
-impl pulp::WithSimd for Packet<'_> {
+/// [`load`] for three arrays.
+#[inline(always)]
+fn load3<V: Lanes>(lanes: V, arrays: &[Lane<f32>; 3], at: usize) -> [V; 3] {
+    [
+        load(lanes, &arrays[0], at),
+        load(lanes, &arrays[1], at),
+        load(lanes, &arrays[2], at),
+    ]
+}
+
+impl Job for Packet<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<Level: pulp::Simd>(mut self, _: Level) -> Self::Output {
+    fn run<V: Lanes>(mut self, lanes: V) {
         let zeros = [0.0_f32; LANES];
-        let mut lanes = Lanes {
-            ray: [None; LANES],
+        let mut marching = Marching {
+            ray: [0; LANES],
+            live: [false; LANES],
             origin: [zeros; 3],
             direction: [zeros; 3],
             inverse_direction: [Vec3::ZERO; LANES],
@@ -224,6 +203,14 @@ impl pulp::WithSimd for Packet<'_> {
             half: [zeros; 3],
             wi_dot_wo: zeros,
         };
+        let mut turn = Turn {
+            cell: [[0; LANES]; 3],
+            fraction: [zeros; 3],
+            length: zeros,
+            sigma: zeros,
+            base: [zeros; 3],
+            gradient: [zeros; 3],
+        };
         let mut highlights = Highlights {
             ts: [0.0; HIGHLIGHTS],
             weights: [0.0; HIGHLIGHTS],
@@ -232,25 +219,29 @@ impl pulp::WithSimd for Packet<'_> {
         };
         let mut next = 0;
         for k in 0..LANES {
-            let r = (next < self.rays.len()).then_some(next);
-            next += usize::from(r.is_some());
-            lanes.start(k, r, &mut self);
+            self.start(&mut marching, k, &mut next);
         }
-        while lanes.ray.iter().any(Option::is_some) {
-            let (cells, fractions, lengths) = self.segments(&mut lanes);
-            let samples = self.sample(&mut lanes, &cells, &fractions);
-            self.composite(&mut lanes, &samples, &lengths, &mut highlights);
+        while marching.live.contains(&true) {
+            self.segments(&mut marching, &mut turn);
+            self.sample(&mut marching, &mut turn);
+            self.composite(lanes, &mut marching, &turn, &mut highlights);
+            let mut ended = [false; LANES];
             for k in 0..LANES {
-                let Some(r) = lanes.ray[k] else { continue };
-                if lanes.t[k] < lanes.end[k] && 1.0 - lanes.transmittance[k] < self.opacity_cutoff {
-                    continue;
+                let going = marching.t[k] < marching.end[k]
+                    && 1.0 - marching.transmittance[k] < self.opacity_cutoff;
+                ended[k] = marching.live[k] & !going;
+            }
+            if ended.contains(&true) {
+                for k in (0..LANES).filter(|&k| ended[k]) {
+                    let r = marching.ray[k];
+                    self.out[r].0 += Vec3::new(
+                        marching.colour[0][k],
+                        marching.colour[1][k],
+                        marching.colour[2][k],
+                    );
+                    self.out[r].1 = marching.transmittance[k];
+                    self.start(&mut marching, k, &mut next);
                 }
-                let colour = Vec3::new(lanes.colour[0][k], lanes.colour[1][k], lanes.colour[2][k]);
-                self.out[r].0 += colour;
-                self.out[r].1 = lanes.transmittance[k];
-                let taken = (next < self.rays.len()).then_some(next);
-                next += usize::from(taken.is_some());
-                lanes.start(k, taken, &mut self);
             }
         }
         if let Some(lit) = self.lit {
@@ -260,77 +251,108 @@ impl pulp::WithSimd for Packet<'_> {
 }
 
 impl Packet<'_> {
-    /// Every lane's next segment: the cell its midpoint lies in, the place there, and its
-    /// length. Advances the lanes past it.
+    /// Lane `k` takes ray `next` of the list (its result cleared) and `next` moves on, or the
+    /// lane idles when the list has run out.
     #[inline(always)]
-    fn segments(&self, lanes: &mut Lanes) -> ([Lane<i32>; 3], [Lane<f32>; 3], Lane<f32>) {
+    fn start(&mut self, marching: &mut Marching, k: usize, next: &mut usize) {
+        let Some(&ray) = self.rays.get(*next) else {
+            marching.live[k] = false;
+            return;
+        };
+        let r = *next;
+        *next += 1;
+        marching.ray[k] = r;
+        marching.live[k] = true;
+        for axis in 0..3 {
+            marching.origin[axis][k] = ray.origin[axis];
+            marching.direction[axis][k] = ray.direction[axis];
+        }
+        // A direction along a grid plane never leaves a brick across it: a huge inverse keeps
+        // that axis's exit out of the minimum (and away from 0 * infinity).
+        marching.inverse_direction[k] = Vec3::select(
+            ray.direction.abs().cmplt(Vec3::splat(1e-12)),
+            Vec3::splat(1e30),
+            ray.direction.recip(),
+        );
+        marching.end[k] = ray.end;
+        marching.first_end[k] = ray.start + ray.first;
+        marching.lattice[k] = ray.start + ray.first - self.step;
+        marching.j[k] = 0;
+        marching.t[k] = ray.start;
+        marching.transmittance[k] = 1.0;
+        for c in 0..3 {
+            marching.colour[c][k] = 0.0;
+        }
+        if let Some(lit) = self.lit {
+            let view = lit.views[r];
+            for axis in 0..3 {
+                marching.wo[axis][k] = view.wo[axis];
+                marching.half[axis][k] = view.half[axis];
+            }
+            marching.wi_dot_wo[k] = view.wi_dot_wo;
+        }
+        self.out[r] = (Vec3::ZERO, 1.0);
+    }
+
+    /// Every lane's next segment: its length, the cell its midpoint lies in and the place
+    /// there. Advances the lanes past it.
+    #[inline(always)]
+    fn segments(&self, marching: &mut Marching, turn: &mut Turn) {
         // See `PreparedVolume::cell`: adding 1.5 * 2^23 to p - 1/2 rounds it to an integer.
         const ROUND: f32 = 12_582_912.0;
         let step = self.step;
-        let last_index = self.volume.last_index;
-        let last_cell = self.volume.last_cell;
-        let mut cells = [[0_i32; LANES]; 3];
-        let mut fractions = [[0.0_f32; LANES]; 3];
-        let mut lengths = [0.0_f32; LANES];
+        let (last_index, last_cell) = (self.volume.last_index, self.volume.last_cell);
         for k in 0..LANES {
-            let j = lanes.j[k];
+            let j = marching.j[k];
             let next = if j == 0 {
-                lanes.first_end[k]
+                marching.first_end[k]
             } else {
-                lanes.lattice[k] + (j + 1) as f32 * step
+                marching.lattice[k] + (j + 1) as f32 * step
             };
-            let length = next.min(lanes.end[k]) - lanes.t[k];
-            lengths[k] = length;
-            let middle = lanes.t[k] + 0.5 * length;
+            let length = next.min(marching.end[k]) - marching.t[k];
+            turn.length[k] = length;
+            let middle = marching.t[k] + 0.5 * length;
             for axis in 0..3 {
-                let p = (lanes.origin[axis][k] + lanes.direction[axis][k] * middle)
+                let p = (marching.origin[axis][k] + marching.direction[axis][k] * middle)
                     .max(0.0)
                     .min(last_index[axis]);
                 let rounded = (p - 0.5) + ROUND;
                 let cell = (rounded.to_bits() as i32 - ROUND.to_bits() as i32).min(last_cell[axis]);
-                cells[axis][k] = cell;
-                fractions[axis][k] = p - cell as f32;
+                turn.cell[axis][k] = cell;
+                turn.fraction[axis][k] = p - cell as f32;
             }
-            lanes.t[k] = next;
-            lanes.j[k] = j + 1;
+            marching.t[k] = next;
+            marching.j[k] = j + 1;
         }
-        (cells, fractions, lengths)
     }
 
     /// Each lane's sample, read lane by lane: lanes in empty bricks skip ahead instead.
     #[inline(always)]
-    fn sample(
-        &self,
-        lanes: &mut Lanes,
-        cells: &[Lane<i32>; 3],
-        fractions: &[Lane<f32>; 3],
-    ) -> Samples {
+    fn sample(&self, marching: &mut Marching, turn: &mut Turn) {
         let (volume, classification) = (self.volume, self.classification);
-        let zeros = [0.0_f32; LANES];
-        let mut samples = Samples {
-            sigma: zeros,
-            base: [zeros; 3],
-            gradient: [zeros; 3],
-        };
         for k in 0..LANES {
-            if lanes.ray[k].is_none() {
+            turn.sigma[k] = 0.0;
+            if !marching.live[k] {
                 continue;
             }
-            let cell = IVec3::new(cells[0][k], cells[1][k], cells[2][k]);
+            let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
             if !classification.occupied[volume.brick(cell)] {
-                self.skip(lanes, k, cell);
+                self.skip(marching, k, cell);
                 continue;
             }
-            let f = Vec3::new(fractions[0][k], fractions[1][k], fractions[2][k]);
-            let sample = volume.sample_in(cell, f);
+            let fraction = Vec3::new(
+                turn.fraction[0][k],
+                turn.fraction[1][k],
+                turn.fraction[2][k],
+            );
+            let sample = volume.sample_in(cell, fraction);
             let classified = classification.at(sample.x);
-            samples.sigma[k] = classified.x;
+            turn.sigma[k] = classified.x;
             for c in 0..3 {
-                samples.base[c][k] = classified[c + 1];
-                samples.gradient[c][k] = sample[c + 1];
+                turn.base[c][k] = classified[c + 1];
+                turn.gradient[c][k] = sample[c + 1];
             }
         }
-        samples
     }
 
     /// Lane `k`'s midpoint lies in the empty brick `cell` is in: every sample whose midpoint
@@ -338,80 +360,84 @@ impl Packet<'_> {
     /// margin keeps the one that rounding could place across it); out of the whole region
     /// when it is empty too.
     #[inline(always)]
-    fn skip(&self, lanes: &mut Lanes, k: usize, cell: IVec3) {
+    fn skip(&self, marching: &mut Marching, k: usize, cell: IVec3) {
         let (volume, classification) = (self.volume, self.classification);
-        let origin = Vec3::new(lanes.origin[0][k], lanes.origin[1][k], lanes.origin[2][k]);
-        let inverse_direction = lanes.inverse_direction[k];
+        let origin = Vec3::new(
+            marching.origin[0][k],
+            marching.origin[1][k],
+            marching.origin[2][k],
+        );
+        let inverse_direction = marching.inverse_direction[k];
         let exit = if classification.occupied_regions[volume.region(cell)] {
             volume.brick_exit(cell, origin, inverse_direction)
         } else {
             volume.region_exit(cell, origin, inverse_direction)
         };
-        let beyond = (exit - lanes.t[k]) / self.step - 0.5 - 1e-3;
+        let beyond = (exit - marching.t[k]) / self.step - 0.5 - 1e-3;
         if beyond > 0.0 {
             // ceil without a library call (beyond > 0).
             let skipped = beyond as i32;
-            lanes.j[k] += skipped as u32 + u32::from((skipped as f32) < beyond);
-            lanes.t[k] = lanes.lattice[k] + lanes.j[k] as f32 * self.step;
+            marching.j[k] += skipped as u32 + u32::from((skipped as f32) < beyond);
+            marching.t[k] = marching.lattice[k] + marching.j[k] as f32 * self.step;
         }
     }
 
-    /// Composites each lane's sample front to back, lit, and gathers its highlight. A
+    /// Composites each lane's sample front to back, lit, and gathers its highlight: a
     /// segment of `length` at extinction `sigma` is opaque by `1 - exp(-sigma length)`.
     #[inline(always)]
-    fn composite(
+    fn composite<V: Lanes>(
         &mut self,
-        lanes: &mut Lanes,
-        samples: &Samples,
-        lengths: &Lane<f32>,
+        lanes: V,
+        marching: &mut Marching,
+        turn: &Turn,
         highlights: &mut Highlights,
     ) {
-        let mut carried = [0.0_f32; LANES];
-        let mut sampled = [false; LANES];
-        for k in 0..LANES {
-            let sigma = samples.sigma[k].max(0.0);
-            let alpha = 1.0 - exp2_nonpositive(-sigma * lengths[k] * core::f32::consts::LOG2_E);
-            carried[k] = lanes.transmittance[k] * alpha;
-            lanes.transmittance[k] *= 1.0 - alpha;
-            sampled[k] = sigma > 0.0;
-        }
-        let Some(lit) = self.lit else {
-            for c in 0..3 {
-                for k in 0..LANES {
-                    lanes.colour[c][k] += carried[k] * samples.base[c][k];
-                }
-            }
-            return;
-        };
+        let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
         let mut ts = [0.0_f32; LANES];
         let mut weights = [0.0_f32; LANES];
-        let mut keep = [false; LANES];
-        for k in 0..LANES {
-            let parts = lit.lighting.lit_parts(
-                Vec3::new(
-                    samples.gradient[0][k],
-                    samples.gradient[1][k],
-                    samples.gradient[2][k],
-                ),
-                Vec3::new(lanes.wo[0][k], lanes.wo[1][k], lanes.wo[2][k]),
-                Vec3::new(lanes.half[0][k], lanes.half[1][k], lanes.half[2][k]),
-                lanes.wi_dot_wo[k],
-            );
+        for at in (0..LANES).step_by(V::WIDTH) {
+            let sigma = load(lanes, &turn.sigma, at).max(zero);
+            let length = load(lanes, &turn.length, at);
+            let alpha =
+                one - exp2_nonpositive(sigma * length * lanes.splat(-core::f32::consts::LOG2_E));
+            let transmittance = load(lanes, &marching.transmittance, at);
+            let carried = transmittance * alpha;
+            (transmittance * (one - alpha)).store(&mut marching.transmittance[at..at + V::WIDTH]);
+            let base = load3(lanes, &turn.base, at);
+            let colour = load3(lanes, &marching.colour, at);
+            // Written out rather than `array::map`: a closure a library function calls is
+            // compiled without the level's instruction set.
+            let lit_scale = match self.lit {
+                None => one,
+                Some(lit) => {
+                    let view = LanesView {
+                        wo: load3(lanes, &marching.wo, at),
+                        half: load3(lanes, &marching.half, at),
+                        wi_dot_wo: load(lanes, &marching.wi_dot_wo, at),
+                    };
+                    let gradient = load3(lanes, &turn.gradient, at);
+                    let light = lit.lighting.light_lanes(gradient, &view);
+                    light.t.store(&mut ts[at..at + V::WIDTH]);
+                    // Every lobe is 0 at a cosine of 0 or less; a lane that took no sample
+                    // carried nothing (its weight is 0 and it is not gathered).
+                    (carried * light.highlight)
+                        .keep(light.t.gt(zero))
+                        .store(&mut weights[at..at + V::WIDTH]);
+                    light.colour_scale
+                }
+            };
             for c in 0..3 {
-                lanes.colour[c][k] += carried[k] * (samples.base[c][k] * parts.colour_scale);
+                (colour[c] + carried * (base[c] * lit_scale))
+                    .store(&mut marching.colour[c][at..at + V::WIDTH]);
             }
-            ts[k] = parts.t;
-            weights[k] = carried[k] * parts.highlight;
-            // Every lobe is 0 at a cosine of 0 or less; a lane that took no sample carried
-            // nothing.
-            keep[k] = sampled[k] && parts.highlight > 0.0 && parts.t > 0.0;
         }
+        let Some(lit) = self.lit else { return };
         for k in 0..LANES {
             let at = highlights.gathered;
             highlights.ts[at] = ts[k];
             highlights.weights[at] = weights[k];
-            highlights.rays[at] = lanes.ray[k].unwrap_or(0);
-            highlights.gathered += usize::from(keep[k]);
+            highlights.rays[at] = marching.ray[k];
+            highlights.gathered += usize::from(weights[k] > 0.0);
         }
         if highlights.gathered > HIGHLIGHTS - LANES {
             highlights.flush(lit.lighting, self.out);

@@ -190,7 +190,7 @@ fn empty_bricks_are_skipped_without_changing_a_pixel() {
     let march_with = |c: &Classification, rays: &[Ray]| {
         let mut out = vec![(Vec3::ZERO, 1.0); rays.len()];
         march_rays(
-            pulp::Arch::new(),
+            specula::simd::Level::detect(),
             &prepared,
             c,
             None,

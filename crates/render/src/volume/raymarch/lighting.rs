@@ -2,6 +2,7 @@
 //! highlight.
 
 use glam::Vec3;
+use specula::simd::Lanes;
 use specula::{Geometry, Lobe, Normalisation};
 
 use crate::volume::Volume;
@@ -107,94 +108,70 @@ impl Lighting {
         }
     }
 
-    /// A sample's colour `base` lit by the classic model, with its `gradient` (value per mm)
-    /// as the normal, seen along `wo`.
-    #[must_use]
-    pub fn shade(&self, gradient: Vec3, base: Vec3, wo: Vec3) -> Vec3 {
-        let lit = self.light(gradient, base, &RayView::new(self, wo));
-        lit.colour + Vec3::splat(lit.highlight * self.shading.lobe.eval(lit.t))
-    }
-
-    /// [`Lighting::shade`] in parts, the lobe left unevaluated (a ray gathers its cosines
-    /// and evaluates them together).
+    /// Samples lit by the classic model, a vector of them at once (the ray marcher lights
+    /// several rays' samples together): lane `k` has the `gradient` (value per mm) whose
+    /// opposite, turned to face the viewer, is its normal, and the view `wo`, `half` vector
+    /// and `wi . wo` of its own ray. Lane-wise, with no branch on a sample.
     #[inline(always)]
-    #[must_use]
-    pub fn light(&self, gradient: Vec3, base: Vec3, view: &RayView) -> LitSample {
-        let parts = self.lit_parts(gradient, view.wo, view.half, view.wi_dot_wo);
-        LitSample {
-            colour: base * parts.colour_scale,
-            highlight: parts.highlight,
-            t: parts.t,
-        }
-    }
-
-    /// [`Lighting::light`] without a branch on the sample (the ray marcher lights several
-    /// rays' samples at once, lane by lane): the view is `wo`, its `half` vector and
-    /// `wi . wo`.
-    #[inline(always)]
-    pub(crate) fn lit_parts(
+    pub(crate) fn light_lanes<V: Lanes>(
         &self,
-        gradient: Vec3,
-        wo: Vec3,
-        half: Vec3,
-        wi_dot_wo: f32,
-    ) -> LitParts {
-        let squared = gradient.length_squared();
+        gradient: [V; 3],
+        view: &LanesView<V>,
+    ) -> LitLanes<V> {
+        let shading = &self.shading;
+        let [gx, gy, gz] = gradient;
+        let lanes = gx;
+        let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
+        let dot = |v: [V; 3]| gx * v[0] + gy * v[1] + gz * v[2];
+        let squared = dot(gradient);
         // No gradient (or an infinite one): unlit, as a sample inside uniform tissue.
-        let lit = squared > 0.0 && squared < f32::INFINITY;
-        let inverse = if lit { squared } else { 1.0 }.sqrt().recip();
+        let finite = squared.keep(squared.lt(lanes.splat(f32::INFINITY)));
+        let shaded = finite.gt(zero);
+        let inverse = one / finite.select(shaded, one).sqrt();
         // The normal is the gradient's opposite turned to face the viewer: `k g` with
         // `|k| = 1 / |g|`, so its dot products are those of the gradient, scaled.
-        let towards_viewer = gradient.dot(wo);
-        let k = if towards_viewer > 0.0 {
-            inverse
-        } else {
-            -inverse
-        };
-        let shading = &self.shading;
-        let along_light = k * gradient.dot(self.light);
-        let diffuse = along_light.max(0.0);
+        let towards_viewer = dot(view.wo);
+        let k = inverse.select(towards_viewer.gt(zero), zero - inverse);
+        let light = [self.light.x, self.light.y, self.light.z];
+        let along_light = k * dot([
+            lanes.splat(light[0]),
+            lanes.splat(light[1]),
+            lanes.splat(light[2]),
+        ]);
+        let diffuse = along_light.max(zero);
         let t = match shading.geometry {
-            Geometry::Phong => 2.0 * along_light * (k * towards_viewer) - wi_dot_wo,
-            Geometry::Blinn => k * gradient.dot(half),
+            Geometry::Phong => {
+                lanes.splat(2.0) * along_light * (k * towards_viewer) - view.wi_dot_wo
+            }
+            Geometry::Blinn => k * dot(view.half),
         };
         // base.lerp(lit, weight), the highlight's share kept apart.
-        let weight = (squared * inverse * self.per_gradient_reference).min(1.0);
-        LitParts {
-            colour_scale: if lit {
-                1.0 + weight * (shading.ka + shading.kd * diffuse - 1.0)
-            } else {
-                1.0
-            },
-            highlight: if lit {
-                weight * shading.ks * self.normalisation
-            } else {
-                0.0
-            },
-            t: if lit { t } else { 0.0 },
+        let weight = (squared * inverse * lanes.splat(self.per_gradient_reference)).min(one);
+        let lit =
+            one + weight * (lanes.splat(shading.ka) + lanes.splat(shading.kd) * diffuse - one);
+        LitLanes {
+            colour_scale: lit.select(shaded, one),
+            highlight: (weight * lanes.splat(shading.ks * self.normalisation)).keep(shaded),
+            t: t.keep(shaded),
         }
     }
 }
 
-/// A sample's lighting, its colour apart: the sample is `colour_scale * base + highlight *
-/// lobe(t)` in every channel.
+/// Rays' views, lane by lane (see [`RayView`]).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct LitParts {
-    pub colour_scale: f32,
-    pub highlight: f32,
-    pub t: f32,
+pub(crate) struct LanesView<V> {
+    pub wo: [V; 3],
+    pub half: [V; 3],
+    pub wi_dot_wo: V,
 }
 
-/// A sample lit, its highlight apart: the sample is `colour + highlight * lobe(t)` in every
-/// channel (the highlight is white).
+/// Samples' lighting, their colours apart: a sample is `colour_scale * base + highlight *
+/// lobe(t)` in every channel (the highlight is white).
 #[derive(Clone, Copy, Debug)]
-pub struct LitSample {
-    /// Ambient and diffuse.
-    pub colour: Vec3,
-    /// The lobe's weight.
-    pub highlight: f32,
-    /// The lobe's cosine.
-    pub t: f32,
+pub(crate) struct LitLanes<V> {
+    pub colour_scale: V,
+    pub highlight: V,
+    pub t: V,
 }
 
 /// What one ray's samples share: the view direction and, for Blinn, the half vector.

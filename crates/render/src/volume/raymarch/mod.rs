@@ -12,13 +12,13 @@
 //! (two-sided). Rays stop once 99 % opaque (early ray termination). `view.rs` names the views
 //! and frames their rays; `march` is how the CPU computes all this fast.
 
-mod lighting;
+pub(crate) mod lighting;
 mod view;
 
 use glam::Vec3;
 use rayon::prelude::*;
 
-pub use lighting::{Light, Lighting, LitSample, RayView, Shading};
+pub use lighting::{Light, Lighting, RayView, Shading};
 pub use view::{surface_camera, RayCamera, View};
 
 use super::march::ray::{march_rays, Lit, Ray};
@@ -155,7 +155,7 @@ pub fn render_dvr_prepared(
         lighting,
     } = DvrPlan::new(volume, settings)?;
     let classification = Classification::new(prepared, transfer);
-    let arch = pulp::Arch::new();
+    let level = specula::simd::Level::detect();
     let mut pixels = vec![settings.background; width as usize * height as usize];
     // Bands of TILE rows, drawn tile by tile: a tile's rays cross the same few columns of
     // voxels, which then stay in cache from one ray to the next.
@@ -203,7 +203,7 @@ pub fn render_dvr_prepared(
                 marched.clear();
                 marched.resize(rays.len(), (Vec3::ZERO, 1.0));
                 march_rays(
-                    arch,
+                    level,
                     prepared,
                     &classification,
                     lighting.as_ref().map(|lighting| Lit {
