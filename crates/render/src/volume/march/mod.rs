@@ -155,13 +155,26 @@ impl PreparedVolume {
         self.sample_in(cell, f)
     }
 
-    /// The cell's corners are four pairs of neighbours along `i`, each pair eight numbers in
-    /// a row: they are interpolated pairwise along `y`, then `z` (eight lanes at a time), and
-    /// the pair's two ends along `x` last.
+    /// The first voxel of `cell` (its corner of smallest indices). Plain `i32` arithmetic
+    /// (a grid holds fewer than `2^31` voxels), so that lanes compute it side by side.
+    #[inline(always)]
+    fn voxel(&self, cell: [i32; 3]) -> i32 {
+        let [nx, ny, _] = self.dims.map(|d| d as i32);
+        cell[0] + nx * (cell[1] + ny * cell[2])
+    }
+
     #[inline(always)]
     fn sample_in(&self, cell: IVec3, f: Vec3) -> Vec4 {
+        self.sample_at(self.voxel(cell.to_array()) as usize, f)
+    }
+
+    /// The trilinear value and gradient at `f` in the cell whose first voxel is `at`. The
+    /// cell's corners are four pairs of neighbours along `i`, each pair eight numbers in a
+    /// row: they are interpolated pairwise along `y`, then `z` (eight lanes at a time), and
+    /// the pair's two ends along `x` last.
+    #[inline(always)]
+    fn sample_at(&self, at: usize, f: Vec3) -> Vec4 {
         let (nx, nxy) = (self.dims[0], self.dims[0] * self.dims[1]);
-        let at = cell.x as usize + nx * cell.y as usize + nxy * cell.z as usize;
         let pair = |voxel: usize| -> [f32; 8] {
             *self.voxels[voxel..]
                 .as_flattened()
@@ -176,11 +189,11 @@ impl PreparedVolume {
         low + (high - low) * f.x
     }
 
-    /// The index of the brick holding `cell`.
+    /// The index of the brick holding `cell` (`i32` arithmetic, as [`Self::voxel`]).
     #[inline(always)]
-    fn brick(&self, cell: IVec3) -> usize {
-        let b = cell >> BRICK_SHIFT;
-        b.x as usize + self.bricks[0] * (b.y as usize + self.bricks[1] * b.z as usize)
+    fn brick(&self, cell: [i32; 3]) -> i32 {
+        let [bx, by, _] = self.bricks.map(|b| b as i32);
+        (cell[0] >> BRICK_SHIFT) + bx * ((cell[1] >> BRICK_SHIFT) + by * (cell[2] >> BRICK_SHIFT))
     }
 
     /// Where a ray (grid index `origin + direction * t`) leaves the brick holding `cell`.

@@ -128,6 +128,9 @@ struct Marching {
 /// One turn's segments and samples, lane by lane.
 struct Turn {
     cell: [Lane<i32>; 3],
+    /// The cell's first voxel, and the brick holding it.
+    voxel: Lane<i32>,
+    brick: Lane<i32>,
     /// The midpoint's place in its cell.
     fraction: [Lane<f32>; 3],
     length: Lane<f32>,
@@ -205,6 +208,8 @@ impl Job for Packet<'_> {
         };
         let mut turn = Turn {
             cell: [[0; LANES]; 3],
+            voxel: [0; LANES],
+            brick: [0; LANES],
             fraction: [zeros; 3],
             length: zeros,
             sigma: zeros,
@@ -321,12 +326,17 @@ impl Packet<'_> {
                 turn.cell[axis][k] = cell;
                 turn.fraction[axis][k] = p - cell as f32;
             }
+            let cell = [turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]];
+            turn.voxel[k] = self.volume.voxel(cell);
+            turn.brick[k] = self.volume.brick(cell);
             marching.t[k] = next;
             marching.j[k] = j + 1;
         }
     }
 
-    /// Each lane's sample, read lane by lane: lanes in empty bricks skip ahead instead.
+    /// Each lane's sample, read lane by lane: lanes in empty bricks skip ahead instead (in
+    /// step with the others: a lane skipping brick after brick on its own would be one long
+    /// chain of dependent instructions while the rest wait).
     #[inline(always)]
     fn sample(&self, marching: &mut Marching, turn: &mut Turn) {
         let (volume, classification) = (self.volume, self.classification);
@@ -335,8 +345,8 @@ impl Packet<'_> {
             if !marching.live[k] {
                 continue;
             }
-            let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
-            if !classification.occupied[volume.brick(cell)] {
+            if !classification.occupied[turn.brick[k] as usize] {
+                let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
                 self.skip(marching, k, cell);
                 continue;
             }
@@ -345,7 +355,7 @@ impl Packet<'_> {
                 turn.fraction[1][k],
                 turn.fraction[2][k],
             );
-            let sample = volume.sample_in(cell, fraction);
+            let sample = volume.sample_at(turn.voxel[k] as usize, fraction);
             let classified = classification.at(sample.x);
             turn.sigma[k] = classified.x;
             for c in 0..3 {
