@@ -140,6 +140,22 @@ struct Turn {
     base: [Lane<f32>; 3],
     /// The field's gradient there (world, value per mm).
     gradient: [Lane<f32>; 3],
+    /// Where the lane's march stands after this turn (past its segment or a skip).
+    t_end: Lane<f32>,
+}
+
+impl Turn {
+    const EMPTY: Self = Self {
+        cell: [[0; LANES]; 3],
+        voxel: [0; LANES],
+        brick: [0; LANES],
+        fraction: [[0.0; LANES]; 3],
+        length: [0.0; LANES],
+        sigma: [0.0; LANES],
+        base: [[0.0; LANES]; 3],
+        gradient: [[0.0; LANES]; 3],
+        t_end: [0.0; LANES],
+    };
 }
 
 /// Highlights waiting for their lobe: cosine, weight and the ray they belong to.
@@ -206,16 +222,6 @@ impl Job for Packet<'_> {
             half: [zeros; 3],
             wi_dot_wo: zeros,
         };
-        let mut turn = Turn {
-            cell: [[0; LANES]; 3],
-            voxel: [0; LANES],
-            brick: [0; LANES],
-            fraction: [zeros; 3],
-            length: zeros,
-            sigma: zeros,
-            base: [zeros; 3],
-            gradient: [zeros; 3],
-        };
         let mut highlights = Highlights {
             ts: [0.0; HIGHLIGHTS],
             weights: [0.0; HIGHLIGHTS],
@@ -226,13 +232,21 @@ impl Job for Packet<'_> {
         for k in 0..LANES {
             self.start(&mut marching, k, &mut next);
         }
+        // Software-pipelined: the next turn's samples are read before this turn's are
+        // composited, so that the vector loads of a turn's lanes find them stored a whole
+        // phase earlier (a vector load of values just stored lane by lane cannot be
+        // forwarded from the stores and waits for all of them). A lane whose ray ends has its
+        // read-ahead sample replaced by its next ray's first.
+        let (mut current, mut ahead) = (Turn::EMPTY, Turn::EMPTY);
+        self.segments(&mut marching, &mut current);
+        self.sample(&mut marching, &mut current);
         while marching.live.contains(&true) {
-            self.segments(&mut marching, &mut turn);
-            self.sample(&mut marching, &mut turn);
-            self.composite(lanes, &mut marching, &turn, &mut highlights);
+            self.segments(&mut marching, &mut ahead);
+            self.sample(&mut marching, &mut ahead);
+            self.composite(lanes, &mut marching, &current, &mut highlights);
             let mut ended = [false; LANES];
             for k in 0..LANES {
-                let going = marching.t[k] < marching.end[k]
+                let going = current.t_end[k] < marching.end[k]
                     && 1.0 - marching.transmittance[k] < self.opacity_cutoff;
                 ended[k] = marching.live[k] & !going;
             }
@@ -246,8 +260,13 @@ impl Job for Packet<'_> {
                     );
                     self.out[r].1 = marching.transmittance[k];
                     self.start(&mut marching, k, &mut next);
+                    if marching.live[k] {
+                        self.segment(&mut marching, &mut ahead, k);
+                        self.sample_lane(&mut marching, &mut ahead, k);
+                    }
                 }
             }
+            core::mem::swap(&mut current, &mut ahead);
         }
         if let Some(lit) = self.lit {
             highlights.flush(lit.lighting, self.out);
@@ -303,11 +322,19 @@ impl Packet<'_> {
     /// there. Advances the lanes past it.
     #[inline(always)]
     fn segments(&self, marching: &mut Marching, turn: &mut Turn) {
+        for k in 0..LANES {
+            self.segment(marching, turn, k);
+        }
+    }
+
+    /// [`Self::segments`] for lane `k`.
+    #[inline(always)]
+    fn segment(&self, marching: &mut Marching, turn: &mut Turn, k: usize) {
         // See `PreparedVolume::cell`: adding 1.5 * 2^23 to p - 1/2 rounds it to an integer.
         const ROUND: f32 = 12_582_912.0;
         let step = self.step;
         let (last_index, last_cell) = (self.volume.last_index, self.volume.last_cell);
-        for k in 0..LANES {
+        {
             let j = marching.j[k];
             let next = if j == 0 {
                 marching.first_end[k]
@@ -339,29 +366,37 @@ impl Packet<'_> {
     /// chain of dependent instructions while the rest wait).
     #[inline(always)]
     fn sample(&self, marching: &mut Marching, turn: &mut Turn) {
-        let (volume, classification) = (self.volume, self.classification);
         for k in 0..LANES {
-            turn.sigma[k] = 0.0;
-            if !marching.live[k] {
-                continue;
-            }
-            if !classification.occupied[turn.brick[k] as usize] {
-                let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
-                self.skip(marching, k, cell);
-                continue;
-            }
-            let fraction = Vec3::new(
-                turn.fraction[0][k],
-                turn.fraction[1][k],
-                turn.fraction[2][k],
-            );
-            let sample = volume.sample_at(turn.voxel[k] as usize, fraction);
-            let classified = classification.at(sample.x);
-            turn.sigma[k] = classified.x;
-            for c in 0..3 {
-                turn.base[c][k] = classified[c + 1];
-                turn.gradient[c][k] = sample[c + 1];
-            }
+            self.sample_lane(marching, turn, k);
+        }
+    }
+
+    /// [`Self::sample`] for lane `k`.
+    #[inline(always)]
+    fn sample_lane(&self, marching: &mut Marching, turn: &mut Turn, k: usize) {
+        let (volume, classification) = (self.volume, self.classification);
+        turn.sigma[k] = 0.0;
+        if !marching.live[k] {
+            return;
+        }
+        if !classification.occupied[turn.brick[k] as usize] {
+            let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
+            self.skip(marching, k, cell);
+            turn.t_end[k] = marching.t[k];
+            return;
+        }
+        turn.t_end[k] = marching.t[k];
+        let fraction = Vec3::new(
+            turn.fraction[0][k],
+            turn.fraction[1][k],
+            turn.fraction[2][k],
+        );
+        let sample = volume.sample_at(turn.voxel[k] as usize, fraction);
+        let classified = classification.at(sample.x);
+        turn.sigma[k] = classified.x;
+        for c in 0..3 {
+            turn.base[c][k] = classified[c + 1];
+            turn.gradient[c][k] = sample[c + 1];
         }
     }
 
