@@ -243,7 +243,11 @@ impl Job for Packet<'_> {
         while marching.live.contains(&true) {
             self.segments(&mut marching, &mut ahead);
             self.sample(&mut marching, &mut ahead);
-            self.composite(lanes, &mut marching, &current, &mut highlights);
+            // A turn in which no lane took a sample with extinction composites nothing
+            // (common where a packet's rays cross air or tissue the transfer function hides).
+            if current.sigma.iter().any(|&sigma| sigma > 0.0) {
+                self.composite(lanes, &mut marching, &current, &mut highlights);
+            }
             let mut ended = [false; LANES];
             for k in 0..LANES {
                 let going = current.t_end[k] < marching.end[k]
