@@ -8,7 +8,9 @@
 //!   the outer sample of the difference, the prepared field the voxel's.
 //! - **Empty space skipped exactly.** The grid is cut into bricks of [`BRICK`]^3 cells with
 //!   each brick's smallest and largest value; a render marks the bricks whose whole value
-//!   range has no extinction, and a ray inside such a brick jumps to its exit along its own
+//!   range has no extinction and finds, for each, how far the empty space around it reaches
+//!   (its chessboard distance to the nearest occupied brick, two raster passes). A ray in an
+//!   empty brick jumps to its exit from the empty cube of bricks centred there, along its own
 //!   lattice of segments, so every sample it still takes is one it would have taken.
 //! - **Classification without a search.** A table over the volume's range finds the piece
 //!   of the transfer function a value falls in, whose line then gives extinction and colour
@@ -32,11 +34,9 @@ pub const BRICK: usize = 1 << BRICK_SHIFT;
 
 const BRICK_SHIFT: i32 = 2;
 
-/// Bricks along each side of a region, the coarser level a ray skips by in empty space:
-/// `2^REGION_SHIFT`.
-pub const REGION: usize = 1 << REGION_SHIFT;
-
-const REGION_SHIFT: i32 = 2;
+/// How far, in bricks, an empty brick's clearance is counted: a ray skips at most this many
+/// bricks' worth of empty space at once.
+const MOST_CLEARANCE: u8 = 16;
 
 /// Entries of the table that finds a value's piece of the transfer function.
 pub const CLASSIFICATION_ENTRIES: usize = 4096;
@@ -53,7 +53,6 @@ pub struct PreparedVolume {
     last_cell: IVec3,
     last_index: Vec3,
     bricks: [usize; 3],
-    regions: [usize; 3],
     /// Smallest and largest value of each brick's voxels (its cells' corners).
     brick_ranges: Vec<(f32, f32)>,
     range: (f32, f32),
@@ -118,7 +117,6 @@ impl PreparedVolume {
             last_cell: IVec3::from(dims.map(|d| (d - 2) as i32)),
             last_index: volume.last_index(),
             bricks,
-            regions: bricks.map(|b| b.div_ceil(REGION)),
             brick_ranges,
             range: volume.range(),
         }
@@ -196,30 +194,13 @@ impl PreparedVolume {
         (cell[0] >> BRICK_SHIFT) + bx * ((cell[1] >> BRICK_SHIFT) + by * (cell[2] >> BRICK_SHIFT))
     }
 
-    /// Where a ray (grid index `origin + direction * t`) leaves the brick holding `cell`.
+    /// Where a ray (grid index `origin + direction * t`) leaves the cube of bricks within
+    /// `reach - 1` bricks of the one holding `cell` (that brick alone for a reach of 1).
     #[inline(always)]
-    fn brick_exit(&self, cell: IVec3, origin: Vec3, inverse_direction: Vec3) -> f32 {
-        Self::exit(cell, BRICK_SHIFT, origin, inverse_direction)
-    }
-
-    /// The index of the region of [`REGION`] bricks a side holding `cell`.
-    #[inline(always)]
-    fn region(&self, cell: IVec3) -> usize {
-        let r = cell >> (BRICK_SHIFT + REGION_SHIFT);
-        r.x as usize + self.regions[0] * (r.y as usize + self.regions[1] * r.z as usize)
-    }
-
-    /// Where a ray leaves the region holding `cell`.
-    #[inline(always)]
-    fn region_exit(&self, cell: IVec3, origin: Vec3, inverse_direction: Vec3) -> f32 {
-        Self::exit(cell, BRICK_SHIFT + REGION_SHIFT, origin, inverse_direction)
-    }
-
-    /// Where a ray leaves the aligned cube of `2^shift` cells a side holding `cell`.
-    #[inline(always)]
-    fn exit(cell: IVec3, shift: i32, origin: Vec3, inverse_direction: Vec3) -> f32 {
-        let low = (cell >> shift << shift).as_vec3();
-        let high = low + (1 << shift) as f32;
+    fn clear_exit(cell: IVec3, reach: i32, origin: Vec3, inverse_direction: Vec3) -> f32 {
+        let brick = cell >> BRICK_SHIFT;
+        let low = ((brick - (reach - 1)) << BRICK_SHIFT).as_vec3();
+        let high = ((brick + reach) << BRICK_SHIFT).as_vec3();
         let a = (low - origin) * inverse_direction;
         let c = (high - origin) * inverse_direction;
         a.max(c).min_element()
@@ -251,10 +232,10 @@ pub struct Classification {
     first_piece: Vec<u16>,
     lowest: f32,
     per_entry: f32,
-    /// Whether each brick holds any value with extinction.
-    occupied: Vec<bool>,
-    /// Whether each region holds an occupied brick.
-    occupied_regions: Vec<bool>,
+    /// Per brick, 0 where it holds a value with extinction, else its chessboard distance in
+    /// bricks to the nearest such brick (at most [`MOST_CLEARANCE`]): every brick less than
+    /// that far from it is empty too.
+    clearance: Vec<u8>,
 }
 
 impl Classification {
@@ -309,21 +290,14 @@ impl Classification {
                         .any(|p| p.sigma > 0.0 && p.value > lo && p.value < hi)
             })
             .collect();
-        let mut occupied_regions = vec![false; volume.regions.iter().product()];
-        for (b, _) in occupied.iter().enumerate().filter(|(_, &o)| o) {
-            let [bx, by] = [volume.bricks[0], volume.bricks[1]];
-            let brick = [b % bx, b / bx % by, b / (bx * by)].map(|c| c / REGION);
-            let [rx, ry] = [volume.regions[0], volume.regions[1]];
-            occupied_regions[brick[0] + rx * (brick[1] + ry * brick[2])] = true;
-        }
+        let clearance = chessboard_distance(&occupied, volume.bricks);
         Self {
             bounds,
             pieces,
             first_piece,
             lowest,
             per_entry,
-            occupied,
-            occupied_regions,
+            clearance,
         }
     }
 
@@ -343,4 +317,66 @@ impl Classification {
         let (start, at_start, slope) = self.pieces[piece];
         at_start + slope * (value - start)
     }
+}
+
+/// Per brick of a `[nx, ny, nz]` grid, 0 where `occupied`, else the chessboard distance to
+/// the nearest occupied brick (at most [`MOST_CLEARANCE`], also where none is). Two raster
+/// passes over the 3 x 3 x 3 neighbourhood, forward then backward, give the chessboard
+/// distance exactly (Rosenfeld and Pfaltz's sequential transform); the grid is padded by one
+/// empty brick a side so that every neighbour exists, and each row takes the minimum over
+/// the rows before it (lane-wise) before the sweep along itself.
+fn chessboard_distance(occupied: &[bool], [nx, ny, nz]: [usize; 3]) -> Vec<u8> {
+    let (px, py) = (nx + 2, ny + 2);
+    let padded = |i: usize, j: usize, k: usize| (i + 1) + px * ((j + 1) + py * (k + 1));
+    let mut distance = vec![MOST_CLEARANCE; px * py * (nz + 2)];
+    for (b, _) in occupied.iter().enumerate().filter(|(_, &o)| o) {
+        distance[padded(b % nx, b / nx % ny, b / (nx * ny))] = 0;
+    }
+    // The 12 neighbours in the slice and the row before a brick, as distances back from it
+    // in the padded grid (the 13th, the brick before it in its row, is the sweep's).
+    let (row, slice) = (px, px * py);
+    let mut earlier = [0_usize; 12];
+    for (n, (dj, di)) in (0..3)
+        .flat_map(|dj| (0..3).map(move |di| (dj, di)))
+        .enumerate()
+    {
+        earlier[n] = slice + dj * row + di - row - 1;
+    }
+    for di in 0..3 {
+        earlier[9 + di] = row + di - 1;
+    }
+    let mut nearest = vec![0_u8; px];
+    for forward in [true, false] {
+        for kk in 0..nz {
+            for jj in 0..ny {
+                let (j, k) = if forward {
+                    (jj, kk)
+                } else {
+                    (ny - 1 - jj, nz - 1 - kk)
+                };
+                let start = padded(0, j, k);
+                for i in 0..nx {
+                    let at = start + i;
+                    let mut least = MOST_CLEARANCE;
+                    for &back in &earlier {
+                        least = least.min(distance[if forward { at - back } else { at + back }]);
+                    }
+                    nearest[i] = least;
+                }
+                let mut before = MOST_CLEARANCE;
+                for ii in 0..nx {
+                    let i = if forward { ii } else { nx - 1 - ii };
+                    let at = start + i;
+                    let value = distance[at]
+                        .min(nearest[i].saturating_add(1))
+                        .min(before.saturating_add(1));
+                    distance[at] = value;
+                    before = value;
+                }
+            }
+        }
+    }
+    (0..nx * ny * nz)
+        .map(|b| distance[padded(b % nx, b / nx % ny, b / (nx * ny))])
+        .collect()
 }

@@ -383,9 +383,10 @@ impl Packet<'_> {
         if !marching.live[k] {
             return;
         }
-        if !classification.occupied[turn.brick[k] as usize] {
+        let clearance = classification.clearance[turn.brick[k] as usize];
+        if clearance > 0 {
             let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
-            self.skip(marching, k, cell);
+            self.skip(marching, k, cell, clearance);
             turn.t_end[k] = marching.t[k];
             return;
         }
@@ -404,24 +405,23 @@ impl Packet<'_> {
         }
     }
 
-    /// Lane `k`'s midpoint lies in the empty brick `cell` is in: every sample whose midpoint
-    /// lies before the brick's exit has no extinction, so the lane skips those segments (a
-    /// margin keeps the one that rounding could place across it); out of the whole region
-    /// when it is empty too.
+    /// Lane `k`'s midpoint lies in the empty brick `cell` is in, whose empty surroundings
+    /// reach `clearance` bricks: every sample whose midpoint lies before the ray leaves the
+    /// empty cube of bricks centred there has no extinction, so the lane skips those segments
+    /// (a margin keeps the one that rounding could place across its exit).
     #[inline(always)]
-    fn skip(&self, marching: &mut Marching, k: usize, cell: IVec3) {
-        let (volume, classification) = (self.volume, self.classification);
+    fn skip(&self, marching: &mut Marching, k: usize, cell: IVec3, clearance: u8) {
         let origin = Vec3::new(
             marching.origin[0][k],
             marching.origin[1][k],
             marching.origin[2][k],
         );
-        let inverse_direction = marching.inverse_direction[k];
-        let exit = if classification.occupied_regions[volume.region(cell)] {
-            volume.brick_exit(cell, origin, inverse_direction)
-        } else {
-            volume.region_exit(cell, origin, inverse_direction)
-        };
+        let exit = PreparedVolume::clear_exit(
+            cell,
+            i32::from(clearance),
+            origin,
+            marching.inverse_direction[k],
+        );
         let beyond = (exit - marching.t[k]) / self.step - 0.5 - 1e-3;
         if beyond > 0.0 {
             // ceil without a library call (beyond > 0).

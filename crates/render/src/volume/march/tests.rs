@@ -166,13 +166,17 @@ fn empty_bricks_are_skipped_without_changing_a_pixel() {
         .for_volume(&volume);
     let step = 0.37;
     let skipping = Classification::new(&prepared, &transfer);
-    let occupied = skipping.occupied.iter().filter(|&&o| o).count();
+    let occupied = skipping.clearance.iter().filter(|&&c| c == 0).count();
     assert!(
-        occupied * 4 < skipping.occupied.len(),
+        occupied * 4 < skipping.clearance.len(),
         "{occupied} bricks occupied"
     );
+    assert!(
+        skipping.clearance.iter().any(|&c| c > 4),
+        "some empty space reaches beyond 4 bricks"
+    );
     let mut everything = skipping.clone();
-    everything.occupied.iter_mut().for_each(|o| *o = true);
+    everything.clearance.iter_mut().for_each(|c| *c = 0);
     let direction = Vec3::new(0.3, 0.8, 0.52).normalize();
     let mut rays = Vec::new();
     for (k, first) in [0.1_f32, 0.5, 1.0].into_iter().enumerate() {
@@ -285,6 +289,40 @@ fn every_instruction_set_marches_the_same_rays() {
                 );
             }
         }
+    }
+}
+
+/// The clearance is the chessboard distance to the nearest occupied brick, as a search over
+/// every pair of bricks finds it.
+#[test]
+fn clearance_is_the_chessboard_distance_to_the_nearest_occupied_brick() {
+    let dims = [9, 7, 6];
+    let count = dims.iter().product::<usize>();
+    for (seed, density) in [(1_u32, 0.02_f32), (7, 0.1), (11, 0.0), (13, 0.5)] {
+        let occupied: Vec<bool> = (0..count as u32)
+            .map(|b| pixel_jitter(b, seed) < density)
+            .collect();
+        let position = |b: usize| [b % dims[0], b / dims[0] % dims[1], b / (dims[0] * dims[1])];
+        let expected: Vec<u8> = (0..count)
+            .map(|b| {
+                let here = position(b);
+                (0..count)
+                    .filter(|&o| occupied[o])
+                    .map(|o| {
+                        let there = position(o);
+                        (0..3).map(|a| here[a].abs_diff(there[a])).max().unwrap()
+                    })
+                    .min()
+                    .map_or(super::MOST_CLEARANCE, |d| {
+                        (d as u8).min(super::MOST_CLEARANCE)
+                    })
+            })
+            .collect();
+        assert_eq!(
+            super::chessboard_distance(&occupied, dims),
+            expected,
+            "seed {seed}"
+        );
     }
 }
 
