@@ -355,13 +355,13 @@ fn chessboard_distance(occupied: &[bool], [nx, ny, nz]: [usize; 3]) -> Vec<u8> {
                     (ny - 1 - jj, nz - 1 - kk)
                 };
                 let start = padded(0, j, k);
-                for i in 0..nx {
+                for (i, nearest) in nearest.iter_mut().enumerate().take(nx) {
                     let at = start + i;
                     let mut least = MOST_CLEARANCE;
                     for &back in &earlier {
                         least = least.min(distance[if forward { at - back } else { at + back }]);
                     }
-                    nearest[i] = least;
+                    *nearest = least;
                 }
                 let mut before = MOST_CLEARANCE;
                 for ii in 0..nx {
