@@ -6,8 +6,9 @@
 //! voxels and the transfer function is a loop over the lanes, since each lane reads elsewhere;
 //! opacity, lighting and compositing are written in the core's vectors ([`Lanes`]), with no
 //! branch on a sample's value (whether a noisy sample faces the light is a coin toss that a
-//! branch would mispredict). A lane whose ray ends takes the next ray of the list, so the
-//! packet stays full until the list runs out. Highlights are gathered across lanes and their
+//! branch would mispredict). The turns are software-pipelined: the next turn's samples are
+//! read before this turn's are composited. A lane whose ray ends takes the next ray of the
+//! list, so the packet stays full until the list runs out. Highlights are gathered across lanes and their
 //! lobe evaluated together by the lobe's vector kernel ([`specula::Lobe::eval_batch`]).
 //!
 //! Every ray gets exactly the samples of a march on its own, front to back; only the order in
@@ -101,6 +102,7 @@ struct Packet<'a> {
 }
 
 /// The lanes' rays partway through their marches.
+#[derive(Clone, Copy)]
 struct Marching {
     /// The ray each lane marches (an index into the list); `live` says whether it has one.
     ray: Lane<usize>,
@@ -126,6 +128,7 @@ struct Marching {
 }
 
 /// One turn's segments and samples, lane by lane.
+#[derive(Clone, Copy)]
 struct Turn {
     cell: [Lane<i32>; 3],
     /// The cell's first voxel, and the brick holding it.
@@ -142,6 +145,27 @@ struct Turn {
     gradient: [Lane<f32>; 3],
     /// Where the lane's march stands after this turn (past its segment or a skip).
     t_end: Lane<f32>,
+}
+
+impl Marching {
+    /// Every lane without a ray.
+    const IDLE: Self = Self {
+        ray: [0; LANES],
+        live: [false; LANES],
+        origin: [[0.0; LANES]; 3],
+        direction: [[0.0; LANES]; 3],
+        inverse_direction: [Vec3::ZERO; LANES],
+        end: [0.0; LANES],
+        first_end: [0.0; LANES],
+        lattice: [0.0; LANES],
+        j: [0; LANES],
+        t: [0.0; LANES],
+        colour: [[0.0; LANES]; 3],
+        transmittance: [0.0; LANES],
+        wo: [[0.0; LANES]; 3],
+        half: [[0.0; LANES]; 3],
+        wi_dot_wo: [0.0; LANES],
+    };
 }
 
 impl Turn {
@@ -167,6 +191,13 @@ struct Highlights {
 }
 
 impl Highlights {
+    const EMPTY: Self = Self {
+        ts: [0.0; HIGHLIGHTS],
+        weights: [0.0; HIGHLIGHTS],
+        rays: [0; HIGHLIGHTS],
+        gathered: 0,
+    };
+
     /// Evaluates the gathered highlights' lobe and adds each, white, to its ray's colour.
     #[inline(always)]
     fn flush(&mut self, lighting: &Lighting, out: &mut [Marched]) {
@@ -204,30 +235,8 @@ impl Job for Packet<'_> {
 
     #[inline(always)]
     fn run<V: Lanes>(mut self, lanes: V) {
-        let zeros = [0.0_f32; LANES];
-        let mut marching = Marching {
-            ray: [0; LANES],
-            live: [false; LANES],
-            origin: [zeros; 3],
-            direction: [zeros; 3],
-            inverse_direction: [Vec3::ZERO; LANES],
-            end: zeros,
-            first_end: zeros,
-            lattice: zeros,
-            j: [0; LANES],
-            t: zeros,
-            colour: [zeros; 3],
-            transmittance: zeros,
-            wo: [zeros; 3],
-            half: [zeros; 3],
-            wi_dot_wo: zeros,
-        };
-        let mut highlights = Highlights {
-            ts: [0.0; HIGHLIGHTS],
-            weights: [0.0; HIGHLIGHTS],
-            rays: [0; HIGHLIGHTS],
-            gathered: 0,
-        };
+        let mut marching = Marching::IDLE;
+        let mut highlights = Highlights::EMPTY;
         let mut next = 0;
         for k in 0..LANES {
             self.start(&mut marching, k, &mut next);
