@@ -26,13 +26,14 @@ pub(crate) mod x86;
 
 use core::ops::{Add, Div, Mul, Sub};
 
-/// `2^x` on every lane for `x` in `[-126, 0]` (within 2 ulp), 0 at or below `-127`: the
-/// kernels' polynomial, for code outside a lobe that needs `exp` of a non-positive argument
-/// (an opacity's `exp(-sigma d)`) without a library call.
+/// `2^x` on every lane for `x` in `[-126, 0]` (within 2 ulp), 0 at or below `-127`, 1 for a
+/// positive `x` or NaN (taken as 0): the kernels' polynomial, for code outside a lobe that
+/// needs `exp` of a non-positive argument (an opacity's `exp(-sigma d)`) without a library
+/// call.
 #[inline(always)]
 #[must_use]
 pub fn exp2_nonpositive<V: Lanes>(x: V) -> V {
-    math::exp2(x)
+    math::exp2(x.min(x.splat(0.0)))
 }
 
 /// Independent vectors the driver evaluates per step: enough to cover a 4-cycle FMA latency

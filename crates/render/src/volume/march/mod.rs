@@ -38,6 +38,10 @@ const BRICK_SHIFT: i32 = 2;
 /// bricks' worth of empty space at once.
 const MOST_CLEARANCE: u8 = 16;
 
+// Lanes compute voxel and brick indices in `i32`, and `PreparedVolume::cell_along`'s rounding
+// holds for indices below 2^22: the grid's limits keep both true.
+const _: () = assert!(super::MAX_VOXELS <= i32::MAX as usize && super::MAX_SIDE <= 1 << 22);
+
 /// Entries of the table that finds a value's piece of the transfer function.
 pub const CLASSIFICATION_ENTRIES: usize = 4096;
 
@@ -131,17 +135,23 @@ impl PreparedVolume {
     /// The cell holding grid index `p` (already within the grid), and `p`'s place in it.
     #[inline(always)]
     fn cell(&self, p: Vec3) -> (IVec3, Vec3) {
-        // Adding 1.5 * 2^23 to p - 1/2 rounds it to an integer held in the low mantissa bits
-        // (the sum lies in [2^23, 2^24), where the spacing is 1): floor of p, or p - 1 where p
-        // is an odd whole number (a tie rounded to even), whose cell then holds p at its far
-        // corner (f = 1). Two instructions a lane, where `as i32` (saturating) takes several;
-        // p lies in [0, 4096). The last layer of voxels belongs to the last cell.
+        let [(x, fx), (y, fy), (z, fz)] =
+            [0, 1, 2].map(|axis| Self::cell_along(p[axis], self.last_cell[axis]));
+        (IVec3::new(x, y, z), Vec3::new(fx, fy, fz))
+    }
+
+    /// [`Self::cell`] along one axis whose last cell is `last_cell`. Adding 1.5 * 2^23 to
+    /// p - 1/2 rounds it to an integer held in the low mantissa bits (the sum lies in
+    /// [2^23, 2^24), where the spacing is 1): floor of p, or p - 1 where p is an odd whole
+    /// number (a tie rounded to even), whose cell then holds p at its far corner (f = 1). Two
+    /// instructions a lane, where `as i32` (saturating) takes several; p lies in [0, 4096)
+    /// (`MAX_SIDE`). The last layer of voxels belongs to the last cell.
+    #[inline(always)]
+    fn cell_along(p: f32, last_cell: i32) -> (i32, f32) {
         const ROUND: f32 = 12_582_912.0;
         let rounded = (p - 0.5) + ROUND;
-        let bits = |x: f32| x.to_bits() as i32 - ROUND.to_bits() as i32;
-        let cell =
-            IVec3::new(bits(rounded.x), bits(rounded.y), bits(rounded.z)).min(self.last_cell);
-        (cell, p - cell.as_vec3())
+        let cell = (rounded.to_bits() as i32 - ROUND.to_bits() as i32).min(last_cell);
+        (cell, p - cell as f32)
     }
 
     /// Value and world gradient at grid index `p` (clamped to the grid), interpolated
@@ -150,20 +160,15 @@ impl PreparedVolume {
     #[must_use]
     pub fn sample(&self, p: Vec3) -> Vec4 {
         let (cell, f) = self.cell(p.clamp(Vec3::ZERO, self.last_index));
-        self.sample_in(cell, f)
+        self.sample_at(self.voxel(cell.to_array()) as usize, f)
     }
 
-    /// The first voxel of `cell` (its corner of smallest indices). Plain `i32` arithmetic
-    /// (a grid holds fewer than `2^31` voxels), so that lanes compute it side by side.
+    /// The first voxel of `cell` (its corner of smallest indices). Plain `i32` arithmetic (a
+    /// grid holds at most `MAX_VOXELS`, 2^28, voxels), so that lanes compute it side by side.
     #[inline(always)]
     fn voxel(&self, cell: [i32; 3]) -> i32 {
         let [nx, ny, _] = self.dims.map(|d| d as i32);
         cell[0] + nx * (cell[1] + ny * cell[2])
-    }
-
-    #[inline(always)]
-    fn sample_in(&self, cell: IVec3, f: Vec3) -> Vec4 {
-        self.sample_at(self.voxel(cell.to_array()) as usize, f)
     }
 
     /// The trilinear value and gradient at `f` in the cell whose first voxel is `at`. The
@@ -345,7 +350,7 @@ fn chessboard_distance(occupied: &[bool], [nx, ny, nz]: [usize; 3]) -> Vec<u8> {
     for di in 0..3 {
         earlier[9 + di] = row + di - 1;
     }
-    let mut nearest = vec![0_u8; px];
+    let mut nearest = vec![0_u8; nx];
     for forward in [true, false] {
         for kk in 0..nz {
             for jj in 0..ny {

@@ -9,7 +9,8 @@
 //! branch would mispredict). The turns are software-pipelined: the next turn's samples are
 //! read before this turn's are composited. A lane whose ray ends takes the next ray of the
 //! list, so the packet stays full until the list runs out. Highlights are gathered across lanes and their
-//! lobe evaluated together by the lobe's vector kernel ([`specula::Lobe::eval_batch`]).
+//! lobe evaluated together by the lobe's vector kernel
+//! ([`specula::Lobe::eval_batch`]).
 //!
 //! Every ray gets exactly the samples of a march on its own, front to back; only the order in
 //! which its highlights are summed differs.
@@ -273,10 +274,13 @@ impl Job for Packet<'_> {
                     );
                     self.out[r].1 = marching.transmittance[k];
                     self.start(&mut marching, k, &mut next);
+                    // The read-ahead sample was the ended ray's: the lane's next ray takes its
+                    // first segment instead, and an idle lane's sample is cleared (composited,
+                    // it would add light to a ray already written out).
                     if marching.live[k] {
                         self.segment(&mut marching, &mut ahead, k);
-                        self.sample_lane(&mut marching, &mut ahead, k);
                     }
+                    self.sample_lane(&mut marching, &mut ahead, k);
                 }
             }
             core::mem::swap(&mut current, &mut ahead);
@@ -343,35 +347,29 @@ impl Packet<'_> {
     /// [`Self::segments`] for lane `k`.
     #[inline(always)]
     fn segment(&self, marching: &mut Marching, turn: &mut Turn, k: usize) {
-        // See `PreparedVolume::cell`: adding 1.5 * 2^23 to p - 1/2 rounds it to an integer.
-        const ROUND: f32 = 12_582_912.0;
-        let step = self.step;
-        let (last_index, last_cell) = (self.volume.last_index, self.volume.last_cell);
-        {
-            let j = marching.j[k];
-            let next = if j == 0 {
-                marching.first_end[k]
-            } else {
-                marching.lattice[k] + (j + 1) as f32 * step
-            };
-            let length = next.min(marching.end[k]) - marching.t[k];
-            turn.length[k] = length;
-            let middle = marching.t[k] + 0.5 * length;
-            for axis in 0..3 {
-                let p = (marching.origin[axis][k] + marching.direction[axis][k] * middle)
-                    .max(0.0)
-                    .min(last_index[axis]);
-                let rounded = (p - 0.5) + ROUND;
-                let cell = (rounded.to_bits() as i32 - ROUND.to_bits() as i32).min(last_cell[axis]);
-                turn.cell[axis][k] = cell;
-                turn.fraction[axis][k] = p - cell as f32;
-            }
-            let cell = [turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]];
-            turn.voxel[k] = self.volume.voxel(cell);
-            turn.brick[k] = self.volume.brick(cell);
-            marching.t[k] = next;
-            marching.j[k] = j + 1;
+        let volume = self.volume;
+        let j = marching.j[k];
+        let next = if j == 0 {
+            marching.first_end[k]
+        } else {
+            marching.lattice[k] + (j + 1) as f32 * self.step
+        };
+        let length = next.min(marching.end[k]) - marching.t[k];
+        turn.length[k] = length;
+        let middle = marching.t[k] + 0.5 * length;
+        for axis in 0..3 {
+            let p = (marching.origin[axis][k] + marching.direction[axis][k] * middle)
+                .max(0.0)
+                .min(volume.last_index[axis]);
+            let (cell, fraction) = PreparedVolume::cell_along(p, volume.last_cell[axis]);
+            turn.cell[axis][k] = cell;
+            turn.fraction[axis][k] = fraction;
         }
+        let cell = [turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]];
+        turn.voxel[k] = volume.voxel(cell);
+        turn.brick[k] = volume.brick(cell);
+        marching.t[k] = next;
+        marching.j[k] = j + 1;
     }
 
     /// Each lane's sample, read lane by lane: lanes in empty bricks skip ahead instead (in
@@ -387,26 +385,29 @@ impl Packet<'_> {
     /// [`Self::sample`] for lane `k`.
     #[inline(always)]
     fn sample_lane(&self, marching: &mut Marching, turn: &mut Turn, k: usize) {
-        let (volume, classification) = (self.volume, self.classification);
         turn.sigma[k] = 0.0;
-        if !marching.live[k] {
-            return;
-        }
-        let clearance = classification.clearance[turn.brick[k] as usize];
-        if clearance > 0 {
-            let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
-            self.skip(marching, k, cell, clearance);
-            turn.t_end[k] = marching.t[k];
-            return;
+        if marching.live[k] {
+            let clearance = self.classification.clearance[turn.brick[k] as usize];
+            if clearance > 0 {
+                let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
+                self.skip(marching, k, cell, clearance);
+            } else {
+                self.read(turn, k);
+            }
         }
         turn.t_end[k] = marching.t[k];
+    }
+
+    /// Lane `k`'s value and gradient at its midpoint, and the transfer function there.
+    #[inline(always)]
+    fn read(&self, turn: &mut Turn, k: usize) {
         let fraction = Vec3::new(
             turn.fraction[0][k],
             turn.fraction[1][k],
             turn.fraction[2][k],
         );
-        let sample = volume.sample_at(turn.voxel[k] as usize, fraction);
-        let classified = classification.at(sample.x);
+        let sample = self.volume.sample_at(turn.voxel[k] as usize, fraction);
+        let classified = self.classification.at(sample.x);
         turn.sigma[k] = classified.x;
         for c in 0..3 {
             turn.base[c][k] = classified[c + 1];
@@ -463,8 +464,6 @@ impl Packet<'_> {
             (transmittance * (one - alpha)).store(&mut marching.transmittance[at..at + V::WIDTH]);
             let base = load3(lanes, &turn.base, at);
             let colour = load3(lanes, &marching.colour, at);
-            // Written out rather than `array::map`: a closure a library function calls is
-            // compiled without the level's instruction set.
             let lit_scale = match self.lit {
                 None => one,
                 Some(lit) => {
@@ -484,8 +483,12 @@ impl Packet<'_> {
                     light.colour_scale
                 }
             };
+            // Written out rather than `array::map`: a closure a library function calls is
+            // compiled without the level's instruction set. A lane that carried nothing adds
+            // nothing, whatever its colour.
+            let carrying = carried.gt(zero);
             for c in 0..3 {
-                (colour[c] + carried * (base[c] * lit_scale))
+                (colour[c] + (carried * (base[c] * lit_scale)).keep(carrying))
                     .store(&mut marching.colour[c][at..at + V::WIDTH]);
             }
         }

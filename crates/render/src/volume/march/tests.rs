@@ -8,8 +8,8 @@ use crate::volume::raymarch::{
 use specula::simd::Level;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 
-/// The classic model as the module states it, written here apart from `Lighting::light`'s
-/// rearranged arithmetic: the gradient's opposite, turned to the viewer, as the normal; the
+/// The classic model as the module states it, written here apart from
+/// `Lighting::light_lanes`'s rearranged arithmetic: the gradient's opposite, turned to the viewer, as the normal; the
 /// geometry's own cosine; lit blended with unlit by the gradient's strength.
 fn classic(lighting: &Lighting, gradient: Vec3, base: Vec3, wo: Vec3) -> Vec3 {
     let strength = gradient.length();
@@ -68,6 +68,31 @@ fn reference(volume: &Volume, transfer: &TransferFunction, settings: &DvrSetting
     pixels
 }
 
+/// Per pixel, the largest difference in a channel between `render_dvr` and the reference
+/// march (infinite where either is NaN).
+fn errors_against_the_reference(
+    volume: &Volume,
+    transfer: &TransferFunction,
+    settings: &DvrSettings,
+) -> Vec<f32> {
+    let fast = render_dvr(volume, transfer, settings, &|| {}).unwrap();
+    let expected = reference(volume, transfer, settings);
+    expected
+        .iter()
+        .enumerate()
+        .map(|(p, e)| {
+            let error = (fast.get(p as u32 % settings.width, p as u32 / settings.width) - *e)
+                .abs()
+                .max_element();
+            if error.is_nan() {
+                f32::INFINITY
+            } else {
+                error
+            }
+        })
+        .collect()
+}
+
 /// The Shepp-Logan head of `side` voxels inside a margin of 4 empty voxels, so that the
 /// last layer (where the two gradients differ by definition) is uniform.
 fn padded_head(side: usize) -> Volume {
@@ -123,17 +148,7 @@ fn the_prepared_march_is_the_reference_march() {
         };
         let mut settings = DvrSettings::new(48, 40, view, Some(shading));
         settings.background = Vec3::new(0.1, 0.2, 0.3);
-        let fast = render_dvr(&volume, &transfer, &settings, &|| {}).unwrap();
-        let expected = reference(&volume, &transfer, &settings);
-        let errors: Vec<f32> = expected
-            .iter()
-            .enumerate()
-            .map(|(p, e)| {
-                (fast.get(p as u32 % 48, p as u32 / 48) - *e)
-                    .abs()
-                    .max_element()
-            })
-            .collect();
+        let errors = errors_against_the_reference(&volume, &transfer, &settings);
         let worst = errors.iter().copied().fold(0.0, f32::max);
         let mean = errors.iter().sum::<f32>() / errors.len() as f32;
         assert!(
@@ -234,27 +249,9 @@ fn every_instruction_set_marches_the_same_rays() {
     let lobe = Lobe::new(LobeKind::Pow, Exponent::new(24.0));
     for geometry in Geometry::ALL {
         let shading = Shading::new(lobe, geometry, Normalisation::None);
-        let (width, height) = (20, 14);
-        let settings = DvrSettings::new(width, height, View::Anterior, Some(shading));
-        let plan = DvrPlan::new(&volume, &settings).unwrap();
+        let settings = DvrSettings::new(20, 14, View::Anterior, Some(shading));
+        let (plan, rays, views) = lit_rays(&volume, &settings, |_, _| true);
         let lighting = plan.lighting.unwrap();
-        let (mut rays, mut views) = (Vec::new(), Vec::new());
-        for y in 0..height {
-            for x in 0..width {
-                let (origin, direction) = plan.camera.ray(x, y, width, height);
-                let (o, d) = (volume.index(origin), volume.index_direction(direction));
-                if let Some((start, end)) = inside_grid(&volume, o, d) {
-                    rays.push(Ray {
-                        origin: o,
-                        direction: d,
-                        start,
-                        end,
-                        first: plan.step * pixel_jitter(x, y),
-                    });
-                    views.push(RayView::new(&lighting, -direction));
-                }
-            }
-        }
         let march = |level: Level| {
             let mut out = vec![(Vec3::ZERO, 1.0); rays.len()];
             let lit = Lit {
@@ -296,12 +293,23 @@ fn every_instruction_set_marches_the_same_rays() {
 /// every pair of bricks finds it.
 #[test]
 fn clearance_is_the_chessboard_distance_to_the_nearest_occupied_brick() {
-    let dims = [9, 7, 6];
-    let count = dims.iter().product::<usize>();
-    for (seed, density) in [(1_u32, 0.02_f32), (7, 0.1), (11, 0.0), (13, 0.5)] {
-        let occupied: Vec<bool> = (0..count as u32)
+    // Random grids, and a long one with a single occupied brick at its end, whose far bricks
+    // lie beyond the cap.
+    let long = [22, 3, 2];
+    for (dims, seed, density) in [
+        ([9, 7, 6], 1_u32, 0.02_f32),
+        ([9, 7, 6], 7, 0.1),
+        ([9, 7, 6], 11, 0.0),
+        ([9, 7, 6], 13, 0.5),
+        (long, 0, 0.0),
+    ] {
+        let count = dims.iter().product::<usize>();
+        let mut occupied: Vec<bool> = (0..count as u32)
             .map(|b| pixel_jitter(b, seed) < density)
             .collect();
+        if dims == long {
+            occupied[0] = true;
+        }
         let position = |b: usize| [b % dims[0], b / dims[0] % dims[1], b / (dims[0] * dims[1])];
         let expected: Vec<u8> = (0..count)
             .map(|b| {
@@ -321,9 +329,127 @@ fn clearance_is_the_chessboard_distance_to_the_nearest_occupied_brick() {
         assert_eq!(
             super::chessboard_distance(&occupied, dims),
             expected,
-            "seed {seed}"
+            "{dims:?}, seed {seed}"
         );
     }
+}
+
+/// The rays of a render, lit, that cross the grid (in grid units), with their views.
+fn lit_rays(
+    volume: &Volume,
+    settings: &DvrSettings,
+    keep: impl Fn(u32, u32) -> bool,
+) -> (DvrPlan, Vec<Ray>, Vec<RayView>) {
+    let plan = DvrPlan::new(volume, settings).unwrap();
+    let lighting = plan.lighting.unwrap();
+    let (width, height) = (settings.width, settings.height);
+    let (mut rays, mut views) = (Vec::new(), Vec::new());
+    for y in 0..height {
+        for x in (0..width).filter(|&x| keep(x, y)) {
+            let (origin, direction) = plan.camera.ray(x, y, width, height);
+            let (o, d) = (volume.index(origin), volume.index_direction(direction));
+            if let Some((start, end)) = inside_grid(volume, o, d) {
+                rays.push(Ray {
+                    origin: o,
+                    direction: d,
+                    start,
+                    end,
+                    first: plan.step * pixel_jitter(x, y),
+                });
+                views.push(RayView::new(&lighting, -direction));
+            }
+        }
+    }
+    (plan, rays, views)
+}
+
+/// Lit rays marched in lists of a tile's size (so that lanes run out of rays and idle again
+/// and again) give each ray what it gets marched alone, up to the order its highlights are
+/// summed in, whether rays end by their opacity or at the grid.
+#[test]
+fn lit_rays_marched_together_are_each_ray_marched_alone() {
+    let volume = padded_head(24);
+    let prepared = PreparedVolume::new(&volume);
+    // n = 1: broad highlights, so that a highlight added to the wrong ray shows.
+    let lobe = Lobe::new(LobeKind::Pow, Exponent::new(1.0));
+    for (preset, cutoff) in [
+        ("mr", 0.99),
+        ("mr", 0.3),
+        ("surface", 0.99),
+        ("surface", 0.3),
+    ] {
+        let transfer = TransferFunction::preset(preset)
+            .unwrap()
+            .for_volume(&volume);
+        let classification = Classification::new(&prepared, &transfer);
+        let shading = Shading::new(lobe, Geometry::Blinn, Normalisation::None);
+        let settings = DvrSettings::new(20, 14, View::Anterior, Some(shading));
+        // The middle of the image, where every ray crosses the head.
+        let (plan, rays, views) = lit_rays(&volume, &settings, |x, y| {
+            (6..14).contains(&x) && (4..10).contains(&y)
+        });
+        let lighting = plan.lighting.unwrap();
+        let march = |rays: &[Ray], views: &[RayView]| {
+            let mut out = vec![(Vec3::ZERO, 1.0); rays.len()];
+            let lit = Lit {
+                lighting: &lighting,
+                views,
+            };
+            march_rays(
+                Level::detect(),
+                &prepared,
+                &classification,
+                Some(lit),
+                rays,
+                plan.step,
+                cutoff,
+                &mut out,
+            );
+            out
+        };
+        for tile in (0..rays.len()).step_by(13) {
+            let end = (tile + 13).min(rays.len());
+            let together = march(&rays[tile..end], &views[tile..end]);
+            for (r, got) in (tile..end).zip(&together) {
+                let alone = march(&rays[r..=r], &views[r..=r])[0];
+                assert!(
+                    (got.0 - alone.0).abs().max_element() < 1e-5 && got.1 == alone.1,
+                    "{preset}, cutoff {cutoff}, ray {r}: {got:?} together, {alone:?} alone"
+                );
+            }
+        }
+    }
+}
+
+/// A dense layer on the grid's far face, behind empty space: rays end at the grid a step
+/// after crossing it, in every tile, and the march is the reference's.
+#[test]
+fn rays_ending_on_a_dense_far_face_are_the_reference() {
+    use crate::volume::transfer::{ControlPoint, Scale};
+    let n = 16;
+    let samples = (0..n * n * n)
+        .map(|v| if v / (n * n) == n - 1 { 1.0 } else { 0.0 })
+        .collect();
+    let volume =
+        Volume::centred([n; 3], Vec3::ONE, samples, crate::volume::Units::Arbitrary).unwrap();
+    let point = |value, sigma| ControlPoint {
+        value,
+        sigma,
+        colour: Vec3::ONE,
+    };
+    let transfer = TransferFunction::try_new(
+        vec![point(0.0, 0.0), point(0.95, 0.0), point(1.0, 1000.0)],
+        Scale::Absolute,
+    )
+    .unwrap();
+    let lobe = Lobe::new(LobeKind::Pow, Exponent::new(24.0));
+    let shading = Shading::new(lobe, Geometry::Blinn, Normalisation::None);
+    let settings = DvrSettings::new(48, 48, View::Inferior, Some(shading));
+    let errors = errors_against_the_reference(&volume, &transfer, &settings);
+    let worst = errors.iter().copied().fold(0.0, f32::max);
+    assert!(worst < 2e-3, "worst {worst}");
+    let seen = render_dvr(&volume, &transfer, &settings, &|| {}).unwrap();
+    assert!(seen.get(24, 24).max_element() > 0.5, "the far face is seen");
 }
 
 #[test]

@@ -120,38 +120,30 @@ impl Lighting {
     ) -> LitLanes<V> {
         let shading = &self.shading;
         let [gx, gy, gz] = gradient;
-        let lanes = gx;
-        let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
+        let (zero, one) = (gx.splat(0.0), gx.splat(1.0));
         let dot = |v: [V; 3]| gx * v[0] + gy * v[1] + gz * v[2];
         let squared = dot(gradient);
         // No gradient (or an infinite one): unlit, as a sample inside uniform tissue.
-        let finite = squared.keep(squared.lt(lanes.splat(f32::INFINITY)));
+        let finite = squared.keep(squared.lt(gx.splat(f32::INFINITY)));
         let shaded = finite.gt(zero);
         let inverse = one / finite.select(shaded, one).sqrt();
         // The normal is the gradient's opposite turned to face the viewer: `k g` with
         // `|k| = 1 / |g|`, so its dot products are those of the gradient, scaled.
         let towards_viewer = dot(view.wo);
         let k = inverse.select(towards_viewer.gt(zero), zero - inverse);
-        let light = [self.light.x, self.light.y, self.light.z];
-        let along_light = k * dot([
-            lanes.splat(light[0]),
-            lanes.splat(light[1]),
-            lanes.splat(light[2]),
-        ]);
+        let light = self.light;
+        let along_light = k * dot([gx.splat(light.x), gx.splat(light.y), gx.splat(light.z)]);
         let diffuse = along_light.max(zero);
         let t = match shading.geometry {
-            Geometry::Phong => {
-                lanes.splat(2.0) * along_light * (k * towards_viewer) - view.wi_dot_wo
-            }
+            Geometry::Phong => gx.splat(2.0) * along_light * (k * towards_viewer) - view.wi_dot_wo,
             Geometry::Blinn => k * dot(view.half),
         };
         // base.lerp(lit, weight), the highlight's share kept apart.
-        let weight = (squared * inverse * lanes.splat(self.per_gradient_reference)).min(one);
-        let lit =
-            one + weight * (lanes.splat(shading.ka) + lanes.splat(shading.kd) * diffuse - one);
+        let weight = (squared * inverse * gx.splat(self.per_gradient_reference)).min(one);
+        let lit = one + weight * (gx.splat(shading.ka) + gx.splat(shading.kd) * diffuse - one);
         LitLanes {
             colour_scale: lit.select(shaded, one),
-            highlight: (weight * lanes.splat(shading.ks * self.normalisation)).keep(shaded),
+            highlight: (weight * gx.splat(shading.ks * self.normalisation)).keep(shaded),
             t: t.keep(shaded),
         }
     }

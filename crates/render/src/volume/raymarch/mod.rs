@@ -105,6 +105,12 @@ impl DvrPlan {
         if !(settings.step_fraction > 0.0 && settings.step_fraction <= 4.0) {
             return Err(VolumeError("the step must be in (0, 4] voxels".into()));
         }
+        if !(settings.opacity_cutoff > 0.0 && settings.opacity_cutoff <= 1.0) {
+            return Err(VolumeError(format!(
+                "an opacity cutoff of {}: it must be in (0, 1] (1 never stops a ray early)",
+                settings.opacity_cutoff
+            )));
+        }
         let camera = RayCamera::new(settings.view, volume)?;
         Ok(Self {
             camera,
@@ -315,6 +321,17 @@ mod tests {
             let image = render_dvr(&volume, &flat(1.0, Vec3::X), &settings, &|| {}).unwrap();
             assert_eq!(image.get(0, 0), Vec3::Z, "{view:?}: a corner misses");
             assert!(image.get(20, 20).x > 0.99, "{view:?}: the centre is inside");
+        }
+    }
+
+    #[test]
+    fn an_opacity_cutoff_outside_its_range_is_refused() {
+        let volume = constant([10, 10, 10], Vec3::ONE, 1.0);
+        for cutoff in [0.0, -1.0, 1.5, f32::NAN] {
+            let mut settings = DvrSettings::new(8, 8, View::Anterior, None);
+            settings.opacity_cutoff = cutoff;
+            let refused = render_dvr(&volume, &flat(1.0, Vec3::X), &settings, &|| {}).unwrap_err();
+            assert!(refused.0.contains("opacity cutoff"), "{cutoff}: {refused}");
         }
     }
 
