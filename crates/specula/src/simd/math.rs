@@ -238,6 +238,33 @@ mod tests {
         }
     }
 
+    /// `exp2_nonpositive` is `exp2` on its range and takes a positive argument or NaN as 0,
+    /// on every level.
+    #[test]
+    fn exp2_nonpositive_takes_positive_arguments_and_nan_as_zero() {
+        struct Run;
+        impl super::super::Job for Run {
+            type Output = Vec<f32>;
+            fn run<V: Lanes>(self, lanes: V) -> Vec<f32> {
+                let xs = [0.5, 100.0, f32::NAN, f32::INFINITY, -1.0, 0.0, -3.0, -200.0];
+                let mut out = vec![0.0; xs.len()];
+                for (x, o) in xs.chunks(V::WIDTH).zip(out.chunks_mut(V::WIDTH)) {
+                    super::super::exp2_nonpositive(lanes.load(x)).store(o);
+                }
+                out
+            }
+        }
+        for level in Level::available() {
+            let expected = [1.0, 1.0, 1.0, 1.0, 0.5, 1.0, 0.125, 0.0];
+            for (got, expected) in dispatch(level, Run).iter().zip(expected) {
+                assert!(
+                    (got - expected).abs() <= 2.0 * f32::EPSILON,
+                    "{level:?}: {got} against {expected}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn acos_is_within_2_5e_7_on_zero_one() {
         let mut xs: Vec<f32> = (0..=1_000_000).map(|k| k as f32 / 1e6).collect();

@@ -248,11 +248,9 @@ impl Job for Packet<'_> {
         // forwarded from the stores and waits for all of them). A lane whose ray ends has its
         // read-ahead sample replaced by its next ray's first.
         let (mut current, mut ahead) = (Turn::EMPTY, Turn::EMPTY);
-        self.segments(&mut marching, &mut current);
-        self.sample(&mut marching, &mut current);
+        self.take_turn(&mut marching, &mut current);
         while marching.live.contains(&true) {
-            self.segments(&mut marching, &mut ahead);
-            self.sample(&mut marching, &mut ahead);
+            self.take_turn(&mut marching, &mut ahead);
             // A turn in which no lane took a sample with extinction composites nothing
             // (common where a packet's rays cross air or tissue the transfer function hides).
             if current.sigma.iter().any(|&sigma| sigma > 0.0) {
@@ -280,7 +278,7 @@ impl Job for Packet<'_> {
                     if marching.live[k] {
                         self.segment(&mut marching, &mut ahead, k);
                     }
-                    self.sample_lane(&mut marching, &mut ahead, k);
+                    self.sample(&mut marching, &mut ahead, k);
                 }
             }
             core::mem::swap(&mut current, &mut ahead);
@@ -335,16 +333,23 @@ impl Packet<'_> {
         self.out[r] = (Vec3::ZERO, 1.0);
     }
 
-    /// Every lane's next segment: its length, the cell its midpoint lies in and the place
-    /// there. Advances the lanes past it.
+    /// Every lane's turn: its next segment (its length, the cell its midpoint lies in and the
+    /// place there), then its sample there, read, or a skip where the brick is empty. Two
+    /// loops, not one: the first is arithmetic the compiler vectorises across lanes; the
+    /// second reads elsewhere in each lane, and its lanes skip in step with one another (a lane
+    /// skipping brick after brick on its own would be one long chain of dependent
+    /// instructions while the rest wait).
     #[inline(always)]
-    fn segments(&self, marching: &mut Marching, turn: &mut Turn) {
+    fn take_turn(&self, marching: &mut Marching, turn: &mut Turn) {
         for k in 0..LANES {
             self.segment(marching, turn, k);
         }
+        for k in 0..LANES {
+            self.sample(marching, turn, k);
+        }
     }
 
-    /// [`Self::segments`] for lane `k`.
+    /// Lane `k`'s next segment (see [`Self::take_turn`]).
     #[inline(always)]
     fn segment(&self, marching: &mut Marching, turn: &mut Turn, k: usize) {
         let volume = self.volume;
@@ -372,19 +377,9 @@ impl Packet<'_> {
         marching.j[k] = j + 1;
     }
 
-    /// Each lane's sample, read lane by lane: lanes in empty bricks skip ahead instead (in
-    /// step with the others: a lane skipping brick after brick on its own would be one long
-    /// chain of dependent instructions while the rest wait).
+    /// Lane `k`'s sample at its segment (see [`Self::take_turn`]); an idle lane's is cleared.
     #[inline(always)]
-    fn sample(&self, marching: &mut Marching, turn: &mut Turn) {
-        for k in 0..LANES {
-            self.sample_lane(marching, turn, k);
-        }
-    }
-
-    /// [`Self::sample`] for lane `k`.
-    #[inline(always)]
-    fn sample_lane(&self, marching: &mut Marching, turn: &mut Turn, k: usize) {
+    fn sample(&self, marching: &mut Marching, turn: &mut Turn, k: usize) {
         turn.sigma[k] = 0.0;
         if marching.live[k] {
             let clearance = self.classification.clearance[turn.brick[k] as usize];

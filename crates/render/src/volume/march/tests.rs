@@ -68,16 +68,16 @@ fn reference(volume: &Volume, transfer: &TransferFunction, settings: &DvrSetting
     pixels
 }
 
-/// Per pixel, the largest difference in a channel between `render_dvr` and the reference
-/// march (infinite where either is NaN).
-fn errors_against_the_reference(
+/// The reference march's image, and per pixel the largest difference in a channel between
+/// `render_dvr` and it (infinite where either is NaN).
+fn against_the_reference(
     volume: &Volume,
     transfer: &TransferFunction,
     settings: &DvrSettings,
-) -> Vec<f32> {
+) -> (Vec<Vec3>, Vec<f32>) {
     let fast = render_dvr(volume, transfer, settings, &|| {}).unwrap();
     let expected = reference(volume, transfer, settings);
-    expected
+    let errors = expected
         .iter()
         .enumerate()
         .map(|(p, e)| {
@@ -90,7 +90,8 @@ fn errors_against_the_reference(
                 error
             }
         })
-        .collect()
+        .collect();
+    (expected, errors)
 }
 
 /// The Shepp-Logan head of `side` voxels inside a margin of 4 empty voxels, so that the
@@ -148,7 +149,7 @@ fn the_prepared_march_is_the_reference_march() {
         };
         let mut settings = DvrSettings::new(48, 40, view, Some(shading));
         settings.background = Vec3::new(0.1, 0.2, 0.3);
-        let errors = errors_against_the_reference(&volume, &transfer, &settings);
+        let (_, errors) = against_the_reference(&volume, &transfer, &settings);
         let worst = errors.iter().copied().fold(0.0, f32::max);
         let mean = errors.iter().sum::<f32>() / errors.len() as f32;
         assert!(
@@ -445,11 +446,13 @@ fn rays_ending_on_a_dense_far_face_are_the_reference() {
     let lobe = Lobe::new(LobeKind::Pow, Exponent::new(24.0));
     let shading = Shading::new(lobe, Geometry::Blinn, Normalisation::None);
     let settings = DvrSettings::new(48, 48, View::Inferior, Some(shading));
-    let errors = errors_against_the_reference(&volume, &transfer, &settings);
+    let (expected, errors) = against_the_reference(&volume, &transfer, &settings);
     let worst = errors.iter().copied().fold(0.0, f32::max);
     assert!(worst < 2e-3, "worst {worst}");
-    let seen = render_dvr(&volume, &transfer, &settings, &|| {}).unwrap();
-    assert!(seen.get(24, 24).max_element() > 0.5, "the far face is seen");
+    assert!(
+        expected.iter().any(|e| e.max_element() > 0.5),
+        "the far face is seen"
+    );
 }
 
 #[test]
