@@ -30,6 +30,7 @@ pub mod input;
 mod load;
 pub mod lobe_file;
 mod material;
+pub mod measured;
 mod mesh;
 pub mod metrics;
 mod output;

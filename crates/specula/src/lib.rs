@@ -44,6 +44,7 @@ pub mod formula;
 pub mod geometry;
 pub mod gpu_cost;
 pub mod lobe;
+pub mod measured;
 pub mod normalisation;
 pub mod ops;
 pub mod quadrature;
