@@ -25,6 +25,7 @@
 //! luminance table, then by the VNDF, into a half vector, so a render draws directions where
 //! the material reflects.
 
+pub mod fit;
 mod marginal;
 pub mod tensor;
 
@@ -266,7 +267,7 @@ impl MeasuredBrdf {
         let m = DVec3::new(cos_phi * sin_theta, sin_phi * sin_theta, cos_theta);
         let wi = 2.0 * wo.dot(m) * m - wo;
         let pdf = vndf_pdf * luminance_pdf / Self::to_solid_angle(u_m[0], m, wo);
-        if wi.z <= 0.0 || !(pdf > 0.0) {
+        if wi.z <= 0.0 || pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         let u_o = [theta_to_u(theta_o), phi_to_u(phi_o)];

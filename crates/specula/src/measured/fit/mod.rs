@@ -1,0 +1,524 @@
+//! Fitting the classic model to a measured material, for every lobe, and GGX beside them.
+//!
+//! The model is `f(wo, wi) = kd / pi + K lobe(t)` per RGB channel, `t` the lobe's cosine in
+//! either geometry and `K = ks N(n)`: because `ks` is free, every normalisation describes
+//! the same set of functions, so one fit per lobe and geometry serves them all, and each
+//! normalisation's `ks` is `K / N(n)` ([`Fit::ks`]). `n` is one per material
+//! ([`Sharing::Shared`], what a renderer's material has) or one per channel. The baseline
+//! is GGX: `kd / pi + K D(h) G2(wo, wi) / (4 cos(theta_o) cos(theta_i))`, Trowbridge-Reitz
+//! with Smith's height-correlated masking, `alpha` in place of `n` and no Fresnel term (the
+//! lobes have none either; `K` plays a constant `F0`).
+//!
+//! **Error**, in the spirit of Ngan, Durand and Matusik (2005): the material and the model
+//! are compared as `f cos(theta_i)`, the radiance a unit irradiance reflects, at the
+//! [`comparison_pairs`] (half/difference angles, weighted by solid angle, grazing pairs
+//! beyond 80 degrees dropped), after a **cube root**, which compresses a highlight's range
+//! roughly as lightness does (CIE `L*` goes as `Y^(1/3)`), so that neither the peak alone
+//! nor the diffuse floor alone decides the fit:
+//! `E = sqrt( sum_j w_j sum_c (cbrt(y_jc cos_j) - cbrt(m_jc cos_j))^2 / 3 )`, weights summing
+//! to 1. [`Fit::error`] is that `E`; the per-channel figures split it.
+//!
+//! **Optimiser.** For a given `n` the best `(kd, K)` of a channel is a two-parameter
+//! problem that is linear but for the cube root: it starts from the weighted linear least
+//! squares that linearises the root at the data and takes projected Gauss-Newton steps
+//! (`kd, K >= 0`). Over `n` the error is not convex (a lobe can fit the sheen or the peak),
+//! so `ln n` is first scanned on a grid of [`GRID_POINTS`] over `[1, 1000]`, then refined by
+//! Brent's method (the `argmin` crate) between the best grid point's neighbours: a global
+//! start, then a local polish. The same procedure fits GGX's `ln alpha` over
+//! `[ALPHA_RANGE]`. Everything is deterministic, so a fit is reproducible to the last bit.
+
+mod observations;
+pub mod verdict;
+
+use core::f64::consts::{FRAC_1_PI, FRAC_PI_4, TAU};
+
+use argmin::core::{CostFunction, Executor};
+use argmin::solver::brent::BrentOpt;
+use glam::DVec3;
+use rayon::prelude::*;
+use serde::Serialize;
+
+pub use observations::{comparison_pairs, Observations, GRID, MAX_ELEVATION_DEGREES};
+
+use crate::analysis::albedo::specular_albedo_per_unit;
+use crate::fit::ggx;
+use crate::quadrature::integrate_pieces;
+use crate::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+
+/// Points of the global scan over `ln n` (or `ln alpha`).
+pub const GRID_POINTS: usize = 24;
+
+/// GGX's `alpha` range searched.
+pub const ALPHA_RANGE: [f64; 2] = [0.002, 1.0];
+
+/// The specular term's family.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "family", rename_all = "kebab-case")]
+pub enum Specular {
+    /// One of specula's lobes in one geometry.
+    Lobe {
+        /// The lobe.
+        #[serde(serialize_with = "serialize_kind")]
+        kind: LobeKind,
+        /// Phong or Blinn.
+        geometry: Geometry,
+    },
+    /// The GGX microfacet model.
+    Ggx,
+}
+
+fn serialize_kind<S: serde::Serializer>(kind: &LobeKind, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(&kind.to_string())
+}
+
+impl Specular {
+    /// A short name: `pow/phong`, `ggx`.
+    #[must_use]
+    pub fn label(self) -> String {
+        match self {
+            Specular::Lobe { kind, geometry } => format!("{kind}/{}", geometry.id()),
+            Specular::Ggx => "ggx".into(),
+        }
+    }
+
+    /// The searched range of the shape parameter's logarithm.
+    fn log_range(self) -> [f64; 2] {
+        match self {
+            Specular::Lobe { .. } => [Exponent::MIN.ln(), Exponent::MAX.ln()],
+            Specular::Ggx => ALPHA_RANGE.map(f64::ln),
+        }
+    }
+
+    /// The specular term per unit `K` at every observation (without the cosine).
+    fn values(self, parameter: f64, observations: &Prepared) -> Vec<f64> {
+        match self {
+            Specular::Lobe { kind, geometry } => {
+                let lobe = Lobe::new(kind, exponent(parameter));
+                let t = match geometry {
+                    Geometry::Phong => &observations.t_phong,
+                    Geometry::Blinn => &observations.t_blinn,
+                };
+                t.iter().map(|&t| lobe.eval(t)).collect()
+            }
+            Specular::Ggx => observations
+                .pairs
+                .iter()
+                .map(|&(wo, wi)| ggx_specular(parameter, wo, wi))
+                .collect(),
+        }
+    }
+}
+
+/// A fitted `n` as an exponent (the search's ends may round a hair outside the range).
+fn exponent(n: f64) -> Exponent {
+    Exponent::new(n.clamp(Exponent::MIN, Exponent::MAX))
+}
+
+/// Smith's `Lambda` for GGX at a direction of cosine `c`.
+fn smith_lambda(alpha: f64, c: f64) -> f64 {
+    let tan2 = (1.0 - c * c).max(0.0) / (c * c);
+    0.5 * (-1.0 + (1.0 + alpha * alpha * tan2).sqrt())
+}
+
+/// GGX's `D G2 / (4 cos_o cos_i)`.
+#[must_use]
+pub fn ggx_specular(alpha: f64, wo: DVec3, wi: DVec3) -> f64 {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return 0.0;
+    }
+    let h = (wo + wi).normalize();
+    let masking = 1.0 / (1.0 + smith_lambda(alpha, wo.z) + smith_lambda(alpha, wi.z));
+    ggx(alpha, h.z) * masking / (4.0 * wo.z * wi.z)
+}
+
+/// One `n` per material, or one per channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Sharing {
+    /// One `n` for the three channels.
+    Shared,
+    /// Each channel its own `n`.
+    PerChannel,
+}
+
+/// A fitted model.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Fit {
+    /// The specular family.
+    pub specular: Specular,
+    /// How `n` is shared.
+    pub sharing: Sharing,
+    /// `n` (or GGX's `alpha`) per channel; equal when shared.
+    pub parameter: [f64; 3],
+    /// Diffuse reflectance per channel.
+    pub kd: [f64; 3],
+    /// `K = ks N(n)`, the specular scale of the peak-1 lobe, per channel.
+    pub k: [f64; 3],
+    /// The fit error `E` (see the module page).
+    pub error: f64,
+    /// Each channel's share, `sqrt(sum_j w_j r_jc^2)`.
+    pub channel_error: [f64; 3],
+}
+
+impl Fit {
+    /// `ks` per channel under `normalisation` (`K / N(n)`); `None` for GGX.
+    #[must_use]
+    pub fn ks(&self, normalisation: Normalisation) -> Option<[f64; 3]> {
+        let Specular::Lobe { kind, .. } = self.specular else {
+            return None;
+        };
+        Some(core::array::from_fn(|c| {
+            let lobe = Lobe::new(kind, exponent(self.parameter[c]));
+            self.k[c] / normalisation.constant_for(&lobe)
+        }))
+    }
+
+    /// The fitted model's albedo at normal incidence per channel (`kd` plus the specular
+    /// term's hemispherical integral): above 1 the fit creates energy.
+    #[must_use]
+    pub fn albedo_at_normal(&self) -> [f64; 3] {
+        core::array::from_fn(|c| {
+            let specular = match self.specular {
+                Specular::Lobe { kind, geometry } => {
+                    let lobe = Lobe::new(kind, exponent(self.parameter[c]));
+                    specular_albedo_per_unit(&lobe, geometry, 0.0)
+                }
+                Specular::Ggx => ggx_albedo_at_normal(self.parameter[c]),
+            };
+            self.kd[c] + self.k[c] * specular
+        })
+    }
+
+    /// `f(wo, wi) cos(theta_i)` of the fitted model.
+    #[must_use]
+    pub fn f_cos(&self, wo: DVec3, wi: DVec3) -> DVec3 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return DVec3::ZERO;
+        }
+        let channel = |c: usize| {
+            let specular = match self.specular {
+                Specular::Lobe { kind, geometry } => Lobe::new(kind, exponent(self.parameter[c]))
+                    .eval(geometry.cos_lobe_local(wo, wi)),
+                Specular::Ggx => ggx_specular(self.parameter[c], wo, wi),
+            };
+            (self.kd[c] * FRAC_1_PI + self.k[c] * specular) * wi.z
+        };
+        DVec3::new(channel(0), channel(1), channel(2))
+    }
+}
+
+/// `int D G2 / (4 cos_o cos_i) cos_i dwi` for `wo` along the normal: with `wi` the mirror
+/// of `wo` about `h`, `dwi = 4 cos(theta_h) dwh`, and `wi` stays above the horizon while
+/// `theta_h < pi / 4`.
+fn ggx_albedo_at_normal(alpha: f64) -> f64 {
+    let integrand = |theta_h: f64| {
+        let (s, c) = theta_h.sin_cos();
+        let cos_i = (2.0 * theta_h).cos();
+        TAU * ggx(alpha, c) * c * s / (1.0 + smith_lambda(alpha, cos_i))
+    };
+    let peak = alpha.atan().min(FRAC_PI_4);
+    integrate_pieces(integrand, &[0.0, peak * 0.5, peak, FRAC_PI_4], 1e-10)
+}
+
+/// Observations with what every fit needs computed once.
+struct Prepared<'a> {
+    pairs: Vec<(DVec3, DVec3)>,
+    weight: &'a [f64],
+    /// `cos(theta_i)`.
+    cosine: Vec<f64>,
+    t_phong: Vec<f64>,
+    t_blinn: Vec<f64>,
+    /// Per channel, the cube root of the material's `f cos`.
+    target: [Vec<f64>; 3],
+    /// Per channel, the weight that linearises the cube root at the data.
+    linearised: [Vec<f64>; 3],
+}
+
+impl<'a> Prepared<'a> {
+    fn new(observations: &'a Observations) -> Self {
+        let pairs: Vec<(DVec3, DVec3)> = observations
+            .wo
+            .iter()
+            .zip(&observations.wi)
+            .map(|(&wo, &wi)| (wo, wi))
+            .collect();
+        let channel =
+            |c: usize| -> Vec<f64> { observations.value.iter().map(|v| v[c].cbrt()).collect() };
+        let linearised = |c: usize| -> Vec<f64> {
+            // d cbrt(y) = dy / (3 y^(2/3)): the squared slope, with a floor where y is ~0.
+            observations
+                .value
+                .iter()
+                .zip(&observations.weight)
+                .map(|(v, w)| w / (9.0 * v[c].abs().max(1e-4).powf(4.0 / 3.0)))
+                .collect()
+        };
+        Self {
+            cosine: pairs.iter().map(|(_, wi)| wi.z).collect(),
+            t_phong: pairs
+                .iter()
+                .map(|&(wo, wi)| Geometry::Phong.cos_lobe_local(wo, wi))
+                .collect(),
+            t_blinn: pairs
+                .iter()
+                .map(|&(wo, wi)| Geometry::Blinn.cos_lobe_local(wo, wi))
+                .collect(),
+            pairs,
+            weight: &observations.weight,
+            target: [channel(0), channel(1), channel(2)],
+            linearised: [linearised(0), linearised(1), linearised(2)],
+        }
+    }
+
+    /// The error sum of channel `c` with `(kd, K)` over specular values `specular`.
+    fn cost(&self, c: usize, specular: &[f64], [kd, k]: [f64; 2]) -> f64 {
+        specular
+            .iter()
+            .zip(&self.cosine)
+            .zip(&self.target[c])
+            .zip(self.weight)
+            .map(|(((&s, &cosine), &target), &w)| {
+                let r = target - ((kd * FRAC_1_PI + k * s) * cosine).cbrt();
+                w * r * r
+            })
+            .sum()
+    }
+
+    /// The best `(kd, K) >= 0` of channel `c` for these specular values, and its cost.
+    fn solve_channel(&self, c: usize, specular: &[f64]) -> ([f64; 2], f64) {
+        let p = |j: usize| FRAC_1_PI * self.cosine[j];
+        let q = |j: usize| specular[j] * self.cosine[j];
+        // The start: weighted least squares in f cos with the cube root's slope as weight.
+        let mut normal = [[0.0; 2]; 2];
+        let mut rhs = [0.0; 2];
+        for j in 0..specular.len() {
+            let (a, b, w) = (p(j), q(j), self.linearised[c][j]);
+            let y = self.target[c][j].powi(3);
+            normal[0][0] += w * a * a;
+            normal[0][1] += w * a * b;
+            normal[1][1] += w * b * b;
+            rhs[0] += w * a * y;
+            rhs[1] += w * b * y;
+        }
+        let mut x = solve_nonnegative(normal, rhs);
+        let mut cost = self.cost(c, specular, x);
+        for _ in 0..6 {
+            let mut normal = [[0.0; 2]; 2];
+            let mut rhs = [0.0; 2];
+            for j in 0..specular.len() {
+                let model = (x[0] * p(j) + x[1] * q(j)).max(1e-12);
+                let root = model.cbrt();
+                let slope = 1.0 / (3.0 * root * root);
+                let (a, b) = (slope * p(j), slope * q(j));
+                let (w, r) = (self.weight[j], self.target[c][j] - root);
+                normal[0][0] += w * a * a;
+                normal[0][1] += w * a * b;
+                normal[1][1] += w * b * b;
+                rhs[0] += w * a * r;
+                rhs[1] += w * b * r;
+            }
+            let step = solve_nonnegative_step(normal, rhs, x);
+            let mut scale = 1.0;
+            let improved = loop {
+                let trial = [
+                    (x[0] + scale * step[0]).max(0.0),
+                    (x[1] + scale * step[1]).max(0.0),
+                ];
+                let trial_cost = self.cost(c, specular, trial);
+                if trial_cost < cost {
+                    break Some((trial, trial_cost));
+                }
+                scale *= 0.25;
+                if scale < 1e-3 {
+                    break None;
+                }
+            };
+            let Some((trial, trial_cost)) = improved else {
+                break;
+            };
+            let converged = cost - trial_cost < 1e-12 * cost;
+            (x, cost) = (trial, trial_cost);
+            if converged {
+                break;
+            }
+        }
+        (x, cost)
+    }
+}
+
+/// The 2x2 symmetric system `normal x = rhs` solved with `x >= 0` (each bound tried when
+/// the unconstrained solution breaks it).
+fn solve_nonnegative(normal: [[f64; 2]; 2], rhs: [f64; 2]) -> [f64; 2] {
+    let det = normal[0][0] * normal[1][1] - normal[0][1] * normal[0][1];
+    if det > 1e-300 {
+        let x = [
+            (rhs[0] * normal[1][1] - rhs[1] * normal[0][1]) / det,
+            (rhs[1] * normal[0][0] - rhs[0] * normal[0][1]) / det,
+        ];
+        if x[0] >= 0.0 && x[1] >= 0.0 {
+            return x;
+        }
+    }
+    let only_diffuse = [(rhs[0] / normal[0][0]).max(0.0), 0.0];
+    let only_specular = [0.0, (rhs[1] / normal[1][1]).max(0.0)];
+    let residual = |x: [f64; 2]| {
+        // The quadratic's value up to a constant: x' N x - 2 x' rhs.
+        x[0] * x[0] * normal[0][0] + 2.0 * x[0] * x[1] * normal[0][1] + x[1] * x[1] * normal[1][1]
+            - 2.0 * (x[0] * rhs[0] + x[1] * rhs[1])
+    };
+    let candidates = [only_diffuse, only_specular].map(|x| {
+        if x.iter().all(|v| v.is_finite()) {
+            x
+        } else {
+            [0.0; 2]
+        }
+    });
+    if residual(candidates[0]) <= residual(candidates[1]) {
+        candidates[0]
+    } else {
+        candidates[1]
+    }
+}
+
+/// A Gauss-Newton step from `x` that keeps a parameter at its bound 0 when the step would
+/// push it below.
+fn solve_nonnegative_step(normal: [[f64; 2]; 2], rhs: [f64; 2], x: [f64; 2]) -> [f64; 2] {
+    let det = normal[0][0] * normal[1][1] - normal[0][1] * normal[0][1];
+    let free = if det > 1e-300 {
+        [
+            (rhs[0] * normal[1][1] - rhs[1] * normal[0][1]) / det,
+            (rhs[1] * normal[0][0] - rhs[0] * normal[0][1]) / det,
+        ]
+    } else {
+        [0.0; 2]
+    };
+    if x[0] + free[0] >= 0.0 && x[1] + free[1] >= 0.0 {
+        return free;
+    }
+    if x[0] + free[0] < 0.0 && normal[1][1] > 0.0 {
+        return [-x[0], rhs[1] / normal[1][1]];
+    }
+    if normal[0][0] > 0.0 {
+        return [rhs[0] / normal[0][0], -x[1]];
+    }
+    [0.0; 2]
+}
+
+/// One shape parameter's profile: its best error over `(kd, K)` for some channels.
+struct Profile<'p, 'a> {
+    prepared: &'p Prepared<'a>,
+    specular: Specular,
+    channels: &'p [usize],
+}
+
+impl Profile<'_, '_> {
+    fn solve(&self, log_parameter: f64) -> (Vec<([f64; 2], f64)>, f64) {
+        let values = self.specular.values(log_parameter.exp(), self.prepared);
+        let solutions: Vec<([f64; 2], f64)> = self
+            .channels
+            .iter()
+            .map(|&c| self.prepared.solve_channel(c, &values))
+            .collect();
+        let total = solutions.iter().map(|s| s.1).sum();
+        (solutions, total)
+    }
+}
+
+impl CostFunction for Profile<'_, '_> {
+    type Param = f64;
+    type Output = f64;
+
+    fn cost(&self, log_parameter: &f64) -> Result<f64, argmin::core::Error> {
+        Ok(self.solve(*log_parameter).1)
+    }
+}
+
+/// The best log-parameter of a profile: the grid's best point, then Brent between its
+/// neighbours.
+fn minimise(profile: &Profile) -> f64 {
+    let [low, high] = profile.specular.log_range();
+    let grid: Vec<f64> = (0..GRID_POINTS)
+        .map(|i| low + (high - low) * i as f64 / (GRID_POINTS - 1) as f64)
+        .collect();
+    let costs: Vec<f64> = grid.iter().map(|&p| profile.solve(p).1).collect();
+    let best = (0..GRID_POINTS)
+        .min_by(|&a, &b| costs[a].total_cmp(&costs[b]))
+        .unwrap_or(0);
+    let (a, b) = (
+        grid[best.saturating_sub(1)],
+        grid[(best + 1).min(GRID_POINTS - 1)],
+    );
+    let polished = Executor::new(
+        Profile { ..*profile },
+        BrentOpt::new(a, b).set_tolerance(1e-8, 1e-5),
+    )
+    .configure(|state| state.max_iters(60))
+    .run()
+    .ok()
+    .and_then(|result| {
+        let state = result.state();
+        state.best_param.map(|p| (p, state.best_cost))
+    });
+    match polished {
+        Some((p, cost)) if cost <= costs[best] => p,
+        _ => grid[best],
+    }
+}
+
+/// Fits `specular` to the observations with `n` shared or per channel.
+#[must_use]
+pub fn fit(observations: &Observations, specular: Specular, sharing: Sharing) -> Fit {
+    fit_prepared(&Prepared::new(observations), specular, sharing)
+}
+
+fn fit_prepared(prepared: &Prepared, specular: Specular, sharing: Sharing) -> Fit {
+    let groups: Vec<Vec<usize>> = match sharing {
+        Sharing::Shared => vec![vec![0, 1, 2]],
+        Sharing::PerChannel => vec![vec![0], vec![1], vec![2]],
+    };
+    let mut fit = Fit {
+        specular,
+        sharing,
+        parameter: [0.0; 3],
+        kd: [0.0; 3],
+        k: [0.0; 3],
+        error: 0.0,
+        channel_error: [0.0; 3],
+    };
+    for channels in &groups {
+        let profile = Profile {
+            prepared,
+            specular,
+            channels,
+        };
+        let best = minimise(&profile);
+        let (solutions, _) = profile.solve(best);
+        for (&c, ([kd, k], cost)) in channels.iter().zip(solutions) {
+            fit.parameter[c] = best.exp();
+            fit.kd[c] = kd;
+            fit.k[c] = k;
+            fit.channel_error[c] = cost.sqrt();
+        }
+    }
+    fit.error = (fit.channel_error.iter().map(|e| e * e).sum::<f64>() / 3.0).sqrt();
+    fit
+}
+
+/// Every family in `kinds` in both geometries, and GGX, each shared and per channel, fitted
+/// in parallel; in that order (lobes in `kinds`' order, Phong before Blinn, shared first).
+#[must_use]
+pub fn fit_all(observations: &Observations, kinds: &[LobeKind]) -> Vec<Fit> {
+    let prepared = Prepared::new(observations);
+    let families: Vec<Specular> = kinds
+        .iter()
+        .flat_map(|&kind| Geometry::ALL.map(|geometry| Specular::Lobe { kind, geometry }))
+        .chain([Specular::Ggx])
+        .collect();
+    let jobs: Vec<(Specular, Sharing)> = families
+        .iter()
+        .flat_map(|&s| [(s, Sharing::Shared), (s, Sharing::PerChannel)])
+        .collect();
+    jobs.par_iter()
+        .map(|&(specular, sharing)| fit_prepared(&prepared, specular, sharing))
+        .collect()
+}

@@ -1,0 +1,112 @@
+//! The verdict on a material: which lobe to ship.
+//!
+//! A renderer's material has one `n`, so candidates are the shared-`n` fits. The reference is
+//! `pow`'s better fit of the two geometries; a lobe *meets* when its fit error is within
+//! `margin` of it (`E <= (1 + margin) E_pow`), and the verdict is the meeting lobe with the
+//! highest rate on the target, the rate given by the caller (a cost model, a benchmark):
+//! the core decides, the face measures. `pow` always meets, so there is always a verdict.
+
+use serde::Serialize;
+
+use super::{Fit, Sharing, Specular};
+use crate::LobeKind;
+
+/// One candidate's standing.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Standing {
+    /// Its index in the fits given.
+    pub fit: usize,
+    /// `E / E_pow` (pow's fit in the same geometry and sharing).
+    pub relative_to_pow: f64,
+    /// `E / E_ggx` (GGX's fit with the same sharing).
+    pub relative_to_ggx: f64,
+    /// The target's rate at the fitted `n` (higher is cheaper); `None` where it cannot run.
+    pub rate: Option<f64>,
+    /// Within the margin of pow's best fit.
+    pub meets: bool,
+}
+
+/// The ranking of a material's fits on one target.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Verdict {
+    /// The margin allowed over pow's error, as a fraction.
+    pub margin: f64,
+    /// Pow's best shared-`n` error, the reference.
+    pub reference_error: f64,
+    /// Every fit's standing, in the fits' order.
+    pub standings: Vec<Standing>,
+    /// The index (in the fits) of the cheapest meeting shared-`n` lobe.
+    pub chosen: usize,
+}
+
+/// The best error among `fits` matching `pick`, or NaN where none does.
+fn best_error(fits: &[Fit], pick: impl Fn(&Fit) -> bool) -> f64 {
+    fits.iter()
+        .filter(|f| pick(f))
+        .map(|f| f.error)
+        .min_by(f64::total_cmp)
+        .unwrap_or(f64::NAN)
+}
+
+/// Ranks `fits` (as [`super::fit_all`] returns them, pow among the lobes) with `rate` giving
+/// each shared-`n` lobe fit's rate on the target. `None` when pow's shared fit is missing.
+pub fn verdict(fits: &[Fit], margin: f64, rate: impl Fn(&Fit) -> Option<f64>) -> Option<Verdict> {
+    let is_pow = |f: &Fit| {
+        matches!(
+            f.specular,
+            Specular::Lobe {
+                kind: LobeKind::Pow,
+                ..
+            }
+        )
+    };
+    let reference_error = best_error(fits, |f| is_pow(f) && f.sharing == Sharing::Shared);
+    if !reference_error.is_finite() {
+        return None;
+    }
+    let standings: Vec<Standing> = fits
+        .iter()
+        .enumerate()
+        .map(|(index, fit)| {
+            let pow = best_error(fits, |f| {
+                is_pow(f)
+                    && f.sharing == fit.sharing
+                    && match (f.specular, fit.specular) {
+                        (
+                            Specular::Lobe { geometry: a, .. },
+                            Specular::Lobe { geometry: b, .. },
+                        ) => a == b,
+                        _ => true,
+                    }
+            });
+            let ggx = best_error(fits, |f| {
+                f.specular == Specular::Ggx && f.sharing == fit.sharing
+            });
+            let candidate =
+                fit.sharing == Sharing::Shared && matches!(fit.specular, Specular::Lobe { .. });
+            let rate = if candidate { rate(fit) } else { None };
+            Standing {
+                fit: index,
+                relative_to_pow: fit.error / pow,
+                relative_to_ggx: fit.error / ggx,
+                rate,
+                meets: candidate && rate.is_some() && fit.error <= (1.0 + margin) * reference_error,
+            }
+        })
+        .collect();
+    let chosen = standings
+        .iter()
+        .filter(|s| s.meets)
+        .max_by(|a, b| {
+            let (ra, rb) = (a.rate.unwrap_or(0.0), b.rate.unwrap_or(0.0));
+            ra.total_cmp(&rb)
+                .then_with(|| fits[b.fit].error.total_cmp(&fits[a.fit].error))
+        })?
+        .fit;
+    Some(Verdict {
+        margin,
+        reference_error,
+        standings,
+        chosen,
+    })
+}

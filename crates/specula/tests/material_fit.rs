@@ -1,0 +1,162 @@
+//! The material fit recovers models it is given: observations made by the core's `Brdf`
+//! (a second implementation of the classic model) or by a GGX written out here are fitted
+//! back to their own parameters, with an error at rounding level; channels with different
+//! exponents are told apart by the per-channel fit and not by the shared one; and the
+//! verdict picks the cheapest lobe within the margin.
+
+#![allow(clippy::needless_range_loop)]
+
+use core::f64::consts::PI;
+
+use glam::DVec3;
+use specula::measured::fit::{fit, verdict::verdict, Fit, Observations, Sharing, Specular};
+use specula::{Brdf, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
+
+fn close(a: f64, b: f64, relative: f64) -> bool {
+    (a - b).abs() <= relative * b.abs().max(1e-9)
+}
+
+#[test]
+fn a_classic_model_is_fitted_back_to_its_parameters() {
+    for (geometry, n) in [(Geometry::Phong, 37.0), (Geometry::Blinn, 180.0)] {
+        let lobe = Lobe::new(LobeKind::Pow, Exponent::new(n));
+        let (kd, ks) = (Rgb::new(0.30, 0.12, 0.05), Rgb::new(0.04, 0.05, 0.06));
+        let brdf = Brdf::new(kd, ks, lobe, geometry, Normalisation::Lobe);
+        let observations = Observations::of(|wo, wi| brdf.f(wo, wi) * wi.z);
+        let fitted = fit(
+            &observations,
+            Specular::Lobe {
+                kind: LobeKind::Pow,
+                geometry,
+            },
+            Sharing::Shared,
+        );
+        assert!(fitted.error < 1e-6, "{geometry:?}: error {}", fitted.error);
+        assert!(
+            close(fitted.parameter[0], n, 1e-3),
+            "n {:?}",
+            fitted.parameter
+        );
+        let ks_lobe = fitted.ks(Normalisation::Lobe).expect("a lobe has ks");
+        for c in 0..3 {
+            assert!(close(fitted.kd[c], kd[c], 1e-3), "kd {:?}", fitted.kd);
+            assert!(close(ks_lobe[c], ks[c], 1e-3), "ks {ks_lobe:?}");
+            // K is ks N(n) under any normalisation: the analytic (n + 1) / 2 pi here.
+            assert!(close(fitted.k[c], ks[c] * (n + 1.0) / (2.0 * PI), 1e-3));
+        }
+    }
+}
+
+#[test]
+fn channels_with_their_own_exponents_need_the_per_channel_fit() {
+    let exponents = [12.0, 60.0, 400.0];
+    let brdfs = exponents.map(|n| {
+        Brdf::new(
+            Rgb::splat(0.2),
+            Rgb::splat(0.05),
+            Lobe::new(LobeKind::Pow, Exponent::new(n)),
+            Geometry::Blinn,
+            Normalisation::Lobe,
+        )
+    });
+    let observations = Observations::of(|wo, wi| {
+        Rgb::new(
+            brdfs[0].f(wo, wi).x,
+            brdfs[1].f(wo, wi).y,
+            brdfs[2].f(wo, wi).z,
+        ) * wi.z
+    });
+    let pow = Specular::Lobe {
+        kind: LobeKind::Pow,
+        geometry: Geometry::Blinn,
+    };
+    let per_channel = fit(&observations, pow, Sharing::PerChannel);
+    let shared = fit(&observations, pow, Sharing::Shared);
+    for c in 0..3 {
+        assert!(
+            close(per_channel.parameter[c], exponents[c], 2e-3),
+            "{:?}",
+            per_channel.parameter
+        );
+    }
+    assert!(per_channel.error < 1e-6);
+    assert!(shared.error > 100.0 * per_channel.error.max(1e-9));
+}
+
+/// GGX with height-correlated Smith masking, written from Heitz (2014) independently of the
+/// library's.
+fn ggx_f(alpha: f64, wo: DVec3, wi: DVec3) -> f64 {
+    let h = (wo + wi).normalize();
+    let a2 = alpha * alpha;
+    let d = a2 / (PI * (h.z * h.z * (a2 - 1.0) + 1.0).powi(2));
+    let lambda = |z: f64| ((1.0 + a2 * (1.0 / (z * z) - 1.0)).sqrt() - 1.0) / 2.0;
+    d / (1.0 + lambda(wo.z) + lambda(wi.z)) / (4.0 * wo.z * wi.z)
+}
+
+#[test]
+fn ggx_is_fitted_back_to_its_roughness() {
+    let alpha = 0.12;
+    let observations = Observations::of(|wo, wi| {
+        (Rgb::new(0.1, 0.2, 0.3) / PI + Rgb::new(0.9, 0.7, 0.5) * ggx_f(alpha, wo, wi)) * wi.z
+    });
+    let fitted = fit(&observations, Specular::Ggx, Sharing::Shared);
+    assert!(fitted.error < 1e-6, "{}", fitted.error);
+    assert!(
+        close(fitted.parameter[0], alpha, 1e-3),
+        "{:?}",
+        fitted.parameter
+    );
+    assert!(close(fitted.k[1], 0.7, 1e-3) && close(fitted.kd[2], 0.3, 1e-3));
+}
+
+fn stub(kind: LobeKind, error: f64) -> Fit {
+    Fit {
+        specular: Specular::Lobe {
+            kind,
+            geometry: Geometry::Phong,
+        },
+        sharing: Sharing::Shared,
+        parameter: [10.0; 3],
+        kd: [0.0; 3],
+        k: [0.0; 3],
+        error,
+        channel_error: [error; 3],
+    }
+}
+
+#[test]
+fn the_verdict_is_the_cheapest_lobe_within_the_margin() {
+    let mut ggx = stub(LobeKind::Pow, 0.5);
+    ggx.specular = Specular::Ggx;
+    let fits = vec![
+        stub(LobeKind::Pow, 0.100),
+        stub(LobeKind::Schlick, 0.104),
+        stub(LobeKind::ALL[8], 0.103),
+        stub(LobeKind::FasterPow, 0.2),
+        ggx,
+    ];
+    // Rates: faster-pow is cheapest but 2x pow's error; schlick is next and within 5 %.
+    let rate = |f: &Fit| match f.specular {
+        Specular::Lobe {
+            kind: LobeKind::Pow,
+            ..
+        } => Some(1.0),
+        Specular::Lobe {
+            kind: LobeKind::Schlick,
+            ..
+        } => Some(3.0),
+        Specular::Lobe {
+            kind: LobeKind::FasterPow,
+            ..
+        } => Some(9.0),
+        _ => Some(2.0),
+    };
+    let within_5 = verdict(&fits, 0.05, rate).expect("pow is there");
+    assert_eq!(within_5.chosen, 1);
+    assert!(!within_5.standings[3].meets && !within_5.standings[4].meets);
+    assert!(close(within_5.standings[1].relative_to_pow, 1.04, 1e-12));
+    assert!(close(within_5.standings[0].relative_to_ggx, 0.2, 1e-12));
+    // Within 3.5 % schlick (4 %) is out and cosquad (3 %) the cheapest left; within 1 %, pow.
+    assert_eq!(verdict(&fits, 0.035, rate).unwrap().chosen, 2);
+    assert_eq!(verdict(&fits, 0.01, rate).unwrap().chosen, 0);
+}
