@@ -30,9 +30,18 @@ enum Command {
     #[command(
         after_help = "Examples:\n  specula recommend --target gpu-nvidia --n 64 --max-error 1%\n  \
                             specula recommend --target cpu --n 8..512 --max-error 0.5% --zone epicentre\n  \
-                            specula recommend --target gpu-amd --n 64 --max-error 2% --zone whole --energy-conserving --format json"
+                            specula recommend --target gpu-amd --n 64 --max-error 2% --zone whole --energy-conserving --format json\n  \
+                            specula recommend --material paper_white_rgb.bsdf --target gpu-nvidia --margin 5%"
     )]
     Recommend(commands::recommend::Args),
+    /// Fit every lobe (and GGX) to measured materials (RGL isotropic RGB `.bsdf` files): the
+    /// parameters, the fit errors against pow's and GGX's, the energy, and the lobe to ship.
+    #[command(
+        after_help = "Examples:\n  specula fit --material paper_white_rgb.bsdf\n  \
+                            specula fit --material a.bsdf b.bsdf --target cpu --margin 2% --format json >> fits.jsonl\n  \
+                            specula recommend --material paper_white_rgb.bsdf --target gpu-nvidia"
+    )]
+    Fit(commands::fit::Args),
     /// Evaluate one lobe at one cosine or angle, next to the exact t^n.
     #[command(
         after_help = "Examples:\n  specula eval --lobe schlick --n 32 --cos 0.98\n  \
@@ -211,6 +220,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Models(args) => commands::models::run(&args),
         Command::Recommend(args) => commands::recommend::run(&args),
+        Command::Fit(args) => commands::fit::run(&args),
         Command::Eval(args) => commands::eval::run(&args),
         Command::Analyze(args) => commands::analyze::run(&args),
         Command::Claims(args) => commands::claims::run(&args),

@@ -136,27 +136,13 @@ fn the_verdict_is_the_cheapest_lobe_within_the_margin() {
         ggx,
     ];
     // Rates: faster-pow is cheapest but 2x pow's error; schlick is next and within 5 %.
-    let rate = |f: &Fit| match f.specular {
-        Specular::Lobe {
-            kind: LobeKind::Pow,
-            ..
-        } => Some(1.0),
-        Specular::Lobe {
-            kind: LobeKind::Schlick,
-            ..
-        } => Some(3.0),
-        Specular::Lobe {
-            kind: LobeKind::FasterPow,
-            ..
-        } => Some(9.0),
-        _ => Some(2.0),
-    };
-    let within_5 = verdict(&fits, 0.05, rate).expect("pow is there");
+    let rate = [Some(1.0), Some(3.0), Some(2.0), Some(9.0), None];
+    let within_5 = verdict(&fits, 0.05, &rate).expect("pow is there");
     assert_eq!(within_5.chosen, 1);
     assert!(!within_5.standings[3].meets && !within_5.standings[4].meets);
     assert!(close(within_5.standings[1].relative_to_pow, 1.04, 1e-12));
     assert!(close(within_5.standings[0].relative_to_ggx, 0.2, 1e-12));
     // Within 3.5 % schlick (4 %) is out and cosquad (3 %) the cheapest left; within 1 %, pow.
-    assert_eq!(verdict(&fits, 0.035, rate).unwrap().chosen, 2);
-    assert_eq!(verdict(&fits, 0.01, rate).unwrap().chosen, 0);
+    assert_eq!(verdict(&fits, 0.035, &rate).unwrap().chosen, 2);
+    assert_eq!(verdict(&fits, 0.01, &rate).unwrap().chosen, 0);
 }

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod claims;
 pub mod diff;
 pub mod eval;
+pub mod fit;
 pub mod fpga_estimate;
 pub mod hw;
 pub mod lobe;

@@ -56,8 +56,15 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = parse_exponents)]
     n: Exponents,
     /// The largest error allowed, as a percentage (`1%` or `1`).
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_percent)]
-    max_error: f64,
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_percent, required_unless_present = "material")]
+    max_error: Option<f64>,
+    /// Rank by the fit to a measured material instead (an RGL isotropic RGB `.bsdf`): the
+    /// cheapest lobe whose fit error is within `--margin` of pow's (see `specula fit`).
+    #[arg(long, conflicts_with_all = ["max_error", "n", "zone", "energy_conserving"])]
+    material: Option<std::path::PathBuf>,
+    /// With `--material`: the fit error allowed over pow's, as a percentage.
+    #[arg(long, allow_hyphen_values = true, default_value = "5%", value_parser = parse_percent)]
+    margin: f64,
     /// Which error.
     #[arg(long, value_enum, default_value_t = ZoneChoice::Epicentre)]
     zone: ZoneChoice,
@@ -97,7 +104,7 @@ fn parse_exponents(text: &str) -> Result<Exponents, String> {
     Ok(Exponents(values.into_iter().map(Exponent::new).collect()))
 }
 
-fn parse_percent(text: &str) -> Result<f64, String> {
+pub(crate) fn parse_percent(text: &str) -> Result<f64, String> {
     let number = text.trim().trim_end_matches('%');
     match number.parse::<f64>() {
         Ok(value) if value > 0.0 && value <= 100.0 => Ok(value / 100.0),
@@ -331,8 +338,45 @@ pub(crate) fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
         .collect()
 }
 
+/// Why `--material` refuses the FPGA target.
+pub(crate) const FPGA_MATERIAL_REFUSAL: &str = "a material verdict cannot target fpga: the fixed-point datapaths take an integer n and a word length chosen for an error against t^n, which a material's fit does not give; valid targets: cpu, gpu-nvidia, gpu-amd";
+
+/// A lobe's rate on `target` for a material's verdict (higher is cheaper): measured on the
+/// CPU, modelled on a GPU.
+pub(crate) fn lobe_rate(target: Target, lobe: &Lobe) -> Result<f64, String> {
+    if target == Target::Fpga {
+        return Err(FPGA_MATERIAL_REFUSAL.to_owned());
+    }
+    match Costing::new(target, &[lobe.exponent()])? {
+        Costing::Measured => Ok(super::bench::lobes::kernel_rate(lobe)),
+        Costing::Modelled(family) => {
+            let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
+            Ok(family.cost(&ops).evals_per_clock)
+        }
+        Costing::Estimated(_) | Costing::Synthesized(_) => Err(FPGA_MATERIAL_REFUSAL.to_owned()),
+    }
+}
+
+/// The unit of [`lobe_rate`] on `target`.
+pub(crate) fn rate_unit(target: Target) -> &'static str {
+    match target {
+        Target::Cpu => Costing::Measured.unit(),
+        Target::GpuNvidia | Target::GpuAmd => "evals/clock/multiprocessor (modelled)",
+        Target::Fpga => "",
+    }
+}
+
 /// Measures, ranks and prints.
 pub fn run(args: &Args) -> CommandResult {
+    if let Some(material) = &args.material {
+        let kinds = super::fit::lobes_to_fit(&crate::args::flatten(&args.lobe))?;
+        if args.target == Target::Fpga {
+            return Err(FPGA_MATERIAL_REFUSAL.to_owned());
+        }
+        let assessment = super::fit::assess(material, &kinds, args.target, args.margin)?;
+        return super::fit::print_ranking(&assessment, args.format);
+    }
+    let max_error = args.max_error.unwrap_or(f64::NAN);
     let exponents = &args.n.0;
     let yours = crate::args::flatten(&args.lobe);
     crate::args::check_lobes(&yours, exponents)?;
@@ -359,7 +403,7 @@ pub fn run(args: &Args) -> CommandResult {
         for &n in exponents {
             let lobe = Lobe::new(kind, n);
             energy = energy.max(energy_ratio(&lobe));
-            match costing.point(&lobe, args.zone, args.max_error)? {
+            match costing.point(&lobe, args.zone, max_error)? {
                 Some(point) => {
                     error = error.max(point.error);
                     cheapest = cheapest.min(point.rate);
@@ -372,7 +416,7 @@ pub fn run(args: &Args) -> CommandResult {
             (error, cheapest, datapath) = (f64::INFINITY, 0.0, None);
         }
         let unit = costing.unit();
-        let meets = error <= args.max_error && (!args.energy_conserving || energy <= 1.001);
+        let meets = error <= max_error && (!args.energy_conserving || energy <= 1.001);
         candidates.push(Candidate {
             lobe: kind.to_string(),
             datapath,
@@ -403,7 +447,7 @@ pub fn run(args: &Args) -> CommandResult {
     candidates.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
     let best = candidates.iter().find(|c| c.meets).map(|c| c.lobe.clone());
     for candidate in &mut candidates {
-        candidate.why = why(candidate, best.as_deref(), pow_rate, args);
+        candidate.why = why(candidate, best.as_deref(), pow_rate, args.target, max_error);
     }
     if args.format == crate::args::Format::Json {
         return super::print_json(&candidates);
@@ -427,12 +471,12 @@ pub fn run(args: &Args) -> CommandResult {
     match &best {
         Some(lobe) => println!(
             "{lobe}: the cheapest lobe within {} % ({zone} error) at {span} on {target}",
-            100.0 * args.max_error
+            100.0 * max_error
         ),
         None => println!(
             "no lobe is within {} % ({zone} error) at {span} on {target}; every lobe is listed, \
              with the Pareto front marked",
-            100.0 * args.max_error
+            100.0 * max_error
         ),
     }
     let mut table = Table::new(&[
@@ -474,7 +518,7 @@ fn versus_pow(rate: f64, pow_rate: f64) -> String {
     }
 }
 
-fn why(c: &Candidate, best: Option<&str>, pow_rate: f64, args: &Args) -> String {
+fn why(c: &Candidate, best: Option<&str>, pow_rate: f64, target: Target, max_error: f64) -> String {
     let speed = versus_pow(c.rate, pow_rate);
     let relative = if speed == "-" {
         String::new()
@@ -482,14 +526,14 @@ fn why(c: &Candidate, best: Option<&str>, pow_rate: f64, args: &Args) -> String 
         format!(" at {speed} pow's rate")
     };
     if !c.meets {
-        if args.target == Target::Fpga && c.datapath.is_none() {
+        if target == Target::Fpga && c.datapath.is_none() {
             return "no fixed-point datapath for this lobe".to_owned();
         }
-        if c.error > args.max_error {
+        if c.error > max_error {
             return format!(
                 "error {:.3} % exceeds {:.3} %",
                 100.0 * c.error,
-                100.0 * args.max_error
+                100.0 * max_error
             );
         }
         return format!("energy {:.2} % above t^n's", 100.0 * (c.energy_ratio - 1.0));

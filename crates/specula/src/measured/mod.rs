@@ -275,6 +275,24 @@ impl MeasuredBrdf {
         Some(MeasuredSample { wi, f, pdf })
     }
 
+    /// The directional albedo `int f(wo, wi) cos(theta_i) dwi`, estimated by importance
+    /// sampling the data at the midpoints of a `strata x strata` grid of the unit square (no
+    /// random numbers: the figure is reproducible).
+    #[must_use]
+    pub fn albedo(&self, wo: DVec3, strata: usize) -> Rgb {
+        let total: Rgb = (0..strata * strata)
+            .filter_map(|i| {
+                let u = [
+                    ((i % strata) as f64 + 0.5) / strata as f64,
+                    ((i / strata) as f64 + 0.5) / strata as f64,
+                ];
+                self.sample(wo, u)
+            })
+            .map(|drawn| drawn.f * (drawn.wi.z / drawn.pdf))
+            .sum();
+        total / (strata * strata) as f64
+    }
+
     /// The density with which [`MeasuredBrdf::sample`] draws `wi`, per unit solid angle.
     #[must_use]
     pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {

@@ -48,9 +48,11 @@ fn best_error(fits: &[Fit], pick: impl Fn(&Fit) -> bool) -> f64 {
         .unwrap_or(f64::NAN)
 }
 
-/// Ranks `fits` (as [`super::fit_all`] returns them, pow among the lobes) with `rate` giving
-/// each shared-`n` lobe fit's rate on the target. `None` when pow's shared fit is missing.
-pub fn verdict(fits: &[Fit], margin: f64, rate: impl Fn(&Fit) -> Option<f64>) -> Option<Verdict> {
+/// Ranks `fits` (as [`super::fit_all`] returns them, pow among the lobes) with `rates[i]`
+/// the rate of `fits[i]` on the target (read for shared-`n` lobes only; `None` where the
+/// target cannot run it). `None` when pow's shared fit is missing.
+#[must_use]
+pub fn verdict(fits: &[Fit], margin: f64, rates: &[Option<f64>]) -> Option<Verdict> {
     let is_pow = |f: &Fit| {
         matches!(
             f.specular,
@@ -84,7 +86,11 @@ pub fn verdict(fits: &[Fit], margin: f64, rate: impl Fn(&Fit) -> Option<f64>) ->
             });
             let candidate =
                 fit.sharing == Sharing::Shared && matches!(fit.specular, Specular::Lobe { .. });
-            let rate = if candidate { rate(fit) } else { None };
+            let rate = if candidate {
+                rates.get(index).copied().flatten()
+            } else {
+                None
+            };
             Standing {
                 fit: index,
                 relative_to_pow: fit.error / pow,
