@@ -1,10 +1,26 @@
-//! Measured materials from files: an RGL `.bsdf` read through [`crate::input`] (a regular
-//! file, within [`MAX_MATERIAL_BYTES`], checked before a byte is read) and handed to the
-//! core's [`MeasuredBrdf`], whose refusals come back prefixed by the path.
+//! Measured materials from files and in pictures: an RGL `.bsdf` read through
+//! [`crate::input`] (a regular file, within [`MAX_MATERIAL_BYTES`], checked before a byte is
+//! read) and handed to the core's [`MeasuredBrdf`], whose refusals come back prefixed by the
+//! path; the measured material and its fits as the environment renderer's BRDFs
+//! ([`MeasuredReflectance`], [`FittedReflectance`]); and the comparison render, every model
+//! in the same scene with the same random numbers, each scored by FLIP against the
+//! measurement ([`render_comparison`]).
 
+use core::f64::consts::{FRAC_1_PI, TAU};
 use std::path::Path;
 
+use glam::DVec3;
+use specula::fit::ggx;
+use specula::measured::fit::{ggx_specular, Fit, Specular};
 pub use specula::measured::MeasuredBrdf;
+use specula::sampling::SpecularSampler;
+use specula::{Exponent, Geometry, Lobe, Normalisation};
+
+use crate::ibl::{
+    cosine_direction, render_ibl_with, Environment, IblSettings, Reflectance, Strategy,
+};
+use crate::metrics::compare;
+use crate::{Image, Overrides, Scene};
 
 /// The largest material file read: 64 MiB (the RGL RGB files are 0.7 to 10 MiB).
 pub const MAX_MATERIAL_BYTES: u64 = 64 << 20;
@@ -22,4 +38,209 @@ pub fn material_name(path: &Path) -> String {
         || path.display().to_string(),
         |s| s.to_string_lossy().into_owned(),
     )
+}
+
+/// A measured material as the environment renderer's BRDF, sampled by its own data (the
+/// luminance and VNDF warps, as Mitsuba's `measured` plugin samples it). Channels that dip
+/// below zero (a spectrum's RGB) are taken as zero, so no pixel goes negative.
+pub struct MeasuredReflectance<'a>(pub &'a MeasuredBrdf);
+
+impl Reflectance for MeasuredReflectance<'_> {
+    fn f_and_pdf(&self, wo: DVec3, wi: DVec3) -> (DVec3, f64) {
+        (self.0.f(wo, wi).max(DVec3::ZERO), self.0.pdf(wo, wi))
+    }
+
+    fn sample(&self, wo: DVec3, u: [f64; 3]) -> Option<(DVec3, DVec3, f64)> {
+        let drawn = self.0.sample(wo, [u[1], u[2]])?;
+        Some((drawn.wi, drawn.f.max(DVec3::ZERO), drawn.pdf))
+    }
+}
+
+/// How a fitted model's specular directions are drawn.
+enum SpecularDraw {
+    /// The lobe's own sampler (at the first channel's `n`), its value per channel apart.
+    Lobe {
+        sampler: SpecularSampler,
+        lobes: [Lobe; 3],
+        geometry: Geometry,
+    },
+    /// GGX normals in proportion to `D(h) cos(theta_h)`, at the first channel's `alpha`.
+    Ggx { alpha: [f64; 3] },
+}
+
+/// A fitted model as the environment renderer's BRDF: `kd / pi + K spec(wo, wi)` per channel,
+/// drawn from a mixture of the cosine and the specular term in proportion to their albedos.
+pub struct FittedReflectance {
+    diffuse: DVec3,
+    k: DVec3,
+    draw: SpecularDraw,
+    specular_share: f64,
+}
+
+impl FittedReflectance {
+    /// Prepares `fit` for rendering.
+    #[must_use]
+    pub fn new(fit: &Fit) -> Self {
+        let exponent = |n: f64| Exponent::new(n.clamp(Exponent::MIN, Exponent::MAX));
+        let draw = match fit.specular {
+            Specular::Lobe { kind, geometry } => {
+                let lobes = fit.parameter.map(|n| Lobe::new(kind, exponent(n)));
+                SpecularDraw::Lobe {
+                    sampler: SpecularSampler::new(lobes[0], geometry, Normalisation::None),
+                    lobes,
+                    geometry,
+                }
+            }
+            Specular::Ggx => SpecularDraw::Ggx {
+                alpha: fit.parameter,
+            },
+        };
+        let albedo = fit.albedo_at_normal();
+        let luminance = |v: [f64; 3]| 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
+        let (d, total) = (luminance(fit.kd), luminance(albedo));
+        Self {
+            diffuse: DVec3::from_array(fit.kd) * FRAC_1_PI,
+            k: DVec3::from_array(fit.k),
+            draw,
+            specular_share: if total > 0.0 {
+                ((total - d) / total).clamp(0.0, 1.0)
+            } else {
+                0.0
+            },
+        }
+    }
+
+    fn specular(&self, wo: DVec3, wi: DVec3) -> DVec3 {
+        match &self.draw {
+            SpecularDraw::Lobe {
+                lobes, geometry, ..
+            } => {
+                let t = geometry.cos_lobe_local(wo, wi);
+                DVec3::new(lobes[0].eval(t), lobes[1].eval(t), lobes[2].eval(t))
+            }
+            SpecularDraw::Ggx { alpha } => DVec3::new(
+                ggx_specular(alpha[0], wo, wi),
+                ggx_specular(alpha[1], wo, wi),
+                ggx_specular(alpha[2], wo, wi),
+            ),
+        }
+    }
+
+    fn specular_pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
+        match &self.draw {
+            SpecularDraw::Lobe { sampler, .. } => sampler.pdf(wo, wi),
+            SpecularDraw::Ggx { alpha } => {
+                let h = (wo + wi).normalize();
+                ggx(alpha[0], h.z) * h.z / (4.0 * wo.dot(h).abs())
+            }
+        }
+    }
+
+    fn specular_direction(&self, wo: DVec3, u: [f64; 2]) -> Option<DVec3> {
+        match &self.draw {
+            SpecularDraw::Lobe { sampler, .. } => Some(sampler.sample(wo, u)?.wi),
+            SpecularDraw::Ggx { alpha } => {
+                let theta = (alpha[0] * (u[0] / (1.0 - u[0])).sqrt()).atan();
+                let (s, c) = (TAU * u[1]).sin_cos();
+                let h = DVec3::new(theta.sin() * c, theta.sin() * s, theta.cos());
+                Some(2.0 * wo.dot(h) * h - wo)
+            }
+        }
+    }
+}
+
+impl Reflectance for FittedReflectance {
+    fn f_and_pdf(&self, wo: DVec3, wi: DVec3) -> (DVec3, f64) {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return (DVec3::ZERO, 0.0);
+        }
+        let share = self.specular_share;
+        let specular_pdf = if share > 0.0 {
+            self.specular_pdf(wo, wi)
+        } else {
+            0.0
+        };
+        (
+            self.diffuse + self.k * self.specular(wo, wi),
+            (1.0 - share) * wi.z * FRAC_1_PI + share * specular_pdf,
+        )
+    }
+
+    fn sample(&self, wo: DVec3, u: [f64; 3]) -> Option<(DVec3, DVec3, f64)> {
+        let wi = if u[0] < self.specular_share {
+            self.specular_direction(wo, [u[1], u[2]])?
+        } else {
+            cosine_direction([u[1], u[2]])
+        };
+        let (f, pdf) = self.f_and_pdf(wo, wi);
+        (pdf > 0.0).then_some((wi, f, pdf))
+    }
+}
+
+/// The environment scene (a sphere and the teapot under the sky) at `width` pixels wide,
+/// every object to be shown in one material.
+#[must_use]
+pub fn material_scene(width: u32) -> Scene {
+    let mut scene = Scene::ibl_scene();
+    scene.apply(&Overrides {
+        width: Some(width),
+        height: Some((width * 9 / 16).max(1)),
+        ..Overrides::default()
+    });
+    scene
+}
+
+/// One image of a material comparison and how far it is from the measured one.
+pub struct ComparedRender {
+    /// What is shown: `measured`, or a fit's label.
+    pub label: String,
+    /// The image (linear radiance).
+    pub image: Image,
+    /// Mean FLIP against the measured render (0 for the measured render itself).
+    pub mean_flip: f64,
+}
+
+/// Renders `material` and each of `fits` in [`material_scene`] under `environment` with the
+/// same random numbers (seed 0), so the differences FLIP measures are the models'.
+pub fn render_comparison(
+    material: &MeasuredBrdf,
+    fits: &[&Fit],
+    environment: &Environment,
+    width: u32,
+    spp: u32,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Vec<ComparedRender>, String> {
+    let scene = material_scene(width);
+    let settings = IblSettings {
+        spp,
+        seed: 0,
+        strategy: Strategy::Mis,
+    };
+    let total = fits.len() + 1;
+    let render = |reflectance: &dyn Reflectance, index: usize| {
+        render_ibl_with(&scene, environment, &settings, reflectance, &|done, rows| {
+            progress(index * rows + done, total * rows);
+        })
+        .map_err(|e| e.to_string())
+    };
+    let measured = render(&MeasuredReflectance(material), 0)?;
+    let mut renders = Vec::with_capacity(total);
+    for (index, fit) in fits.iter().enumerate() {
+        let image = render(&FittedReflectance::new(fit), index + 1)?;
+        let difference = compare(&measured, &image, scene.display).map_err(|e| e.to_string())?;
+        renders.push(ComparedRender {
+            label: fit.specular.label(),
+            image,
+            mean_flip: difference.mean_flip,
+        });
+    }
+    renders.insert(
+        0,
+        ComparedRender {
+            label: "measured".to_owned(),
+            image: measured,
+            mean_flip: 0.0,
+        },
+    );
+    Ok(renders)
 }

@@ -197,10 +197,9 @@ fn triple(v: [f64; 3]) -> String {
     format!("{:.3}/{:.3}/{:.3}", v[0], v[1], v[2])
 }
 
-/// The sentence naming the lobe to ship.
-pub fn verdict_line(a: &Assessment) -> String {
-    let chosen = &a.fits[a.chosen];
-    let pow_rate = a
+/// Pow's rate on the target (its better geometry's, at its fitted `n`).
+fn pow_rate(a: &Assessment) -> f64 {
+    a
         .fits
         .iter()
         .filter(|r| {
@@ -213,7 +212,13 @@ pub fn verdict_line(a: &Assessment) -> String {
             )
         })
         .filter_map(|r| r.rate)
-        .fold(f64::NAN, f64::max);
+        .fold(f64::NAN, f64::max)
+}
+
+/// The sentence naming the lobe to ship.
+pub fn verdict_line(a: &Assessment) -> String {
+    let chosen = &a.fits[a.chosen];
+    let pow_rate = pow_rate(a);
     let target = clap::ValueEnum::to_possible_value(&a.target)
         .map_or_else(String::new, |v| v.get_name().to_owned());
     format!(
@@ -292,20 +297,7 @@ struct Ranked<'a> {
 
 /// `recommend --material`: the shared-`n` lobes ranked on the target, the verdict first.
 pub fn print_ranking(a: &Assessment, format: crate::args::Format) -> CommandResult {
-    let pow_rate = a
-        .fits
-        .iter()
-        .filter(|r| {
-            matches!(
-                r.fit.specular,
-                Specular::Lobe {
-                    kind: LobeKind::Pow,
-                    ..
-                }
-            )
-        })
-        .filter_map(|r| r.rate)
-        .fold(f64::NAN, f64::max);
+    let pow_rate = pow_rate(a);
     let mut ranked: Vec<Ranked> = a
         .fits
         .iter()

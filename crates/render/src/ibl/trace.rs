@@ -17,6 +17,19 @@ fn luminance(colour: DVec3) -> f64 {
     colour.dot(LUMINANCE.as_dvec3())
 }
 
+/// A BRDF as the estimator needs it, in the local frame (`z` the normal, `wo` the viewer):
+/// its value with the density of its own sampler, and that sampler. Materials of the scene
+/// format are one; a measured material or a fitted model rendered in their place
+/// ([`render_ibl_with`]) are others.
+pub trait Reflectance: Sync {
+    /// `f(wo, wi)` per channel and the density with which [`Reflectance::sample`] draws
+    /// `wi` (per unit solid angle); both zero below the horizon.
+    fn f_and_pdf(&self, wo: DVec3, wi: DVec3) -> (DVec3, f64);
+
+    /// Draws `wi` from three uniform numbers: `(wi, f(wo, wi), pdf)`, or `None`.
+    fn sample(&self, wo: DVec3, u: [f64; 3]) -> Option<(DVec3, DVec3, f64)>;
+}
+
 /// A material prepared for environment lighting: the physical model's BRDF
 /// `kd C / pi + ks S N(n) lobe(t)` and how its directions are drawn.
 struct Surface {
@@ -42,9 +55,27 @@ impl Surface {
         }
     }
 
-    /// The BRDF and the BRDF strategy's density (the mixture of the cosine and the lobe) at
-    /// local `wi`, for `wo` above the surface.
-    fn brdf_and_pdf(&self, wo: DVec3, wi: DVec3) -> (DVec3, f64) {
+    /// The BRDF from the lobe's value, and the BRDF strategy's density (the mixture of the
+    /// cosine and the lobe) from the lobe's.
+    fn combine(&self, wi: DVec3, lobe_value: f64, lobe_pdf: f64) -> (DVec3, f64) {
+        let share = self.specular_share;
+        (
+            self.diffuse + self.specular * lobe_value,
+            (1.0 - share) * wi.z * FRAC_1_PI + share * lobe_pdf,
+        )
+    }
+}
+
+/// A cosine-distributed direction about the normal from two uniform numbers.
+#[must_use]
+pub fn cosine_direction(u: [f64; 2]) -> DVec3 {
+    let (sine, cosine) = (u[0].sqrt(), (1.0 - u[0]).sqrt());
+    let (s, c) = (TAU * u[1]).sin_cos();
+    DVec3::new(sine * c, sine * s, cosine)
+}
+
+impl Reflectance for Surface {
+    fn f_and_pdf(&self, wo: DVec3, wi: DVec3) -> (DVec3, f64) {
         if wi.z <= 0.0 {
             return (DVec3::ZERO, 0.0);
         }
@@ -56,70 +87,59 @@ impl Surface {
         self.combine(wi, self.sampler.value(wo, wi), lobe_pdf)
     }
 
-    /// The BRDF and the mixture density at `wi` from the lobe's value and density there.
-    fn combine(&self, wi: DVec3, lobe_value: f64, lobe_pdf: f64) -> (DVec3, f64) {
-        let share = self.specular_share;
-        (
-            self.diffuse + self.specular * lobe_value,
-            (1.0 - share) * wi.z * FRAC_1_PI + share * lobe_pdf,
-        )
-    }
-
-    /// A direction from the BRDF strategy with the BRDF and the density there: `u[0]` picks
-    /// the term, `u[1..3]` draw in it. A lobe draw brings its own value and density.
-    fn brdf_sample(&self, wo: DVec3, u: [f64; 3]) -> Option<(DVec3, DVec3, f64)> {
+    /// `u[0]` picks the term, `u[1..3]` draw in it; a lobe draw brings its own value and
+    /// density.
+    fn sample(&self, wo: DVec3, u: [f64; 3]) -> Option<(DVec3, DVec3, f64)> {
         if u[0] < self.specular_share {
             let drawn = self.sampler.sample(wo, [u[1], u[2]])?;
             let (f, pdf) = self.combine(drawn.wi, drawn.value, drawn.pdf);
             Some((drawn.wi, f, pdf))
         } else {
-            let (sine, cosine) = (u[1].sqrt(), (1.0 - u[1]).sqrt());
-            let (s, c) = (TAU * u[2]).sin_cos();
-            let wi = DVec3::new(sine * c, sine * s, cosine);
-            let (f, pdf) = self.brdf_and_pdf(wo, wi);
+            let wi = cosine_direction([u[1], u[2]]);
+            let (f, pdf) = self.f_and_pdf(wo, wi);
             Some((wi, f, pdf))
         }
     }
+}
 
-    /// One sample of the radiance leaving towards `wo` (local, above the surface) at a
-    /// surface with `frame`, lit by `environment`: one draw from the environment and one from
-    /// the BRDF, combined as `strategy` says. `u` holds five uniform numbers.
-    fn estimate(
-        &self,
-        environment: &Environment,
-        frame: &Frame,
-        wo: DVec3,
-        strategy: Strategy,
-        u: [f64; 5],
-    ) -> DVec3 {
-        let mut radiance = DVec3::ZERO;
-        if strategy != Strategy::Brdf {
-            if let Some(light) = environment.sample([u[0], u[1]]) {
-                let wi = frame.to_local(light.wi);
-                let (f, brdf_pdf) = self.brdf_and_pdf(wo, wi);
-                if f != DVec3::ZERO {
-                    let weight = match strategy {
-                        Strategy::Mis => power_heuristic(light.pdf, brdf_pdf),
-                        _ => 1.0,
-                    };
-                    radiance += f * light.radiance.as_dvec3() * (wi.z * weight / light.pdf);
-                }
+/// One sample of the radiance leaving towards `wo` (local, above the surface) at a
+/// surface with `frame`, lit by `environment`: one draw from the environment and one from
+/// the BRDF, combined as `strategy` says. `u` holds five uniform numbers.
+fn estimate(
+    surface: &dyn Reflectance,
+    environment: &Environment,
+    frame: &Frame,
+    wo: DVec3,
+    strategy: Strategy,
+    u: [f64; 5],
+) -> DVec3 {
+    let mut radiance = DVec3::ZERO;
+    if strategy != Strategy::Brdf {
+        if let Some(light) = environment.sample([u[0], u[1]]) {
+            let wi = frame.to_local(light.wi);
+            let (f, brdf_pdf) = surface.f_and_pdf(wo, wi);
+            if f != DVec3::ZERO {
+                let weight = match strategy {
+                    Strategy::Mis => power_heuristic(light.pdf, brdf_pdf),
+                    _ => 1.0,
+                };
+                radiance += f * light.radiance.as_dvec3() * (wi.z * weight / light.pdf);
             }
         }
-        if strategy != Strategy::Environment {
-            if let Some((wi, f, pdf)) = self.brdf_sample(wo, [u[2], u[3], u[4]]) {
-                if pdf > 0.0 && f != DVec3::ZERO {
-                    let world = frame.to_world(wi);
-                    let weight = match strategy {
-                        Strategy::Mis => power_heuristic(pdf, environment.pdf(world)),
-                        _ => 1.0,
-                    };
-                    radiance += f * environment.radiance(world).as_dvec3() * (wi.z * weight / pdf);
-                }
-            }
-        }
-        radiance
     }
+    if strategy != Strategy::Environment {
+        if let Some((wi, f, pdf)) = surface.sample(wo, [u[2], u[3], u[4]]) {
+            if pdf > 0.0 && f != DVec3::ZERO {
+                let world = frame.to_world(wi);
+                let weight = match strategy {
+                    Strategy::Mis => power_heuristic(pdf, environment.pdf(world)),
+                    _ => 1.0,
+                };
+                radiance += f * environment.radiance(world).as_dvec3() * (wi.z * weight / pdf);
+            }
+        }
+    }
+    radiance
 }
 
 /// An orthonormal frame about a unit normal: world directions to the local frame (`z` the
@@ -160,7 +180,7 @@ enum View<'a> {
     Fixed(DVec3),
     /// A surface to integrate over.
     Surface {
-        surface: &'a Surface,
+        surface: &'a dyn Reflectance,
         frame: Frame,
         wo: DVec3,
     },
@@ -207,15 +227,41 @@ pub fn render_ibl(
     settings: &IblSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Image, RenderError> {
-    if !(1..=MAX_SPP).contains(&settings.spp) {
-        return Err(RenderError::Spp { spp: settings.spp });
-    }
-    let points = surfaces(scene)?;
     let surfaces: Vec<Surface> = scene
         .objects
         .iter()
         .map(|object| Surface::new(&object.material))
         .collect();
+    let reflectances: Vec<&dyn Reflectance> =
+        surfaces.iter().map(|s| s as &dyn Reflectance).collect();
+    render(scene, environment, settings, &reflectances, progress)
+}
+
+/// [`render_ibl`] with every object's material replaced by `reflectance` (a measured
+/// material, a fitted model).
+pub fn render_ibl_with(
+    scene: &Scene,
+    environment: &Environment,
+    settings: &IblSettings,
+    reflectance: &dyn Reflectance,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Image, RenderError> {
+    let reflectances = vec![reflectance; scene.objects.len()];
+    render(scene, environment, settings, &reflectances, progress)
+}
+
+/// The render loop, object `i` shown with `reflectances[i]`.
+fn render(
+    scene: &Scene,
+    environment: &Environment,
+    settings: &IblSettings,
+    reflectances: &[&dyn Reflectance],
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Image, RenderError> {
+    if !(1..=MAX_SPP).contains(&settings.spp) {
+        return Err(RenderError::Spp { spp: settings.spp });
+    }
+    let points = surfaces(scene)?;
     let rays = Rays::new(scene);
     let (width, height, s) = (
         scene.settings.width,
@@ -240,7 +286,7 @@ pub fn render_ibl(
                         None => {
                             View::Fixed(environment.radiance(rays.direction(sx, sy)).as_dvec3())
                         }
-                        Some(point) => view(&surfaces, scene, point),
+                        Some(point) => view(reflectances, scene, point),
                     }
                 }));
                 let index = u64::from(y * width + x);
@@ -252,7 +298,7 @@ pub fn render_ibl(
                             let draw = index * u64::from(settings.spp) + u64::from(i);
                             let u =
                                 core::array::from_fn(|d| uniform(settings.seed, draw, d as u64));
-                            surface.estimate(environment, frame, *wo, settings.strategy, u)
+                            estimate(*surface, environment, frame, *wo, settings.strategy, u)
                         }
                     };
                 }
@@ -264,14 +310,14 @@ pub fn render_ibl(
 }
 
 /// What a visible surface point shows: its material, frame and `wo` in that frame.
-fn view<'a>(surfaces: &'a [Surface], scene: &Scene, point: SurfacePoint) -> View<'a> {
+fn view<'a>(surfaces: &[&'a dyn Reflectance], scene: &Scene, point: SurfacePoint) -> View<'a> {
     let frame = Frame::new(point.normal.as_dvec3());
     let wo = frame.to_local(scene.camera.towards_viewer(point.position).as_dvec3());
     if wo.z <= 0.0 {
         return View::Fixed(DVec3::ZERO);
     }
     View::Surface {
-        surface: &surfaces[point.object as usize],
+        surface: surfaces[point.object as usize],
         frame,
         wo,
     }

@@ -504,6 +504,24 @@ fn fit_prepared(prepared: &Prepared, specular: Specular, sharing: Sharing) -> Fi
     fit
 }
 
+/// The plane of incidence seen from elevation `theta_o` (radians): `count` light directions
+/// at signed elevations evenly spaced over `(-90, 90)` degrees, as `(elevation, wo, wi)`,
+/// with `wo = (sin theta_o, 0, cos theta_o)`, so the mirror direction is at `-theta_o`. The
+/// polar plots of a material against its fits are drawn along it.
+#[must_use]
+pub fn plane_of_incidence(theta_o: f64, count: usize) -> Vec<(f64, DVec3, DVec3)> {
+    let wo = DVec3::new(theta_o.sin(), 0.0, theta_o.cos());
+    (0..count)
+        .map(|i| {
+            let elevation = core::f64::consts::PI * ((i as f64 + 0.5) / count as f64 - 0.5);
+            (elevation, wo, DVec3::new(elevation.sin(), 0.0, elevation.cos()))
+        })
+        .collect()
+}
+
+/// The viewing elevations of the polar plots, degrees.
+pub const POLAR_ANGLES_DEGREES: [f64; 3] = [0.0, 30.0, 60.0];
+
 /// Every family in `kinds` in both geometries, and GGX, each shared and per channel, fitted
 /// in parallel; in that order (lobes in `kinds`' order, Phong before Blinn, shared first).
 #[must_use]
