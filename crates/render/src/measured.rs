@@ -60,7 +60,7 @@ impl Reflectance for MeasuredReflectance<'_> {
 enum SpecularDraw {
     /// The lobe's own sampler (at the first channel's `n`), its value per channel apart.
     Lobe {
-        sampler: SpecularSampler,
+        sampler: Box<SpecularSampler>,
         lobes: [Lobe; 3],
         geometry: Geometry,
     },
@@ -86,7 +86,11 @@ impl FittedReflectance {
             Specular::Lobe { kind, geometry } => {
                 let lobes = fit.parameter.map(|n| Lobe::new(kind, exponent(n)));
                 SpecularDraw::Lobe {
-                    sampler: SpecularSampler::new(lobes[0], geometry, Normalisation::None),
+                    sampler: Box::new(SpecularSampler::new(
+                        lobes[0],
+                        geometry,
+                        Normalisation::None,
+                    )),
                     lobes,
                     geometry,
                 }
@@ -218,9 +222,15 @@ pub fn render_comparison(
     };
     let total = fits.len() + 1;
     let render = |reflectance: &dyn Reflectance, index: usize| {
-        render_ibl_with(&scene, environment, &settings, reflectance, &|done, rows| {
-            progress(index * rows + done, total * rows);
-        })
+        render_ibl_with(
+            &scene,
+            environment,
+            &settings,
+            reflectance,
+            &|done, rows| {
+                progress(index * rows + done, total * rows);
+            },
+        )
         .map_err(|e| e.to_string())
     };
     let measured = render(&MeasuredReflectance(material), 0)?;

@@ -87,6 +87,11 @@ fn u_to_phi(u: f64) -> f64 {
     (2.0 * u - 1.0) * PI
 }
 
+/// Whether a direction is above the surface (a NaN component is not).
+fn above(d: DVec3) -> bool {
+    d.z > 0.0 && d.is_finite()
+}
+
 /// The angle from the normal, accurate near it (`acos` of `z` loses half the digits there).
 fn elevation(d: DVec3) -> f64 {
     let distance = (d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0)).sqrt();
@@ -156,6 +161,11 @@ impl MeasuredBrdf {
                 "the tables' shapes disagree: phi_i {p}, theta_i {t}, vndf {vndf_shape:?}, luminance {luminance_shape:?}, rgb {rgb_shape:?} (expected [phi_i, theta_i, h, w], rgb [phi_i, theta_i, 3, h, w] on luminance's grid, tables at least 2 x 2)"
             )));
         }
+        if jacobian[0] != 0 && !(sigma.iter().all(|&v| v > 0.0) && ndf.iter().all(|&v| v >= 0.0)) {
+            return Err(refuse(
+                "tables 'sigma' and 'ndf' must be positive and non-negative (the Jacobian divides by sigma)",
+            ));
+        }
         for (name, table, shape) in [
             ("vndf", &vndf, &vndf_shape),
             ("luminance", &luminance, &luminance_shape),
@@ -209,7 +219,7 @@ impl MeasuredBrdf {
     /// dip slightly below zero where a spectrum's RGB does.
     #[must_use]
     pub fn f_cos(&self, wo: DVec3, wi: DVec3) -> Rgb {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        if !above(wo) || !above(wi) {
             return Rgb::ZERO;
         }
         let m = (wo + wi).normalize();
@@ -237,7 +247,7 @@ impl MeasuredBrdf {
     /// `f(wo, wi)`: [`MeasuredBrdf::f_cos`] without the light's cosine.
     #[must_use]
     pub fn f(&self, wo: DVec3, wi: DVec3) -> Rgb {
-        if wi.z <= 0.0 {
+        if !above(wi) {
             return Rgb::ZERO;
         }
         self.f_cos(wo, wi) / wi.z
@@ -254,7 +264,7 @@ impl MeasuredBrdf {
     /// distributed (luminance, then visible normals); `None` below the horizon.
     #[must_use]
     pub fn sample(&self, wo: DVec3, u: [f64; 2]) -> Option<MeasuredSample> {
-        if wo.z <= 0.0 {
+        if !above(wo) || !u.iter().all(|v| v.is_finite()) {
             return None;
         }
         let (theta_o, phi_o) = (elevation(wo), wo.y.atan2(wo.x));
@@ -296,7 +306,7 @@ impl MeasuredBrdf {
     /// The density with which [`MeasuredBrdf::sample`] draws `wi`, per unit solid angle.
     #[must_use]
     pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        if !above(wo) || !above(wi) {
             return 0.0;
         }
         let m = (wo + wi).normalize();

@@ -1,0 +1,140 @@
+//! `specula fit` and `recommend --material` on real measured materials: one JSON line per
+//! material, whose figures hold together (each per-channel fit at least as good as its shared
+//! one, the verdict within the margin of pow's best and the cheapest such, GGX without
+//! `ks`); the table's verdict; and bad files refused in one line before any output.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{ok, specula};
+use serde_json::Value;
+
+fn rgl(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/rgl")
+        .join(format!("{name}.bsdf"))
+}
+
+fn text(path: &Path) -> String {
+    path.to_str().expect("utf-8 path").to_owned()
+}
+
+fn number(value: &Value) -> f64 {
+    value.as_f64().expect("a number")
+}
+
+#[test]
+fn each_material_is_one_consistent_json_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let files = [rgl("paper_white_rgb"), rgl("cc_iris_purple_gem_rgb")];
+    let output = ok(
+        dir.path(),
+        &[
+            "fit",
+            "--material",
+            &text(&files[0]),
+            &text(&files[1]),
+            "--format",
+            "json",
+        ],
+    );
+    let stdout = String::from_utf8(output.stdout).unwrap();
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    for (line, file) in lines.iter().zip(&files) {
+        let report: Value = serde_json::from_str(line).expect("one JSON object per line");
+        assert_eq!(report["file"], text(file));
+        let fits = report["fits"].as_array().unwrap();
+        // Every built-in lobe in both geometries and GGX, each shared and per channel.
+        assert_eq!(fits.len(), (13 * 2 + 1) * 2);
+        for pair in fits.chunks(2) {
+            let (shared, per_channel) = (&pair[0], &pair[1]);
+            assert_eq!(
+                (shared["sharing"].as_str(), per_channel["sharing"].as_str()),
+                (Some("shared"), Some("per-channel"))
+            );
+            // The per-channel model contains the shared one: a fit that does worse is stuck.
+            assert!(
+                number(&per_channel["error"]) <= number(&shared["error"]) * (1.0 + 1e-6),
+                "{shared} {per_channel}"
+            );
+            let ggx = shared["specular"]["family"] == "ggx";
+            assert_eq!(shared.get("ks").is_none(), ggx);
+        }
+        let is_shared_pow = |f: &&Value| f["specular"]["kind"] == "pow" && f["sharing"] == "shared";
+        let reference = fits
+            .iter()
+            .filter(is_shared_pow)
+            .map(|f| number(&f["error"]))
+            .fold(f64::INFINITY, f64::min);
+        assert!((number(&report["reference_error"]) - reference).abs() < 1e-12);
+        let margin = number(&report["margin"]);
+        let chosen = &fits[report["chosen"].as_u64().unwrap() as usize];
+        assert!(number(&chosen["error"]) <= (1.0 + margin) * reference);
+        let meeting: Vec<&Value> = fits
+            .iter()
+            .filter(|f| f["sharing"] == "shared" && f["specular"]["family"] == "lobe")
+            .filter(|f| number(&f["error"]) <= (1.0 + margin) * reference)
+            .collect();
+        let best_rate = meeting
+            .iter()
+            .map(|f| number(&f["rate"]))
+            .fold(0.0, f64::max);
+        assert_eq!(number(&chosen["rate"]), best_rate);
+        assert!(meeting.iter().all(|f| f["meets"] == true));
+    }
+}
+
+#[test]
+fn recommend_names_the_verdict_and_refuses_the_fpga() {
+    let dir = tempfile::tempdir().unwrap();
+    let paper = text(&rgl("paper_white_rgb"));
+    let output = ok(
+        dir.path(),
+        &["recommend", "--material", &paper, "--target", "gpu-amd"],
+    );
+    let stdout = String::from_utf8(output.stdout).unwrap();
+    assert!(
+        stdout.contains("the cheapest lobe on gpu-amd whose fit is within 5 % of pow's"),
+        "{stdout}"
+    );
+    let refused = specula(
+        dir.path(),
+        &["recommend", "--material", &paper, "--target", "fpga"],
+    );
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success());
+    assert!(
+        stderr.contains("valid targets: cpu, gpu-nvidia, gpu-amd"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn bad_files_are_refused_in_one_line_before_any_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let truncated = dir.path().join("truncated.bsdf");
+    let bytes = std::fs::read(rgl("paper_white_rgb")).unwrap();
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
+    let not_tensor = dir.path().join("scene.bsdf");
+    std::fs::write(&not_tensor, "not a tensor file").unwrap();
+    let paper = text(&rgl("paper_white_rgb"));
+    for (bad, expected) in [
+        (text(&truncated), "truncated"),
+        (text(&not_tensor), "not a tensor file"),
+        (text(dir.path()), "not a regular file"),
+        ("/dev/zero".to_owned(), "not a regular file"),
+    ] {
+        // The good file first: nothing may be printed for it when a later one is bad.
+        let output = specula(
+            dir.path(),
+            &["fit", "--material", &paper, &bad, "--format", "json"],
+        );
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{bad}");
+        assert!(output.stdout.is_empty(), "{bad}: printed before refusing");
+        assert!(stderr.contains(expected), "{bad}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    }
+}
