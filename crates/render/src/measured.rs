@@ -60,8 +60,8 @@ impl Reflectance for MeasuredReflectance<'_> {
 enum SpecularDraw {
     /// The lobe's own sampler (at the first channel's `n`), its value per channel apart.
     Lobe {
-        sampler: Box<SpecularSampler>,
-        lobes: [Lobe; 3],
+        sampler: SpecularSampler,
+        lobes: Box<[Lobe; 3]>,
         geometry: Geometry,
     },
     /// GGX normals in proportion to `D(h) cos(theta_h)`, at the first channel's `alpha`.
@@ -86,12 +86,8 @@ impl FittedReflectance {
             Specular::Lobe { kind, geometry } => {
                 let lobes = fit.parameter.map(|n| Lobe::new(kind, exponent(n)));
                 SpecularDraw::Lobe {
-                    sampler: Box::new(SpecularSampler::new(
-                        lobes[0],
-                        geometry,
-                        Normalisation::None,
-                    )),
-                    lobes,
+                    sampler: SpecularSampler::new(lobes[0], geometry, Normalisation::None),
+                    lobes: Box::new(lobes),
                     geometry,
                 }
             }
