@@ -1,0 +1,114 @@
+//! A measured material and fitted models as the environment renderer's BRDFs: in a white
+//! furnace every pixel of a plane seen from `theta_o` estimates the directional albedo, so
+//! the render's mean must match it by each strategy alone (the data's own sampler, and the
+//! environment's uniform one) and by their combination; the albedo comes from a second
+//! method (the material's stratified estimate, checked against quadrature in the core's
+//! tests; the fits' closed-form quadrature).
+
+use std::path::Path;
+
+use glam::Vec3;
+use specula::measured::fit::{Fit, Sharing, Specular};
+use specula::{Geometry, LobeKind};
+use specula_render::ibl::{render_ibl_with, Environment, IblSettings, Reflectance, Strategy};
+use specula_render::measured::{load_measured, FittedReflectance, MeasuredReflectance};
+use specula_render::{Image, Scene};
+
+/// A plane filling an orthographic view from `theta_o` degrees off its normal.
+fn plane_at(theta_o: f64) -> Scene {
+    let (s, c) = theta_o.to_radians().sin_cos();
+    let text = format!(
+        "[camera]\neye = [0, {}, {}]\ntarget = [0, 0, 0]\nup = [0, 1, 0]\northographic = 1.0\n\
+         [render]\nwidth = 16\nheight = 16\nsamples = 1\nmodel = \"physical\"\n\
+         [[objects]]\nshape = \"plane\"\nsize = 100.0\n",
+        -10.0 * s,
+        10.0 * c
+    );
+    Scene::from_toml(&text, "plane.toml", None).unwrap().scene
+}
+
+/// The mean of each channel and the largest standard error.
+fn mean_and_error(image: &Image) -> (Vec3, f32) {
+    let n = image.pixels().len() as f32;
+    let mean = image.pixels().iter().copied().sum::<Vec3>() / n;
+    let variance = image
+        .pixels()
+        .iter()
+        .map(|p| (*p - mean) * (*p - mean))
+        .sum::<Vec3>()
+        / (n - 1.0);
+    (mean, (variance / n).max_element().sqrt())
+}
+
+fn furnace(reflectance: &dyn Reflectance, theta_o: f64, strategy: Strategy) -> (Vec3, f32) {
+    let settings = IblSettings {
+        spp: 512,
+        seed: 3,
+        strategy,
+    };
+    let image = render_ibl_with(
+        &plane_at(theta_o),
+        &Environment::constant(Vec3::ONE),
+        &settings,
+        reflectance,
+        &|_, _| {},
+    )
+    .unwrap();
+    assert!(image
+        .pixels()
+        .iter()
+        .all(|p| p.is_finite() && p.min_element() >= 0.0));
+    mean_and_error(&image)
+}
+
+#[test]
+fn a_measured_material_reflects_its_albedo_by_every_strategy() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/rgl");
+    for (name, theta_o) in [
+        ("paper_white_rgb", 0.0_f64),
+        ("cc_iris_purple_gem_rgb", 40.0),
+    ] {
+        let material = load_measured(&path.join(format!("{name}.bsdf"))).unwrap();
+        let wo = glam::DVec3::new(theta_o.to_radians().sin(), 0.0, theta_o.to_radians().cos());
+        let albedo = material.albedo(wo, 512).as_vec3();
+        for strategy in [Strategy::Mis, Strategy::Brdf, Strategy::Environment] {
+            let (mean, error) = furnace(&MeasuredReflectance(&material), theta_o, strategy);
+            assert!(
+                (mean - albedo).abs().max_element() < 5.0 * error + 2e-3,
+                "{name} {strategy:?}: {mean} +- {error}, albedo {albedo}"
+            );
+        }
+    }
+}
+
+#[test]
+fn fitted_models_reflect_their_quadrature_albedo() {
+    let lobe = Fit {
+        specular: Specular::Lobe {
+            kind: LobeKind::Pow,
+            geometry: Geometry::Blinn,
+        },
+        sharing: Sharing::PerChannel,
+        parameter: [20.0, 60.0, 200.0],
+        kd: [0.3, 0.2, 0.1],
+        k: [0.5, 1.5, 4.0],
+        error: 0.0,
+        channel_error: [0.0; 3],
+    };
+    let ggx = Fit {
+        specular: Specular::Ggx,
+        parameter: [0.3, 0.2, 0.1],
+        ..lobe.clone()
+    };
+    for fit in [lobe, ggx] {
+        let albedo = Vec3::from_array(fit.albedo_at_normal().map(|v| v as f32));
+        for strategy in [Strategy::Mis, Strategy::Brdf] {
+            let (mean, error) = furnace(&FittedReflectance::new(&fit), 0.0, strategy);
+            assert!(
+                (mean - albedo).abs().max_element() < 5.0 * error + 2e-3,
+                "{} {strategy:?}: {mean} +- {error}, albedo {albedo}",
+                fit.specular.label()
+            );
+        }
+    }
+}
