@@ -505,38 +505,43 @@ pub fn fit(observations: &Observations, specular: Specular, sharing: Sharing) ->
 /// Both fits of one family, from one scan.
 fn fit_family(prepared: &Prepared, specular: Specular) -> [Fit; 2] {
     let (grid, costs) = scan(prepared, specular);
-    [Sharing::Shared, Sharing::PerChannel].map(|sharing| {
-        let groups: &[&[usize]] = match sharing {
-            Sharing::Shared => &[&[0, 1, 2]],
-            Sharing::PerChannel => &[&[0], &[1], &[2]],
-        };
-        let mut fit = Fit {
+    let fit = |sharing, parameter: [f64; 3], solutions: [([f64; 2], f64); 3]| {
+        let channel_error = solutions.map(|(_, cost)| cost.sqrt());
+        Fit {
             specular,
             sharing,
-            parameter: [0.0; 3],
-            kd: [0.0; 3],
-            k: [0.0; 3],
-            error: 0.0,
-            channel_error: [0.0; 3],
-        };
-        for channels in groups {
-            let profile = Profile {
-                prepared,
-                specular,
-                channels,
-            };
-            let best = minimise(&profile, &grid, &costs);
-            let (solutions, _) = profile.solve(best);
-            for (&c, ([kd, k], cost)) in channels.iter().zip(solutions) {
-                fit.parameter[c] = best.exp();
-                fit.kd[c] = kd;
-                fit.k[c] = k;
-                fit.channel_error[c] = cost.sqrt();
-            }
+            parameter: parameter.map(f64::exp),
+            kd: solutions.map(|([kd, _], _)| kd),
+            k: solutions.map(|([_, k], _)| k),
+            error: (channel_error.iter().map(|e| e * e).sum::<f64>() / 3.0).sqrt(),
+            channel_error,
         }
-        fit.error = (fit.channel_error.iter().map(|e| e * e).sum::<f64>() / 3.0).sqrt();
-        fit
-    })
+    };
+    let profile = |channels| Profile {
+        prepared,
+        specular,
+        channels,
+    };
+    let all = profile(&[0, 1, 2]);
+    let shared = minimise(&all, &grid, &costs);
+    let at_shared = all.solve(shared).0;
+    let shared_solutions = [at_shared[0], at_shared[1], at_shared[2]];
+    // Each channel from its own scan, or from the shared optimum where that is better (a
+    // second start: a channel's scan can bracket another basin than the sum's).
+    let mut parameter = [shared; 3];
+    let mut solutions = shared_solutions;
+    for (c, channel) in [[0], [1], [2]].iter().enumerate() {
+        let own = profile(channel);
+        let best = minimise(&own, &grid, &costs);
+        let (solved, cost) = own.solve(best);
+        if cost < solutions[c].1 {
+            (parameter[c], solutions[c]) = (best, solved[0]);
+        }
+    }
+    [
+        fit(Sharing::Shared, [shared; 3], shared_solutions),
+        fit(Sharing::PerChannel, parameter, solutions),
+    ]
 }
 
 /// The plane of incidence seen from elevation `theta_o` (radians): `count` light directions
