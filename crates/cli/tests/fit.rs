@@ -138,3 +138,40 @@ fn bad_files_are_refused_in_one_line_before_any_output() {
         assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
     }
 }
+
+#[test]
+fn a_users_lobe_is_fitted_beside_the_built_in_ones() {
+    // `t^n` written as a formula is pow: its fits must be pow's, to rounding.
+    let dir = tempfile::tempdir().unwrap();
+    let file = text(&rgl("colodur_napoli_4f_rgb"));
+    let output = ok(
+        dir.path(),
+        &[
+            "fit",
+            "--material",
+            &file,
+            "--lobe",
+            "=t^n",
+            "--format",
+            "json",
+        ],
+    );
+    let report: Value = serde_json::from_slice(&output.stdout).unwrap();
+    let fits = report["fits"].as_array().unwrap();
+    let find = |kind: &str, geometry: &str| {
+        fits.iter()
+            .find(|f| {
+                f["specular"]["kind"] == kind
+                    && f["specular"]["geometry"] == geometry
+                    && f["sharing"] == "shared"
+            })
+            .unwrap_or_else(|| panic!("no {kind}/{geometry} fit"))
+    };
+    for geometry in ["phong", "blinn"] {
+        let (pow, yours) = (find("pow", geometry), find("formula", geometry));
+        let (a, b) = (number(&pow["error"]), number(&yours["error"]));
+        assert!((a - b).abs() <= 1e-9 * a, "{geometry}: {a} vs {b}");
+        let (n, m) = (number(&pow["parameter"][0]), number(&yours["parameter"][0]));
+        assert!((n - m).abs() <= 1e-6 * n, "{geometry}: n {n} vs {m}");
+    }
+}
