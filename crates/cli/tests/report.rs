@@ -1,7 +1,8 @@
 //! `specula report --quick`: a well-formed page whose every image exists, every SVG parses,
 //! and no number is NaN or infinite; with the real scans (Debian's `invesalius-examples` and
 //! `mricron-data`) and VTK (the `vtk` wheel in the test's Python), the medical section's real
-//! CT and MRI and its comparison with VTK's CPU ray caster.
+//! CT and MRI and its comparison with VTK's CPU ray caster; with `--materials` the five RGL
+//! materials in `shared/data/rgl`, each with its fits, polar plot and renders scored by FLIP.
 
 mod common;
 
@@ -24,6 +25,20 @@ const REAL_SCANS: [(&str, &str, &str); 2] = [
 /// The lobes `--quick` renders the real scans with.
 const QUICK_REAL_SCAN_LOBES: [&str; 3] = ["pow", "schlick", "cosquad"];
 
+/// The measured materials in `shared/data/rgl`, by name.
+const MATERIALS: [&str; 5] = [
+    "cc_ibiza_sunset_rgb",
+    "cc_iris_purple_gem_rgb",
+    "colodur_napoli_4f_rgb",
+    "paper_white_rgb",
+    "vch_golden_yellow_rgb",
+];
+
+/// The folder of RGL materials the repository shares.
+fn rgl() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/rgl")
+}
+
 #[test]
 fn the_quick_report_is_complete_and_well_formed() {
     let directory = tempfile::tempdir().unwrap();
@@ -33,7 +48,8 @@ fn the_quick_report_is_complete_and_well_formed() {
         .expect("binary built")
         .current_dir(d)
         .env("SPECULA_PYTHON", python())
-        .args(["report", "--quick", "--out", "out"])
+        .args(["report", "--quick", "--out", "out", "--materials"])
+        .arg(rgl())
         .output()
         .expect("runs");
     assert!(
@@ -55,7 +71,7 @@ fn the_quick_report_is_complete_and_well_formed() {
         .descendants()
         .filter(|n| n.has_tag_name("section"))
         .count();
-    assert_eq!(sections, 12);
+    assert_eq!(sections, 13);
     // Into other renderers: every lobe's record and its lowering give the lobe's own bits.
     let renderers = page
         .find("Into other renderers")
@@ -118,6 +134,7 @@ fn the_quick_report_is_complete_and_well_formed() {
         check_row(&out, "volume", &row[0], &row[1], &row[2], &row[3]);
     }
     real_scans(&document, &text, &out);
+    materials(&document, &out);
     // Nothing but the report was written: no temporary files left.
     let stray = std::fs::read_dir(&out)
         .unwrap()
@@ -247,4 +264,114 @@ fn real_scans(document: &roxmltree::Document, text: &str, out: &std::path::Path)
         let flip_map = out.join(format!("{prefix}-flip.png"));
         assert!(flip_map.is_file(), "{}", flip_map.display());
     }
+}
+
+/// The real materials' section: every material in name order, each with its table (every
+/// lobe and GGX, one verdict), its polar plot and its renders, each fit's captioned with a mean
+/// FLIP against the measured render.
+fn materials(document: &roxmltree::Document, out: &std::path::Path) {
+    let section = document
+        .descendants()
+        .filter(|n| n.has_tag_name("section"))
+        .find(|s| {
+            s.children().any(|n| {
+                n.has_tag_name("h2") && n.text().is_some_and(|t| t.ends_with("Real materials"))
+            })
+        })
+        .expect("a real materials section");
+    let names: Vec<&str> = section
+        .children()
+        .filter(|n| n.has_tag_name("h3"))
+        .filter_map(|n| n.text())
+        .collect();
+    assert_eq!(names, MATERIALS);
+    let tables: Vec<roxmltree::Node> = section
+        .children()
+        .filter(|n| n.has_tag_name("table"))
+        .collect();
+    assert_eq!(tables.len(), MATERIALS.len());
+    for table in tables {
+        let cells: Vec<Vec<String>> = table
+            .descendants()
+            .filter(|n| n.has_tag_name("tr"))
+            .skip(1)
+            .map(|row| {
+                row.children()
+                    .filter(|n| n.has_tag_name("td"))
+                    .map(|cell| cell.text().unwrap_or("").to_owned())
+                    .collect()
+            })
+            .collect();
+        // Every lobe in its better geometry, then GGX; one verdict, a lobe that meets.
+        assert_eq!(cells.len(), specula::LobeKind::ALL.len() + 1, "{cells:?}");
+        assert_eq!(cells.last().unwrap()[0], "ggx");
+        let verdicts = cells
+            .iter()
+            .filter(|row| row[6] == "yes: the verdict")
+            .count();
+        assert_eq!(verdicts, 1, "{cells:?}");
+    }
+    let figures: Vec<(String, String)> = section
+        .descendants()
+        .filter(|n| n.has_tag_name("figure"))
+        .map(|figure| {
+            let source = figure
+                .descendants()
+                .find(|n| n.has_tag_name("img"))
+                .and_then(|n| n.attribute("src"))
+                .expect("an image")
+                .to_owned();
+            let caption: String = figure
+                .descendants()
+                .filter(|n| n.has_tag_name("figcaption"))
+                .filter_map(|n| n.text())
+                .collect();
+            (source, caption)
+        })
+        .collect();
+    for (k, name) in MATERIALS.iter().enumerate() {
+        let prefix = format!("material-{}-{name}-", k + 1);
+        let own: Vec<&(String, String)> = figures
+            .iter()
+            .filter(|(source, _)| source.starts_with(&prefix))
+            .collect();
+        let polar = format!("{prefix}polar.svg");
+        assert!(own.iter().any(|(source, _)| *source == polar), "{polar}");
+        assert!(
+            own.iter()
+                .any(|(source, _)| *source == format!("{prefix}measured.png")),
+            "{name}: the measured render"
+        );
+        // Pow's fit, the verdict's lobe (unless pow) and GGX, each scored against it.
+        let renders: Vec<&&(String, String)> = own
+            .iter()
+            .filter(|(source, _)| source.ends_with(".png") && !source.ends_with("measured.png"))
+            .collect();
+        assert!((2..=3).contains(&renders.len()), "{name}: {renders:?}");
+        for (source, caption) in renders {
+            assert!(out.join(source).is_file(), "{source}");
+            let flip: f64 = caption
+                .split("mean FLIP ")
+                .nth(1)
+                .and_then(|rest| rest.split_whitespace().next())
+                .and_then(|number| number.parse().ok())
+                .unwrap_or_else(|| panic!("{source}: no mean FLIP in '{caption}'"));
+            assert!(flip > 0.0 && flip < 1.0, "{source}: mean FLIP {flip}");
+        }
+    }
+}
+
+#[test]
+fn a_materials_folder_without_materials_is_refused_before_any_section() {
+    let directory = tempfile::tempdir().unwrap();
+    let empty = directory.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let output = common::specula(
+        directory.path(),
+        &["report", "--quick", "--out", "out", "--materials", "empty"],
+    );
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("empty: no .bsdf files"), "{stderr}");
+    assert!(!directory.path().join("out/index.html").exists());
 }

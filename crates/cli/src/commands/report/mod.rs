@@ -9,6 +9,7 @@
 mod energy;
 mod hardware;
 mod html;
+mod materials;
 mod plot;
 mod real_scans;
 mod renderers;
@@ -47,6 +48,10 @@ pub struct Args {
     /// Add your own lobes to every section (`@FILE.toml`, `=FORMULA`; comma separated).
     #[arg(long, value_parser = crate::args::LobeListParser)]
     lobe: Vec<crate::args::LobeList>,
+    /// Also fit every lobe to the measured materials in this folder (RGL isotropic RGB
+    /// `.bsdf` files, the first 16 by name) and compare them in polar plots and renders.
+    #[arg(long, value_name = "DIR")]
+    materials: Option<PathBuf>,
 }
 
 /// How much each section computes.
@@ -64,6 +69,8 @@ pub struct Sizes {
     pub render: (u32, u32, u32),
     /// The environment-lit renders' width, height and samples per pixel.
     pub environment: (u32, u32, u32),
+    /// The real materials' render width (the height is 9/16 of it) and samples per pixel.
+    pub materials: (u32, u32),
     /// The medical section's phantom side (voxels), image side (pixels) and frames timed per
     /// lobe and backend.
     pub volume: (usize, u32, usize),
@@ -98,6 +105,8 @@ pub struct Context {
     shared: Arc<Shared>,
     /// Every lobe the sections show: the built-in ones, then the user's.
     lobes: Vec<LobeKind>,
+    /// The folder of measured materials (`--materials`).
+    materials: Option<PathBuf>,
 }
 
 /// Every datapath's sweeps over word lengths, per hardware exponent.
@@ -208,7 +217,7 @@ const VERDICT: &str = "Which lobe when";
 const HARDWARE: &str = "Hardware";
 
 /// The answer first (which lobe when), then the thesis's claims, then the details.
-const SECTIONS: [Section; 12] = [
+const SECTIONS: [Section; 13] = [
     (VERDICT, verdict::verdict),
     ("The thesis's claims", sections::claims),
     ("Models", sections::models),
@@ -217,6 +226,7 @@ const SECTIONS: [Section; 12] = [
     ("Energy and normalisation", energy::energy),
     ("Reciprocity and white furnace", energy::reciprocity),
     ("Renders", renders::renders),
+    ("Real materials", materials::materials),
     ("Medical volumes", volumes::volumes),
     ("Into other renderers", renderers::renderers),
     (sections::COST, sections::cost),
@@ -253,6 +263,9 @@ pub fn run(args: &Args) -> CommandResult {
             .map(|&n| Exponent::new(f64::from(n))),
     );
     crate::args::check_lobes(&yours, &checked)?;
+    if let Some(directory) = &args.materials {
+        materials::check(directory, &yours)?;
+    }
     let shared = Arc::new(Shared::default());
     let context = || Context {
         lobes: lobes.clone(),
@@ -261,6 +274,7 @@ pub fn run(args: &Args) -> CommandResult {
         bench: args.bench,
         files: Vec::new(),
         shared: Arc::clone(&shared),
+        materials: args.materials.clone(),
     };
     let bar = ProgressBar::new(SECTIONS.len() as u64).with_style(
         ProgressStyle::with_template("report {bar:30} {pos}/{len} sections {elapsed}")

@@ -442,6 +442,7 @@ pub fn sizes(quick: bool) -> Sizes {
             },
             render: (240, 135, 1),
             environment: (240, 135, 16),
+            materials: (160, 16),
             volume: (32, 96, 1),
             real_scans: RealScanSizes {
                 side: 64,
@@ -460,6 +461,7 @@ pub fn sizes(quick: bool) -> Sizes {
             claims: ClaimOptions::default(),
             render: (480, 270, 2),
             environment: (480, 270, 128),
+            materials: (480, 64),
             volume: (64, 192, 2),
             real_scans: RealScanSizes {
                 side: 128,

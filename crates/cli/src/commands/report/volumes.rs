@@ -57,6 +57,7 @@ pub fn volumes(context: &mut Context) -> Result<String, String> {
         files: Vec::new(),
         shared: std::sync::Arc::clone(&context.shared),
         lobes: context.lobes.clone(),
+        materials: context.materials.clone(),
     };
     // The real scans wait on files and on VTK's process, and time specula beside VTK's
     // threads: on threads of their own (as many as the sections share) they hold none of the

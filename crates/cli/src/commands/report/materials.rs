@@ -1,0 +1,403 @@
+//! The report's real materials (`--materials DIR`): each measured material (an RGL isotropic
+//! RGB `.bsdf` file) assessed as `specula fit --material` assesses it (every lobe and GGX
+//! fitted, the verdict on a target), its shared-`n` fits in a table, polar plots of the
+//! measurement against the fits in the plane of incidence, and renders under the sky of the
+//! measured material beside pow's fit, the verdict's lobe and GGX, each scored by FLIP
+//! against the measured render.
+
+use std::path::{Path, PathBuf};
+
+use specula::measured::fit::{plane_of_incidence, Fit, Sharing, Specular, POLAR_ANGLES_DEGREES};
+use specula::measured::MeasuredBrdf;
+use specula::LobeKind;
+use specula_render::ibl::{Environment, SKY_WIDTH};
+use specula_render::measured::{load_measured, material_name, material_scene, render_comparison};
+
+use super::html::{escape, figure, paragraph, table};
+use super::plot::{Polar, PolarCurve, PolarPanel, DASHED, DASH_DOT};
+use super::sections::colour;
+use super::Context;
+use crate::commands::fit::{
+    assess, lobes_to_fit, luminance, parameter_text, verdict_line, Assessment, FitRow,
+};
+use crate::commands::recommend::Target;
+
+/// The most materials one report shows (the first, by file name).
+pub const MAX_MATERIALS: usize = 16;
+
+/// The verdict's target and margin over pow's fit error (`specula fit`'s defaults).
+const TARGET: Target = Target::GpuNvidia;
+const MARGIN: f64 = 0.05;
+
+/// Light directions per polar curve (every half degree).
+const POLAR_POINTS: usize = 361;
+
+/// How far beyond the measurement's largest radius the polar plots reach (a fit's spike
+/// beyond is clipped at the rim).
+const POLAR_HEADROOM: f64 = 1.25;
+
+/// GGX's colour in the polar plots: a grey lighter than fastpow's, drawn dash-dot.
+const GGX_GREY: plotters::style::RGBColor = plotters::style::RGBColor(150, 150, 150);
+
+/// How to get the section, shown without `--materials`.
+const HOW_TO: &str = "Not computed: run specula report --materials DIR, with DIR holding measured materials as the RGL database's isotropic RGB .bsdf files (the '_rgb.bsdf' ones; for example the five in shared/data/rgl), to see each fitted with every lobe and GGX: the verdict on which lobe to ship, the fits' errors, polar plots of the measurement against the fits and renders under the sky scored by FLIP.";
+
+/// The `.bsdf` files in `directory` sorted by name, at most [`MAX_MATERIALS`], and how many
+/// more there were.
+pub(super) fn material_files(directory: &Path) -> Result<(Vec<PathBuf>, usize), String> {
+    let refuse = |e: std::io::Error| {
+        format!(
+            "{}: cannot read the materials folder: {e}",
+            directory.display()
+        )
+    };
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(directory).map_err(refuse)? {
+        let path = entry.map_err(refuse)?.path();
+        if path.extension().is_some_and(|e| e == "bsdf") && path.is_file() {
+            files.push(path);
+        }
+    }
+    if files.is_empty() {
+        return Err(format!(
+            "{}: no .bsdf files (--materials takes a folder of RGL isotropic RGB .bsdf files)",
+            directory.display()
+        ));
+    }
+    files.sort();
+    let more = files.len().saturating_sub(MAX_MATERIALS);
+    files.truncate(MAX_MATERIALS);
+    Ok((files, more))
+}
+
+/// Refuses a bad `--materials` before any section runs: every file shown must read as a
+/// material, and the user's lobes must hold over the fits' range of `n`.
+pub(super) fn check(directory: &Path, yours: &[LobeKind]) -> Result<(), String> {
+    let (files, _) = material_files(directory)?;
+    for file in &files {
+        load_measured(file)?;
+    }
+    lobes_to_fit(yours).map(drop)
+}
+
+/// A material's name as part of a file name: letters, digits, `-` and `_` kept.
+fn file_safe(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect()
+}
+
+/// The section: each material in turn (its fits already run in parallel), or, without
+/// `--materials`, how to get it.
+pub fn materials(context: &mut Context) -> Result<String, String> {
+    let Some(directory) = context.materials.clone() else {
+        return Ok(paragraph(HOW_TO));
+    };
+    let (files, more) = material_files(&directory)?;
+    let yours: Vec<LobeKind> = context
+        .lobes
+        .iter()
+        .copied()
+        .filter(|kind| !LobeKind::ALL.contains(kind))
+        .collect();
+    let kinds = lobes_to_fit(&yours)?;
+    let sky = Environment::sky(SKY_WIDTH);
+    let mut shown = String::new();
+    let mut error_measure = String::new();
+    for (index, path) in files.iter().enumerate() {
+        let assessment = assess(path, &kinds, TARGET, MARGIN)?;
+        shown += &material(context, index, path, &assessment, &sky)?;
+        error_measure.clone_from(&assessment.error_measure);
+    }
+    let (width, spp) = context.sizes.materials;
+    let height = material_scene(width).settings.height;
+    let mut html = paragraph(&format!(
+        "The measured materials in {} ({} of them, in name order{}), each fitted as specula fit --material FILE fits it: every lobe in both geometries and GGX, kd / pi + K spec per channel, with one n for the three channels (what a renderer's material has) and with one per channel. E, the fit error, is the {error_measure}. The verdict is the cheapest lobe on {} whose one-n fit is within {} % of pow's best. Each table shows every lobe's one-n fit in its better geometry, and in its last column the same model's fit with one n per channel. The renders are the environment scene under the procedural sky ({width}x{height}, {spp} samples per pixel, the same random numbers for every model), the measured material sampled by its own data.",
+        directory.display(),
+        files.len(),
+        if more > 0 {
+            format!("; {more} more .bsdf files not shown, as a report shows at most {MAX_MATERIALS}")
+        } else {
+            String::new()
+        },
+        target_name(),
+        100.0 * MARGIN,
+    ));
+    html += &shown;
+    Ok(html)
+}
+
+fn target_name() -> String {
+    clap::ValueEnum::to_possible_value(&TARGET)
+        .map_or_else(String::new, |v| v.get_name().to_owned())
+}
+
+/// The shape parameter's name: `n` for a lobe, `alpha` for GGX.
+fn parameter_name(specular: Specular) -> &'static str {
+    match specular {
+        Specular::Ggx => "alpha",
+        Specular::Lobe { .. } => "n",
+    }
+}
+
+fn triple(v: [f64; 3]) -> String {
+    format!("{:.3}/{:.3}/{:.3}", v[0], v[1], v[2])
+}
+
+/// Each lobe's shared-`n` fit in its better geometry (in the fits' order), then GGX's.
+fn shown_fits(a: &Assessment) -> Vec<&FitRow> {
+    let mut best: Vec<&FitRow> = Vec::new();
+    let mut ggx = None;
+    for row in a.fits.iter().filter(|r| r.fit.sharing == Sharing::Shared) {
+        match row.fit.specular {
+            Specular::Lobe { kind, .. } => {
+                let same = best.iter_mut().find(
+                    |b| matches!(b.fit.specular, Specular::Lobe { kind: k, .. } if k == kind),
+                );
+                match same {
+                    Some(b) if row.fit.error < b.fit.error => *b = row,
+                    Some(_) => {}
+                    None => best.push(row),
+                }
+            }
+            Specular::Ggx => ggx = Some(row),
+        }
+    }
+    best.extend(ggx);
+    best
+}
+
+/// One material: what it is, the verdict, the table, the polar plots and the renders.
+fn material(
+    context: &mut Context,
+    index: usize,
+    path: &Path,
+    a: &Assessment,
+    sky: &Environment,
+) -> Result<String, String> {
+    let measured = load_measured(path)?;
+    let name = material_name(path);
+    let prefix = format!("material-{}-{}", index + 1, file_safe(&name));
+    let shown = shown_fits(a);
+    let mut html = format!("<h3>{}</h3>\n", escape(&name));
+    html += &paragraph(&format!(
+        "{} ({}): measured albedo at normal incidence {} (luminance {:.3}); compared at {} direction pairs. Verdict on {}: {}.",
+        a.description,
+        a.file,
+        triple(a.measured_albedo_at_normal),
+        luminance(a.measured_albedo_at_normal),
+        a.pairs,
+        target_name(),
+        verdict_line(a),
+    ));
+    html += &fits_table(a, &shown);
+    html += &polar(context, &prefix, &name, &measured, &shown)?;
+    html += &renders(context, &prefix, &name, &measured, a, &shown, sky)?;
+    Ok(html)
+}
+
+fn fits_table(a: &Assessment, shown: &[&FitRow]) -> String {
+    let chosen = &a.fits[a.chosen].fit;
+    let rows: Vec<Vec<String>> = shown
+        .iter()
+        .map(|row| {
+            let fit = &row.fit;
+            let per_channel = a
+                .fits
+                .iter()
+                .find(|r| r.fit.specular == fit.specular && r.fit.sharing == Sharing::PerChannel)
+                .map_or_else(
+                    || "-".to_owned(),
+                    |r| {
+                        format!(
+                            "{:.5} ({} {})",
+                            r.fit.error,
+                            parameter_name(r.fit.specular),
+                            parameter_text(&r.fit)
+                        )
+                    },
+                );
+            let albedo = luminance(row.albedo_at_normal);
+            vec![
+                fit.specular.label(),
+                parameter_text(fit),
+                format!("{:.5}", fit.error),
+                format!("{:.3}", row.relative_to_pow),
+                format!("{:.3}", row.relative_to_ggx),
+                if albedo > 1.0 {
+                    format!("{albedo:.3} (creates energy)")
+                } else {
+                    format!("{albedo:.3}")
+                },
+                if fit == chosen {
+                    "yes: the verdict".to_owned()
+                } else if row.meets {
+                    "yes".to_owned()
+                } else if fit.specular == Specular::Ggx {
+                    "-".to_owned()
+                } else {
+                    "no".to_owned()
+                },
+                per_channel,
+            ]
+        })
+        .collect();
+    table(
+        &[
+            "model",
+            "n (alpha for ggx)",
+            "E",
+            "E vs pow (same geometry)",
+            "E vs GGX",
+            "albedo at normal incidence",
+            "meets",
+            "one n per channel: E (n or alpha r/g/b)",
+        ],
+        &rows,
+    )
+}
+
+/// The cube root of the luminance of `f cos theta_i` (0 where it dips below).
+fn radius(f_cos: glam::DVec3) -> f64 {
+    luminance(f_cos.to_array()).max(0.0).cbrt()
+}
+
+/// The polar plots at [`POLAR_ANGLES_DEGREES`], one figure of three panels.
+fn polar(
+    context: &mut Context,
+    prefix: &str,
+    name: &str,
+    measured: &MeasuredBrdf,
+    shown: &[&FitRow],
+) -> Result<String, String> {
+    let curve_of = |f: &dyn Fn(glam::DVec3, glam::DVec3) -> glam::DVec3, theta_o: f64| {
+        plane_of_incidence(theta_o, POLAR_POINTS)
+            .into_iter()
+            .map(|(elevation, wo, wi)| (elevation, radius(f(wo, wi))))
+            .collect::<Vec<_>>()
+    };
+    let panels = POLAR_ANGLES_DEGREES
+        .iter()
+        .map(|&degrees| {
+            let theta_o = degrees.to_radians();
+            let mut curves = vec![PolarCurve {
+                name: "measured".to_owned(),
+                points: curve_of(&|wo, wi| measured.f_cos(wo, wi), theta_o),
+                colour: plotters::style::BLACK,
+                opacity: 0.4,
+                width: 6,
+                dash: &[],
+            }];
+            for row in shown {
+                let fit: &Fit = &row.fit;
+                let (colour, dash) = match fit.specular {
+                    Specular::Lobe { kind, .. } => (
+                        colour(kind),
+                        if kind.line_style().dashed {
+                            DASHED
+                        } else {
+                            &[]
+                        },
+                    ),
+                    Specular::Ggx => (GGX_GREY, DASH_DOT),
+                };
+                curves.push(PolarCurve {
+                    name: fit.specular.label(),
+                    points: curve_of(&|wo, wi| fit.f_cos(wo, wi), theta_o),
+                    colour,
+                    opacity: 1.0,
+                    width: 2,
+                    dash,
+                });
+            }
+            PolarPanel {
+                title: format!("viewed from {degrees}°"),
+                viewer: theta_o,
+                curves,
+            }
+        })
+        .collect();
+    let svg = Polar {
+        panels,
+        headroom: POLAR_HEADROOM,
+    }
+    .to_svg()?;
+    let file = format!("{prefix}-polar.svg");
+    context.write(&file, svg.as_bytes())?;
+    let angles: Vec<String> = POLAR_ANGLES_DEGREES
+        .iter()
+        .map(|d| format!("{d}°"))
+        .collect();
+    Ok(figure(
+        &file,
+        &format!(
+            "{name} in the plane of incidence, viewed from {} (dotted line; the mirror direction is opposite): the radius is the cube root of the luminance of f cos theta_i, the quantity (per channel) that the fit error E compares. Measured: broad black; each lobe's one-n fit in its better geometry in the lobe's own line style; GGX (one alpha): grey dash-dot. Curves beyond {POLAR_HEADROOM} times the measurement's largest radius are clipped at the rim.",
+            angles.join(", ")
+        ),
+    ))
+}
+
+/// The measured material rendered beside pow's fit, the verdict's lobe and GGX (each the
+/// one-`n` fit), each captioned with its mean FLIP against the measured render.
+fn renders(
+    context: &mut Context,
+    prefix: &str,
+    name: &str,
+    measured: &MeasuredBrdf,
+    a: &Assessment,
+    shown: &[&FitRow],
+    sky: &Environment,
+) -> Result<String, String> {
+    let pow = shown
+        .iter()
+        .find(|r| {
+            matches!(
+                r.fit.specular,
+                Specular::Lobe {
+                    kind: LobeKind::Pow,
+                    ..
+                }
+            )
+        })
+        .ok_or("no pow fit")?;
+    let ggx = shown
+        .iter()
+        .find(|r| r.fit.specular == Specular::Ggx)
+        .ok_or("no GGX fit")?;
+    let chosen = &a.fits[a.chosen];
+    let mut models: Vec<(&FitRow, &str)> = vec![(pow, "pow's best fit")];
+    if chosen.fit != pow.fit {
+        models.push((chosen, "the verdict's lobe"));
+    } else {
+        models[0].1 = "pow's best fit, the verdict";
+    }
+    models.push((ggx, "GGX"));
+    let fits: Vec<&Fit> = models.iter().map(|(row, _)| &row.fit).collect();
+    let (width, spp) = context.sizes.materials;
+    let images = render_comparison(measured, &fits, sky, width, spp, &|_, _| {})?;
+    let scene = material_scene(width);
+    let mut html = String::new();
+    for (k, render) in images.iter().enumerate() {
+        let file = format!("{prefix}-{}.png", file_safe(&render.label));
+        let caption = if k == 0 {
+            format!("{name}, measured")
+        } else {
+            let (row, role) = models[k - 1];
+            let parameter = parameter_name(row.fit.specular);
+            format!(
+                "{} ({role}, {parameter} = {}): mean FLIP {:.4} against the measured render",
+                render.label,
+                parameter_text(&row.fit),
+                render.mean_flip
+            )
+        };
+        html += &context.png(&file, &render.image, &scene, &caption)?;
+    }
+    Ok(html)
+}
