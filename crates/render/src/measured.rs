@@ -27,8 +27,9 @@ pub const MAX_MATERIAL_BYTES: u64 = 64 << 20;
 
 /// Reads the measured material at `path`; every refusal is one line naming the file.
 pub fn load_measured(path: &Path) -> Result<MeasuredBrdf, String> {
-    let bytes = crate::input::read_within(path, MAX_MATERIAL_BYTES)?;
-    MeasuredBrdf::from_bytes(&bytes).map_err(|e| format!("{}: {e}", path.display()))
+    let named = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    let bytes = crate::input::read_within(path, MAX_MATERIAL_BYTES).map_err(|e| named(&e))?;
+    MeasuredBrdf::from_bytes(&bytes).map_err(|e| named(&e))
 }
 
 /// The material's name: the file's stem (`paper_white_rgb` for `.../paper_white_rgb.bsdf`).

@@ -18,7 +18,9 @@
 //! - `GET /api/volume?volume&view&lobe&n&geometry&normalisation&size`: a volume (a built-in
 //!   one, or a real scan while its file is installed) ray marched on the CPU, as a PNG;
 //! - `GET /api/environment?lobe&n&geometry&normalisation&size&spp`: the environment scene lit
-//!   by the procedural sky (Monte Carlo, CPU), as a PNG.
+//!   by the procedural sky (Monte Carlo, CPU), as a PNG;
+//! - `GET /api/materials`, `GET /api/fits?material`, `GET /api/material-render?material&fit&size&spp`:
+//!   the measured materials of the `--data` folder, by name (`measured.rs`).
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -43,6 +45,7 @@ use specula_render::volume::phantom::BuiltIn;
 use super::environment::{
     environment_png, EnvironmentRequest, MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP,
 };
+use super::measured::Materials;
 use super::volume::{volume_png, Choice, VolumeRequest, MAX_VOLUME_SIZE};
 
 /// The largest render side, in pixels.
@@ -78,8 +81,9 @@ pub fn cpu_cost(lobe: &Lobe) -> TargetCost {
 #[derive(Clone)]
 pub struct AppState {
     computations: Limiter,
-    costs: CostModel,
+    pub(crate) costs: CostModel,
     hosts: Hosts,
+    pub(crate) materials: Arc<Materials>,
 }
 
 impl AppState {
@@ -90,6 +94,16 @@ impl AppState {
             computations: Limiter::default(),
             costs,
             hosts: Hosts::default(),
+            materials: Arc::new(Materials::none()),
+        }
+    }
+
+    /// The state offering `materials` (the `--data` folder's; by default none).
+    #[must_use]
+    pub fn with_materials(self, materials: Materials) -> Self {
+        Self {
+            materials: Arc::new(materials),
+            ..self
         }
     }
 
@@ -128,7 +142,7 @@ pub struct ApiError {
 }
 
 impl ApiError {
-    fn bad(parameter: &str, error: String, valid: String) -> Self {
+    pub(crate) fn bad(parameter: &str, error: String, valid: String) -> Self {
         Self {
             status: StatusCode::BAD_REQUEST,
             error,
@@ -137,7 +151,7 @@ impl ApiError {
         }
     }
 
-    fn internal(error: String) -> Self {
+    pub(crate) fn internal(error: String) -> Self {
         Self {
             status: StatusCode::INTERNAL_SERVER_ERROR,
             error,
@@ -160,9 +174,9 @@ impl From<ApiError> for Response {
 }
 
 /// The query string as key-value pairs, or a JSON 400 when it is not well-formed.
-type QueryPairs = Result<Query<Vec<(String, String)>>, QueryRejection>;
+pub(crate) type QueryPairs = Result<Query<Vec<(String, String)>>, QueryRejection>;
 
-fn pairs(query: QueryPairs) -> Result<Vec<(String, String)>, ApiError> {
+pub(crate) fn pairs(query: QueryPairs) -> Result<Vec<(String, String)>, ApiError> {
     query.map(|Query(pairs)| pairs).map_err(|e| ApiError {
         status: StatusCode::BAD_REQUEST,
         error: format!("the query string is malformed: {e}"),
@@ -172,13 +186,13 @@ fn pairs(query: QueryPairs) -> Result<Vec<(String, String)>, ApiError> {
 }
 
 /// A request's query parameters, each read at most once.
-struct Params {
+pub(crate) struct Params {
     values: HashMap<String, String>,
 }
 
 impl Params {
     /// The query, refusing any parameter outside `known`.
-    fn new(query: Vec<(String, String)>, known: &[&str]) -> Result<Self, ApiError> {
+    pub(crate) fn new(query: Vec<(String, String)>, known: &[&str]) -> Result<Self, ApiError> {
         let mut values = HashMap::new();
         for (key, value) in query {
             if !known.contains(&key.as_str()) {
@@ -199,7 +213,7 @@ impl Params {
         Ok(Self { values })
     }
 
-    fn text(&self, name: &str) -> Option<&str> {
+    pub(crate) fn text(&self, name: &str) -> Option<&str> {
         self.values.get(name).map(String::as_str)
     }
 
@@ -221,7 +235,7 @@ impl Params {
     }
 
     /// A finite number in `range`, or `default`.
-    fn number(
+    pub(crate) fn number(
         &self,
         name: &str,
         range: core::ops::RangeInclusive<f64>,
@@ -311,7 +325,7 @@ fn checked(kind: LobeKind, n: Exponent) -> Result<Lobe, ApiError> {
 
 /// Runs `work` on the blocking pool once a worker is free, or answers the full queue's 503; a
 /// panic inside becomes a 500, never a dropped server.
-async fn compute<T: Send + 'static>(
+pub(crate) async fn compute<T: Send + 'static>(
     state: &AppState,
     work: impl FnOnce() -> T + Send + 'static,
 ) -> Result<T, Response> {
@@ -341,7 +355,7 @@ pub async fn not_found() -> ApiError {
         error: "no such page or endpoint".into(),
         parameter: None,
         valid: Some(
-            "/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume, /api/environment"
+            "/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume, /api/environment, /api/materials, /api/fits, /api/material-render"
                 .into(),
         ),
     }
@@ -537,7 +551,7 @@ pub async fn environment(
 }
 
 /// The encoded image as a PNG response.
-fn png(encoded: Vec<u8>) -> Response {
+pub(crate) fn png(encoded: Vec<u8>) -> Response {
     (
         [
             (header::CONTENT_TYPE, "image/png"),

@@ -43,10 +43,15 @@ fn scene(request: &EnvironmentRequest) -> Scene {
     scene
 }
 
+/// The procedural sky, made at its first use (the measured materials' renders share it).
+pub fn sky() -> &'static Environment {
+    static SKY: OnceLock<Environment> = OnceLock::new();
+    SKY.get_or_init(|| Environment::sky(SKY_WIDTH))
+}
+
 /// The render as an sRGB PNG.
 pub fn environment_png(request: &EnvironmentRequest) -> Result<Vec<u8>, String> {
-    static SKY: OnceLock<Environment> = OnceLock::new();
-    let sky = SKY.get_or_init(|| Environment::sky(SKY_WIDTH));
+    let sky = sky();
     let scene = scene(request);
     let settings = IblSettings {
         spp: request.spp,

@@ -8,13 +8,15 @@
 //! its own host names ([`Hosts`]), serves at most [`MAX_CONNECTIONS`] connections with header
 //! and idle timeouts (`listen.rs`), runs [`CONCURRENT_COMPUTATIONS`] computations at once on
 //! the blocking pool behind a queue of [`QUEUED_COMPUTATIONS`] (a full queue answers 503), and
-//! caps request bodies (the API takes none).
+//! caps request bodies (the API takes none). Measured materials come only from the folder
+//! given at start-up, named by their stems (`measured.rs`).
 
 mod api;
 mod environment;
 mod explorer;
 mod guard;
 mod listen;
+mod measured;
 #[cfg(test)]
 mod tests;
 mod volume;
@@ -25,6 +27,9 @@ pub use api::{cpu_cost, AppState, CostModel, TargetCost, MAX_RENDER_SIZE};
 pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
 pub use listen::{CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT, MAX_CONNECTIONS};
+pub use measured::{
+    Materials, MAX_MATERIALS, MAX_MATERIAL_RENDER_SIZE, MAX_MATERIAL_RENDER_SPP, POLAR_POINTS,
+};
 pub use volume::{Scan, MAX_VOLUME_SIZE};
 
 use axum::extract::DefaultBodyLimit;
@@ -63,6 +68,13 @@ pub fn router_with(state: api::AppState) -> Router {
             ),
         )
         .route(
+            "/measured.js",
+            asset(
+                "text/javascript; charset=utf-8",
+                include_str!("assets/measured.js"),
+            ),
+        )
+        .route(
             "/style.css",
             asset("text/css; charset=utf-8", include_str!("assets/style.css")),
         )
@@ -72,6 +84,9 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/render", get(api::render))
         .route("/api/volume", get(api::volume))
         .route("/api/environment", get(api::environment))
+        .route("/api/materials", get(measured::list))
+        .route("/api/fits", get(measured::fits))
+        .route("/api/material-render", get(measured::render_material))
         .fallback(api::not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
         .layer(axum::middleware::from_fn_with_state(
@@ -82,9 +97,15 @@ pub fn router_with(state: api::AppState) -> Router {
 }
 
 /// Serves on `address` until Ctrl-C, printing the URL; `open` also opens it in a browser;
-/// `costs` prices each lobe on each target.
+/// `costs` prices each lobe on each target; `materials` are the measured materials offered
+/// (`--data`).
 /// Anything but a loopback address is warned about: the explorer has no authentication.
-pub fn serve(address: SocketAddr, open: bool, costs: api::CostModel) -> Result<(), String> {
+pub fn serve(
+    address: SocketAddr,
+    open: bool,
+    costs: api::CostModel,
+    materials: Materials,
+) -> Result<(), String> {
     if !address.ip().is_loopback() {
         eprintln!(
             "warning: listening on {}, reachable from other machines; the explorer has no authentication",
@@ -104,6 +125,7 @@ pub fn serve(address: SocketAddr, open: bool, costs: api::CostModel) -> Result<(
             open_browser(&url);
         }
         let state = api::AppState::with_costs(costs)
+            .with_materials(materials)
             .answering(Hosts::new(Some(local.ip()), Some(local.port())));
         listen::serve(listener, router_with(state), async {
             let _ = tokio::signal::ctrl_c().await;

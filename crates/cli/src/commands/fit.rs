@@ -61,6 +61,8 @@ pub struct FitRow {
     pub ks: BTreeMap<&'static str, [f64; 3]>,
     /// The fitted model's albedo at normal incidence, per channel.
     pub albedo_at_normal: [f64; 3],
+    /// A channel's `n` (or `alpha`) at an end of the range searched.
+    pub at_range_end: bool,
     /// `E / E_pow` in the same geometry and sharing.
     pub relative_to_pow: f64,
     /// `E / E_ggx` with the same sharing.
@@ -154,6 +156,7 @@ pub fn assess(
                 .filter_map(|&norm| Some((norm.id(), fit.ks(norm)?)))
                 .collect(),
             albedo_at_normal: fit.albedo_at_normal(),
+            at_range_end: fit.at_range_end(),
             relative_to_pow: standing.relative_to_pow,
             relative_to_ggx: standing.relative_to_ggx,
             rate: standing.rate,
@@ -179,8 +182,14 @@ pub fn assess(
     })
 }
 
-/// `n` (or `alpha`) as printed: one value, or three when the channels differ.
+/// `n` (or `alpha`) as printed: one value, or three when the channels differ; marked `*`
+/// at an end of the range searched.
 pub fn parameter_text(fit: &Fit) -> String {
+    let end = if fit.at_range_end() { "*" } else { "" };
+    format!("{}{end}", parameter_values(fit))
+}
+
+fn parameter_values(fit: &Fit) -> String {
     let p = fit.parameter;
     let one = |v: f64| match fit.specular {
         Specular::Ggx => format!("{v:.4}"),
@@ -274,7 +283,7 @@ fn print_table(a: &Assessment) {
     }
     table.print(crate::args::Format::Table);
     println!(
-        "E: {}; albedo: the fit's at normal incidence (luminance); rate: {}.\n",
+        "E: {}; albedo: the fit's at normal incidence (luminance); rate: {}; *: at an end of the range searched.\n",
         a.error_measure, a.rate_unit
     );
 }

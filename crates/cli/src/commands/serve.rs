@@ -1,11 +1,12 @@
 //! `specula serve`: the BRDF explorer (`crates/serve`), served by the binary itself.
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use specula::gpu_cost::GpuFamily;
 use specula::Lobe;
-use specula_serve::{cpu_cost, TargetCost};
+use specula_serve::{cpu_cost, Materials, TargetCost};
 
 use super::CommandResult;
 
@@ -21,14 +22,38 @@ pub struct Args {
     /// Open the explorer in the default browser.
     #[arg(long)]
     open: bool,
+    /// A folder of measured materials (RGL isotropic RGB `.bsdf` files) for the explorer's
+    /// measured-materials view: the files directly in it, listed at start-up (at most 64),
+    /// offered by name; each is fitted at its first request (seconds) and kept.
+    #[arg(long, value_name = "DIR")]
+    data: Option<PathBuf>,
 }
 
 /// Serves until Ctrl-C.
 pub fn run(args: &Args) -> CommandResult {
+    let materials = match &args.data {
+        Some(folder) => {
+            let (materials, skipped) = Materials::from_folder(folder)?;
+            for line in skipped {
+                eprintln!("warning: {line}");
+            }
+            let names: Vec<&str> = materials.names().collect();
+            println!(
+                "{} measured material{} from {}: {}",
+                names.len(),
+                if names.len() == 1 { "" } else { "s" },
+                folder.display(),
+                names.join(", ")
+            );
+            materials
+        }
+        None => Materials::none(),
+    };
     specula_serve::serve(
         SocketAddr::new(args.bind, args.port),
         args.open,
         Arc::new(costs),
+        materials,
     )
 }
 

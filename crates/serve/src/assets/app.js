@@ -76,6 +76,8 @@ function currentState() {
     volume: $("volume").value,
     view: $("view").value,
     volume_lobe: $("volume_lobe").value === FORMULA ? FORMULA : lobeName({ value: $("volume_lobe").value }),
+    // The measured-materials view's (measured.js), when a material is chosen.
+    ...measuredAddress(),
   };
 }
 
@@ -426,8 +428,9 @@ async function update() {
 
 const DIFFERENCE_GAIN = 8;
 
-// |a - b| per 8-bit sRGB channel, amplified, and the PSNR of a against b over the frame.
-function drawDifference(a, b, canvas, caption) {
+// |a - b| per 8-bit sRGB channel, amplified, and the PSNR of a against b (named `against`)
+// over the frame.
+function drawDifference(a, b, canvas, caption, against = "pow") {
   const pixelsOf = (img) => {
     const c = Object.assign(document.createElement("canvas"), { width: img.naturalWidth, height: img.naturalHeight });
     const g = c.getContext("2d");
@@ -449,7 +452,7 @@ function drawDifference(a, b, canvas, caption) {
   }
   g.putImageData(out, 0, 0);
   const mse = squares / (3 * pa.width * pa.height);
-  caption.textContent = mse === 0 ? "identical to pow" : `PSNR ${(10 * Math.log10(255 * 255 / mse)).toFixed(1)} dB against pow (8-bit sRGB)`;
+  caption.textContent = mse === 0 ? `identical to ${against}` : `PSNR ${(10 * Math.log10(255 * 255 / mse)).toFixed(1)} dB against ${against} (8-bit sRGB)`;
 }
 
 function draw(data, state) {
@@ -497,6 +500,8 @@ function schedule() { clearTimeout(pending); pending = setTimeout(update, 60); }
 async function start() {
   registry = await getJson("/api/models");
   buildControls(readState());
+  // Not awaited: the measured view fills itself in while the rest of the page draws.
+  measuredStart().catch((error) => measuredStatus(error.message));
   $("n").addEventListener("input", () => { $("n-box").value = String(nFromSlider(Number($("n").value))); });
   $("n-box").addEventListener("input", () => {
     const n = Number($("n-box").value);

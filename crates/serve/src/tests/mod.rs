@@ -8,9 +8,16 @@ use tower::ServiceExt as _;
 use super::router;
 
 mod formula;
+mod measured;
 
 async fn get(uri: &str) -> (StatusCode, Vec<u8>) {
-    let response = router()
+    get_from(&router(), uri).await
+}
+
+/// `GET uri` from `app`: the status and the body.
+async fn get_from(app: &axum::Router, uri: &str) -> (StatusCode, Vec<u8>) {
+    let response = app
+        .clone()
         .oneshot(Request::get(uri).body(Body::empty()).expect("request"))
         .await
         .expect("infallible");
@@ -274,7 +281,7 @@ async fn bodies_are_refused_and_the_page_is_self_contained() {
         .await
         .expect("infallible");
     assert_eq!(response.status(), StatusCode::METHOD_NOT_ALLOWED);
-    for asset in ["/", "/app.js", "/style.css"] {
+    for asset in ["/", "/app.js", "/measured.js", "/style.css"] {
         let (status, body) = get(asset).await;
         let text = String::from_utf8(body).expect("text");
         assert_eq!(status, StatusCode::OK);

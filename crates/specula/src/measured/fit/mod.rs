@@ -164,6 +164,17 @@ pub struct Fit {
 }
 
 impl Fit {
+    /// Whether a channel's `n` (or `alpha`) sits at an end of the range searched: the
+    /// material would have it further out, and the figure is the range's, not the
+    /// material's.
+    #[must_use]
+    pub fn at_range_end(&self) -> bool {
+        let [low, high] = self.specular.log_range();
+        self.parameter
+            .iter()
+            .any(|p| (p.ln() - low).abs() < 1e-6 || (p.ln() - high).abs() < 1e-6)
+    }
+
     /// `ks` per channel under `normalisation` (`K / N(n)`); `None` for GGX.
     #[must_use]
     pub fn ks(&self, normalisation: Normalisation) -> Option<[f64; 3]> {

@@ -4,7 +4,8 @@
 //! `pow`'s better fit of the two geometries; a lobe *meets* when its fit error is within
 //! `margin` of it (`E <= (1 + margin) E_pow`), and the verdict is the meeting lobe with the
 //! highest rate on the target, the rate given by the caller (a cost model, a benchmark):
-//! the core decides, the face measures. `pow` always meets, so there is always a verdict.
+//! the core decides, the face measures. `pow` meets by definition, so wherever the target can
+//! run it there is a verdict.
 
 use serde::Serialize;
 
@@ -50,7 +51,8 @@ fn best_error(fits: &[Fit], pick: impl Fn(&Fit) -> bool) -> f64 {
 
 /// Ranks `fits` (as [`super::fit_all`] returns them, pow among the lobes) with `rates[i]`
 /// the rate of `fits[i]` on the target (read for shared-`n` lobes only; `None` where the
-/// target cannot run it). `None` when pow's shared fit is missing.
+/// target cannot run it). `None` when pow's shared fit is missing or no lobe that meets has
+/// a rate.
 #[must_use]
 pub fn verdict(fits: &[Fit], margin: f64, rates: &[Option<f64>]) -> Option<Verdict> {
     let is_pow = |f: &Fit| {

@@ -1,0 +1,542 @@
+//! The explorer's measured-materials view: the `.bsdf` files of the `--data` folder, every
+//! lobe and GGX fitted to each (the library's fit, `specula fit --material`'s), and the polar
+//! plots of the material against its fits.
+//!
+//! **Names, never paths.** The folder is listed once, at start-up ([`Materials::from_folder`]):
+//! the `*.bsdf` entries directly in it whose final target is a regular file (as every file the
+//! renderer reads), at most [`MAX_MATERIALS`]. A request names a material by its stem from
+//! that list (`paper_white_rgb`); anything else, a path included, is refused with the valid
+//! names, so no request reaches a file that was not listed.
+//!
+//! **Computed once.** A material's fits take seconds (27 shared-`n` fits: 13 lobes in both
+//! geometries and GGX), so each material's result is computed at its first request, through
+//! the bounded computation queue like every other computation, and kept (with its JSON); a
+//! request for a material already fitted is answered at once, without taking a place in the
+//! queue. The view shows the shared-`n` fits (one `n` per material, what a renderer's material
+//! has).
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Instant;
+
+use axum::body::Bytes;
+use axum::extract::State;
+use axum::http::header;
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+use glam::DVec3;
+use serde::Serialize;
+use serde_json::json;
+use specula::measured::fit::{
+    fit_all, plane_of_incidence, Fit, Observations, Sharing, Specular, GRID, MAX_ELEVATION_DEGREES,
+    POLAR_ANGLES_DEGREES,
+};
+use specula::{Exponent, Geometry, Lobe, LobeKind};
+use specula_render::ibl::{render_ibl_with, IblSettings, Reflectance, Strategy};
+use specula_render::measured::{
+    load_measured, material_scene, FittedReflectance, MeasuredBrdf, MeasuredReflectance,
+};
+
+use super::api::{
+    compute, pairs, png, ApiError, AppState, CostModel, Params, QueryPairs, TargetCost,
+};
+
+/// The most materials a `--data` folder may hold.
+pub const MAX_MATERIALS: usize = 64;
+
+/// Directions along each polar plot's plane of incidence.
+pub const POLAR_POINTS: usize = 120;
+
+/// The widest material render, in pixels (the height is 9/16 of it).
+pub const MAX_MATERIAL_RENDER_SIZE: u32 = 384;
+
+/// The most samples per pixel of a material render.
+pub const MAX_MATERIAL_RENDER_SPP: u32 = 64;
+
+/// What a material render shows besides its fits: the measurement itself.
+pub const MEASURED: &str = "measured";
+
+/// The measured materials the server offers: the files of its `--data` folder, each with its
+/// fits once computed.
+#[derive(Debug, Default)]
+pub struct Materials {
+    entries: Vec<Entry>,
+    /// The last material read for a render (one at a time: a file holds megabytes of tables).
+    loaded: Mutex<Option<(usize, Arc<MeasuredBrdf>)>>,
+}
+
+#[derive(Debug)]
+struct Entry {
+    name: String,
+    path: PathBuf,
+    assessment: OnceLock<Result<Arc<Assessment>, String>>,
+}
+
+/// A material's shared-`n` fits (in `fit_all`'s order) and the view's JSON of them.
+#[derive(Debug)]
+pub struct Assessment {
+    fits: Vec<Fit>,
+    body: Bytes,
+}
+
+impl Assessment {
+    /// The JSON the fits endpoint answers.
+    #[must_use]
+    pub fn body(&self) -> Bytes {
+        self.body.clone()
+    }
+}
+
+impl Materials {
+    /// No folder: the view says how to give one.
+    #[must_use]
+    pub fn none() -> Self {
+        Self::default()
+    }
+
+    /// The `*.bsdf` files directly in `folder` whose final target is a regular file, by name.
+    /// Refused, in a line: a folder that cannot be listed, one with no such file, or one with
+    /// more than [`MAX_MATERIALS`]. Entries whose names are not UTF-8 are left out and said in
+    /// the second value, one line each.
+    pub fn from_folder(folder: &Path) -> Result<(Self, Vec<String>), String> {
+        let shown = folder.display();
+        let listing = std::fs::read_dir(folder)
+            .map_err(|e| format!("--data {shown}: cannot list the folder: {e}"))?;
+        let mut entries = Vec::new();
+        let mut skipped = Vec::new();
+        for item in listing {
+            let item = item.map_err(|e| format!("--data {shown}: cannot list the folder: {e}"))?;
+            let path = item.path();
+            if path.extension().is_none_or(|e| e != "bsdf") {
+                continue;
+            }
+            if !std::fs::metadata(&path).is_ok_and(|meta| meta.is_file()) {
+                continue;
+            }
+            let Some(name) = path.file_stem().and_then(|s| s.to_str()) else {
+                skipped.push(format!(
+                    "{}: left out, its name is not UTF-8",
+                    path.display()
+                ));
+                continue;
+            };
+            if entries.len() == MAX_MATERIALS {
+                return Err(format!(
+                    "--data {shown} holds more than {MAX_MATERIALS} .bsdf files; the explorer offers at most {MAX_MATERIALS}: pass a folder with fewer (links to the files will do)"
+                ));
+            }
+            entries.push(Entry {
+                name: name.to_owned(),
+                path: path.clone(),
+                assessment: OnceLock::new(),
+            });
+        }
+        if entries.is_empty() {
+            return Err(format!(
+                "--data {shown} holds no .bsdf file (measured materials are read from the folder itself, not its subfolders)"
+            ));
+        }
+        entries.sort_by(|a, b| a.name.cmp(&b.name));
+        let materials = Self {
+            entries,
+            loaded: Mutex::new(None),
+        };
+        Ok((materials, skipped))
+    }
+
+    /// The names offered, sorted.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.entries.iter().map(|e| e.name.as_str())
+    }
+
+    /// The index of the material named `name`, if it is offered.
+    #[must_use]
+    pub fn find(&self, name: &str) -> Option<usize> {
+        self.entries.iter().position(|e| e.name == name)
+    }
+
+    /// Whether the material at `index` has been fitted.
+    #[must_use]
+    pub fn is_fitted(&self, index: usize) -> bool {
+        self.entries[index].assessment.get().is_some()
+    }
+
+    /// The fits of the material at `index` if already computed.
+    #[must_use]
+    pub fn fitted(&self, index: usize) -> Option<Result<Arc<Assessment>, String>> {
+        self.entries[index].assessment.get().cloned()
+    }
+
+    /// The fits of the material at `index`, computed now if they were not (seconds: run it on
+    /// the blocking pool). A file that cannot be read is an error kept like a result: the
+    /// folder was listed once, at start-up.
+    pub fn assess(&self, index: usize, costs: &CostModel) -> Result<Arc<Assessment>, String> {
+        self.entries[index]
+            .assessment
+            .get_or_init(|| {
+                let material = self.load(index)?;
+                assess(&self.entries[index].name, &material, costs).map(Arc::new)
+            })
+            .clone()
+    }
+
+    /// The material at `index`, read from its file unless it was the last one read.
+    fn load(&self, index: usize) -> Result<Arc<MeasuredBrdf>, String> {
+        let mut loaded = self.loaded.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((at, material)) = loaded.as_ref() {
+            if *at == index {
+                return Ok(Arc::clone(material));
+            }
+        }
+        let entry = &self.entries[index];
+        let material = Arc::new(load_measured(&entry.path).map_err(|message| {
+            // The file's folder is the server's business; its name is the material's.
+            let prefix = format!("{}: ", entry.path.display());
+            let reason = message.strip_prefix(&prefix).unwrap_or(&message);
+            format!("the material `{}` cannot be read: {reason}", entry.name)
+        })?);
+        *loaded = Some((index, Arc::clone(&material)));
+        Ok(material)
+    }
+
+    /// The material at `index` (or its fit labelled `shown`) under the sky, as a PNG.
+    pub fn render_png(
+        &self,
+        index: usize,
+        shown: &str,
+        costs: &CostModel,
+        size: u32,
+        spp: u32,
+    ) -> Result<Vec<u8>, String> {
+        if shown == MEASURED {
+            let material = self.load(index)?;
+            return render(&MeasuredReflectance(&material), size, spp);
+        }
+        let fitted = self.assess(index, costs)?;
+        let fit = fitted
+            .fits
+            .iter()
+            .find(|f| f.specular.label() == shown)
+            .ok_or_else(|| format!("no fit labelled `{shown}`"))?;
+        render(&FittedReflectance::new(fit), size, spp)
+    }
+}
+
+/// `reflectance` on the environment scene under the sky, `size` wide, as an sRGB PNG; seed 0,
+/// so the measured image and a fit's share their random numbers.
+fn render(reflectance: &dyn Reflectance, size: u32, spp: u32) -> Result<Vec<u8>, String> {
+    let scene = material_scene(size);
+    let settings = IblSettings {
+        spp,
+        seed: 0,
+        strategy: Strategy::Mis,
+    };
+    let image = render_ibl_with(
+        &scene,
+        super::environment::sky(),
+        &settings,
+        reflectance,
+        &|_, _| {},
+    )
+    .map_err(|e| e.to_string())?;
+    specula_render::encode_png_srgb8(
+        image.width(),
+        image.height(),
+        &image.to_srgb8(scene.display),
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// Every family fitted with one `n` per material, in `fit_all`'s order: the lobes of
+/// [`LobeKind::ALL`], Phong before Blinn, then GGX.
+fn shared_families() -> Vec<Specular> {
+    LobeKind::ALL
+        .iter()
+        .flat_map(|&kind| Geometry::ALL.map(|geometry| Specular::Lobe { kind, geometry }))
+        .chain([Specular::Ggx])
+        .collect()
+}
+
+/// The labels a render may show: [`MEASURED`] and every shared fit's.
+#[must_use]
+pub fn render_labels() -> Vec<String> {
+    std::iter::once(MEASURED.to_owned())
+        .chain(shared_families().into_iter().map(Specular::label))
+        .collect()
+}
+
+/// Rec. 709 luminance of linear RGB.
+fn luminance(rgb: DVec3) -> f64 {
+    0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
+}
+
+/// One fit as the view shows it.
+#[derive(Serialize)]
+struct FitSummary {
+    label: String,
+    /// The lobe's id, or `ggx`.
+    family: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    geometry: Option<&'static str>,
+    /// The fitted exponent (lobes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    n: Option<f64>,
+    /// GGX's fitted roughness.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    alpha: Option<f64>,
+    kd: [f64; 3],
+    k: [f64; 3],
+    error: f64,
+    relative_to_pow_best: f64,
+    relative_to_ggx: f64,
+    albedo_at_normal: [f64; 3],
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    costs: Vec<TargetCost>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cost_error: Option<String>,
+}
+
+/// One viewing elevation's polar data: the measured luminance of `f cos(theta_i)` and each
+/// fit's, in the fits' order.
+#[derive(Serialize)]
+struct PolarView {
+    theta_o_deg: f64,
+    measured: Vec<f32>,
+    fits: Vec<Vec<f32>>,
+}
+
+#[derive(Serialize)]
+struct AssessmentBody<'a> {
+    material: &'a str,
+    description: &'a str,
+    error_measure: String,
+    pairs: usize,
+    /// Pow's best shared-`n` error (either geometry), the reference.
+    reference_error: f64,
+    ggx_error: f64,
+    fits: Vec<FitSummary>,
+    /// The light's signed elevation along the plane of incidence, degrees (the viewer at
+    /// `+theta_o`, its mirror at `-theta_o`).
+    polar_elevations_deg: Vec<f32>,
+    polar: Vec<PolarView>,
+    seconds: f64,
+}
+
+/// Fits `material` and writes the view's JSON.
+fn assess(name: &str, material: &MeasuredBrdf, costs: &CostModel) -> Result<Assessment, String> {
+    let started = Instant::now();
+    let observations = Observations::of(|wo, wi| material.f_cos(wo, wi));
+    let fits: Vec<Fit> = fit_all(&observations, &LobeKind::ALL)
+        .into_iter()
+        .filter(|f| f.sharing == Sharing::Shared)
+        .collect();
+    let best = |pick: &dyn Fn(&Fit) -> bool| {
+        fits.iter()
+            .filter(|f| pick(f))
+            .map(|f| f.error)
+            .min_by(f64::total_cmp)
+            .unwrap_or(f64::NAN)
+    };
+    let reference_error = best(&|f| {
+        matches!(
+            f.specular,
+            Specular::Lobe {
+                kind: LobeKind::Pow,
+                ..
+            }
+        )
+    });
+    let ggx_error = best(&|f| f.specular == Specular::Ggx);
+    let summaries = fits
+        .iter()
+        .map(|fit| summary(fit, reference_error, ggx_error, costs))
+        .collect();
+    let elevations = plane_of_incidence(0.0, POLAR_POINTS)
+        .iter()
+        .map(|(elevation, _, _)| elevation.to_degrees() as f32)
+        .collect();
+    let polar = POLAR_ANGLES_DEGREES
+        .iter()
+        .map(|&theta_o| {
+            let plane = plane_of_incidence(theta_o.to_radians(), POLAR_POINTS);
+            let along = |f_cos: &dyn Fn(DVec3, DVec3) -> DVec3| {
+                plane
+                    .iter()
+                    .map(|&(_, wo, wi)| luminance(f_cos(wo, wi)) as f32)
+                    .collect()
+            };
+            PolarView {
+                theta_o_deg: theta_o,
+                measured: along(&|wo, wi| material.f_cos(wo, wi)),
+                fits: fits
+                    .iter()
+                    .map(|fit| along(&|wo, wi| fit.f_cos(wo, wi)))
+                    .collect(),
+            }
+        })
+        .collect();
+    let [nh, nd, nphi] = GRID;
+    let body = AssessmentBody {
+        material: name,
+        description: material.description(),
+        error_measure: format!(
+            "root mean square over {} direction pairs (a {nh} x {nd} x {nphi} grid in half and difference angles, both directions within {MAX_ELEVATION_DEGREES} degrees of the normal, weighted by solid angle) of the difference of the cube roots of f cos(theta_i), the three channels averaged",
+            observations.len()
+        ),
+        pairs: observations.len(),
+        reference_error,
+        ggx_error,
+        fits: summaries,
+        polar_elevations_deg: elevations,
+        polar,
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    let body = serde_json::to_vec(&body).map_err(|e| e.to_string())?;
+    Ok(Assessment {
+        fits,
+        body: Bytes::from(body),
+    })
+}
+
+fn summary(fit: &Fit, reference_error: f64, ggx_error: f64, costs: &CostModel) -> FitSummary {
+    let (family, geometry, n, alpha, priced) = match fit.specular {
+        Specular::Lobe { kind, geometry } => {
+            let n = fit.parameter[0];
+            let lobe = Lobe::new(kind, Exponent::new(n.clamp(Exponent::MIN, Exponent::MAX)));
+            (
+                kind.to_string(),
+                Some(geometry.id()),
+                Some(n),
+                None,
+                Some(costs(&lobe)),
+            )
+        }
+        Specular::Ggx => ("ggx".to_owned(), None, None, Some(fit.parameter[0]), None),
+    };
+    let (costs, cost_error) = match priced {
+        Some(Ok(costs)) => (costs, None),
+        Some(Err(error)) => (Vec::new(), Some(error)),
+        None => (Vec::new(), None),
+    };
+    FitSummary {
+        label: fit.specular.label(),
+        family,
+        geometry,
+        n,
+        alpha,
+        kd: fit.kd,
+        k: fit.k,
+        error: fit.error,
+        relative_to_pow_best: fit.error / reference_error,
+        relative_to_ggx: fit.error / ggx_error,
+        albedo_at_normal: fit.albedo_at_normal(),
+        costs,
+        cost_error,
+    }
+}
+
+/// The request's `material`: a name from the list, never a path. Refused with the valid
+/// names, or with how to start the server with some when it has none.
+fn material(params: &Params, materials: &Materials) -> Result<usize, ApiError> {
+    let names: Vec<&str> = materials.names().collect();
+    if names.is_empty() {
+        return Err(ApiError::bad(
+            "material",
+            NO_DATA.into(),
+            "none: this server was started without --data".into(),
+        ));
+    }
+    let valid = || names.join(", ");
+    let Some(text) = params.text("material") else {
+        return Err(ApiError::bad(
+            "material",
+            "`material` is required".into(),
+            valid(),
+        ));
+    };
+    materials.find(text).ok_or_else(|| {
+        ApiError::bad(
+            "material",
+            format!("unknown material `{}`", specula::excerpt(text)),
+            valid(),
+        )
+    })
+}
+
+/// What the view says when the server has no materials.
+const NO_DATA: &str = "the server offers no measured materials: start it with `specula serve --data DIR`, DIR a folder of RGL .bsdf files";
+
+/// The material's fits: the cached ones at once, or computed in a turn of the queue.
+async fn assessment(state: &AppState, index: usize) -> Result<Arc<Assessment>, Response> {
+    let result = match state.materials.fitted(index) {
+        Some(done) => done,
+        None => {
+            let (materials, costs) = (Arc::clone(&state.materials), state.costs.clone());
+            compute(state, move || materials.assess(index, &costs)).await?
+        }
+    };
+    result.map_err(|error| ApiError::internal(error).into())
+}
+
+/// `GET /api/materials`: the materials offered (each with whether its fits are ready), the
+/// polar plots' viewing elevations and the renders' limits and choices.
+pub async fn list(State(state): State<AppState>) -> Response {
+    let materials = &state.materials;
+    let offered: Vec<_> = materials
+        .names()
+        .enumerate()
+        .map(|(index, name)| json!({ "name": name, "fitted": materials.is_fitted(index) }))
+        .collect();
+    Json(json!({
+        "hint": if offered.is_empty() { Some(NO_DATA) } else { None },
+        "materials": offered,
+        "max_materials": MAX_MATERIALS,
+        "polar_angles_deg": POLAR_ANGLES_DEGREES,
+        "render_fits": render_labels(),
+        "max_render_size": MAX_MATERIAL_RENDER_SIZE,
+        "max_render_spp": MAX_MATERIAL_RENDER_SPP,
+    }))
+    .into_response()
+}
+
+/// `GET /api/fits?material=NAME`: the shared-`n` fits and the polar data (see
+/// [`Assessment`]'s JSON: `fits`, `polar_elevations_deg`, `polar`).
+pub async fn fits(State(state): State<AppState>, query: QueryPairs) -> Result<Response, Response> {
+    let params = Params::new(pairs(query)?, &["material"])?;
+    let index = material(&params, &state.materials)?;
+    let assessment = assessment(&state, index).await?;
+    Ok((
+        [(header::CONTENT_TYPE, "application/json")],
+        assessment.body(),
+    )
+        .into_response())
+}
+
+/// `GET /api/material-render?material=NAME&fit=LABEL&size&spp`: the environment scene in the
+/// material (`fit=measured`, the default) or one of its shared fits (`pow/phong`, `ggx`), as a
+/// PNG; every render uses seed 0.
+pub async fn render_material(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<Response, Response> {
+    let params = Params::new(pairs(query)?, &["material", "fit", "size", "spp"])?;
+    let index = material(&params, &state.materials)?;
+    let labels = render_labels();
+    let shown = params.text("fit").unwrap_or(MEASURED).to_owned();
+    if !labels.contains(&shown) {
+        return Err(ApiError::bad(
+            "fit",
+            format!("unknown fit `{}`", specula::excerpt(&shown)),
+            labels.join(", "),
+        )
+        .into());
+    }
+    let size = params.number("size", 16.0..=f64::from(MAX_MATERIAL_RENDER_SIZE), 256.0)? as u32;
+    let spp = params.number("spp", 1.0..=f64::from(MAX_MATERIAL_RENDER_SPP), 8.0)? as u32;
+    let (materials, costs) = (Arc::clone(&state.materials), state.costs.clone());
+    let encoded = compute(&state, move || {
+        materials.render_png(index, &shown, &costs, size, spp)
+    })
+    .await?;
+    Ok(png(encoded.map_err(ApiError::internal)?))
+}
