@@ -208,8 +208,7 @@ fn triple(v: [f64; 3]) -> String {
 
 /// Pow's rate on the target (its better geometry's, at its fitted `n`).
 fn pow_rate(a: &Assessment) -> f64 {
-    a
-        .fits
+    a.fits
         .iter()
         .filter(|r| {
             matches!(
