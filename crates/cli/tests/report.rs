@@ -343,9 +343,11 @@ fn materials(document: &roxmltree::Document, out: &std::path::Path) {
             "{name}: the measured render"
         );
         // Pow's fit, the verdict's lobe (unless pow) and GGX, each scored against it.
+        let small = format!("{prefix}small-");
         let renders: Vec<&&(String, String)> = own
             .iter()
             .filter(|(source, _)| source.ends_with(".png") && !source.ends_with("measured.png"))
+            .filter(|(source, _)| !source.starts_with(&small))
             .collect();
         assert!((2..=3).contains(&renders.len()), "{name}: {renders:?}");
         for (source, caption) in renders {
@@ -357,6 +359,21 @@ fn materials(document: &roxmltree::Document, out: &std::path::Path) {
                 .and_then(|number| number.parse().ok())
                 .unwrap_or_else(|| panic!("{source}: no mean FLIP in '{caption}'"));
             assert!(flip > 0.0 && flip < 1.0, "{source}: mean FLIP {flip}");
+        }
+        // Then every lobe's fit and GGX, small, beside the measured material, each scored.
+        let thumbnails: Vec<&&(String, String)> = own
+            .iter()
+            .filter(|(source, _)| source.starts_with(&small) && !source.ends_with("measured.png"))
+            .collect();
+        assert_eq!(thumbnails.len(), 14, "{name}: {thumbnails:?}");
+        for (source, caption) in thumbnails {
+            assert!(out.join(source).is_file(), "{source}");
+            let flip: f64 = caption
+                .split("FLIP ")
+                .nth(1)
+                .and_then(|number| number.trim().parse().ok())
+                .unwrap_or_else(|| panic!("{source}: no FLIP in '{caption}'"));
+            assert!(flip > 0.0 && flip < 1.0, "{source}: FLIP {flip}");
         }
     }
 }

@@ -344,7 +344,8 @@ fn polar(
 }
 
 /// The measured material rendered beside pow's fit, the verdict's lobe and GGX (each the
-/// one-`n` fit), each captioned with its mean FLIP against the measured render.
+/// one-`n` fit), each captioned with its mean FLIP against the measured render; then every
+/// model, small.
 fn renders(
     context: &mut Context,
     prefix: &str,
@@ -396,6 +397,37 @@ fn renders(
                 parameter_text(&row.fit),
                 render.mean_flip
             )
+        };
+        html += &context.png(&file, &render.image, &scene, &caption)?;
+    }
+    html += &every_fit(context, prefix, measured, shown, sky)?;
+    Ok(html)
+}
+
+/// Every lobe's one-`n` fit (in its better geometry) and GGX rendered small beside the
+/// measured material, each with its mean FLIP against the measured render at that size.
+fn every_fit(
+    context: &mut Context,
+    prefix: &str,
+    measured: &MeasuredBrdf,
+    shown: &[&FitRow],
+    sky: &Environment,
+) -> Result<String, String> {
+    let (width, spp) = context.sizes.materials;
+    let (width, spp) = ((width / 2).max(16), (spp / 4).max(4));
+    let fits: Vec<&Fit> = shown.iter().map(|row| &row.fit).collect();
+    let images = render_comparison(measured, &fits, sky, width, spp, &|_, _| {})?;
+    let scene = material_scene(width);
+    let mut html = paragraph(&format!(
+        "Every model beside the measurement ({width}x{}, {spp} samples per pixel), each with its mean FLIP against the measured render at that size:",
+        scene.settings.height
+    ));
+    for render in &images {
+        let file = format!("{prefix}-small-{}.png", file_safe(&render.label));
+        let caption = if render.label == "measured" {
+            "measured".to_owned()
+        } else {
+            format!("{}: FLIP {:.4}", render.label, render.mean_flip)
         };
         html += &context.png(&file, &render.image, &scene, &caption)?;
     }
