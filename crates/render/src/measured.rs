@@ -10,6 +10,7 @@ use core::f64::consts::{FRAC_1_PI, TAU};
 use std::path::Path;
 
 use glam::DVec3;
+use specula::brdf::luminance;
 use specula::fit::ggx;
 use specula::measured::fit::{ggx_specular, Fit, Specular};
 pub use specula::measured::MeasuredBrdf;
@@ -82,10 +83,9 @@ impl FittedReflectance {
     /// Prepares `fit` for rendering.
     #[must_use]
     pub fn new(fit: &Fit) -> Self {
-        let exponent = |n: f64| Exponent::new(n.clamp(Exponent::MIN, Exponent::MAX));
         let draw = match fit.specular {
             Specular::Lobe { kind, geometry } => {
-                let lobes = fit.parameter.map(|n| Lobe::new(kind, exponent(n)));
+                let lobes = fit.parameter.map(|n| Lobe::new(kind, Exponent::clamped(n)));
                 SpecularDraw::Lobe {
                     sampler: SpecularSampler::new(lobes[0], geometry, Normalisation::None),
                     lobes: Box::new(lobes),
@@ -97,8 +97,10 @@ impl FittedReflectance {
             },
         };
         let albedo = fit.albedo_at_normal();
-        let luminance = |v: [f64; 3]| 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
-        let (d, total) = (luminance(fit.kd), luminance(albedo));
+        let (d, total) = (
+            luminance(DVec3::from_array(fit.kd)),
+            luminance(DVec3::from_array(albedo)),
+        );
         Self {
             diffuse: DVec3::from_array(fit.kd) * FRAC_1_PI,
             k: DVec3::from_array(fit.k),

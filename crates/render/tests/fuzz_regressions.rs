@@ -7,9 +7,11 @@ use std::path::{Path, PathBuf};
 
 use specula_render::{MeshFormat, Scene};
 
-/// The fuzz targets' own check.
+/// The fuzz targets' own checks.
 #[path = "../../../fuzz/fuzz_targets/checks/mesh.rs"]
 mod checks;
+#[path = "../../../fuzz/fuzz_targets/checks/measured.rs"]
+mod measured_checks;
 
 fn inputs(target: &str) -> Vec<PathBuf> {
     let fuzz = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
@@ -49,5 +51,19 @@ fn mesh_inputs_load_valid_meshes_or_fail_cleanly() {
         for path in files {
             checks::check_mesh(&std::fs::read(&path).expect("read"), format);
         }
+    }
+}
+
+#[test]
+fn measured_material_inputs_load_or_fail_cleanly() {
+    let files = inputs("measured");
+    assert!(!files.is_empty(), "the measured-material seeds are missing");
+    for path in files {
+        let bytes = std::fs::read(&path).expect("read");
+        if path.ends_with("seeds/measured/minimal.bsdf") {
+            // The seed is a valid material, so the check evaluates it.
+            specula::measured::MeasuredBrdf::from_bytes(&bytes).expect("the minimal seed loads");
+        }
+        measured_checks::check_measured(&bytes);
     }
 }

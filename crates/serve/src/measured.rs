@@ -27,6 +27,7 @@ use axum::Json;
 use glam::DVec3;
 use serde::Serialize;
 use serde_json::json;
+use specula::brdf::luminance;
 use specula::measured::fit::{
     fit_all, plane_of_incidence, Fit, Observations, Sharing, Specular, GRID, MAX_ELEVATION_DEGREES,
     POLAR_ANGLES_DEGREES,
@@ -265,11 +266,6 @@ pub fn render_labels() -> Vec<String> {
         .collect()
 }
 
-/// Rec. 709 luminance of linear RGB.
-fn luminance(rgb: DVec3) -> f64 {
-    0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
-}
-
 /// One fit as the view shows it.
 #[derive(Serialize)]
 struct FitSummary {
@@ -402,7 +398,7 @@ fn summary(fit: &Fit, reference_error: f64, ggx_error: f64, costs: &CostModel) -
     let (family, geometry, n, alpha, priced) = match fit.specular {
         Specular::Lobe { kind, geometry } => {
             let n = fit.parameter[0];
-            let lobe = Lobe::new(kind, Exponent::new(n.clamp(Exponent::MIN, Exponent::MAX)));
+            let lobe = Lobe::new(kind, Exponent::clamped(n));
             (
                 kind.to_string(),
                 Some(geometry.id()),

@@ -15,6 +15,12 @@ use crate::{Geometry, Lobe, Normalisation};
 /// A linear RGB triple (reflectances, intensities, radiances).
 pub type Rgb = DVec3;
 
+/// The luminance of linear RGB (Rec. 709 primaries): how bright a colour looks.
+#[must_use]
+pub fn luminance(rgb: Rgb) -> f64 {
+    rgb.dot(Rgb::new(0.2126, 0.7152, 0.0722))
+}
+
 /// The physically based specular + diffuse BRDF.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Brdf {

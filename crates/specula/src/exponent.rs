@@ -40,6 +40,17 @@ impl Exponent {
         }
     }
 
+    /// The exponent nearest `n` in `[1, 1000]` (a search's ends may round a hair outside;
+    /// NaN gives the smallest).
+    #[must_use]
+    pub fn clamped(n: f64) -> Self {
+        Self(if n.is_nan() {
+            Self::MIN
+        } else {
+            n.clamp(Self::MIN, Self::MAX)
+        })
+    }
+
     /// The exponent's value.
     #[must_use]
     pub fn get(self) -> f64 {

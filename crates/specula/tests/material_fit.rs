@@ -146,3 +146,43 @@ fn the_verdict_is_the_cheapest_lobe_within_the_margin() {
     assert_eq!(verdict(&fits, 0.035, &rate).unwrap().chosen, 2);
     assert_eq!(verdict(&fits, 0.01, &rate).unwrap().chosen, 0);
 }
+
+/// The bounds `kd, K >= 0` are reached exactly: a purely specular material is fitted with no
+/// diffuse term, a purely diffuse one with no specular term.
+#[test]
+fn pure_terms_are_fitted_at_their_bounds() {
+    let pow = Specular::Lobe {
+        kind: LobeKind::Pow,
+        geometry: Geometry::Phong,
+    };
+    let glossy = Brdf::new(
+        Rgb::ZERO,
+        Rgb::new(0.2, 0.3, 0.4),
+        Lobe::new(LobeKind::Pow, Exponent::new(50.0)),
+        Geometry::Phong,
+        Normalisation::Lobe,
+    );
+    let fitted = fit(
+        &Observations::of(|wo, wi| glossy.f(wo, wi) * wi.z),
+        pow,
+        Sharing::Shared,
+    );
+    assert!(
+        fitted.error < 1e-6 && close(fitted.parameter[0], 50.0, 1e-3),
+        "{fitted:?}"
+    );
+    assert!(fitted.kd.iter().all(|&kd| kd < 1e-6), "{:?}", fitted.kd);
+    let matte = Rgb::new(0.5, 0.4, 0.3);
+    let fitted = fit(
+        &Observations::of(|_, wi| matte / PI * wi.z),
+        pow,
+        Sharing::PerChannel,
+    );
+    assert!(fitted.error < 1e-6, "{fitted:?}");
+    for c in 0..3 {
+        assert!(
+            close(fitted.kd[c], matte[c], 1e-6) && fitted.k[c] < 1e-6,
+            "{fitted:?}"
+        );
+    }
+}

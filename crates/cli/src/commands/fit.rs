@@ -15,9 +15,12 @@ use specula::measured::fit::{
 use specula::{Exponent, Lobe, LobeKind, Normalisation};
 use specula_render::measured::{load_measured, material_name};
 
-use super::recommend::{lobe_rate, parse_percent, Target};
+use super::recommend::{lobe_rate, parse_margin, Target};
 use super::CommandResult;
 use crate::output::Table;
+
+/// The fit error allowed over pow's by default: 5 %.
+pub const DEFAULT_MARGIN: f64 = 0.05;
 
 /// How `fit` prints.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -39,7 +42,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Target::GpuNvidia)]
     target: Target,
     /// The fit error allowed over pow's, as a percentage (`5%`).
-    #[arg(long, allow_hyphen_values = true, default_value = "5%", value_parser = parse_percent)]
+    #[arg(long, allow_hyphen_values = true, default_value = "5%", value_parser = parse_margin)]
     margin: f64,
     /// Also fit these lobes: your own (`@FILE.toml`, `=FORMULA`) or a built-in with other
     /// parameters (`cosquad:v=5`); comma separated.
@@ -103,9 +106,9 @@ pub struct Assessment {
     pub reference_error: f64,
 }
 
-/// Luminance of linear RGB (Rec. 709).
+/// Luminance of a linear RGB triple (Rec. 709).
 pub fn luminance(rgb: [f64; 3]) -> f64 {
-    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+    specula::brdf::luminance(glam::DVec3::from_array(rgb))
 }
 
 /// Every built-in lobe and `extra`, with user lobes checked over the whole range of `n`.
@@ -125,12 +128,20 @@ pub fn assess(
 ) -> Result<Assessment, String> {
     let material = load_measured(path)?;
     let observations = Observations::of(|wo, wi| material.f_cos(wo, wi));
+    let broken = observations.value.iter().filter(|v| !v.is_finite()).count();
+    if broken > 0 {
+        return Err(format!(
+            "{}: the material's values are not finite at {broken} of the {} comparison pairs",
+            path.display(),
+            observations.len()
+        ));
+    }
     let fits = fit_all(&observations, kinds);
     let mut rates = Vec::with_capacity(fits.len());
     for fit in &fits {
         rates.push(match (fit.specular, fit.sharing) {
             (Specular::Lobe { kind, .. }, Sharing::Shared) => {
-                let n = Exponent::new(fit.parameter[0].clamp(Exponent::MIN, Exponent::MAX));
+                let n = Exponent::clamped(fit.parameter[0]);
                 Some(lobe_rate(target, &Lobe::new(kind, n))?)
             }
             _ => None,
@@ -143,7 +154,10 @@ pub fn assess(
         ..
     }) = verdict(&fits, margin, &rates)
     else {
-        return Err("no pow fit to compare with".to_owned());
+        return Err(format!(
+            "{}: no verdict: pow's fit or every rate on the target is missing",
+            path.display()
+        ));
     };
     let normal = glam::DVec3::Z;
     let measured = material.albedo(normal, 256);

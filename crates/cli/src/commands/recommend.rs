@@ -62,9 +62,9 @@ pub struct Args {
     /// cheapest lobe whose fit error is within `--margin` of pow's (see `specula fit`).
     #[arg(long, conflicts_with_all = ["max_error", "n", "zone", "energy_conserving"])]
     material: Option<std::path::PathBuf>,
-    /// With `--material`: the fit error allowed over pow's, as a percentage.
-    #[arg(long, allow_hyphen_values = true, default_value = "5%", value_parser = parse_percent)]
-    margin: f64,
+    /// With `--material`: the fit error allowed over pow's, as a percentage [default: 5%].
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_margin, requires = "material", conflicts_with = "max_error")]
+    margin: Option<f64>,
     /// Which error.
     #[arg(long, value_enum, default_value_t = ZoneChoice::Epicentre)]
     zone: ZoneChoice,
@@ -104,7 +104,18 @@ fn parse_exponents(text: &str) -> Result<Exponents, String> {
     Ok(Exponents(values.into_iter().map(Exponent::new).collect()))
 }
 
-pub(crate) fn parse_percent(text: &str) -> Result<f64, String> {
+/// A margin over pow's fit error: a percentage in `[0, 100]`.
+pub(crate) fn parse_margin(text: &str) -> Result<f64, String> {
+    let number = text.trim().trim_end_matches('%');
+    match number.parse::<f64>() {
+        Ok(value) if (0.0..=100.0).contains(&value) => Ok(value / 100.0),
+        _ => Err(format!(
+            "'{text}' is not a margin in [0, 100] %; write it as 5% or 2.5"
+        )),
+    }
+}
+
+fn parse_percent(text: &str) -> Result<f64, String> {
     let number = text.trim().trim_end_matches('%');
     match number.parse::<f64>() {
         Ok(value) if value > 0.0 && value <= 100.0 => Ok(value / 100.0),
@@ -373,7 +384,8 @@ pub fn run(args: &Args) -> CommandResult {
         if args.target == Target::Fpga {
             return Err(FPGA_MATERIAL_REFUSAL.to_owned());
         }
-        let assessment = super::fit::assess(material, &kinds, args.target, args.margin)?;
+        let margin = args.margin.unwrap_or(super::fit::DEFAULT_MARGIN);
+        let assessment = super::fit::assess(material, &kinds, args.target, margin)?;
         return super::fit::print_ranking(&assessment, args.format);
     }
     let max_error = args.max_error.unwrap_or(f64::NAN);

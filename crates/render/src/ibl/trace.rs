@@ -7,15 +7,10 @@ use glam::{DVec3, Vec3, Vec4};
 use rayon::prelude::*;
 use specula::sampling::{power_heuristic, uniform, SpecularSampler};
 
-use super::environment::LUMINANCE;
 use super::{Environment, IblSettings, Strategy, MAX_SPP};
 use crate::pipeline::{surfaces, SurfacePoint};
 use crate::{Image, Material, RenderError, Scene};
-
-/// How bright a colour looks: the weight of a material's term when BRDF draws are split.
-fn luminance(colour: DVec3) -> f64 {
-    colour.dot(LUMINANCE.as_dvec3())
-}
+use specula::brdf::luminance;
 
 /// A BRDF as the estimator needs it, in the local frame (`z` the normal, `wo` the viewer):
 /// its value with the density of its own sampler, and that sampler. Materials of the scene

@@ -65,7 +65,9 @@ impl Marginal2D {
         table
     }
 
-    /// A density: each slice scaled to integrate to 1, with the CDFs that sample it.
+    /// A density: each slice scaled to integrate to 1, with the CDFs that sample it; `None`
+    /// when a slice's integral is not a finite positive number (in `f32`, as the CDFs are
+    /// kept), which no density can be scaled from.
     ///
     /// # Panics
     /// As [`Marginal2D::raw`].
@@ -75,7 +77,7 @@ impl Marginal2D {
         width: usize,
         height: usize,
         parameters: Vec<Vec<f32>>,
-    ) -> Self {
+    ) -> Option<Self> {
         let mut table = Self::shaped(data, width, height, parameters);
         let (w, h) = (width, height);
         let slices = table.data.len() / (w * h);
@@ -100,13 +102,17 @@ impl Marginal2D {
                         + f64::from(conditional[(y + 2) * w - 1]));
                 marginal[y + 1] = sum as f32;
             }
-            let normalisation = 1.0 / marginal[h - 1];
+            let total = marginal[h - 1];
+            if !(total.is_finite() && total > 0.0) {
+                return None;
+            }
+            let normalisation = 1.0 / total;
             conditional.iter_mut().for_each(|v| *v *= normalisation);
             marginal.iter_mut().for_each(|v| *v *= normalisation);
             data.iter_mut().for_each(|v| *v *= normalisation);
         }
         table.scale = ((w - 1) * (h - 1)) as f64;
-        table
+        Some(table)
     }
 
     fn shaped(data: Vec<f32>, width: usize, height: usize, parameters: Vec<Vec<f32>>) -> Self {
@@ -278,7 +284,9 @@ impl Marginal2D {
         let row_start = blend.slice * size + cy * w;
         let r0 = self.lookup(&self.conditional_cdf, &blend, row_start + w - 1, size);
         let r1 = self.lookup(&self.conditional_cdf, &blend, row_start + 2 * w - 1, size);
-        sx /= (1.0 - sy) * r0 + sy * r1;
+        // A row pair without mass (which sampling never lands in) inverts to its start.
+        let row_mass = (1.0 - sy) * r0 + sy * r1;
+        sx = if row_mass > 0.0 { sx / row_mass } else { 0.0 };
 
         sy *= r0 + 0.5 * sy * (r1 - r0);
         sy += self.lookup(&self.marginal_cdf, &blend, blend.slice * h + cy, h);
@@ -300,6 +308,7 @@ mod tests {
             })
             .collect();
         Marginal2D::normalised(data, w, h, vec![vec![0.0, 1.0], vec![0.0, 0.5, 2.0]])
+            .expect("a positive table")
     }
 
     #[test]

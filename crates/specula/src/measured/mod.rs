@@ -87,6 +87,16 @@ fn u_to_phi(u: f64) -> f64 {
     (2.0 * u - 1.0) * PI
 }
 
+/// `value`, or zero where a table's extreme values (a file may hold any finite `f32`)
+/// overflow: no caller, a pixel or a fit, ever receives an infinity or a NaN.
+fn finite_or_zero(value: Rgb) -> Rgb {
+    if value.is_finite() {
+        value
+    } else {
+        Rgb::ZERO
+    }
+}
+
 /// Whether a direction is above the surface (a NaN component is not).
 fn above(d: DVec3) -> bool {
     d.z > 0.0 && d.is_finite()
@@ -128,10 +138,14 @@ impl MeasuredBrdf {
                 theta.len()
             )));
         }
-        if !theta.windows(2).all(|w| w[0] < w[1]) || !theta.iter().all(|t| t.is_finite()) {
+        let elevations = 0.0..=core::f32::consts::FRAC_PI_2;
+        if !theta.windows(2).all(|w| w[0] < w[1]) || !theta.iter().all(|t| elevations.contains(t)) {
             return Err(refuse(
-                "theta_i is not a finite increasing list of elevations",
+                "theta_i is not an increasing list of elevations in [0, pi/2] radians",
             ));
+        }
+        if !phi.windows(2).all(|w| w[0] < w[1]) || !phi.iter().all(|p| p.is_finite()) {
+            return Err(refuse("phi_i is not an increasing list of finite azimuths"));
         }
         let (ndf, ndf_shape) = finite(file.f32s("ndf", 2)?, "ndf")?;
         let (sigma, sigma_shape) = finite(file.f32s("sigma", 2)?, "sigma")?;
@@ -181,17 +195,21 @@ impl MeasuredBrdf {
             }
         }
         let angles = |phi: &[f32]| vec![phi.to_vec(), theta.clone()];
+        let density = |name: &str, table, shape: &[usize]| {
+            Marginal2D::normalised(table, shape[3], shape[2], angles(&phi)).ok_or_else(|| {
+                refuse(format!(
+                    "table '{name}' has a slice whose integral is not a finite positive number"
+                ))
+            })
+        };
+        let vndf = density("vndf", vndf, &vndf_shape)?;
+        let luminance = density("luminance", luminance, &luminance_shape)?;
         Ok(Self {
             description,
             ndf: Marginal2D::raw(ndf, ndf_shape[1], ndf_shape[0], Vec::new()),
             sigma: Marginal2D::raw(sigma, sigma_shape[1], sigma_shape[0], Vec::new()),
-            vndf: Marginal2D::normalised(vndf, vndf_shape[3], vndf_shape[2], angles(&phi)),
-            luminance: Marginal2D::normalised(
-                luminance,
-                luminance_shape[3],
-                luminance_shape[2],
-                angles(&phi),
-            ),
+            vndf,
+            luminance,
             rgb: Marginal2D::raw(
                 rgb,
                 rgb_shape[4],
@@ -230,7 +248,7 @@ impl MeasuredBrdf {
         u_m[1] -= u_m[1].floor();
         let angles = [phi_o, theta_o];
         let (square, _) = self.vndf.invert(u_m, &angles);
-        self.shade(square, angles, u_m, u_o)
+        finite_or_zero(self.shade(square, angles, u_m, u_o))
     }
 
     /// The reflectance at the point `square` of the unit square, for a half vector at `u_m`.
@@ -281,8 +299,8 @@ impl MeasuredBrdf {
             return None;
         }
         let u_o = [theta_to_u(theta_o), phi_to_u(phi_o)];
-        let f = self.shade(square, angles, u_m, u_o) / wi.z;
-        Some(MeasuredSample { wi, f, pdf })
+        let f = finite_or_zero(self.shade(square, angles, u_m, u_o) / wi.z);
+        (pdf.is_finite() && wi.is_finite()).then_some(MeasuredSample { wi, f, pdf })
     }
 
     /// The directional albedo `int f(wo, wi) cos(theta_i) dwi`, estimated by importance
@@ -317,7 +335,12 @@ impl MeasuredBrdf {
         let angles = [phi_o, theta_o];
         let (square, vndf_pdf) = self.vndf.invert(u_m, &angles);
         let luminance_pdf = self.luminance.eval(square, &angles);
-        vndf_pdf * luminance_pdf / Self::to_solid_angle(u_m[0], m, wo)
+        let pdf = vndf_pdf * luminance_pdf / Self::to_solid_angle(u_m[0], m, wo);
+        if pdf.is_finite() {
+            pdf
+        } else {
+            0.0
+        }
     }
 }
 

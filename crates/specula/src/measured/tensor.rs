@@ -15,6 +15,9 @@ pub const MAGIC: &[u8; 12] = b"tensor_file\0";
 /// The most elements one field may declare (a 4 x 32 x 3 x 128 x 128 RGB table is 6.3 M).
 pub const MAX_ELEMENTS: u64 = 1 << 26;
 
+/// The longest field name (Mitsuba's are a few characters).
+pub const MAX_NAME_BYTES: usize = 64;
+
 /// The most fields a file may declare (Mitsuba's measured files have about a dozen).
 pub const MAX_FIELDS: u32 = 256;
 
@@ -185,11 +188,17 @@ impl<'a> TensorFile<'a> {
             )));
         }
         let mut fields = Vec::new();
+        let mut declared = 0u64;
         for index in 0..count {
             let what = format!("field {index}");
             let length = reader.u16(&what)?;
-            let name =
-                String::from_utf8_lossy(reader.take(usize::from(length), &what)?).into_owned();
+            let raw = reader.take(usize::from(length), &what)?;
+            if raw.len() > MAX_NAME_BYTES || !raw.iter().all(|b| b.is_ascii_graphic()) {
+                return Err(error(format!(
+                    "field {index}'s name is not up to {MAX_NAME_BYTES} printable ASCII characters"
+                )));
+            }
+            let name = String::from_utf8_lossy(raw).into_owned();
             let rank = reader.u16(&name)?;
             if rank > 8 {
                 return Err(error(format!(
@@ -216,6 +225,15 @@ impl<'a> TensorFile<'a> {
                 return Err(error(format!(
                     "truncated: field '{name}' ({} x {shape:?}) extends past the end of the file ({} bytes)",
                     dtype.name(),
+                    bytes.len()
+                )));
+            }
+            // Fields may not share bytes beyond the file's size in all: a header whose tables
+            // alias one another cannot make the reader copy the file many times over.
+            declared += elements * dtype.size();
+            if declared > bytes.len() as u64 {
+                return Err(error(format!(
+                    "the fields declare {declared} bytes of data, more than the file's {} bytes",
                     bytes.len()
                 )));
             }

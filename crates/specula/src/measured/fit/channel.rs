@@ -183,28 +183,41 @@ fn solve_nonnegative(normal: [[f64; 2]; 2], rhs: [f64; 2]) -> [f64; 2] {
     }
 }
 
-/// A Gauss-Newton step from `x` that keeps a parameter at its bound 0 when the step would
-/// push it below.
+/// The Gauss-Newton step from `x` within `x + step >= 0`: the free step where it stays
+/// inside, else the better (by the Gauss-Newton model) of the two steps with one parameter
+/// moved to its bound 0 and the other solved with it there.
 fn solve_nonnegative_step(normal: [[f64; 2]; 2], rhs: [f64; 2], x: [f64; 2]) -> [f64; 2] {
     let det = normal[0][0] * normal[1][1] - normal[0][1] * normal[0][1];
-    let free = if det > 1e-300 {
-        [
+    if det > 1e-300 {
+        let free = [
             (rhs[0] * normal[1][1] - rhs[1] * normal[0][1]) / det,
             (rhs[1] * normal[0][0] - rhs[0] * normal[0][1]) / det,
-        ]
-    } else {
-        [0.0; 2]
+        ];
+        if x[0] + free[0] >= 0.0 && x[1] + free[1] >= 0.0 {
+            return free;
+        }
+    }
+    // The model's value of a step, up to a constant: step' N step - 2 step' rhs.
+    let model = |d: [f64; 2]| {
+        d[0] * d[0] * normal[0][0] + 2.0 * d[0] * d[1] * normal[0][1] + d[1] * d[1] * normal[1][1]
+            - 2.0 * (d[0] * rhs[0] + d[1] * rhs[1])
     };
-    if x[0] + free[0] >= 0.0 && x[1] + free[1] >= 0.0 {
-        return free;
+    let pinned = |at: usize| {
+        let other = 1 - at;
+        let mut step = [0.0; 2];
+        step[at] = -x[at];
+        if normal[other][other] > 0.0 {
+            step[other] =
+                ((rhs[other] - normal[0][1] * step[at]) / normal[other][other]).max(-x[other]);
+        }
+        step
+    };
+    let (a, b) = (pinned(0), pinned(1));
+    if model(a) <= model(b) {
+        a
+    } else {
+        b
     }
-    if x[0] + free[0] < 0.0 && normal[1][1] > 0.0 {
-        return [-x[0], rhs[1] / normal[1][1]];
-    }
-    if normal[0][0] > 0.0 {
-        return [rhs[0] / normal[0][0], -x[1]];
-    }
-    [0.0; 2]
 }
 
 #[cfg(test)]

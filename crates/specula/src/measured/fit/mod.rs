@@ -96,7 +96,7 @@ impl Specular {
     fn values(self, parameter: f64, observations: &Prepared) -> Vec<f64> {
         match self {
             Specular::Lobe { kind, geometry } => {
-                let lobe = Lobe::new(kind, exponent(parameter));
+                let lobe = Lobe::new(kind, Exponent::clamped(parameter));
                 let t = match geometry {
                     Geometry::Phong => &observations.t_phong,
                     Geometry::Blinn => &observations.t_blinn,
@@ -110,11 +110,6 @@ impl Specular {
                 .collect(),
         }
     }
-}
-
-/// A fitted `n` as an exponent (the search's ends may round a hair outside the range).
-fn exponent(n: f64) -> Exponent {
-    Exponent::new(n.clamp(Exponent::MIN, Exponent::MAX))
 }
 
 /// Smith's `Lambda` for GGX at a direction of cosine `c`.
@@ -182,7 +177,7 @@ impl Fit {
             return None;
         };
         Some(core::array::from_fn(|c| {
-            let lobe = Lobe::new(kind, exponent(self.parameter[c]));
+            let lobe = Lobe::new(kind, Exponent::clamped(self.parameter[c]));
             self.k[c] / normalisation.constant_for(&lobe)
         }))
     }
@@ -194,7 +189,7 @@ impl Fit {
         core::array::from_fn(|c| {
             let specular = match self.specular {
                 Specular::Lobe { kind, geometry } => {
-                    let lobe = Lobe::new(kind, exponent(self.parameter[c]));
+                    let lobe = Lobe::new(kind, Exponent::clamped(self.parameter[c]));
                     specular_albedo_per_unit(&lobe, geometry, 0.0)
                 }
                 Specular::Ggx => ggx_albedo_at_normal(self.parameter[c]),
@@ -211,8 +206,10 @@ impl Fit {
         }
         let channel = |c: usize| {
             let specular = match self.specular {
-                Specular::Lobe { kind, geometry } => Lobe::new(kind, exponent(self.parameter[c]))
-                    .eval(geometry.cos_lobe_local(wo, wi)),
+                Specular::Lobe { kind, geometry } => {
+                    Lobe::new(kind, Exponent::clamped(self.parameter[c]))
+                        .eval(geometry.cos_lobe_local(wo, wi))
+                }
                 Specular::Ggx => ggx_specular(self.parameter[c], wo, wi),
             };
             (self.kd[c] * FRAC_1_PI + self.k[c] * specular) * wi.z

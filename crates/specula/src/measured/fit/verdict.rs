@@ -17,7 +17,8 @@ use crate::LobeKind;
 pub struct Standing {
     /// Its index in the fits given.
     pub fit: usize,
-    /// `E / E_pow` (pow's fit in the same geometry and sharing).
+    /// `E / E_pow`: pow's fit in the same geometry and sharing (for GGX, pow's better
+    /// geometry with the same sharing).
     pub relative_to_pow: f64,
     /// `E / E_ggx` (GGX's fit with the same sharing).
     pub relative_to_ggx: f64,
