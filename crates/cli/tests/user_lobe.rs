@@ -232,9 +232,27 @@ fn a_new_lobe_goes_through_every_command() {
             ],
         );
     }
+    // One measured material, so that the materials section fits the lobe too.
+    let materials = dir.join("materials");
+    std::fs::create_dir(&materials).unwrap();
+    std::os::unix::fs::symlink(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../../shared/data/rgl/paper_white_rgb.bsdf"),
+        materials.join("paper_white_rgb.bsdf"),
+    )
+    .unwrap();
     ok(
         dir,
-        &["report", "--quick", "--out", "report", "--lobe", &quartic],
+        &[
+            "report",
+            "--quick",
+            "--out",
+            "report",
+            "--lobe",
+            &quartic,
+            "--materials",
+            "materials",
+        ],
     );
     let page = std::fs::read_to_string(dir.join("report/index.html")).unwrap();
     // A section shows the lobe in its text or in one of its figures (plots' legends).
