@@ -29,10 +29,10 @@ use serde::Serialize;
 use serde_json::json;
 use specula::brdf::luminance;
 use specula::measured::fit::{
-    fit_all, plane_of_incidence, Fit, Observations, Sharing, Specular, GRID, MAX_ELEVATION_DEGREES,
-    POLAR_ANGLES_DEGREES,
+    families, fit_all, plane_of_incidence, Fit, Observations, Sharing, Specular, GRID,
+    MAX_ELEVATION_DEGREES, POLAR_ANGLES_DEGREES,
 };
-use specula::{Exponent, Geometry, Lobe, LobeKind};
+use specula::{Exponent, Lobe, LobeKind};
 use specula_render::ibl::{render_ibl_with, IblSettings, Reflectance, Strategy};
 use specula_render::measured::{
     load_measured, material_scene, FittedReflectance, MeasuredBrdf, MeasuredReflectance,
@@ -248,21 +248,11 @@ fn render(reflectance: &dyn Reflectance, size: u32, spp: u32) -> Result<Vec<u8>,
     .map_err(|e| e.to_string())
 }
 
-/// Every family fitted with one `n` per material, in `fit_all`'s order: the lobes of
-/// [`LobeKind::ALL`], Phong before Blinn, then GGX.
-fn shared_families() -> Vec<Specular> {
-    LobeKind::ALL
-        .iter()
-        .flat_map(|&kind| Geometry::ALL.map(|geometry| Specular::Lobe { kind, geometry }))
-        .chain([Specular::Ggx])
-        .collect()
-}
-
 /// The labels a render may show: [`MEASURED`] and every shared fit's.
 #[must_use]
 pub fn render_labels() -> Vec<String> {
     std::iter::once(MEASURED.to_owned())
-        .chain(shared_families().into_iter().map(Specular::label))
+        .chain(families(&LobeKind::ALL).into_iter().map(Specular::label))
         .collect()
 }
 

@@ -379,17 +379,23 @@ pub fn plane_of_incidence(theta_o: f64, count: usize) -> Vec<(f64, DVec3, DVec3)
 /// The viewing elevations of the polar plots, degrees.
 pub const POLAR_ANGLES_DEGREES: [f64; 3] = [0.0, 30.0, 60.0];
 
+/// The families [`fit_all`] fits, in its order: each of `kinds` in Phong then Blinn, then
+/// GGX.
+#[must_use]
+pub fn families(kinds: &[LobeKind]) -> Vec<Specular> {
+    kinds
+        .iter()
+        .flat_map(|&kind| Geometry::ALL.map(|geometry| Specular::Lobe { kind, geometry }))
+        .chain([Specular::Ggx])
+        .collect()
+}
+
 /// Every family in `kinds` in both geometries, and GGX, each shared and per channel, fitted
 /// in parallel; in that order (lobes in `kinds`' order, Phong before Blinn, shared first).
 #[must_use]
 pub fn fit_all(observations: &Observations, kinds: &[LobeKind]) -> Vec<Fit> {
     let prepared = Prepared::new(observations);
-    let families: Vec<Specular> = kinds
-        .iter()
-        .flat_map(|&kind| Geometry::ALL.map(|geometry| Specular::Lobe { kind, geometry }))
-        .chain([Specular::Ggx])
-        .collect();
-    families
+    families(kinds)
         .par_iter()
         .flat_map_iter(|&specular| fit_family(&prepared, specular))
         .collect()
