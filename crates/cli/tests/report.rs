@@ -149,6 +149,16 @@ fn the_quick_report_is_complete_and_well_formed() {
     assert_eq!(stray, 0);
 }
 
+/// The FLIP figure a render's caption gives (the number after `FLIP `).
+fn flip_in(source: &str, caption: &str) -> f64 {
+    caption
+        .split("FLIP ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|number| number.parse().ok())
+        .unwrap_or_else(|| panic!("{source}: no FLIP in '{caption}'"))
+}
+
 /// The cells of the table with a column headed `header`, below its header row.
 fn table_rows(document: &roxmltree::Document, header: &str) -> Vec<Vec<String>> {
     let table = document
@@ -159,6 +169,11 @@ fn table_rows(document: &roxmltree::Document, header: &str) -> Vec<Vec<String>> 
                 .any(|n| n.has_tag_name("th") && n.text() == Some(header))
         })
         .unwrap_or_else(|| panic!("a table with '{header}'"));
+    cells(table)
+}
+
+/// A table's cells, below its header row.
+fn cells(table: roxmltree::Node) -> Vec<Vec<String>> {
     table
         .descendants()
         .filter(|n| n.has_tag_name("tr"))
@@ -291,17 +306,7 @@ fn materials(document: &roxmltree::Document, out: &std::path::Path) {
         .collect();
     assert_eq!(tables.len(), MATERIALS.len());
     for table in tables {
-        let cells: Vec<Vec<String>> = table
-            .descendants()
-            .filter(|n| n.has_tag_name("tr"))
-            .skip(1)
-            .map(|row| {
-                row.children()
-                    .filter(|n| n.has_tag_name("td"))
-                    .map(|cell| cell.text().unwrap_or("").to_owned())
-                    .collect()
-            })
-            .collect();
+        let cells = cells(table);
         // Every lobe in its better geometry, then GGX; one verdict, a lobe that meets.
         assert_eq!(cells.len(), specula::LobeKind::ALL.len() + 1, "{cells:?}");
         assert_eq!(cells.last().unwrap()[0], "ggx");
@@ -352,12 +357,7 @@ fn materials(document: &roxmltree::Document, out: &std::path::Path) {
         assert!((2..=3).contains(&renders.len()), "{name}: {renders:?}");
         for (source, caption) in renders {
             assert!(out.join(source).is_file(), "{source}");
-            let flip: f64 = caption
-                .split("mean FLIP ")
-                .nth(1)
-                .and_then(|rest| rest.split_whitespace().next())
-                .and_then(|number| number.parse().ok())
-                .unwrap_or_else(|| panic!("{source}: no mean FLIP in '{caption}'"));
+            let flip = flip_in(source, caption);
             assert!(flip > 0.0 && flip < 1.0, "{source}: mean FLIP {flip}");
         }
         // Then every lobe's fit and GGX, small, beside the measured material, each scored.
@@ -368,11 +368,7 @@ fn materials(document: &roxmltree::Document, out: &std::path::Path) {
         assert_eq!(thumbnails.len(), 14, "{name}: {thumbnails:?}");
         for (source, caption) in thumbnails {
             assert!(out.join(source).is_file(), "{source}");
-            let flip: f64 = caption
-                .split("FLIP ")
-                .nth(1)
-                .and_then(|number| number.trim().parse().ok())
-                .unwrap_or_else(|| panic!("{source}: no FLIP in '{caption}'"));
+            let flip = flip_in(source, caption);
             assert!(flip > 0.0 && flip < 1.0, "{source}: FLIP {flip}");
         }
     }

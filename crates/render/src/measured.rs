@@ -12,10 +12,10 @@ use std::path::Path;
 use glam::DVec3;
 use specula::brdf::luminance;
 use specula::fit::ggx;
-use specula::measured::fit::{ggx_specular, Fit, Specular};
+use specula::measured::fit::{Fit, FittedModel, Specular};
 pub use specula::measured::MeasuredBrdf;
 use specula::sampling::SpecularSampler;
-use specula::{Exponent, Geometry, Lobe, Normalisation};
+use specula::{Exponent, Lobe, Normalisation};
 
 use crate::ibl::{
     cosine_direction, render_ibl_with, Environment, IblSettings, Reflectance, Strategy,
@@ -58,23 +58,19 @@ impl Reflectance for MeasuredReflectance<'_> {
     }
 }
 
-/// How a fitted model's specular directions are drawn.
+/// How a fitted model's specular directions are drawn: at the first channel's parameter,
+/// the others' values apart (the mixture's density is exact, so the estimate is unbiased).
 enum SpecularDraw {
-    /// The lobe's own sampler (at the first channel's `n`), its value per channel apart.
-    Lobe {
-        sampler: SpecularSampler,
-        lobes: Box<[Lobe; 3]>,
-        geometry: Geometry,
-    },
-    /// GGX normals in proportion to `D(h) cos(theta_h)`, at the first channel's `alpha`.
-    Ggx { alpha: [f64; 3] },
+    /// The lobe's own sampler.
+    Lobe(SpecularSampler),
+    /// GGX normals in proportion to `D(h) cos(theta_h)`.
+    Ggx { alpha: f64 },
 }
 
-/// A fitted model as the environment renderer's BRDF: `kd / pi + K spec(wo, wi)` per channel,
-/// drawn from a mixture of the cosine and the specular term in proportion to their albedos.
+/// A fitted model as the environment renderer's BRDF, drawn from a mixture of the cosine and
+/// the specular term in proportion to their albedos.
 pub struct FittedReflectance {
-    diffuse: DVec3,
-    k: DVec3,
+    model: FittedModel,
     draw: SpecularDraw,
     specular_share: f64,
 }
@@ -84,26 +80,21 @@ impl FittedReflectance {
     #[must_use]
     pub fn new(fit: &Fit) -> Self {
         let draw = match fit.specular {
-            Specular::Lobe { kind, geometry } => {
-                let lobes = fit.parameter.map(|n| Lobe::new(kind, Exponent::clamped(n)));
-                SpecularDraw::Lobe {
-                    sampler: SpecularSampler::new(lobes[0], geometry, Normalisation::None),
-                    lobes: Box::new(lobes),
-                    geometry,
-                }
-            }
+            Specular::Lobe { kind, geometry } => SpecularDraw::Lobe(SpecularSampler::new(
+                Lobe::new(kind, Exponent::clamped(fit.parameter[0])),
+                geometry,
+                Normalisation::None,
+            )),
             Specular::Ggx => SpecularDraw::Ggx {
-                alpha: fit.parameter,
+                alpha: fit.parameter[0],
             },
         };
-        let albedo = fit.albedo_at_normal();
         let (d, total) = (
             luminance(DVec3::from_array(fit.kd)),
-            luminance(DVec3::from_array(albedo)),
+            luminance(DVec3::from_array(fit.albedo_at_normal())),
         );
         Self {
-            diffuse: DVec3::from_array(fit.kd) * FRAC_1_PI,
-            k: DVec3::from_array(fit.k),
+            model: fit.prepare(),
             draw,
             specular_share: if total > 0.0 {
                 ((total - d) / total).clamp(0.0, 1.0)
@@ -113,37 +104,21 @@ impl FittedReflectance {
         }
     }
 
-    fn specular(&self, wo: DVec3, wi: DVec3) -> DVec3 {
-        match &self.draw {
-            SpecularDraw::Lobe {
-                lobes, geometry, ..
-            } => {
-                let t = geometry.cos_lobe_local(wo, wi);
-                DVec3::new(lobes[0].eval(t), lobes[1].eval(t), lobes[2].eval(t))
-            }
-            SpecularDraw::Ggx { alpha } => DVec3::new(
-                ggx_specular(alpha[0], wo, wi),
-                ggx_specular(alpha[1], wo, wi),
-                ggx_specular(alpha[2], wo, wi),
-            ),
-        }
-    }
-
     fn specular_pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
         match &self.draw {
-            SpecularDraw::Lobe { sampler, .. } => sampler.pdf(wo, wi),
+            SpecularDraw::Lobe(sampler) => sampler.pdf(wo, wi),
             SpecularDraw::Ggx { alpha } => {
                 let h = (wo + wi).normalize();
-                ggx(alpha[0], h.z) * h.z / (4.0 * wo.dot(h).abs())
+                ggx(*alpha, h.z) * h.z / (4.0 * wo.dot(h).abs())
             }
         }
     }
 
     fn specular_direction(&self, wo: DVec3, u: [f64; 2]) -> Option<DVec3> {
         match &self.draw {
-            SpecularDraw::Lobe { sampler, .. } => Some(sampler.sample(wo, u)?.wi),
+            SpecularDraw::Lobe(sampler) => Some(sampler.sample(wo, u)?.wi),
             SpecularDraw::Ggx { alpha } => {
-                let theta = (alpha[0] * (u[0] / (1.0 - u[0])).sqrt()).atan();
+                let theta = (alpha * (u[0] / (1.0 - u[0])).sqrt()).atan();
                 let (s, c) = (TAU * u[1]).sin_cos();
                 let h = DVec3::new(theta.sin() * c, theta.sin() * s, theta.cos());
                 Some(2.0 * wo.dot(h) * h - wo)
@@ -164,7 +139,7 @@ impl Reflectance for FittedReflectance {
             0.0
         };
         (
-            self.diffuse + self.k * self.specular(wo, wi),
+            self.model.f(wo, wi),
             (1.0 - share) * wi.z * FRAC_1_PI + share * specular_pdf,
         )
     }

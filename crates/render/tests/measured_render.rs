@@ -86,6 +86,7 @@ fn a_measured_material_reflects_its_albedo_by_every_strategy() {
 fn quadrature_albedo(fit: &Fit, theta_o: f64) -> Vec3 {
     let wo = glam::DVec3::new(theta_o.to_radians().sin(), 0.0, theta_o.to_radians().cos());
     let (m, k) = (400, 800);
+    let model = fit.prepare();
     let mut sum = glam::DVec3::ZERO;
     for i in 0..m {
         let theta = core::f64::consts::FRAC_PI_2 * (i as f64 + 0.5) / m as f64;
@@ -96,7 +97,7 @@ fn quadrature_albedo(fit: &Fit, theta_o: f64) -> Vec3 {
                 theta.sin() * phi.sin(),
                 theta.cos(),
             );
-            sum += fit.f_cos(wo, wi) * theta.sin();
+            sum += model.f_cos(wo, wi) * theta.sin();
         }
     }
     (sum * (core::f64::consts::FRAC_PI_2 / m as f64) * (core::f64::consts::TAU / k as f64))

@@ -356,7 +356,10 @@ fn assess(name: &str, material: &MeasuredBrdf, costs: &CostModel) -> Result<Asse
                 measured: along(&|wo, wi| material.f_cos(wo, wi)),
                 fits: fits
                     .iter()
-                    .map(|fit| along(&|wo, wi| fit.f_cos(wo, wi)))
+                    .map(|fit| {
+                        let model = fit.prepare();
+                        along(&|wo, wi| model.f_cos(wo, wi))
+                    })
                     .collect(),
             }
         })

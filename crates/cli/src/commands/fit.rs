@@ -13,7 +13,7 @@ use specula::measured::fit::{
     fit_all, Fit, Observations, Sharing, Specular, MAX_ELEVATION_DEGREES,
 };
 use specula::{Exponent, Lobe, LobeKind, Normalisation};
-use specula_render::measured::{load_measured, material_name};
+use specula_render::measured::{load_measured, material_name, MeasuredBrdf};
 
 use super::recommend::{lobe_rate, parse_margin, Target};
 use super::CommandResult;
@@ -119,23 +119,15 @@ pub fn lobes_to_fit(extra: &[LobeKind]) -> Result<Vec<LobeKind>, String> {
     Ok(kinds)
 }
 
-/// Fits every lobe in `kinds` to the material at `path` and ranks them on `target`.
+/// Fits every lobe in `kinds` to `material` (read from `path`) and ranks them on `target`.
 pub fn assess(
+    material: &MeasuredBrdf,
     path: &Path,
     kinds: &[LobeKind],
     target: Target,
     margin: f64,
 ) -> Result<Assessment, String> {
-    let material = load_measured(path)?;
     let observations = Observations::of(|wo, wi| material.f_cos(wo, wi));
-    let broken = observations.value.iter().filter(|v| !v.is_finite()).count();
-    if broken > 0 {
-        return Err(format!(
-            "{}: the material's values are not finite at {broken} of the {} comparison pairs",
-            path.display(),
-            observations.len()
-        ));
-    }
     let fits = fit_all(&observations, kinds);
     let mut rates = Vec::with_capacity(fits.len());
     for fit in &fits {
@@ -401,7 +393,13 @@ pub fn run(args: &Args) -> CommandResult {
     );
     for path in &args.material {
         progress.set_message(material_name(path));
-        let assessment = assess(path, &kinds, args.target, args.margin)?;
+        let assessment = assess(
+            &load_measured(path)?,
+            path,
+            &kinds,
+            args.target,
+            args.margin,
+        )?;
         progress.suspend(|| match args.format {
             FitFormat::Json => serde_json::to_string(&assessment)
                 .map(|line| println!("{line}"))

@@ -371,9 +371,9 @@ pub(crate) fn lobe_rate(target: Target, lobe: &Lobe) -> Result<f64, String> {
 /// The unit of [`lobe_rate`] on `target`.
 pub(crate) fn rate_unit(target: Target) -> &'static str {
     match target {
-        Target::Cpu => Costing::Measured.unit(),
-        Target::GpuNvidia | Target::GpuAmd => "evals/clock/multiprocessor (modelled)",
+        // Costing the FPGA would run its sweeps; material verdicts refuse it anyway.
         Target::Fpga => "",
+        _ => Costing::new(target, &[]).map_or("", |costing| costing.unit()),
     }
 }
 
@@ -385,7 +385,8 @@ pub fn run(args: &Args) -> CommandResult {
             return Err(FPGA_MATERIAL_REFUSAL.to_owned());
         }
         let margin = args.margin.unwrap_or(super::fit::DEFAULT_MARGIN);
-        let assessment = super::fit::assess(material, &kinds, args.target, margin)?;
+        let loaded = specula_render::measured::load_measured(material)?;
+        let assessment = super::fit::assess(&loaded, material, &kinds, args.target, margin)?;
         return super::fit::print_ranking(&assessment, args.format);
     }
     let max_error = args.max_error.unwrap_or(f64::NAN);

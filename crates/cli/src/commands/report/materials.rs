@@ -19,15 +19,16 @@ use super::sections::colour;
 use super::Context;
 use crate::commands::fit::{
     assess, lobes_to_fit, luminance, parameter_text, verdict_line, Assessment, FitRow,
+    DEFAULT_MARGIN,
 };
 use crate::commands::recommend::Target;
 
 /// The most materials one report shows (the first, by file name).
 pub const MAX_MATERIALS: usize = 16;
 
-/// The verdict's target and margin over pow's fit error (`specula fit`'s defaults).
+/// The verdict's target (`specula fit`'s default) and margin over pow's fit error.
 const TARGET: Target = Target::GpuNvidia;
-const MARGIN: f64 = 0.05;
+const MARGIN: f64 = DEFAULT_MARGIN;
 
 /// Light directions per polar curve (every half degree).
 const POLAR_POINTS: usize = 361;
@@ -111,8 +112,9 @@ pub fn materials(context: &mut Context) -> Result<String, String> {
     let mut shown = String::new();
     let mut error_measure = String::new();
     for (index, path) in files.iter().enumerate() {
-        let assessment = assess(path, &kinds, TARGET, MARGIN)?;
-        shown += &material(context, index, path, &assessment, &sky)?;
+        let measured = load_measured(path)?;
+        let assessment = assess(&measured, path, &kinds, TARGET, MARGIN)?;
+        shown += &material(context, index, path, &measured, &assessment, &sky)?;
         error_measure.clone_from(&assessment.error_measure);
     }
     let (width, spp) = context.sizes.materials;
@@ -178,10 +180,10 @@ fn material(
     context: &mut Context,
     index: usize,
     path: &Path,
+    measured: &MeasuredBrdf,
     a: &Assessment,
     sky: &Environment,
 ) -> Result<String, String> {
-    let measured = load_measured(path)?;
     let name = material_name(path);
     let prefix = format!("material-{}-{}", index + 1, file_safe(&name));
     let shown = shown_fits(a);
@@ -197,8 +199,8 @@ fn material(
         verdict_line(a),
     ));
     html += &fits_table(a, &shown);
-    html += &polar(context, &prefix, &name, &measured, &shown)?;
-    html += &renders(context, &prefix, &name, &measured, a, &shown, sky)?;
+    html += &polar(context, &prefix, &name, measured, &shown)?;
+    html += &renders(context, &prefix, &name, measured, a, &shown, sky)?;
     Ok(html)
 }
 
@@ -307,9 +309,10 @@ fn polar(
                     ),
                     Specular::Ggx => (GGX_GREY, DASH_DOT),
                 };
+                let model = fit.prepare();
                 curves.push(PolarCurve {
                     name: fit.specular.label(),
-                    points: curve_of(&|wo, wi| fit.f_cos(wo, wi), theta_o),
+                    points: curve_of(&|wo, wi| model.f_cos(wo, wi), theta_o),
                     colour,
                     opacity: 1.0,
                     width: 2,

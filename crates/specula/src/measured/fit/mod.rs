@@ -198,23 +198,77 @@ impl Fit {
         })
     }
 
-    /// `f(wo, wi) cos(theta_i)` of the fitted model.
+    /// The fitted model prepared for evaluation: each channel's lobe made once, so that
+    /// evaluating it (per pixel, per plotted point) prepares nothing.
     #[must_use]
-    pub fn f_cos(&self, wo: DVec3, wi: DVec3) -> DVec3 {
+    pub fn prepare(&self) -> FittedModel {
+        FittedModel {
+            kd: DVec3::from_array(self.kd),
+            k: DVec3::from_array(self.k),
+            shape: match self.specular {
+                Specular::Lobe { kind, geometry } => FittedShape::Lobe {
+                    lobes: Box::new(
+                        self.parameter
+                            .map(|n| Lobe::new(kind, Exponent::clamped(n))),
+                    ),
+                    geometry,
+                },
+                Specular::Ggx => FittedShape::Ggx {
+                    alpha: self.parameter,
+                },
+            },
+        }
+    }
+}
+
+/// A [`Fit`] ready to evaluate: `f = kd / pi + K spec(wo, wi)` per channel.
+#[derive(Clone, Debug)]
+pub struct FittedModel {
+    kd: DVec3,
+    k: DVec3,
+    shape: FittedShape,
+}
+
+/// The specular term's prepared form, per channel.
+#[derive(Clone, Debug)]
+enum FittedShape {
+    Lobe {
+        lobes: Box<[Lobe; 3]>,
+        geometry: Geometry,
+    },
+    Ggx {
+        alpha: [f64; 3],
+    },
+}
+
+impl FittedModel {
+    /// The specular term per unit `K`, per channel (without the cosine).
+    #[must_use]
+    pub fn specular(&self, wo: DVec3, wi: DVec3) -> DVec3 {
+        match &self.shape {
+            FittedShape::Lobe { lobes, geometry } => {
+                let t = geometry.cos_lobe_local(wo, wi);
+                DVec3::new(lobes[0].eval(t), lobes[1].eval(t), lobes[2].eval(t))
+            }
+            FittedShape::Ggx { alpha } => {
+                DVec3::from_array(alpha.map(|alpha| ggx_specular(alpha, wo, wi)))
+            }
+        }
+    }
+
+    /// `f(wo, wi)` per channel; zero when either direction is at or below the horizon.
+    #[must_use]
+    pub fn f(&self, wo: DVec3, wi: DVec3) -> DVec3 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return DVec3::ZERO;
         }
-        let channel = |c: usize| {
-            let specular = match self.specular {
-                Specular::Lobe { kind, geometry } => {
-                    Lobe::new(kind, Exponent::clamped(self.parameter[c]))
-                        .eval(geometry.cos_lobe_local(wo, wi))
-                }
-                Specular::Ggx => ggx_specular(self.parameter[c], wo, wi),
-            };
-            (self.kd[c] * FRAC_1_PI + self.k[c] * specular) * wi.z
-        };
-        DVec3::new(channel(0), channel(1), channel(2))
+        self.kd * FRAC_1_PI + self.k * self.specular(wo, wi)
+    }
+
+    /// `f(wo, wi) cos(theta_i)`.
+    #[must_use]
+    pub fn f_cos(&self, wo: DVec3, wi: DVec3) -> DVec3 {
+        self.f(wo, wi) * wi.z.max(0.0)
     }
 }
 
