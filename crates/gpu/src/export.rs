@@ -122,6 +122,73 @@ impl ShaderCode {
     }
 }
 
+/// Every format a lobe is exported to: a language naga writes, or a renderer's own format
+/// (`specula_targets`). The CLI's `shader --lang` and the Python package's `Lobe.shader` both
+/// list and write through it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// A shading language, through naga.
+    Naga(Language),
+    /// A renderer's file: OSL, MaterialX, Mitsuba 3.
+    Renderer(specula_targets::Renderer),
+}
+
+impl Format {
+    /// Every format, in the order `--help` lists them.
+    pub const ALL: [Format; 8] = [
+        Format::Naga(Language::Wgsl),
+        Format::Naga(Language::Glsl),
+        Format::Naga(Language::Hlsl),
+        Format::Naga(Language::Msl),
+        Format::Naga(Language::Spirv),
+        Format::Renderer(specula_targets::Renderer::Osl),
+        Format::Renderer(specula_targets::Renderer::MaterialX),
+        Format::Renderer(specula_targets::Renderer::Mitsuba),
+    ];
+
+    /// The name on the command line.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            Format::Naga(language) => language.id(),
+            Format::Renderer(renderer) => renderer.id(),
+        }
+    }
+
+    /// The format named `id`, or a message naming the valid ones.
+    pub fn parse(id: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|format| format.id() == id)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::ALL.iter().map(|format| format.id()).collect();
+                format!(
+                    "unknown shader language '{}'; valid languages: {}",
+                    specula::excerpt(id),
+                    names.join(", ")
+                )
+            })
+    }
+
+    /// `lobe` in this format (`options` apply to naga's languages).
+    pub fn write(
+        self,
+        lobe: &Lobe,
+        geometry: Geometry,
+        normalisation: Normalisation,
+        options: Options,
+    ) -> Result<ShaderCode, String> {
+        match self {
+            Format::Naga(language) => {
+                export(lobe, geometry, normalisation, language, options).map_err(|e| e.to_string())
+            }
+            Format::Renderer(renderer) => renderer
+                .write(lobe, geometry, normalisation)
+                .map(ShaderCode::Text),
+        }
+    }
+}
+
 /// An export naga could not complete (a bug in specula's WGSL if it ever happens).
 #[derive(Clone, Debug, Error, PartialEq)]
 #[error("shader export to {language} failed: {message}")]

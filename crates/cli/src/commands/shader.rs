@@ -3,8 +3,7 @@
 use std::path::PathBuf;
 
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-use specula_gpu::export::{export, GlslVersion, Language, Options, ShaderCode};
-use specula_targets::Renderer;
+use specula_gpu::export::{Format, GlslVersion, Language, Options, ShaderCode};
 
 use super::CommandResult;
 use crate::args::{choice, parse_exponent, LobeParser};
@@ -28,8 +27,8 @@ pub struct Args {
     /// The shading language: wgsl, glsl, hlsl, msl, spirv (a function for one's own
     /// shader), osl (a Blender Cycles script node), mtlx (a MaterialX
     /// document) or mitsuba (a Mitsuba 3 BSDF plugin in Python).
-    #[arg(long, value_parser = choice(&Lang::ALL, Lang::id))]
-    lang: Lang,
+    #[arg(long, value_parser = choice(&Format::ALL, Format::id))]
+    lang: Format,
     /// The GLSL dialect (with --lang glsl): 450 (Vulkan, OpenGL 4.5), 300es (OpenGL ES 3,
     /// WebGL 2) or 100 (OpenGL ES 2, WebGL 1; lobes that read a float's bits are refused).
     #[arg(long, value_parser = choice(&GlslVersion::ALL, GlslVersion::id), default_value = "450")]
@@ -43,52 +42,19 @@ pub struct Args {
     output: Option<PathBuf>,
 }
 
-/// A language naga writes, or a renderer's own format.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Lang {
-    Naga(Language),
-    Renderer(Renderer),
-}
-
-impl Lang {
-    const ALL: [Lang; 8] = [
-        Lang::Naga(Language::Wgsl),
-        Lang::Naga(Language::Glsl),
-        Lang::Naga(Language::Hlsl),
-        Lang::Naga(Language::Msl),
-        Lang::Naga(Language::Spirv),
-        Lang::Renderer(Renderer::Osl),
-        Lang::Renderer(Renderer::MaterialX),
-        Lang::Renderer(Renderer::Mitsuba),
-    ];
-
-    fn id(self) -> &'static str {
-        match self {
-            Lang::Naga(language) => language.id(),
-            Lang::Renderer(renderer) => renderer.id(),
-        }
-    }
-}
-
 /// Exports and writes.
 pub fn run(args: &Args) -> CommandResult {
-    if args.lang == Lang::Naga(Language::Spirv) && args.output.is_none() {
+    if args.lang == Format::Naga(Language::Spirv) && args.output.is_none() {
         return Err("SPIR-V is binary; give an output file with -o (e.g. -o lobe.spv)".into());
     }
     let lobe = Lobe::checked(args.lobe, args.n).map_err(|e| e.to_string())?;
-    let code = match args.lang {
-        Lang::Naga(language) => {
-            let options = Options {
-                example: args.example,
-                glsl: args.glsl_version,
-            };
-            export(&lobe, args.geometry, args.normalisation, language, options)
-                .map_err(|e| e.to_string())?
-        }
-        Lang::Renderer(renderer) => {
-            ShaderCode::Text(renderer.write(&lobe, args.geometry, args.normalisation)?)
-        }
+    let options = Options {
+        example: args.example,
+        glsl: args.glsl_version,
     };
+    let code = args
+        .lang
+        .write(&lobe, args.geometry, args.normalisation, options)?;
     match &args.output {
         Some(path) => specula_render::write_atomically(path, |writer| {
             writer

@@ -1,0 +1,197 @@
+"""specula: specular lobes for Python.
+
+The Phong/Blinn lobe ``cos^n`` and its cheap approximations (modified Schlick, quadratic
+Chebyshev, log/exp, the cosine-quadratic ``K_4``, ...), exact in float64 and fast in float32
+(the SIMD batch kernels), with the analysis against ``t^n``, the thesis's claims, the
+recommendation of a lobe for a target, importance sampling, rendering and shader export.
+
+One library under two faces: the ``specula`` command and this package call the same Rust
+functions, so a row here reads the same as the CLI's JSON.
+
+Examples
+--------
+>>> import numpy as np, specula
+>>> lobe = specula.Lobe("cosquad", n=64)
+>>> t = np.linspace(0.9, 1.0, 5, dtype=np.float32)
+>>> lobe(t).dtype
+dtype('float32')
+"""
+
+from __future__ import annotations
+
+import json as _json
+import os as _os
+from typing import Any, Dict, List, Optional, Sequence, Union
+
+from . import _specula
+from ._specula import Lobe, Volume, default_scene, render, render_volume
+
+__version__: str = _specula.__version__
+
+__all__ = [
+    "Lobe",
+    "Volume",
+    "analyze",
+    "claims",
+    "cost",
+    "default_scene",
+    "errors",
+    "languages",
+    "lobe_ids",
+    "models",
+    "recommend",
+    "render",
+    "report",
+    "render_volume",
+    "zones",
+]
+
+
+def lobe_ids() -> List[str]:
+    """The built-in lobes' ids, in the registry's order."""
+    return _specula.lobe_ids()
+
+
+def models() -> List[Dict[str, str]]:
+    """The built-in lobes: id, name, one-line summary and plot colour (``specula models``)."""
+    return _json.loads(_specula.models_json())
+
+
+def languages() -> List[str]:
+    """The shader languages and renderer formats :meth:`Lobe.shader` writes."""
+    return _specula.languages()
+
+
+def zones(n: float) -> Dict[str, float]:
+    """The zones of ``t^n`` (SPEC section 3).
+
+    Returns
+    -------
+    dict
+        ``epicentre_cos`` (``2^(-1/n)``, where ``t^n = 1/2``), ``bloom_cos``
+        (``2^(-8/n)``, where ``t^n = 1/256``) and the matching angles in radians.
+    """
+    return _json.loads(_specula.zones_json(float(n)))
+
+
+def errors(lobe: Lobe, samples_per_zone: int = 20_001) -> Dict[str, float]:
+    """A lobe's error figures against ``t^n`` (SPEC section 4), in float64.
+
+    Returns
+    -------
+    dict
+        ``epicentre_max_rel``, ``epicentre_max_abs``, ``bloom_max_abs``, ``tail_max_abs``,
+        ``rms`` and the rest of ``specula analyze --format json``'s error columns.
+    """
+    return _json.loads(lobe.errors_json(samples_per_zone))
+
+
+def analyze(
+    lobes: Optional[Sequence[str]] = None,
+    n: Union[float, Sequence[float], None] = None,
+    precision: str = "f64",
+) -> List[Dict[str, Any]]:
+    """Every figure of ``specula analyze --format json`` for lobes x exponents.
+
+    Parameters
+    ----------
+    lobes : sequence of str, optional
+        Lobe ids or specifications (``"cosquad:v=5"``, ``"@lobe.toml"``, ``"=t^n"``);
+        every built-in lobe when omitted.
+    n : float or sequence of float, optional
+        Exponents in [1, 1000]; 1, 2, 4, ..., 512, 1000 when omitted.
+    precision : {"f64", "f32", "simd"}
+        The arithmetic of the error figures.
+    """
+    if lobes is None:
+        lobes = lobe_ids()
+    if isinstance(lobes, str):
+        lobes = [lobes]
+    if n is None:
+        n = [1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1000]
+    if isinstance(n, (int, float)):
+        n = [n]
+    return _json.loads(_specula.analyze_json(list(lobes), [float(v) for v in n], precision))
+
+
+def claims(
+    exponent_steps: int = 48,
+    samples_per_zone: int = 100_001,
+    reciprocity_pairs: int = 100_000,
+    seed: int = 0x5EED5BEC,
+) -> List[Dict[str, Any]]:
+    """The thesis's accuracy and energy claims, measured, with their verdicts.
+
+    The rows of ``specula claims --format json`` (without the hardware claim, which needs
+    Yosys). Smaller arguments give a quick, coarser run.
+    """
+    return _json.loads(
+        _specula.claims_json(exponent_steps, samples_per_zone, reciprocity_pairs, seed)
+    )
+
+
+def recommend(
+    target: str,
+    n: Union[float, str] = 64,
+    max_error: float = 0.01,
+    zone: str = "epicentre",
+    energy_conserving: bool = False,
+    lobes: Sequence[str] = (),
+) -> List[Dict[str, Any]]:
+    """Which lobe to ship on ``target`` at an accuracy: the ranked rows of ``specula
+    recommend --format json``.
+
+    Parameters
+    ----------
+    target : {"cpu", "gpu-nvidia", "gpu-amd", "fpga"}
+    n : float or str
+        An exponent, or a range ``"LOW..HIGH"`` the answer must hold over.
+    max_error : float
+        The largest error allowed, as a fraction (0.01 is 1 %).
+    zone : {"epicentre", "bloom", "whole"}
+    energy_conserving : bool
+        Only lobes whose energy stays within 0.1 % of ``t^n``'s.
+    lobes : sequence of str
+        More candidates: your own (``"=t^n"``, ``"@lobe.toml"``) or built-ins with other
+        parameters.
+
+    Returns
+    -------
+    list of dict
+        One row per lobe (``lobe``, ``datapath``, ``error``, ``rate``, ``unit``,
+        ``energy_ratio``, ``meets``, ``pareto``, ``why``), the cheapest that meets it first.
+    """
+    return _json.loads(
+        _specula.recommend_json(
+            target, str(n), float(max_error), zone, bool(energy_conserving), list(lobes)
+        )
+    )
+
+
+def cost(target: str, lobe: Lobe) -> Dict[str, Any]:
+    """A lobe's cost figure on ``target`` (higher is cheaper): measured on the CPU, modelled
+    on a GPU family, synthesized (or estimated) on the FPGA.
+
+    Returns
+    -------
+    dict
+        ``rate`` and its ``unit``.
+    """
+    return _json.loads(_specula.cost_json(target, lobe))
+
+
+def report(
+    out: Union[str, "_os.PathLike[str]"] = "report",
+    quick: bool = False,
+    bench: bool = False,
+    lobes: Sequence[str] = (),
+    materials: Union[str, "_os.PathLike[str]", None] = None,
+) -> str:
+    """Writes the report (``specula report``) to the folder ``out``; returns the page's path."""
+    return _specula.report(
+        _os.fspath(out),
+        bool(quick),
+        bool(bench),
+        list(lobes),
+        None if materials is None else _os.fspath(materials),
+    )

@@ -1,0 +1,45 @@
+//! Shader export: a lobe as text (or SPIR-V bytes) for another pipeline, as `specula shader`.
+
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use specula_gpu::export::{Format, GlslVersion, Options, ShaderCode};
+
+use crate::errors::value_error;
+use crate::lobe::Lobe;
+use crate::render::choose;
+
+/// The languages and formats :meth:`Lobe.shader` writes.
+#[pyfunction]
+pub fn languages() -> Vec<&'static str> {
+    Format::ALL.iter().map(|format| format.id()).collect()
+}
+
+/// `lobe` in `language`: a `str`, or `bytes` for SPIR-V.
+pub fn shader(
+    py: Python<'_>,
+    lobe: &Lobe,
+    language: &str,
+    glsl_version: &str,
+    example: bool,
+) -> PyResult<Py<PyAny>> {
+    let format = Format::parse(language).map_err(value_error)?;
+    let glsl = choose(
+        &GlslVersion::ALL,
+        GlslVersion::id,
+        glsl_version,
+        "GLSL version",
+    )?;
+    let (geometry, normalisation) = lobe.shading();
+    let code = format
+        .write(
+            lobe.core(),
+            geometry,
+            normalisation,
+            Options { example, glsl },
+        )
+        .map_err(value_error)?;
+    Ok(match code {
+        ShaderCode::Text(text) => text.into_pyobject(py)?.into_any().unbind(),
+        ShaderCode::SpirV(_) => PyBytes::new(py, &code.to_bytes()).into_any().unbind(),
+    })
+}

@@ -1,0 +1,166 @@
+//! Rendering a scene (a file or the embedded default) to an `H x W x 3` float32 array of
+//! linear radiance: the rasterizer with direct lights, or the path tracer under an
+//! environment, as `specula render`.
+
+use std::path::PathBuf;
+
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use specula_render::ibl::{render_ibl, Environment, IblSettings, Strategy, MAX_SPP, SKY_WIDTH};
+use specula_render::{
+    render as rasterize, IlluminationModel, Image, Overrides, Scene, Shading, DEFAULT_SCENE,
+    IBL_SCENE, MAX_SAMPLES,
+};
+
+use crate::arrays::shaped;
+use crate::errors::{file_error, guarded, value_error};
+use crate::lobe::{exponent, geometry, normalisation};
+
+/// The one of `all` whose id is `text`, or a message naming the valid ones.
+pub fn choose<T: Copy>(
+    all: &[T],
+    id: fn(T) -> &'static str,
+    text: &str,
+    what: &str,
+) -> PyResult<T> {
+    all.iter()
+        .copied()
+        .find(|&value| id(value) == text)
+        .ok_or_else(|| {
+            let names: Vec<&str> = all.iter().map(|&value| id(value)).collect();
+            value_error(format!(
+                "unknown {what} '{}'; valid {what}s: {}",
+                specula::excerpt(text),
+                names.join(", ")
+            ))
+        })
+}
+
+/// `image` as an `H x W x 3` float32 array.
+pub fn image_array(py: Python<'_>, image: &Image) -> PyResult<Py<PyAny>> {
+    let shape = [image.height() as usize, image.width() as usize, 3];
+    let values: Vec<f32> = image.pixels().iter().flat_map(|p| p.to_array()).collect();
+    Ok(shaped(&shape, values)?.into_pyarray(py).into_any().unbind())
+}
+
+/// The embedded default scene's TOML, to copy and edit (``specula render
+/// --dump-default-scene``).
+#[pyfunction]
+pub fn default_scene() -> &'static str {
+    DEFAULT_SCENE
+}
+
+/// Renders a scene to linear radiance.
+///
+/// Parameters
+/// ----------
+/// scene : str or os.PathLike, optional
+///     A scene file (TOML, see docs/scenes.md); the embedded default when omitted.
+/// lobe, n, geometry, normalisation, shading, model, width, height, samples
+///     Override every material's lobe and the scene's settings, as the CLI's options.
+/// environment : str, optional
+///     ``"sky"`` or an HDR/EXR file: path-traced image-based lighting instead of the
+///     scene's lights (``shading`` and ``model`` do not apply).
+/// spp, seed : int
+///     With an environment: samples per pixel and the seed of the uniform numbers.
+///
+/// Returns
+/// -------
+/// numpy.ndarray
+///     float32, shape ``(height, width, 3)``, linear RGB radiance.
+#[pyfunction]
+#[pyo3(signature = (scene = None, *, lobe = None, n = None, geometry = None, normalisation = None,
+    shading = None, model = None, width = None, height = None, samples = None,
+    environment = None, spp = 64, seed = 0))]
+#[allow(clippy::too_many_arguments)]
+pub fn render(
+    py: Python<'_>,
+    scene: Option<PathBuf>,
+    lobe: Option<&str>,
+    n: Option<f64>,
+    geometry: Option<&str>,
+    normalisation: Option<&str>,
+    shading: Option<&str>,
+    model: Option<&str>,
+    width: Option<u32>,
+    height: Option<u32>,
+    samples: Option<u32>,
+    environment: Option<PathBuf>,
+    spp: u32,
+    seed: u64,
+) -> PyResult<Py<PyAny>> {
+    guarded(|| {
+        let overrides = Overrides {
+            lobe: lobe
+                .map(|text| specula_render::lobe_file::parse_lobe(text, None).map_err(value_error))
+                .transpose()?,
+            n: n.map(exponent).transpose()?,
+            geometry: geometry.map(self::geometry).transpose()?,
+            normalisation: normalisation.map(self::normalisation).transpose()?,
+            shading: shading
+                .map(|text| choose(&Shading::ALL, Shading::id, text, "shading"))
+                .transpose()?,
+            model: model
+                .map(|text| {
+                    choose(
+                        &IlluminationModel::ALL,
+                        IlluminationModel::id,
+                        text,
+                        "model",
+                    )
+                })
+                .transpose()?,
+            width: width.map(|w| within("width", w, 1, 16_384)).transpose()?,
+            height: height.map(|h| within("height", h, 1, 16_384)).transpose()?,
+            samples: samples
+                .map(|s| within("samples", s, 1, MAX_SAMPLES))
+                .transpose()?,
+        };
+        within("spp", spp, 1, MAX_SPP)?;
+        if environment.is_some() && (shading.is_some() || model.is_some()) {
+            return Err(value_error(
+                "shading and model do not apply under an environment (it is path traced); drop them",
+            ));
+        }
+        let loaded = match (&scene, &environment) {
+            (Some(path), _) => Scene::from_file(path).map_err(|e| file_error(path, e.to_string())),
+            (None, None) => Scene::from_toml(DEFAULT_SCENE, "<default scene>", None)
+                .map_err(|e| value_error(e.to_string())),
+            (None, Some(_)) => Scene::from_toml(IBL_SCENE, "<environment scene>", None)
+                .map_err(|e| value_error(e.to_string())),
+        }?;
+        let mut scene = loaded.scene;
+        scene.apply(&overrides);
+        scene.check_lobes().map_err(value_error)?;
+        let environment = match environment {
+            None => None,
+            Some(path) if path.as_os_str() == "sky" => Some(Environment::sky(SKY_WIDTH)),
+            Some(path) => {
+                Some(Environment::load(&path).map_err(|e| file_error(&path, e.to_string()))?)
+            }
+        };
+        let image = py.detach(|| match &environment {
+            Some(environment) => {
+                let settings = IblSettings {
+                    spp,
+                    seed,
+                    strategy: Strategy::Mis,
+                };
+                render_ibl(&scene, environment, &settings, &|_, _| {}).map_err(|e| e.to_string())
+            }
+            None => rasterize(&scene, &|_, _| {}).map_err(|e| e.to_string()),
+        });
+        image_array(py, &image.map_err(value_error)?)
+    })
+}
+
+/// `value` if it lies in `[low, high]`, else a message naming the range.
+pub fn within(name: &str, value: u32, low: u32, high: u32) -> PyResult<u32> {
+    if (low..=high).contains(&value) {
+        Ok(value)
+    } else {
+        Err(value_error(format!(
+            "{name} {value} is out of range; give {low} to {high}"
+        )))
+    }
+}

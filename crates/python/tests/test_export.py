@@ -1,0 +1,41 @@
+"""Shader export: every language, and the text the CLI writes."""
+
+import pytest
+
+import specula
+
+
+@pytest.mark.parametrize("language", specula.languages())
+def test_every_language_is_written(language):
+    # OSL takes no normalisation (its closure is GGX, normalised by construction).
+    normalisation = "none" if language == "osl" else "lobe"
+    code = specula.Lobe("cosquad", 64, normalisation=normalisation).shader(language)
+    if language == "spirv":
+        assert isinstance(code, bytes) and code[:4] == b"\x03\x02\x23\x07"
+    else:
+        assert isinstance(code, str) and len(code) > 100
+
+
+@pytest.mark.parametrize("language", ["wgsl", "glsl", "osl", "mtlx", "mitsuba"])
+def test_the_text_is_the_clis(cli, language):
+    lobe = specula.Lobe("schlick", 32, geometry="blinn")
+    code, out, err = cli("shader", "--lobe", "schlick", "--n", "32", "--geometry", "blinn",
+                         "--lang", language)
+    assert code == 0, err
+    assert lobe.shader(language) == out
+
+
+def test_bad_languages_are_refused():
+    lobe = specula.Lobe("pow", 8)
+    with pytest.raises(ValueError, match=r"valid languages: wgsl, glsl, hlsl, msl, spirv, osl"):
+        lobe.shader("cuda")
+    with pytest.raises(ValueError, match=r"valid GLSL versions: 450, 300es, 100"):
+        lobe.shader("glsl", glsl_version="330")
+
+
+def test_osl_refuses_a_normalisation_as_the_cli_does(cli):
+    with pytest.raises(ValueError) as raised:
+        specula.Lobe("pow", 8, normalisation="lobe").shader("osl")
+    code, _, err = cli("shader", "--lobe", "pow", "--n", "8", "--normalisation", "lobe",
+                       "--lang", "osl")
+    assert code != 0 and str(raised.value) in err
