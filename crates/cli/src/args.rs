@@ -4,7 +4,7 @@
 use clap::builder::{PossibleValue, TypedValueParser};
 use clap::{Arg, Command, ValueEnum};
 use specula::analysis::Precision;
-use specula::{Exponent, Geometry, LobeKind};
+use specula::{Geometry, LobeKind};
 
 /// Parses lobe ids against the registry and lists its ids as the possible values in `--help`.
 #[derive(Clone, Copy, Debug, Default)]
@@ -68,14 +68,9 @@ pub fn flatten(lists: &[LobeList]) -> Vec<LobeKind> {
         .collect()
 }
 
-/// Parses a specular exponent in `[1, 1000]`.
-pub fn parse_exponent(text: &str) -> Result<Exponent, String> {
-    let value: f64 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{text}' is not a number; n must be a number in [1, 1000]"))?;
-    Exponent::try_new(value).map_err(|error| error.to_string())
-}
+/// Parses a specular exponent in `[1, 1000]` (`N`), or one or a range (`LOW..HIGH` as
+/// `steps + 1` log-spaced ones): the library's parsers, which every face shares.
+pub use specula_decide::{parse_exponent, parse_exponent_range};
 
 /// Parses a cosine in `[-1, 1]`.
 pub fn parse_cosine(text: &str) -> Result<f64, String> {
@@ -211,31 +206,49 @@ impl InputLimit {
     }
 }
 
-/// One exponent, or `LOW..HIGH` as `steps + 1` log-spaced ones.
-pub fn parse_exponent_range(text: &str, steps: u32) -> Result<Vec<Exponent>, String> {
-    let Some((low, high)) = text.split_once("..") else {
-        return Ok(vec![parse_exponent(text)?]);
-    };
-    let (low, high) = (parse_exponent(low)?.get(), parse_exponent(high)?.get());
-    if low >= high {
-        return Err(format!(
-            "'{text}': a range needs LOW < HIGH, both in [1, 1000]"
-        ));
-    }
-    Ok((0..=steps)
-        .map(|k| Exponent::new(low * (high / low).powf(f64::from(k) / f64::from(steps))))
-        .collect())
+/// Refuses, before any work, a user's lobe whose formula is not a lobe at one of the
+/// exponents; the library's check, which every face runs.
+pub use specula_decide::check_lobes;
+
+/// Parses one of a library's closed sets of choices (a target, a zone) through its `FromStr`,
+/// so the refusal is the library's, and lists the choices with their summaries in `--help`.
+#[derive(Clone, Copy)]
+pub struct ChoiceParser<T: 'static> {
+    all: &'static [T],
+    id: fn(T) -> &'static str,
+    summary: fn(T) -> &'static str,
 }
 
-/// Refuses, before any work, a user's lobe whose formula is not a lobe at one of `exponents`
-/// (see [`specula::Lobe::checked`]); built-in lobes pass.
-pub fn check_lobes(kinds: &[LobeKind], exponents: &[Exponent]) -> Result<(), String> {
-    for &kind in kinds {
-        if matches!(kind, LobeKind::Formula(_)) {
-            for &n in exponents {
-                specula::Lobe::checked(kind, n).map_err(|e| e.to_string())?;
-            }
-        }
+/// A [`ChoiceParser`] over `all`, named by `id` and described by `summary`.
+pub fn described<T: Copy>(
+    all: &'static [T],
+    id: fn(T) -> &'static str,
+    summary: fn(T) -> &'static str,
+) -> ChoiceParser<T> {
+    ChoiceParser { all, id, summary }
+}
+
+impl<T> TypedValueParser for ChoiceParser<T>
+where
+    T: Copy + Send + Sync + std::str::FromStr<Err = String> + 'static,
+{
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        cmd: &Command,
+        arg: Option<&Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<T, clap::Error> {
+        value
+            .to_string_lossy()
+            .parse()
+            .map_err(|error: String| invalid_value(cmd, arg, &error))
     }
-    Ok(())
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        Some(Box::new(self.all.iter().map(|&value| {
+            PossibleValue::new((self.id)(value)).help((self.summary)(value))
+        })))
+    }
 }

@@ -1,4 +1,7 @@
-//! Plain-text tables and CSV for the commands' results.
+//! Plain-text tables and CSV for the commands' results; figures as text are the report's
+//! (`specula_report::format`), so the page and the tables write them alike.
+
+pub use specula_report::format::{percent, sig};
 
 /// A table of strings with a header row.
 pub struct Table {
@@ -111,31 +114,6 @@ fn csv_field(cell: &str) -> String {
     }
 }
 
-/// A figure with 4 significant digits, in plain or scientific notation as fits.
-pub fn sig(value: f64) -> String {
-    if value == 0.0 || !value.is_finite() {
-        return value.to_string();
-    }
-    // The decimal exponent after rounding to 4 digits (0.99996 rounds to 1.000e0, not 9.9996e-1).
-    let scientific = format!("{value:.3e}");
-    let exponent: i32 = scientific
-        .rsplit('e')
-        .next()
-        .and_then(|e| e.parse().ok())
-        .unwrap_or(0);
-    if (-3..5).contains(&exponent) {
-        let decimals = (3 - exponent).max(0) as usize;
-        format!("{value:.decimals$}")
-    } else {
-        scientific
-    }
-}
-
-/// A ratio as a percentage with 3 significant digits.
-pub fn percent(ratio: f64) -> String {
-    format!("{}%", sig(ratio * 100.0))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -145,14 +123,5 @@ mod tests {
         let mut table = Table::new(&["a", "b"]);
         table.push(vec!["x, y".into(), "1".into()]);
         assert_eq!(table.csv(), "a,b\n\"x, y\",1\n");
-    }
-
-    #[test]
-    fn significant_digits() {
-        assert_eq!(sig(0.0123456), "0.01235");
-        assert_eq!(sig(123.456), "123.5");
-        assert_eq!(sig(1.5e-7), "1.500e-7");
-        assert_eq!(sig(0.99996), "1.000");
-        assert_eq!(sig(1.0), "1.000");
     }
 }

@@ -2,11 +2,14 @@
 //! and no number is NaN or infinite; with the real scans (Debian's `invesalius-examples` and
 //! `mricron-data`) and VTK (the `vtk` wheel in the test's Python), the medical section's real
 //! CT and MRI and its comparison with VTK's CPU ray caster; with `--materials` the five RGL
-//! materials in `shared/data/rgl`, each with its fits, polar plot and renders scored by FLIP.
+//! materials in `shared/data/rgl`, each with its fits, polar plot and renders scored by FLIP;
+//! and one answer everywhere: every cell of "Which lobe when" is what `specula recommend`
+//! answers for its target, exponent and bound (on the FPGA, synthesized with Yosys and
+//! nextpnr, which `CI=true` requires).
 
 mod common;
 
-use common::{have_python_module, ok, python};
+use common::{have_python_module, have_tool, ok, python};
 
 /// The real scans the medical section shows, and the Debian packages that install them.
 const REAL_SCANS: [(&str, &str, &str); 2] = [
@@ -135,6 +138,7 @@ fn the_quick_report_is_complete_and_well_formed() {
     }
     real_scans(&document, &text, &out);
     materials(&document, &out);
+    one_answer(&document, d);
     // Nothing but the report was written: no temporary files left.
     let stray = std::fs::read_dir(&out)
         .unwrap()
@@ -147,6 +151,66 @@ fn the_quick_report_is_complete_and_well_formed() {
         })
         .count();
     assert_eq!(stray, 0);
+}
+
+/// "Which lobe when": every cell is `specula recommend --target T --n N --max-error B`'s
+/// answer, run beside it: on a GPU the best lobe and its rate over pow's, on the FPGA the
+/// best lobe's datapath, word length, rate and unit (synthesized where the tools are, as
+/// under `CI=true` they must be; the formula estimate on both sides otherwise).
+fn one_answer(document: &roxmltree::Document, directory: &std::path::Path) {
+    let synthesized = have_tool("yosys", "-V", "yosys")
+        && have_tool("nextpnr-ice40", "--version", "nextpnr-ice40");
+    let bounds = ["0.5%", "2%", "10%"];
+    let rows = table_rows(document, "within 0.5 %");
+    let mut checked = [0; 2];
+    for row in &rows {
+        assert_eq!(row.len(), 2 + bounds.len(), "{row:?}");
+        let target = match row[0].as_str() {
+            "NVIDIA" => "gpu-nvidia",
+            "AMD RDNA" => "gpu-amd",
+            "FPGA" => "fpga",
+            other => panic!("an unknown target row '{other}'"),
+        };
+        for (cell, bound) in row[2..].iter().zip(bounds) {
+            let line = format!(
+                "recommend --target {target} --n {} --max-error {bound} --format json",
+                row[1]
+            );
+            let output = ok(directory, &line.split_whitespace().collect::<Vec<_>>());
+            let answer: Vec<serde_json::Value> =
+                serde_json::from_slice(&output.stdout).expect("JSON");
+            let rate = |c: &serde_json::Value| c["rate"].as_f64().expect("a rate");
+            let Some(best) = answer.iter().find(|c| c["meets"] == true) else {
+                assert_eq!(cell, "-", "{target} n = {} within {bound}", row[1]);
+                continue;
+            };
+            let lobe = best["lobe"].as_str().unwrap();
+            let expected = if target == "fpga" {
+                let datapath = best["datapath"].as_str().expect("a datapath on the FPGA");
+                let unit = best["unit"].as_str().unwrap();
+                assert_eq!(unit.contains("synthesized"), synthesized, "{unit}");
+                let named = if datapath.starts_with(&format!("{lobe} at ")) {
+                    datapath.to_owned()
+                } else {
+                    format!("{lobe} as {datapath}")
+                };
+                checked[1] += 1;
+                format!(
+                    "{named}: {} {unit}",
+                    specula_report::format::sig(rate(best))
+                )
+            } else {
+                let pow = answer.iter().find(|c| c["lobe"] == "pow").expect("pow");
+                checked[0] += 1;
+                format!("{lobe} ({:.2}x pow)", rate(best) / rate(pow))
+            };
+            assert_eq!(cell, &expected, "{target} n = {} within {bound}", row[1]);
+        }
+    }
+    assert!(
+        checked[0] > 0 && checked[1] > 0,
+        "GPU and FPGA cells: {checked:?}"
+    );
 }
 
 /// The FLIP figure a render's caption gives (the number after `FLIP `).

@@ -13,8 +13,8 @@ use rayon::prelude::*;
 
 use crate::errors::value_error;
 
-/// Elements per parallel chunk: small enough that a chunk's input stays in L2 between the
-/// finiteness check and the kernel, large enough that scheduling is noise.
+/// Elements per piece: small enough that a piece's input stays in L2 between the finiteness
+/// check and the kernel.
 pub const CHUNK: usize = 16 * 1024;
 
 /// An array argument of one of the two float dtypes.
@@ -70,11 +70,22 @@ pub fn float64_rows<'py>(
         })?;
     if array.shape().last() != Some(&last) {
         return Err(value_error(format!(
-            "{name} has shape {:?}; it must be (..., {last})",
-            array.shape()
+            "{name} has shape {}; it must be (..., {last})",
+            tuple(array.shape())
         )));
     }
     Ok(array)
+}
+
+/// `shape` as Python writes a tuple: `(3, 4)`, `(3,)`, `()`.
+pub fn tuple(shape: &[usize]) -> String {
+    match shape {
+        [one] => format!("({one},)"),
+        _ => {
+            let parts: Vec<String> = shape.iter().map(usize::to_string).collect();
+            format!("({})", parts.join(", "))
+        }
+    }
 }
 
 /// `view` as a contiguous slice: borrowed when it is one, copied in logical order when not.
@@ -85,18 +96,34 @@ pub fn contiguous<'a, T: Copy>(view: &'a ArrayViewD<'a, T>) -> std::borrow::Cow<
     }
 }
 
-/// The index of a non-finite value in `values`, if any (a vectorisable scan first, the
+/// A float element whose finiteness is checked on its bits (an exponent of all ones is a NaN
+/// or an infinity), which vectorises to integer compares.
+pub trait Finite: Copy + Send + Sync {
+    /// Whether the value is neither NaN nor infinite.
+    fn finite(self) -> bool;
+}
+
+impl Finite for f32 {
+    #[inline(always)]
+    fn finite(self) -> bool {
+        self.to_bits() & 0x7f80_0000 != 0x7f80_0000
+    }
+}
+
+impl Finite for f64 {
+    #[inline(always)]
+    fn finite(self) -> bool {
+        self.to_bits() & 0x7ff0_0000_0000_0000 != 0x7ff0_0000_0000_0000
+    }
+}
+
+/// The index of a non-finite value in `values`, if any (a branch-free scan first, the
 /// search only on failure).
-pub fn first_non_finite<T: Copy + Into<f64>>(values: &[T]) -> Option<usize> {
-    let all_finite = values
-        .iter()
-        .fold(true, |ok, &v| ok & Into::<f64>::into(v).is_finite());
-    if all_finite {
+pub fn first_non_finite<T: Finite>(values: &[T]) -> Option<usize> {
+    if values.iter().fold(true, |ok, &v| ok & v.finite()) {
         None
     } else {
-        values
-            .iter()
-            .position(|&v| !Into::<f64>::into(v).is_finite())
+        values.iter().position(|&v| !v.finite())
     }
 }
 
@@ -108,22 +135,31 @@ pub fn non_finite(name: &str, index: usize) -> PyErr {
     ))
 }
 
-/// Applies `kernel` to `input` in parallel chunks after checking each chunk is finite;
-/// `Err(index)` names a non-finite input.
-pub fn map_chunks<T: Copy + Send + Sync + Into<f64>>(
+/// Applies `kernel` to `input`: a few large chunks per thread (so the pool schedules a
+/// handful of tasks, not thousands), each walked in [`CHUNK`]-sized pieces that are checked
+/// finite and then evaluated while still in L2. `Err(index)` names a non-finite input.
+pub fn map_chunks<T: Finite>(
     input: &[T],
     output: &mut [T],
     kernel: &(dyn Fn(&[T], &mut [T]) + Sync),
 ) -> Result<(), usize> {
+    let tasks = 4 * rayon::current_num_threads();
+    let task = input.len().div_ceil(tasks).div_ceil(CHUNK).max(1) * CHUNK;
     input
-        .par_chunks(CHUNK)
-        .zip(output.par_chunks_mut(CHUNK))
+        .par_chunks(task)
+        .zip(output.par_chunks_mut(task))
         .enumerate()
         .try_for_each(|(k, (input, output))| {
-            if let Some(i) = first_non_finite(input) {
-                return Err(k * CHUNK + i);
+            for (piece, (input, output)) in input
+                .chunks(CHUNK)
+                .zip(output.chunks_mut(CHUNK))
+                .enumerate()
+            {
+                if let Some(i) = first_non_finite(input) {
+                    return Err(k * task + piece * CHUNK + i);
+                }
+                kernel(input, output);
             }
-            kernel(input, output);
             Ok(())
         })
 }

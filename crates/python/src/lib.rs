@@ -10,6 +10,7 @@
 
 mod analysis;
 mod arrays;
+mod decide;
 mod errors;
 mod export;
 mod lobe;
@@ -28,6 +29,9 @@ fn _specula(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(analysis::zones_json, module)?)?;
     module.add_function(wrap_pyfunction!(analysis::analyze_json, module)?)?;
     module.add_function(wrap_pyfunction!(analysis::claims_json, module)?)?;
+    module.add_function(wrap_pyfunction!(decide::recommend_json, module)?)?;
+    module.add_function(wrap_pyfunction!(decide::cost_json, module)?)?;
+    module.add_function(wrap_pyfunction!(decide::report, module)?)?;
     module.add_function(wrap_pyfunction!(render::render, module)?)?;
     module.add_function(wrap_pyfunction!(render::default_scene, module)?)?;
     module.add_function(wrap_pyfunction!(volume::render_volume, module)?)?;

@@ -5,7 +5,9 @@
 use std::sync::OnceLock;
 
 use glam::DVec3;
-use numpy::{IntoPyArray, PyReadwriteArrayDyn, PyUntypedArrayMethods};
+use numpy::{
+    Element, IntoPyArray, PyArrayDyn, PyArrayMethods, PyReadwriteArrayDyn, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use specula::analysis::{
@@ -15,7 +17,8 @@ use specula::sampling::SpecularSampler;
 use specula::{Brdf, Exponent, Geometry, LobeKind, Normalisation};
 
 use crate::arrays::{
-    contiguous, first_non_finite, float64_rows, floats, map_chunks, non_finite, shaped, Floats,
+    contiguous, first_non_finite, float64_rows, floats, map_chunks, non_finite, shaped, tuple,
+    Finite, Floats,
 };
 use crate::errors::{guarded, value_error};
 
@@ -132,8 +135,9 @@ fn outgoing(wo: &Bound<'_, PyAny>, leading: &[usize]) -> PyResult<Outgoing> {
     }
     if &view.shape()[..view.ndim() - 1] != leading {
         return Err(value_error(format!(
-            "wo has shape {:?}; it must be (3,) or match the other array's leading shape {leading:?} with 3 last",
-            view.shape()
+            "wo has shape {}; it must be (3,) or the other array's leading shape {} with 3 last",
+            tuple(view.shape()),
+            tuple(leading)
         )));
     }
     Ok(Outgoing::Each(rows))
@@ -463,20 +467,21 @@ fn evaluate_into<'py, T>(
     kernel: &(dyn Fn(&[T], &mut [T]) + Sync),
 ) -> PyResult<Py<PyAny>>
 where
-    T: numpy::Element + Copy + Default + Send + Sync + Into<f64>,
+    T: Element + Finite,
 {
     match out {
         Some(out) => {
             let mut written = out.extract::<PyReadwriteArrayDyn<'py, T>>().map_err(|_| {
                 value_error(format!(
-                    "out must be a writable {dtype} array of t's shape {shape:?} \
-                     (and not t itself)"
+                    "out must be a writable {dtype} array of t's shape {} (and not t itself)",
+                    tuple(shape)
                 ))
             })?;
             if written.shape() != shape {
                 return Err(value_error(format!(
-                    "out has shape {:?}; it must be t's, {shape:?}",
-                    written.shape()
+                    "out has shape {}; it must be t's, {}",
+                    tuple(written.shape()),
+                    tuple(shape)
                 )));
             }
             let slice = written.as_slice_mut().map_err(|_| {
@@ -489,10 +494,23 @@ where
             Ok(out.clone().unbind())
         }
         None => {
-            let mut values = vec![T::default(); input.len()];
-            py.detach(|| map_chunks(input, &mut values, kernel))
-                .map_err(|index| non_finite("t", index))?;
-            Ok(shaped(shape, values)?.into_pyarray(py).into_any().unbind())
+            // Allocated by `numpy.empty`, as NumPy allocates its own results (with its
+            // huge-page advice for large arrays; measured: 3.5x faster than a zeroed
+            // allocation from here at 10 M), then written in place with the GIL released.
+            let array = py
+                .import("numpy")?
+                .getattr("empty")?
+                .call1((shape.to_vec(), T::get_dtype(py)))?
+                .cast_into::<PyArrayDyn<T>>()?;
+            {
+                let mut written = array.readwrite();
+                let slice = written
+                    .as_slice_mut()
+                    .map_err(|e| value_error(e.to_string()))?;
+                py.detach(|| map_chunks(input, slice, kernel))
+                    .map_err(|index| non_finite("t", index))?;
+            }
+            Ok(array.into_any().unbind())
         }
     }
 }

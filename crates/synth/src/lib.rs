@@ -323,7 +323,7 @@ fn place_and_route(
         return Ok(());
     }
     let frequency = TARGET_MHZ.to_string();
-    tools::run(
+    let placed = tools::run(
         Tool::Nextpnr,
         &[
             &format!("--{}", device.id()),
@@ -342,7 +342,20 @@ fn place_and_route(
         ],
         design,
         Some(scratch),
-    )?;
+    );
+    // Yosys's count is below the part's, but packing (carry chains, flip-flops that cannot
+    // share a cell) needs more cells than the part has: it does not fit either.
+    if let Err(SynthError::ToolFailed { log, .. }) = &placed {
+        if log.contains("Failed to expand region") {
+            result.fmax_note = Some(format!(
+                "does not fit the {} once packed: {} LUTs by Yosys's count, more logic cells than its {cells_available} after packing",
+                device.id().to_uppercase(),
+                result.cells.logic
+            ));
+            return Ok(());
+        }
+    }
+    placed?;
     let placed = scratch.join(PLACED);
     let placed_report = report::placed(&read(&placed, Tool::Nextpnr, design)?)
         .map_err(|problem| report_error(Tool::Nextpnr, design, problem))?;

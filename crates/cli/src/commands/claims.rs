@@ -36,12 +36,12 @@ pub fn hardware_claim(
     on_miss: OnMiss,
     on_each: &(dyn Fn() + Sync),
 ) -> Result<HardwareClaim, String> {
-    let sweeps = super::hw::sweeps(
+    let sweeps = specula_decide::sweeps(
         &HwLobe::ALL,
         CLAIM_N,
         (*BITS.start(), *BITS.end()),
         samples_per_zone,
-        false,
+        &ProgressBar::hidden(),
     )?;
     claim::evaluate(
         &sweeps,

@@ -4,9 +4,10 @@
 use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use rayon::prelude::*;
-use specula_hw::analysis::{sweep, WidthSweep, MEETS_TOLERANCE};
-use specula_hw::{diagram, integer_exponent, verilog, HwLobe, Resources, BITS};
+use specula_decide::sweeps;
+use specula_hw::analysis::MEETS_TOLERANCE;
+use specula_hw::{diagram, integer_exponent, verilog, HwLobe, BITS};
+use specula_report::format::resource_cells;
 
 use super::{print_json, synth, CommandResult};
 use crate::args::Format;
@@ -209,66 +210,17 @@ fn write_verilog(args: &VerilogArgs) -> CommandResult {
     )
 }
 
-/// The resources, a cell each: multipliers, squarers, adders, dividers, shifters (their
-/// widths), ROM bits, register bits, latency.
-pub fn resource_cells(r: &Resources) -> [String; 8] {
-    let list = |items: Vec<String>| {
-        if items.is_empty() {
-            "-".to_owned()
-        } else {
-            items.join(" ")
-        }
-    };
-    [
-        list(
-            r.multipliers
-                .iter()
-                .map(|(a, b)| format!("{a}x{b}"))
-                .collect(),
-        ),
-        list(r.squarers.iter().map(u32::to_string).collect()),
-        list(r.adders.iter().map(u32::to_string).collect()),
-        list(r.dividers.iter().map(|(a, b)| format!("{a}/{b}")).collect()),
-        list(r.shifters.iter().map(u32::to_string).collect()),
-        r.rom_bits.to_string(),
-        r.register_bits.to_string(),
-        r.latency.to_string(),
-    ]
-}
-
-/// Sweeps every chosen datapath in parallel; with `show_progress`, a bar counts the widths.
-pub fn sweeps(
-    lobes: &[HwLobe],
-    n: u32,
-    (low, high): (u32, u32),
-    samples: usize,
-    show_progress: bool,
-) -> Result<Vec<WidthSweep>, String> {
-    let total = (lobes.len() as u32 * (high - low + 1)).into();
-    let progress = if show_progress {
-        ProgressBar::new(total).with_style(
-            ProgressStyle::with_template("datapaths {bar:30} {pos}/{len} widths {elapsed}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        )
-    } else {
-        ProgressBar::hidden()
-    };
-    let result = lobes
-        .par_iter()
-        .map(|&lobe| sweep(lobe, n, low..=high, samples, &mut |_| progress.inc(1)))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| e.to_string());
-    progress.finish_and_clear();
-    result
-}
-
 fn table(args: &TableArgs) -> CommandResult {
     let lobes = if args.lobe.is_empty() {
         HwLobe::ALL.to_vec()
     } else {
         args.lobe.clone()
     };
-    let results = sweeps(&lobes, args.n, args.bits, args.samples as usize, true)?;
+    let progress = ProgressBar::new(0).with_style(
+        ProgressStyle::with_template("datapaths {bar:30} {pos}/{len} widths {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let results = sweeps(&lobes, args.n, args.bits, args.samples as usize, &progress)?;
     if args.format == Format::Json {
         return print_json(&results);
     }

@@ -6,7 +6,6 @@ pub mod claims;
 pub mod diff;
 pub mod eval;
 pub mod fit;
-pub mod fpga_estimate;
 pub mod hw;
 pub mod lobe;
 pub mod models;
@@ -18,7 +17,6 @@ pub mod serve;
 pub mod shader;
 pub mod synth;
 pub mod volume;
-pub mod vtk_peer;
 
 /// What a command reports when it fails: a one-line message.
 pub type CommandResult = Result<(), String>;

@@ -9,10 +9,10 @@ use specula_render::volume::march::PreparedVolume;
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::vtk;
 use specula_render::{write_image, Display};
+use specula_report::vtk_peer;
 
 use super::Args;
 use crate::commands::volume::{load, Source};
-use crate::commands::vtk_peer;
 use crate::commands::CommandResult;
 use crate::output::Table;
 

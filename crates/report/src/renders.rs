@@ -12,7 +12,7 @@ use specula_render::{
 
 use super::html::{paragraph, table};
 use super::Context;
-use crate::output::sig;
+use crate::format::sig;
 
 fn scene(context: &Context, overrides: Overrides) -> Scene {
     let (width, height, samples) = context.sizes.render;

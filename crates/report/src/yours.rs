@@ -8,7 +8,7 @@ use specula::{Exponent, Lobe, LobeKind};
 
 use super::html::{paragraph, table};
 use super::Context;
-use crate::output::{percent, sig};
+use crate::format::{percent, sig};
 
 /// The exponents the rows are measured at.
 const EXPONENTS: [f64; 3] = [8.0, 64.0, 512.0];

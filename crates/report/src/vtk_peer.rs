@@ -13,8 +13,10 @@ use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::{self, nifti, vtk, Volume};
 use specula_render::Image;
 
-/// The VTK side of a comparison: `vtk_volume.py`, run by the Python that has VTK.
-const VTK_SCRIPT: &str = include_str!("bench/vtk_volume.py");
+/// The VTK side of a comparison: `vtk_volume.py`, run by the Python that has VTK. The script
+/// lives beside the command line's `bench volume` (whose tests run it directly) and is
+/// compiled in, so it is found from any working directory.
+const VTK_SCRIPT: &str = include_str!("../../cli/src/commands/bench/vtk_volume.py");
 
 /// Renders several jobs in one Python process started ahead of them (VTK imported while the
 /// caller prepares the jobs): the script's own `read_job` and `render` on each job file whose

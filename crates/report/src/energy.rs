@@ -10,7 +10,7 @@ use super::html::{paragraph, table};
 use super::plot::{Chart, Series, SEQUENCE};
 use super::sections::{exponents, series};
 use super::Context;
-use crate::output::sig;
+use crate::format::sig;
 
 pub fn energy(context: &mut Context) -> Result<String, String> {
     let grid = exponents(context.sizes.n_steps);

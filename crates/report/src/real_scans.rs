@@ -18,7 +18,7 @@ use specula_render::{read_image, srgb_encode, Display, Image};
 use super::html::{paragraph, table};
 use super::volumes::{shading, EXPONENT};
 use super::{Context, RealScanSizes};
-use crate::commands::vtk_peer;
+use crate::vtk_peer;
 
 /// A real scan a Debian package installs.
 struct Scan {

@@ -1,6 +1,8 @@
 //! The report's hardware section: each datapath's error against word length beside its float
 //! model, the smallest width that matches it, the resources there, and the block diagrams.
 
+use std::sync::Arc;
+
 use specula_hw::analysis::MEETS_TOLERANCE;
 use specula_hw::{diagram, HwLobe, Resources, BITS};
 
@@ -12,9 +14,9 @@ use specula_hw::analysis::WidthSweep;
 use specula_synth::cache::Cache;
 use specula_synth::claim::{self, CLAIM_N};
 
-use crate::commands::fpga_estimate::logic_cells;
-use crate::commands::hw::resource_cells;
-use crate::output::{percent, sig};
+use specula_decide::fpga_estimate::logic_cells;
+
+use crate::format::{percent, resource_cells, sig};
 
 /// The word length the diagrams show.
 const DIAGRAM_BITS: u32 = 16;
@@ -27,7 +29,7 @@ fn arithmetic(r: &Resources) -> String {
 
 /// Claim 8 by synthesis: every datapath at equal error, through Yosys and nextpnr (cached),
 /// or, without the tools or a cached result, the formula estimate, labelled as such.
-fn synthesized(context: &Context, all: &[(u32, Vec<WidthSweep>)]) -> Result<String, String> {
+fn synthesized(context: &Context, all: &[(u32, Arc<Vec<WidthSweep>>)]) -> Result<String, String> {
     let sweeps = all
         .iter()
         .find(|(n, _)| *n == CLAIM_N)
@@ -66,7 +68,7 @@ fn synthesized(context: &Context, all: &[(u32, Vec<WidthSweep>)]) -> Result<Stri
         let (target, designs) = claim::designs(sweeps);
         html += &paragraph(&format!(
             "Not measured: {why}. In its place, a fallback that is not a synthesis: the formula \
-             estimate of LUT4 logic cells (commands/fpga_estimate.rs) for each datapath at the \
+             estimate of LUT4 logic cells (crates/decide/src/fpga_estimate.rs) for each datapath at the \
              smallest width reaching {} epicentre error at n = {CLAIM_N}.",
             percent(target)
         ));
@@ -137,7 +139,7 @@ fn synthesized(context: &Context, all: &[(u32, Vec<WidthSweep>)]) -> Result<Stri
 }
 
 pub fn hardware(context: &mut Context) -> Result<String, String> {
-    let all = context.hardware_sweeps()?.to_vec();
+    let all = context.hardware_sweeps()?;
     let mut html = paragraph(&format!(
         "Each approximation as a bit-accurate fixed-point datapath (SPEC section 8; crates/hw). \
          W is the word length of signals in [0, 1] (UQ1.(W-1)); wider signals keep the same \
@@ -182,7 +184,7 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
             &chart,
             &format!("every datapath's epicentre error against its word length, n = {n}: where each curve flattens, extra bits stop paying; the floor is the float model's own error"),
         )?;
-        for result in results {
+        for result in results.iter() {
             let width = result.minimum_width();
             let at = width.and_then(|w| result.rows.iter().find(|row| row.bits == w));
             rows.push(vec![

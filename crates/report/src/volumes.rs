@@ -18,13 +18,13 @@ use specula_render::{Display, Image};
 
 use super::html::{paragraph, table};
 use super::Context;
-use crate::output::sig;
+use crate::format::sig;
 
 /// The exponent of every lobe in the section (VTK's specular power in the comparison).
-pub(super) const EXPONENT: f64 = 32.0;
+pub(crate) const EXPONENT: f64 = 32.0;
 
 /// The section's shading with `kind` as the specular term.
-pub(super) fn shading(kind: LobeKind) -> Result<Shading, String> {
+pub(crate) fn shading(kind: LobeKind) -> Result<Shading, String> {
     let n = Exponent::try_new(EXPONENT).map_err(|e| e.to_string())?;
     Ok(Shading::new(
         Lobe::new(kind, n),
@@ -55,7 +55,6 @@ pub fn volumes(context: &mut Context) -> Result<String, String> {
         sizes: context.sizes.clone(),
         bench: context.bench,
         files: Vec::new(),
-        shared: std::sync::Arc::clone(&context.shared),
         lobes: context.lobes.clone(),
         materials: context.materials.clone(),
     };

@@ -1,12 +1,16 @@
-//! `specula report`: one page that answers, for each lobe, what it costs, how wrong it is
+//! specula's report: one page that answers, for each lobe, what it costs, how wrong it is
 //! where, what it does to energy, and whether the thesis's claims hold; every number computed
-//! during the run.
+//! during the run. A product of its own, which the command line (`specula report`) and the
+//! Python bindings both write ([`write_report`]); its answers ("Which lobe when", the real
+//! materials' verdicts) come from `specula-decide`, so they are the ones `specula recommend`
+//! and `specula fit` give.
 //!
 //! The page (`index.html`) and its images (SVG plots, PNG renders) go to one folder. Each file
 //! is written atomically, and the page last, so an interrupted run never leaves a page that
 //! points at missing images.
 
 mod energy;
+pub mod format;
 mod hardware;
 mod html;
 mod materials;
@@ -17,46 +21,69 @@ mod renders;
 mod sections;
 mod verdict;
 mod volumes;
+pub mod vtk_peer;
 mod yours;
 
 use std::path::PathBuf;
-use std::sync::{Arc, OnceLock};
-use std::time::Instant;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use specula::claims::ClaimOptions;
 use specula::{Exponent, LobeKind};
 use specula_hw::analysis::WidthSweep;
-use specula_hw::{HwLobe, BITS};
 use specula_render::{write_atomically, write_png_srgb8, Display, Image, Scene};
 
-use super::CommandResult;
-
-/// Arguments of `specula report`.
-#[derive(Debug, clap::Args)]
-pub struct Args {
-    /// The folder to write `index.html` and its images to.
-    #[arg(long, default_value = "report")]
-    out: PathBuf,
-    /// Reduced sizes: fewer exponents and samples, smaller renders (under 20 s on 2 cores).
-    #[arg(long)]
-    quick: bool,
-    /// Also measure each lobe's throughput and plot error against speed.
-    #[arg(long)]
-    bench: bool,
-    /// Add your own lobes to every section (`@FILE.toml`, `=FORMULA`; comma separated).
-    #[arg(long, value_parser = crate::args::LobeListParser)]
-    lobe: Vec<crate::args::LobeList>,
+/// What to write.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Options {
+    /// The folder to write `index.html` and its images to (made if missing).
+    pub out: PathBuf,
+    /// Reduced sizes: fewer exponents and samples, smaller renders.
+    pub quick: bool,
+    /// Also measure each lobe's throughput and plot error against speed (alone, after the
+    /// other sections).
+    pub bench: bool,
+    /// Your lobes, added to every section after the built-in ones (which every section
+    /// shows anyway: listing one here adds nothing; a built-in with other parameters,
+    /// `cosquad:v=5`, is one of yours).
+    pub lobes: Vec<LobeKind>,
     /// Also fit every lobe to the measured materials in this folder (RGL isotropic RGB
-    /// `.bsdf` files, the first 16 by name) and compare them in polar plots and renders.
-    #[arg(long, value_name = "DIR")]
-    materials: Option<PathBuf>,
+    /// `.bsdf` files, the first 16 by name).
+    pub materials: Option<PathBuf>,
+}
+
+impl Options {
+    /// A full report in `out` on the built-in lobes, without the benchmark or materials.
+    #[must_use]
+    pub fn new(out: impl Into<PathBuf>) -> Self {
+        Self {
+            out: out.into(),
+            quick: false,
+            bench: false,
+            lobes: Vec::new(),
+            materials: None,
+        }
+    }
+}
+
+/// What a written report holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Summary {
+    /// The page.
+    pub page: PathBuf,
+    /// The images beside it.
+    pub images: usize,
+    /// How long it took.
+    pub took: Duration,
+    /// The time each section took, in words (they overlap: sections run concurrently).
+    pub timings: String,
 }
 
 /// How much each section computes.
 #[derive(Clone, Debug)]
-pub struct Sizes {
+pub(crate) struct Sizes {
     /// Log steps of `n` from 1 to 1000 in the plots against `n`.
     pub n_steps: usize,
     /// Samples per zone of the error figures.
@@ -85,7 +112,7 @@ pub struct Sizes {
 
 /// How much the medical section does with the real scans.
 #[derive(Clone, Copy, Debug)]
-pub struct RealScanSizes {
+pub(crate) struct RealScanSizes {
     /// Image side in pixels.
     pub side: u32,
     /// Frames timed against VTK.
@@ -97,12 +124,11 @@ pub struct RealScanSizes {
 }
 
 /// What a section works with: where files go, how much to compute, and what it wrote.
-pub struct Context {
+pub(crate) struct Context {
     directory: PathBuf,
     sizes: Sizes,
     bench: bool,
     files: Vec<String>,
-    shared: Arc<Shared>,
     /// Every lobe the sections show: the built-in ones, then the user's.
     lobes: Vec<LobeKind>,
     /// The folder of measured materials (`--materials`).
@@ -110,40 +136,18 @@ pub struct Context {
 }
 
 /// Every datapath's sweeps over word lengths, per hardware exponent.
-type HardwareSweeps = Vec<(u32, Vec<WidthSweep>)>;
-
-/// Work more than one section needs, done once by whichever asks first (the others wait).
-#[derive(Default)]
-pub struct Shared {
-    /// Every datapath's sweep over word lengths at each of the hardware exponents.
-    hardware: OnceLock<Result<HardwareSweeps, String>>,
-}
+type HardwareSweeps = Vec<(u32, Arc<Vec<WidthSweep>>)>;
 
 impl Context {
-    /// The hardware sweeps (the hardware section's, which the verdict's FPGA rows reuse).
-    fn hardware_sweeps(&self) -> Result<&[(u32, Vec<WidthSweep>)], String> {
-        let samples = self.sizes.samples_per_zone.min(20_001);
-        let exponents = self.sizes.hardware_exponents;
-        self.shared
-            .hardware
-            .get_or_init(|| {
-                exponents
-                    .iter()
-                    .map(|&n| {
-                        let sweeps = crate::commands::hw::sweeps(
-                            &HwLobe::ALL,
-                            n,
-                            (*BITS.start(), *BITS.end()),
-                            samples,
-                            false,
-                        )?;
-                        Ok((n, sweeps))
-                    })
-                    .collect()
-            })
-            .as_ref()
-            .map(Vec::as_slice)
-            .map_err(Clone::clone)
+    /// The hardware sweeps at the hardware exponents, which the hardware section shows and
+    /// the verdict's FPGA rows choose from: `specula_decide`'s, computed once per exponent in
+    /// a process, so both read the sweeps `specula recommend --target fpga` reads.
+    fn hardware_sweeps(&self) -> Result<HardwareSweeps, String> {
+        self.sizes
+            .hardware_exponents
+            .iter()
+            .map(|&n| Ok((n, specula_decide::hardware_sweeps(n)?)))
+            .collect()
     }
 }
 
@@ -233,27 +237,24 @@ const SECTIONS: [Section; 13] = [
     (HARDWARE, hardware::hardware),
 ];
 
-/// Writes the report.
+/// Writes the report: what `specula report` does, progress bar included.
 ///
 /// The sections are independent, so they run concurrently, each writing its own files; the
-/// cost section's throughput measurement (`--bench`) runs alone afterwards, on a quiet machine.
-pub fn run(args: &Args) -> CommandResult {
+/// cost section's throughput measurement (`bench`) runs alone afterwards, on a quiet machine.
+/// Refuses, before any section runs, a user's lobe that is not a lobe at an exponent a
+/// section uses and a materials folder without readable materials.
+pub fn write_report(options: &Options) -> Result<Summary, String> {
     let started = Instant::now();
-    std::fs::create_dir_all(&args.out).map_err(|e| {
+    std::fs::create_dir_all(&options.out).map_err(|e| {
         format!(
             "{}: cannot create the report folder: {e}",
-            args.out.display()
+            options.out.display()
         )
     })?;
-    let yours = crate::args::flatten(&args.lobe);
-    let mut lobes = LobeKind::ALL.to_vec();
-    for &kind in &yours {
-        if !lobes.contains(&kind) {
-            lobes.push(kind);
-        }
-    }
+    let lobes = specula_decide::candidates(&options.lobes);
+    let yours = lobes[LobeKind::ALL.len()..].to_vec();
     // Every exponent a section uses lies on the plots' grid or among these.
-    let sizes = sections::sizes(args.quick);
+    let sizes = sections::sizes(options.quick);
     let mut checked = sections::exponents(sizes.n_steps);
     checked.extend([8.0, 64.0, 100.0, 512.0].map(Exponent::new));
     checked.extend(
@@ -262,19 +263,17 @@ pub fn run(args: &Args) -> CommandResult {
             .iter()
             .map(|&n| Exponent::new(f64::from(n))),
     );
-    crate::args::check_lobes(&yours, &checked)?;
-    if let Some(directory) = &args.materials {
+    specula_decide::check_lobes(&yours, &checked)?;
+    if let Some(directory) = &options.materials {
         materials::check(directory, &yours)?;
     }
-    let shared = Arc::new(Shared::default());
     let context = || Context {
         lobes: lobes.clone(),
-        directory: args.out.clone(),
-        sizes: sections::sizes(args.quick),
-        bench: args.bench,
+        directory: options.out.clone(),
+        sizes: sections::sizes(options.quick),
+        bench: options.bench,
         files: Vec::new(),
-        shared: Arc::clone(&shared),
-        materials: args.materials.clone(),
+        materials: options.materials.clone(),
     };
     let bar = ProgressBar::new(SECTIONS.len() as u64).with_style(
         ProgressStyle::with_template("report {bar:30} {pos}/{len} sections {elapsed}")
@@ -287,7 +286,7 @@ pub fn run(args: &Args) -> CommandResult {
         bar.inc(1);
         body.map(|body| (heading, body, begun.elapsed(), own.files))
     };
-    let alone = |(heading, _): &&Section| args.bench && *heading == sections::COST;
+    let alone = |(heading, _): &&Section| options.bench && *heading == sections::COST;
     // The hardware sweeps run beside the sections that do not need them (waiting for them
     // inside a section would hold one of the two worker threads idle); then the two that do.
     let needs_sweeps = |(heading, _): &&Section| HARDWARE_SECTIONS.contains(heading);
@@ -331,19 +330,22 @@ pub fn run(args: &Args) -> CommandResult {
         sweeps_took.as_secs_f64()
     ));
     let timings = format!("sections concurrently: {}", timings.join(", "));
-    let page = html::page("specula report", &bodies, &footer(args, started, &timings));
+    let page = html::page(
+        "specula report",
+        &bodies,
+        &footer(options, started, &timings),
+    );
     let mut page_context = context();
     page_context.write("index.html", page.as_bytes())?;
-    eprintln!(
-        "wrote {} and {} images ({:.1} s; {timings})",
-        args.out.join("index.html").display(),
-        files.len(),
-        started.elapsed().as_secs_f64()
-    );
-    Ok(())
+    Ok(Summary {
+        page: options.out.join("index.html"),
+        images: files.len(),
+        took: started.elapsed(),
+        timings,
+    })
 }
 
-fn footer(args: &Args, started: Instant, timings: &str) -> String {
+fn footer(options: &Options, started: Instant, timings: &str) -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|info| {
@@ -360,7 +362,7 @@ fn footer(args: &Args, started: Instant, timings: &str) -> String {
         env!("CARGO_PKG_VERSION"),
         std::env::consts::OS,
         std::env::consts::ARCH,
-        if args.quick { "quick" } else { "full" },
+        if options.quick { "quick" } else { "full" },
         started.elapsed().as_secs_f64(),
         command.join(" ")
     ))

@@ -11,25 +11,25 @@ use specula_synth::OnMiss;
 use super::html::{escape, paragraph, table};
 use super::plot::{Chart, Series, SEQUENCE};
 use super::{Context, RealScanSizes, Sizes};
-use crate::output::sig;
+use crate::format::sig;
 
 /// Chooses one figure.
 type Pick = fn(&ErrorFigures) -> f64;
 
 /// Exponents from 1 to 1000, log-spaced, `steps + 1` of them.
-pub(super) fn exponents(steps: usize) -> Vec<Exponent> {
+pub(crate) fn exponents(steps: usize) -> Vec<Exponent> {
     (0..=steps)
         .map(|k| Exponent::new(1000f64.powf(k as f64 / steps as f64).clamp(1.0, 1000.0)))
         .collect()
 }
 
 /// The lobe's colour, the same in every plot and in the explorer (`LobeKind::line_style`).
-pub(super) fn colour(kind: LobeKind) -> plotters::style::RGBColor {
+pub(crate) fn colour(kind: LobeKind) -> plotters::style::RGBColor {
     let [r, g, b] = kind.line_style().rgb;
     plotters::style::RGBColor(r, g, b)
 }
 
-pub(super) fn series(kind: LobeKind, points: Vec<(f64, f64)>) -> Series {
+pub(crate) fn series(kind: LobeKind, points: Vec<(f64, f64)>) -> Series {
     Series {
         name: kind.to_string(),
         points,
@@ -343,9 +343,9 @@ pub const COST: &str = "Cost";
 
 pub fn cost(context: &mut Context) -> Result<String, String> {
     let n = Exponent::new(64.0);
-    let measured = context.bench.then(|| {
-        crate::commands::bench::lobes::measure(n, false, &indicatif::ProgressBar::hidden())
-    });
+    let measured = context
+        .bench
+        .then(|| specula_decide::rates::measure(n, false, &indicatif::ProgressBar::hidden()));
     let mut rows = Vec::new();
     let mut points = Vec::new();
     for (k, kind) in context.lobes.clone().into_iter().enumerate() {

@@ -1,7 +1,7 @@
-//! An FPGA cost estimate from a datapath's operators, the fallback where Yosys is missing and
-//! the quick figure where synthesizing every width would take minutes (the report's "Which
-//! lobe when" rows): logic cells of a LUT4 fabric without DSP blocks (an iCE40-class part, where each cell is
-//! one 4-input LUT, one flip-flop and a carry link). Per operator, the textbook mapping:
+//! An FPGA cost estimate from a datapath's operators: how [`crate::cheapest_datapath`] picks
+//! among a lobe's datapaths before one is synthesized, and the cost itself where Yosys is
+//! missing. Logic cells of a LUT4 fabric without DSP blocks (an iCE40-class part, where each
+//! cell is one 4-input LUT, one flip-flop and a carry link). Per operator, the textbook mapping:
 //! a `b`-bit adder or comparator takes `b` cells (one per bit on the carry chain); an `a x b`
 //! array multiplier `a b` cells (a partial-product AND and a full adder per bit); a `b`-bit
 //! squarer half that (the product's symmetric half); an `a / b` divider `a b` cells (`a`

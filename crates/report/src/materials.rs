@@ -17,11 +17,11 @@ use super::html::{escape, figure, paragraph, table};
 use super::plot::{Polar, PolarCurve, PolarPanel, DASHED, DASH_DOT};
 use super::sections::colour;
 use super::Context;
-use crate::commands::fit::{
+use specula_decide::material::{
     assess, lobes_to_fit, luminance, parameter_text, verdict_line, Assessment, FitRow,
     DEFAULT_MARGIN,
 };
-use crate::commands::recommend::Target;
+use specula_decide::Target;
 
 /// The most materials one report shows (the first, by file name).
 pub const MAX_MATERIALS: usize = 16;
@@ -45,7 +45,7 @@ const HOW_TO: &str = "Not computed: run specula report --materials DIR, with DIR
 
 /// The `.bsdf` files in `directory` sorted by name, at most [`MAX_MATERIALS`], and how many
 /// more there were.
-pub(super) fn material_files(directory: &Path) -> Result<(Vec<PathBuf>, usize), String> {
+pub(crate) fn material_files(directory: &Path) -> Result<(Vec<PathBuf>, usize), String> {
     let refuse = |e: std::io::Error| {
         format!(
             "{}: cannot read the materials folder: {e}",
@@ -73,7 +73,7 @@ pub(super) fn material_files(directory: &Path) -> Result<(Vec<PathBuf>, usize), 
 
 /// Refuses a bad `--materials` before any section runs: every file shown must read as a
 /// material, and the user's lobes must hold over the fits' range of `n`.
-pub(super) fn check(directory: &Path, yours: &[LobeKind]) -> Result<(), String> {
+pub(crate) fn check(directory: &Path, yours: &[LobeKind]) -> Result<(), String> {
     let (files, _) = material_files(directory)?;
     for file in &files {
         load_measured(file)?;
@@ -128,16 +128,11 @@ pub fn materials(context: &mut Context) -> Result<String, String> {
         } else {
             String::new()
         },
-        target_name(),
+        TARGET,
         100.0 * MARGIN,
     ));
     html += &shown;
     Ok(html)
-}
-
-fn target_name() -> String {
-    clap::ValueEnum::to_possible_value(&TARGET)
-        .map_or_else(String::new, |v| v.get_name().to_owned())
 }
 
 /// The shape parameter's name: `n` for a lobe, `alpha` for GGX.
@@ -195,7 +190,7 @@ fn material(
         triple(a.measured_albedo_at_normal),
         luminance(a.measured_albedo_at_normal),
         a.pairs,
-        target_name(),
+        TARGET,
         verdict_line(a),
     ));
     html += &fits_table(a, &shown);

@@ -1,0 +1,45 @@
+//! `specula report`: the report (`specula_report`), written where `--out` says.
+
+use std::path::PathBuf;
+
+use super::CommandResult;
+
+/// Arguments of `specula report`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The folder to write `index.html` and its images to.
+    #[arg(long, default_value = "report")]
+    out: PathBuf,
+    /// Reduced sizes: fewer exponents and samples, smaller renders (under 20 s on 2 cores).
+    #[arg(long)]
+    quick: bool,
+    /// Also measure each lobe's throughput and plot error against speed.
+    #[arg(long)]
+    bench: bool,
+    /// Add your own lobes to every section (`@FILE.toml`, `=FORMULA`; comma separated).
+    #[arg(long, value_parser = crate::args::LobeListParser)]
+    lobe: Vec<crate::args::LobeList>,
+    /// Also fit every lobe to the measured materials in this folder (RGL isotropic RGB
+    /// `.bsdf` files, the first 16 by name) and compare them in polar plots and renders.
+    #[arg(long, value_name = "DIR")]
+    materials: Option<PathBuf>,
+}
+
+/// Writes the report and says where.
+pub fn run(args: &Args) -> CommandResult {
+    let summary = specula_report::write_report(&specula_report::Options {
+        out: args.out.clone(),
+        quick: args.quick,
+        bench: args.bench,
+        lobes: crate::args::flatten(&args.lobe),
+        materials: args.materials.clone(),
+    })?;
+    eprintln!(
+        "wrote {} and {} images ({:.1} s; {})",
+        summary.page.display(),
+        summary.images,
+        summary.took.as_secs_f64(),
+        summary.timings
+    );
+    Ok(())
+}

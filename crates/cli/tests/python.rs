@@ -1,0 +1,91 @@
+//! The Python package (`crates/python`) as a user installs it: `pip install
+//! --no-build-isolation ./crates/python` into `target/venv` with no package index (offline),
+//! then its pytest suite on the installed wheel, which compares the package with this
+//! build's `specula` binary.
+//!
+//! The wheel is built in a target folder of its own (`target/python-wheel`): `cargo test`
+//! holds the workspace's, and a build inside it would wait forever for its lock.
+
+use std::path::Path;
+use std::process::Command;
+
+mod common;
+
+use common::{have_python_module, python};
+
+fn root() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// Runs `command`, requiring success, and prints what it printed.
+fn run(what: &str, command: &mut Command) {
+    let output = command.output().unwrap_or_else(|e| panic!("{what}: {e}"));
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    println!("{text}");
+    assert!(output.status.success(), "{what} failed:\n{text}");
+}
+
+#[test]
+fn the_package_installs_offline_and_its_tests_pass() {
+    for (module, package) in [
+        ("maturin", "maturin"),
+        ("pytest", "pytest"),
+        ("scipy", "scipy"),
+        ("nbclient", "nbclient"),
+        ("nibabel", "nibabel"),
+    ] {
+        if !have_python_module(module, package) {
+            return;
+        }
+    }
+    let root = root();
+    let venv_bin = python()
+        .parent()
+        .expect("the Python is in a folder")
+        .to_path_buf();
+    let path = std::env::join_paths(std::iter::once(venv_bin).chain(std::env::split_paths(
+        &std::env::var_os("PATH").unwrap_or_default(),
+    )))
+    .expect("PATH joins");
+    // The crates the wheel builds from, into cargo's cache (a no-op once the workspace has
+    // built), so that the build itself runs offline.
+    run(
+        "cargo fetch",
+        Command::new(env!("CARGO"))
+            .current_dir(&root)
+            .args(["fetch", "--locked"]),
+    );
+    run(
+        "pip install ./crates/python",
+        Command::new(python())
+            .current_dir(&root)
+            .args([
+                "-m",
+                "pip",
+                "install",
+                "--no-index",
+                "--no-build-isolation",
+                "--no-deps",
+                "--force-reinstall",
+                "--quiet",
+                "./crates/python",
+            ])
+            .env("PATH", &path)
+            .env("CARGO_TARGET_DIR", root.join("target/python-wheel"))
+            .env("CARGO_NET_OFFLINE", "true"),
+    );
+    let scratch = tempfile::tempdir().expect("scratch folder");
+    run(
+        "pytest crates/python/tests",
+        Command::new(python())
+            .current_dir(scratch.path())
+            .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+            .arg(root.join("crates/python/tests"))
+            .env("PATH", &path)
+            .env("SPECULA_BIN", env!("CARGO_BIN_EXE_specula")),
+    );
+}

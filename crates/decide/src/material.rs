@@ -1,0 +1,293 @@
+//! A measured material's verdict: every lobe (and GGX) fitted to it (`specula::measured::fit`),
+//! each shared-`n` lobe's rate on a target at its fitted `n` ([`crate::lobe_rate`]), and the
+//! cheapest lobe whose fit is within a margin of pow's (the core's verdict), with the figures a
+//! renderer needs. What `specula fit`, `recommend --material`, the report's real materials and
+//! the JSON lines share.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::Serialize;
+use specula::measured::fit::verdict::{verdict, Verdict};
+use specula::measured::fit::{
+    fit_all, Fit, Observations, Sharing, Specular, MAX_ELEVATION_DEGREES,
+};
+use specula::{Exponent, Lobe, LobeKind, Normalisation};
+use specula_render::measured::{material_name, MeasuredBrdf};
+
+use crate::{lobe_rate, log_spaced, rate_unit, Target, FPGA_MATERIAL_REFUSAL};
+
+/// The fit error allowed over pow's by default: 5 %.
+pub const DEFAULT_MARGIN: f64 = 0.05;
+
+/// A fit as shown: the library's figures and what they mean for a renderer.
+#[derive(Clone, Debug, Serialize)]
+pub struct FitRow {
+    /// The fit.
+    #[serde(flatten)]
+    pub fit: Fit,
+    /// `ks` per channel under each normalisation (lobes only).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub ks: BTreeMap<&'static str, [f64; 3]>,
+    /// The fitted model's albedo at normal incidence, per channel.
+    pub albedo_at_normal: [f64; 3],
+    /// A channel's `n` (or `alpha`) at an end of the range searched.
+    pub at_range_end: bool,
+    /// `E / E_pow` in the same geometry and sharing.
+    pub relative_to_pow: f64,
+    /// `E / E_ggx` with the same sharing.
+    pub relative_to_ggx: f64,
+    /// The rate on the target at the fitted `n` (shared-`n` lobes only; higher is cheaper).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rate: Option<f64>,
+    /// Within the margin of pow's best fit (shared-`n` lobes only).
+    pub meets: bool,
+}
+
+/// One material's assessment: its fits and the verdict on a target.
+#[derive(Clone, Debug, Serialize)]
+pub struct Assessment {
+    /// The file's stem.
+    pub material: String,
+    /// The file.
+    pub file: String,
+    /// The file's own description.
+    pub description: String,
+    /// How the fits were compared (the error's definition, in words).
+    pub error_measure: String,
+    /// Direction pairs compared.
+    pub pairs: usize,
+    /// The measured material's albedo at normal incidence, per channel.
+    pub measured_albedo_at_normal: [f64; 3],
+    /// The target costed.
+    pub target: Target,
+    /// Its rate's unit.
+    pub rate_unit: &'static str,
+    /// The margin over pow's error, as a fraction.
+    pub margin: f64,
+    /// Every fit.
+    pub fits: Vec<FitRow>,
+    /// The index in `fits` of the lobe to ship.
+    pub chosen: usize,
+    /// Pow's best shared-`n` fit error, the reference.
+    pub reference_error: f64,
+}
+
+/// Luminance of a linear RGB triple (Rec. 709).
+#[must_use]
+pub fn luminance(rgb: [f64; 3]) -> f64 {
+    specula::brdf::luminance(glam::DVec3::from_array(rgb))
+}
+
+/// Every built-in lobe and `extra`, with user lobes checked over the whole range of `n` (the
+/// fits search it).
+pub fn lobes_to_fit(extra: &[LobeKind]) -> Result<Vec<LobeKind>, String> {
+    crate::check_lobes(
+        extra,
+        &log_spaced(Exponent::new(1.0), Exponent::new(1000.0), 8),
+    )?;
+    Ok(crate::candidates(extra))
+}
+
+/// Fits every lobe in `kinds` to `material` (read from `path`, which names it) and ranks them
+/// on `target` (not the FPGA: [`FPGA_MATERIAL_REFUSAL`]) with `margin`, a fraction in
+/// `[0, 1]`, allowed over pow's fit error.
+pub fn assess(
+    material: &MeasuredBrdf,
+    path: &Path,
+    kinds: &[LobeKind],
+    target: Target,
+    margin: f64,
+) -> Result<Assessment, String> {
+    if target == Target::Fpga {
+        return Err(FPGA_MATERIAL_REFUSAL.to_owned());
+    }
+    if !(0.0..=1.0).contains(&margin) {
+        return Err(format!(
+            "the margin over pow's fit error must be a fraction in [0, 1], not {margin}"
+        ));
+    }
+    let observations = Observations::of(|wo, wi| material.f_cos(wo, wi));
+    let fits = fit_all(&observations, kinds);
+    let mut rates = Vec::with_capacity(fits.len());
+    for fit in &fits {
+        rates.push(match (fit.specular, fit.sharing) {
+            (Specular::Lobe { kind, .. }, Sharing::Shared) => {
+                let n = Exponent::clamped(fit.parameter[0]);
+                Some(lobe_rate(target, &Lobe::new(kind, n))?)
+            }
+            _ => None,
+        });
+    }
+    let Some(Verdict {
+        standings,
+        chosen,
+        reference_error,
+        ..
+    }) = verdict(&fits, margin, &rates)
+    else {
+        return Err(format!(
+            "{}: no verdict: pow's fit or every rate on the target is missing",
+            path.display()
+        ));
+    };
+    let normal = glam::DVec3::Z;
+    let measured = material.albedo(normal, 256);
+    let rows = fits
+        .into_iter()
+        .zip(standings)
+        .map(|(fit, standing)| FitRow {
+            ks: Normalisation::ALL
+                .iter()
+                .filter_map(|&norm| Some((norm.id(), fit.ks(norm)?)))
+                .collect(),
+            albedo_at_normal: fit.albedo_at_normal(),
+            at_range_end: fit.at_range_end(),
+            relative_to_pow: standing.relative_to_pow,
+            relative_to_ggx: standing.relative_to_ggx,
+            rate: standing.rate,
+            meets: standing.meets,
+            fit,
+        })
+        .collect();
+    Ok(Assessment {
+        material: material_name(path),
+        file: path.display().to_string(),
+        description: material.description().to_owned(),
+        error_measure: format!(
+            "RMS over solid-angle-weighted direction pairs (theta <= {MAX_ELEVATION_DEGREES} deg) and channels of cbrt(f cos theta_i)"
+        ),
+        pairs: observations.len(),
+        measured_albedo_at_normal: measured.to_array(),
+        target,
+        rate_unit: rate_unit(target),
+        margin,
+        fits: rows,
+        chosen,
+        reference_error,
+    })
+}
+
+/// `n` (or `alpha`) as shown: one value, or three when the channels differ; marked `*` at an
+/// end of the range searched.
+#[must_use]
+pub fn parameter_text(fit: &Fit) -> String {
+    let end = if fit.at_range_end() { "*" } else { "" };
+    format!("{}{end}", parameter_values(fit))
+}
+
+fn parameter_values(fit: &Fit) -> String {
+    let p = fit.parameter;
+    let one = |v: f64| match fit.specular {
+        Specular::Ggx => format!("{v:.4}"),
+        Specular::Lobe { .. } => format!("{v:.1}"),
+    };
+    if p[0] == p[1] && p[1] == p[2] {
+        one(p[0])
+    } else {
+        format!("{}/{}/{}", one(p[0]), one(p[1]), one(p[2]))
+    }
+}
+
+/// Pow's rate on the target (its better geometry's, at its fitted `n`).
+fn pow_rate(a: &Assessment) -> f64 {
+    a.fits
+        .iter()
+        .filter(|r| {
+            matches!(
+                r.fit.specular,
+                Specular::Lobe {
+                    kind: LobeKind::Pow,
+                    ..
+                }
+            )
+        })
+        .filter_map(|r| r.rate)
+        .fold(f64::NAN, f64::max)
+}
+
+/// The sentence naming the lobe to ship.
+#[must_use]
+pub fn verdict_line(a: &Assessment) -> String {
+    let chosen = &a.fits[a.chosen];
+    let pow_rate = pow_rate(a);
+    format!(
+        "{}, n = {}: the cheapest lobe on {} whose fit is within {} % of pow's (E = {:.4}, {:.3}x pow's best; {:.2}x pow's rate)",
+        chosen.fit.specular.label(),
+        parameter_text(&chosen.fit),
+        a.target,
+        100.0 * a.margin,
+        chosen.fit.error,
+        chosen.fit.error / a.reference_error,
+        chosen.rate.unwrap_or(f64::NAN) / pow_rate,
+    )
+}
+
+/// One candidate of a material's ranking (`recommend --material`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Ranked {
+    /// The model's label (lobe and geometry).
+    pub lobe: String,
+    /// Its fitted `n`.
+    pub n: f64,
+    /// Within the margin of pow's best fit.
+    pub meets: bool,
+    /// Its fit error.
+    pub error: f64,
+    /// Its fit error over pow's best.
+    pub relative_to_pow: f64,
+    /// Its rate on the target at the fitted `n` (higher is cheaper).
+    pub rate: f64,
+    /// The rate's unit.
+    pub unit: &'static str,
+    /// The luminance of the fit's albedo at normal incidence.
+    pub albedo_at_normal: f64,
+    /// Why it stands where it does.
+    pub why: String,
+    /// Its row in [`Assessment::fits`].
+    #[serde(skip)]
+    pub row: usize,
+}
+
+/// The shared-`n` lobes of `a` ranked on its target: those within the margin first, then by
+/// rate, highest first; each with why.
+#[must_use]
+pub fn ranking(a: &Assessment) -> Vec<Ranked> {
+    let pow_rate = pow_rate(a);
+    let mut ranked: Vec<Ranked> = a
+        .fits
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.rate.is_some())
+        .map(|(i, row)| {
+            let rate = row.rate.unwrap_or(0.0);
+            let why = if i == a.chosen {
+                format!(
+                    "cheapest within the margin, {:.2}x pow's rate",
+                    rate / pow_rate
+                )
+            } else if row.meets {
+                format!("within the margin, {:.2}x pow's rate", rate / pow_rate)
+            } else {
+                format!(
+                    "fit error {:.1} % above pow's best",
+                    100.0 * (row.fit.error / a.reference_error - 1.0)
+                )
+            };
+            Ranked {
+                lobe: row.fit.specular.label(),
+                n: row.fit.parameter[0],
+                meets: row.meets,
+                error: row.fit.error,
+                relative_to_pow: row.fit.error / a.reference_error,
+                rate,
+                unit: a.rate_unit,
+                albedo_at_normal: luminance(row.albedo_at_normal),
+                why,
+                row: i,
+            }
+        })
+        .collect();
+    ranked.sort_by(|x, y| y.meets.cmp(&x.meets).then(y.rate.total_cmp(&x.rate)));
+    ranked
+}

@@ -1,0 +1,480 @@
+//! Which lobe to ship on a target at an accuracy.
+//!
+//! Every lobe is measured against `t^n` at each exponent asked for; a lobe's error is its
+//! worst over them. Those within the allowed error are ranked by cost on the target: on the
+//! CPU, the measured throughput of its SIMD kernel on this machine (one thread, L1, the
+//! slowest over the exponents, [`crate::rates::kernel_rate`]); on a GPU family, the modelled
+//! evaluations per clock per multiprocessor of its exported shader (`specula::gpu_cost` over
+//! `specula_gpu::shader_ops`); on the FPGA, the datapath [`cheapest_datapath`] picks at the
+//! width the error needs, synthesized by `specula_synth` (cached), or, without the tools,
+//! estimated ([`crate::fpga_estimate`]). The Pareto front is taken over every lobe, met or not.
+
+use indicatif::ProgressBar;
+use serde::Serialize;
+use specula::analysis::{energy_ratio, error_figures, Precision};
+use specula::gpu_cost::GpuFamily;
+use specula::{Exponent, Lobe, LobeKind};
+use specula_hw::analysis::WidthSweep;
+
+use crate::hardware::{cheapest_datapath, hardware_sweeps, SWEEP_SAMPLES};
+use crate::{check_lobes, Target, Zone};
+
+/// What to decide: the cheapest of `lobes` on `target` within `max_error` at every exponent.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Request {
+    /// Where the lobe will run.
+    pub target: Target,
+    /// The exponents the answer must hold at (at least one; see [`crate::sample_exponents`]
+    /// for a range).
+    pub exponents: Vec<Exponent>,
+    /// The largest error allowed, as a fraction in `(0, 1]`.
+    pub max_error: f64,
+    /// Where the error is measured.
+    pub zone: Zone,
+    /// Only lobes whose energy stays within 0.1 % of `t^n`'s meet the request.
+    pub energy_conserving: bool,
+    /// The candidates (at least one), ranked in this order where their costs tie.
+    pub lobes: Vec<LobeKind>,
+}
+
+impl Request {
+    /// Every built-in lobe on `target` at `exponents` within `max_error`, in the epicentre,
+    /// energy not asked for.
+    #[must_use]
+    pub fn new(target: Target, exponents: Vec<Exponent>, max_error: f64) -> Self {
+        Self {
+            target,
+            exponents,
+            max_error,
+            zone: Zone::Epicentre,
+            energy_conserving: false,
+            lobes: LobeKind::ALL.to_vec(),
+        }
+    }
+}
+
+/// One lobe's figures.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Candidate {
+    /// The lobe's id (a user's lobe as its name).
+    pub lobe: String,
+    /// On the FPGA, the datapath and word length costed (at the first exponent); `None` where
+    /// the lobe has no datapath, and off the FPGA.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub datapath: Option<String>,
+    /// The worst error over the exponents, as a fraction (infinite where the target cannot
+    /// run the lobe).
+    pub error: f64,
+    /// The cost figure in [`Candidate::unit`], the smallest over the exponents. Higher is
+    /// cheaper.
+    pub rate: f64,
+    /// Its unit.
+    pub unit: &'static str,
+    /// The worst energy ratio against `t^n` over the exponents.
+    pub energy_ratio: f64,
+    /// Whether it meets the error (and the energy condition, if asked).
+    pub meets: bool,
+    /// No other lobe is at least as accurate and at least as cheap, and better in one.
+    pub pareto: bool,
+    /// Why it stands where it does.
+    pub why: String,
+}
+
+/// The answer: every candidate, those that meet the request first, cheapest first.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Recommendation {
+    /// The cheapest lobe that meets the request, if any does.
+    pub best: Option<String>,
+    /// The unit of every candidate's rate.
+    pub unit: &'static str,
+    /// What a face should tell its user about how the costs were obtained (the FPGA's tools
+    /// missing, so its costs are the formula estimate), if anything.
+    pub note: Option<String>,
+    /// Every candidate: those that meet the request first, then by rate, highest first.
+    pub candidates: Vec<Candidate>,
+}
+
+impl Recommendation {
+    /// The exact lobe's rate, what "vs pow" compares with (NaN where pow was no candidate).
+    #[must_use]
+    pub fn pow_rate(&self) -> f64 {
+        self.candidates
+            .iter()
+            .find(|c| c.lobe == LobeKind::Pow.id())
+            .map_or(f64::NAN, |c| c.rate)
+    }
+
+    /// The best lobe's candidate, if any meets the request.
+    #[must_use]
+    pub fn best_candidate(&self) -> Option<&Candidate> {
+        let best = self.best.as_deref()?;
+        self.candidates.iter().find(|c| c.lobe == best)
+    }
+}
+
+/// How a target's costs are obtained.
+enum Costing {
+    /// Timed on this machine's CPU.
+    Measured,
+    /// The GPU cost model of one family.
+    Modelled(GpuFamily),
+    /// Estimated from the fixed-point datapaths' sweeps, per exponent (without Yosys).
+    Estimated(Vec<(Exponent, std::sync::Arc<Vec<WidthSweep>>)>),
+    /// Synthesized and placed (Yosys, nextpnr-ice40 on an iCE40 HX8K; cached), at the word
+    /// lengths the sweeps choose.
+    Synthesized(Vec<(Exponent, std::sync::Arc<Vec<WidthSweep>>)>),
+}
+
+/// Where the FPGA's costs are synthesized: every operator in LUTs, one area figure.
+pub const FPGA_TARGET: specula_synth::Target =
+    specula_synth::Target::Ice40(specula_synth::Ice40Device::Hx8k);
+
+/// One lobe at one exponent: its error, its cost figure (higher is cheaper), and on the FPGA
+/// the datapath costed.
+struct Point {
+    error: f64,
+    rate: f64,
+    datapath: Option<String>,
+}
+
+/// The integer exponent the datapaths take for `n`.
+fn datapath_exponent(n: Exponent) -> u32 {
+    n.get().round().clamp(1.0, 1000.0) as u32
+}
+
+impl Costing {
+    /// The costing of `target` at `exponents`, and a note for the user where the FPGA's tools
+    /// are missing.
+    fn new(target: Target, exponents: &[Exponent]) -> Result<(Self, Option<String>), String> {
+        let family = |id: &str| {
+            GpuFamily::find(id).ok_or_else(|| format!("no GPU family '{id}' in the model"))
+        };
+        Ok(match target {
+            Target::Cpu => (Costing::Measured, None),
+            Target::GpuNvidia => (Costing::Modelled(family("gpu-nvidia")?), None),
+            Target::GpuAmd => (Costing::Modelled(family("gpu-amd")?), None),
+            Target::Fpga => {
+                let sweeps = exponents
+                    .iter()
+                    .map(|&n| Ok((n, hardware_sweeps(datapath_exponent(n))?)))
+                    .collect::<Result<Vec<_>, String>>()?;
+                match specula_synth::ToolVersions::find(FPGA_TARGET) {
+                    Ok(_) => (Costing::Synthesized(sweeps), None),
+                    Err(missing) => (
+                        Costing::Estimated(sweeps),
+                        Some(format!(
+                            "{missing}; FPGA costs are the formula estimate instead"
+                        )),
+                    ),
+                }
+            }
+        })
+    }
+
+    fn unit(&self) -> &'static str {
+        match self {
+            Costing::Measured => "evals/s, 1 thread",
+            Costing::Modelled(_) => "evals/clock/multiprocessor (modelled)",
+            Costing::Estimated(_) => "evals/clock per 1000 logic cells (estimated)",
+            Costing::Synthesized(_) => "results/us per 1000 LUTs (synthesized, iCE40 HX8K)",
+        }
+    }
+
+    /// `lobe` at its exponent, or `None` where the target cannot run it (no datapath).
+    fn point(&self, lobe: &Lobe, zone: Zone, max_error: f64) -> Result<Option<Point>, String> {
+        let float_error = || zone.error(&error_figures(lobe, &mut Precision::F64, SWEEP_SAMPLES));
+        Ok(match self {
+            Costing::Measured => Some(Point {
+                error: float_error(),
+                rate: crate::rates::kernel_rate(lobe),
+                datapath: None,
+            }),
+            Costing::Modelled(family) => {
+                let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
+                Some(Point {
+                    error: float_error(),
+                    rate: family.cost(&ops).evals_per_clock,
+                    datapath: None,
+                })
+            }
+            Costing::Estimated(hardware) | Costing::Synthesized(hardware) => {
+                let Some(chosen) = hardware
+                    .iter()
+                    .find(|(at, _)| *at == lobe.exponent())
+                    .and_then(|(_, sweeps)| {
+                        cheapest_datapath(sweeps, lobe.kind(), zone, max_error)
+                    })
+                else {
+                    return Ok(None);
+                };
+                let mut datapath = format!("{} at {} bits", chosen.lobe.id(), chosen.bits);
+                let rate = match self {
+                    // A datapath that cannot reach the error is not worth the tools' minutes:
+                    // it is listed, with its error, as not meeting.
+                    Costing::Synthesized(_) if chosen.error > max_error => {
+                        datapath += " (not synthesized: short of the error)";
+                        0.0
+                    }
+                    Costing::Synthesized(_) => {
+                        let cache = specula_synth::cache::Cache::default_location();
+                        let synthesis = specula_synth::synthesize(
+                            chosen.lobe,
+                            chosen.bits,
+                            FPGA_TARGET,
+                            cache.as_ref(),
+                        )
+                        .map_err(|e| e.to_string())?;
+                        match synthesis.logic_ns_per_result() {
+                            Some(lut_ns) => 1e6 / lut_ns,
+                            // Placed nowhere: it does not fit the part (the note says why).
+                            None => {
+                                datapath += " (does not fit the iCE40 HX8K)";
+                                0.0
+                            }
+                        }
+                    }
+                    _ => 1e3 / chosen.cells as f64,
+                };
+                Some(Point {
+                    error: chosen.error,
+                    rate,
+                    datapath: Some(datapath),
+                })
+            }
+        })
+    }
+}
+
+/// Which of `points` (error, rate) no other point dominates (at least as accurate and at
+/// least as cheap, and better in one).
+#[must_use]
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
+    points
+        .iter()
+        .map(|&(error, rate)| {
+            !points
+                .iter()
+                .any(|&(e, r)| e <= error && r >= rate && (e < error || r > rate))
+        })
+        .collect()
+}
+
+/// Why a material's verdict refuses the FPGA.
+pub const FPGA_MATERIAL_REFUSAL: &str = "a material verdict cannot target fpga: the fixed-point datapaths take an integer n and a word length chosen for an error against t^n, which a material's fit does not give; valid targets: cpu, gpu-nvidia, gpu-amd";
+
+/// A lobe's rate on `target` for a material's verdict (higher is cheaper): measured on the
+/// CPU, modelled on a GPU; the FPGA is refused ([`FPGA_MATERIAL_REFUSAL`]).
+pub fn lobe_rate(target: Target, lobe: &Lobe) -> Result<f64, String> {
+    if target == Target::Fpga {
+        return Err(FPGA_MATERIAL_REFUSAL.to_owned());
+    }
+    match Costing::new(target, &[lobe.exponent()])?.0 {
+        Costing::Measured => Ok(crate::rates::kernel_rate(lobe)),
+        Costing::Modelled(family) => {
+            let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
+            Ok(family.cost(&ops).evals_per_clock)
+        }
+        Costing::Estimated(_) | Costing::Synthesized(_) => Err(FPGA_MATERIAL_REFUSAL.to_owned()),
+    }
+}
+
+/// The unit of [`lobe_rate`] on `target` (empty for the FPGA, which it refuses).
+#[must_use]
+pub fn rate_unit(target: Target) -> &'static str {
+    match target {
+        // Costing the FPGA would run its sweeps; material verdicts refuse it anyway.
+        Target::Fpga => "",
+        _ => Costing::new(target, &[]).map_or("", |(costing, _)| costing.unit()),
+    }
+}
+
+/// Refuses a request no answer can come from, in one line.
+fn check(request: &Request) -> Result<(), String> {
+    let max_error = request.max_error;
+    if !(max_error.is_finite() && max_error > 0.0 && max_error <= 1.0) {
+        return Err(format!(
+            "the largest error allowed must be a fraction in (0, 1], not {max_error}"
+        ));
+    }
+    if request.exponents.is_empty() {
+        return Err("no exponent to decide at: give at least one n in [1, 1000]".to_owned());
+    }
+    if request.lobes.is_empty() {
+        return Err("no lobe to choose from: give at least one candidate".to_owned());
+    }
+    check_lobes(&request.lobes, &request.exponents)
+}
+
+/// Measures every candidate of `request` on its target and ranks them: those that meet the
+/// request first, cheapest first, each with why it stands there. `progress` counts the
+/// lobes, names the one being measured, and is cleared at the end (pass
+/// [`ProgressBar::hidden`] for none).
+pub fn recommend(request: &Request, progress: &ProgressBar) -> Result<Recommendation, String> {
+    check(request)?;
+    let (target, max_error) = (request.target, request.max_error);
+    let (costing, note) = Costing::new(target, &request.exponents)?;
+    let unit = costing.unit();
+    progress.set_length(request.lobes.len() as u64);
+    let mut candidates = Vec::new();
+    for &kind in &request.lobes {
+        progress.set_message(kind.to_string());
+        let mut error = 0.0_f64;
+        let mut energy = 0.0_f64;
+        let mut cheapest = f64::INFINITY;
+        // The datapath named at the first exponent; none if any exponent has none.
+        let mut datapath = None;
+        let mut unavailable = false;
+        for &n in &request.exponents {
+            let lobe = Lobe::new(kind, n);
+            energy = energy.max(energy_ratio(&lobe));
+            match costing.point(&lobe, request.zone, max_error)? {
+                Some(point) => {
+                    error = error.max(point.error);
+                    cheapest = cheapest.min(point.rate);
+                    datapath = datapath.or(point.datapath);
+                }
+                None => unavailable = true,
+            }
+        }
+        if unavailable {
+            (error, cheapest, datapath) = (f64::INFINITY, 0.0, None);
+        }
+        // A rate of 0 is a lobe the target cannot run (a datapath that does not fit the part).
+        let meets =
+            error <= max_error && cheapest > 0.0 && (!request.energy_conserving || energy <= 1.001);
+        candidates.push(Candidate {
+            lobe: kind.to_string(),
+            datapath,
+            error,
+            rate: cheapest,
+            unit,
+            energy_ratio: energy,
+            meets,
+            pareto: false,
+            why: String::new(),
+        });
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    let front = pareto_front(
+        &candidates
+            .iter()
+            .map(|c| (c.error, c.rate))
+            .collect::<Vec<_>>(),
+    );
+    for (candidate, on_front) in candidates.iter_mut().zip(front) {
+        candidate.pareto = on_front;
+    }
+    candidates.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
+    let mut recommendation = Recommendation {
+        best: candidates.iter().find(|c| c.meets).map(|c| c.lobe.clone()),
+        unit,
+        note,
+        candidates,
+    };
+    let pow_rate = recommendation.pow_rate();
+    let best = recommendation.best.clone();
+    for candidate in &mut recommendation.candidates {
+        candidate.why = why(candidate, best.as_deref(), pow_rate, target, max_error);
+    }
+    Ok(recommendation)
+}
+
+/// `rate` as a multiple of pow's (`1.52x`), or `-` where pow has no cost on the target (no
+/// datapath).
+#[must_use]
+pub fn versus_pow(rate: f64, pow_rate: f64) -> String {
+    if pow_rate > 0.0 && pow_rate.is_finite() {
+        format!("{:.2}x", rate / pow_rate)
+    } else {
+        "-".to_owned()
+    }
+}
+
+fn why(c: &Candidate, best: Option<&str>, pow_rate: f64, target: Target, max_error: f64) -> String {
+    let speed = versus_pow(c.rate, pow_rate);
+    let relative = if speed == "-" {
+        String::new()
+    } else {
+        format!(" at {speed} pow's rate")
+    };
+    if !c.meets {
+        if target == Target::Fpga && c.datapath.is_none() {
+            return "no fixed-point datapath for this lobe".to_owned();
+        }
+        if let Some(datapath) = c.datapath.as_deref().filter(|_| c.rate <= 0.0) {
+            if c.error <= max_error {
+                return format!("{datapath}: it cannot be built on the part");
+            }
+        }
+        if c.error > max_error {
+            return format!(
+                "error {:.3} % exceeds {:.3} %",
+                100.0 * c.error,
+                100.0 * max_error
+            );
+        }
+        return format!("energy {:.2} % above t^n's", 100.0 * (c.energy_ratio - 1.0));
+    }
+    if Some(c.lobe.as_str()) == best {
+        return format!("cheapest that meets it{relative}");
+    }
+    if c.lobe == LobeKind::Pow.id() {
+        return "exact, the reference".to_owned();
+    }
+    format!("meets it{relative}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_front_keeps_exactly_the_undominated() {
+        // (error, rate): b dominates c; a and b trade off; d is dominated by a.
+        let points = [(0.0, 1.0), (0.01, 3.0), (0.02, 2.0), (0.001, 0.5)];
+        assert_eq!(pareto_front(&points), [true, true, false, false]);
+    }
+
+    #[test]
+    fn bad_requests_are_refused_in_one_line() {
+        let n = vec![Exponent::new(64.0)];
+        for max_error in [0.0, -0.01, 1.5, f64::NAN, f64::INFINITY] {
+            let request = Request::new(Target::GpuAmd, n.clone(), max_error);
+            let refusal = recommend(&request, &ProgressBar::hidden()).unwrap_err();
+            assert_eq!(refusal.lines().count(), 1, "{refusal}");
+        }
+        let none = Request::new(Target::GpuAmd, Vec::new(), 0.01);
+        assert!(recommend(&none, &ProgressBar::hidden()).is_err());
+        let empty = Request {
+            lobes: Vec::new(),
+            ..Request::new(Target::GpuAmd, n, 0.01)
+        };
+        assert!(recommend(&empty, &ProgressBar::hidden()).is_err());
+    }
+
+    #[test]
+    fn on_a_gpu_the_exact_lobe_always_meets_and_the_met_come_first() {
+        let request = Request::new(Target::GpuNvidia, vec![Exponent::new(64.0)], 0.01);
+        let answer = recommend(&request, &ProgressBar::hidden()).unwrap();
+        assert_eq!(answer.candidates.len(), LobeKind::ALL.len());
+        assert!(answer.note.is_none());
+        let pow = answer.candidates.iter().find(|c| c.lobe == "pow").unwrap();
+        assert!(pow.meets && pow.error == 0.0, "{pow:?}");
+        let best = answer.best_candidate().expect("pow at least meets");
+        assert_eq!(Some(best), answer.candidates.first());
+        assert!(
+            best.why.starts_with("cheapest that meets it"),
+            "{}",
+            best.why
+        );
+        let met: Vec<f64> = answer
+            .candidates
+            .iter()
+            .take_while(|c| c.meets)
+            .map(|c| c.rate)
+            .collect();
+        assert!(met.windows(2).all(|w| w[0] >= w[1]), "{met:?}");
+        assert!(answer.candidates.iter().all(|c| c.datapath.is_none()));
+    }
+}

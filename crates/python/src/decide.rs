@@ -1,0 +1,87 @@
+//! The decision and the report: `specula recommend`'s rows, one lobe's cost on a target, and
+//! the report, each one call into `specula-decide` or `specula-report`.
+
+use std::path::PathBuf;
+use std::str::FromStr;
+
+use indicatif::ProgressBar;
+use pyo3::prelude::*;
+use specula::LobeKind;
+use specula_decide::{lobe_rate, parse_exponents, rate_unit, recommend, Request, Target, Zone};
+
+use crate::errors::{guarded, value_error};
+use crate::lobe::Lobe;
+
+fn lobes(texts: &[String]) -> PyResult<Vec<LobeKind>> {
+    texts
+        .iter()
+        .map(|text| specula_render::lobe_file::parse_lobe(text, None).map_err(value_error))
+        .collect()
+}
+
+/// `specula recommend --format json`'s rows: every candidate ranked on `target`.
+#[pyfunction]
+#[pyo3(signature = (target, n, max_error, zone, energy_conserving, extra_lobes))]
+pub fn recommend_json(
+    py: Python<'_>,
+    target: &str,
+    n: &str,
+    max_error: f64,
+    zone: &str,
+    energy_conserving: bool,
+    extra_lobes: Vec<String>,
+) -> PyResult<String> {
+    guarded(|| {
+        let request = Request {
+            target: Target::from_str(target).map_err(value_error)?,
+            exponents: parse_exponents(n).map_err(value_error)?,
+            max_error,
+            zone: Zone::from_str(zone).map_err(value_error)?,
+            energy_conserving,
+            lobes: specula_decide::candidates(&lobes(&extra_lobes)?),
+        };
+        let answer = py
+            .detach(|| recommend(&request, &ProgressBar::hidden()))
+            .map_err(value_error)?;
+        serde_json::to_string(&answer.candidates).map_err(|e| value_error(e.to_string()))
+    })
+}
+
+/// One lobe's cost figure on `target` (higher is cheaper) and its unit.
+#[pyfunction]
+pub fn cost_json(py: Python<'_>, target: &str, lobe: &Lobe) -> PyResult<String> {
+    guarded(|| {
+        let target = Target::from_str(target).map_err(value_error)?;
+        let core = *lobe.core();
+        let rate = py
+            .detach(|| lobe_rate(target, &core))
+            .map_err(value_error)?;
+        Ok(serde_json::json!({ "rate": rate, "unit": rate_unit(target) }).to_string())
+    })
+}
+
+/// Writes the report to `out`; returns the page's path.
+#[pyfunction]
+#[pyo3(signature = (out, quick, bench, extra_lobes, materials))]
+pub fn report(
+    py: Python<'_>,
+    out: PathBuf,
+    quick: bool,
+    bench: bool,
+    extra_lobes: Vec<String>,
+    materials: Option<PathBuf>,
+) -> PyResult<String> {
+    guarded(|| {
+        let options = specula_report::Options {
+            out,
+            quick,
+            bench,
+            lobes: lobes(&extra_lobes)?,
+            materials,
+        };
+        let summary = py
+            .detach(|| specula_report::write_report(&options))
+            .map_err(value_error)?;
+        Ok(summary.page.display().to_string())
+    })
+}

@@ -1,0 +1,71 @@
+"""The decision: the rows of `specula recommend`, one lobe's cost, and the report, each the
+same answer the CLI gives (one library under both faces)."""
+
+import json
+import math
+
+import pytest
+
+import specula
+
+
+@pytest.mark.parametrize("target", ["gpu-nvidia", "gpu-amd", "fpga"])
+@pytest.mark.parametrize("n, max_error", [("64", 0.02), ("8..512", 0.05)])
+def test_recommend_gives_the_clis_rows(cli_json, target, n, max_error):
+    ours = specula.recommend(target, n=n, max_error=max_error)
+    theirs = cli_json("recommend", "--target", target, "--n", n,
+                      "--max-error", f"{100 * max_error}%", "--format", "json")
+    assert ours == theirs
+
+
+def test_on_the_cpu_the_same_lobes_are_ranked_by_measured_rates(cli_json):
+    # Rates are timed on this machine, so they differ run to run; the errors, the energy
+    # and which lobes meet the request do not.
+    ours = specula.recommend("cpu", n=32, max_error=0.01)
+    theirs = cli_json("recommend", "--target", "cpu", "--n", "32", "--max-error", "1%",
+                      "--format", "json")
+    key = lambda rows: sorted((r["lobe"], r["error"], r["energy_ratio"], r["meets"]) for r in rows)
+    assert key(ours) == key(theirs)
+    meeting = [r for r in ours if r["meets"]]
+    assert all(a["rate"] >= b["rate"] for a, b in zip(meeting, meeting[1:]))
+
+
+def test_your_own_lobe_is_a_candidate(cli_json):
+    ours = specula.recommend("gpu-nvidia", n=64, max_error=0.01, lobes=["=t^n"])
+    theirs = cli_json("recommend", "--target", "gpu-nvidia", "--n", "64", "--max-error", "1%",
+                      "--lobe", "=t^n", "--format", "json")
+    assert ours == theirs
+    assert any(r["lobe"].startswith("formula") for r in ours)
+
+
+def test_cost_is_the_rows_rate():
+    rows = {r["lobe"]: r for r in specula.recommend("gpu-amd", n=64, max_error=0.5)}
+    for lobe_id in ["pow", "cosquad", "sg"]:
+        cost = specula.cost("gpu-amd", specula.Lobe(lobe_id, 64))
+        assert cost["rate"] == rows[lobe_id]["rate"] and cost["unit"] == rows[lobe_id]["unit"]
+    cpu = specula.cost("cpu", specula.Lobe("cosquad", 64))
+    assert cpu["rate"] > 1e6 and "evals/s" in cpu["unit"]
+
+
+def test_bad_requests_raise_the_clis_message(cli):
+    with pytest.raises(ValueError, match=r"valid targets: cpu, gpu-nvidia, gpu-amd, fpga"):
+        specula.recommend("tpu")
+    with pytest.raises(ValueError, match=r"valid zones"):
+        specula.recommend("cpu", zone="core")
+    with pytest.raises(ValueError) as raised:
+        specula.recommend("gpu-amd", n="512..8")
+    code, _, err = cli("recommend", "--target", "gpu-amd", "--n", "512..8", "--max-error", "1%")
+    assert code != 0 and str(raised.value) in err
+    for bad in [0.0, -0.1, 1.5, math.nan]:
+        with pytest.raises(ValueError, match=r"max_error|error"):
+            specula.recommend("gpu-amd", max_error=bad)
+
+
+def test_the_report_is_written_from_python(tmp_path):
+    page = specula.report(tmp_path / "report", quick=True)
+    html = (tmp_path / "report" / "index.html").read_text()
+    assert page.endswith("index.html") and "Which lobe when" in html
+    # Every image the page names is there.
+    import re
+    for name in set(re.findall(r'src="([^"]+\.(?:svg|png))"', html)):
+        assert (tmp_path / "report" / name).exists(), name

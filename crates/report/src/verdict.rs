@@ -1,0 +1,226 @@
+//! The report's first section, "Which lobe when": for each GPU family of the cost model and the
+//! FPGA, the cheapest lobe within a few epicentre accuracies at a few exponents, and for the
+//! GPUs the Pareto plot of error against modelled cost. Every cell is `specula recommend`'s
+//! answer for its target, exponent and bound ([`specula_decide::recommend`] itself, over the
+//! report's lobes), so the page and the command cannot disagree. The CPU's answer needs timing
+//! on a quiet machine, so it is `specula recommend --target cpu` (and the cost section with
+//! `--bench`).
+
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+use specula::{Exponent, LobeKind};
+use specula_decide::{recommend, versus_pow, Recommendation, Request, Target};
+
+use super::html::{paragraph, table};
+use super::plot::{Chart, Series};
+use super::sections::series;
+use super::Context;
+use crate::format::sig;
+
+const FAMILIES: [(Target, &str); 2] = [(Target::GpuNvidia, "NVIDIA"), (Target::GpuAmd, "AMD RDNA")];
+const EXPONENTS: [f64; 3] = [8.0, 64.0, 512.0];
+const ACCURACIES: [f64; 3] = [0.005, 0.02, 0.10];
+/// The exponent of the Pareto plots.
+const PLOTTED: f64 = 64.0;
+/// Where exact `pow` is drawn on the log axis.
+const EXACT_FLOOR: f64 = 1e-6;
+
+/// `specula recommend --target TARGET --n N --max-error BOUND` over the report's lobes.
+fn answer(
+    lobes: &[LobeKind],
+    target: Target,
+    n: f64,
+    bound: f64,
+) -> Result<Recommendation, String> {
+    let request = Request {
+        lobes: lobes.to_vec(),
+        ..Request::new(target, vec![Exponent::new(n)], bound)
+    };
+    recommend(&request, &ProgressBar::hidden())
+}
+
+/// A GPU cell: the best lobe and its modelled rate over pow's, or `-`.
+fn gpu_cell(answer: &Recommendation) -> String {
+    answer.best_candidate().map_or("-".to_owned(), |best| {
+        format!(
+            "{} ({} pow)",
+            best.lobe,
+            versus_pow(best.rate, answer.pow_rate())
+        )
+    })
+}
+
+/// An FPGA cell: the best lobe's datapath at its word length, its rate and the rate's unit,
+/// or `-`.
+fn fpga_cell(answer: &Recommendation) -> String {
+    answer.best_candidate().map_or("-".to_owned(), |best| {
+        let named = match &best.datapath {
+            // The datapath's id is the lobe's, or one of its variants (logexp-mitchell).
+            Some(datapath) if datapath.starts_with(&format!("{} at ", best.lobe)) => {
+                datapath.clone()
+            }
+            Some(datapath) => format!("{} as {datapath}", best.lobe),
+            None => best.lobe.clone(),
+        };
+        format!("{named}: {} {}", sig(best.rate), answer.unit)
+    })
+}
+
+pub fn verdict(context: &mut Context) -> Result<String, String> {
+    let mut html = paragraph(
+        "The cheapest lobe whose epicentre error (largest relative error where t^n >= 1/2) \
+         stays within each accuracy: each cell is what specula recommend --target TARGET \
+         --n N --max-error BOUND answers (the same library call, the lobes below as \
+         candidates). On the GPUs, by the cost model: each lobe's exported shader, its \
+         instructions counted and weighed by the vendor's published per-clock rates \
+         (crates/specula/src/gpu_cost.rs); the ratio is its modelled rate over pow's. For \
+         the CPU, run specula recommend --target cpu: its costs are measured.",
+    );
+    let yours: Vec<String> = context
+        .lobes
+        .iter()
+        .filter(|kind| matches!(kind, LobeKind::Formula(_)))
+        .map(LobeKind::to_string)
+        .collect();
+    if !yours.is_empty() {
+        html += &paragraph(&format!(
+            "Your lobes are candidates too: {}.",
+            yours.join(", ")
+        ));
+    }
+    let lobes = context.lobes.clone();
+    let gpu_cells: Vec<(Target, f64, f64)> = FAMILIES
+        .iter()
+        .flat_map(|&(target, _)| {
+            EXPONENTS
+                .iter()
+                .flat_map(move |&n| ACCURACIES.map(|bound| (target, n, bound)))
+        })
+        .collect();
+    let hardware: Vec<u32> = context.sizes.hardware_exponents.to_vec();
+    // The GPU cells in parallel; the FPGA's one after another, so that a design two bounds
+    // share is synthesized once and then read from the cache.
+    let (gpu, fpga) = rayon::join(
+        || {
+            gpu_cells
+                .par_iter()
+                .map(|&(target, n, bound)| answer(&lobes, target, n, bound))
+                .collect::<Result<Vec<_>, String>>()
+        },
+        || {
+            hardware
+                .iter()
+                .map(|&n| {
+                    ACCURACIES
+                        .iter()
+                        .map(|&bound| answer(&lobes, Target::Fpga, f64::from(n), bound))
+                        .collect::<Result<Vec<_>, String>>()
+                })
+                .collect::<Result<Vec<_>, String>>()
+        },
+    );
+    let (gpu, fpga) = (gpu?, fpga?);
+    let gpu_answer = |target: Target, n: f64, bound: f64| {
+        gpu_cells
+            .iter()
+            .position(|&cell| cell == (target, n, bound))
+            .map(|k| &gpu[k])
+            .ok_or("every GPU cell was answered")
+    };
+    let mut rows = Vec::new();
+    for (target, name) in FAMILIES {
+        for n in EXPONENTS {
+            let mut row = vec![name.to_owned(), n.to_string()];
+            for bound in ACCURACIES {
+                row.push(gpu_cell(gpu_answer(target, n, bound)?));
+            }
+            rows.push(row);
+        }
+    }
+    for (n, answers) in hardware.iter().zip(&fpga) {
+        let mut row = vec!["FPGA".to_owned(), n.to_string()];
+        row.extend(answers.iter().map(fpga_cell));
+        rows.push(row);
+    }
+    html += &table(
+        &["target", "n", "within 0.5 %", "within 2 %", "within 10 %"],
+        &rows,
+    );
+    html += &paragraph(
+        "FPGA rows: specula recommend --target fpga's answer too. Each lobe is costed as its \
+         fixed-point datapath (of a lobe's datapaths, the one with the fewest estimated logic \
+         cells) at the smallest word length whose epicentre error is within the bound, \
+         synthesized with Yosys and placed with nextpnr on an iCE40 HX8K (the synthesis is \
+         cached, so only the first run waits for the tools), and ranked by results per \
+         microsecond per 1000 LUTs; each cell names the datapath, its word length and that \
+         rate. Where the tools are missing, the rate is the formula estimate instead, per \
+         1000 estimated logic cells, and its unit says so. '-': no lobe meets it.",
+    );
+    for note in fpga
+        .iter()
+        .flatten()
+        .filter_map(|a| a.note.as_deref())
+        .take(1)
+    {
+        html += &paragraph(&format!("Note: {note}."));
+    }
+    for (target, name) in FAMILIES {
+        let plotted_answer = gpu_answer(target, PLOTTED, ACCURACIES[0])?;
+        let candidates: Vec<(LobeKind, &specula_decide::Candidate)> = context
+            .lobes
+            .iter()
+            .filter_map(|&kind| {
+                let id = kind.to_string();
+                let candidate = plotted_answer.candidates.iter().find(|c| c.lobe == id)?;
+                Some((kind, candidate))
+            })
+            .collect();
+        let plotted: Vec<(f64, f64)> = candidates
+            .iter()
+            .map(|(_, c)| (c.error.max(EXACT_FLOOR), c.rate))
+            .collect();
+        let mut front: Vec<(f64, f64)> = candidates
+            .iter()
+            .zip(&plotted)
+            .filter(|((_, c), _)| c.pareto)
+            .map(|(_, p)| *p)
+            .collect();
+        front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut series_list: Vec<Series> = candidates
+            .iter()
+            .zip(&plotted)
+            .map(|((kind, _), &point)| Series {
+                markers: true,
+                ..series(*kind, vec![point])
+            })
+            .collect();
+        series_list.push(Series {
+            name: "Pareto front".into(),
+            points: front,
+            colour: plotters::style::RGBColor(150, 150, 150),
+            width: 1,
+            markers: false,
+            dashed: false,
+        });
+        let most = plotted.iter().map(|p| p.1).fold(0.0, f64::max);
+        let chart = Chart {
+            title: format!("{name}: epicentre error against modelled cost, n = {PLOTTED}"),
+            x_label: format!("epicentre max relative error (pow, exact, at {EXACT_FLOOR:e})"),
+            y_label: "modelled evaluations per clock per multiprocessor".into(),
+            // Room on the right, past any error, for the legend.
+            x: (EXACT_FLOOR / 2.0, 1e3),
+            y: (0.1, most * 2.0),
+            log_x: true,
+            log_y: true,
+            series: series_list,
+            bands: Vec::new(),
+            legend_below: true,
+        };
+        html += &context.svg(
+            &format!("verdict-{}.svg", target.id()),
+            &chart,
+            &format!("{name}: error against cost, higher left is better; the grey line joins the Pareto front"),
+        )?;
+    }
+    Ok(html)
+}
