@@ -305,6 +305,30 @@ fn check(request: &Request) -> Result<(), String> {
     check_lobes(&request.lobes, &request.exponents)
 }
 
+/// Synthesizes, in parallel, every design the ranking of `request` will cost, so that the
+/// ranking finds each in the cache: Yosys and nextpnr run one thread each, and a request
+/// over a range needs dozens of designs on an empty cache. A failure is left for the
+/// ranking, which reports it.
+fn synthesize_ahead(hardware: &[(Exponent, std::sync::Arc<Vec<WidthSweep>>)], request: &Request) {
+    use rayon::prelude::*;
+    let mut designs: Vec<(specula_hw::HwLobe, u32)> = hardware
+        .iter()
+        .flat_map(|(_, sweeps)| {
+            request.lobes.iter().filter_map(|&kind| {
+                cheapest_datapath(sweeps, kind, request.zone, request.max_error)
+                    .filter(|chosen| chosen.error <= request.max_error)
+                    .map(|chosen| (chosen.lobe, chosen.bits))
+            })
+        })
+        .collect();
+    designs.sort_by_key(|&(lobe, bits)| (lobe.id(), bits));
+    designs.dedup();
+    let cache = specula_synth::cache::Cache::default_location();
+    designs.par_iter().for_each(|&(lobe, bits)| {
+        let _ = specula_synth::synthesize(lobe, bits, FPGA_TARGET, cache.as_ref());
+    });
+}
+
 /// Measures every candidate of `request` on its target and ranks them: those that meet the
 /// request first, cheapest first, each with why it stands there. `progress` counts the
 /// lobes, names the one being measured, and is cleared at the end (pass
@@ -314,6 +338,9 @@ pub fn recommend(request: &Request, progress: &ProgressBar) -> Result<Recommenda
     let (target, max_error) = (request.target, request.max_error);
     let (costing, note) = Costing::new(target, &request.exponents)?;
     let unit = costing.unit();
+    if let Costing::Synthesized(hardware) = &costing {
+        synthesize_ahead(hardware, request);
+    }
     progress.set_length(request.lobes.len() as u64);
     let mut candidates = Vec::new();
     for &kind in &request.lobes {
@@ -331,7 +358,13 @@ pub fn recommend(request: &Request, progress: &ProgressBar) -> Result<Recommenda
                 Some(point) => {
                     error = error.max(point.error);
                     cheapest = cheapest.min(point.rate);
-                    datapath = datapath.or(point.datapath);
+                    // The first exponent's datapath names the lobe's, unless one cannot be
+                    // built: that one says why the lobe does not meet the request.
+                    datapath = if point.rate <= 0.0 && point.datapath.is_some() {
+                        point.datapath
+                    } else {
+                        datapath.or(point.datapath)
+                    };
                 }
                 None => unavailable = true,
             }

@@ -37,41 +37,38 @@ def best_rate(work, repeats=7):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--lobe", default="cosquad")
+    parser.add_argument("--lobe", default="cosquad", help="a lobe id, or 'all'")
     parser.add_argument("--n", type=float, default=64.0)
     parser.add_argument("--cli", default=os.environ.get("SPECULA_BIN") or shutil.which("specula"))
     args = parser.parse_args()
 
     t = np.random.default_rng(0).uniform(0.8, 1.0, SIZE).astype(np.float32)
     out = np.empty_like(t)
-    lobe = specula.Lobe(args.lobe, args.n)
     n32 = np.float32(args.n)
-    allocating = best_rate(lambda: lobe(t))
-    into = best_rate(lambda: lobe(t, out=out))
     numpy_rate = best_rate(lambda: np.power(t, n32))
     numpy_into = best_rate(lambda: np.power(t, n32, out=out))
-    print(f"{args.lobe} at n = {args.n:g}, {SIZE:,} float32 cosines, {os.cpu_count()} CPUs")
-    print(f"  specula lobe(t)          {allocating / 1e9:7.3f} G evals/s")
-    print(f"  specula lobe(t, out=)    {into / 1e9:7.3f} G evals/s")
-    print(f"  numpy t**n               {numpy_rate / 1e9:7.3f} G evals/s")
-    print(f"  numpy t**n, out=         {numpy_into / 1e9:7.3f} G evals/s")
-    print(f"  specula / numpy          {allocating / numpy_rate:7.2f}x (both allocating), "
-          f"{into / numpy_into:.2f}x (both out=)")
-    if not args.cli:
-        print("  (no specula binary: give --cli or set SPECULA_BIN for the CLI ratio)")
-        return
-    measured = json.loads(
-        subprocess.run([args.cli, "bench", "lobes", "--n", f"{args.n:g}", "--format", "json"],
-                       capture_output=True, text=True, check=True).stdout
-    )
-    row = next(r for r in measured["lobes"] if r["lobe"] == args.lobe)
-    if not row.get("stream"):
-        print("  (the CLI measured no streaming rate)")
-        return
-    cli_rate = row["stream"][1]
-    print(f"  CLI streaming, all threads {cli_rate / 1e9:5.3f} G evals/s ({measured['threads']} threads)")
-    print(f"  specula from Python / CLI {into / cli_rate:6.2f} (out=, reused as the CLI's buffers), "
-          f"{allocating / cli_rate:.2f} (allocating, which the CLI does not time)")
+    cli = {}
+    if args.cli:
+        measured = json.loads(
+            subprocess.run([args.cli, "bench", "lobes", "--n", f"{args.n:g}", "--format", "json"],
+                           capture_output=True, text=True, check=True).stdout
+        )
+        cli = {r["lobe"]: r["stream"][1] for r in measured["lobes"] if r.get("stream")}
+    lobes = specula.lobe_ids() if args.lobe == "all" else [args.lobe]
+    print(f"n = {args.n:g}, {SIZE:,} float32 cosines, {os.cpu_count()} CPUs; G evals/s")
+    print(f"numpy t**n: {numpy_rate / 1e9:.3f} allocating, {numpy_into / 1e9:.3f} with out=")
+    print(f"{'lobe':12s} {'lobe(t)':>8s} {'out=':>8s} {'CLI':>8s}  {'vs numpy':>18s}  {'vs CLI':>6s}")
+    for lobe_id in lobes:
+        lobe = specula.Lobe(lobe_id, args.n)
+        allocating = best_rate(lambda: lobe(t))
+        into = best_rate(lambda: lobe(t, out=out))
+        stream = cli.get(lobe_id)
+        versus_cli = f"{into / stream:6.2f}" if stream else "     -"
+        print(f"{lobe_id:12s} {allocating / 1e9:8.3f} {into / 1e9:8.3f} "
+              f"{(stream or float('nan')) / 1e9:8.3f}  "
+              f"{allocating / numpy_rate:6.2f}x {into / numpy_into:6.2f}x (out=)  {versus_cli}")
+    print("vs numpy: allocating against allocating, out= against out=; vs CLI: out= (buffers "
+          "reused, the CLI's condition) against `specula bench lobes`' all-thread streaming rate")
 
 
 if __name__ == "__main__":

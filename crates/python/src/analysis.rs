@@ -2,16 +2,17 @@
 //! as the CLI's JSON, which `specula/__init__.py` parses.
 
 use pyo3::prelude::*;
-use rayon::prelude::*;
-use specula::analysis::{analyze, LobeReport, Precision};
+use specula::analysis::{analyze_all, Precision, DEFAULT_EXPONENTS};
 use specula::claims::{claim_exponents, evaluate_all, ClaimOptions};
 use specula::zones::{bloom_angle, bloom_cos, epicentre_angle, epicentre_cos};
-use specula::LobeKind;
+use specula::{Exponent, LobeKind};
 
+use crate::arrays::count;
 use crate::errors::{guarded, value_error};
 use crate::lobe::exponent;
 
-fn json(value: &impl serde::Serialize) -> PyResult<String> {
+/// `value` as JSON text.
+pub fn json(value: &impl serde::Serialize) -> PyResult<String> {
     serde_json::to_string(value).map_err(|e| value_error(e.to_string()))
 }
 
@@ -19,91 +20,79 @@ fn json(value: &impl serde::Serialize) -> PyResult<String> {
 /// (``t^n >= 1/256``) end, as cosines and angles (radians).
 #[pyfunction]
 pub fn zones_json(n: f64) -> PyResult<String> {
-    let n = exponent(n)?;
-    json(&serde_json::json!({
-        "n": n.get(),
-        "epicentre_cos": epicentre_cos(n),
-        "bloom_cos": bloom_cos(n),
-        "epicentre_angle": epicentre_angle(n),
-        "bloom_angle": bloom_angle(n),
-    }))
+    guarded(|| {
+        let n = exponent(n)?;
+        json(&serde_json::json!({
+            "n": n.get(),
+            "epicentre_cos": epicentre_cos(n),
+            "bloom_cos": bloom_cos(n),
+            "epicentre_angle": epicentre_angle(n),
+            "bloom_angle": bloom_angle(n),
+        }))
+    })
 }
 
-/// Every figure of ``specula analyze`` for lobes x exponents, as its JSON rows.
+/// Every figure of ``specula analyze`` for lobes x exponents (its defaults where ``None``),
+/// as its JSON rows.
 #[pyfunction]
-#[pyo3(signature = (lobes, exponents, precision = "f64"))]
+#[pyo3(signature = (lobes = None, exponents = None, precision = "f64"))]
 pub fn analyze_json(
     py: Python<'_>,
-    lobes: Vec<String>,
-    exponents: Vec<f64>,
+    lobes: Option<Vec<String>>,
+    exponents: Option<Vec<f64>>,
     precision: &str,
 ) -> PyResult<String> {
-    let precision = match precision {
-        "f64" => Precision::F64,
-        "f32" => Precision::F32,
-        "simd" => Precision::F32Simd,
-        other => {
-            return Err(value_error(format!(
-                "unknown precision '{other}'; valid precisions: f64, f32, simd"
-            )))
-        }
-    };
-    let kinds = lobes
-        .iter()
-        .map(|text| {
-            let lobe = specula_render::lobe_file::parse_lobe(text, None).map_err(value_error)?;
-            Ok(lobe)
-        })
-        .collect::<PyResult<Vec<LobeKind>>>()?;
-    let exponents = exponents
-        .into_iter()
-        .map(exponent)
-        .collect::<PyResult<Vec<_>>>()?;
-    for &kind in &kinds {
-        for &n in &exponents {
-            specula::Lobe::checked(kind, n).map_err(|e| value_error(e.to_string()))?;
-        }
-    }
-    let jobs: Vec<_> = kinds
-        .iter()
-        .flat_map(|&kind| exponents.iter().map(move |&n| (kind, n)))
-        .collect();
     guarded(|| {
-        let reports: Vec<LobeReport> = py.detach(|| {
-            jobs.par_iter()
-                .map(|&(kind, n)| analyze(kind, n, &mut { precision }))
-                .collect()
-        });
-        json(&reports)
+        let precision = Precision::parse(precision).map_err(value_error)?;
+        let kinds = match lobes {
+            None => LobeKind::ALL.to_vec(),
+            Some(texts) => texts
+                .iter()
+                .map(|text| specula_render::lobe_file::parse_lobe(text, None).map_err(value_error))
+                .collect::<PyResult<Vec<LobeKind>>>()?,
+        };
+        let exponents: Vec<Exponent> = match exponents {
+            None => DEFAULT_EXPONENTS
+                .iter()
+                .map(|&n| Exponent::new(n))
+                .collect(),
+            Some(values) => values.into_iter().map(exponent).collect::<PyResult<_>>()?,
+        };
+        specula_decide::check_lobes(&kinds, &exponents).map_err(value_error)?;
+        json(&py.detach(|| analyze_all(&kinds, &exponents, precision, &|| {})))
     })
 }
 
 /// The thesis's accuracy and energy claims with their verdicts, as ``specula claims
-/// --format json`` (without the hardware claim, which synthesizes).
+/// --format json`` (without the hardware claim, which synthesizes); each option the CLI's
+/// default where ``None``.
 #[pyfunction]
-#[pyo3(signature = (exponent_steps = 48, samples_per_zone = 100_001, reciprocity_pairs = 100_000, seed = 0x5eed_5bec))]
+#[pyo3(signature = (exponent_steps = None, samples_per_zone = None, reciprocity_pairs = None, seed = None))]
 pub fn claims_json(
     py: Python<'_>,
-    exponent_steps: usize,
-    samples_per_zone: usize,
-    reciprocity_pairs: usize,
-    seed: u64,
+    exponent_steps: Option<i64>,
+    samples_per_zone: Option<i64>,
+    reciprocity_pairs: Option<i64>,
+    seed: Option<i64>,
 ) -> PyResult<String> {
-    if !(1..=1000).contains(&exponent_steps)
-        || !(2..=10_000_000).contains(&samples_per_zone)
-        || !(1..=100_000_000).contains(&reciprocity_pairs)
-    {
-        return Err(value_error(format!(
-            "claims: exponent_steps {exponent_steps} (1 to 1000), samples_per_zone \
-             {samples_per_zone} (2 to 10000000) or reciprocity_pairs {reciprocity_pairs} \
-             (1 to 100000000) is out of range"
-        )));
-    }
-    let options = ClaimOptions {
-        exponents: claim_exponents(exponent_steps),
-        samples_per_zone,
-        reciprocity_pairs,
-        seed,
-    };
-    guarded(|| json(&py.detach(|| evaluate_all(&options))))
+    guarded(|| {
+        let defaults = ClaimOptions::default();
+        let options = ClaimOptions {
+            exponents: match exponent_steps {
+                None => defaults.exponents,
+                Some(steps) => claim_exponents(count("exponent_steps", steps, 1, 200)?),
+            },
+            samples_per_zone: samples_per_zone.map_or(Ok(defaults.samples_per_zone), |s| {
+                count("samples_per_zone", s, 2, 1_000_001)
+            })?,
+            reciprocity_pairs: reciprocity_pairs.map_or(Ok(defaults.reciprocity_pairs), |p| {
+                count("reciprocity_pairs", p, 1, 10_000_000)
+            })?,
+            seed: seed.map_or(Ok(defaults.seed), |s| {
+                u64::try_from(s)
+                    .map_err(|_| value_error(format!("seed {s} is negative; give 0 or more")))
+            })?,
+        };
+        json(&py.detach(|| evaluate_all(&options)))
+    })
 }

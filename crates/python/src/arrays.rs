@@ -7,7 +7,7 @@
 
 use numpy::ndarray::{ArrayD, ArrayViewD, IxDyn};
 use numpy::{PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods};
-use pyo3::exceptions::PyTypeError;
+use pyo3::exceptions::{PyMemoryError, PyTypeError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
@@ -51,7 +51,7 @@ pub fn floats<'py>(object: &Bound<'py, PyAny>, name: &str) -> PyResult<Floats<'p
     )))
 }
 
-/// A `float64` array argument of shape `(..., last)` (or `(last,)` when `single` allows it).
+/// A `float64` array argument of shape `(..., last)`.
 pub fn float64_rows<'py>(
     object: &Bound<'py, PyAny>,
     name: &str,
@@ -88,16 +88,40 @@ pub fn tuple(shape: &[usize]) -> String {
     }
 }
 
-/// `view` as a contiguous slice: borrowed when it is one, copied in logical order when not.
-pub fn contiguous<'a, T: Copy>(view: &'a ArrayViewD<'a, T>) -> std::borrow::Cow<'a, [T]> {
-    match view.as_slice() {
-        Some(slice) => std::borrow::Cow::Borrowed(slice),
-        None => std::borrow::Cow::Owned(view.iter().copied().collect()),
+/// `view` as a contiguous slice: borrowed when it is one, copied in logical order when not
+/// (a `MemoryError` rather than an abort where the copy does not fit: a broadcast view of a
+/// few bytes can stand for terabytes).
+pub fn contiguous<'a, T: Copy>(view: &'a ArrayViewD<'a, T>) -> PyResult<std::borrow::Cow<'a, [T]>> {
+    if let Some(slice) = view.as_slice() {
+        return Ok(std::borrow::Cow::Borrowed(slice));
     }
+    let mut copy = Vec::new();
+    copy.try_reserve_exact(view.len()).map_err(|_| {
+        PyMemoryError::new_err(format!(
+            "a strided array of {} elements does not fit in memory as a contiguous copy",
+            view.len()
+        ))
+    })?;
+    copy.extend(view.iter().copied());
+    Ok(std::borrow::Cow::Owned(copy))
+}
+
+/// `value` as a count in `[low, high]`, or a `ValueError` naming `name` and the range (Python
+/// integers may be negative or huge; neither reaches the library).
+pub fn count(name: &str, value: i64, low: usize, high: usize) -> PyResult<usize> {
+    usize::try_from(value)
+        .ok()
+        .filter(|v| (low..=high).contains(v))
+        .ok_or_else(|| {
+            value_error(format!(
+                "{name} {value} is out of range; give {low} to {high}"
+            ))
+        })
 }
 
 /// A float element whose finiteness is checked on its bits (an exponent of all ones is a NaN
-/// or an infinity), which vectorises to integer compares.
+/// or an infinity): integer compares, which vectorise (measured faster than a max-reduction
+/// of the magnitudes' bits).
 pub trait Finite: Copy + Send + Sync {
     /// Whether the value is neither NaN nor infinite.
     fn finite(self) -> bool;

@@ -19,7 +19,8 @@ fn lobes(texts: &[String]) -> PyResult<Vec<LobeKind>> {
         .collect()
 }
 
-/// `specula recommend --format json`'s rows: every candidate ranked on `target`.
+/// `specula recommend --format json`'s rows (every candidate ranked on `target`) and the
+/// note the CLI prints on standard error, if any.
 #[pyfunction]
 #[pyo3(signature = (target, n, max_error, zone, energy_conserving, extra_lobes))]
 pub fn recommend_json(
@@ -43,7 +44,8 @@ pub fn recommend_json(
         let answer = py
             .detach(|| recommend(&request, &ProgressBar::hidden()))
             .map_err(value_error)?;
-        serde_json::to_string(&answer.candidates).map_err(|e| value_error(e.to_string()))
+        let reply = serde_json::json!({ "note": answer.note, "candidates": answer.candidates });
+        Ok(reply.to_string())
     })
 }
 
@@ -52,6 +54,13 @@ pub fn recommend_json(
 pub fn cost_json(py: Python<'_>, target: &str, lobe: &Lobe) -> PyResult<String> {
     guarded(|| {
         let target = Target::from_str(target).map_err(value_error)?;
+        if target == Target::Fpga {
+            return Err(value_error(
+                "an FPGA cost depends on the accuracy asked for (it sets the datapath's word \
+                 length): use recommend(\"fpga\", n, max_error), whose rows name the datapath \
+                 and its cost; valid targets here: cpu, gpu-nvidia, gpu-amd",
+            ));
+        }
         let core = *lobe.core();
         let rate = py
             .detach(|| lobe_rate(target, &core))

@@ -17,8 +17,8 @@ use specula::sampling::SpecularSampler;
 use specula::{Brdf, Exponent, Geometry, LobeKind, Normalisation};
 
 use crate::arrays::{
-    contiguous, first_non_finite, float64_rows, floats, map_chunks, non_finite, shaped, tuple,
-    Finite, Floats,
+    contiguous, count, first_non_finite, float64_rows, floats, map_chunks, non_finite, shaped,
+    tuple, Finite, Floats,
 };
 use crate::errors::{guarded, value_error};
 
@@ -95,7 +95,7 @@ impl Lobe {
         let wi = float64_rows(wi, "wi", 3)?;
         let wi_view = wi.as_array();
         let leading = wi_view.shape()[..wi_view.ndim() - 1].to_vec();
-        let wi = directions(&contiguous(&wi_view), "wi")?;
+        let wi = directions(&contiguous(&wi_view)?, "wi")?;
         let wo = outgoing(wo, &leading)?;
         let sampler = self.sampler();
         let values: Vec<f64> = py.detach(|| {
@@ -129,7 +129,7 @@ impl Outgoing {
 fn outgoing(wo: &Bound<'_, PyAny>, leading: &[usize]) -> PyResult<Outgoing> {
     let wo = float64_rows(wo, "wo", 3)?;
     let view = wo.as_array();
-    let rows = directions(&contiguous(&view), "wo")?;
+    let rows = directions(&contiguous(&view)?, "wo")?;
     if view.ndim() == 1 {
         return Ok(Outgoing::One(rows[0]));
     }
@@ -201,8 +201,8 @@ impl Lobe {
 
     /// The normalisation constant ``N(n)`` for this lobe.
     #[getter]
-    fn constant(&self) -> f64 {
-        self.normalisation.constant_for(&self.lobe)
+    fn constant(&self) -> PyResult<f64> {
+        guarded(|| Ok(self.normalisation.constant_for(&self.lobe)))
     }
 
     fn __repr__(&self) -> String {
@@ -260,14 +260,10 @@ impl Lobe {
     ///     ``epicentre_max_rel``, ``epicentre_max_abs``, ``bloom_max_abs``, ``tail_max_abs``,
     ///     ``rms`` and the other figures of ``specula analyze --format json``.
     #[pyo3(signature = (samples_per_zone = 20_001))]
-    fn errors_json(&self, py: Python<'_>, samples_per_zone: usize) -> PyResult<String> {
-        if !(2..=10_000_000).contains(&samples_per_zone) {
-            return Err(value_error(format!(
-                "samples_per_zone {samples_per_zone} is out of range; give 2 to 10000000"
-            )));
-        }
+    fn errors_json(&self, py: Python<'_>, samples_per_zone: i64) -> PyResult<String> {
         let lobe = self.lobe;
         guarded(|| {
+            let samples_per_zone = count("samples_per_zone", samples_per_zone, 2, 1_000_001)?;
             let figures = py.detach(|| error_figures(&lobe, &mut Precision::F64, samples_per_zone));
             serde_json::to_string(&figures).map_err(|e| value_error(e.to_string()))
         })
@@ -282,32 +278,32 @@ impl Lobe {
     /// The specular term's directional albedo ``int N(n) lobe(t) cos(theta_i) dwi`` for an
     /// outgoing direction at polar angle ``theta_o`` (radians, clamped to [0, pi/2]).
     fn albedo(&self, py: Python<'_>, theta_o: f64) -> PyResult<f64> {
-        if !theta_o.is_finite() {
-            return Err(value_error(format!(
-                "theta_o is {theta_o}; give a finite angle in radians"
-            )));
-        }
-        let (lobe, geometry, constant) = (self.lobe, self.geometry, self.constant());
-        guarded(|| Ok(py.detach(|| constant * specular_albedo_per_unit(&lobe, geometry, theta_o))))
+        guarded(|| {
+            if !theta_o.is_finite() {
+                return Err(value_error(format!(
+                    "theta_o is {theta_o}; give a finite angle in radians"
+                )));
+            }
+            let (lobe, geometry, constant) = (self.lobe, self.geometry, self.constant()?);
+            Ok(py.detach(|| constant * specular_albedo_per_unit(&lobe, geometry, theta_o)))
+        })
     }
 
     /// The worst Helmholtz asymmetry ``|f(a, b) - f(b, a)| / max`` of the specular BRDF over
     /// ``pairs`` direction pairs drawn uniformly on the hemisphere from ``seed``.
     #[pyo3(signature = (pairs = 100_000, seed = 0x5eed_5bec))]
-    fn reciprocity_error(&self, py: Python<'_>, pairs: usize, seed: u64) -> PyResult<f64> {
-        if !(1..=100_000_000).contains(&pairs) {
-            return Err(value_error(format!(
-                "pairs {pairs} is out of range; give 1 to 100000000"
-            )));
-        }
-        let brdf = Brdf::new(
-            DVec3::ZERO,
-            DVec3::ONE,
-            self.lobe,
-            self.geometry,
-            self.normalisation,
-        );
+    fn reciprocity_error(&self, py: Python<'_>, pairs: i64, seed: i64) -> PyResult<f64> {
         guarded(|| {
+            let pairs = count("pairs", pairs, 1, 10_000_000)?;
+            let seed = u64::try_from(seed)
+                .map_err(|_| value_error(format!("seed {seed} is negative; give 0 or more")))?;
+            let brdf = Brdf::new(
+                DVec3::ZERO,
+                DVec3::ONE,
+                self.lobe,
+                self.geometry,
+                self.normalisation,
+            );
             Ok(py.detach(|| {
                 use rand::SeedableRng;
                 let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
@@ -344,7 +340,7 @@ impl Lobe {
             let u = float64_rows(u, "u", 2)?;
             let u_view = u.as_array();
             let leading = u_view.shape()[..u_view.ndim() - 1].to_vec();
-            let flat = contiguous(&u_view);
+            let flat = contiguous(&u_view)?;
             if let Some(index) = flat.iter().position(|v| !(0.0..1.0).contains(v)) {
                 return Err(value_error(format!(
                     "u holds {} at flat index {index}; uniform numbers must be in [0, 1)",
@@ -430,6 +426,9 @@ impl Lobe {
     ) -> PyResult<Py<PyAny>> {
         let lobe = self.lobe;
         match floats(t, "t")? {
+            Floats::Scalar(_) if out.is_some() => Err(value_error(
+                "out is given but t is a number; out= takes an array of t's dtype and shape",
+            )),
             Floats::Scalar(t) => {
                 if !t.is_finite() {
                     return Err(non_finite("t", 0));
@@ -438,13 +437,13 @@ impl Lobe {
             }
             Floats::Single(array) => {
                 let view = array.as_array();
-                let input = contiguous(&view);
+                let input = contiguous(&view)?;
                 let kernel = |t: &[f32], o: &mut [f32]| lobe.eval_batch(t, o);
                 evaluate_into(py, &input, view.shape(), out, "float32", &kernel)
             }
             Floats::Double(array) => {
                 let view = array.as_array();
-                let input = contiguous(&view);
+                let input = contiguous(&view)?;
                 let kernel = |t: &[f64], o: &mut [f64]| {
                     for (o, &t) in o.iter_mut().zip(t) {
                         *o = lobe.eval(t);

@@ -5,11 +5,12 @@
 use std::path::PathBuf;
 
 use numpy::IntoPyArray;
+use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
-use specula_render::ibl::{render_ibl, Environment, IblSettings, Strategy, MAX_SPP, SKY_WIDTH};
+use specula_render::ibl::{render_ibl, Environment, IblSettings, Strategy, MAX_SPP};
 use specula_render::{
     render as rasterize, IlluminationModel, Image, Overrides, Scene, Shading, DEFAULT_SCENE,
-    IBL_SCENE, MAX_SAMPLES,
+    MAX_SAMPLES,
 };
 
 use crate::arrays::shaped;
@@ -82,12 +83,12 @@ pub fn render(
     normalisation: Option<&str>,
     shading: Option<&str>,
     model: Option<&str>,
-    width: Option<u32>,
-    height: Option<u32>,
-    samples: Option<u32>,
+    width: Option<i64>,
+    height: Option<i64>,
+    samples: Option<i64>,
     environment: Option<PathBuf>,
-    spp: u32,
-    seed: u64,
+    spp: i64,
+    seed: i64,
 ) -> PyResult<Py<PyAny>> {
     guarded(|| {
         let overrides = Overrides {
@@ -116,27 +117,33 @@ pub fn render(
                 .map(|s| within("samples", s, 1, MAX_SAMPLES))
                 .transpose()?,
         };
-        within("spp", spp, 1, MAX_SPP)?;
+        let spp = within("spp", spp, 1, MAX_SPP)?;
+        let seed = u64::try_from(seed)
+            .map_err(|_| value_error(format!("seed {seed} is negative; give 0 or more")))?;
         if environment.is_some() && (shading.is_some() || model.is_some()) {
             return Err(value_error(
                 "shading and model do not apply under an environment (it is path traced); drop them",
             ));
         }
-        let loaded = match (&scene, &environment) {
-            (Some(path), _) => Scene::from_file(path).map_err(|e| file_error(path, e.to_string())),
-            (None, None) => Scene::from_toml(DEFAULT_SCENE, "<default scene>", None)
-                .map_err(|e| value_error(e.to_string())),
-            (None, Some(_)) => Scene::from_toml(IBL_SCENE, "<environment scene>", None)
-                .map_err(|e| value_error(e.to_string())),
-        }?;
+        let loaded =
+            Scene::from_file_or_default(scene.as_deref(), environment.is_some()).map_err(|e| {
+                match &scene {
+                    Some(path) => file_error(path, e.to_string()),
+                    None => value_error(e.to_string()),
+                }
+            })?;
+        for warning in &loaded.warnings {
+            let text = std::ffi::CString::new(warning.to_string())
+                .unwrap_or_else(|_| c"a scene warning".to_owned());
+            PyErr::warn(py, &py.get_type::<PyUserWarning>(), &text, 1)?;
+        }
         let mut scene = loaded.scene;
         scene.apply(&overrides);
         scene.check_lobes().map_err(value_error)?;
         let environment = match environment {
             None => None,
-            Some(path) if path.as_os_str() == "sky" => Some(Environment::sky(SKY_WIDTH)),
-            Some(path) => {
-                Some(Environment::load(&path).map_err(|e| file_error(&path, e.to_string()))?)
+            Some(name) => {
+                Some(Environment::named(&name).map_err(|e| file_error(&name, e.to_string()))?)
             }
         };
         let image = py.detach(|| match &environment {
@@ -155,12 +162,13 @@ pub fn render(
 }
 
 /// `value` if it lies in `[low, high]`, else a message naming the range.
-pub fn within(name: &str, value: u32, low: u32, high: u32) -> PyResult<u32> {
-    if (low..=high).contains(&value) {
-        Ok(value)
-    } else {
-        Err(value_error(format!(
-            "{name} {value} is out of range; give {low} to {high}"
-        )))
-    }
+pub fn within(name: &str, value: i64, low: u32, high: u32) -> PyResult<u32> {
+    u32::try_from(value)
+        .ok()
+        .filter(|v| (low..=high).contains(v))
+        .ok_or_else(|| {
+            value_error(format!(
+                "{name} {value} is out of range; give {low} to {high}"
+            ))
+        })
 }

@@ -13,6 +13,7 @@ use specula_render::volume::raymarch::{render_dvr, DvrSettings, Shading, View};
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::{self, Units};
 
+use crate::arrays::count;
 use crate::errors::{file_error, guarded, value_error};
 use crate::lobe::{geometry, normalisation, parse};
 use crate::render::{image_array, within};
@@ -42,11 +43,13 @@ impl Volume {
         })
     }
 
-    /// A built-in volume (``"shepp-logan"``, ``"marschner-lobb"``) of ``side`` voxels a side.
+    /// A built-in volume (``"phantom"``, the 3D Shepp-Logan head, or ``"marschner-lobb"``)
+    /// of ``side`` voxels a side (8 to 512).
     #[staticmethod]
     #[pyo3(signature = (name, side = 128))]
-    fn phantom(py: Python<'_>, name: &str, side: usize) -> PyResult<Self> {
+    fn phantom(py: Python<'_>, name: &str, side: i64) -> PyResult<Self> {
         guarded(|| {
+            let side = count("side", side, *BuiltIn::SIDES.start(), *BuiltIn::SIDES.end())?;
             let built_in = BuiltIn::parse(name).ok_or_else(|| {
                 let names = BuiltIn::ALL.map(BuiltIn::id);
                 value_error(format!(
@@ -67,10 +70,13 @@ impl Volume {
     /// ``get_fdata()`` (a Fortran-ordered copy).
     #[getter]
     fn data(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        let [nx, ny, nz] = self.volume.dims();
-        let array = numpy::ndarray::ArrayView3::from_shape((nx, ny, nz).f(), self.volume.samples())
-            .map_err(|e| value_error(e.to_string()))?;
-        Ok(array.to_pyarray(py).into_any().unbind())
+        guarded(|| {
+            let [nx, ny, nz] = self.volume.dims();
+            let array =
+                numpy::ndarray::ArrayView3::from_shape((nx, ny, nz).f(), self.volume.samples())
+                    .map_err(|e| value_error(e.to_string()))?;
+            Ok(array.to_pyarray(py).into_any().unbind())
+        })
     }
 
     /// The 4 x 4 float64 map from grid index ``(i, j, k, 1)`` to world millimetres (RAS).
@@ -156,8 +162,8 @@ pub fn render_volume(
     n: f64,
     geometry: &str,
     normalisation: &str,
-    width: u32,
-    height: u32,
+    width: i64,
+    height: i64,
     view: &str,
     transfer: Option<&str>,
 ) -> PyResult<Py<PyAny>> {
@@ -167,8 +173,9 @@ pub fn render_volume(
             self::geometry(geometry)?,
             self::normalisation(normalisation)?,
         );
-        within("width", width, 1, 16_384)?;
-        within("height", height, 1, 16_384)?;
+        // The ray marcher's plan refuses an image beyond its pixel budget.
+        let width = within("width", width, 1, u32::MAX)?;
+        let height = within("height", height, 1, u32::MAX)?;
         let view = View::parse(view).map_err(value_error)?;
         let data = &volume.volume;
         let function = match (transfer, volume.built_in) {

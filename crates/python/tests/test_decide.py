@@ -30,8 +30,19 @@ def test_on_the_cpu_the_same_lobes_are_ranked_by_measured_rates(cli_json):
     assert all(a["rate"] >= b["rate"] for a, b in zip(meeting, meeting[1:]))
 
 
+def test_a_datapath_that_does_not_fit_the_part_does_not_meet():
+    # Over 8..512 within 5 % schlick-mod needs 16 bits at some exponent, which Yosys counts
+    # below the iCE40 HX8K's 7,680 LUTs but nextpnr cannot pack into it.
+    rows = {r["lobe"]: r for r in specula.recommend("fpga", n="8..512", max_error=0.05)}
+    unfit = [r for r in rows.values() if "does not fit" in (r.get("datapath") or "")]
+    assert unfit, rows
+    for row in unfit:
+        assert row["rate"] == 0 and not row["meets"]
+    assert rows[next(r["lobe"] for r in rows.values() if r["meets"])]["rate"] > 0
+
+
 def test_your_own_lobe_is_a_candidate(cli_json):
-    ours = specula.recommend("gpu-nvidia", n=64, max_error=0.01, lobes=["=t^n"])
+    ours = specula.recommend("gpu-nvidia", n=64, max_error=0.01, lobes="=t^n")
     theirs = cli_json("recommend", "--target", "gpu-nvidia", "--n", "64", "--max-error", "1%",
                       "--lobe", "=t^n", "--format", "json")
     assert ours == theirs
@@ -57,8 +68,12 @@ def test_bad_requests_raise_the_clis_message(cli):
     code, _, err = cli("recommend", "--target", "gpu-amd", "--n", "512..8", "--max-error", "1%")
     assert code != 0 and str(raised.value) in err
     for bad in [0.0, -0.1, 1.5, math.nan]:
-        with pytest.raises(ValueError, match=r"max_error|error"):
+        with pytest.raises(ValueError, match=r"\(0, 1\]"):
             specula.recommend("gpu-amd", max_error=bad)
+    with pytest.raises(ValueError, match=r"FPGA cost depends on the accuracy"):
+        specula.cost("fpga", specula.Lobe("pow", 8))
+    with pytest.raises(ValueError, match=r"valid targets"):
+        specula.cost("asic", specula.Lobe("pow", 8))
 
 
 def test_the_report_is_written_from_python(tmp_path):
@@ -67,5 +82,7 @@ def test_the_report_is_written_from_python(tmp_path):
     assert page.endswith("index.html") and "Which lobe when" in html
     # Every image the page names is there.
     import re
-    for name in set(re.findall(r'src="([^"]+\.(?:svg|png))"', html)):
+    images = set(re.findall(r'src="([^"]+\.(?:svg|png))"', html))
+    assert len(images) > 10
+    for name in images:
         assert (tmp_path / "report" / name).exists(), name

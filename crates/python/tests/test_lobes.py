@@ -87,6 +87,40 @@ def test_out_receives_the_values_without_allocating():
         lobe(t, out=np.empty_like(t, dtype=np.float64))
 
 
+def test_out_must_be_a_separate_writable_contiguous_array():
+    lobe = specula.Lobe("pow", 4)
+    t = cosines(dtype=np.float32)
+    with pytest.raises(ValueError, match=r"not t itself"):
+        lobe(t, out=t)
+    frozen = np.empty_like(t)
+    frozen.setflags(write=False)
+    with pytest.raises(ValueError, match=r"writable float32"):
+        lobe(t, out=frozen)
+    strided = np.empty(2 * t.size, dtype=np.float32)[::2]
+    with pytest.raises(ValueError, match=r"not C-contiguous"):
+        lobe(t, out=strided)
+    with pytest.raises(ValueError, match=r"out is given but t is a number"):
+        lobe(0.5, out=np.empty(1))
+
+
+def test_a_broadcast_view_of_terabytes_is_a_memory_error_not_a_crash():
+    huge = np.broadcast_to(np.float32(0.5), (1 << 40,))
+    with pytest.raises(MemoryError):
+        specula.Lobe("pow", 8)(huge)
+
+
+def test_sizes_and_seeds_are_refused_as_values_not_overflows():
+    lobe = specula.Lobe("pow", 8)
+    with pytest.raises(ValueError, match=r"pairs -1 is out of range; give 1 to 10000000"):
+        lobe.reciprocity_error(pairs=-1)
+    with pytest.raises(ValueError, match=r"seed -5 is negative"):
+        lobe.reciprocity_error(pairs=10, seed=-5)
+    with pytest.raises(ValueError, match=r"samples_per_zone 10000000000 is out of range"):
+        specula.errors(lobe, samples_per_zone=10**10)
+    with pytest.raises(ValueError, match=r"exponent_steps 100000 is out of range"):
+        specula.claims(exponent_steps=100_000)
+
+
 def test_other_dtypes_are_refused_by_name_not_converted():
     lobe = specula.Lobe("pow", 8)
     with pytest.raises(ValueError, match=r"t has dtype int64; specula takes float32"):

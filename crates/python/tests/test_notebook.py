@@ -2,14 +2,17 @@
 
 from pathlib import Path
 
-import pytest
+from conftest import required
 
 NOTEBOOK = Path(__file__).resolve().parents[3] / "docs" / "python-example.ipynb"
 
 
 def test_the_example_notebook_executes(tmp_path):
-    nbformat = pytest.importorskip("nbformat")
-    nbclient = pytest.importorskip("nbclient")
+    try:
+        import nbclient
+        import nbformat
+    except ImportError:
+        required("nbclient and nbformat", "pip install -r crates/python/tests/requirements.txt")
     notebook = nbformat.read(NOTEBOOK, as_version=4)
     client = nbclient.NotebookClient(
         notebook, timeout=600, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import specula
+from conftest import required
 
 
 def test_the_default_scene_renders_to_linear_radiance():
@@ -48,12 +49,17 @@ def test_bad_render_requests_are_refused(tmp_path):
         specula.render(shading="toon")
     with pytest.raises(ValueError, match=r"width 0 is out of range"):
         specula.render(width=0)
-    with pytest.raises(OverflowError):
+    with pytest.raises(ValueError, match=r"width -3 is out of range"):
         specula.render(width=-3)
+    with pytest.raises(ValueError, match=r"seed -1 is negative"):
+        specula.render(environment="sky", seed=-1)
 
 
 def test_a_real_mri_reads_as_nibabel_reads_it(mri):
-    nibabel = pytest.importorskip("nibabel")
+    try:
+        import nibabel
+    except ImportError:
+        required("nibabel", "pip install nibabel (crates/cli/tests/renderers/requirements.txt)")
     volume = specula.Volume.load(mri)
     theirs = nibabel.load(str(mri))
     assert volume.shape == theirs.shape
@@ -71,6 +77,9 @@ def test_phantoms_render_and_bad_volumes_are_refused(tmp_path):
     assert np.isfinite(image).all()
     with pytest.raises(ValueError, match=r"valid phantoms: phantom, marschner-lobb"):
         specula.Volume.phantom("teapot")
+    for side in [0, 7, 513, -1]:
+        with pytest.raises(ValueError, match=rf"side {side} is out of range; give 8 to 512"):
+            specula.Volume.phantom("phantom", side)
     with pytest.raises(OSError):
         specula.Volume.load(tmp_path / "absent.nii")
     junk = tmp_path / "junk.nii"

@@ -2,7 +2,7 @@
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use specula::analysis::{analyze, LobeReport, DEFAULT_EXPONENTS};
+use specula::analysis::{analyze, analyze_all, LobeReport, DEFAULT_EXPONENTS};
 use specula::{Exponent, LobeKind};
 use specula_gpu::{Gpu, GpuEvaluator, LobeEvaluator};
 
@@ -44,24 +44,17 @@ pub fn run(args: &Args) -> CommandResult {
         args.n.clone()
     };
     crate::args::check_lobes(&lobes, &exponents)?;
-    let jobs: Vec<(LobeKind, Exponent)> = lobes
-        .iter()
-        .flat_map(|&lobe| exponents.iter().map(move |&n| (lobe, n)))
-        .collect();
-    let progress = ProgressBar::new(jobs.len() as u64).with_style(
+    let progress = ProgressBar::new((lobes.len() * exponents.len()) as u64).with_style(
         ProgressStyle::with_template("analyzing {bar:30} {pos}/{len} {elapsed}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let reports: Vec<LobeReport> = match args.backend.cpu_precision() {
-        Some(precision) => jobs
-            .par_iter()
-            .map(|&(lobe, n)| {
-                let report = analyze(lobe, n, &mut { precision });
-                progress.inc(1);
-                report
-            })
-            .collect(),
+        Some(precision) => analyze_all(&lobes, &exponents, precision, &|| progress.inc(1)),
         None => {
+            let jobs: Vec<(LobeKind, Exponent)> = lobes
+                .iter()
+                .flat_map(|&lobe| exponents.iter().map(move |&n| (lobe, n)))
+                .collect();
             let gpu = Gpu::new().map_err(|e| e.to_string())?;
             let evaluator = LobeEvaluator::new(&gpu).map_err(|e| e.to_string())?;
             jobs.par_iter()

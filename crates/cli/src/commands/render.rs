@@ -6,10 +6,10 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use specula::{Exponent, Geometry, LobeKind, Normalisation};
 use specula_gpu::{Gpu, GpuRenderer};
-use specula_render::ibl::{render_ibl, Environment, IblSettings, Strategy, MAX_SPP, SKY_WIDTH};
+use specula_render::ibl::{render_ibl, Environment, IblSettings, Strategy, MAX_SPP};
 use specula_render::{
     check_output_path, render, render_grid_with, write_image, write_png_srgb8, GridOptions,
-    IlluminationModel, Image, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE, IBL_SCENE,
+    IlluminationModel, Image, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE,
 };
 
 use super::CommandResult;
@@ -102,12 +102,8 @@ fn load(args: &Args) -> Result<Scene, String> {
     let LoadedScene {
         mut scene,
         warnings,
-    } = match (&args.scene, &args.env) {
-        (Some(path), _) => Scene::from_file(path),
-        (None, None) => Scene::from_toml(DEFAULT_SCENE, "<default scene>", None),
-        (None, Some(_)) => Scene::from_toml(IBL_SCENE, "<environment scene>", None),
-    }
-    .map_err(|e| e.to_string())?;
+    } = Scene::from_file_or_default(args.scene.as_deref(), args.env.is_some())
+        .map_err(|e| e.to_string())?;
     for warning in warnings {
         eprintln!("warning: {warning}");
     }
@@ -150,8 +146,7 @@ pub fn run(args: &Args) -> CommandResult {
         Some(_) if args.backend == RendererArg::Gpu => {
             return Err("--env renders on the CPU only; drop --backend gpu".into())
         }
-        Some(path) if path.as_os_str() == "sky" => Some(Environment::sky(SKY_WIDTH)),
-        Some(path) => Some(Environment::load(path).map_err(|e| e.to_string())?),
+        Some(name) => Some(Environment::named(name).map_err(|e| e.to_string())?),
         None => None,
     };
     let gpu = match args.backend {

@@ -117,7 +117,7 @@ pub struct Source {
     #[arg(long, default_value = "phantom")]
     input: String,
     /// Voxels along each side of a built-in volume.
-    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=512))]
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(*BuiltIn::SIDES.start() as i64..=*BuiltIn::SIDES.end() as i64))]
     size: u32,
     #[command(flatten)]
     input_limit: InputLimit,

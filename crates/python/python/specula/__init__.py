@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json as _json
 import os as _os
+import warnings as _warnings
 from typing import Any, Dict, List, Optional, Sequence, Union
 
 from . import _specula
@@ -52,8 +53,9 @@ def lobe_ids() -> List[str]:
     return _specula.lobe_ids()
 
 
-def models() -> List[Dict[str, str]]:
-    """The built-in lobes: id, name, one-line summary and plot colour (``specula models``)."""
+def models() -> List[Dict[str, Any]]:
+    """The built-in lobes as ``specula models --format json`` lists them (id, summary,
+    formula, parameters, origin), each with its plot colour (``colour``, ``#rrggbb``)."""
     return _json.loads(_specula.models_json())
 
 
@@ -103,27 +105,30 @@ def analyze(
     precision : {"f64", "f32", "simd"}
         The arithmetic of the error figures.
     """
-    if lobes is None:
-        lobes = lobe_ids()
     if isinstance(lobes, str):
         lobes = [lobes]
-    if n is None:
-        n = [1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1000]
     if isinstance(n, (int, float)):
         n = [n]
-    return _json.loads(_specula.analyze_json(list(lobes), [float(v) for v in n], precision))
+    return _json.loads(
+        _specula.analyze_json(
+            None if lobes is None else list(lobes),
+            None if n is None else [float(v) for v in n],
+            precision,
+        )
+    )
 
 
 def claims(
-    exponent_steps: int = 48,
-    samples_per_zone: int = 100_001,
-    reciprocity_pairs: int = 100_000,
-    seed: int = 0x5EED5BEC,
+    exponent_steps: Optional[int] = None,
+    samples_per_zone: Optional[int] = None,
+    reciprocity_pairs: Optional[int] = None,
+    seed: Optional[int] = None,
 ) -> List[Dict[str, Any]]:
     """The thesis's accuracy and energy claims, measured, with their verdicts.
 
     The rows of ``specula claims --format json`` (without the hardware claim, which needs
-    Yosys). Smaller arguments give a quick, coarser run.
+    Yosys), each option the CLI's where omitted (49 exponents, 100,001 samples per zone,
+    100,000 direction pairs). Smaller values give a quick, coarser run.
     """
     return _json.loads(
         _specula.claims_json(exponent_steps, samples_per_zone, reciprocity_pairs, seed)
@@ -161,16 +166,22 @@ def recommend(
         One row per lobe (``lobe``, ``datapath``, ``error``, ``rate``, ``unit``,
         ``energy_ratio``, ``meets``, ``pareto``, ``why``), the cheapest that meets it first.
     """
-    return _json.loads(
+    if isinstance(lobes, str):
+        lobes = [lobes]
+    reply = _json.loads(
         _specula.recommend_json(
             target, str(n), float(max_error), zone, bool(energy_conserving), list(lobes)
         )
     )
+    if reply["note"]:
+        _warnings.warn(reply["note"], stacklevel=2)
+    return reply["candidates"]
 
 
 def cost(target: str, lobe: Lobe) -> Dict[str, Any]:
-    """A lobe's cost figure on ``target`` (higher is cheaper): measured on the CPU, modelled
-    on a GPU family, synthesized (or estimated) on the FPGA.
+    """A lobe's cost figure on ``target`` (higher is cheaper): measured on this CPU (one
+    thread) or modelled on a GPU family. The FPGA's cost depends on the accuracy (the
+    datapath's word length), so it is :func:`recommend`'s, not this function's.
 
     Returns
     -------
@@ -187,7 +198,12 @@ def report(
     lobes: Sequence[str] = (),
     materials: Union[str, "_os.PathLike[str]", None] = None,
 ) -> str:
-    """Writes the report (``specula report``) to the folder ``out``; returns the page's path."""
+    """Writes the report (``specula report``) to the folder ``out``; returns the page's path.
+
+    ``lobes`` adds your own lobes to every section (the built-in ones are always there).
+    """
+    if isinstance(lobes, str):
+        lobes = [lobes]
     return _specula.report(
         _os.fspath(out),
         bool(quick),

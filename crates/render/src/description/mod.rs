@@ -122,6 +122,21 @@ impl Locator<'_> {
 }
 
 impl Scene {
+    /// The scene a render starts from: the file at `path`, else the embedded default scene
+    /// (lit by lights), or the environment scene when the render is `lit_by_environment`.
+    pub fn from_file_or_default(
+        path: Option<&Path>,
+        lit_by_environment: bool,
+    ) -> Result<LoadedScene, SceneError> {
+        match path {
+            Some(path) => Scene::from_file(path),
+            None if lit_by_environment => {
+                Scene::from_toml(crate::IBL_SCENE, "<environment scene>", None)
+            }
+            None => Scene::from_toml(crate::DEFAULT_SCENE, "<default scene>", None),
+        }
+    }
+
     /// Reads a scene file; mesh paths in it are relative to the file's directory.
     pub fn from_file(path: &Path) -> Result<LoadedScene, SceneError> {
         let fail = |message: String| SceneError {

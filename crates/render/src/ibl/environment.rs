@@ -125,6 +125,15 @@ impl Environment {
         Self::from_image(read_image(path)?, &path.display().to_string())
     }
 
+    /// The environment `name` gives: `sky` (the built-in sky at [`super::SKY_WIDTH`]) or
+    /// an image file ([`Environment::load`]).
+    pub fn named(name: &Path) -> Result<Self, EnvironmentError> {
+        if name.as_os_str() == "sky" {
+            return Ok(Self::sky(super::SKY_WIDTH));
+        }
+        Self::load(name)
+    }
+
     /// A constant environment: `radiance` from every direction (a white furnace when 1).
     #[must_use]
     pub fn constant(radiance: Vec3) -> Self {

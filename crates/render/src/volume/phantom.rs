@@ -147,6 +147,9 @@ impl BuiltIn {
     /// Every built-in volume.
     pub const ALL: [BuiltIn; 2] = [BuiltIn::SheppLogan, BuiltIn::MarschnerLobb];
 
+    /// The sides (voxels) a built-in volume may be made at.
+    pub const SIDES: std::ops::RangeInclusive<usize> = 8..=512;
+
     /// Its name as `--input` takes it.
     #[must_use]
     pub fn id(self) -> &'static str {
@@ -162,8 +165,15 @@ impl BuiltIn {
         Self::ALL.into_iter().find(|b| b.id() == name)
     }
 
-    /// The volume on a `side^3` grid.
+    /// The volume on a `side^3` grid, `side` in [`BuiltIn::SIDES`].
     pub fn make(self, side: usize) -> Result<Volume, VolumeError> {
+        if !Self::SIDES.contains(&side) {
+            return Err(VolumeError(format!(
+                "a built-in volume of side {side}: the side must be {} to {} voxels",
+                Self::SIDES.start(),
+                Self::SIDES.end()
+            )));
+        }
         match self {
             BuiltIn::SheppLogan => shepp_logan(side),
             BuiltIn::MarschnerLobb => marschner_lobb(side),

@@ -23,6 +23,36 @@ pub enum Precision {
     F32Simd,
 }
 
+impl Precision {
+    /// Every CPU precision.
+    pub const ALL: [Precision; 3] = [Precision::F64, Precision::F32, Precision::F32Simd];
+
+    /// Its name (`f64`, `f32`, `simd`), as `specula analyze --backend` takes it.
+    #[must_use]
+    pub fn id(self) -> &'static str {
+        match self {
+            Precision::F64 => "f64",
+            Precision::F32 => "f32",
+            Precision::F32Simd => "simd",
+        }
+    }
+
+    /// The precision named `id`, or a message naming the valid ones.
+    pub fn parse(id: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|precision| precision.id() == id)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::ALL.iter().map(|p| p.id()).collect();
+                format!(
+                    "unknown precision '{}'; valid precisions: {}",
+                    crate::excerpt(id),
+                    names.join(", ")
+                )
+            })
+    }
+}
+
 /// Evaluates a lobe at a batch of cosines: where, and in what arithmetic, error figures are
 /// measured. Batches let a backend such as a GPU amortise its dispatch.
 pub trait Evaluator {

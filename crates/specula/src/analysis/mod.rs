@@ -74,6 +74,30 @@ pub fn analyze(kind: LobeKind, n: Exponent, evaluator: &mut dyn Evaluator) -> Lo
     }
 }
 
+/// [`analyze`] for every lobe at every exponent (lobes outer, exponents inner), in parallel,
+/// with the error figures in `precision` (the rows of `specula analyze`); `on_each` is called
+/// as each row is done.
+#[must_use]
+pub fn analyze_all(
+    kinds: &[LobeKind],
+    exponents: &[Exponent],
+    precision: Precision,
+    on_each: &(dyn Fn() + Sync),
+) -> Vec<LobeReport> {
+    use rayon::prelude::*;
+    let jobs: Vec<(LobeKind, Exponent)> = kinds
+        .iter()
+        .flat_map(|&kind| exponents.iter().map(move |&n| (kind, n)))
+        .collect();
+    jobs.par_iter()
+        .map(|&(kind, n)| {
+            let report = analyze(kind, n, &mut { precision });
+            on_each();
+            report
+        })
+        .collect()
+}
+
 /// The lobe's energy relative to `t^n`: `(n + 1) int_0^{pi/2} lobe(cos g) sin g dg`.
 #[must_use]
 pub fn energy_ratio(lobe: &Lobe) -> f64 {
