@@ -133,6 +133,14 @@ enum Command {
                             specula volume-convert --input ct-series/ -o ct.nii.gz"
     )]
     VolumeConvert(commands::volume::ConvertArgs),
+    /// Write the built-in sky (`--env sky`) as an EXR or HDR map, for other renderers.
+    #[command(
+        after_help = "Examples:\n  specula sky -o sky.exr\n  specula sky --width 2048 -o sky.hdr\n\n\
+                      The map is equirectangular with world z up: row y covers polar angles \
+                      pi y / H to pi (y + 1) / H from the zenith; column x looks along azimuth \
+                      3 pi / 2 - 2 pi (x + 0.5) / W, so the middle column looks along +y."
+    )]
+    Sky(commands::sky::Args),
     /// Serve the interactive BRDF explorer (page and JSON API) on 127.0.0.1.
     #[command(
         after_help = "Examples:\n  specula serve --open\n  specula serve --port 9000\n  specula serve --port 0   # a free port, printed"
@@ -234,6 +242,7 @@ fn main() -> ExitCode {
         Command::Shader(args) => commands::shader::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
         Command::Hw(args) => commands::hw::run(&args),
+        Command::Sky(args) => commands::sky::run(&args),
         Command::Serve(args) => commands::serve::run(&args),
     };
     match result {

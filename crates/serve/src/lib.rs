@@ -5,7 +5,8 @@
 //!
 //! The page, its script and its styles are compiled in (`assets/`); nothing is fetched from
 //! the network. The server binds to 127.0.0.1 unless `--bind` says otherwise, answers only to
-//! its own host names ([`Hosts`]), serves at most [`MAX_CONNECTIONS`] connections with header
+//! its own host names ([`Hosts`]), keeps at most [`max_waiting`] connections waiting for their
+//! request (closing the oldest beyond that, so idle floods never block a request) with header
 //! and idle timeouts (`listen.rs`), runs [`CONCURRENT_COMPUTATIONS`] computations at once on
 //! the blocking pool behind a queue of [`QUEUED_COMPUTATIONS`] (a full queue answers 503), and
 //! caps request bodies (the API takes none). Measured materials come only from the folder
@@ -26,7 +27,7 @@ use std::net::SocketAddr;
 pub use api::{cpu_cost, AppState, CostModel, TargetCost, MAX_RENDER_SIZE};
 pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
-pub use listen::{CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT, MAX_CONNECTIONS};
+pub use listen::{max_waiting, CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT};
 pub use measured::{
     Materials, MAX_MATERIALS, MAX_MATERIAL_RENDER_SIZE, MAX_MATERIAL_RENDER_SPP, POLAR_POINTS,
 };

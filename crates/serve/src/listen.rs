@@ -2,54 +2,105 @@
 //!
 //! `axum::serve` has no header or idle timeout, so 20,000 idle connections exhaust the file
 //! descriptors. Here:
-//! - at most [`MAX_CONNECTIONS`] are served at once; one more is answered `503` with
-//!   `Retry-After` and closed at once, so the server keeps answering while it is flooded;
-//! - a connection must send its first byte within [`IDLE_TIMEOUT`] and its whole header
-//!   within [`HEADER_TIMEOUT`] (hyper's header-read timer; slow-loris);
+//! - a connection that has not yet sent a whole request header is *waiting*; at most
+//!   [`max_waiting`] wait at once (half the process's descriptor limit, at most 16,384), and
+//!   a new connection beyond that closes the oldest waiting one. A flood of idle or slow
+//!   (slow-loris) connections therefore costs a bounded number of descriptors and a few
+//!   kilobytes each, and never blocks a real request, which sends its header at once and
+//!   stops waiting: it is answered however many idle connections are open;
+//! - a waiting connection must send its first byte within [`IDLE_TIMEOUT`] and its whole
+//!   header within [`HEADER_TIMEOUT`] (hyper's header-read timer);
 //! - one request per connection (no keep-alive, so no idle connection is held between
 //!   requests), and every connection is closed after [`CONNECTION_TIMEOUT`] whatever it does.
+//!   The work requests cause is bounded apart, by the computation queue (`guard.rs`).
 
-use std::sync::Arc;
+use std::collections::VecDeque;
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
 use axum::Router;
 use hyper_util::rt::{TokioIo, TokioTimer};
 use hyper_util::service::TowerToHyperService;
-use tokio::io::AsyncWriteExt;
 use tokio::net::TcpListener;
-use tokio::sync::Semaphore;
+use tokio::task::AbortHandle;
+use tower::ServiceExt;
 
-/// Connections served at once.
-pub const MAX_CONNECTIONS: usize = 256;
 /// How long a new connection may stay silent.
 pub const IDLE_TIMEOUT: Duration = Duration::from_secs(10);
 /// How long a request's header may take to arrive.
 pub const HEADER_TIMEOUT: Duration = Duration::from_secs(10);
 /// How long any connection may last (a render takes a few seconds at most).
 pub const CONNECTION_TIMEOUT: Duration = Duration::from_secs(120);
+/// The most connections that may wait for their request at once, whatever the limit.
+const MOST_WAITING: usize = 16_384;
 
-/// The answer to a connection beyond the limit.
-fn busy() -> Vec<u8> {
-    let body = format!(
-        "{{\"error\":\"more than {MAX_CONNECTIONS} connections at once; retry in a second\"}}\n"
-    );
-    format!(
-        "HTTP/1.1 503 Service Unavailable\r\nRetry-After: 1\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
-        body.len()
-    )
-    .into_bytes()
+/// How many connections may wait for their request header at once: half this process's
+/// soft limit on open files (read from `/proc/self/limits`; 1,024 assumed where it cannot
+/// be read), at least 64 and at most 16,384, so that accepting never runs out of
+/// descriptors while the oldest waiting connection is closed to make room.
+#[must_use]
+pub fn max_waiting() -> usize {
+    let soft_limit = std::fs::read_to_string("/proc/self/limits")
+        .ok()
+        .and_then(|limits| {
+            let line = limits.lines().find(|l| l.starts_with("Max open files"))?;
+            line.split_whitespace().nth(3)?.parse::<usize>().ok()
+        })
+        .unwrap_or(1024);
+    (soft_limit / 2).clamp(64, MOST_WAITING)
 }
 
-/// Serves `router` on `listener` until `shutdown` completes.
+/// The connections waiting for their request, oldest first.
+#[derive(Default)]
+struct Waiting {
+    next_id: u64,
+    queue: VecDeque<(u64, AbortHandle)>,
+}
+
+impl Waiting {
+    /// No longer waiting: its request arrived, or it ended.
+    fn remove(waiting: &Mutex<Waiting>, id: u64) {
+        let mut waiting = waiting.lock().unwrap_or_else(PoisonError::into_inner);
+        if let Some(index) = waiting.queue.iter().position(|(other, _)| *other == id) {
+            waiting.queue.remove(index);
+        }
+    }
+}
+
+/// Removes its connection from the waiting ones when the connection's task ends, however
+/// it ends.
+struct Registered {
+    waiting: Arc<Mutex<Waiting>>,
+    id: u64,
+}
+
+impl Drop for Registered {
+    fn drop(&mut self) {
+        Waiting::remove(&self.waiting, self.id);
+    }
+}
+
+/// Serves `router` on `listener` until `shutdown` completes, at most [`max_waiting`]
+/// connections waiting for their request.
 pub async fn serve(
     listener: TcpListener,
     router: Router,
     shutdown: impl std::future::Future<Output = ()>,
 ) -> Result<(), String> {
-    let slots = Arc::new(Semaphore::new(MAX_CONNECTIONS));
+    serve_with(listener, router, shutdown, max_waiting()).await
+}
+
+/// [`serve`] with at most `most_waiting` connections waiting for their request.
+pub async fn serve_with(
+    listener: TcpListener,
+    router: Router,
+    shutdown: impl std::future::Future<Output = ()>,
+    most_waiting: usize,
+) -> Result<(), String> {
+    let waiting = Arc::new(Mutex::new(Waiting::default()));
     let mut shutdown = std::pin::pin!(shutdown);
     loop {
-        let (mut stream, _) = tokio::select! {
+        let (stream, _) = tokio::select! {
             accepted = listener.accept() => match accepted {
                 Ok(accepted) => accepted,
                 // Out of descriptors or a reset before accept: keep serving the others.
@@ -60,16 +111,23 @@ pub async fn serve(
             },
             () = &mut shutdown => return Ok(()),
         };
-        let Ok(slot) = Arc::clone(&slots).try_acquire_owned() else {
-            tokio::spawn(async move {
-                let _ =
-                    tokio::time::timeout(Duration::from_secs(1), stream.write_all(&busy())).await;
-            });
-            continue;
+        let mut queue = waiting.lock().unwrap_or_else(PoisonError::into_inner);
+        let id = queue.next_id;
+        queue.next_id += 1;
+        // The request's arrival takes the connection out of the waiting ones, for good.
+        let arrived = Arc::clone(&waiting);
+        let service = TowerToHyperService::new(router.clone().map_request(
+            move |request: hyper::Request<hyper::body::Incoming>| {
+                Waiting::remove(&arrived, id);
+                request
+            },
+        ));
+        let registered = Registered {
+            waiting: Arc::clone(&waiting),
+            id,
         };
-        let service = TowerToHyperService::new(router.clone());
-        tokio::spawn(async move {
-            let _slot = slot;
+        let task = tokio::spawn(async move {
+            let _registered = registered;
             if !matches!(
                 tokio::time::timeout(IDLE_TIMEOUT, stream.readable()).await,
                 Ok(Ok(()))
@@ -83,5 +141,11 @@ pub async fn serve(
             let connection = http.serve_connection(TokioIo::new(stream), service);
             let _ = tokio::time::timeout(CONNECTION_TIMEOUT, connection).await;
         });
+        queue.queue.push_back((id, task.abort_handle()));
+        while queue.queue.len() > most_waiting {
+            if let Some((_, oldest)) = queue.queue.pop_front() {
+                oldest.abort();
+            }
+        }
     }
 }

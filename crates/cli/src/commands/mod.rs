@@ -15,6 +15,7 @@ pub mod report;
 pub mod sample;
 pub mod serve;
 pub mod shader;
+pub mod sky;
 pub mod synth;
 pub mod volume;
 

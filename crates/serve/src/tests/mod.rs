@@ -370,44 +370,117 @@ async fn other_host_names_are_refused() {
     assert_eq!(status("127.0.0.1:8123").await, StatusCode::OK);
 }
 
-/// Idle connections and slow headers are closed after their timeouts; connections beyond the
-/// limit get an immediate 503, so the server answers while flooded.
-#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
-async fn floods_of_idle_connections_are_bounded_and_timed_out() {
-    use tokio::io::{AsyncReadExt, AsyncWriteExt};
-    let address = spawn_server().await;
-    let mut idle = Vec::new();
-    for _ in 0..crate::MAX_CONNECTIONS {
+/// Opens `count` connections to `address` that send nothing.
+async fn idle_connections(
+    address: std::net::SocketAddr,
+    count: usize,
+) -> Vec<tokio::net::TcpStream> {
+    let mut idle = Vec::with_capacity(count);
+    for _ in 0..count {
         idle.push(
             tokio::net::TcpStream::connect(address)
                 .await
-                .expect("connect"),
+                .expect("connect (the test needs 2 descriptors per idle connection)"),
         );
     }
+    idle
+}
+
+/// One real request on a fresh connection, answered within a second.
+async fn answered_within_a_second(address: std::net::SocketAddr) -> String {
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    let request = async {
+        let mut fresh = tokio::net::TcpStream::connect(address)
+            .await
+            .expect("connect");
+        let head = format!("GET /api/models HTTP/1.1\r\nHost: {address}\r\n\r\n");
+        fresh.write_all(head.as_bytes()).await.expect("send");
+        let mut response = Vec::new();
+        fresh.read_to_end(&mut response).await.expect("read");
+        String::from_utf8_lossy(&response).into_owned()
+    };
+    tokio::time::timeout(std::time::Duration::from_secs(1), request)
+        .await
+        .expect("a request is answered within a second")
+}
+
+/// 2,000 idle connections and slow headers held open by another program do not stop a real
+/// request: it is answered within a second, with every flooding connection still open.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_request_is_answered_under_two_thousand_idle_connections() {
+    use tokio::io::AsyncWriteExt;
+    let address = spawn_server().await;
+    assert!(
+        crate::max_waiting() >= 2_100,
+        "this test needs a descriptor limit of at least 4,200 (ulimit -n); it is {}",
+        2 * crate::max_waiting()
+    );
+    let idle = idle_connections(address, 2_000).await;
+    let mut slow = Vec::new();
+    for _ in 0..50 {
+        let mut stream = tokio::net::TcpStream::connect(address)
+            .await
+            .expect("connect");
+        stream
+            .write_all(b"GET / HTTP/1.1\r\nHost: loc")
+            .await
+            .expect("send");
+        slow.push(stream);
+    }
+    let answer = answered_within_a_second(address).await;
+    assert!(answer.starts_with("HTTP/1.1 200"), "{answer}");
+    drop((idle, slow));
+}
+
+/// Beyond the waiting bound the oldest waiting connection is closed to make room: a flood
+/// far larger than the bound costs the bound, and a request is still answered.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn beyond_the_bound_the_oldest_waiting_connection_is_closed() {
+    use tokio::io::AsyncReadExt;
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
+        .await
+        .expect("bind");
+    let address = listener.local_addr().expect("address");
+    tokio::spawn(crate::listen::serve_with(
+        listener,
+        router(),
+        std::future::pending(),
+        64,
+    ));
+    let mut idle = idle_connections(address, 2_000).await;
+    let answer = answered_within_a_second(address).await;
+    assert!(answer.starts_with("HTTP/1.1 200"), "{answer}");
+    // The first connections were closed by the server at once (not after the idle timeout),
+    // the last 64 are still open.
+    let mut buffer = [0_u8; 16];
+    let first = tokio::time::timeout(std::time::Duration::from_secs(1), idle[0].read(&mut buffer))
+        .await
+        .expect("the oldest connection was closed");
+    assert!(matches!(first, Ok(0) | Err(_)), "{first:?}");
+    let last = idle.last_mut().expect("connections");
+    assert!(
+        tokio::time::timeout(
+            std::time::Duration::from_millis(200),
+            last.read(&mut buffer)
+        )
+        .await
+        .is_err(),
+        "the newest waiting connection is still open"
+    );
+}
+
+/// Idle connections and slow headers are closed after their timeouts.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn idle_connections_and_slow_headers_are_timed_out() {
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    let address = spawn_server().await;
+    let mut idle = idle_connections(address, 16).await;
     let mut slow = tokio::net::TcpStream::connect(address)
         .await
         .expect("connect");
     slow.write_all(b"GET / HTTP/1.1\r\nHost: loc")
         .await
         .expect("send");
-    // One more: answered at once, with 503.
-    let mut extra = tokio::net::TcpStream::connect(address)
-        .await
-        .expect("connect");
-    let mut answer = Vec::new();
-    tokio::time::timeout(
-        std::time::Duration::from_secs(2),
-        extra.read_to_end(&mut answer),
-    )
-    .await
-    .expect("answered at once")
-    .expect("read");
-    let answer = String::from_utf8_lossy(&answer);
-    assert!(
-        answer.starts_with("HTTP/1.1 503") && answer.contains("Retry-After: 1"),
-        "{answer}"
-    );
-    // The idle ones, and the slow header, are closed by the server after their timeouts.
     let limit = crate::IDLE_TIMEOUT.max(crate::HEADER_TIMEOUT) + std::time::Duration::from_secs(5);
     let mut buffer = [0_u8; 64];
     let closed = tokio::time::timeout(limit, idle[0].read(&mut buffer))
@@ -418,16 +491,6 @@ async fn floods_of_idle_connections_are_bounded_and_timed_out() {
     let _ = tokio::time::timeout(limit, slow.read(&mut buffer))
         .await
         .expect("the slow header is cut off in time");
-    drop(idle);
-    // And then a request is served.
-    let mut fresh = tokio::net::TcpStream::connect(address)
-        .await
-        .expect("connect");
-    let head = format!("GET /api/models HTTP/1.1\r\nHost: {address}\r\n\r\n");
-    fresh.write_all(head.as_bytes()).await.expect("send");
-    let mut response = Vec::new();
-    fresh.read_to_end(&mut response).await.expect("read");
-    assert!(String::from_utf8_lossy(&response).starts_with("HTTP/1.1 200"));
 }
 
 /// The real server (accept loop and all) on a free loopback port, until the test ends.
