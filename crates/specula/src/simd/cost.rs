@@ -23,12 +23,29 @@ use super::Level;
 pub struct Peaks {
     /// Where they were measured.
     pub level: Level,
-    /// Vector instructions per second of each class alone, `None` where not measured.
+    /// Vector instructions per second of each class alone, `None` where not measured
+    /// (serialised as an object keyed by the class's name, as a kernel's instruction counts
+    /// are: `{"fma": ..., "mul": ..., "min/max": ...}`).
+    #[serde(serialize_with = "by_class_name")]
     pub per_class: [Option<f64>; Class::ALL.len()],
     /// Vector instructions per second of an independent mix of `fma`, `add` and `and`.
     pub dispatch: f64,
     /// Vectors per second the driver loads and stores with nothing in between (L1).
     pub copy: f64,
+}
+
+/// `per_class` as an object keyed by each class's name ([`Class::name`], the keys of a
+/// kernel's [`crate::simd::tally::Instructions`]), in [`Class::ALL`]'s order.
+fn by_class_name<S: serde::Serializer>(
+    per_class: &[Option<f64>; Class::ALL.len()],
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    let mut map = serializer.serialize_map(Some(per_class.len()))?;
+    for (class, rate) in Class::ALL.iter().zip(per_class) {
+        map.serialize_entry(class.name(), rate)?;
+    }
+    map.end()
 }
 
 /// The resource that bounds a kernel.
@@ -146,6 +163,22 @@ mod tests {
             dispatch: 4e9,
             copy: 1e9,
         }
+    }
+
+    #[test]
+    fn each_peak_is_named_by_its_class_in_json() {
+        let json = serde_json::to_value(peaks()).expect("serialises");
+        let per_class = json["per_class"]
+            .as_object()
+            .expect("an object, not an array");
+        assert_eq!(per_class.len(), Class::ALL.len());
+        assert_eq!(per_class["fma"], 2e9);
+        assert_eq!(per_class["div"], 0.25e9);
+        assert!(per_class["cvt"].is_null() && per_class["min/max"].is_null());
+        let names: Vec<&str> = per_class.keys().map(String::as_str).collect();
+        let expected: Vec<&str> = Class::ALL.iter().map(|class| class.name()).collect();
+        assert_eq!(names.len(), expected.len());
+        assert!(expected.iter().all(|name| names.contains(name)));
     }
 
     #[test]
