@@ -3,7 +3,8 @@
 
 use axum::http::StatusCode;
 
-use super::{json, served_png, spawn_server};
+use super::connections::spawn_server;
+use super::{json, served_png};
 
 /// `text` percent-encoded for a query value (every byte but letters and digits).
 fn encoded(text: &str) -> String {
