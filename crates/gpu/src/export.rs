@@ -157,17 +157,7 @@ impl Format {
 
     /// The format named `id`, or a message naming the valid ones.
     pub fn parse(id: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|format| format.id() == id)
-            .ok_or_else(|| {
-                let names: Vec<&str> = Self::ALL.iter().map(|format| format.id()).collect();
-                format!(
-                    "unknown shader language '{}'; valid languages: {}",
-                    specula::excerpt(id),
-                    names.join(", ")
-                )
-            })
+        specula::choose(&Self::ALL, Self::id, id, "shader language", "languages")
     }
 
     /// `lobe` in this format (`options` apply to naga's languages).

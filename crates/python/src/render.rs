@@ -17,24 +17,14 @@ use crate::arrays::shaped;
 use crate::errors::{file_error, guarded, value_error};
 use crate::lobe::{exponent, geometry, normalisation};
 
-/// The one of `all` whose id is `text`, or a message naming the valid ones.
+/// The one of `all` whose id is `text`, or the library's message naming the valid ones.
 pub fn choose<T: Copy>(
     all: &[T],
     id: fn(T) -> &'static str,
     text: &str,
     what: &str,
 ) -> PyResult<T> {
-    all.iter()
-        .copied()
-        .find(|&value| id(value) == text)
-        .ok_or_else(|| {
-            let names: Vec<&str> = all.iter().map(|&value| id(value)).collect();
-            value_error(format!(
-                "unknown {what} '{}'; valid {what}s: {}",
-                specula::excerpt(text),
-                names.join(", ")
-            ))
-        })
+    specula::choose(all, id, text, what, &format!("{what}s")).map_err(value_error)
 }
 
 /// `image` as an `H x W x 3` float32 array.

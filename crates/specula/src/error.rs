@@ -113,6 +113,28 @@ pub fn nearest<'a>(typed: &str, choices: impl IntoIterator<Item = &'a str>) -> O
         .map(|(_, choice)| choice)
 }
 
+/// The one of `all` whose `id` is `text`, or the one-line refusal every face prints:
+/// `unknown {what} '{text}'; valid {plural}: a, b, c` (the text excerpted).
+pub fn choose<T: Copy>(
+    all: &[T],
+    id: fn(T) -> &'static str,
+    text: &str,
+    what: &str,
+    plural: &str,
+) -> core::result::Result<T, String> {
+    all.iter()
+        .copied()
+        .find(|&value| id(value) == text)
+        .ok_or_else(|| {
+            let names: Vec<&str> = all.iter().map(|&value| id(value)).collect();
+            format!(
+                "unknown {what} '{}'; valid {plural}: {}",
+                excerpt(text),
+                names.join(", ")
+            )
+        })
+}
+
 /// `; did you mean 'x'?` for [`nearest`], or nothing.
 #[must_use]
 pub fn did_you_mean<'a>(typed: &str, choices: impl IntoIterator<Item = &'a str>) -> String {
@@ -156,4 +178,19 @@ pub(crate) fn parse_choice<T: Copy>(
                 .join(", "),
             hint: did_you_mean(text, choices.iter().map(|&c| name(c))),
         })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::choose;
+
+    #[test]
+    fn choose_finds_by_id_or_names_every_valid_one() {
+        let id = |n: u8| ["one", "two", "three"][usize::from(n)];
+        assert_eq!(choose(&[0, 1, 2], id, "two", "digit", "digits"), Ok(1));
+        assert_eq!(
+            choose(&[0, 1, 2], id, "four", "digit", "digits"),
+            Err("unknown digit 'four'; valid digits: one, two, three".to_owned())
+        );
+    }
 }

@@ -54,7 +54,9 @@ pub mod simd;
 pub mod zones;
 
 pub use brdf::{Brdf, ClassicModel, Rgb};
-pub use error::{did_you_mean, excerpt, line_column, nearest, Error, Result, QUOTED_CHARACTERS};
+pub use error::{
+    choose, did_you_mean, excerpt, line_column, nearest, Error, Result, QUOTED_CHARACTERS,
+};
 pub use exponent::Exponent;
 pub use geometry::Geometry;
 pub use lobe::{LineStyle, Lobe, LobeKind};

@@ -39,17 +39,7 @@ impl Precision {
 
     /// The precision named `id`, or a message naming the valid ones.
     pub fn parse(id: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|precision| precision.id() == id)
-            .ok_or_else(|| {
-                let names: Vec<&str> = Self::ALL.iter().map(|p| p.id()).collect();
-                format!(
-                    "unknown precision '{}'; valid precisions: {}",
-                    crate::excerpt(id),
-                    names.join(", ")
-                )
-            })
+        crate::choose(&Self::ALL, Self::id, id, "precision", "precisions")
     }
 }
 
