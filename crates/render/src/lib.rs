@@ -33,6 +33,7 @@ mod material;
 pub mod measured;
 mod mesh;
 pub mod metrics;
+mod mitsuba;
 mod output;
 mod phong;
 mod pipeline;
@@ -52,6 +53,7 @@ pub use image::{
 pub use load::{load_mesh, parse_mesh, LoadError, LoadedMesh, MeshFormat, MESH_EXTENSIONS};
 pub use material::{IlluminationModel, Light, Material, Shader, Shading};
 pub use mesh::{Mesh, MeshError};
+pub use mitsuba::write_mitsuba_scene;
 pub use output::{remove_temporaries, write_atomically, SeekWrite};
 pub use pipeline::{
     overdraw, render, surfaces, RenderError, SurfacePoint, MAX_PIXELS, MAX_SAMPLES,

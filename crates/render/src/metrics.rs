@@ -1,4 +1,6 @@
-//! Image differences: PSNR, the largest absolute error and FLIP.
+//! Image differences: PSNR, the largest absolute error and FLIP; and, in linear radiance,
+//! the RMS difference and mean that compare two Monte Carlo renders ([`rms_difference`],
+//! [`mean_radiance`]).
 //!
 //! All three compare what a viewer sees: both images are taken through the same [`Display`]
 //! (exposure, tone map, sRGB curve, 8 bits), exactly as a PNG stores them. FLIP is NVIDIA's
@@ -9,6 +11,32 @@
 use thiserror::Error;
 
 use crate::{Display, Image};
+
+/// The RMS over pixels of the difference of two linear images of one size (the length of
+/// each pixel's RGB difference): two renders' disagreement, to hold against the same figure
+/// between two seeds of one renderer (its noise).
+#[must_use]
+pub fn rms_difference(a: &Image, b: &Image) -> f64 {
+    let sum: f64 = a
+        .pixels()
+        .iter()
+        .zip(b.pixels())
+        .map(|(p, q)| f64::from((*p - *q).length_squared()))
+        .sum();
+    (sum / a.pixels().len().max(1) as f64).sqrt()
+}
+
+/// The mean over pixels of `r + g + b`: a render's brightness, whose ratio between two
+/// renders shows a bias.
+#[must_use]
+pub fn mean_radiance(image: &Image) -> f64 {
+    image
+        .pixels()
+        .iter()
+        .map(|p| f64::from(p.x + p.y + p.z))
+        .sum::<f64>()
+        / image.pixels().len().max(1) as f64
+}
 
 /// Two images that cannot be compared.
 #[derive(Clone, Debug, Error, PartialEq)]

@@ -4,7 +4,10 @@
     python mitsuba_check.py chi2 --plugin FILE.py --bsdf specula_pow --variant llvm_ad_rgb \
         [--n 8 64 512] [--theta 0 35 70] [--geometry phong blinn] [--kd 0] [--ks 1]
     python mitsuba_check.py render --plugin FILE.py --bsdf specula_pow --scene SCENE.json \
-        --output OUT.exr --variant scalar_rgb|llvm_ad_rgb
+        --output OUT.exr --variant scalar_rgb|llvm_ad_rgb [--frames N] [--threads T]
+
+render writes the first frame; with --frames it then times N more frames (new seeds) on T
+threads and prints `{"seconds": [...], "first": s, "mitsuba": version, "threads": T}`.
 
 chi2 prints one line per case, `pass|fail bsdf=... n=... geometry=... theta=... p=...`, then
 `N passed, M failed`, and exits 1 if any case fails.
@@ -354,16 +357,34 @@ def scene_dict(mi, scene, bsdf, base):
 
 def cmd_render(args):
     mi = init_mitsuba(args.variant)
+    if args.threads:
+        import drjit as dr
+        dr.set_thread_count(args.threads)
     load_plugin(args.plugin)
     with open(args.scene) as f:
         scene = json.load(f)
     base = os.path.dirname(os.path.abspath(args.scene))
     start = time.time()
     loaded = mi.load_dict(scene_dict(mi, scene, args.bsdf, base))
-    image = mi.render(loaded, seed=int(scene.get("seed", 0)), spp=int(scene.get("spp", 16)))
+    seed, spp = int(scene.get("seed", 0)), int(scene.get("spp", 16))
+    image = mi.render(loaded, seed=seed, spp=spp)
     # Linear float32 RGB EXR; no tone mapping or sRGB curve.
     mi.Bitmap(image, pixel_format=mi.Bitmap.PixelFormat.RGB).write(args.output)
-    print("wrote %s (%s, %.2fs)" % (args.output, args.variant, time.time() - start))
+    first = time.time() - start
+    print("wrote %s (%s, %.2fs)" % (args.output, args.variant, first), flush=True)
+    if args.frames:
+        # Timed frames after the first (which loaded the scene and compiled the kernels):
+        # each renders and waits for the whole image, as specula's frames do.
+        import drjit as dr
+        seconds = []
+        for frame in range(args.frames):
+            begin = time.perf_counter()
+            image = mi.render(loaded, seed=seed + 1 + frame, spp=spp)
+            dr.eval(image)
+            dr.sync_thread()
+            seconds.append(time.perf_counter() - begin)
+        print(json.dumps({"seconds": seconds, "first": first, "mitsuba": mi.__version__,
+                          "threads": dr.thread_count()}), flush=True)
     return 0
 
 
@@ -391,6 +412,9 @@ def parse_args(argv):
     r = sub.choices["render"]
     r.add_argument("--scene", required=True)
     r.add_argument("--output", required=True)
+    r.add_argument("--frames", type=int, default=0,
+                   help="then time this many frames and print their seconds as JSON")
+    r.add_argument("--threads", type=int, default=0, help="Dr.Jit's threads (default: all)")
     return parser.parse_args(argv)
 
 

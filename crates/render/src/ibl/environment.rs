@@ -18,9 +18,10 @@ use core::f64::consts::{PI, TAU};
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
-use specula::sampling::Distribution2D;
+use specula::sampling::{AliasTable, Distribution2D};
 use thiserror::Error;
 
+use super::angles;
 use crate::{read_image, Image, ImageError};
 
 /// Rec. 709 luminance weights: how bright a linear RGB radiance looks (the map's sampling
@@ -74,6 +75,12 @@ pub struct EnvironmentSample {
 pub struct Environment {
     image: Image,
     distribution: Distribution2D,
+    /// The same distribution over texels for the `f32` renderer: drawn by alias in constant
+    /// time ([`Environment::draw`]).
+    alias: AliasTable,
+    /// Each texel's density on the unit square (its weight over the mean weight), as
+    /// `distribution` gives it.
+    texel_density: Vec<f32>,
 }
 
 impl Environment {
@@ -105,17 +112,33 @@ impl Environment {
                     .map(move |p| f64::from(p.dot(LUMINANCE)) * sine)
             })
             .collect();
+        let shape = || EnvironmentError::Shape {
+            name: name.to_owned(),
+            width,
+            height,
+        };
         let distribution = (width >= 2)
             .then(|| Distribution2D::new(&weights, width as usize))
             .flatten()
-            .ok_or_else(|| EnvironmentError::Shape {
-                name: name.to_owned(),
-                width,
-                height,
-            })?;
+            .ok_or_else(shape)?;
+        let alias = AliasTable::new(&weights).ok_or_else(shape)?;
+        let total: f64 = weights.iter().sum();
+        let cells = weights.len() as f64;
+        let texel_density = weights
+            .iter()
+            .map(|w| {
+                if total > 0.0 {
+                    (w * cells / total) as f32
+                } else {
+                    1.0
+                }
+            })
+            .collect();
         Ok(Self {
             image,
             distribution,
+            alias,
+            texel_density,
         })
     }
 
@@ -181,6 +204,53 @@ impl Environment {
             return 0.0;
         }
         self.distribution.pdf(to_square(wi)) / (2.0 * PI * PI * sine)
+    }
+}
+
+impl Environment {
+    /// [`Environment::sample`]'s distribution for the `f32` renderer, drawn by alias: a texel
+    /// from 32 random bits and a uniform `keep`, a point within it from `within`. The unit
+    /// direction, its density per solid angle and the radiance there; `None` on the poles.
+    #[must_use]
+    #[inline]
+    pub fn draw(&self, bits: u32, keep: f32, within: [f32; 2]) -> Option<(Vec3, f32, Vec3)> {
+        let texel = self.alias.sample(bits, keep);
+        let width = self.image.width() as usize;
+        let (column, row) = ((texel % width) as f32, (texel / width) as f32);
+        let x = (column + within[0]) / width as f32;
+        let y = (row + within[1]) / self.image.height() as f32;
+        let (sine, cosine) = angles::sin_cos_turns(0.5 * y);
+        if sine <= 0.0 {
+            return None;
+        }
+        // phi = 3 pi / 2 - 2 pi x, in turns.
+        let (sin_phi, cos_phi) = angles::sin_cos_turns(0.75 - x);
+        let wi = Vec3::new(sine * cos_phi, sine * sin_phi, cosine);
+        let pdf = self.texel_density[texel]
+            / (2.0 * core::f32::consts::PI * core::f32::consts::PI * sine);
+        Some((wi, pdf, self.image.pixels()[texel]))
+    }
+
+    /// The radiance from the unit direction `wi` and its density under
+    /// [`Environment::draw`] (per solid angle), in `f32`.
+    #[must_use]
+    #[inline]
+    pub fn look_up(&self, wi: Vec3) -> (Vec3, f32) {
+        let z = wi.z.clamp(-1.0, 1.0);
+        let y = angles::acos(z) * core::f32::consts::FRAC_1_PI;
+        let x = 0.75 - angles::atan2(wi.y, wi.x) * (0.5 * core::f32::consts::FRAC_1_PI);
+        let x = if x >= 1.0 { x - 1.0 } else { x };
+        let (width, height) = (self.image.width(), self.image.height());
+        let column = ((x * width as f32) as u32).min(width - 1);
+        let row = ((y * height as f32) as u32).min(height - 1);
+        let texel = (row * width + column) as usize;
+        let sine = (1.0 - z * z).max(0.0).sqrt();
+        let pdf = if sine > 0.0 {
+            self.texel_density[texel] / (2.0 * core::f32::consts::PI * core::f32::consts::PI * sine)
+        } else {
+            0.0
+        };
+        (self.image.pixels()[texel], pdf)
     }
 }
 

@@ -7,6 +7,7 @@ use glam::{DVec3, Vec3, Vec4};
 use rayon::prelude::*;
 use specula::sampling::{power_heuristic, uniform, SpecularSampler};
 
+use super::packet::{shade, Frame32, PacketSurface, Point};
 use super::{Environment, IblSettings, Strategy, MAX_SPP};
 use crate::pipeline::{surfaces, SurfacePoint};
 use crate::{Image, Material, RenderError, Scene};
@@ -25,9 +26,12 @@ pub trait Reflectance: Sync {
     fn sample(&self, wo: DVec3, u: [f64; 3]) -> Option<(DVec3, DVec3, f64)>;
 }
 
-/// A material prepared for environment lighting: the physical model's BRDF
-/// `kd C / pi + ks S N(n) lobe(t)` and how its directions are drawn.
-struct Surface {
+/// A material prepared for environment lighting one sample at a time in `f64`: the physical
+/// model's BRDF `kd C / pi + ks S N(n) lobe(t)` and how its directions are drawn. The
+/// renderer shades scene materials by packets in `f32` ([`render_ibl`]); this is the same
+/// estimator written plainly, the reference those packets are tested against
+/// (`render_ibl_with(scene, env, settings, &MaterialReflectance::new(material), ..)`).
+pub struct MaterialReflectance {
     /// `kd C / pi`.
     diffuse: DVec3,
     /// `ks S`; the sampler's value carries `N(n) lobe(t)`.
@@ -37,8 +41,10 @@ struct Surface {
     specular_share: f64,
 }
 
-impl Surface {
-    fn new(material: &Material) -> Self {
+impl MaterialReflectance {
+    /// `material`'s BRDF and sampler.
+    #[must_use]
+    pub fn new(material: &Material) -> Self {
         let diffuse = (material.kd * material.colour).as_dvec3();
         let specular = (material.ks * material.specular_colour).as_dvec3();
         let (d, s) = (luminance(diffuse), luminance(specular));
@@ -69,7 +75,7 @@ pub fn cosine_direction(u: [f64; 2]) -> DVec3 {
     DVec3::new(sine * c, sine * s, cosine)
 }
 
-impl Reflectance for Surface {
+impl Reflectance for MaterialReflectance {
     fn f_and_pdf(&self, wo: DVec3, wi: DVec3) -> (DVec3, f64) {
         if wi.z <= 0.0 {
             return (DVec3::ZERO, 0.0);
@@ -166,19 +172,14 @@ impl Frame {
     fn to_world(&self, v: DVec3) -> DVec3 {
         self.tangent * v.x + self.bitangent * v.y + self.normal * v.z
     }
-}
 
-/// What one sample position of a pixel sees, prepared once for all the samples it takes.
-enum View<'a> {
-    /// Radiance that needs no sampling: the environment behind nothing, or black where the
-    /// surface faces away from the camera (an interpolated normal past the silhouette).
-    Fixed(DVec3),
-    /// A surface to integrate over.
-    Surface {
-        surface: &'a dyn Reflectance,
-        frame: Frame,
-        wo: DVec3,
-    },
+    fn as_f32(&self) -> Frame32 {
+        Frame32::new(
+            self.tangent.as_vec3(),
+            self.bitangent.as_vec3(),
+            self.normal.as_vec3(),
+        )
+    }
 }
 
 /// The unit camera ray through each sample position's centre, for the background.
@@ -222,14 +223,18 @@ pub fn render_ibl(
     settings: &IblSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Image, RenderError> {
-    let surfaces: Vec<Surface> = scene
+    let surfaces: Vec<PacketSurface> = scene
         .objects
         .iter()
-        .map(|object| Surface::new(&object.material))
+        .map(|object| PacketSurface::new(&object.material))
         .collect();
-    let reflectances: Vec<&dyn Reflectance> =
-        surfaces.iter().map(|s| s as &dyn Reflectance).collect();
-    render(scene, environment, settings, &reflectances, progress)
+    render(
+        scene,
+        environment,
+        settings,
+        Shading::Packets(&surfaces),
+        progress,
+    )
 }
 
 /// [`render_ibl`] with every object's material replaced by `reflectance` (a measured
@@ -242,15 +247,29 @@ pub fn render_ibl_with(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Image, RenderError> {
     let reflectances = vec![reflectance; scene.objects.len()];
-    render(scene, environment, settings, &reflectances, progress)
+    render(
+        scene,
+        environment,
+        settings,
+        Shading::Reflectances(&reflectances),
+        progress,
+    )
 }
 
-/// The render loop, object `i` shown with `reflectances[i]`.
+/// How the visible surfaces are shaded: the scene's materials by the packet estimator, or
+/// any [`Reflectance`] one sample at a time in `f64`.
+#[derive(Clone, Copy)]
+enum Shading<'a> {
+    Packets(&'a [PacketSurface]),
+    Reflectances(&'a [&'a dyn Reflectance]),
+}
+
+/// The render loop, object `i` shown with `shading`'s `i`th surface.
 fn render(
     scene: &Scene,
     environment: &Environment,
     settings: &IblSettings,
-    reflectances: &[&dyn Reflectance],
+    shading: Shading,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Image, RenderError> {
     if !(1..=MAX_SPP).contains(&settings.spp) {
@@ -263,38 +282,59 @@ fn render(
         scene.settings.height,
         scene.settings.samples,
     );
-    let positions = (s * s) as usize;
+    let positions = (s * s).min(settings.spp);
     let done = AtomicUsize::new(0);
     let mut image = Image::new(width, height, Vec3::ZERO);
     image
         .pixels_mut()
         .par_chunks_mut(width as usize)
         .enumerate()
-        .for_each_init(Vec::new, |views, (y, row)| {
+        .for_each(|(y, row)| {
             let y = y as u32;
             for (x, pixel) in (0..width).zip(row.iter_mut()) {
-                // Each position the pixel's samples visit, prepared once.
-                views.clear();
-                views.extend((0..positions.min(settings.spp as usize)).map(|position| {
-                    let (sx, sy) = (x * s + position as u32 % s, y * s + position as u32 / s);
-                    match points[(sy * width * s + sx) as usize] {
-                        None => {
-                            View::Fixed(environment.radiance(rays.direction(sx, sy)).as_dvec3())
-                        }
-                        Some(point) => view(reflectances, scene, point),
-                    }
-                }));
-                let index = u64::from(y * width + x);
+                let first = u64::from(y * width + x) * u64::from(settings.spp);
                 let mut sum = DVec3::ZERO;
-                for i in 0..settings.spp {
-                    sum += match &views[i as usize % positions] {
-                        View::Fixed(radiance) => *radiance,
-                        View::Surface { surface, frame, wo } => {
-                            let draw = index * u64::from(settings.spp) + u64::from(i);
-                            let u =
-                                core::array::from_fn(|d| uniform(settings.seed, draw, d as u64));
-                            estimate(*surface, environment, frame, *wo, settings.strategy, u)
+                // Sample `i` of the pixel takes position `i % positions`.
+                for position in 0..positions {
+                    let (sx, sy) = (x * s + position % s, y * s + position / s);
+                    let samples = (position..settings.spp).step_by(positions as usize);
+                    let draws = samples.clone().map(|i| first + u64::from(i));
+                    sum += match points[(sy * width * s + sx) as usize] {
+                        None => {
+                            let direction = rays.direction(sx, sy);
+                            environment.radiance(direction).as_dvec3() * samples.len() as f64
                         }
+                        Some(point) => match view(scene, point) {
+                            None => DVec3::ZERO,
+                            Some((frame, wo)) => match shading {
+                                Shading::Packets(surfaces) => shade(
+                                    &Point {
+                                        surface: &surfaces[point.object as usize],
+                                        frame: frame.as_f32(),
+                                        wo: wo.as_vec3(),
+                                    },
+                                    environment,
+                                    settings.strategy,
+                                    settings.seed,
+                                    draws,
+                                ),
+                                Shading::Reflectances(surfaces) => draws
+                                    .map(|draw| {
+                                        let u = core::array::from_fn(|d| {
+                                            uniform(settings.seed, draw, d as u64)
+                                        });
+                                        estimate(
+                                            surfaces[point.object as usize],
+                                            environment,
+                                            &frame,
+                                            wo,
+                                            settings.strategy,
+                                            u,
+                                        )
+                                    })
+                                    .sum(),
+                            },
+                        },
                     };
                 }
                 *pixel = (sum / f64::from(settings.spp)).as_vec3();
@@ -304,16 +344,10 @@ fn render(
     Ok(image)
 }
 
-/// What a visible surface point shows: its material, frame and `wo` in that frame.
-fn view<'a>(surfaces: &[&'a dyn Reflectance], scene: &Scene, point: SurfacePoint) -> View<'a> {
+/// A visible surface point's frame and `wo` in it, or `None` where the surface faces away
+/// from the camera (an interpolated normal past the silhouette: black).
+fn view(scene: &Scene, point: SurfacePoint) -> Option<(Frame, DVec3)> {
     let frame = Frame::new(point.normal.as_dvec3());
     let wo = frame.to_local(scene.camera.towards_viewer(point.position).as_dvec3());
-    if wo.z <= 0.0 {
-        return View::Fixed(DVec3::ZERO);
-    }
-    View::Surface {
-        surface: surfaces[point.object as usize],
-        frame,
-        wo,
-    }
+    (wo.z > 0.0).then_some((frame, wo))
 }

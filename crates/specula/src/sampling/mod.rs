@@ -18,10 +18,12 @@
 //! Conventions are the library's: local frame with `z` the normal, unit `wo` towards the
 //! viewer, `wi` towards the light. [`chi2`] holds the statistical tests every lobe passes.
 
+mod alias;
 pub mod chi2;
 mod cosine;
 mod distribution;
 
+pub use alias::AliasTable;
 pub use cosine::{CosineDistribution, TABLE_BINS};
 pub use distribution::{power_heuristic, Distribution1D, Distribution2D, Draw1D, Draw2D};
 
@@ -53,18 +55,34 @@ pub struct SpecularSampler {
     scale: f64,
 }
 
-/// A uniform number (counter-based, so a draw is the same on any thread and in any order) in `[0, 1)` for draw `index`, dimension `dimension` of stream `seed`
-/// (SplitMix64's finaliser over the three, 53 bits kept).
+/// A uniform number (counter-based, so a draw is the same on any thread and in any order) in
+/// `[0, 1)` for draw `index`, dimension `dimension` of stream `seed` ([`random_bits`], 53
+/// bits kept).
 #[must_use]
 pub fn uniform(seed: u64, index: u64, dimension: u64) -> f64 {
+    (random_bits(seed, index, dimension) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// 64 random bits for draw `index`, dimension `dimension` of stream `seed`: SplitMix64's
+/// finaliser over the three, counter-based like [`uniform`] (a renderer working in `f32`
+/// takes two 32-bit numbers from each).
+#[must_use]
+#[inline]
+pub fn random_bits(seed: u64, index: u64, dimension: u64) -> u64 {
     let mut z = seed
         .wrapping_mul(0x9E37_79B9_7F4A_7C15)
         .wrapping_add(index.wrapping_mul(0xD1B5_4A32_D192_ED03))
         .wrapping_add(dimension.wrapping_mul(0x8CB9_2BA7_2F3D_8DD7));
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
-    (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    z ^ (z >> 31)
+}
+
+/// A uniform `f32` in `[0, 1)` from the top 24 of 32 random bits.
+#[must_use]
+#[inline]
+pub fn unit_f32(bits: u32) -> f32 {
+    (bits >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// The mirror direction of `wo` about the normal: the Phong lobe's axis.

@@ -10,6 +10,7 @@ use specula_render::{render, Overrides, Scene, Shading};
 use super::CommandResult;
 use crate::output::Table;
 
+pub mod environment;
 pub mod lobes;
 pub mod volume;
 
@@ -26,6 +27,11 @@ pub enum Target {
     Gpu,
     /// Every lobe in a GPU compute shader: G evaluations/s and the ratio to pow.
     GpuLobes,
+    /// The environment-lit renderer (`render --env sky`): shaded samples per second on the
+    /// embedded scene and a full-frame sphere, for pow and cosquad on 1 and all threads,
+    /// beside Mitsuba 3 (llvm_ad_rgb) rendering the same views when the `mitsuba` wheel is
+    /// present.
+    Environment,
     /// The volume renderer on the CPU: frames per second of `--input` (512 x 512 unless
     /// `--width`/`--height` say otherwise), beside VTK's CPU ray caster when the `vtk` wheel
     /// is present.
@@ -44,6 +50,9 @@ pub struct Args {
     /// Frame height (1080, or 512 for `bench volume`).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     height: Option<u32>,
+    /// Samples per pixel (`bench environment`).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=i64::from(specula_render::ibl::MAX_SPP)))]
+    spp: u32,
     /// Timed frames per method (after one untimed warm-up frame).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     frames: u32,
@@ -90,6 +99,7 @@ pub fn run(args: &Args) -> CommandResult {
         Target::Gpu => bench_gpu(args),
         Target::GpuLobes => bench_gpu_lobes(args),
         Target::Volume => volume::run(args),
+        Target::Environment => environment::run(args),
     }
 }
 

@@ -1,0 +1,313 @@
+//! The estimator of [`super::trace`] for the scene's own materials, run over packets of
+//! samples in `f32`: what Mitsuba 3's LLVM backend does with wide vectors, arranged so that
+//! the expensive parts vectorise or vanish.
+//!
+//! A packet is up to [`LANES`] samples of one surface point (one view, one frame, one `wo`).
+//! The estimator is the same as [`super::trace`]'s, one environment draw and one BRDF draw
+//! combined by the power heuristic; what differs is how it is computed:
+//! - the lobe is evaluated **once per direction**, for all the packet's directions in one
+//!   call of its SIMD kernel ([`specula::Lobe::eval_batch`]), and that one value gives both
+//!   the BRDF and (over the lobe's integral) the sampler's density, where the `f64` path
+//!   evaluates it twice;
+//! - the environment is drawn by **alias** in constant time ([`Environment::draw`]) and looked
+//!   up once per BRDF direction for both its radiance and its density
+//!   ([`Environment::look_up`]);
+//! - the frame's tangents and the Phong axis's basis are built once per surface point, and
+//!   closed-form lobes draw their cosine in `f32`.
+//!
+//! Random numbers come from [`specula::sampling::random_bits`] by (seed, draw, dimension),
+//! two 32-bit numbers from each, so an image is the same on any number of threads. The
+//! images agree with the `f64` path's within Monte Carlo noise (tested), not bit for bit:
+//! the draws map the numbers to directions differently.
+
+use core::f32::consts::FRAC_1_PI;
+
+use glam::Vec3;
+use specula::brdf::luminance;
+use specula::lobe::Warp;
+use specula::sampling::{random_bits, unit_f32, SpecularSampler};
+use specula::{Geometry, Lobe};
+
+use super::angles::sin_cos_turns;
+use super::{Environment, Strategy};
+use crate::Material;
+
+/// Samples per packet: enough for the lobe's kernel to run at full width, few enough to live
+/// on the stack.
+pub(super) const LANES: usize = 64;
+
+/// A scene material prepared for the packet estimator: `f = diffuse + specular lobe(t)`.
+pub(super) struct PacketSurface {
+    /// `kd C / pi`.
+    diffuse: Vec3,
+    /// `ks S N(n)`.
+    specular: Vec3,
+    /// The probability that a BRDF draw goes to the lobe rather than the cosine.
+    share: f32,
+    /// `1 / (2 pi int_0^1 lobe)`: the lobe's value to its sampler's density about its axis.
+    density_per_value: f32,
+    lobe: Lobe,
+    geometry: Geometry,
+    /// Draws Newton-sampled and tabulated cosines (in `f64`), and a table's density.
+    sampler: SpecularSampler,
+    warp: Warp,
+}
+
+impl PacketSurface {
+    pub(super) fn new(material: &Material) -> Self {
+        let diffuse = material.kd * material.colour;
+        let specular = material.ks * material.specular_colour;
+        let (d, s) = (
+            luminance(diffuse.as_dvec3()),
+            luminance(specular.as_dvec3()),
+        );
+        let sampler =
+            SpecularSampler::new(material.lobe, material.geometry, material.normalisation);
+        let scale = material.normalisation.constant_for(&material.lobe) as f32;
+        let total = sampler.cosine().total();
+        Self {
+            diffuse: diffuse * FRAC_1_PI,
+            specular: specular * scale,
+            share: if d + s > 0.0 {
+                (s / (d + s)) as f32
+            } else {
+                0.0
+            },
+            density_per_value: if total > 0.0 {
+                (1.0 / (core::f64::consts::TAU * total)) as f32
+            } else {
+                0.0
+            },
+            lobe: material.lobe,
+            geometry: material.geometry,
+            warp: sampler.warp(),
+            sampler,
+        }
+    }
+
+    /// The lobe's cosine `t` for `wi` (local), and for Blinn `wo . h` (the Jacobian's);
+    /// `t = 0` where the half vector is undefined.
+    fn cosine(&self, wo: Vec3, wi: Vec3) -> (f32, f32) {
+        match self.geometry {
+            Geometry::Phong => (Vec3::new(-wo.x, -wo.y, wo.z).dot(wi), 1.0),
+            Geometry::Blinn => {
+                let sum = wo + wi;
+                let length_squared = sum.length_squared();
+                if length_squared > 0.0 {
+                    let h = sum / length_squared.sqrt();
+                    (h.z, wo.dot(h))
+                } else {
+                    (0.0, 1.0)
+                }
+            }
+        }
+    }
+
+    /// A cosine drawn from the lobe for the uniform `u`.
+    fn draw_cosine(&self, u: f32) -> f32 {
+        match self.warp {
+            Warp::Analytic => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
+            _ => self.sampler.cosine().sample(f64::from(u)).x as f32,
+        }
+    }
+
+    /// The BRDF and the BRDF strategy's density at `wi` (local, above the surface), from the
+    /// lobe's value `value` at its cosine `t` (and `wo . h` for Blinn).
+    fn f_and_pdf(&self, wi: Vec3, t: f32, half_cosine: f32, value: f32) -> (Vec3, f32) {
+        let density = match self.warp {
+            Warp::Table => {
+                (self.sampler.cosine().density(f64::from(t)) / core::f64::consts::TAU) as f32
+            }
+            _ => value * self.density_per_value,
+        };
+        let lobe_pdf = match self.geometry {
+            Geometry::Phong => density,
+            Geometry::Blinn if half_cosine > 0.0 => density / (4.0 * half_cosine),
+            Geometry::Blinn => 0.0,
+        };
+        (
+            self.diffuse + self.specular * value,
+            (1.0 - self.share) * wi.z * FRAC_1_PI + self.share * lobe_pdf,
+        )
+    }
+}
+
+/// An orthonormal frame about a unit normal, in `f32`.
+#[derive(Clone, Copy)]
+pub(super) struct Frame32 {
+    tangent: Vec3,
+    bitangent: Vec3,
+    normal: Vec3,
+}
+
+impl Frame32 {
+    pub(super) fn new(tangent: Vec3, bitangent: Vec3, normal: Vec3) -> Self {
+        Self {
+            tangent,
+            bitangent,
+            normal,
+        }
+    }
+
+    fn to_local(self, v: Vec3) -> Vec3 {
+        Vec3::new(
+            v.dot(self.tangent),
+            v.dot(self.bitangent),
+            v.dot(self.normal),
+        )
+    }
+
+    fn to_world(self, v: Vec3) -> Vec3 {
+        self.tangent * v.x + self.bitangent * v.y + self.normal * v.z
+    }
+}
+
+/// One sample's two directions, as the packet's first pass leaves them for the lobe's kernel.
+#[derive(Clone, Copy, Default)]
+struct Lane {
+    /// The environment's draw (local), its density and radiance; `pdf` 0 when there is none.
+    light_wi: Vec3,
+    light_pdf: f32,
+    light_radiance: Vec3,
+    light_half_cosine: f32,
+    /// The BRDF's draw (local), `true` when above the surface, and what the environment
+    /// sends along it with the density it would have drawn it with.
+    brdf_wi: Vec3,
+    brdf_ok: bool,
+    brdf_half_cosine: f32,
+    brdf_radiance: Vec3,
+    brdf_light_pdf: f32,
+}
+
+/// A surface point, prepared once for all its samples.
+pub(super) struct Point<'a> {
+    pub(super) surface: &'a PacketSurface,
+    pub(super) frame: Frame32,
+    /// Towards the viewer, local, above the surface.
+    pub(super) wo: Vec3,
+}
+
+/// The sum of the estimates of `draws` (each a draw index of the stream `seed`) at `point`.
+pub(super) fn shade(
+    point: &Point,
+    environment: &Environment,
+    strategy: Strategy,
+    seed: u64,
+    draws: impl Iterator<Item = u64>,
+) -> glam::DVec3 {
+    let surface = point.surface;
+    let wo = point.wo;
+    // The basis the lobe's directions are drawn in: about the mirror direction (Phong) or
+    // the normal (Blinn's half vector).
+    let axis = match surface.geometry {
+        Geometry::Phong => Vec3::new(-wo.x, -wo.y, wo.z),
+        Geometry::Blinn => Vec3::Z,
+    };
+    let (b1, b2) = axis.any_orthonormal_pair();
+    let mut draws = draws.peekable();
+    let mut sum = glam::DVec3::ZERO;
+    let mut lanes = [Lane::default(); LANES];
+    let mut cosines = [0.0_f32; 2 * LANES];
+    let mut values = [0.0_f32; 2 * LANES];
+    while draws.peek().is_some() {
+        let mut count = 0;
+        for (k, draw) in draws.by_ref().take(LANES).enumerate() {
+            count = k + 1;
+            let lane = &mut lanes[k];
+            *lane = Lane::default();
+            cosines[k] = 0.0;
+            cosines[LANES + k] = 0.0;
+            if strategy != Strategy::Brdf {
+                let bits = random_bits(seed, draw, 0);
+                let within = random_bits(seed, draw, 1);
+                let light = environment.draw(
+                    bits as u32,
+                    unit_f32((bits >> 32) as u32),
+                    [unit_f32(within as u32), unit_f32((within >> 32) as u32)],
+                );
+                if let Some((wi, pdf, radiance)) = light {
+                    let wi = point.frame.to_local(wi);
+                    if wi.z > 0.0 {
+                        let (t, half_cosine) = surface.cosine(wo, wi);
+                        (lane.light_wi, lane.light_pdf, lane.light_radiance) = (wi, pdf, radiance);
+                        lane.light_half_cosine = half_cosine;
+                        cosines[k] = t;
+                    }
+                }
+            }
+            if strategy != Strategy::Environment {
+                let bits = random_bits(seed, draw, 2);
+                let more = random_bits(seed, draw, 3);
+                let (choice, u1, u2) = (
+                    unit_f32(bits as u32),
+                    unit_f32((bits >> 32) as u32),
+                    unit_f32(more as u32),
+                );
+                let (sin_phi, cos_phi) = sin_cos_turns(u2);
+                let (wi, t, half_cosine) = if choice < surface.share {
+                    let t = surface.draw_cosine(u1);
+                    let sine = (1.0 - t * t).max(0.0).sqrt();
+                    let direction = (t * axis + sine * (cos_phi * b1 + sin_phi * b2)).normalize();
+                    match surface.geometry {
+                        Geometry::Phong => (direction, t, 1.0),
+                        Geometry::Blinn => {
+                            let half_cosine = wo.dot(direction);
+                            let wi = (2.0 * half_cosine * direction - wo).normalize();
+                            (wi, if half_cosine > 0.0 { t } else { 0.0 }, half_cosine)
+                        }
+                    }
+                } else {
+                    let (sine, cosine) = (u1.sqrt(), (1.0 - u1).max(0.0).sqrt());
+                    let wi = Vec3::new(sine * cos_phi, sine * sin_phi, cosine);
+                    let (t, half_cosine) = surface.cosine(wo, wi);
+                    (wi, t, half_cosine)
+                };
+                if wi.z > 0.0 && half_cosine > 0.0 {
+                    let (radiance, light_pdf) = environment.look_up(point.frame.to_world(wi));
+                    lane.brdf_wi = wi;
+                    lane.brdf_ok = true;
+                    lane.brdf_half_cosine = half_cosine;
+                    lane.brdf_radiance = radiance;
+                    lane.brdf_light_pdf = light_pdf;
+                    cosines[LANES + k] = t;
+                }
+            }
+        }
+        surface.lobe.eval_batch(&cosines, &mut values);
+        let mut packet = Vec3::ZERO;
+        for (k, lane) in lanes[..count].iter().enumerate() {
+            if lane.light_pdf > 0.0 {
+                let (f, brdf_pdf) =
+                    surface.f_and_pdf(lane.light_wi, cosines[k], lane.light_half_cosine, values[k]);
+                let weight = match strategy {
+                    Strategy::Mis => power_heuristic(lane.light_pdf, brdf_pdf),
+                    _ => 1.0,
+                };
+                packet += f * lane.light_radiance * (lane.light_wi.z * weight / lane.light_pdf);
+            }
+            if lane.brdf_ok {
+                let (f, pdf) = surface.f_and_pdf(
+                    lane.brdf_wi,
+                    cosines[LANES + k],
+                    lane.brdf_half_cosine,
+                    values[LANES + k],
+                );
+                if pdf > 0.0 {
+                    let weight = match strategy {
+                        Strategy::Mis => power_heuristic(pdf, lane.brdf_light_pdf),
+                        _ => 1.0,
+                    };
+                    packet += f * lane.brdf_radiance * (lane.brdf_wi.z * weight / pdf);
+                }
+            }
+        }
+        sum += packet.as_dvec3();
+    }
+    sum
+}
+
+/// Veach's power heuristic ([`specula::sampling::power_heuristic`], whose care for zero and
+/// infinite densities it keeps) on `f32` densities.
+fn power_heuristic(pdf: f32, other: f32) -> f32 {
+    specula::sampling::power_heuristic(f64::from(pdf), f64::from(other)) as f32
+}
