@@ -226,6 +226,16 @@ fn environment(rows_on_poles: bool) -> specula_render::Image {
     image
 }
 
+/// The environment scene's sphere alone, as `sphere.toml` for `specula render`.
+fn write_sphere_scene(dir: &std::path::Path) {
+    let sphere_only = specula_render::IBL_SCENE
+        .split("\n[[objects]]")
+        .take(2)
+        .collect::<Vec<_>>()
+        .join("\n[[objects]]");
+    std::fs::write(dir.join("sphere.toml"), sphere_only).unwrap();
+}
+
 /// The environment scene's first `objects` objects at `size` (width, height, spp) for the
 /// harness, lit by `mitsuba-map.exr`, as `<name>.json`.
 fn mitsuba_scene(dir: &std::path::Path, name: &str, objects: usize, size: [u32; 3]) {
@@ -268,12 +278,7 @@ fn mitsuba_renders_the_environment_scene_as_specula_does() {
         display,
     )
     .unwrap();
-    let sphere_only = specula_render::IBL_SCENE
-        .split("\n[[objects]]")
-        .take(2)
-        .collect::<Vec<_>>()
-        .join("\n[[objects]]");
-    std::fs::write(dir.path().join("sphere.toml"), sphere_only).unwrap();
+    write_sphere_scene(dir.path());
     mitsuba_scene(dir.path(), "sphere", 1, size);
     mitsuba_scene(dir.path(), "scene", 2, size);
     let [width, height, spp] = size.map(|v| v.to_string());
@@ -381,12 +386,7 @@ fn mitsuba_lit_by_the_written_sky_renders_as_env_sky() {
     });
     specula_render::write_mitsuba_scene(&scene, dir.path(), "sphere", "sky.exr", size[2], 7)
         .unwrap();
-    let sphere_only = specula_render::IBL_SCENE
-        .split("\n[[objects]]")
-        .take(2)
-        .collect::<Vec<_>>()
-        .join("\n[[objects]]");
-    std::fs::write(dir.path().join("sphere.toml"), sphere_only).unwrap();
+    write_sphere_scene(dir.path());
     export(dir.path(), "pow", 64.0, "pow.py");
     let [width, height, spp] = size.map(|v| v.to_string());
     let render = |seed: &str, output: &str| {

@@ -87,25 +87,24 @@ impl AliasTable {
             entry.alias as usize
         }
     }
+}
 
-    /// The probability of drawing each cell, from the table itself (for tests: it equals
-    /// the normalised weights).
-    #[must_use]
-    pub fn probabilities(&self) -> Vec<f64> {
-        let n = self.entries.len() as f64;
-        let mut p = vec![0.0; self.entries.len()];
-        for (i, entry) in self.entries.iter().enumerate() {
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The probability the table draws each cell with, from its entries: what a draw
+    /// keeps, plus what every slot aliased to it gives away.
+    fn probabilities(table: &AliasTable) -> Vec<f64> {
+        let n = table.entries.len() as f64;
+        let mut p = vec![0.0; table.entries.len()];
+        for (i, entry) in table.entries.iter().enumerate() {
             let kept = f64::from(entry.threshold).min(1.0);
             p[i] += kept / n;
             p[entry.alias as usize] += (1.0 - kept) / n;
         }
         p
     }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
 
     #[test]
     fn each_cell_is_drawn_in_proportion_to_its_weight() {
@@ -118,7 +117,7 @@ mod tests {
             .collect();
         let total: f64 = weights.iter().sum();
         let table = AliasTable::new(&weights).unwrap();
-        for (i, (p, w)) in table.probabilities().iter().zip(&weights).enumerate() {
+        for (i, (p, w)) in probabilities(&table).iter().zip(&weights).enumerate() {
             assert!(
                 (p - w / total).abs() < 1e-7,
                 "cell {i}: {p} against {}",
@@ -138,8 +137,7 @@ mod tests {
     #[test]
     fn degenerate_weights_are_uniform_or_refused() {
         let table = AliasTable::new(&[0.0, 0.0, 0.0]).unwrap();
-        assert!(table
-            .probabilities()
+        assert!(probabilities(&table)
             .iter()
             .all(|p| (p - 1.0 / 3.0).abs() < 1e-12));
         assert!(AliasTable::new(&[]).is_none());
