@@ -348,7 +348,7 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
         .then(|| specula_decide::rates::measure(n, false, &indicatif::ProgressBar::hidden()));
     let mut rows = Vec::new();
     let mut points = Vec::new();
-    for (k, kind) in context.lobes.clone().into_iter().enumerate() {
+    for kind in context.lobes.clone() {
         let lobe = Lobe::new(kind, n);
         let error = error_figures(&lobe, &mut Precision::F64, context.sizes.samples_per_zone)
             .epicentre_max_rel;
@@ -365,13 +365,20 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
                 .map(|family| format!("{:.2}", family.cost(&shader).evals_per_clock)),
         );
         if let Some(measured) = &measured {
-            let rate = &measured.lobes[k];
-            row.extend([
-                format!("{:.2}", rate.explicit / 1e9),
-                format!("{:.0}% ({})", 100.0 * rate.of_bound(), rate.bound.limit),
-                format!("{:.1}x", rate.explicit / measured.powf),
-            ]);
-            points.push((kind, 1e9 / rate.explicit, error.max(1e-7)));
+            // The measured lobes are the built-in ones and K4's formula: a lobe of the
+            // user's is found by its id or shown unmeasured.
+            let id = kind.to_string();
+            match measured.lobes.iter().find(|rate| rate.lobe == id) {
+                Some(rate) => {
+                    row.extend([
+                        format!("{:.2}", rate.explicit / 1e9),
+                        format!("{:.0}% ({})", 100.0 * rate.of_bound(), rate.bound.limit),
+                        format!("{:.1}x", rate.explicit / measured.powf),
+                    ]);
+                    points.push((kind, 1e9 / rate.explicit, error.max(1e-7)));
+                }
+                None => row.extend(["not measured".to_owned(), "-".to_owned(), "-".to_owned()]),
+            }
         }
         rows.push(row);
     }

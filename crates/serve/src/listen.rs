@@ -14,7 +14,7 @@
 //!   requests), and every connection is closed after [`CONNECTION_TIMEOUT`] whatever it does.
 //!   The work requests cause is bounded apart, by the computation queue (`guard.rs`).
 
-use std::collections::VecDeque;
+use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
@@ -50,20 +50,19 @@ pub fn max_waiting() -> usize {
     (soft_limit / 2).clamp(64, MOST_WAITING)
 }
 
-/// The connections waiting for their request, oldest first.
+/// The connections waiting for their request by id: ids only grow, so the first is the
+/// oldest, and removing one is logarithmic in their number.
 #[derive(Default)]
 struct Waiting {
     next_id: u64,
-    queue: VecDeque<(u64, AbortHandle)>,
+    queue: BTreeMap<u64, AbortHandle>,
 }
 
 impl Waiting {
     /// No longer waiting: its request arrived, or it ended.
     fn remove(waiting: &Mutex<Waiting>, id: u64) {
         let mut waiting = waiting.lock().unwrap_or_else(PoisonError::into_inner);
-        if let Some(index) = waiting.queue.iter().position(|(other, _)| *other == id) {
-            waiting.queue.remove(index);
-        }
+        waiting.queue.remove(&id);
     }
 }
 
@@ -141,9 +140,9 @@ pub async fn serve_with(
             let connection = http.serve_connection(TokioIo::new(stream), service);
             let _ = tokio::time::timeout(CONNECTION_TIMEOUT, connection).await;
         });
-        queue.queue.push_back((id, task.abort_handle()));
+        queue.queue.insert(id, task.abort_handle());
         while queue.queue.len() > most_waiting {
-            if let Some((_, oldest)) = queue.queue.pop_front() {
+            if let Some((_, oldest)) = queue.queue.pop_first() {
                 oldest.abort();
             }
         }
