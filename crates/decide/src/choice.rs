@@ -105,32 +105,12 @@ impl Zone {
     }
 }
 
-/// The value of `all` whose id is `text`, or a one-line refusal naming the valid ids.
-fn parse<T: Copy>(
-    text: &str,
-    all: &[T],
-    id: fn(T) -> &'static str,
-    what: &str,
-) -> Result<T, String> {
-    all.iter()
-        .copied()
-        .find(|&value| id(value) == text)
-        .ok_or_else(|| {
-            let valid: Vec<&str> = all.iter().map(|&value| id(value)).collect();
-            format!(
-                "unknown {what} '{}'; valid {what}s: {}",
-                text.escape_default(),
-                valid.join(", ")
-            )
-        })
-}
-
 impl FromStr for Target {
     type Err = String;
 
     /// `cpu`, `gpu-nvidia`, `gpu-amd` or `fpga`.
     fn from_str(text: &str) -> Result<Self, String> {
-        parse(text, &Target::ALL, Target::id, "target")
+        specula::choose(&Target::ALL, Target::id, text, "target", "targets")
     }
 }
 
@@ -139,7 +119,7 @@ impl FromStr for Zone {
 
     /// `epicentre`, `bloom` or `whole`.
     fn from_str(text: &str) -> Result<Self, String> {
-        parse(text, &Zone::ALL, Zone::id, "zone")
+        specula::choose(&Zone::ALL, Zone::id, text, "zone", "zones")
     }
 }
 

@@ -16,7 +16,7 @@ use crate::fpga_estimate::logic_cells;
 use crate::Zone;
 
 /// Angles sampled per zone in the sweeps the decisions read (as `recommend`'s float errors).
-pub const SWEEP_SAMPLES: usize = 20_001;
+pub(crate) const SWEEP_SAMPLES: usize = 20_001;
 
 /// Sweeps each of `lobes` at the integer exponent `n` over the word lengths `low..=high` with
 /// `samples` angles per zone, in parallel; `progress` counts the widths (pass
@@ -62,7 +62,7 @@ pub fn hardware_sweeps(n: u32) -> Result<Arc<Vec<WidthSweep>>, String> {
 
 /// A datapath at a word length, with its error there and its formula estimate.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Chosen {
+pub(crate) struct Chosen {
     /// The datapath.
     pub lobe: HwLobe,
     /// The word length.
@@ -77,7 +77,7 @@ pub struct Chosen {
 /// is at most `max_error` (or at its widest, where none is), the one with the fewest estimated
 /// logic cells, those within the bound first; `None` where `kind` has no datapath.
 #[must_use]
-pub fn cheapest_datapath(
+pub(crate) fn cheapest_datapath(
     sweeps: &[WidthSweep],
     kind: LobeKind,
     zone: Zone,

@@ -1,4 +1,4 @@
-//! specula's decisions, the same from every face (the command line, the explorer, Python):
+//! specula's decisions, the same from every face (the command line, the report, Python):
 //! which lobe to ship on a target at an accuracy ([`recommend`]), which for a measured
 //! material ([`material`]), and the costs they rank by, pulled from the GPU cost model
 //! (`specula-gpu`'s instruction counts), the fixed-point datapaths (`specula-hw`) and their
@@ -16,10 +16,10 @@ pub mod rates;
 mod recommend;
 
 pub use choice::{Target, Zone};
-pub use hardware::{cheapest_datapath, hardware_sweeps, sweeps, Chosen};
+pub use hardware::{hardware_sweeps, sweeps};
 pub use recommend::{
     lobe_rate, pareto_front, rate_unit, recommend, versus_pow, Candidate, Recommendation, Request,
-    FPGA_MATERIAL_REFUSAL, FPGA_TARGET,
+    FPGA_MATERIAL_REFUSAL,
 };
 
 use specula::{Exponent, LobeKind};
@@ -70,7 +70,7 @@ pub fn parse_exponents(text: &str) -> Result<Vec<Exponent>, String> {
 /// `steps + 1` exponents from `low` to `high`, log-spaced, both ends included (`low` alone
 /// for no steps).
 #[must_use]
-pub fn log_spaced(low: Exponent, high: Exponent, steps: u32) -> Vec<Exponent> {
+pub(crate) fn log_spaced(low: Exponent, high: Exponent, steps: u32) -> Vec<Exponent> {
     if steps == 0 {
         return vec![low];
     }

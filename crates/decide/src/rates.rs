@@ -103,7 +103,7 @@ fn cosines(len: usize) -> Vec<f32> {
 
 /// Evaluations per second of `lobe`'s SIMD kernel, L1-resident, one thread (best of 3).
 #[must_use]
-pub fn kernel_rate(lobe: &Lobe) -> f64 {
+pub(crate) fn kernel_rate(lobe: &Lobe) -> f64 {
     let level = Level::detect();
     l1_rate(&|t: &[f32], o: &mut [f32]| {
         lobe.eval_batch_with(level, BatchLoop::Explicit, t, o);

@@ -126,7 +126,7 @@ enum Costing {
 }
 
 /// Where the FPGA's costs are synthesized: every operator in LUTs, one area figure.
-pub const FPGA_TARGET: specula_synth::Target =
+pub(crate) const FPGA_TARGET: specula_synth::Target =
     specula_synth::Target::Ice40(specula_synth::Ice40Device::Hx8k);
 
 /// One lobe at one exponent: its error, its cost figure (higher is cheaper), and on the FPGA
