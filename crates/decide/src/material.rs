@@ -15,7 +15,7 @@ use specula::measured::fit::{
 use specula::{Exponent, Lobe, LobeKind, Normalisation};
 use specula_render::measured::{material_name, MeasuredBrdf};
 
-use crate::{lobe_rate, log_spaced, rate_unit, Target, FPGA_MATERIAL_REFUSAL};
+use crate::{lobe_rate, log_spaced, rate_unit, Target};
 
 /// The fit error allowed over pow's by default: 5 %.
 pub const DEFAULT_MARGIN: f64 = 0.05;
@@ -79,9 +79,11 @@ pub fn luminance(rgb: [f64; 3]) -> f64 {
     specula::brdf::luminance(glam::DVec3::from_array(rgb))
 }
 
-/// Every built-in lobe and `extra`, with user lobes checked over the whole range of `n` (the
-/// fits search it).
-pub fn lobes_to_fit(extra: &[LobeKind]) -> Result<Vec<LobeKind>, String> {
+/// Every built-in lobe and `extra` to fit for a verdict on `target`, with user lobes checked
+/// over the whole range of `n` (the fits search it) and the target refused if a material's
+/// verdict cannot take it: what a face calls before it loads any material.
+pub fn lobes_to_fit(extra: &[LobeKind], target: Target) -> Result<Vec<LobeKind>, String> {
+    crate::recommend::material_target(target)?;
     crate::check_lobes(
         extra,
         &log_spaced(Exponent::new(1.0), Exponent::new(1000.0), 8),
@@ -90,7 +92,7 @@ pub fn lobes_to_fit(extra: &[LobeKind]) -> Result<Vec<LobeKind>, String> {
 }
 
 /// Fits every lobe in `kinds` to `material` (read from `path`, which names it) and ranks them
-/// on `target` (not the FPGA: [`FPGA_MATERIAL_REFUSAL`]) with `margin`, a fraction in
+/// on `target` (not the FPGA: [`crate::FPGA_MATERIAL_REFUSAL`]) with `margin`, a fraction in
 /// `[0, 1]`, allowed over pow's fit error.
 pub fn assess(
     material: &MeasuredBrdf,
@@ -99,9 +101,7 @@ pub fn assess(
     target: Target,
     margin: f64,
 ) -> Result<Assessment, String> {
-    if target == Target::Fpga {
-        return Err(FPGA_MATERIAL_REFUSAL.to_owned());
-    }
+    crate::recommend::material_target(target)?;
     if !(0.0..=1.0).contains(&margin) {
         return Err(format!(
             "the margin over pow's fit error must be a fraction in [0, 1], not {margin}"

@@ -262,12 +262,20 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
 /// Why a material's verdict refuses the FPGA.
 pub const FPGA_MATERIAL_REFUSAL: &str = "a material verdict cannot target fpga: the fixed-point datapaths take an integer n and a word length chosen for an error against t^n, which a material's fit does not give; valid targets: cpu, gpu-nvidia, gpu-amd";
 
-/// A lobe's rate on `target` for a material's verdict (higher is cheaper): measured on the
-/// CPU, modelled on a GPU; the FPGA is refused ([`FPGA_MATERIAL_REFUSAL`]).
-pub fn lobe_rate(target: Target, lobe: &Lobe) -> Result<f64, String> {
-    if target == Target::Fpga {
-        return Err(FPGA_MATERIAL_REFUSAL.to_owned());
+/// `target` if a material's verdict can be given on it: every target but the FPGA
+/// ([`FPGA_MATERIAL_REFUSAL`]).
+pub(crate) fn material_target(target: Target) -> Result<Target, String> {
+    match target {
+        Target::Fpga => Err(FPGA_MATERIAL_REFUSAL.to_owned()),
+        _ => Ok(target),
     }
+}
+
+/// A lobe's rate on `target` for a material's verdict (higher is cheaper): measured on the
+/// CPU, modelled on a GPU; the FPGA is refused ([`FPGA_MATERIAL_REFUSAL`]) before any
+/// costing starts (costing it would run its sweeps).
+pub fn lobe_rate(target: Target, lobe: &Lobe) -> Result<f64, String> {
+    let target = material_target(target)?;
     match Costing::new(target, &[lobe.exponent()])?.0 {
         Costing::Measured => Ok(crate::rates::kernel_rate(lobe)),
         Costing::Modelled(family) => {

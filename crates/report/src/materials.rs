@@ -78,7 +78,7 @@ pub(crate) fn check(directory: &Path, yours: &[LobeKind]) -> Result<(), String> 
     for file in &files {
         load_measured(file)?;
     }
-    lobes_to_fit(yours).map(drop)
+    lobes_to_fit(yours, TARGET).map(drop)
 }
 
 /// A material's name as part of a file name: letters, digits, `-` and `_` kept.
@@ -107,7 +107,7 @@ pub fn materials(context: &mut Context) -> Result<String, String> {
         .copied()
         .filter(|kind| !LobeKind::ALL.contains(kind))
         .collect();
-    let kinds = lobes_to_fit(&yours)?;
+    let kinds = lobes_to_fit(&yours, TARGET)?;
     let sky = Environment::sky(SKY_WIDTH);
     let mut shown = String::new();
     let mut error_measure = String::new();

@@ -68,16 +68,28 @@ pub type Result<T, E = Error> = core::result::Result<T, E>;
 pub const QUOTED_CHARACTERS: usize = 80;
 
 /// `text` as a message quotes it: whole up to [`QUOTED_CHARACTERS`], else its start and its
-/// length (a 50 MB typo is not echoed back).
+/// length (a 50 MB typo is not echoed back); control characters escaped (`\n`, `\u{7}`), so
+/// a message stays one line whatever the user typed.
 #[must_use]
 pub fn excerpt(text: &str) -> String {
     let count = text.chars().count();
-    if count <= QUOTED_CHARACTERS {
-        text.to_owned()
+    let shown = if count <= QUOTED_CHARACTERS {
+        QUOTED_CHARACTERS
     } else {
-        let start: String = text.chars().take(QUOTED_CHARACTERS - 20).collect();
-        format!("{start}... ({count} characters)")
+        QUOTED_CHARACTERS - 20
+    };
+    let mut quoted = String::new();
+    for c in text.chars().take(shown) {
+        if c.is_control() {
+            quoted.extend(c.escape_default());
+        } else {
+            quoted.push(c);
+        }
     }
+    if count > QUOTED_CHARACTERS {
+        quoted += &format!("... ({count} characters)");
+    }
+    quoted
 }
 
 /// The 1-based line and column (in characters) of byte offset `at` in `text`, as messages
@@ -182,7 +194,7 @@ pub(crate) fn parse_choice<T: Copy>(
 
 #[cfg(test)]
 mod tests {
-    use super::choose;
+    use super::{choose, excerpt, QUOTED_CHARACTERS};
 
     #[test]
     fn choose_finds_by_id_or_names_every_valid_one() {
@@ -191,6 +203,27 @@ mod tests {
         assert_eq!(
             choose(&[0, 1, 2], id, "four", "digit", "digits"),
             Err("unknown digit 'four'; valid digits: one, two, three".to_owned())
+        );
+        assert_eq!(
+            choose(&[0, 1, 2], id, "fo\nur\u{7}", "digit", "digits"),
+            Err(r"unknown digit 'fo\nur\u{7}'; valid digits: one, two, three".to_owned())
+        );
+    }
+
+    #[test]
+    fn an_excerpt_is_one_line_and_bounded() {
+        assert_eq!(excerpt("a\tb\r\nc é"), r"a\tb\r\nc é");
+        let long = "x".repeat(1000);
+        assert_eq!(
+            excerpt(&long),
+            format!(
+                "{}... (1000 characters)",
+                "x".repeat(QUOTED_CHARACTERS - 20)
+            )
+        );
+        assert_eq!(
+            excerpt(&"y".repeat(QUOTED_CHARACTERS)),
+            "y".repeat(QUOTED_CHARACTERS)
         );
     }
 }

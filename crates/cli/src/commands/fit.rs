@@ -10,7 +10,7 @@ use specula::measured::fit::Sharing;
 use specula_decide::material::{
     assess, lobes_to_fit, luminance, parameter_text, verdict_line, Assessment, Ranked,
 };
-use specula_decide::{Target, FPGA_MATERIAL_REFUSAL};
+use specula_decide::Target;
 use specula_render::measured::{load_measured, material_name};
 
 use super::recommend::parse_margin;
@@ -139,10 +139,7 @@ pub fn print_ranking(
 
 /// Checks every file, then fits and prints one material at a time.
 pub fn run(args: &Args) -> CommandResult {
-    let kinds = lobes_to_fit(&crate::args::flatten(&args.lobe))?;
-    if args.target == Target::Fpga {
-        return Err(FPGA_MATERIAL_REFUSAL.to_owned());
-    }
+    let kinds = lobes_to_fit(&crate::args::flatten(&args.lobe), args.target)?;
     // Refuse a bad file before any output, so a list either runs or prints nothing.
     for path in &args.material {
         load_measured(path)?;

@@ -5,7 +5,7 @@
 use indicatif::{ProgressBar, ProgressStyle};
 use specula::Exponent;
 use specula_decide::material::{assess, lobes_to_fit, ranking, DEFAULT_MARGIN};
-use specula_decide::{recommend, versus_pow, Request, Target, Zone, FPGA_MATERIAL_REFUSAL};
+use specula_decide::{recommend, versus_pow, Request, Target, Zone};
 
 use super::CommandResult;
 use crate::args::described;
@@ -79,10 +79,7 @@ fn parse_percent(text: &str) -> Result<f64, String> {
 /// Measures, ranks and prints.
 pub fn run(args: &Args) -> CommandResult {
     if let Some(material) = &args.material {
-        let kinds = lobes_to_fit(&crate::args::flatten(&args.lobe))?;
-        if args.target == Target::Fpga {
-            return Err(FPGA_MATERIAL_REFUSAL.to_owned());
-        }
+        let kinds = lobes_to_fit(&crate::args::flatten(&args.lobe), args.target)?;
         let margin = args.margin.unwrap_or(DEFAULT_MARGIN);
         let loaded = specula_render::measured::load_measured(material)?;
         let assessment = assess(&loaded, material, &kinds, args.target, margin)?;
