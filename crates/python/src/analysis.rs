@@ -7,9 +7,9 @@ use specula::claims::{claim_exponents, evaluate_all, ClaimOptions};
 use specula::zones::{bloom_angle, bloom_cos, epicentre_angle, epicentre_cos};
 use specula::{Exponent, LobeKind};
 
-use crate::arrays::count;
+use crate::arrays::{self, count};
 use crate::errors::{guarded, value_error};
-use crate::lobe::exponent;
+use crate::lobe::{exponent, lobe_kind};
 
 /// `value` as JSON text.
 pub fn json(value: &impl serde::Serialize) -> PyResult<String> {
@@ -48,7 +48,7 @@ pub fn analyze_json(
             None => LobeKind::ALL.to_vec(),
             Some(texts) => texts
                 .iter()
-                .map(|text| specula_render::lobe_file::parse_lobe(text, None).map_err(value_error))
+                .map(|text| lobe_kind(text))
                 .collect::<PyResult<Vec<LobeKind>>>()?,
         };
         let exponents: Vec<Exponent> = match exponents {
@@ -88,10 +88,7 @@ pub fn claims_json(
             reciprocity_pairs: reciprocity_pairs.map_or(Ok(defaults.reciprocity_pairs), |p| {
                 count("reciprocity_pairs", p, 1, 10_000_000)
             })?,
-            seed: seed.map_or(Ok(defaults.seed), |s| {
-                u64::try_from(s)
-                    .map_err(|_| value_error(format!("seed {s} is negative; give 0 or more")))
-            })?,
+            seed: seed.map_or(Ok(defaults.seed), arrays::seed)?,
         };
         json(&py.detach(|| evaluate_all(&options)))
     })

@@ -119,6 +119,24 @@ pub fn count(name: &str, value: i64, low: usize, high: usize) -> PyResult<usize>
         })
 }
 
+/// `value` as the unsigned integer type `T` (a Python integer may be negative or huge), or a
+/// `ValueError` naming `name`; the range beyond that is the library's to check.
+pub fn unsigned<T: TryFrom<i64>>(name: &str, value: i64) -> PyResult<T> {
+    T::try_from(value).map_err(|_| {
+        value_error(if value < 0 {
+            format!("{name} {value} is negative; give 0 or more")
+        } else {
+            let max = u128::MAX >> (128 - 8 * std::mem::size_of::<T>());
+            format!("{name} {value} is out of range; give at most {max}")
+        })
+    })
+}
+
+/// A seed of the random numbers: 0 or more.
+pub fn seed(value: i64) -> PyResult<u64> {
+    unsigned("seed", value)
+}
+
 /// A float element whose finiteness is checked on its bits (an exponent of all ones is a NaN
 /// or an infinity): integer compares, which vectorise (measured faster than a max-reduction
 /// of the magnitudes' bits).

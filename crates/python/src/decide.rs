@@ -10,13 +10,10 @@ use specula::LobeKind;
 use specula_decide::{lobe_rate, parse_exponents, rate_unit, recommend, Request, Target, Zone};
 
 use crate::errors::{guarded, value_error};
-use crate::lobe::Lobe;
+use crate::lobe::{lobe_kind, Lobe};
 
 fn lobes(texts: &[String]) -> PyResult<Vec<LobeKind>> {
-    texts
-        .iter()
-        .map(|text| specula_render::lobe_file::parse_lobe(text, None).map_err(value_error))
-        .collect()
+    texts.iter().map(|text| lobe_kind(text)).collect()
 }
 
 /// `specula recommend --format json`'s rows (every candidate ranked on `target`) and the

@@ -5,27 +5,31 @@
 use std::sync::OnceLock;
 
 use glam::DVec3;
-use numpy::{
-    Element, IntoPyArray, PyArrayDyn, PyArrayMethods, PyReadwriteArrayDyn, PyUntypedArrayMethods,
-};
+use numpy::{Element, IntoPyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use specula::analysis::{
     energy_ratio, error_figures, max_reciprocity_error, specular_albedo_per_unit, Precision,
+    DEFAULT_SAMPLES_PER_ZONE,
 };
+use specula::claims::ClaimOptions;
 use specula::sampling::SpecularSampler;
 use specula::{Brdf, Exponent, Geometry, LobeKind, Normalisation};
 
 use crate::arrays::{
-    contiguous, count, first_non_finite, float64_rows, floats, map_chunks, non_finite, shaped,
-    tuple, Finite, Floats,
+    self, contiguous, count, first_non_finite, float64_rows, floats, map_chunks, non_finite,
+    shaped, tuple, Finite, Floats,
 };
 use crate::errors::{guarded, value_error};
 
-/// Parses the CLI's lobe text (`cosquad`, `cosquad:v=5`, `@lobe.toml`, `=t^n`) and `n`,
-/// checking a user's lobe at `n` as the CLI does.
+/// The CLI's lobe text (`cosquad`, `cosquad:v=5`, `@lobe.toml`, `=t^n`) as a lobe kind.
+pub fn lobe_kind(text: &str) -> PyResult<LobeKind> {
+    specula_render::lobe_file::parse_lobe(text, None).map_err(value_error)
+}
+
+/// Parses the CLI's lobe text and `n`, checking a user's lobe at `n` as the CLI does.
 pub fn parse(lobe: &str, n: f64) -> PyResult<specula::Lobe> {
-    let kind = specula_render::lobe_file::parse_lobe(lobe, None).map_err(value_error)?;
+    let kind = lobe_kind(lobe)?;
     let n = exponent(n)?;
     specula::Lobe::checked(kind, n).map_err(|e| value_error(e.to_string()))
 }
@@ -249,7 +253,7 @@ impl Lobe {
         t: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Py<PyAny>> {
-        guarded(|| self.evaluate(py, t, out))
+        self.__call__(py, t, out)
     }
 
     /// The error figures against ``t^n`` (SPEC section 4), exact arithmetic.
@@ -258,12 +262,15 @@ impl Lobe {
     /// -------
     /// dict
     ///     ``epicentre_max_rel``, ``epicentre_max_abs``, ``bloom_max_abs``, ``tail_max_abs``,
-    ///     ``rms`` and the other figures of ``specula analyze --format json``.
-    #[pyo3(signature = (samples_per_zone = 20_001))]
-    fn errors_json(&self, py: Python<'_>, samples_per_zone: i64) -> PyResult<String> {
+    ///     ``rms`` and the other figures of ``specula analyze --format json``, taken on
+    ///     ``samples_per_zone`` cosines per zone (``specula analyze``'s where ``None``).
+    #[pyo3(signature = (samples_per_zone = None))]
+    fn errors_json(&self, py: Python<'_>, samples_per_zone: Option<i64>) -> PyResult<String> {
         let lobe = self.lobe;
         guarded(|| {
-            let samples_per_zone = count("samples_per_zone", samples_per_zone, 2, 1_000_001)?;
+            let samples_per_zone = samples_per_zone.map_or(Ok(DEFAULT_SAMPLES_PER_ZONE), |s| {
+                count("samples_per_zone", s, 2, 1_000_001)
+            })?;
             let figures = py.detach(|| error_figures(&lobe, &mut Precision::F64, samples_per_zone));
             serde_json::to_string(&figures).map_err(|e| value_error(e.to_string()))
         })
@@ -290,13 +297,21 @@ impl Lobe {
     }
 
     /// The worst Helmholtz asymmetry ``|f(a, b) - f(b, a)| / max`` of the specular BRDF over
-    /// ``pairs`` direction pairs drawn uniformly on the hemisphere from ``seed``.
-    #[pyo3(signature = (pairs = 100_000, seed = 0x5eed_5bec))]
-    fn reciprocity_error(&self, py: Python<'_>, pairs: i64, seed: i64) -> PyResult<f64> {
+    /// ``pairs`` direction pairs drawn uniformly on the hemisphere from ``seed`` (each
+    /// ``specula claims``' where ``None``).
+    #[pyo3(signature = (pairs = None, seed = None))]
+    fn reciprocity_error(
+        &self,
+        py: Python<'_>,
+        pairs: Option<i64>,
+        seed: Option<i64>,
+    ) -> PyResult<f64> {
         guarded(|| {
-            let pairs = count("pairs", pairs, 1, 10_000_000)?;
-            let seed = u64::try_from(seed)
-                .map_err(|_| value_error(format!("seed {seed} is negative; give 0 or more")))?;
+            let defaults = ClaimOptions::default();
+            let pairs = pairs.map_or(Ok(defaults.reciprocity_pairs), |p| {
+                count("pairs", p, 1, 10_000_000)
+            })?;
+            let seed = seed.map_or(Ok(defaults.seed), arrays::seed)?;
             let brdf = Brdf::new(
                 DVec3::ZERO,
                 DVec3::ONE,
@@ -468,50 +483,43 @@ fn evaluate_into<'py, T>(
 where
     T: Element + Finite,
 {
-    match out {
+    // Either `out`, checked, or a new array allocated by `numpy.empty`, as NumPy allocates
+    // its own results (with its huge-page advice for large arrays; measured: 3.5x faster
+    // than a zeroed allocation from here at 10 M); then written in place with the GIL
+    // released.
+    let refused = || {
+        value_error(format!(
+            "out must be a writable {dtype} array of t's shape {} (and not t itself)",
+            tuple(shape)
+        ))
+    };
+    let target = match out {
         Some(out) => {
-            let mut written = out.extract::<PyReadwriteArrayDyn<'py, T>>().map_err(|_| {
-                value_error(format!(
-                    "out must be a writable {dtype} array of t's shape {} (and not t itself)",
-                    tuple(shape)
-                ))
-            })?;
-            if written.shape() != shape {
+            let array = out.cast::<PyArrayDyn<T>>().map_err(|_| refused())?;
+            if array.shape() != shape {
                 return Err(value_error(format!(
                     "out has shape {}; it must be t's, {}",
-                    tuple(written.shape()),
+                    tuple(array.shape()),
                     tuple(shape)
                 )));
             }
-            let slice = written.as_slice_mut().map_err(|_| {
-                value_error(
-                    "out is not C-contiguous; give a contiguous array (numpy.empty_like(t))",
-                )
-            })?;
-            py.detach(|| map_chunks(input, slice, kernel))
-                .map_err(|index| non_finite("t", index))?;
-            Ok(out.clone().unbind())
+            array.clone()
         }
-        None => {
-            // Allocated by `numpy.empty`, as NumPy allocates its own results (with its
-            // huge-page advice for large arrays; measured: 3.5x faster than a zeroed
-            // allocation from here at 10 M), then written in place with the GIL released.
-            let array = py
-                .import("numpy")?
-                .getattr("empty")?
-                .call1((shape.to_vec(), T::get_dtype(py)))?
-                .cast_into::<PyArrayDyn<T>>()?;
-            {
-                let mut written = array.readwrite();
-                let slice = written
-                    .as_slice_mut()
-                    .map_err(|e| value_error(e.to_string()))?;
-                py.detach(|| map_chunks(input, slice, kernel))
-                    .map_err(|index| non_finite("t", index))?;
-            }
-            Ok(array.into_any().unbind())
-        }
+        None => py
+            .import("numpy")?
+            .getattr("empty")?
+            .call1((shape.to_vec(), T::get_dtype(py)))?
+            .cast_into::<PyArrayDyn<T>>()?,
+    };
+    {
+        let mut written = target.try_readwrite().map_err(|_| refused())?;
+        let slice = written.as_slice_mut().map_err(|_| {
+            value_error("out is not C-contiguous; give a contiguous array (numpy.empty_like(t))")
+        })?;
+        py.detach(|| map_chunks(input, slice, kernel))
+            .map_err(|index| non_finite("t", index))?;
     }
+    Ok(target.into_any().unbind())
 }
 
 /// The ids of the built-in lobes, in the registry's order.

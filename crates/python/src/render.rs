@@ -7,15 +7,14 @@ use std::path::PathBuf;
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
-use specula_render::ibl::{render_ibl, Environment, IblSettings, Strategy, MAX_SPP};
+use specula_render::ibl::{render_ibl, Environment, IblSettings, Strategy};
 use specula_render::{
     render as rasterize, IlluminationModel, Image, Overrides, Scene, Shading, DEFAULT_SCENE,
-    MAX_SAMPLES,
 };
 
-use crate::arrays::shaped;
+use crate::arrays::{self, shaped, unsigned};
 use crate::errors::{file_error, guarded, value_error};
-use crate::lobe::{exponent, geometry, normalisation};
+use crate::lobe::{exponent, geometry, lobe_kind, normalisation};
 
 /// The one of `all` whose id is `text`, or the library's message naming the valid ones.
 pub fn choose<T: Copy>(
@@ -82,9 +81,7 @@ pub fn render(
 ) -> PyResult<Py<PyAny>> {
     guarded(|| {
         let overrides = Overrides {
-            lobe: lobe
-                .map(|text| specula_render::lobe_file::parse_lobe(text, None).map_err(value_error))
-                .transpose()?,
+            lobe: lobe.map(lobe_kind).transpose()?,
             n: n.map(exponent).transpose()?,
             geometry: geometry.map(self::geometry).transpose()?,
             normalisation: normalisation.map(self::normalisation).transpose()?,
@@ -101,15 +98,14 @@ pub fn render(
                     )
                 })
                 .transpose()?,
-            width: width.map(|w| within("width", w, 1, 16_384)).transpose()?,
-            height: height.map(|h| within("height", h, 1, 16_384)).transpose()?,
-            samples: samples
-                .map(|s| within("samples", s, 1, MAX_SAMPLES))
-                .transpose()?,
+            // Only made unsigned here: the renderers refuse a size, samples or spp out of
+            // their range, with the limits in the message.
+            width: width.map(|w| unsigned("width", w)).transpose()?,
+            height: height.map(|h| unsigned("height", h)).transpose()?,
+            samples: samples.map(|s| unsigned("samples", s)).transpose()?,
         };
-        let spp = within("spp", spp, 1, MAX_SPP)?;
-        let seed = u64::try_from(seed)
-            .map_err(|_| value_error(format!("seed {seed} is negative; give 0 or more")))?;
+        let spp = unsigned("spp", spp)?;
+        let seed = arrays::seed(seed)?;
         if environment.is_some() && (shading.is_some() || model.is_some()) {
             return Err(value_error(
                 "shading and model do not apply under an environment (it is path traced); drop them",
@@ -149,16 +145,4 @@ pub fn render(
         });
         image_array(py, &image.map_err(value_error)?)
     })
-}
-
-/// `value` if it lies in `[low, high]`, else a message naming the range.
-pub fn within(name: &str, value: i64, low: u32, high: u32) -> PyResult<u32> {
-    u32::try_from(value)
-        .ok()
-        .filter(|v| (low..=high).contains(v))
-        .ok_or_else(|| {
-            value_error(format!(
-                "{name} {value} is out of range; give {low} to {high}"
-            ))
-        })
 }

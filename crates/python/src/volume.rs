@@ -3,7 +3,6 @@
 //! the CPU ray marcher with any lobe as the specular term, as `specula volume`.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 use numpy::ndarray::{Array2, ShapeBuilder};
 use numpy::{IntoPyArray, ToPyArray};
@@ -13,17 +12,17 @@ use specula_render::volume::raymarch::{render_dvr, DvrSettings, Shading, View};
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::{self, Units};
 
-use crate::arrays::count;
+use crate::arrays::unsigned;
 use crate::errors::{file_error, guarded, value_error};
 use crate::lobe::{geometry, normalisation, parse};
-use crate::render::{image_array, within};
+use crate::render::{choose, image_array};
 
 /// A scalar volume on a regular grid, placed in world millimetres (RAS, as NIfTI).
 ///
 /// Build one with :meth:`Volume.load` (a file or folder) or :meth:`Volume.phantom`.
 #[pyclass(frozen, module = "specula._specula")]
 pub struct Volume {
-    volume: Arc<volume::Volume>,
+    volume: volume::Volume,
     /// The built-in it was made from, whose transfer function is its default.
     built_in: Option<BuiltIn>,
 }
@@ -37,7 +36,7 @@ impl Volume {
         guarded(|| {
             let read = py.detach(|| volume::read(&path));
             Ok(Self {
-                volume: Arc::new(read.map_err(|e| volume_error(&path, e.to_string()))?),
+                volume: read.map_err(|e| volume_error(&path, e.to_string()))?,
                 built_in: None,
             })
         })
@@ -49,18 +48,12 @@ impl Volume {
     #[pyo3(signature = (name, side = 128))]
     fn phantom(py: Python<'_>, name: &str, side: i64) -> PyResult<Self> {
         guarded(|| {
-            let side = count("side", side, *BuiltIn::SIDES.start(), *BuiltIn::SIDES.end())?;
-            let built_in = BuiltIn::parse(name).ok_or_else(|| {
-                let names = BuiltIn::ALL.map(BuiltIn::id);
-                value_error(format!(
-                    "unknown phantom '{}'; valid phantoms: {}",
-                    specula::excerpt(name),
-                    names.join(", ")
-                ))
-            })?;
+            let built_in = choose(&BuiltIn::ALL, BuiltIn::id, name, "phantom")?;
+            // `make` refuses a side out of `BuiltIn::SIDES`, naming the range.
+            let side = unsigned("side", side)?;
             let made = py.detach(|| built_in.make(side));
             Ok(Self {
-                volume: Arc::new(made.map_err(|e| value_error(e.to_string()))?),
+                volume: made.map_err(|e| value_error(e.to_string()))?,
                 built_in: Some(built_in),
             })
         })
@@ -174,8 +167,8 @@ pub fn render_volume(
             self::normalisation(normalisation)?,
         );
         // The ray marcher's plan refuses an image beyond its pixel budget.
-        let width = within("width", width, 1, u32::MAX)?;
-        let height = within("height", height, 1, u32::MAX)?;
+        let width = unsigned("width", width)?;
+        let height = unsigned("height", height)?;
         let view = View::parse(view).map_err(value_error)?;
         let data = &volume.volume;
         let function = match (transfer, volume.built_in) {

@@ -78,7 +78,7 @@ def test_epicentre_error_is_numpys_on_a_dense_grid(lobe):
     t = np.linspace(specula.zones(n)["epicentre_cos"], 1.0, 400_001)
     reference = t**n
     dense = np.max(np.abs(model(t) - reference) / reference)
-    # The library samples each zone (20,001 points); the dense grid can only find more.
+    # The library samples each zone (100,001 points); the dense grid can only find more.
     assert figures["epicentre_max_rel"] <= dense * (1 + 1e-9) + 1e-15
     assert figures["epicentre_max_rel"] >= dense * 0.98 - 1e-12
 
@@ -99,6 +99,16 @@ def test_analyze_rows_are_the_clis(cli_json):
     theirs = cli_json("analyze", "--lobe", "cosquad,schlick", "--n", "16,64",
                       "--format", "json")
     assert ours == theirs
+
+
+def test_errors_are_analyzes_figures_and_numpy_scalars_are_exponents():
+    # errors() samples as `specula analyze` does by default, so the figures are its row's;
+    # a NumPy scalar is one exponent, as a Python number is.
+    for n in [np.int64(64), np.float32(16.0), 64]:
+        rows = specula.analyze("cosquad", n)
+        assert len(rows) == 1 and rows[0]["n"] == float(n)
+        figures = specula.errors(specula.Lobe("cosquad", float(n)))
+        assert figures and figures == {key: rows[0][key] for key in figures}
 
 
 VERDICTS = {"holds", "holds with qualification", "does not hold"}

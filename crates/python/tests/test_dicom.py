@@ -41,8 +41,14 @@ def test_the_enhanced_ct_reads_as_pydicom_reads_it():
 
     volume = specula.Volume.load(path)
     assert volume.units == "hounsfield"
-    assert volume.data.shape == expected.shape
-    np.testing.assert_allclose(volume.data, expected, atol=1e-3)
+    assert volume.data.shape == expected.shape == (512, 512, 2)
+    # Stored integers rescaled by -1024 and held as float32: exact.
+    np.testing.assert_array_equal(volume.data, expected)
+    # Not vacuous: the frames differ, lie 10 mm apart, and hold air and tissue in HU.
+    assert np.any(hu[0] != hu[-1])
+    step = (positions[order[-1]] - positions[order[0]]) @ normal / (frames - 1)
+    assert step == pytest.approx(10.0, abs=1e-6)
+    assert expected.min() == -1024.0 and expected.max() > 0.0
     # Voxel (i, j, k) at slice k's LPS position plus i column spacings along the row and j
     # row spacings along the column, x and y negated for RAS.
     for k in (0, frames - 1):

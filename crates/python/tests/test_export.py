@@ -16,7 +16,7 @@ def test_every_language_is_written(language):
         assert isinstance(code, str) and len(code) > 100
 
 
-@pytest.mark.parametrize("language", ["wgsl", "glsl", "osl", "mtlx", "mitsuba"])
+@pytest.mark.parametrize("language", ["wgsl", "glsl", "hlsl", "msl", "osl", "mtlx", "mitsuba"])
 def test_the_text_is_the_clis(cli, language):
     lobe = specula.Lobe("schlick", 32, geometry="blinn")
     code, out, err = cli("shader", "--lobe", "schlick", "--n", "32", "--geometry", "blinn",

@@ -24,6 +24,8 @@ import os as _os
 import warnings as _warnings
 from typing import Any, Dict, List, Optional, Sequence, Union
 
+import numpy as _np
+
 from . import _specula
 from ._specula import Lobe, Volume, default_scene, render, render_volume
 
@@ -76,8 +78,10 @@ def zones(n: float) -> Dict[str, float]:
     return _json.loads(_specula.zones_json(float(n)))
 
 
-def errors(lobe: Lobe, samples_per_zone: int = 20_001) -> Dict[str, float]:
-    """A lobe's error figures against ``t^n`` (SPEC section 4), in float64.
+def errors(lobe: Lobe, samples_per_zone: Optional[int] = None) -> Dict[str, float]:
+    """A lobe's error figures against ``t^n`` (SPEC section 4), in float64, on
+    ``samples_per_zone`` cosines per zone: ``specula analyze``'s (100,001) where omitted, so
+    the figures are :func:`analyze`'s.
 
     Returns
     -------
@@ -107,7 +111,7 @@ def analyze(
     """
     if isinstance(lobes, str):
         lobes = [lobes]
-    if isinstance(n, (int, float)):
+    if n is not None and _np.ndim(n) == 0:  # a number, NumPy's scalars included
         n = [n]
     return _json.loads(
         _specula.analyze_json(
