@@ -189,14 +189,11 @@ impl Costing {
                 rate: crate::rates::kernel_rate(lobe),
                 datapath: None,
             }),
-            Costing::Modelled(family) => {
-                let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
-                Some(Point {
-                    error: float_error(),
-                    rate: family.cost(&ops).evals_per_clock,
-                    datapath: None,
-                })
-            }
+            Costing::Modelled(family) => Some(Point {
+                error: float_error(),
+                rate: modelled_rate(family, lobe)?,
+                datapath: None,
+            }),
             Costing::Estimated(hardware) | Costing::Synthesized(hardware) => {
                 let Some(chosen) = hardware
                     .iter()
@@ -262,6 +259,13 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
 /// Why a material's verdict refuses the FPGA.
 pub const FPGA_MATERIAL_REFUSAL: &str = "a material verdict cannot target fpga: the fixed-point datapaths take an integer n and a word length chosen for an error against t^n, which a material's fit does not give; valid targets: cpu, gpu-nvidia, gpu-amd";
 
+/// `lobe`'s evaluations per clock per multiprocessor on `family`, by the GPU cost model over
+/// the instructions of its exported shader (higher is cheaper).
+pub fn modelled_rate(family: &GpuFamily, lobe: &Lobe) -> Result<f64, String> {
+    let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
+    Ok(family.cost(&ops).evals_per_clock)
+}
+
 /// `target` if a material's verdict can be given on it: every target but the FPGA
 /// ([`FPGA_MATERIAL_REFUSAL`]).
 pub(crate) fn material_target(target: Target) -> Result<Target, String> {
@@ -278,10 +282,7 @@ pub fn lobe_rate(target: Target, lobe: &Lobe) -> Result<f64, String> {
     let target = material_target(target)?;
     match Costing::new(target, &[lobe.exponent()])?.0 {
         Costing::Measured => Ok(crate::rates::kernel_rate(lobe)),
-        Costing::Modelled(family) => {
-            let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
-            Ok(family.cost(&ops).evals_per_clock)
-        }
+        Costing::Modelled(family) => modelled_rate(&family, lobe),
         Costing::Estimated(_) | Costing::Synthesized(_) => Err(FPGA_MATERIAL_REFUSAL.to_owned()),
     }
 }

@@ -233,6 +233,12 @@ pub fn check_output_path(path: &Path) -> Result<(), ImageError> {
     format_of(path).map(|_| ())
 }
 
+/// Whether `path` names a format that keeps linear radiance above 1 (EXR, HDR; not PNG's
+/// 8-bit display values), or why it names no format this module writes.
+pub fn is_linear_output(path: &Path) -> Result<bool, ImageError> {
+    format_of(path).map(|format| format != Format::Png)
+}
+
 /// Writes 8-bit sRGB bytes (three per pixel) as a PNG, atomically.
 pub fn write_png_srgb8(
     path: &Path,

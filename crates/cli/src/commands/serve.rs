@@ -59,12 +59,12 @@ pub fn run(args: &Args) -> CommandResult {
 
 /// A lobe's costs: the CPU's counted SIMD instructions and the GPU families' modelled rates.
 pub fn costs(lobe: &Lobe) -> Result<Vec<TargetCost>, String> {
-    let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
-    Ok(std::iter::once(cpu_cost(lobe))
-        .chain(GpuFamily::ALL.iter().map(|family| TargetCost {
+    let gpus = GpuFamily::ALL.iter().map(|family| {
+        Ok(TargetCost {
             target: family.id.to_owned(),
-            value: family.cost(&ops).evals_per_clock,
+            value: specula_decide::modelled_rate(family, lobe)?,
             unit: "evaluations per clock per multiprocessor (modelled; more is cheaper)".to_owned(),
-        }))
-        .collect())
+        })
+    });
+    std::iter::once(Ok(cpu_cost(lobe))).chain(gpus).collect()
 }

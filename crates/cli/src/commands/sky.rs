@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use specula_render::ibl::{sun_direction, Environment, SKY_WIDTH, SUN_RADIANCE, SUN_RADIUS};
-use specula_render::{check_output_path, write_image, Display};
+use specula_render::{is_linear_output, write_image, Display};
 
 use super::CommandResult;
 
@@ -22,13 +22,7 @@ pub struct Args {
 
 /// Writes the sky and says what it holds.
 pub fn run(args: &Args) -> CommandResult {
-    check_output_path(&args.output).map_err(|e| e.to_string())?;
-    let extension = args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    if !matches!(extension.as_deref(), Some("exr" | "hdr")) {
+    if !is_linear_output(&args.output).map_err(|e| e.to_string())? {
         return Err(format!(
             "{}: the sky is linear radiance up to {} (the sun); write it as .exr or .hdr",
             args.output.display(),
