@@ -18,8 +18,8 @@ mod recommend;
 pub use choice::{Target, Zone};
 pub use hardware::{hardware_sweeps, sweeps};
 pub use recommend::{
-    lobe_rate, modelled_rate, pareto_front, rate_unit, recommend, versus_pow, Candidate,
-    Recommendation, Request, FPGA_MATERIAL_REFUSAL,
+    lobe_rate, modelled_rate, pareto_front, rate_unit, recommend, recommend_each, versus_pow,
+    Candidate, Recommendation, Request, FPGA_MATERIAL_REFUSAL,
 };
 
 use specula::{Exponent, LobeKind};

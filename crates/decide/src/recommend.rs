@@ -131,6 +131,7 @@ pub(crate) const FPGA_TARGET: specula_synth::Target =
 
 /// One lobe at one exponent: its error, its cost figure (higher is cheaper), and on the FPGA
 /// the datapath costed.
+#[derive(Clone)]
 struct Point {
     error: f64,
     rate: f64,
@@ -318,14 +319,19 @@ fn check(request: &Request) -> Result<(), String> {
 /// ranking finds each in the cache: Yosys and nextpnr run one thread each, and a request
 /// over a range needs dozens of designs on an empty cache. A failure is left for the
 /// ranking, which reports it.
-fn synthesize_ahead(hardware: &[(Exponent, std::sync::Arc<Vec<WidthSweep>>)], request: &Request) {
+fn synthesize_ahead(
+    hardware: &[(Exponent, std::sync::Arc<Vec<WidthSweep>>)],
+    lobes: &[LobeKind],
+    zone: Zone,
+    max_error: f64,
+) {
     use rayon::prelude::*;
     let mut designs: Vec<(specula_hw::HwLobe, u32)> = hardware
         .iter()
         .flat_map(|(_, sweeps)| {
-            request.lobes.iter().filter_map(|&kind| {
-                cheapest_datapath(sweeps, kind, request.zone, request.max_error)
-                    .filter(|chosen| chosen.error <= request.max_error)
+            lobes.iter().filter_map(|&kind| {
+                cheapest_datapath(sweeps, kind, zone, max_error)
+                    .filter(|chosen| chosen.error <= max_error)
                     .map(|chosen| (chosen.lobe, chosen.bits))
             })
         })
@@ -343,61 +349,146 @@ fn synthesize_ahead(hardware: &[(Exponent, std::sync::Arc<Vec<WidthSweep>>)], re
 /// lobes, names the one being measured, and is cleared at the end (pass
 /// [`ProgressBar::hidden`] for none).
 pub fn recommend(request: &Request, progress: &ProgressBar) -> Result<Recommendation, String> {
-    check(request)?;
-    let (target, max_error) = (request.target, request.max_error);
-    let (costing, note) = Costing::new(target, &request.exponents)?;
-    let unit = costing.unit();
+    let mut answers = recommend_each(request, &[request.max_error], progress)?;
+    Ok(answers.remove(0))
+}
+
+/// [`recommend`] at each of `bounds` in place of `request.max_error`, one answer per bound:
+/// each lobe's error, cost and energy are measured once where they do not depend on the
+/// bound (the CPU's and the GPUs'), and the FPGA's datapath, whose word length does, is
+/// chosen per bound.
+pub fn recommend_each(
+    request: &Request,
+    bounds: &[f64],
+    progress: &ProgressBar,
+) -> Result<Vec<Recommendation>, String> {
+    for &max_error in bounds {
+        check(&Request {
+            max_error,
+            lobes: request.lobes.clone(),
+            exponents: request.exponents.clone(),
+            ..*request
+        })?;
+    }
+    let (costing, note) = Costing::new(request.target, &request.exponents)?;
+    let per_bound = matches!(costing, Costing::Estimated(_) | Costing::Synthesized(_));
     if let Costing::Synthesized(hardware) = &costing {
-        synthesize_ahead(hardware, request);
+        for &max_error in bounds {
+            synthesize_ahead(hardware, request.lobes.as_slice(), request.zone, max_error);
+        }
     }
     progress.set_length(request.lobes.len() as u64);
-    let mut candidates = Vec::new();
+    let mut tallies: Vec<Vec<Tally>> = vec![Vec::new(); bounds.len()];
     for &kind in &request.lobes {
         progress.set_message(kind.to_string());
-        let mut error = 0.0_f64;
+        let mut lobe_tallies = vec![Tally::default(); bounds.len()];
         let mut energy = 0.0_f64;
-        let mut cheapest = f64::INFINITY;
-        // The datapath named at the first exponent; none if any exponent has none.
-        let mut datapath = None;
-        let mut unavailable = false;
         for &n in &request.exponents {
             let lobe = Lobe::new(kind, n);
             energy = energy.max(energy_ratio(&lobe));
-            match costing.point(&lobe, request.zone, max_error)? {
-                Some(point) => {
-                    error = error.max(point.error);
-                    cheapest = cheapest.min(point.rate);
-                    // The first exponent's datapath names the lobe's, unless one cannot be
-                    // built: that one says why the lobe does not meet the request.
-                    datapath = if point.rate <= 0.0 && point.datapath.is_some() {
-                        point.datapath
-                    } else {
-                        datapath.or(point.datapath)
-                    };
-                }
-                None => unavailable = true,
+            let shared = if per_bound {
+                None
+            } else {
+                Some(costing.point(&lobe, request.zone, bounds[0])?)
+            };
+            for (tally, &max_error) in lobe_tallies.iter_mut().zip(bounds) {
+                let point = match &shared {
+                    Some(point) => point.clone(),
+                    None => costing.point(&lobe, request.zone, max_error)?,
+                };
+                tally.add(point);
             }
         }
-        if unavailable {
-            (error, cheapest, datapath) = (f64::INFINITY, 0.0, None);
+        for (all, mut tally) in tallies.iter_mut().zip(lobe_tallies) {
+            tally.energy = energy;
+            tally.kind = Some(kind);
+            all.push(tally);
         }
-        // A rate of 0 is a lobe the target cannot run (a datapath that does not fit the part).
-        let meets =
-            error <= max_error && cheapest > 0.0 && (!request.energy_conserving || energy <= 1.001);
-        candidates.push(Candidate {
-            lobe: kind.to_string(),
-            datapath,
-            error,
-            rate: cheapest,
-            unit,
-            energy_ratio: energy,
-            meets,
-            pareto: false,
-            why: String::new(),
-        });
         progress.inc(1);
     }
     progress.finish_and_clear();
+    let unit = costing.unit();
+    Ok(tallies
+        .into_iter()
+        .zip(bounds)
+        .map(|(tallies, &max_error)| {
+            let candidates = tallies
+                .into_iter()
+                .map(|tally| tally.candidate(unit, max_error, request.energy_conserving))
+                .collect();
+            rank(candidates, unit, note.clone(), request.target, max_error)
+        })
+        .collect())
+}
+
+/// One lobe's measurements over the request's exponents, at one bound.
+#[derive(Clone, Debug, Default)]
+struct Tally {
+    kind: Option<LobeKind>,
+    /// The largest error over the exponents.
+    error: f64,
+    /// The lowest rate over the exponents (`None` before the first).
+    cheapest: Option<f64>,
+    /// The datapath named at the first exponent, or the one that cannot be built.
+    datapath: Option<String>,
+    /// Some exponent has no datapath.
+    unavailable: bool,
+    energy: f64,
+}
+
+impl Tally {
+    fn add(&mut self, point: Option<Point>) {
+        let Some(point) = point else {
+            self.unavailable = true;
+            return;
+        };
+        self.error = self.error.max(point.error);
+        self.cheapest = Some(self.cheapest.map_or(point.rate, |c| c.min(point.rate)));
+        // The first exponent's datapath names the lobe's, unless one cannot be built: that
+        // one says why the lobe does not meet the request.
+        self.datapath = if point.rate <= 0.0 && point.datapath.is_some() {
+            point.datapath
+        } else {
+            self.datapath.take().or(point.datapath)
+        };
+    }
+
+    fn candidate(self, unit: &'static str, max_error: f64, energy_conserving: bool) -> Candidate {
+        let (error, rate, datapath) = if self.unavailable {
+            (f64::INFINITY, 0.0, None)
+        } else {
+            (
+                self.error,
+                self.cheapest.unwrap_or(f64::INFINITY),
+                self.datapath,
+            )
+        };
+        // A rate of 0 is a lobe the target cannot run (a datapath that does not fit the part).
+        let meets =
+            error <= max_error && rate > 0.0 && (!energy_conserving || self.energy <= 1.001);
+        Candidate {
+            lobe: self.kind.map(|k| k.to_string()).unwrap_or_default(),
+            datapath,
+            error,
+            rate,
+            unit,
+            energy_ratio: self.energy,
+            meets,
+            pareto: false,
+            why: String::new(),
+        }
+    }
+}
+
+/// The answer from measured candidates: the Pareto front marked, those that meet first and
+/// cheapest first, each with why.
+fn rank(
+    mut candidates: Vec<Candidate>,
+    unit: &'static str,
+    note: Option<String>,
+    target: Target,
+    max_error: f64,
+) -> Recommendation {
     let front = pareto_front(
         &candidates
             .iter()
@@ -419,7 +510,7 @@ pub fn recommend(request: &Request, progress: &ProgressBar) -> Result<Recommenda
     for candidate in &mut recommendation.candidates {
         candidate.why = why(candidate, best.as_deref(), pow_rate, target, max_error);
     }
-    Ok(recommendation)
+    recommendation
 }
 
 /// `rate` as a multiple of pow's (`1.52x`), or `-` where pow has no cost on the target (no
@@ -493,6 +584,27 @@ mod tests {
             ..Request::new(Target::GpuAmd, n, 0.01)
         };
         assert!(recommend(&empty, &ProgressBar::hidden()).is_err());
+    }
+
+    /// Measuring once for several bounds answers as measuring for each: the same candidates,
+    /// order and reasons.
+    #[test]
+    fn answers_at_several_bounds_are_the_answers_at_each() {
+        let bounds = [0.005, 0.02, 0.1];
+        let request = Request::new(Target::GpuAmd, vec![Exponent::new(64.0)], bounds[0]);
+        let together = recommend_each(&request, &bounds, &ProgressBar::hidden()).unwrap();
+        for (answer, max_error) in together.iter().zip(bounds) {
+            let alone = Request {
+                max_error,
+                ..request.clone()
+            };
+            assert_eq!(answer, &recommend(&alone, &ProgressBar::hidden()).unwrap());
+        }
+        let met = |answer: &Recommendation| answer.candidates.iter().filter(|c| c.meets).count();
+        assert!(
+            met(&together[0]) < met(&together[2]),
+            "the bounds admit different lobes"
+        );
     }
 
     #[test]

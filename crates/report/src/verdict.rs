@@ -1,15 +1,15 @@
 //! The report's first section, "Which lobe when": for each GPU family of the cost model and the
 //! FPGA, the cheapest lobe within a few epicentre accuracies at a few exponents, and for the
 //! GPUs the Pareto plot of error against modelled cost. Every cell is `specula recommend`'s
-//! answer for its target, exponent and bound ([`specula_decide::recommend`] itself, over the
-//! report's lobes), so the page and the command cannot disagree. The CPU's answer needs timing
+//! answer for its target, exponent and bound ([`specula_decide::recommend_each`]: `recommend`
+//! at a row's three bounds, each lobe measured once, over the report's lobes), so the page and the command cannot disagree. The CPU's answer needs timing
 //! on a quiet machine, so it is `specula recommend --target cpu` (and the cost section with
 //! `--bench`).
 
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use specula::{Exponent, LobeKind};
-use specula_decide::{recommend, versus_pow, Recommendation, Request, Target};
+use specula_decide::{recommend_each, versus_pow, Recommendation, Request, Target};
 
 use super::html::{paragraph, table};
 use super::plot::{Chart, Series};
@@ -26,17 +26,12 @@ const PLOTTED: f64 = 64.0;
 const EXACT_FLOOR: f64 = 1e-6;
 
 /// `specula recommend --target TARGET --n N --max-error BOUND` over the report's lobes.
-fn answer(
-    lobes: &[LobeKind],
-    target: Target,
-    n: f64,
-    bound: f64,
-) -> Result<Recommendation, String> {
+fn answers(lobes: &[LobeKind], target: Target, n: f64) -> Result<Vec<Recommendation>, String> {
     let request = Request {
         lobes: lobes.to_vec(),
-        ..Request::new(target, vec![Exponent::new(n)], bound)
+        ..Request::new(target, vec![Exponent::new(n)], ACCURACIES[0])
     };
-    recommend(&request, &ProgressBar::hidden())
+    recommend_each(&request, &ACCURACIES, &ProgressBar::hidden())
 }
 
 /// A GPU cell: the best lobe and its modelled rate over pow's, or `-`.
@@ -89,51 +84,41 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
         ));
     }
     let lobes = context.lobes.clone();
-    let gpu_cells: Vec<(Target, f64, f64)> = FAMILIES
+    // One row per GPU family and n, each lobe measured once for the row's bounds; the rows
+    // in parallel. The FPGA's one after another, so that a design two rows share is
+    // synthesized once and then read from the cache.
+    let gpu_rows: Vec<(Target, f64)> = FAMILIES
         .iter()
-        .flat_map(|&(target, _)| {
-            EXPONENTS
-                .iter()
-                .flat_map(move |&n| ACCURACIES.map(|bound| (target, n, bound)))
-        })
+        .flat_map(|&(target, _)| EXPONENTS.iter().map(move |&n| (target, n)))
         .collect();
     let hardware: Vec<u32> = context.sizes.hardware_exponents.to_vec();
-    // The GPU cells in parallel; the FPGA's one after another, so that a design two bounds
-    // share is synthesized once and then read from the cache.
     let (gpu, fpga) = rayon::join(
         || {
-            gpu_cells
+            gpu_rows
                 .par_iter()
-                .map(|&(target, n, bound)| answer(&lobes, target, n, bound))
+                .map(|&(target, n)| answers(&lobes, target, n))
                 .collect::<Result<Vec<_>, String>>()
         },
         || {
             hardware
                 .iter()
-                .map(|&n| {
-                    ACCURACIES
-                        .iter()
-                        .map(|&bound| answer(&lobes, Target::Fpga, f64::from(n), bound))
-                        .collect::<Result<Vec<_>, String>>()
-                })
+                .map(|&n| answers(&lobes, Target::Fpga, f64::from(n)))
                 .collect::<Result<Vec<_>, String>>()
         },
     );
     let (gpu, fpga) = (gpu?, fpga?);
-    let gpu_answer = |target: Target, n: f64, bound: f64| {
-        gpu_cells
+    let gpu_answers = |target: Target, n: f64| {
+        gpu_rows
             .iter()
-            .position(|&cell| cell == (target, n, bound))
+            .position(|&row| row == (target, n))
             .map(|k| &gpu[k])
-            .ok_or("every GPU cell was answered")
+            .ok_or("every GPU row was answered")
     };
     let mut rows = Vec::new();
     for (target, name) in FAMILIES {
         for n in EXPONENTS {
             let mut row = vec![name.to_owned(), n.to_string()];
-            for bound in ACCURACIES {
-                row.push(gpu_cell(gpu_answer(target, n, bound)?));
-            }
+            row.extend(gpu_answers(target, n)?.iter().map(gpu_cell));
             rows.push(row);
         }
     }
@@ -165,7 +150,7 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
         html += &paragraph(&format!("Note: {note}."));
     }
     for (target, name) in FAMILIES {
-        let plotted_answer = gpu_answer(target, PLOTTED, ACCURACIES[0])?;
+        let plotted_answer = &gpu_answers(target, PLOTTED)?[0];
         let candidates: Vec<(LobeKind, &specula_decide::Candidate)> = context
             .lobes
             .iter()
