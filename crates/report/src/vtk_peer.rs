@@ -14,9 +14,9 @@ use specula_render::volume::{self, nifti, vtk, Volume};
 use specula_render::Image;
 
 /// The VTK side of a comparison: `vtk_volume.py`, run by the Python that has VTK. The script
-/// lives beside the command line's `bench volume` (whose tests run it directly) and is
+/// lives beside this module (`crates/cli/tests/volumes/vtk_facts.py` runs it directly) and is
 /// compiled in, so it is found from any working directory.
-const VTK_SCRIPT: &str = include_str!("../../cli/src/commands/bench/vtk_volume.py");
+const VTK_SCRIPT: &str = include_str!("vtk_volume.py");
 
 /// Renders several jobs in one Python process started ahead of them (VTK imported while the
 /// caller prepares the jobs): the script's own `read_job` and `render` on each job file whose

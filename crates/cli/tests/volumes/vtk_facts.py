@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Probe the behaviours of VTK's CPU ray caster that VTK_NOTES.md describes, on the installed
-vtk wheel, through crates/cli/src/commands/bench/vtk_volume.py and small synthetic NIfTI volumes (identity affine, 1 mm).
+vtk wheel, through crates/report/src/vtk_volume.py and small synthetic NIfTI volumes (identity affine, 1 mm).
 
     python vtk_facts.py [--keep DIR]
 
@@ -48,7 +48,7 @@ def main():
         path = os.path.join(folder, "job.json")
         with open(path, "w") as f:
             json.dump(job, f)
-        done = subprocess.run([sys.executable, os.path.join(HERE, "..", "..", "src", "commands", "bench", "vtk_volume.py"), path], capture_output=True, text=True)
+        done = subprocess.run([sys.executable, os.path.join(HERE, "..", "..", "..", "report", "src", "vtk_volume.py"), path], capture_output=True, text=True)
         if done.returncode != 0:
             raise SystemExit(f"vtk_facts.py: vtk_volume.py failed: {done.stderr.strip()}")
         reader = vtk.vtkPNGReader()

@@ -1,6 +1,6 @@
 //! VTK's CPU ray caster (`vtkFixedPointVolumeRayCastMapper`, what 3D Slicer and ParaView
 //! build on) as the yardstick: specula's ray marcher and VTK set up alike, and the job that
-//! `vtk_volume.py` (beside the CLI's benchmark) runs.
+//! `vtk_volume.py` (in `crates/report`, beside the module that runs it) runs.
 //!
 //! Alike means the same volume, view, image size, sample distance, transfer function (VTK's
 //! opacity per millimetre is `1 - exp(-sigma)`, which its sample-distance correction turns
