@@ -36,14 +36,12 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
         x: (1.0, 1000.0),
         y: (0.0, high * 1.05),
         log_x: true,
-        log_y: false,
         series: kinds
             .iter()
             .zip(ratios)
             .map(|(&k, points)| series(k, points))
             .collect(),
-        bands: Vec::new(),
-        legend_below: false,
+        ..Chart::default()
     };
     let mut html = paragraph("Energy ratio 1 means the lobe reflects what t^n reflects; the analytic (n+1)/(2 pi) applied to an approximation scales its energy by exactly this ratio.");
     html += &context.svg("energy-ratio.svg", &chart, "energy ratio against n: 1 reflects what t^n reflects; above 1 a lobe with t^n's normalisation creates energy, below it darkens")?;
@@ -54,7 +52,6 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
         x: (1.0, 1000.0),
         y: (0.4, 1.2),
         log_x: true,
-        log_y: false,
         series: vec![
             Series {
                 name: "coef1 / exact".into(),
@@ -76,8 +73,7 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
                 dashed: true,
             },
         ],
-        bands: Vec::new(),
-        legend_below: false,
+        ..Chart::default()
     };
     html += &context.svg("coef1.svg", &coef1, "coef1 against the exact normalisation: it crosses 1 at a single n, so the thesis's coefficient is right only there")?;
     let table_n = [1.0, 8.0, 64.0, 512.0, 1000.0].map(Exponent::new);

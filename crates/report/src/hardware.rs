@@ -173,11 +173,9 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
             y_label: "epicentre max rel error".into(),
             x: (f64::from(*BITS.start()), f64::from(*BITS.end())),
             y: (1e-4, 1.0),
-            log_x: false,
             log_y: true,
             series,
-            bands: Vec::new(),
-            legend_below: false,
+            ..Chart::default()
         };
         html += &context.svg(
             &format!("hardware-error-n{n}.svg"),

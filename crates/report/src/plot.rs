@@ -17,7 +17,10 @@ pub struct Series {
     pub dashed: bool,
 }
 
-/// A chart: axes, curves and shaded bands along `x`.
+/// A chart: axes, curves and shaded bands along `x`. Its default (linear axes, no bands,
+/// the legend at the top) fills what a chart leaves unsaid (`..Chart::default()`); every
+/// chart names its title, labels, ranges and curves.
+#[derive(Default)]
 pub struct Chart {
     pub title: String,
     pub x_label: String,
@@ -503,8 +506,6 @@ mod tests {
             y_label: "y".into(),
             x: (0.0, 1.0),
             y: (0.0, 1.0),
-            log_x: false,
-            log_y: false,
             series: vec![Series {
                 name: "y = x".into(),
                 points: (0..=2000)
@@ -516,8 +517,7 @@ mod tests {
                 markers: false,
                 dashed: false,
             }],
-            bands: Vec::new(),
-            legend_below: false,
+            ..Chart::default()
         };
         let svg = chart.to_svg(580, 360).unwrap();
         let header = format!(

@@ -110,7 +110,6 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
                 y_label: "lobe value".into(),
                 x: (0.0, right),
                 y: if log_y { (1e-4, 1.0) } else { (0.0, 1.05) },
-                log_x: false,
                 log_y,
                 series: curves.clone(),
                 bands: vec![
@@ -127,7 +126,7 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
                         "bloom",
                     ),
                 ],
-                legend_below: false,
+                ..Chart::default()
             };
             let name = format!("shape-n{n}{}.svg", if log_y { "-log" } else { "" });
             html += &context.svg(
@@ -188,11 +187,8 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
             y_label: "lobe - t^n".into(),
             x: (0.0, 1.5),
             y: (low - pad, high + pad),
-            log_x: false,
-            log_y: false,
             series: curves,
-            bands: Vec::new(),
-            legend_below: false,
+            ..Chart::default()
         };
         html += &context.svg(
             &format!("error-angle-{}.svg", kind.id()),
@@ -262,8 +258,8 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
             log_x: true,
             log_y: true,
             series: curves,
-            bands: Vec::new(),
             legend_below: true,
+            ..Chart::default()
         };
         let caption = format!("{title} against n for every lobe: flat lines are errors that hold at every n; rising ones grow with the exponent");
         html += &context.svg(file, &chart, &caption)?;
@@ -415,7 +411,6 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
             y_label: "epicentre max relative error".into(),
             x: (0.0, right),
             y: (1e-7, 1.0),
-            log_x: false,
             log_y: true,
             series: points
                 .iter()
@@ -424,8 +419,8 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
                     ..series(kind, vec![(ns, error)])
                 })
                 .collect(),
-            bands: Vec::new(),
             legend_below: true,
+            ..Chart::default()
         };
         html += &context.svg("pareto.svg", &chart, "error against time per evaluation: lower left is better; a lobe below and left of another beats it on both")?;
     } else {

@@ -198,8 +198,8 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
             log_x: true,
             log_y: true,
             series: series_list,
-            bands: Vec::new(),
             legend_below: true,
+            ..Chart::default()
         };
         html += &context.svg(
             &format!("verdict-{}.svg", target.id()),
