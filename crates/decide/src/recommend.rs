@@ -83,8 +83,6 @@ pub struct Candidate {
 /// The answer: every candidate, those that meet the request first, cheapest first.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Recommendation {
-    /// The cheapest lobe that meets the request, if any does.
-    pub best: Option<String>,
     /// The unit of every candidate's rate.
     pub unit: &'static str,
     /// What a face should tell its user about how the costs were obtained (the FPGA's tools
@@ -104,11 +102,11 @@ impl Recommendation {
             .map_or(f64::NAN, |c| c.rate)
     }
 
-    /// The best lobe's candidate, if any meets the request.
+    /// The cheapest candidate that meets the request, if any does: the first, as those that
+    /// meet come first, cheapest first.
     #[must_use]
     pub fn best_candidate(&self) -> Option<&Candidate> {
-        let best = self.best.as_deref()?;
-        self.candidates.iter().find(|c| c.lobe == best)
+        self.candidates.first().filter(|c| c.meets)
     }
 }
 
@@ -500,13 +498,12 @@ fn rank(
     }
     candidates.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
     let mut recommendation = Recommendation {
-        best: candidates.iter().find(|c| c.meets).map(|c| c.lobe.clone()),
         unit,
         note,
         candidates,
     };
     let pow_rate = recommendation.pow_rate();
-    let best = recommendation.best.clone();
+    let best = recommendation.best_candidate().map(|c| c.lobe.clone());
     for candidate in &mut recommendation.candidates {
         candidate.why = why(candidate, best.as_deref(), pow_rate, target, max_error);
     }
@@ -616,7 +613,6 @@ mod tests {
         let pow = answer.candidates.iter().find(|c| c.lobe == "pow").unwrap();
         assert!(pow.meets && pow.error == 0.0, "{pow:?}");
         let best = answer.best_candidate().expect("pow at least meets");
-        assert_eq!(Some(best), answer.candidates.first());
         assert!(
             best.why.starts_with("cheapest that meets it"),
             "{}",
@@ -629,6 +625,10 @@ mod tests {
             .map(|c| c.rate)
             .collect();
         assert!(met.windows(2).all(|w| w[0] >= w[1]), "{met:?}");
+        assert!(
+            answer.candidates[met.len()..].iter().all(|c| !c.meets),
+            "every lobe that meets comes before every one that does not"
+        );
         assert!(answer.candidates.iter().all(|c| c.datapath.is_none()));
     }
 }

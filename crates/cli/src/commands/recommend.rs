@@ -120,7 +120,7 @@ pub fn run(args: &Args) -> CommandResult {
     let (zone, target) = (args.zone, args.target);
     // Off the FPGA, pow is exact, keeps t^n's energy and so always meets the request; the
     // FPGA has no datapath for it, so there nothing may meet it.
-    match &answer.best {
+    match answer.best_candidate().map(|c| &c.lobe) {
         Some(lobe) => println!(
             "{lobe}: the cheapest lobe within {} % ({zone} error) at {span} on {target}",
             100.0 * max_error
