@@ -8,6 +8,7 @@
 //! progress goes to a [`indicatif::ProgressBar`] the caller passes (hidden for none); what a
 //! face should tell its user comes back as data ([`Recommendation::note`]).
 
+pub mod c_twins;
 mod choice;
 pub mod fpga_estimate;
 pub mod hardware;

@@ -22,7 +22,7 @@
 //!   `x_0 = max(0, 1 - a)` the base at `t = 0`.
 //! - **Source**: the thesis, slide "A model based on a cosine-quadratic function".
 
-use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::batch::LobeKernel;
 use crate::real::Real;
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
@@ -119,9 +119,15 @@ impl CosQuad {
     }
 }
 
-/// The batch kernel: `max(0, a (t - 1) + 1)` fused, squared `SQUARINGS` times, unrolled.
-/// With `t` clamped to `[0, 1]`, NaN and `t <= 0` give a base of at most `1 - a`, which the
-/// `max` zeroes when `a >= 1` (`n >= 2^v`); below that (`MASKED`) a compare zeroes them.
+/// The batch kernel: the base `a (t - 1) + 1` fused, clamped to `[0, 1]`, squared
+/// `SQUARINGS` times, unrolled. The clamp on the base serves both range rules that a clamp
+/// of `t` and a `max` on the base spent three instructions on: `t > 1` gives a base above 1,
+/// clamped to 1; `t <= 0` gives at most `1 - a`, which the lower clamp zeroes when `a >= 1`
+/// (`n >= 2^v`); NaN gives NaN, which `max` turns into 0 (x86's `maxps` returns its second
+/// operand). Below `a = 1` (`MASKED`) the base stays above `1 - a > 0` for every `t > 0`, so
+/// a compare zeroes `t <= 0` and NaN instead of the lower clamp. (`a t + (1 - a)` would save
+/// the subtraction, on a pipe this kernel leaves idle, but cancels catastrophically unfused,
+/// as the plain loop runs it.)
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CosQuadKernel<const SQUARINGS: u32, const MASKED: bool> {
     slope: f32,
@@ -148,10 +154,12 @@ impl<const SQUARINGS: u32, const MASKED: bool> Kernel for CosQuadKernel<SQUARING
     #[inline(always)]
     fn apply<V: Lanes>(self, t: V) -> V {
         let one = t.splat(1.0);
-        let c = clamp_unit(t);
-        let mut value = (c - one)
-            .mul_add(t.splat(self.slope), one)
-            .max(t.splat(0.0));
+        let base = (t - one).mul_add(t.splat(self.slope), one);
+        let mut value = if MASKED {
+            base.min(one)
+        } else {
+            base.max(t.splat(0.0)).min(one)
+        };
         for _ in 0..SQUARINGS {
             value = value * value;
         }
@@ -165,15 +173,22 @@ impl<const SQUARINGS: u32, const MASKED: bool> Kernel for CosQuadKernel<SQUARING
 
 impl<const SQUARINGS: u32, const MASKED: bool> LobeKernel for CosQuadKernel<SQUARINGS, MASKED> {
     fn instructions(self) -> Instructions {
-        let base = CLAMP
-            .plus(Class::Add, 1)
-            .plus(Class::Fma, 1)
-            .plus(Class::MinMax, 1)
-            .plus(Class::Mul, SQUARINGS);
         if MASKED {
-            base.plus(Class::Compare, 1).plus(Class::Logic, 1)
+            Instructions::of(&[
+                (Class::Add, 1),
+                (Class::Fma, 1),
+                (Class::MinMax, 1),
+                (Class::Mul, SQUARINGS),
+                (Class::Compare, 1),
+                (Class::Logic, 1),
+            ])
         } else {
-            base
+            Instructions::of(&[
+                (Class::Add, 1),
+                (Class::Fma, 1),
+                (Class::MinMax, 2),
+                (Class::Mul, SQUARINGS),
+            ])
         }
     }
 }

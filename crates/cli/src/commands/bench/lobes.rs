@@ -3,8 +3,10 @@
 //! fast pow, with its error, all from one run: `specula_decide::rates::measure`, printed.
 
 use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
 use specula::simd::tally::Class;
 use specula::{Exponent, LobeKind};
+use specula_decide::c_twins::{self, CTwins};
 use specula_decide::rates::{cosquad_formula, measure, LobeRate, Measured, L1_SIZE, STREAM_SIZE};
 
 use crate::args::Format;
@@ -17,6 +19,10 @@ pub fn run(n: Exponent, format: Format) -> Result<(), String> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let measured = measure(n, true, &progress);
+    let cc = std::env::var("CC").unwrap_or_else(|_| "gcc".into());
+    let twins = c_twins::measure(n, &cc)
+        .inspect_err(|error| eprintln!("no C twins: {error}"))
+        .ok();
     let over: Vec<&LobeRate> = measured
         .lobes
         .iter()
@@ -45,7 +51,10 @@ pub fn run(n: Exponent, format: Format) -> Result<(), String> {
         }
     }
     if format == Format::Json {
-        return super::super::print_json(&measured);
+        return super::super::print_json(&WithTwins {
+            measured: &measured,
+            c_twins: twins.as_ref(),
+        });
     }
     print_peaks(&measured);
     let g = |rate: f64| format!("{:.2}", rate / 1e9);
@@ -111,7 +120,48 @@ pub fn run(n: Exponent, format: Format) -> Result<(), String> {
             percent(mine / built_in)
         );
     }
+    if let Some(twins) = &twins {
+        print_twins(&measured, twins, format);
+    }
     Ok(())
+}
+
+/// `bench lobes --format json`: the run, and the C twins measured in it.
+#[derive(Serialize)]
+struct WithTwins<'a> {
+    #[serde(flatten)]
+    measured: &'a Measured,
+    c_twins: Option<&'a CTwins>,
+}
+
+fn print_twins(measured: &Measured, twins: &CTwins, format: Format) {
+    println!(
+        "C twins: the same formulas as plain C loops ({}, {}; libmvec for exp and log), one \
+         thread, the same cosines in L1",
+        twins.compiler, twins.flags
+    );
+    let mut table = Table::new(&[
+        "lobe",
+        "specula G/s",
+        "C G/s",
+        "specula / C",
+        "max rel difference",
+    ]);
+    for twin in &twins.twins {
+        let mine = measured
+            .lobes
+            .iter()
+            .find(|r| r.lobe == twin.lobe)
+            .map_or(f64::NAN, |r| r.explicit);
+        table.push(vec![
+            twin.lobe.clone(),
+            format!("{:.2}", mine / 1e9),
+            format!("{:.2}", twin.rate / 1e9),
+            format!("{:.2}x", mine / twin.rate),
+            format!("{:.2e}", twin.max_rel_difference),
+        ]);
+    }
+    table.print(format);
 }
 
 fn print_peaks(measured: &Measured) {
