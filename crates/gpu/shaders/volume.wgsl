@@ -1,7 +1,9 @@
-// Direct volume rendering: a transcription of crates/render/src/volume/raymarch.rs, one
-// invocation per pixel. The volume is an r32float 3D texture read with textureLoad and
-// interpolated here, as the CPU does, so the two agree sample for sample (a hardware sampler
-// would filter in 8-bit fixed-point weights).
+// Direct volume rendering: a transcription of crates/render/src/volume/raymarch/, one
+// invocation per pixel. The volume is the CPU marcher's prepared field (value and world
+// gradient per voxel, crates/render/src/volume/march/) as an rgba32float 3D texture read with
+// textureLoad and interpolated here, as the CPU does, so the two agree sample for sample (a
+// hardware sampler would filter in 8-bit fixed-point weights); a sample reads 8 texels where
+// central differences of the trilinear field would read 56.
 
 struct Params {
     // xyz; w = half the view's height.
@@ -27,6 +29,8 @@ struct Params {
     size: vec4<u32>,
     // nx, ny, nz.
     dims: vec4<u32>,
+    // Bricks (4^3 cells each) along x, y, z.
+    bricks: vec4<u32>,
     lobe: Lobe,
 }
 
@@ -40,14 +44,28 @@ struct ControlPoint {
 @group(0) @binding(1) var<storage, read> points: array<ControlPoint>;
 @group(0) @binding(2) var grid: texture_3d<f32>;
 @group(0) @binding(3) var<storage, read_write> pixels: array<vec4<f32>>;
+// Per brick, 0 where it holds a value with extinction, else how many bricks its empty
+// surroundings reach (Classification::clearance).
+@group(0) @binding(4) var<storage, read> clearance: array<u32>;
 
-fn voxel(i: i32, j: i32, k: i32) -> f32 {
-    let high = vec3<i32>(params.dims.xyz) - vec3<i32>(1);
-    let at = clamp(vec3<i32>(i, j, k), vec3<i32>(0), high);
-    return textureLoad(grid, at, 0).x;
+// Where the ray grid_origin + grid_direction t leaves the cube of bricks within reach - 1
+// bricks of the one holding cell (PreparedVolume::clear_exit).
+fn clear_exit(cell: vec3<i32>, reach: i32, origin: vec3<f32>, inverse_direction: vec3<f32>) -> f32 {
+    let brick = cell >> vec3<u32>(2u);
+    let low = vec3<f32>((brick - vec3<i32>(reach - 1)) * 4);
+    let high = vec3<f32>((brick + vec3<i32>(reach)) * 4);
+    let exits = max((low - origin) * inverse_direction, (high - origin) * inverse_direction);
+    return min(exits.x, min(exits.y, exits.z));
 }
 
-fn lerp(a: f32, b: f32, t: f32) -> f32 {
+// Value (x) and world gradient (yzw) of a voxel.
+fn voxel(i: i32, j: i32, k: i32) -> vec4<f32> {
+    let high = vec3<i32>(params.dims.xyz) - vec3<i32>(1);
+    let at = clamp(vec3<i32>(i, j, k), vec3<i32>(0), high);
+    return textureLoad(grid, at, 0);
+}
+
+fn lerp(a: vec4<f32>, b: vec4<f32>, t: f32) -> vec4<f32> {
     return a + (b - a) * t;
 }
 
@@ -55,7 +73,8 @@ fn last_index() -> vec3<f32> {
     return vec3<f32>(params.dims.xyz) - vec3<f32>(1.0);
 }
 
-fn sample_at(index: vec3<f32>) -> f32 {
+// Value and world gradient at a grid index, trilinearly.
+fn sample_at(index: vec3<f32>) -> vec4<f32> {
     let p = clamp(index, vec3<f32>(0.0), last_index());
     let base = floor(p);
     let f = p - base;
@@ -71,13 +90,6 @@ fn sample_at(index: vec3<f32>) -> f32 {
 
 fn to_index() -> mat3x3<f32> {
     return mat3x3<f32>(params.to_index_x.xyz, params.to_index_y.xyz, params.to_index_z.xyz);
-}
-
-fn gradient(index: vec3<f32>) -> vec3<f32> {
-    let dx = 0.5 * (sample_at(index + vec3<f32>(1.0, 0.0, 0.0)) - sample_at(index - vec3<f32>(1.0, 0.0, 0.0)));
-    let dy = 0.5 * (sample_at(index + vec3<f32>(0.0, 1.0, 0.0)) - sample_at(index - vec3<f32>(0.0, 1.0, 0.0)));
-    let dz = 0.5 * (sample_at(index + vec3<f32>(0.0, 0.0, 1.0)) - sample_at(index - vec3<f32>(0.0, 0.0, 1.0)));
-    return transpose(to_index()) * vec3<f32>(dx, dy, dz);
 }
 
 // Extinction (w) and colour (xyz) at a value: piecewise linear, clamped beyond the ends.
@@ -99,8 +111,7 @@ fn transfer(value: f32) -> vec4<f32> {
     return vec4<f32>(last.colour.xyz, last.sigma);
 }
 
-fn shade(index: vec3<f32>, base: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
-    let g = gradient(index);
+fn shade(g: vec3<f32>, base: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     let strength = length(g);
     if !(strength > 0.0) {
         return base;
@@ -172,25 +183,49 @@ fn march(@builtin(global_invocation_id) id: vec3<u32>) {
         pixels[index_of_pixel] = vec4<f32>(params.background.xyz, 1.0);
         return;
     }
+    // Segment j > 0 ends at lattice + (j + 1) step, from j, so that a skip lands on the
+    // lattice (crates/render/src/volume/march/ray.rs).
     let step = params.right.w;
+    let first_end = near + step * pixel_jitter(id.x, id.y);
+    let lattice = first_end - step;
+    // A direction along a grid plane never leaves a brick across it.
+    let inverse_direction = select(1.0 / grid_direction, vec3<f32>(1e30), abs(grid_direction) < vec3<f32>(1e-12));
+    let last_cell = vec3<i32>(params.dims.xyz) - vec3<i32>(2);
     var colour = vec3<f32>(0.0);
     var transmittance = 1.0;
     var t = near;
-    var segment = step * pixel_jitter(id.x, id.y);
+    var j = 0u;
     while t < far && 1.0 - transmittance < params.up.w {
-        segment = min(segment, far - t);
-        let index = grid_origin + grid_direction * (t + 0.5 * segment);
-        t += segment;
-        let span = segment;
-        segment = step;
-        let medium = transfer(sample_at(index));
+        var next = first_end;
+        if j > 0u {
+            next = lattice + f32(j + 1u) * step;
+        }
+        let span = min(next, far) - t;
+        let index = clamp(grid_origin + grid_direction * (t + 0.5 * span), vec3<f32>(0.0), high);
+        t = next;
+        j += 1u;
+        let cell = min(vec3<i32>(floor(index)), last_cell);
+        let brick = cell >> vec3<u32>(2u);
+        let reach = clearance[u32(brick.x) + params.bricks.x * (u32(brick.y) + params.bricks.y * u32(brick.z))];
+        if reach > 0u {
+            // Every sample before the ray leaves the empty cube of bricks has no extinction
+            // (a margin keeps the one rounding could place across the exit).
+            let beyond = (clear_exit(cell, i32(reach), grid_origin, inverse_direction) - t) / step - 0.5 - 1e-3;
+            if beyond > 0.0 {
+                j += u32(ceil(beyond));
+                t = lattice + f32(j) * step;
+            }
+            continue;
+        }
+        let field = sample_at(index);
+        let medium = transfer(field.x);
         if medium.w <= 0.0 {
             continue;
         }
         let alpha = 1.0 - exp(-medium.w * span);
         var shaded = medium.xyz;
         if params.weights.w > 0.5 {
-            shaded = shade(index, medium.xyz, wo);
+            shaded = shade(field.yzw, medium.xyz, wo);
         }
         colour += transmittance * alpha * shaded;
         transmittance *= 1.0 - alpha;

@@ -1,8 +1,10 @@
 //! Direct volume rendering on the GPU: `shaders/volume.wgsl`, one compute invocation per
-//! pixel, marching the rays the CPU's [`DvrPlan`] fixes through the volume uploaded as an
-//! `r32float` 3D texture.
+//! pixel, marching the rays the CPU's [`DvrPlan`] fixes through the volume's value and world
+//! gradient per voxel ([`PreparedVolume`], the CPU marcher's field) uploaded as an
+//! `rgba32float` 3D texture.
 
 use bytemuck::{Pod, Zeroable};
+use specula_render::volume::march::{Classification, PreparedVolume};
 use specula_render::volume::raymarch::{DvrPlan, DvrSettings};
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::Volume;
@@ -27,6 +29,7 @@ struct Params {
     background: [f32; 4],
     size: [u32; 4],
     dims: [u32; 4],
+    bricks: [u32; 4],
     lobe: LobeBlock,
 }
 
@@ -91,7 +94,13 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                 limits.max_storage_buffer_binding_size
             )));
         }
-        let params = params(volume, transfer, settings, &plan);
+        let prepared = PreparedVolume::new(volume);
+        let params = params(volume, &prepared, transfer, settings, &plan);
+        let clearance: Vec<u32> = Classification::new(&prepared, transfer)
+            .clearance()
+            .iter()
+            .map(|&c| u32::from(c))
+            .collect();
         let points: Vec<[f32; 8]> = transfer
             .points()
             .iter()
@@ -112,6 +121,11 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                 contents: bytemuck::cast_slice(&points),
                 usage: wgpu::BufferUsages::STORAGE,
             });
+            let clearance = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("brick clearance"),
+                contents: bytemuck::cast_slice(&clearance),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
             let extent = wgpu::Extent3d {
                 width: dims[0] as u32,
                 height: dims[1] as u32,
@@ -123,16 +137,16 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D3,
-                format: wgpu::TextureFormat::R32Float,
+                format: wgpu::TextureFormat::Rgba32Float,
                 usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
                 view_formats: &[],
             });
             self.gpu.queue.write_texture(
                 texture.as_image_copy(),
-                bytemuck::cast_slice(volume.samples()),
+                bytemuck::cast_slice(prepared.voxels()),
                 wgpu::TexelCopyBufferLayout {
                     offset: 0,
-                    bytes_per_row: Some(4 * dims[0] as u32),
+                    bytes_per_row: Some(16 * dims[0] as u32),
                     rows_per_image: Some(dims[1] as u32),
                 },
                 extent,
@@ -170,6 +184,10 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                         binding: 3,
                         resource: output.as_entire_binding(),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: clearance.as_entire_binding(),
+                    },
                 ],
             });
             let mut encoder =
@@ -201,6 +219,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
 
 fn params(
     volume: &Volume,
+    prepared: &PreparedVolume,
     transfer: &TransferFunction,
     settings: &DvrSettings,
     plan: &DvrPlan,
@@ -243,6 +262,10 @@ fn params(
             geometry,
         ],
         dims: [nx as u32, ny as u32, nz as u32, 0],
+        bricks: {
+            let [bx, by, bz] = prepared.bricks();
+            [bx as u32, by as u32, bz as u32, 0]
+        },
         lobe,
     }
 }

@@ -132,6 +132,19 @@ impl PreparedVolume {
         self.dims
     }
 
+    /// `(value, world gradient)` per voxel, `i` fastest: what the GPU's marcher uploads, so
+    /// that it reads a sample's 8 corners, not the 48 of six differenced samples.
+    #[must_use]
+    pub fn voxels(&self) -> &[[f32; 4]] {
+        &self.voxels
+    }
+
+    /// Bricks along each axis ([`BRICK`]^3 cells each, the last ones possibly partial).
+    #[must_use]
+    pub fn bricks(&self) -> [usize; 3] {
+        self.bricks
+    }
+
     /// The cell holding grid index `p` (already within the grid), and `p`'s place in it.
     #[inline(always)]
     fn cell(&self, p: Vec3) -> (IVec3, Vec3) {
@@ -304,6 +317,14 @@ impl Classification {
             per_entry,
             clearance,
         }
+    }
+
+    /// Per brick (`i` fastest, [`PreparedVolume::bricks`] of them), 0 where it holds a value
+    /// with extinction, else how many bricks its empty surroundings reach: what the GPU's
+    /// marcher skips by, as the CPU's does.
+    #[must_use]
+    pub fn clearance(&self) -> &[u8] {
+        &self.clearance
     }
 
     /// Extinction and colour `(sigma, r, g, b)` at `value`: the transfer function's own
