@@ -4,7 +4,7 @@
 
 use specula::LobeKind;
 use specula_gpu::{Gpu, GpuRenderer};
-use specula_render::ibl::{render_ibl, Environment, IblSettings, SKY_WIDTH};
+use specula_render::ibl::{render_ibl_lobes, Environment, IblSettings, SKY_WIDTH};
 use specula_render::metrics::compare;
 use specula_render::{
     render, render_grid_with, Display, GridOptions, Image, Overrides, Scene, Shading,
@@ -40,17 +40,14 @@ fn lobe_table(
     base: &Scene,
     prefix: &str,
     header: &str,
-    draw: &dyn Fn(&Scene) -> Result<Image, String>,
+    draw: &mut dyn FnMut(&Scene, usize) -> Result<Image, String>,
 ) -> Result<(String, Vec<Option<Image>>), String> {
-    let options = GridOptions {
-        lobes: context.lobes.clone(),
-        reference: LobeKind::Pow,
-    };
+    let options = grid_options(context);
     // The grid draws the reference as render 0 and each other lobe as render `column + 1`;
     // keeping them by that index (not by arrival) ties every image to its lobe.
     let mut renders: Vec<Option<Image>> = vec![None; 1 + options.lobes.len()];
     let grid = render_grid_with(base, &options, &mut |variant, index| {
-        let image = draw(variant)?;
+        let image = draw(variant, index)?;
         renders[index] = Some(image.clone());
         Ok(image)
     })
@@ -105,13 +102,27 @@ fn lobe_table(
     Ok((html, renders))
 }
 
+/// Every lobe against pow.
+fn grid_options(context: &Context) -> GridOptions {
+    GridOptions {
+        lobes: context.lobes.clone(),
+        reference: LobeKind::Pow,
+    }
+}
+
 pub fn renders(context: &mut Context) -> Result<String, String> {
     let base = scene(context, Overrides::default());
     let (width, height, samples) = context.sizes.render;
     let mut html = paragraph(&format!(
         "The default scene ({width}x{height}, {samples}x{samples} samples, classic model, Phong shading) with every material's lobe replaced, and below each its FLIP error map against pow. Look for where the highlights' size and falloff differ from pow's."
     ));
-    let (table_html, mut renders) = lobe_table(context, &base, "render", "PSNR vs pow (dB)", &cpu)?;
+    let (table_html, mut renders) = lobe_table(
+        context,
+        &base,
+        "render",
+        "PSNR vs pow (dB)",
+        &mut |scene, _| cpu(scene),
+    )?;
     html += &table_html;
     // The reference render, kept for the CPU-against-GPU comparison below.
     let reference_image = renders[0].take().ok_or("the grid did not render pow")?;
@@ -161,8 +172,8 @@ pub fn renders(context: &mut Context) -> Result<String, String> {
 }
 
 /// Every lobe in the environment scene lit by the procedural sky: the same seed for every
-/// lobe, so the environment's draws are shared and the differences are the lobes', not the
-/// noise's.
+/// lobe, so the environment's draws are shared (computed once, by [`render_ibl_lobes`]) and
+/// the differences are the lobes', not the noise's.
 fn environment_lit(context: &mut Context) -> Result<String, String> {
     let (width, height, spp) = context.sizes.environment;
     let mut base = Scene::ibl_scene();
@@ -179,14 +190,33 @@ fn environment_lit(context: &mut Context) -> Result<String, String> {
     let mut html = paragraph(&format!(
         "A sphere and the teapot lit by the procedural sky alone ({width}x{height}, {spp} samples per pixel, multiple importance sampling between each lobe's own sampler and the sky, the lobe normalisation, physical model: specula render --env sky --spp {spp} --lobe L). Every lobe's render uses the same random numbers, so what differs from pow is the reflected sun's and sky's shape; the residual Monte Carlo noise sets the floor of these figures."
     ));
-    let draw =
-        |scene: &Scene| render_ibl(scene, &sky, &settings, &|_, _| {}).map_err(|e| e.to_string());
+    // The grid asks for render `index`: 0 the reference, `column + 1` each other lobe.
+    let options = grid_options(context);
+    let asked: Vec<(usize, LobeKind)> = std::iter::once((0, options.reference))
+        .chain(
+            (options.lobes.iter().enumerate())
+                .filter(|(_, &kind)| kind != options.reference)
+                .map(|(column, &kind)| (column + 1, kind)),
+        )
+        .collect();
+    let kinds: Vec<LobeKind> = asked.iter().map(|&(_, kind)| kind).collect();
+    let rendered =
+        render_ibl_lobes(&base, &kinds, &sky, &settings, &|_, _| {}).map_err(|e| e.to_string())?;
+    let mut images: Vec<Option<Image>> = vec![None; 1 + options.lobes.len()];
+    for (&(index, _), image) in asked.iter().zip(rendered) {
+        images[index] = Some(image);
+    }
     let (table_html, _) = lobe_table(
         context,
         &base,
         "environment",
         "PSNR vs pow, lit by the sky (dB)",
-        &draw,
+        &mut |_, index| {
+            images
+                .get_mut(index)
+                .and_then(Option::take)
+                .ok_or_else(|| format!("no environment render {index}"))
+        },
     )?;
     html += &table_html;
     Ok(html)

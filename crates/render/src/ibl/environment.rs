@@ -78,9 +78,10 @@ pub struct Environment {
     /// The same distribution over texels for the `f32` renderer: drawn by alias in constant
     /// time ([`Environment::draw`]).
     alias: AliasTable,
-    /// Each texel's density on the unit square (its weight over the mean weight), as
-    /// `distribution` gives it.
-    texel_density: Vec<f32>,
+    /// Per texel, its radiance and its density on the unit square (its weight over the mean
+    /// weight, as `distribution` gives it) side by side: what a draw or a look-up reads, one
+    /// cache line's worth from a map of megabytes, not two.
+    texels: Vec<[f32; 4]>,
 }
 
 impl Environment {
@@ -124,21 +125,23 @@ impl Environment {
         let alias = AliasTable::new(&weights).ok_or_else(shape)?;
         let total: f64 = weights.iter().sum();
         let cells = weights.len() as f64;
-        let texel_density = weights
+        let texels = weights
             .iter()
-            .map(|w| {
-                if total > 0.0 {
+            .zip(image.pixels())
+            .map(|(w, radiance)| {
+                let density = if total > 0.0 {
                     (w * cells / total) as f32
                 } else {
                     1.0
-                }
+                };
+                [radiance.x, radiance.y, radiance.z, density]
             })
             .collect();
         Ok(Self {
             image,
             distribution,
             alias,
-            texel_density,
+            texels,
         })
     }
 
@@ -208,13 +211,19 @@ impl Environment {
 }
 
 impl Environment {
-    /// [`Environment::sample`]'s distribution for the `f32` renderer, drawn by alias: a texel
-    /// from 32 random bits and a uniform `keep`, a point within it from `within`. The unit
-    /// direction, its density per solid angle and the radiance there; `None` on the poles.
+    /// [`Environment::sample`]'s distribution for the `f32` renderer, drawn by alias: the
+    /// texel for 32 random bits and a uniform `keep` (then [`Environment::draw_in`]).
     #[must_use]
     #[inline]
-    pub fn draw(&self, bits: u32, keep: f32, within: [f32; 2]) -> Option<(Vec3, f32, Vec3)> {
-        let texel = self.alias.sample(bits, keep);
+    pub fn draw_texel(&self, bits: u32, keep: f32) -> usize {
+        self.alias.sample(bits, keep)
+    }
+
+    /// The point `within` the drawn `texel`: the unit direction, its density per solid angle
+    /// and the radiance there; `None` on the poles.
+    #[must_use]
+    #[inline]
+    pub fn draw_in(&self, texel: usize, within: [f32; 2]) -> Option<(Vec3, f32, Vec3)> {
         let width = self.image.width() as usize;
         let (column, row) = ((texel % width) as f32, (texel / width) as f32);
         let x = (column + within[0]) / width as f32;
@@ -226,16 +235,23 @@ impl Environment {
         // phi = 3 pi / 2 - 2 pi x, in turns.
         let (sin_phi, cos_phi) = angles::sin_cos_turns(0.75 - x);
         let wi = Vec3::new(sine * cos_phi, sine * sin_phi, cosine);
-        let pdf = self.texel_density[texel]
-            / (2.0 * core::f32::consts::PI * core::f32::consts::PI * sine);
-        Some((wi, pdf, self.image.pixels()[texel]))
+        let [r, g, b, density] = self.texels[texel];
+        let pdf = density / (2.0 * core::f32::consts::PI * core::f32::consts::PI * sine);
+        Some((wi, pdf, Vec3::new(r, g, b)))
     }
 
-    /// The radiance from the unit direction `wi` and its density under
-    /// [`Environment::draw`] (per solid angle), in `f32`.
+    /// [`Environment::draw_texel`] then [`Environment::draw_in`].
     #[must_use]
     #[inline]
-    pub fn look_up(&self, wi: Vec3) -> (Vec3, f32) {
+    pub fn draw(&self, bits: u32, keep: f32, within: [f32; 2]) -> Option<(Vec3, f32, Vec3)> {
+        self.draw_in(self.draw_texel(bits, keep), within)
+    }
+
+    /// The texel the unit direction `wi` falls in, and `sin theta` there (then
+    /// [`Environment::look_up_texel`]).
+    #[must_use]
+    #[inline]
+    pub fn texel_of(&self, wi: Vec3) -> (usize, f32) {
         let z = wi.z.clamp(-1.0, 1.0);
         let y = angles::acos(z) * core::f32::consts::FRAC_1_PI;
         let x = 0.75 - angles::atan2(wi.y, wi.x) * (0.5 * core::f32::consts::FRAC_1_PI);
@@ -243,14 +259,33 @@ impl Environment {
         let (width, height) = (self.image.width(), self.image.height());
         let column = ((x * width as f32) as u32).min(width - 1);
         let row = ((y * height as f32) as u32).min(height - 1);
-        let texel = (row * width + column) as usize;
-        let sine = (1.0 - z * z).max(0.0).sqrt();
+        (
+            (row * width + column) as usize,
+            (1.0 - z * z).max(0.0).sqrt(),
+        )
+    }
+
+    /// The radiance of `texel` and the density per solid angle [`Environment::draw`] draws a
+    /// direction there with, where `sine` is its `sin theta`.
+    #[must_use]
+    #[inline]
+    pub fn look_up_texel(&self, texel: usize, sine: f32) -> (Vec3, f32) {
+        let [r, g, b, density] = self.texels[texel];
         let pdf = if sine > 0.0 {
-            self.texel_density[texel] / (2.0 * core::f32::consts::PI * core::f32::consts::PI * sine)
+            density / (2.0 * core::f32::consts::PI * core::f32::consts::PI * sine)
         } else {
             0.0
         };
-        (self.image.pixels()[texel], pdf)
+        (Vec3::new(r, g, b), pdf)
+    }
+
+    /// The radiance from the unit direction `wi` and its density under
+    /// [`Environment::draw`] (per solid angle), in `f32`.
+    #[must_use]
+    #[inline]
+    pub fn look_up(&self, wi: Vec3) -> (Vec3, f32) {
+        let (texel, sine) = self.texel_of(wi);
+        self.look_up_texel(texel, sine)
     }
 }
 

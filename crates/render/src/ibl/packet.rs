@@ -11,7 +11,9 @@
 //!   evaluates it twice;
 //! - the environment is drawn by **alias** in constant time ([`Environment::draw`]) and looked
 //!   up once per BRDF direction for both its radiance and its density
-//!   ([`Environment::look_up`]);
+//!   ([`Environment::look_up`]), in passes over the packet: first every lane's texel, then
+//!   every texel's radiance and density (one 16-byte record), so that the reads of a map of
+//!   megabytes overlap rather than wait one after another;
 //! - the frame's tangents and the Phong axis's basis are built once per surface point, and
 //!   closed-form lobes draw their cosine in `f32`.
 //!
@@ -162,40 +164,183 @@ impl Frame32 {
     }
 }
 
-/// One sample's two directions, as the packet's first pass leaves them for the lobe's kernel.
+/// The environment's draw of one sample (local), its density and radiance, and the texel it
+/// came from: the same for every variant of the surface.
+#[derive(Clone, Copy, Default)]
+struct LightDraw {
+    /// The draw's index in the stream.
+    draw: u64,
+    texel: Option<usize>,
+    within: [f32; 2],
+    /// `pdf` 0 when there is no draw above the surface.
+    wi: Vec3,
+    pdf: f32,
+    radiance: Vec3,
+}
+
+/// The BRDF's uniform numbers for one sample, and the cosine-weighted direction they give
+/// with what the environment sends along it: shared by every variant that draws the cosine.
+#[derive(Clone, Copy, Default)]
+struct BrdfDraw {
+    choice: f32,
+    u1: f32,
+    sin_phi: f32,
+    cos_phi: f32,
+    diffuse_wi: Vec3,
+    diffuse_texel: usize,
+    diffuse_sine: f32,
+    diffuse_radiance: Vec3,
+    diffuse_light_pdf: f32,
+}
+
+/// A packet's draws that every variant shares.
+struct SharedDraws {
+    lights: [LightDraw; LANES],
+    brdfs: [BrdfDraw; LANES],
+}
+
+/// One sample's BRDF direction for one variant (local), its half-vector cosine, and what the
+/// environment sends along it with the density it would have drawn it with.
 #[derive(Clone, Copy, Default)]
 struct Lane {
-    /// The environment's draw (local), its density and radiance; `pdf` 0 when there is none.
-    light_wi: Vec3,
-    light_pdf: f32,
-    light_radiance: Vec3,
     light_half_cosine: f32,
-    /// The BRDF's draw (local), `true` when above the surface, and what the environment
-    /// sends along it with the density it would have drawn it with.
     brdf_wi: Vec3,
+    /// `true` when above the surface.
     brdf_ok: bool,
     brdf_half_cosine: f32,
+    brdf_texel: usize,
+    brdf_sine: f32,
     brdf_radiance: Vec3,
     brdf_light_pdf: f32,
 }
 
-/// A surface point, prepared once for all its samples.
+/// A surface point, prepared once for all its samples: one surface per variant of the
+/// image (one lobe each, when every lobe is rendered under the same light).
 pub(super) struct Point<'a> {
-    pub(super) surface: &'a PacketSurface,
+    pub(super) surfaces: &'a [PacketSurface],
     pub(super) frame: Frame32,
     /// Towards the viewer, local, above the surface.
     pub(super) wo: Vec3,
 }
 
-/// The sum of the estimates of `draws` (each a draw index of the stream `seed`) at `point`.
+/// Adds to `sums[v]` the sum of the estimates of `draws` (each a draw index of the stream
+/// `seed`) at `point` with its surface `v`. The random numbers do not depend on the surface,
+/// so every variant's environment draws, and the cosine-weighted BRDF draws of every
+/// variant that makes one, are computed once; each variant's sums are the ones it would
+/// have alone, bit for bit.
 pub(super) fn shade(
     point: &Point,
     environment: &Environment,
     strategy: Strategy,
     seed: u64,
     draws: impl Iterator<Item = u64>,
-) -> glam::DVec3 {
-    let surface = point.surface;
+    sums: &mut [glam::DVec3],
+) {
+    let fewest_lobe_draws = point
+        .surfaces
+        .iter()
+        .map(|s| s.share)
+        .fold(f32::INFINITY, f32::min);
+    let mut draws = draws.peekable();
+    let mut shared = SharedDraws {
+        lights: [LightDraw::default(); LANES],
+        brdfs: [BrdfDraw::default(); LANES],
+    };
+    let mut lanes = [Lane::default(); LANES];
+    let mut cosines = [0.0_f32; 2 * LANES];
+    let mut values = [0.0_f32; 2 * LANES];
+    while draws.peek().is_some() {
+        // In passes over the packet rather than lane by lane: each pass's reads of the map
+        // (megabytes, mostly out of cache) are independent of one another and overlap.
+        let mut count = 0;
+        let SharedDraws { lights, brdfs } = &mut shared;
+        // The environment's draws: random numbers and the alias table's texels.
+        for (k, draw) in draws.by_ref().take(LANES).enumerate() {
+            count = k + 1;
+            let light = &mut lights[k];
+            *light = LightDraw {
+                draw,
+                ..LightDraw::default()
+            };
+            if strategy != Strategy::Brdf {
+                let bits = random_bits(seed, draw, 0);
+                let within = random_bits(seed, draw, 1);
+                light.texel =
+                    Some(environment.draw_texel(bits as u32, unit_f32((bits >> 32) as u32)));
+                light.within = [unit_f32(within as u32), unit_f32((within >> 32) as u32)];
+            }
+        }
+        // The BRDF's numbers, and the cosine-weighted directions' texels.
+        if strategy != Strategy::Environment {
+            for (light, brdf) in lights[..count].iter().zip(brdfs.iter_mut()) {
+                let bits = random_bits(seed, light.draw, 2);
+                let more = random_bits(seed, light.draw, 3);
+                brdf.choice = unit_f32(bits as u32);
+                brdf.u1 = unit_f32((bits >> 32) as u32);
+                (brdf.sin_phi, brdf.cos_phi) = sin_cos_turns(unit_f32(more as u32));
+                brdf.diffuse_wi = Vec3::ZERO;
+                if brdf.choice >= fewest_lobe_draws {
+                    let (sine, cosine) = (brdf.u1.sqrt(), (1.0 - brdf.u1).max(0.0).sqrt());
+                    let wi = Vec3::new(sine * brdf.cos_phi, sine * brdf.sin_phi, cosine);
+                    if wi.z > 0.0 {
+                        brdf.diffuse_wi = wi;
+                        (brdf.diffuse_texel, brdf.diffuse_sine) =
+                            environment.texel_of(point.frame.to_world(wi));
+                    }
+                }
+            }
+        }
+        // The texels' radiances and densities.
+        for (light, brdf) in lights[..count].iter_mut().zip(brdfs.iter_mut()) {
+            if let Some(texel) = light.texel {
+                if let Some((wi, pdf, radiance)) = environment.draw_in(texel, light.within) {
+                    let wi = point.frame.to_local(wi);
+                    if wi.z > 0.0 {
+                        (light.wi, light.pdf, light.radiance) = (wi, pdf, radiance);
+                    }
+                }
+            }
+            if brdf.diffuse_wi.z > 0.0 {
+                (brdf.diffuse_radiance, brdf.diffuse_light_pdf) =
+                    environment.look_up_texel(brdf.diffuse_texel, brdf.diffuse_sine);
+            }
+        }
+        for (surface, sum) in point.surfaces.iter().zip(sums.iter_mut()) {
+            let lanes = &mut lanes[..count];
+            variant_directions(
+                point,
+                environment,
+                surface,
+                strategy,
+                &shared,
+                lanes,
+                &mut cosines,
+            );
+            for lane in lanes
+                .iter_mut()
+                .filter(|lane| lane.brdf_texel != usize::MAX)
+            {
+                (lane.brdf_radiance, lane.brdf_light_pdf) =
+                    environment.look_up_texel(lane.brdf_texel, lane.brdf_sine);
+            }
+            surface.lobe.eval_batch(&cosines, &mut values);
+            *sum += combine(surface, strategy, &shared.lights, lanes, &cosines, &values).as_dvec3();
+        }
+    }
+}
+
+/// One variant's cosines (the environment's draws' in `cosines[..LANES]`, the BRDF's in
+/// `cosines[LANES..]`) and BRDF directions; a lane drawing from this variant's lobe leaves
+/// the texel its direction falls in (`usize::MAX` where it reads nothing new).
+fn variant_directions(
+    point: &Point,
+    environment: &Environment,
+    surface: &PacketSurface,
+    strategy: Strategy,
+    shared: &SharedDraws,
+    lanes: &mut [Lane],
+    cosines: &mut [f32; 2 * LANES],
+) {
     let wo = point.wo;
     // The basis the lobe's directions are drawn in: about the mirror direction (Phong) or
     // the normal (Blinn's half vector).
@@ -204,106 +349,94 @@ pub(super) fn shade(
         Geometry::Blinn => Vec3::Z,
     };
     let (b1, b2) = axis.any_orthonormal_pair();
-    let mut draws = draws.peekable();
-    let mut sum = glam::DVec3::ZERO;
-    let mut lanes = [Lane::default(); LANES];
-    let mut cosines = [0.0_f32; 2 * LANES];
-    let mut values = [0.0_f32; 2 * LANES];
-    while draws.peek().is_some() {
-        let mut count = 0;
-        for (k, draw) in draws.by_ref().take(LANES).enumerate() {
-            count = k + 1;
-            let lane = &mut lanes[k];
-            *lane = Lane::default();
-            cosines[k] = 0.0;
-            cosines[LANES + k] = 0.0;
-            if strategy != Strategy::Brdf {
-                let bits = random_bits(seed, draw, 0);
-                let within = random_bits(seed, draw, 1);
-                let light = environment.draw(
-                    bits as u32,
-                    unit_f32((bits >> 32) as u32),
-                    [unit_f32(within as u32), unit_f32((within >> 32) as u32)],
-                );
-                if let Some((wi, pdf, radiance)) = light {
-                    let wi = point.frame.to_local(wi);
-                    if wi.z > 0.0 {
-                        let (t, half_cosine) = surface.cosine(wo, wi);
-                        (lane.light_wi, lane.light_pdf, lane.light_radiance) = (wi, pdf, radiance);
-                        lane.light_half_cosine = half_cosine;
-                        cosines[k] = t;
-                    }
+    for (k, lane) in lanes.iter_mut().enumerate() {
+        *lane = Lane {
+            brdf_texel: usize::MAX,
+            ..Lane::default()
+        };
+        cosines[k] = 0.0;
+        cosines[LANES + k] = 0.0;
+        let light = &shared.lights[k];
+        if light.pdf > 0.0 {
+            let (t, half_cosine) = surface.cosine(wo, light.wi);
+            lane.light_half_cosine = half_cosine;
+            cosines[k] = t;
+        }
+        if strategy == Strategy::Environment {
+            continue;
+        }
+        let brdf = &shared.brdfs[k];
+        let (wi, t, half_cosine) = if brdf.choice < surface.share {
+            let t = surface.draw_cosine(brdf.u1);
+            let sine = (1.0 - t * t).max(0.0).sqrt();
+            let direction = (t * axis + sine * (brdf.cos_phi * b1 + brdf.sin_phi * b2)).normalize();
+            match surface.geometry {
+                Geometry::Phong => (direction, t, 1.0),
+                Geometry::Blinn => {
+                    let half_cosine = wo.dot(direction);
+                    let wi = (2.0 * half_cosine * direction - wo).normalize();
+                    (wi, if half_cosine > 0.0 { t } else { 0.0 }, half_cosine)
                 }
             }
-            if strategy != Strategy::Environment {
-                let bits = random_bits(seed, draw, 2);
-                let more = random_bits(seed, draw, 3);
-                let (choice, u1, u2) = (
-                    unit_f32(bits as u32),
-                    unit_f32((bits >> 32) as u32),
-                    unit_f32(more as u32),
-                );
-                let (sin_phi, cos_phi) = sin_cos_turns(u2);
-                let (wi, t, half_cosine) = if choice < surface.share {
-                    let t = surface.draw_cosine(u1);
-                    let sine = (1.0 - t * t).max(0.0).sqrt();
-                    let direction = (t * axis + sine * (cos_phi * b1 + sin_phi * b2)).normalize();
-                    match surface.geometry {
-                        Geometry::Phong => (direction, t, 1.0),
-                        Geometry::Blinn => {
-                            let half_cosine = wo.dot(direction);
-                            let wi = (2.0 * half_cosine * direction - wo).normalize();
-                            (wi, if half_cosine > 0.0 { t } else { 0.0 }, half_cosine)
-                        }
-                    }
-                } else {
-                    let (sine, cosine) = (u1.sqrt(), (1.0 - u1).max(0.0).sqrt());
-                    let wi = Vec3::new(sine * cos_phi, sine * sin_phi, cosine);
-                    let (t, half_cosine) = surface.cosine(wo, wi);
-                    (wi, t, half_cosine)
-                };
-                if wi.z > 0.0 && half_cosine > 0.0 {
-                    let (radiance, light_pdf) = environment.look_up(point.frame.to_world(wi));
-                    lane.brdf_wi = wi;
-                    lane.brdf_ok = true;
-                    lane.brdf_half_cosine = half_cosine;
-                    lane.brdf_radiance = radiance;
-                    lane.brdf_light_pdf = light_pdf;
-                    cosines[LANES + k] = t;
-                }
+        } else {
+            let wi = brdf.diffuse_wi;
+            let (t, half_cosine) = surface.cosine(wo, wi);
+            (wi, t, half_cosine)
+        };
+        if wi.z > 0.0 && half_cosine > 0.0 {
+            lane.brdf_wi = wi;
+            lane.brdf_ok = true;
+            lane.brdf_half_cosine = half_cosine;
+            cosines[LANES + k] = t;
+            if brdf.choice < surface.share {
+                (lane.brdf_texel, lane.brdf_sine) = environment.texel_of(point.frame.to_world(wi));
+            } else {
+                (lane.brdf_radiance, lane.brdf_light_pdf) =
+                    (brdf.diffuse_radiance, brdf.diffuse_light_pdf);
             }
         }
-        surface.lobe.eval_batch(&cosines, &mut values);
-        let mut packet = Vec3::ZERO;
-        for (k, lane) in lanes[..count].iter().enumerate() {
-            if lane.light_pdf > 0.0 {
-                let (f, brdf_pdf) =
-                    surface.f_and_pdf(lane.light_wi, cosines[k], lane.light_half_cosine, values[k]);
+    }
+}
+
+/// One variant's estimates over the packet, summed: each lane's environment draw and BRDF
+/// draw, combined by the power heuristic.
+fn combine(
+    surface: &PacketSurface,
+    strategy: Strategy,
+    lights: &[LightDraw; LANES],
+    lanes: &[Lane],
+    cosines: &[f32; 2 * LANES],
+    values: &[f32; 2 * LANES],
+) -> Vec3 {
+    let mut packet = Vec3::ZERO;
+    for (k, lane) in lanes.iter().enumerate() {
+        let light = &lights[k];
+        if light.pdf > 0.0 {
+            let (f, brdf_pdf) =
+                surface.f_and_pdf(light.wi, cosines[k], lane.light_half_cosine, values[k]);
+            let weight = match strategy {
+                Strategy::Mis => power_heuristic(light.pdf, brdf_pdf),
+                _ => 1.0,
+            };
+            packet += f * light.radiance * (light.wi.z * weight / light.pdf);
+        }
+        if lane.brdf_ok {
+            let (f, pdf) = surface.f_and_pdf(
+                lane.brdf_wi,
+                cosines[LANES + k],
+                lane.brdf_half_cosine,
+                values[LANES + k],
+            );
+            if pdf > 0.0 {
                 let weight = match strategy {
-                    Strategy::Mis => power_heuristic(lane.light_pdf, brdf_pdf),
+                    Strategy::Mis => power_heuristic(pdf, lane.brdf_light_pdf),
                     _ => 1.0,
                 };
-                packet += f * lane.light_radiance * (lane.light_wi.z * weight / lane.light_pdf);
-            }
-            if lane.brdf_ok {
-                let (f, pdf) = surface.f_and_pdf(
-                    lane.brdf_wi,
-                    cosines[LANES + k],
-                    lane.brdf_half_cosine,
-                    values[LANES + k],
-                );
-                if pdf > 0.0 {
-                    let weight = match strategy {
-                        Strategy::Mis => power_heuristic(pdf, lane.brdf_light_pdf),
-                        _ => 1.0,
-                    };
-                    packet += f * lane.brdf_radiance * (lane.brdf_wi.z * weight / pdf);
-                }
+                packet += f * lane.brdf_radiance * (lane.brdf_wi.z * weight / pdf);
             }
         }
-        sum += packet.as_dvec3();
     }
-    sum
+    packet
 }
 
 /// Veach's power heuristic ([`specula::sampling::power_heuristic`], whose care for zero and

@@ -10,8 +10,9 @@ use specula::sampling::{power_heuristic, uniform, SpecularSampler};
 use super::packet::{shade, Frame32, PacketSurface, Point};
 use super::{Environment, IblSettings, Strategy, MAX_SPP};
 use crate::pipeline::{surfaces, SurfacePoint};
-use crate::{Image, Material, RenderError, Scene};
+use crate::{Image, Material, Overrides, RenderError, Scene};
 use specula::brdf::luminance;
+use specula::LobeKind;
 
 /// A BRDF as the estimator needs it, in the local frame (`z` the normal, `wo` the viewer):
 /// its value with the density of its own sampler, and that sampler. Materials of the scene
@@ -223,13 +224,58 @@ pub fn render_ibl(
     settings: &IblSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Image, RenderError> {
-    let surfaces: Vec<PacketSurface> = scene
+    let surfaces: Vec<Vec<PacketSurface>> = scene
         .objects
         .iter()
-        .map(|object| PacketSurface::new(&object.material))
+        .map(|object| vec![PacketSurface::new(&object.material)])
+        .collect();
+    let mut images = render(
+        scene,
+        environment,
+        settings,
+        Shading::Packets(&surfaces),
+        progress,
+    )?;
+    Ok(images.remove(0))
+}
+
+/// [`render_ibl`] of `scene` with every material's lobe replaced by each of `lobes` in turn
+/// (as `Overrides { lobe }` replaces it), one image per lobe, bit for bit the images
+/// [`render_ibl`] gives each alone. Every lobe takes the same random numbers, so the
+/// environment's draws, and the cosine-weighted BRDF draws, are computed once for all of
+/// them: a comparison of lobes under one light costs little more than its lobe-specific
+/// work.
+pub fn render_ibl_lobes(
+    scene: &Scene,
+    lobes: &[LobeKind],
+    environment: &Environment,
+    settings: &IblSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Vec<Image>, RenderError> {
+    if lobes.is_empty() {
+        return Ok(Vec::new());
+    }
+    let variants: Vec<Scene> = lobes
+        .iter()
+        .map(|&kind| {
+            let mut variant = scene.clone();
+            variant.apply(&Overrides {
+                lobe: Some(kind),
+                ..Overrides::default()
+            });
+            variant
+        })
+        .collect();
+    let surfaces: Vec<Vec<PacketSurface>> = (0..scene.objects.len())
+        .map(|object| {
+            variants
+                .iter()
+                .map(|variant| PacketSurface::new(&variant.objects[object].material))
+                .collect()
+        })
         .collect();
     render(
-        scene,
+        &variants[0],
         environment,
         settings,
         Shading::Packets(&surfaces),
@@ -247,31 +293,44 @@ pub fn render_ibl_with(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Image, RenderError> {
     let reflectances = vec![reflectance; scene.objects.len()];
-    render(
+    let mut images = render(
         scene,
         environment,
         settings,
         Shading::Reflectances(&reflectances),
         progress,
-    )
+    )?;
+    Ok(images.remove(0))
 }
 
-/// How the visible surfaces are shaded: the scene's materials by the packet estimator, or
-/// any [`Reflectance`] one sample at a time in `f64`.
+/// How the visible surfaces are shaded: the scene's materials by the packet estimator (per
+/// object, one surface per image), or any [`Reflectance`] one sample at a time in `f64` (one
+/// image).
 #[derive(Clone, Copy)]
 enum Shading<'a> {
-    Packets(&'a [PacketSurface]),
+    Packets(&'a [Vec<PacketSurface>]),
     Reflectances(&'a [&'a dyn Reflectance]),
 }
 
-/// The render loop, object `i` shown with `shading`'s `i`th surface.
+impl Shading<'_> {
+    /// How many images the shading makes.
+    fn images(&self) -> usize {
+        match self {
+            Shading::Packets(surfaces) => surfaces.first().map_or(1, Vec::len),
+            Shading::Reflectances(_) => 1,
+        }
+    }
+}
+
+/// The render loop, object `i` shown with `shading`'s `i`th surface(s): one image per
+/// surface of an object.
 fn render(
     scene: &Scene,
     environment: &Environment,
     settings: &IblSettings,
     shading: Shading,
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<Image, RenderError> {
+) -> Result<Vec<Image>, RenderError> {
     if !(1..=MAX_SPP).contains(&settings.spp) {
         return Err(RenderError::Spp { spp: settings.spp });
     }
@@ -282,66 +341,82 @@ fn render(
         scene.settings.height,
         scene.settings.samples,
     );
+    let images = shading.images();
     let positions = (s * s).min(settings.spp);
     let done = AtomicUsize::new(0);
-    let mut image = Image::new(width, height, Vec3::ZERO);
-    image
-        .pixels_mut()
-        .par_chunks_mut(width as usize)
+    // Row by row, each row holding the images' rows one after another.
+    let row_length = width as usize * images;
+    let mut rows = vec![Vec3::ZERO; row_length * height as usize];
+    rows.par_chunks_mut(row_length)
         .enumerate()
         .for_each(|(y, row)| {
             let y = y as u32;
-            for (x, pixel) in (0..width).zip(row.iter_mut()) {
+            let mut sums = vec![DVec3::ZERO; images];
+            for x in 0..width {
                 let first = u64::from(y * width + x) * u64::from(settings.spp);
-                let mut sum = DVec3::ZERO;
+                sums.fill(DVec3::ZERO);
                 // Sample `i` of the pixel takes position `i % positions`.
                 for position in 0..positions {
                     let (sx, sy) = (x * s + position % s, y * s + position / s);
                     let samples = (position..settings.spp).step_by(positions as usize);
                     let draws = samples.clone().map(|i| first + u64::from(i));
-                    sum += match points[(sy * width * s + sx) as usize] {
-                        None => {
-                            let direction = rays.direction(sx, sy);
-                            environment.radiance(direction).as_dvec3() * samples.len() as f64
-                        }
-                        Some(point) => match view(scene, point) {
-                            None => DVec3::ZERO,
-                            Some((frame, wo)) => match shading {
-                                Shading::Packets(surfaces) => shade(
-                                    &Point {
-                                        surface: &surfaces[point.object as usize],
-                                        frame: frame.as_f32(),
-                                        wo: wo.as_vec3(),
-                                    },
-                                    environment,
-                                    settings.strategy,
-                                    settings.seed,
-                                    draws,
-                                ),
-                                Shading::Reflectances(surfaces) => draws
-                                    .map(|draw| {
-                                        let u = core::array::from_fn(|d| {
-                                            uniform(settings.seed, draw, d as u64)
-                                        });
-                                        estimate(
-                                            surfaces[point.object as usize],
-                                            environment,
-                                            &frame,
-                                            wo,
-                                            settings.strategy,
-                                            u,
-                                        )
-                                    })
-                                    .sum(),
-                            },
-                        },
+                    let Some(point) = points[(sy * width * s + sx) as usize] else {
+                        let direction = rays.direction(sx, sy);
+                        let background =
+                            environment.radiance(direction).as_dvec3() * samples.len() as f64;
+                        sums.iter_mut().for_each(|sum| *sum += background);
+                        continue;
                     };
+                    let Some((frame, wo)) = view(scene, point) else {
+                        continue;
+                    };
+                    match shading {
+                        Shading::Packets(surfaces) => shade(
+                            &Point {
+                                surfaces: &surfaces[point.object as usize],
+                                frame: frame.as_f32(),
+                                wo: wo.as_vec3(),
+                            },
+                            environment,
+                            settings.strategy,
+                            settings.seed,
+                            draws,
+                            &mut sums,
+                        ),
+                        Shading::Reflectances(surfaces) => {
+                            sums[0] += draws
+                                .map(|draw| {
+                                    let u = core::array::from_fn(|d| {
+                                        uniform(settings.seed, draw, d as u64)
+                                    });
+                                    estimate(
+                                        surfaces[point.object as usize],
+                                        environment,
+                                        &frame,
+                                        wo,
+                                        settings.strategy,
+                                        u,
+                                    )
+                                })
+                                .sum::<DVec3>();
+                        }
+                    }
                 }
-                *pixel = (sum / f64::from(settings.spp)).as_vec3();
+                for (image, sum) in sums.iter().enumerate() {
+                    row[image * width as usize + x as usize] =
+                        (*sum / f64::from(settings.spp)).as_vec3();
+                }
             }
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, height as usize);
         });
-    Ok(image)
+    let mut out = vec![Image::new(width, height, Vec3::ZERO); images];
+    for (row, y) in rows.chunks_exact(row_length).zip(0..) {
+        for (image, pixels) in out.iter_mut().zip(row.chunks_exact(width as usize)) {
+            let start = y * width as usize;
+            image.pixels_mut()[start..start + width as usize].copy_from_slice(pixels);
+        }
+    }
+    Ok(out)
 }
 
 /// A visible surface point's frame and `wo` in it, or `None` where the surface faces away
