@@ -139,6 +139,19 @@ pub(crate) struct Context {
 type HardwareSweeps = Vec<(u32, Arc<Vec<WidthSweep>>)>;
 
 impl Context {
+    /// A context for part of a section run beside the rest: the same settings, its own
+    /// list of files (appended to the section's when the part is done).
+    fn sibling(&self) -> Self {
+        Self {
+            directory: self.directory.clone(),
+            sizes: self.sizes.clone(),
+            bench: self.bench,
+            files: Vec::new(),
+            lobes: self.lobes.clone(),
+            materials: self.materials.clone(),
+        }
+    }
+
     /// The hardware sweeps at the hardware exponents, which the hardware section shows and
     /// the verdict's FPGA rows choose from: `specula_decide`'s, computed once per exponent in
     /// a process, so both read the sweeps `specula recommend --target fpga` reads.

@@ -2,12 +2,14 @@
 //! shading methods, CPU against GPU when an adapter exists, and the environment scene per
 //! lobe lit by the sky, with FLIP against `pow`.
 
+use rayon::prelude::*;
 use specula::LobeKind;
 use specula_gpu::{Gpu, GpuRenderer};
 use specula_render::ibl::{render_ibl_lobes, Environment, IblSettings, SKY_WIDTH};
 use specula_render::metrics::compare;
 use specula_render::{
-    render, render_grid_with, Display, GridOptions, Image, Overrides, Scene, Shading,
+    render, render_grid_with, write_png_srgb8, Display, GridOptions, Image, Overrides, Scene,
+    Shading,
 };
 
 use super::html::{paragraph, table};
@@ -59,30 +61,45 @@ fn lobe_table(
         &grid.bytes,
         "every lobe, FLIP against pow below",
     )?;
-    let mut written = Vec::new();
-    for (column, &kind) in options.lobes.iter().enumerate() {
-        let index = if kind == options.reference {
-            0
-        } else {
-            column + 1
-        };
-        let image = renders[index]
-            .as_ref()
-            .ok_or_else(|| format!("the grid did not render {kind}"))?;
-        let name = format!("{prefix}-{}.png", kind.id());
-        let bytes = image.to_srgb8(base.display);
-        context.write_png_file(&name, image.width(), image.height(), &bytes)?;
-        let decoded = Image::from_srgb8(image.width(), image.height(), &bytes)
-            .ok_or("inconsistent image size")?;
-        written.push((kind, name, decoded));
-    }
+    // Each lobe's file written, read back and compared on its own thread.
+    let directory = &context.directory;
+    let written = options
+        .lobes
+        .par_iter()
+        .enumerate()
+        .map(|(column, &kind)| {
+            let index = if kind == options.reference {
+                0
+            } else {
+                column + 1
+            };
+            let image = renders[index]
+                .as_ref()
+                .ok_or_else(|| format!("the grid did not render {kind}"))?;
+            let name = format!("{prefix}-{}.png", kind.id());
+            let bytes = image.to_srgb8(base.display);
+            write_png_srgb8(
+                &directory.join(&name),
+                image.width(),
+                image.height(),
+                &bytes,
+            )
+            .map_err(|e| e.to_string())?;
+            let decoded = Image::from_srgb8(image.width(), image.height(), &bytes)
+                .ok_or("inconsistent image size")?;
+            Ok((kind, name, decoded))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    context
+        .files
+        .extend(written.iter().map(|(_, name, _)| name.clone()));
     let reference = written
         .iter()
         .find(|(kind, ..)| *kind == options.reference)
         .map(|(_, name, image)| (name.clone(), image.clone()))
         .ok_or("no reference render")?;
     let rows: Vec<Vec<String>> = written
-        .iter()
+        .par_iter()
         .filter(|(kind, ..)| *kind != options.reference)
         .map(|(kind, name, image)| {
             let d = compare(&reference.1, image, Display::default()).map_err(|e| e.to_string())?;
@@ -111,6 +128,15 @@ fn grid_options(context: &Context) -> GridOptions {
 }
 
 pub fn renders(context: &mut Context) -> Result<String, String> {
+    // The environment-lit renders (most of the section's work) run beside the rest.
+    let mut lit = context.sibling();
+    let (html, environment) = rayon::join(|| default_scene(context), || environment_lit(&mut lit));
+    context.files.append(&mut lit.files);
+    Ok(html? + &environment?)
+}
+
+/// The default scene: every lobe, the three shading methods, CPU against GPU.
+fn default_scene(context: &mut Context) -> Result<String, String> {
     let base = scene(context, Overrides::default());
     let (width, height, samples) = context.sizes.render;
     let mut html = paragraph(&format!(
@@ -167,7 +193,6 @@ pub fn renders(context: &mut Context) -> Result<String, String> {
         }
         Err(error) => html += &paragraph(&format!("CPU against GPU: not run ({error}).")),
     }
-    html += &environment_lit(context)?;
     Ok(html)
 }
 

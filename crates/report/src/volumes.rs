@@ -50,14 +50,7 @@ fn timed(
 
 /// The phantom and, beside it, the real scans.
 pub fn volumes(context: &mut Context) -> Result<String, String> {
-    let mut real = Context {
-        directory: context.directory.clone(),
-        sizes: context.sizes.clone(),
-        bench: context.bench,
-        files: Vec::new(),
-        lobes: context.lobes.clone(),
-        materials: context.materials.clone(),
-    };
+    let mut real = context.sibling();
     // The real scans wait on files and on VTK's process, and time specula beside VTK's
     // threads: on threads of their own (as many as the sections share) they hold none of the
     // sections' workers, and their parallel work does not queue behind the other sections'.

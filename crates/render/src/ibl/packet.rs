@@ -27,7 +27,7 @@ use core::f32::consts::FRAC_1_PI;
 use glam::Vec3;
 use specula::brdf::luminance;
 use specula::lobe::Warp;
-use specula::sampling::{random_bits, unit_f32, SpecularSampler};
+use specula::sampling::{random_bits, unit_f32, CosineTable32, SpecularSampler};
 use specula::{Geometry, Lobe};
 
 use super::angles::sin_cos_turns;
@@ -50,8 +50,10 @@ pub(super) struct PacketSurface {
     density_per_value: f32,
     lobe: Lobe,
     geometry: Geometry,
-    /// Draws Newton-sampled and tabulated cosines (in `f64`), and a table's density.
+    /// Draws Newton-sampled cosines (in `f64`).
     sampler: SpecularSampler,
+    /// A tabulated lobe's table, drawn and read in `f32`.
+    table: Option<CosineTable32>,
     warp: Warp,
 }
 
@@ -83,6 +85,7 @@ impl PacketSurface {
             lobe: material.lobe,
             geometry: material.geometry,
             warp: sampler.warp(),
+            table: sampler.cosine().table32(),
             sampler,
         }
     }
@@ -107,8 +110,9 @@ impl PacketSurface {
 
     /// A cosine drawn from the lobe for the uniform `u`.
     fn draw_cosine(&self, u: f32) -> f32 {
-        match self.warp {
-            Warp::Analytic => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
+        match (self.warp, &self.table) {
+            (Warp::Analytic, _) => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
+            (_, Some(table)) => table.sample(u),
             _ => self.sampler.cosine().sample(f64::from(u)).x as f32,
         }
     }
@@ -116,11 +120,9 @@ impl PacketSurface {
     /// The BRDF and the BRDF strategy's density at `wi` (local, above the surface), from the
     /// lobe's value `value` at its cosine `t` (and `wo . h` for Blinn).
     fn f_and_pdf(&self, wi: Vec3, t: f32, half_cosine: f32, value: f32) -> (Vec3, f32) {
-        let density = match self.warp {
-            Warp::Table => {
-                (self.sampler.cosine().density(f64::from(t)) / core::f64::consts::TAU) as f32
-            }
-            _ => value * self.density_per_value,
+        let density = match &self.table {
+            Some(table) => table.density(t) * (0.5 * FRAC_1_PI),
+            None => value * self.density_per_value,
         };
         let lobe_pdf = match self.geometry {
             Geometry::Phong => density,

@@ -160,4 +160,15 @@ impl CosineDistribution {
     pub fn width(&self) -> f64 {
         zones::epicentre_angle(self.lobe.exponent())
     }
+
+    /// A tabulated lobe's edges' cosines, values at the edges and cumulative masses.
+    pub(super) fn table_parts(&self) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+        self.table.as_ref().map(|table| {
+            (
+                (0..=TABLE_BINS).map(edge).collect(),
+                table.values.clone(),
+                table.cumulative.clone(),
+            )
+        })
+    }
 }

@@ -22,10 +22,12 @@ mod alias;
 pub mod chi2;
 mod cosine;
 mod distribution;
+mod table32;
 
 pub use alias::AliasTable;
 pub use cosine::{CosineDistribution, TABLE_BINS};
 pub use distribution::{power_heuristic, Distribution1D, Distribution2D, Draw1D, Draw2D};
+pub use table32::CosineTable32;
 
 use core::f64::consts::TAU;
 
