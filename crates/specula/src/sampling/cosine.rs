@@ -5,6 +5,7 @@
 use std::sync::Arc;
 
 use crate::lobe::{Inverted, Warp};
+use crate::real::Real;
 use crate::{zones, Lobe};
 
 /// Bins of a tabulated lobe. Their edges are at angles `(pi/2) (k / BINS)^2`, dense near the
@@ -44,6 +45,39 @@ fn edge(k: usize) -> f64 {
 fn bin_of(t: f64) -> usize {
     let angle = t.clamp(0.0, 1.0).acos() / core::f64::consts::FRAC_PI_2;
     ((angle.sqrt() * TABLE_BINS as f64) as usize).min(TABLE_BINS - 1)
+}
+
+/// The cosine at which a table's mass from the peak reaches `target`: the first bin whose
+/// upper cumulative value exceeds it (skipping empty bins), then within it the root of the
+/// bin's quadratic CDF. Generic, so that the `f64` table and its `f32` copy
+/// ([`super::CosineTable32`]) draw alike.
+pub(super) fn draw_from_table<R: Real>(
+    cumulative: &[R],
+    values: &[R],
+    edges: impl Fn(usize) -> R,
+    target: R,
+) -> R {
+    let (zero, one) = (R::from_f64(0.0), R::from_f64(1.0));
+    let k = cumulative[1..]
+        .partition_point(|&c| c <= target)
+        .min(TABLE_BINS - 1);
+    let (below, mass) = (cumulative[k], cumulative[k + 1] - cumulative[k]);
+    let xi = if mass > zero {
+        ((target - below) / mass).max(zero).min(one)
+    } else {
+        R::from_f64(0.5)
+    };
+    // The density falls linearly from `a` at the bin's upper edge to `b`: its CDF
+    // (a s + (b - a) s^2 / 2) / ((a + b) / 2) = xi, solved without cancellation.
+    let (a, b) = (values[k], values[k + 1]);
+    let root = (a * a + xi * (b * b - a * a)).max(zero).sqrt();
+    let s = if a + root > zero {
+        (xi * (a + b) / (a + root)).max(zero).min(one)
+    } else {
+        xi
+    };
+    let (high, low) = (edges(k), edges(k + 1));
+    high - s * (high - low)
 }
 
 impl CosineDistribution {
@@ -105,33 +139,8 @@ impl CosineDistribution {
                 iterations: 0,
             }),
             Some(table) => {
-                let cumulative = &table.cumulative;
-                let target = u * self.total;
-                // The first bin whose upper cumulative value exceeds the target, skipping
-                // empty bins.
-                let k = cumulative[1..]
-                    .partition_point(|&c| c <= target)
-                    .min(TABLE_BINS - 1);
-                let (below, mass) = (cumulative[k], cumulative[k + 1] - cumulative[k]);
-                let xi = if mass > 0.0 {
-                    ((target - below) / mass).clamp(0.0, 1.0)
-                } else {
-                    0.5
-                };
-                // The density falls linearly from `a` at the bin's upper edge to `b`: its CDF
-                // (a s + (b - a) s^2 / 2) / ((a + b) / 2) = xi, solved without cancellation.
-                let (a, b) = (table.values[k], table.values[k + 1]);
-                let root = (a * a + xi * (b * b - a * a)).max(0.0).sqrt();
-                let s = if a + root > 0.0 {
-                    (xi * (a + b) / (a + root)).clamp(0.0, 1.0)
-                } else {
-                    xi
-                };
-                let (high, low) = (edge(k), edge(k + 1));
-                Inverted {
-                    x: high - s * (high - low),
-                    iterations: 0,
-                }
+                let x = draw_from_table(&table.cumulative, &table.values, edge, u * self.total);
+                Inverted { x, iterations: 0 }
             }
         }
     }

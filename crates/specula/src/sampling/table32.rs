@@ -5,7 +5,7 @@
 //! path spends two `cos` on each. Its draws and its density agree with each other (the same
 //! piecewise-linear density), so an estimator that uses both stays unbiased.
 
-use super::cosine::{CosineDistribution, TABLE_BINS};
+use super::cosine::{draw_from_table, CosineDistribution, TABLE_BINS};
 
 /// [`CosineDistribution`]'s table in `f32` ([`CosineDistribution::table32`]).
 #[derive(Clone, Debug)]
@@ -35,30 +35,12 @@ impl CosineTable32 {
     pub fn sample(&self, u: f32) -> f32 {
         // NaN draws as 0.
         let u = if u.is_nan() { 0.0 } else { u.clamp(0.0, 1.0) };
-        let target = u * self.total;
-        let k = self.cumulative[1..]
-            .partition_point(|&c| c <= target)
-            .min(TABLE_BINS - 1);
-        let (below, mass) = (
-            self.cumulative[k],
-            self.cumulative[k + 1] - self.cumulative[k],
-        );
-        let xi = if mass > 0.0 {
-            ((target - below) / mass).clamp(0.0, 1.0)
-        } else {
-            0.5
-        };
-        // The density falls linearly from `a` at the bin's upper edge to `b`: its CDF
-        // (a s + (b - a) s^2 / 2) / ((a + b) / 2) = xi, solved without cancellation.
-        let (a, b) = (self.values[k], self.values[k + 1]);
-        let root = (a * a + xi * (b * b - a * a)).max(0.0).sqrt();
-        let s = if a + root > 0.0 {
-            (xi * (a + b) / (a + root)).clamp(0.0, 1.0)
-        } else {
-            xi
-        };
-        let (high, low) = (self.edges[k], self.edges[k + 1]);
-        high - s * (high - low)
+        draw_from_table(
+            &self.cumulative,
+            &self.values,
+            |k| self.edges[k],
+            u * self.total,
+        )
     }
 
     /// The density of the cosine at `t`: [`CosineDistribution::density`].
