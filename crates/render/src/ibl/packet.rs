@@ -15,7 +15,9 @@
 //!   every texel's radiance and density (one 16-byte record), so that the reads of a map of
 //!   megabytes overlap rather than wait one after another;
 //! - the frame's tangents and the Phong axis's basis are built once per surface point, and
-//!   closed-form lobes draw their cosine in `f32`.
+//!   closed-form lobes draw their cosine in `f32`, and every other lobe from its table
+//!   ([`specula::sampling::CosineTable32`], in `f32`), where the `f64` path iterates
+//!   Newton's method on the lobe's integral or searches its table.
 //!
 //! Random numbers come from [`specula::sampling::random_bits`] by (seed, draw, dimension),
 //! two 32-bit numbers from each, so an image is the same on any number of threads. The
@@ -27,7 +29,7 @@ use core::f32::consts::FRAC_1_PI;
 use glam::Vec3;
 use specula::brdf::luminance;
 use specula::lobe::Warp;
-use specula::sampling::{random_bits, unit_f32, CosineTable32, SpecularSampler};
+use specula::sampling::{random_bits, unit_f32, CosineTable32};
 use specula::{Geometry, Lobe};
 
 use super::angles::sin_cos_turns;
@@ -46,15 +48,14 @@ pub(super) struct PacketSurface {
     specular: Vec3,
     /// The probability that a BRDF draw goes to the lobe rather than the cosine.
     share: f32,
-    /// `1 / (2 pi int_0^1 lobe)`: the lobe's value to its sampler's density about its axis.
+    /// `1 / (2 pi int_0^1 lobe)`: a closed-form lobe's value to its sampler's density about
+    /// its axis.
     density_per_value: f32,
     lobe: Lobe,
     geometry: Geometry,
-    /// Draws Newton-sampled cosines (in `f64`).
-    sampler: SpecularSampler,
-    /// A tabulated lobe's table, drawn and read in `f32`.
+    /// The table a lobe without a closed-form draw is drawn from and read in `f32`: Newton's
+    /// iterations of the integral in `f64` would cost more than the whole rest of a sample.
     table: Option<CosineTable32>,
-    warp: Warp,
 }
 
 impl PacketSurface {
@@ -65,10 +66,9 @@ impl PacketSurface {
             luminance(diffuse.as_dvec3()),
             luminance(specular.as_dvec3()),
         );
-        let sampler =
-            SpecularSampler::new(material.lobe, material.geometry, material.normalisation);
         let scale = material.normalisation.constant_for(&material.lobe) as f32;
-        let total = sampler.cosine().total();
+        let analytic = material.lobe.warp() == Warp::Analytic;
+        let total = material.lobe.tail(0.0).filter(|_| analytic).unwrap_or(0.0);
         Self {
             diffuse: diffuse * FRAC_1_PI,
             specular: specular * scale,
@@ -84,9 +84,7 @@ impl PacketSurface {
             },
             lobe: material.lobe,
             geometry: material.geometry,
-            warp: sampler.warp(),
-            table: sampler.cosine().table32(),
-            sampler,
+            table: (!analytic).then(|| CosineTable32::of(&material.lobe)),
         }
     }
 
@@ -110,10 +108,9 @@ impl PacketSurface {
 
     /// A cosine drawn from the lobe for the uniform `u`.
     fn draw_cosine(&self, u: f32) -> f32 {
-        match (self.warp, &self.table) {
-            (Warp::Analytic, _) => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
-            (_, Some(table)) => table.sample(u),
-            _ => self.sampler.cosine().sample(f64::from(u)).x as f32,
+        match &self.table {
+            Some(table) => table.sample(u),
+            None => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
         }
     }
 

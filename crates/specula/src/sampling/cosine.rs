@@ -33,7 +33,7 @@ struct Table {
 }
 
 /// The cosine at table edge `k` (`k = 0` is the peak, `t = 1`).
-fn edge(k: usize) -> f64 {
+pub(super) fn edge(k: usize) -> f64 {
     if k >= TABLE_BINS {
         return 0.0;
     }
@@ -47,20 +47,25 @@ fn bin_of(t: f64) -> usize {
     ((angle.sqrt() * TABLE_BINS as f64) as usize).min(TABLE_BINS - 1)
 }
 
-/// The cosine at which a table's mass from the peak reaches `target`: the first bin whose
-/// upper cumulative value exceeds it (skipping empty bins), then within it the root of the
-/// bin's quadratic CDF. Generic, so that the `f64` table and its `f32` copy
+/// The bin in which a table's mass from the peak reaches `target`: the first whose upper
+/// cumulative value exceeds it, skipping empty bins.
+pub(super) fn bin_of_mass<R: Real>(cumulative: &[R], target: R) -> usize {
+    cumulative[1..]
+        .partition_point(|&c| c <= target)
+        .min(TABLE_BINS - 1)
+}
+
+/// The cosine in bin `k` at which a table's mass from the peak reaches `target`: the root of
+/// the bin's quadratic CDF. Generic, so that the `f64` table and its `f32` copy
 /// ([`super::CosineTable32`]) draw alike.
-pub(super) fn draw_from_table<R: Real>(
+pub(super) fn draw_in_bin<R: Real>(
+    k: usize,
     cumulative: &[R],
     values: &[R],
     edges: impl Fn(usize) -> R,
     target: R,
 ) -> R {
     let (zero, one) = (R::from_f64(0.0), R::from_f64(1.0));
-    let k = cumulative[1..]
-        .partition_point(|&c| c <= target)
-        .min(TABLE_BINS - 1);
     let (below, mass) = (cumulative[k], cumulative[k + 1] - cumulative[k]);
     let xi = if mass > zero {
         ((target - below) / mass).max(zero).min(one)
@@ -80,6 +85,19 @@ pub(super) fn draw_from_table<R: Real>(
     high - s * (high - low)
 }
 
+/// `lobe` at every edge, and the cumulative trapezoid masses from the peak to each edge.
+pub(super) fn tabulate(lobe: &Lobe) -> (Vec<f64>, Vec<f64>) {
+    let values: Vec<f64> = (0..=TABLE_BINS).map(|k| lobe.eval(edge(k))).collect();
+    let mut cumulative = Vec::with_capacity(TABLE_BINS + 1);
+    cumulative.push(0.0);
+    let mut sum = 0.0;
+    for k in 0..TABLE_BINS {
+        sum += 0.5 * (values[k] + values[k + 1]) * (edge(k) - edge(k + 1));
+        cumulative.push(sum);
+    }
+    (values, cumulative)
+}
+
 impl CosineDistribution {
     /// Prepares `lobe`: its total from the closed form, or, for a tabulated lobe, the lobe
     /// at every edge and the bins' trapezoid masses.
@@ -92,17 +110,10 @@ impl CosineDistribution {
                 table: None,
             };
         }
-        let values: Vec<f64> = (0..=TABLE_BINS).map(|k| lobe.eval(edge(k))).collect();
-        let mut cumulative = Vec::with_capacity(TABLE_BINS + 1);
-        cumulative.push(0.0);
-        let mut sum = 0.0;
-        for k in 0..TABLE_BINS {
-            sum += 0.5 * (values[k] + values[k + 1]) * (edge(k) - edge(k + 1));
-            cumulative.push(sum);
-        }
+        let (values, cumulative) = tabulate(&lobe);
         Self {
             lobe,
-            total: sum,
+            total: cumulative[TABLE_BINS],
             table: Some(Arc::new(Table { values, cumulative })),
         }
     }
@@ -139,7 +150,9 @@ impl CosineDistribution {
                 iterations: 0,
             }),
             Some(table) => {
-                let x = draw_from_table(&table.cumulative, &table.values, edge, u * self.total);
+                let target = u * self.total;
+                let k = bin_of_mass(&table.cumulative, target);
+                let x = draw_in_bin(k, &table.cumulative, &table.values, edge, target);
                 Inverted { x, iterations: 0 }
             }
         }
@@ -168,16 +181,5 @@ impl CosineDistribution {
     #[must_use]
     pub fn width(&self) -> f64 {
         zones::epicentre_angle(self.lobe.exponent())
-    }
-
-    /// A tabulated lobe's edges' cosines, values at the edges and cumulative masses.
-    pub(super) fn table_parts(&self) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
-        self.table.as_ref().map(|table| {
-            (
-                (0..=TABLE_BINS).map(edge).collect(),
-                table.values.clone(),
-                table.cumulative.clone(),
-            )
-        })
     }
 }

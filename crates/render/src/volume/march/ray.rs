@@ -49,12 +49,33 @@ type Lane<T> = [T; LANES];
 /// A ray's result: the colour it gathered and the light it let through.
 pub(crate) type Marched = (Vec3, f32);
 
-/// How the rays' samples are lit: the render's lighting and each ray's view of it.
+/// How the rays' samples are lit: the render's lighting, each ray's view of it, and the
+/// lobes whose highlights the march adds, one image each.
 #[derive(Clone, Copy)]
 pub(crate) struct Lit<'a> {
     pub lighting: &'a Lighting,
     /// `views[r]` is ray `r`'s.
     pub views: &'a [RayView],
+    /// One per image: every image has the same samples, their colours and opacities, and
+    /// differs only in its highlights' lobe.
+    pub highlights: &'a [Highlight],
+}
+
+/// One image's highlight: its lobe, and `ks N(n)` ([`Lighting::highlight_scale`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Highlight {
+    pub lobe: specula::Lobe,
+    pub scale: f32,
+}
+
+impl Highlight {
+    /// `lighting`'s own lobe's.
+    pub(crate) fn of(lighting: &Lighting) -> Self {
+        Self {
+            lobe: lighting.shading.lobe,
+            scale: lighting.highlight_scale(&lighting.shading.lobe),
+        }
+    }
 }
 
 /// Marches `rays` (with `lit`, or emission and absorption only) through `volume`, writing ray
@@ -73,7 +94,12 @@ pub(crate) fn march_rays(
     opacity_cutoff: f32,
     out: &mut [Marched],
 ) {
-    assert_eq!(rays.len(), out.len(), "march_rays: one result per ray");
+    let images = lit.map_or(1, |lit| lit.highlights.len());
+    assert_eq!(
+        rays.len() * images,
+        out.len(),
+        "march_rays: one result per ray and image"
+    );
     if let Some(lit) = lit {
         assert_eq!(rays.len(), lit.views.len(), "march_rays: one view per ray");
     }
@@ -86,6 +112,7 @@ pub(crate) fn march_rays(
             rays,
             step,
             opacity_cutoff,
+            images,
             out,
         },
     );
@@ -99,6 +126,8 @@ struct Packet<'a> {
     rays: &'a [Ray],
     step: f32,
     opacity_cutoff: f32,
+    /// Results per ray: ray `r`'s for image `i` is `out[r * images + i]`.
+    images: usize,
     out: &'a mut [Marched],
 }
 
@@ -183,10 +212,12 @@ impl Turn {
     };
 }
 
-/// Highlights waiting for their lobe: cosine, weight and the ray they belong to.
+/// Highlights waiting for their lobes: cosine, the light the sample carried, its fade, and
+/// the ray they belong to.
 struct Highlights {
     ts: [f32; HIGHLIGHTS],
-    weights: [f32; HIGHLIGHTS],
+    carried: [f32; HIGHLIGHTS],
+    fades: [f32; HIGHLIGHTS],
     rays: [usize; HIGHLIGHTS],
     gathered: usize,
 }
@@ -194,22 +225,25 @@ struct Highlights {
 impl Highlights {
     const EMPTY: Self = Self {
         ts: [0.0; HIGHLIGHTS],
-        weights: [0.0; HIGHLIGHTS],
+        carried: [0.0; HIGHLIGHTS],
+        fades: [0.0; HIGHLIGHTS],
         rays: [0; HIGHLIGHTS],
         gathered: 0,
     };
 
-    /// Evaluates the gathered highlights' lobe and adds each, white, to its ray's colour.
+    /// Evaluates each image's lobe at the gathered highlights and adds each, white, to its
+    /// ray's colour in that image.
     #[inline(always)]
-    fn flush(&mut self, lighting: &Lighting, out: &mut [Marched]) {
+    fn flush(&mut self, highlights: &[Highlight], out: &mut [Marched]) {
         let n = self.gathered;
+        let images = highlights.len();
         let mut lobes = [0.0_f32; HIGHLIGHTS];
-        lighting
-            .shading
-            .lobe
-            .eval_batch(&self.ts[..n], &mut lobes[..n]);
-        for i in 0..n {
-            out[self.rays[i]].0 += Vec3::splat(self.weights[i] * lobes[i]);
+        for (image, highlight) in highlights.iter().enumerate() {
+            highlight.lobe.eval_batch(&self.ts[..n], &mut lobes[..n]);
+            for i in 0..n {
+                let weight = self.carried[i] * (self.fades[i] * highlight.scale);
+                out[self.rays[i] * images + image].0 += Vec3::splat(weight * lobes[i]);
+            }
         }
         self.gathered = 0;
     }
@@ -265,12 +299,15 @@ impl Job for Packet<'_> {
             if ended.contains(&true) {
                 for k in (0..LANES).filter(|&k| ended[k]) {
                     let r = marching.ray[k];
-                    self.out[r].0 += Vec3::new(
+                    let colour = Vec3::new(
                         marching.colour[0][k],
                         marching.colour[1][k],
                         marching.colour[2][k],
                     );
-                    self.out[r].1 = marching.transmittance[k];
+                    for marched in &mut self.out[r * self.images..(r + 1) * self.images] {
+                        marched.0 += colour;
+                        marched.1 = marching.transmittance[k];
+                    }
                     self.start(&mut marching, k, &mut next);
                     // The read-ahead sample was the ended ray's: the lane's next ray takes its
                     // first segment instead, and an idle lane's sample is cleared (composited,
@@ -284,7 +321,7 @@ impl Job for Packet<'_> {
             core::mem::swap(&mut current, &mut ahead);
         }
         if let Some(lit) = self.lit {
-            highlights.flush(lit.lighting, self.out);
+            highlights.flush(lit.highlights, self.out);
         }
     }
 }
@@ -330,7 +367,7 @@ impl Packet<'_> {
             }
             marching.wi_dot_wo[k] = view.wi_dot_wo;
         }
-        self.out[r] = (Vec3::ZERO, 1.0);
+        self.out[r * self.images..(r + 1) * self.images].fill((Vec3::ZERO, 1.0));
     }
 
     /// Every lane's turn: its next segment (its length, the cell its midpoint lies in and the
@@ -448,7 +485,8 @@ impl Packet<'_> {
     ) {
         let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
         let mut ts = [0.0_f32; LANES];
-        let mut weights = [0.0_f32; LANES];
+        let mut carried_light = [0.0_f32; LANES];
+        let mut fades = [0.0_f32; LANES];
         for at in (0..LANES).step_by(V::WIDTH) {
             let sigma = load(lanes, &turn.sigma, at).max(zero);
             let length = load(lanes, &turn.length, at);
@@ -472,9 +510,10 @@ impl Packet<'_> {
                     light.t.store(&mut ts[at..at + V::WIDTH]);
                     // Every lobe is 0 at a cosine of 0 or less; a lane that took no sample
                     // carried nothing (its weight is 0 and it is not gathered).
-                    (carried * light.highlight)
+                    carried
                         .keep(light.t.gt(zero))
-                        .store(&mut weights[at..at + V::WIDTH]);
+                        .store(&mut carried_light[at..at + V::WIDTH]);
+                    light.fade.store(&mut fades[at..at + V::WIDTH]);
                     light.colour_scale
                 }
             };
@@ -491,12 +530,13 @@ impl Packet<'_> {
         for k in 0..LANES {
             let at = highlights.gathered;
             highlights.ts[at] = ts[k];
-            highlights.weights[at] = weights[k];
+            highlights.carried[at] = carried_light[k];
+            highlights.fades[at] = fades[k];
             highlights.rays[at] = marching.ray[k];
-            highlights.gathered += usize::from(weights[k] > 0.0);
+            highlights.gathered += usize::from(carried_light[k] * fades[k] > 0.0);
         }
         if highlights.gathered > HIGHLIGHTS - LANES {
-            highlights.flush(lit.lighting, self.out);
+            highlights.flush(lit.highlights, self.out);
         }
     }
 }

@@ -1,4 +1,4 @@
-use super::ray::{march_rays, Lit, Marched, Ray};
+use super::ray::{march_rays, Highlight, Lit, Marched, Ray};
 use super::*;
 use crate::volume::phantom::BuiltIn;
 use crate::volume::raymarch::{
@@ -255,9 +255,11 @@ fn every_instruction_set_marches_the_same_rays() {
         let lighting = plan.lighting.unwrap();
         let march = |level: Level| {
             let mut out = vec![(Vec3::ZERO, 1.0); rays.len()];
+            let highlights = [Highlight::of(&lighting)];
             let lit = Lit {
                 lighting: &lighting,
                 views: &views,
+                highlights: &highlights,
             };
             march_rays(
                 level,
@@ -392,9 +394,11 @@ fn lit_rays_marched_together_are_each_ray_marched_alone() {
         let lighting = plan.lighting.unwrap();
         let march = |rays: &[Ray], views: &[RayView]| {
             let mut out = vec![(Vec3::ZERO, 1.0); rays.len()];
+            let highlights = [Highlight::of(&lighting)];
             let lit = Lit {
                 lighting: &lighting,
                 views,
+                highlights: &highlights,
             };
             march_rays(
                 Level::detect(),
@@ -502,4 +506,63 @@ fn classification_is_the_transfer_function() {
             );
         }
     }
+}
+
+/// Every lobe's image from one march is, bit for bit, the image marched for that lobe alone:
+/// the samples, their colours and opacities are the lobe's no more than the light is.
+#[test]
+fn lobes_marched_together_are_each_marched_alone() {
+    let volume = BuiltIn::SheppLogan.make(40).unwrap();
+    let prepared = PreparedVolume::new(&volume);
+    let transfer = TransferFunction::default_for(&volume).for_volume(&volume);
+    let n = Exponent::new(32.0);
+    let lobes: Vec<Lobe> = LobeKind::ALL
+        .iter()
+        .map(|&kind| Lobe::new(kind, n))
+        .collect();
+    for (geometry, normalisation, view) in [
+        (Geometry::Blinn, Normalisation::ThesisPhong, View::Anterior),
+        (Geometry::Phong, Normalisation::None, View::Left),
+    ] {
+        let shading = Shading::new(lobes[0], geometry, normalisation);
+        let settings = DvrSettings::new(36, 28, view, Some(shading));
+        let together = crate::volume::raymarch::render_dvr_lobes(
+            &volume,
+            &prepared,
+            &transfer,
+            &settings,
+            &lobes,
+            &|| {},
+        )
+        .unwrap();
+        assert_eq!(together.len(), lobes.len());
+        let mut differ = 0;
+        for (lobe, image) in lobes.iter().zip(&together) {
+            let alone = DvrSettings {
+                shading: Some(Shading::new(*lobe, geometry, normalisation)),
+                ..settings
+            };
+            let alone = render_dvr(&volume, &transfer, &alone, &|| {}).unwrap();
+            assert!(
+                alone.pixels() == image.pixels(),
+                "{lobe:?} {geometry:?}: marched with the others it differs"
+            );
+            differ += usize::from(image.pixels() != together[0].pixels());
+        }
+        // Not vacuous: the lobes' highlights differ.
+        assert!(
+            differ >= lobes.len() - 2,
+            "{differ} images differ from pow's"
+        );
+    }
+    let unshaded = DvrSettings::new(8, 8, View::Anterior, None);
+    let refused = crate::volume::raymarch::render_dvr_lobes(
+        &volume,
+        &prepared,
+        &transfer,
+        &unshaded,
+        &lobes,
+        &|| {},
+    );
+    assert!(refused.unwrap_err().0.contains("no lobe"));
 }

@@ -108,6 +108,13 @@ impl Lighting {
         }
     }
 
+    /// What the highlight of `lobe` is scaled by: `ks N(n)`, this lighting's normalisation's
+    /// constant for `lobe` (a march may light several lobes' images at once).
+    #[must_use]
+    pub fn highlight_scale(&self, lobe: &specula::Lobe) -> f32 {
+        self.shading.ks * self.shading.normalisation.constant_for(lobe) as f32
+    }
+
     /// Samples lit by the classic model, a vector of them at once (the ray marcher lights
     /// several rays' samples together): lane `k` has the `gradient` (value per mm) whose
     /// opposite, turned to face the viewer, is its normal, and the view `wo`, `half` vector
@@ -143,7 +150,7 @@ impl Lighting {
         let lit = one + weight * (gx.splat(shading.ka) + gx.splat(shading.kd) * diffuse - one);
         LitLanes {
             colour_scale: lit.select(shaded, one),
-            highlight: (weight * gx.splat(shading.ks * self.normalisation)).keep(shaded),
+            fade: weight.keep(shaded),
             t: t.keep(shaded),
         }
     }
@@ -157,12 +164,14 @@ pub(crate) struct LanesView<V> {
     pub wi_dot_wo: V,
 }
 
-/// Samples' lighting, their colours apart: a sample is `colour_scale * base + highlight *
-/// lobe(t)` in every channel (the highlight is white).
+/// Samples' lighting, their colours apart: a sample is `colour_scale * base + fade * scale *
+/// lobe(t)` in every channel (the highlight is white), `scale` the lobe's `ks N(n)`
+/// ([`Lighting::highlight_scale`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LitLanes<V> {
     pub colour_scale: V,
-    pub highlight: V,
+    /// The highlight's share of the sample's shading (weak gradients faded; 0 unshaded).
+    pub fade: V,
     pub t: V,
 }
 

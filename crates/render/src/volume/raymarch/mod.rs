@@ -21,7 +21,7 @@ use rayon::prelude::*;
 pub use lighting::{Light, Lighting, RayView, Shading};
 pub use view::{surface_camera, RayCamera, View};
 
-use super::march::ray::{march_rays, Lit, Ray};
+use super::march::ray::{march_rays, Highlight, Lit, Ray};
 use super::march::{Classification, PreparedVolume};
 use super::transfer::TransferFunction;
 use super::{Volume, VolumeError};
@@ -149,6 +149,45 @@ pub fn render_dvr_prepared(
     settings: &DvrSettings,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Image, VolumeError> {
+    let mut images = render_images(volume, prepared, transfer, settings, None, progress)?;
+    Ok(images.remove(0))
+}
+
+/// [`render_dvr_prepared`] once for each of `lobes`, the settings' shading with its lobe
+/// replaced by each in turn, in one march: the rays' samples, their colours and opacities do
+/// not depend on the lobe, so only the highlights are computed per lobe. Each image is, bit
+/// for bit, the one [`render_dvr_prepared`] draws for its lobe alone.
+///
+/// # Errors
+/// As [`render_dvr_prepared`]; and when the settings are unshaded (no lobe to replace).
+pub fn render_dvr_lobes(
+    volume: &Volume,
+    prepared: &PreparedVolume,
+    transfer: &TransferFunction,
+    settings: &DvrSettings,
+    lobes: &[specula::Lobe],
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<Image>, VolumeError> {
+    if settings.shading.is_none() {
+        return Err(VolumeError(
+            "an unshaded render has no lobe to vary: give it a shading".into(),
+        ));
+    }
+    if lobes.is_empty() {
+        return Ok(Vec::new());
+    }
+    render_images(volume, prepared, transfer, settings, Some(lobes), progress)
+}
+
+/// The march behind both: one image per lobe of `lobes`, or the settings' own.
+fn render_images(
+    volume: &Volume,
+    prepared: &PreparedVolume,
+    transfer: &TransferFunction,
+    settings: &DvrSettings,
+    lobes: Option<&[specula::Lobe]>,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<Image>, VolumeError> {
     if prepared.dims() != volume.dims() {
         return Err(VolumeError(
             "the prepared volume is another volume's (its grid differs)".into(),
@@ -162,15 +201,28 @@ pub fn render_dvr_prepared(
     } = DvrPlan::new(volume, settings)?;
     let classification = Classification::new(prepared, transfer);
     let level = specula::simd::Level::detect();
-    let mut pixels = vec![settings.background; width as usize * height as usize];
+    let highlights: Vec<Highlight> = match (&lighting, lobes) {
+        (None, _) => Vec::new(),
+        (Some(lighting), None) => vec![Highlight::of(lighting)],
+        (Some(lighting), Some(lobes)) => lobes
+            .iter()
+            .map(|lobe| Highlight {
+                lobe: *lobe,
+                scale: lighting.highlight_scale(lobe),
+            })
+            .collect(),
+    };
+    let images = highlights.len().max(1);
+    // Pixel `p` of image `i` at `pixels[p * images + i]`.
+    let mut pixels = vec![settings.background; width as usize * height as usize * images];
     // Bands of TILE rows, drawn tile by tile: a tile's rays cross the same few columns of
     // voxels, which then stay in cache from one ray to the next.
-    let band = TILE * width as usize;
+    let band = TILE * width as usize * images;
     pixels
         .par_chunks_mut(band)
         .enumerate()
         .for_each(|(index, band)| {
-            let rows = band.len() / width as usize;
+            let rows = band.len() / (width as usize * images);
             let mut rays = Vec::with_capacity(TILE * TILE);
             let mut views = Vec::with_capacity(TILE * TILE);
             let mut places = Vec::with_capacity(TILE * TILE);
@@ -207,7 +259,7 @@ pub fn render_dvr_prepared(
                     }
                 }
                 marched.clear();
-                marched.resize(rays.len(), (Vec3::ZERO, 1.0));
+                marched.resize(rays.len() * images, (Vec3::ZERO, 1.0));
                 march_rays(
                     level,
                     prepared,
@@ -215,22 +267,30 @@ pub fn render_dvr_prepared(
                     lighting.as_ref().map(|lighting| Lit {
                         lighting,
                         views: &views,
+                        highlights: &highlights,
                     }),
                     &rays,
                     step,
                     settings.opacity_cutoff,
                     &mut marched,
                 );
-                for (&place, &(colour, transmittance)) in places.iter().zip(&marched) {
-                    band[place] = colour + transmittance * settings.background;
+                for (&place, results) in places.iter().zip(marched.chunks_exact(images)) {
+                    for (image, &(colour, transmittance)) in results.iter().enumerate() {
+                        band[place * images + image] = colour + transmittance * settings.background;
+                    }
                 }
             }
             for _ in 0..rows {
                 progress();
             }
         });
-    Image::from_pixels(width, height, pixels)
-        .ok_or_else(|| VolumeError("the image could not be assembled".into()))
+    (0..images)
+        .map(|image| {
+            let own = pixels.iter().skip(image).step_by(images).copied().collect();
+            Image::from_pixels(width, height, own)
+                .ok_or_else(|| VolumeError("the image could not be assembled".into()))
+        })
+        .collect()
 }
 
 /// Pixels along each side of the square tiles drawn one at a time.
