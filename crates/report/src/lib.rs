@@ -25,7 +25,7 @@ pub mod vtk_peer;
 mod yours;
 
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -228,6 +228,9 @@ impl Context {
 
 type Section = (&'static str, fn(&mut Context) -> Result<String, String>);
 
+/// The sections that take longest, started first (the others in the order they are shown).
+const LONGEST_FIRST: [&str; 3] = ["Renders", "Medical volumes", "The thesis's claims"];
+
 /// The sections that read the hardware sweeps.
 const HARDWARE_SECTIONS: [&str; 2] = [VERDICT, HARDWARE];
 const VERDICT: &str = "Which lobe when";
@@ -303,19 +306,42 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
     // The hardware sweeps run beside the sections that do not need them (waiting for them
     // inside a section would hold one of the two worker threads idle); then the two that do.
     let needs_sweeps = |(heading, _): &&Section| HARDWARE_SECTIONS.contains(heading);
-    let (sweeps, first) = rayon::join(
-        || {
+    // Started in this order, first come first served: the longest sections first, so that
+    // the short ones fill in around them rather than leave one running alone at the end.
+    let mut order: Vec<&Section> = SECTIONS
+        .iter()
+        .filter(|section| !alone(section) && !needs_sweeps(section))
+        .collect();
+    order.sort_by_key(|(heading, _)| {
+        LONGEST_FIRST
+            .iter()
+            .position(|h| h == heading)
+            .unwrap_or(LONGEST_FIRST.len())
+    });
+    let mut sweeps = Err("the hardware sweeps did not run".to_owned());
+    let first: Vec<Mutex<Option<Result<_, String>>>> =
+        order.iter().map(|_| Mutex::new(None)).collect();
+    rayon::scope_fifo(|scope| {
+        for (section, slot) in order.iter().zip(&first) {
+            scope.spawn_fifo(move |_| {
+                let done = run_section(section);
+                *slot.lock().unwrap_or_else(PoisonError::into_inner) = Some(done);
+            });
+        }
+        let sweeps = &mut sweeps;
+        scope.spawn_fifo(move |_| {
             let begun = Instant::now();
-            context().hardware_sweeps().map(|_| begun.elapsed())
-        },
-        || {
-            SECTIONS
-                .par_iter()
-                .filter(|section| !alone(section) && !needs_sweeps(section))
-                .map(run_section)
-                .collect::<Result<Vec<_>, String>>()
-        },
-    );
+            *sweeps = context().hardware_sweeps().map(|_| begun.elapsed());
+        });
+    });
+    let first = first
+        .into_iter()
+        .map(|slot| {
+            slot.into_inner()
+                .unwrap_or_else(PoisonError::into_inner)
+                .unwrap_or_else(|| Err("a section did not run".into()))
+        })
+        .collect::<Result<Vec<_>, String>>();
     let sweeps_took = sweeps?;
     let mut done = first?;
     done.extend(
