@@ -322,14 +322,18 @@ pub(super) fn shade(
                 (lane.brdf_radiance, lane.brdf_light_pdf) =
                     environment.look_up_texel(lane.brdf_texel, lane.brdf_sine);
             }
-            surface.lobe.eval_batch(&cosines, &mut values);
+            // The light's cosines then the BRDF's, `count` each: a packet of a pixel's
+            // position may be short of LANES.
+            surface
+                .lobe
+                .eval_batch(&cosines[..2 * count], &mut values[..2 * count]);
             *sum += combine(surface, strategy, &shared.lights, lanes, &cosines, &values).as_dvec3();
         }
     }
 }
 
-/// One variant's cosines (the environment's draws' in `cosines[..LANES]`, the BRDF's in
-/// `cosines[LANES..]`) and BRDF directions; a lane drawing from this variant's lobe leaves
+/// One variant's cosines (of the `count = lanes.len()` lanes: the environment's draws' in
+/// `cosines[..count]`, the BRDF's in `cosines[count..2 count]`) and BRDF directions; a lane drawing from this variant's lobe leaves
 /// the texel its direction falls in (`usize::MAX` where it reads nothing new).
 fn variant_directions(
     point: &Point,
@@ -340,7 +344,7 @@ fn variant_directions(
     lanes: &mut [Lane],
     cosines: &mut [f32; 2 * LANES],
 ) {
-    let wo = point.wo;
+    let (wo, count) = (point.wo, lanes.len());
     // The basis the lobe's directions are drawn in: about the mirror direction (Phong) or
     // the normal (Blinn's half vector).
     let axis = match surface.geometry {
@@ -354,7 +358,7 @@ fn variant_directions(
             ..Lane::default()
         };
         cosines[k] = 0.0;
-        cosines[LANES + k] = 0.0;
+        cosines[count + k] = 0.0;
         let light = &shared.lights[k];
         if light.pdf > 0.0 {
             let (t, half_cosine) = surface.cosine(wo, light.wi);
@@ -386,7 +390,7 @@ fn variant_directions(
             lane.brdf_wi = wi;
             lane.brdf_ok = true;
             lane.brdf_half_cosine = half_cosine;
-            cosines[LANES + k] = t;
+            cosines[count + k] = t;
             if brdf.choice < surface.share {
                 (lane.brdf_texel, lane.brdf_sine) = environment.texel_of(point.frame.to_world(wi));
             } else {
@@ -407,6 +411,7 @@ fn combine(
     cosines: &[f32; 2 * LANES],
     values: &[f32; 2 * LANES],
 ) -> Vec3 {
+    let count = lanes.len();
     let mut packet = Vec3::ZERO;
     for (k, lane) in lanes.iter().enumerate() {
         let light = &lights[k];
@@ -422,9 +427,9 @@ fn combine(
         if lane.brdf_ok {
             let (f, pdf) = surface.f_and_pdf(
                 lane.brdf_wi,
-                cosines[LANES + k],
+                cosines[count + k],
                 lane.brdf_half_cosine,
-                values[LANES + k],
+                values[count + k],
             );
             if pdf > 0.0 {
                 let weight = match strategy {
