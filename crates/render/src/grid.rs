@@ -112,6 +112,21 @@ pub fn render_grid(
     })
 }
 
+/// The lobe of each render [`render_grid_with`] asks for, by index: the reference at 0,
+/// each other lobe at its column + 1 (`None` at the reference's own column, which the grid
+/// fills from render 0).
+#[must_use]
+pub fn grid_renders(options: &GridOptions) -> Vec<Option<LobeKind>> {
+    std::iter::once(Some(options.reference))
+        .chain(
+            options
+                .lobes
+                .iter()
+                .map(|&kind| (kind != options.reference).then_some(kind)),
+        )
+        .collect()
+}
+
 /// [`render_grid`] with any renderer: `render(scene, index)` draws the `index`-th of the
 /// `1 + lobes` renders (the reference first).
 pub fn render_grid_with(

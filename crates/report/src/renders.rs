@@ -5,7 +5,7 @@
 use rayon::prelude::*;
 use specula::LobeKind;
 use specula_gpu::{Gpu, GpuRenderer};
-use specula_render::ibl::{render_ibl_lobes, Environment, IblSettings, SKY_WIDTH};
+use specula_render::ibl::{render_ibl_grid, Environment, IblSettings, SKY_WIDTH};
 use specula_render::metrics::compare;
 use specula_render::{
     render, render_grid_with, write_png_srgb8, Display, GridOptions, Image, Overrides, Scene,
@@ -197,7 +197,7 @@ fn default_scene(context: &mut Context) -> Result<String, String> {
 }
 
 /// Every lobe in the environment scene lit by the procedural sky: the same seed for every
-/// lobe, so the environment's draws are shared (computed once, by [`render_ibl_lobes`]) and
+/// lobe, so the environment's draws are shared (computed once, by [`render_ibl_grid`]) and
 /// the differences are the lobes', not the noise's.
 fn environment_lit(context: &mut Context) -> Result<String, String> {
     let (width, height, spp) = context.sizes.environment;
@@ -215,22 +215,8 @@ fn environment_lit(context: &mut Context) -> Result<String, String> {
     let mut html = paragraph(&format!(
         "A sphere and the teapot lit by the procedural sky alone ({width}x{height}, {spp} samples per pixel, multiple importance sampling between each lobe's own sampler and the sky, the lobe normalisation, physical model: specula render --env sky --spp {spp} --lobe L). Every lobe's render uses the same random numbers, so what differs from pow is the reflected sun's and sky's shape; the residual Monte Carlo noise sets the floor of these figures."
     ));
-    // The grid asks for render `index`: 0 the reference, `column + 1` each other lobe.
-    let options = grid_options(context);
-    let asked: Vec<(usize, LobeKind)> = std::iter::once((0, options.reference))
-        .chain(
-            (options.lobes.iter().enumerate())
-                .filter(|(_, &kind)| kind != options.reference)
-                .map(|(column, &kind)| (column + 1, kind)),
-        )
-        .collect();
-    let kinds: Vec<LobeKind> = asked.iter().map(|&(_, kind)| kind).collect();
-    let rendered =
-        render_ibl_lobes(&base, &kinds, &sky, &settings, &|_, _| {}).map_err(|e| e.to_string())?;
-    let mut images: Vec<Option<Image>> = vec![None; 1 + options.lobes.len()];
-    for (&(index, _), image) in asked.iter().zip(rendered) {
-        images[index] = Some(image);
-    }
+    let mut images = render_ibl_grid(&base, &grid_options(context), &sky, &settings, &|_, _| {})
+        .map_err(|e| e.to_string())?;
     let (table_html, _) = lobe_table(
         context,
         &base,

@@ -6,7 +6,9 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use specula::{Exponent, Geometry, LobeKind, Normalisation};
 use specula_gpu::{Gpu, GpuRenderer};
-use specula_render::ibl::{render_ibl, Environment, IblSettings, Strategy, MAX_SPP};
+use specula_render::ibl::{
+    render_ibl, render_ibl_grid, Environment, IblSettings, Strategy, MAX_SPP,
+};
 use specula_render::{
     check_output_path, render, render_grid_with, write_image, write_png_srgb8, GridOptions,
     IlluminationModel, Image, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE,
@@ -193,7 +195,27 @@ pub fn run(args: &Args) -> CommandResult {
                 lobes: lobes.clone(),
                 reference: LobeKind::Pow,
             };
-            let grid = render_grid_with(&scene, &options, &mut draw).map_err(|e| e.to_string())?;
+            // Lit by an environment on the CPU, every lobe is drawn in one pass from the same
+            // draws, then handed to the grid.
+            let grid = match (&gpu_renderer, &environment) {
+                (None, Some(environment)) => {
+                    let progress = |done: usize, total: usize| {
+                        bar.set_length(total as u64);
+                        bar.set_position(done as u64);
+                    };
+                    let mut images =
+                        render_ibl_grid(&scene, &options, environment, &ibl, &progress)
+                            .map_err(|e| e.to_string())?;
+                    render_grid_with(&scene, &options, &mut |_, index| {
+                        images
+                            .get_mut(index)
+                            .and_then(Option::take)
+                            .ok_or_else(|| format!("no render {index} for the grid"))
+                    })
+                }
+                _ => render_grid_with(&scene, &options, &mut draw),
+            }
+            .map_err(|e| e.to_string())?;
             bar.finish_and_clear();
             write_png_srgb8(&args.output, grid.width, grid.height, &grid.bytes)
                 .map_err(|e| e.to_string())?;

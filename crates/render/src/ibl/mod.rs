@@ -33,8 +33,8 @@ mod trace;
 pub use environment::{Environment, EnvironmentError, EnvironmentSample};
 pub use sky::{sun_direction, SKY_WIDTH, SUN_RADIANCE, SUN_RADIUS};
 pub use trace::{
-    cosine_direction, render_ibl, render_ibl_lobes, render_ibl_with, MaterialReflectance,
-    Reflectance,
+    cosine_direction, render_ibl, render_ibl_grid, render_ibl_lobes, render_ibl_with,
+    MaterialReflectance, Reflectance,
 };
 
 /// The most samples per pixel a render may take.

@@ -10,7 +10,7 @@ use specula::sampling::{power_heuristic, uniform, SpecularSampler};
 use super::packet::{shade, Frame32, PacketSurface, Point};
 use super::{Environment, IblSettings, Strategy, MAX_SPP};
 use crate::pipeline::{surfaces, SurfacePoint};
-use crate::{Image, Material, Overrides, RenderError, Scene};
+use crate::{grid_renders, GridOptions, Image, Material, Overrides, RenderError, Scene};
 use specula::brdf::luminance;
 use specula::LobeKind;
 
@@ -281,6 +281,25 @@ pub fn render_ibl_lobes(
         Shading::Packets(&surfaces),
         progress,
     )
+}
+
+/// The renders a grid of `options`'s lobes asks for ([`crate::grid_renders`]), by index,
+/// from one pass of [`render_ibl_lobes`]: what `render_grid_with`'s callback hands out.
+pub fn render_ibl_grid(
+    scene: &Scene,
+    options: &GridOptions,
+    environment: &Environment,
+    settings: &IblSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Vec<Option<Image>>, RenderError> {
+    let asked = grid_renders(options);
+    let kinds: Vec<LobeKind> = asked.iter().flatten().copied().collect();
+    let mut rendered =
+        render_ibl_lobes(scene, &kinds, environment, settings, progress)?.into_iter();
+    Ok(asked
+        .iter()
+        .map(|kind| kind.and_then(|_| rendered.next()))
+        .collect())
 }
 
 /// [`render_ibl`] with every object's material replaced by `reflectance` (a measured
