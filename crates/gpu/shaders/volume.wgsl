@@ -25,23 +25,29 @@ struct Params {
     // ka, kd, ks, and 1 when samples are shaded.
     weights: vec4<f32>,
     background: vec4<f32>,
-    // width, height, transfer points, geometry id.
+    // width, height, the transfer function's control points, geometry id.
     size: vec4<u32>,
     // nx, ny, nz.
     dims: vec4<u32>,
     // Bricks (4^3 cells each) along x, y, z.
     bricks: vec4<u32>,
+    // The classification table's lowest value, entries per unit of value, last entry.
+    classify: vec4<f32>,
     lobe: Lobe,
 }
 
-struct ControlPoint {
-    value: f32,
-    sigma: f32,
-    colour: vec4<f32>,
+// A piece of the transfer function: (sigma, r, g, b) = at_start + slope * (value - start).
+struct Piece {
+    start: f32,
+    at_start: vec4<f32>,
+    slope: vec4<f32>,
 }
 
 @group(0) @binding(0) var<storage, read> params: Params;
-@group(0) @binding(1) var<storage, read> points: array<ControlPoint>;
+// The transfer function classified as the CPU classifies it (Classification::tables).
+@group(0) @binding(1) var<storage, read> pieces: array<Piece>;
+@group(0) @binding(5) var<storage, read> first_piece: array<u32>;
+@group(0) @binding(6) var<storage, read> bounds: array<f32>;
 @group(0) @binding(2) var grid: texture_3d<f32>;
 @group(0) @binding(3) var<storage, read_write> pixels: array<vec4<f32>>;
 // Per brick, 0 where it holds a value with extinction, else how many bricks its empty
@@ -92,23 +98,20 @@ fn to_index() -> mat3x3<f32> {
     return mat3x3<f32>(params.to_index_x.xyz, params.to_index_y.xyz, params.to_index_z.xyz);
 }
 
-// Extinction (w) and colour (xyz) at a value: piecewise linear, clamped beyond the ends.
+// Extinction (w) and colour (xyz) at a value: the line of the piece of the transfer
+// function it falls in, found by a table over the volume's range (Classification::at).
 fn transfer(value: f32) -> vec4<f32> {
-    let count = params.size.z;
-    let first = points[0];
-    if value <= first.value {
-        return vec4<f32>(first.colour.xyz, first.sigma);
-    }
-    for (var p = 1u; p < count; p++) {
-        let a = points[p - 1u];
-        let b = points[p];
-        if value <= b.value {
-            let t = (value - a.value) / (b.value - a.value);
-            return vec4<f32>(a.colour.xyz + (b.colour.xyz - a.colour.xyz) * t, a.sigma + (b.sigma - a.sigma) * t);
+    let x = clamp((value - params.classify.x) * params.classify.y, 0.0, params.classify.z);
+    let entry = first_piece[u32(x)];
+    var piece = entry & 0x7fffu;
+    if (entry & 0x8000u) != 0u {
+        while piece < params.size.z && value > bounds[piece] {
+            piece += 1u;
         }
     }
-    let last = points[count - 1u];
-    return vec4<f32>(last.colour.xyz, last.sigma);
+    let p = pieces[piece];
+    let line = p.at_start + p.slope * (value - p.start);
+    return vec4<f32>(line.yzw, line.x);
 }
 
 fn shade(g: vec3<f32>, base: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {

@@ -30,6 +30,7 @@ struct Params {
     size: [u32; 4],
     dims: [u32; 4],
     bricks: [u32; 4],
+    classify: [f32; 4],
     lobe: LobeBlock,
 }
 
@@ -95,32 +96,49 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
             )));
         }
         let prepared = PreparedVolume::new(volume);
-        let params = params(volume, &prepared, transfer, settings, &plan);
-        let clearance: Vec<u32> = Classification::new(&prepared, transfer)
+        let classification = Classification::new(&prepared, transfer);
+        let clearance: Vec<u32> = classification
             .clearance()
             .iter()
             .map(|&c| u32::from(c))
             .collect();
-        let points: Vec<[f32; 8]> = transfer
-            .points()
+        let tables = classification.tables();
+        let pieces: Vec<[f32; 12]> = tables
+            .pieces
             .iter()
-            .map(|p| {
-                [
-                    p.value, p.sigma, 0.0, 0.0, p.colour.x, p.colour.y, p.colour.z, 0.0,
-                ]
+            .map(|&(start, [s0, s1, s2, s3], [d0, d1, d2, d3])| {
+                [start, 0.0, 0.0, 0.0, s0, s1, s2, s3, d0, d1, d2, d3]
             })
             .collect();
+        let mut params = params(volume, &prepared, transfer, settings, &plan);
+        params.classify = [
+            tables.lowest,
+            tables.per_entry,
+            (tables.first_piece.len() - 1) as f32,
+            0.0,
+        ];
         let readback = self.gpu.checked(|| {
             let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("volume params"),
                 contents: bytemuck::bytes_of(&params),
                 usage: wgpu::BufferUsages::STORAGE,
             });
-            let points = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("transfer function"),
-                contents: bytemuck::cast_slice(&points),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+            let storage = |label: &str, contents: &[u8]| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: wgpu::BufferUsages::STORAGE,
+                })
+            };
+            let pieces = storage("transfer function pieces", bytemuck::cast_slice(&pieces));
+            let first_piece = storage(
+                "classification table",
+                bytemuck::cast_slice(&tables.first_piece),
+            );
+            let bounds = storage(
+                "transfer function bounds",
+                bytemuck::cast_slice(&tables.bounds),
+            );
             let clearance = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("brick clearance"),
                 contents: bytemuck::cast_slice(&clearance),
@@ -174,7 +192,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                     },
                     wgpu::BindGroupEntry {
                         binding: 1,
-                        resource: points.as_entire_binding(),
+                        resource: pieces.as_entire_binding(),
                     },
                     wgpu::BindGroupEntry {
                         binding: 2,
@@ -187,6 +205,14 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                     wgpu::BindGroupEntry {
                         binding: 4,
                         resource: clearance.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: first_piece.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: bounds.as_entire_binding(),
                     },
                 ],
             });
@@ -266,6 +292,7 @@ fn params(
             let [bx, by, bz] = prepared.bricks();
             [bx as u32, by as u32, bz as u32, 0]
         },
+        classify: [0.0; 4],
         lobe,
     }
 }

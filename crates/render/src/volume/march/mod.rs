@@ -327,6 +327,22 @@ impl Classification {
         &self.clearance
     }
 
+    /// The classification as flat tables, for a GPU to read as this does ([`Self::at`]).
+    #[must_use]
+    pub fn tables(&self) -> ClassificationTables {
+        ClassificationTables {
+            bounds: self.bounds.clone(),
+            pieces: self
+                .pieces
+                .iter()
+                .map(|&(start, at_start, slope)| (start, at_start.to_array(), slope.to_array()))
+                .collect(),
+            first_piece: self.first_piece.iter().map(|&e| u32::from(e)).collect(),
+            lowest: self.lowest,
+            per_entry: self.per_entry,
+        }
+    }
+
     /// Extinction and colour `(sigma, r, g, b)` at `value`: the transfer function's own
     /// interpolation.
     #[inline(always)]
@@ -343,6 +359,25 @@ impl Classification {
         let (start, at_start, slope) = self.pieces[piece];
         at_start + slope * (value - start)
     }
+}
+
+/// [`Classification`] as flat tables ([`Classification::tables`]): a value's entry is
+/// `first_piece[clamp((value - lowest) * per_entry, 0, CLASSIFICATION_ENTRIES - 1)]`, its
+/// piece the entry's low 15 bits, then past every bound below the value when the entry's
+/// bit 15 says a bound lies within it; the piece's line gives `(sigma, r, g, b)` as
+/// `at_start + slope * (value - start)`.
+#[derive(Clone, Debug)]
+pub struct ClassificationTables {
+    /// The control points' values.
+    pub bounds: Vec<f32>,
+    /// Per piece: `(start, at_start, slope)`.
+    pub pieces: Vec<(f32, [f32; 4], [f32; 4])>,
+    /// Per entry: the piece of its smallest value, bit 15 set when a bound lies within it.
+    pub first_piece: Vec<u32>,
+    /// The volume's smallest value.
+    pub lowest: f32,
+    /// Entries per unit of value.
+    pub per_entry: f32,
 }
 
 /// Per brick of a `[nx, ny, nz]` grid, 0 where `occupied`, else the chessboard distance to
