@@ -187,8 +187,8 @@ impl Image {
             .map(|c| {
                 let mapped = display.tonemap.apply(c * display.exposure);
                 // NaN cannot reach here (the renderer never writes one), but a NaN would
-                // saturate to 0 in the cast rather than poison the file.
-                (srgb_encode(mapped) * 255.0).round() as u8
+                // encode as 0 rather than poison the file.
+                crate::srgb8::encode(mapped)
             })
             .collect()
     }
@@ -196,7 +196,7 @@ impl Image {
     /// The image from 8-bit sRGB values, decoded to linear.
     #[must_use]
     pub fn from_srgb8(width: u32, height: u32, bytes: &[u8]) -> Option<Self> {
-        let decode = |b: u8| srgb_decode(f32::from(b) / 255.0);
+        let decode = crate::srgb8::decode;
         let pixels = bytes
             .chunks_exact(3)
             .map(|c| Vec3::new(decode(c[0]), decode(c[1]), decode(c[2])))

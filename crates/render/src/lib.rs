@@ -40,6 +40,7 @@ mod pipeline;
 mod raster;
 mod scene;
 mod shapes;
+mod srgb8;
 mod teapot;
 pub mod volume;
 
