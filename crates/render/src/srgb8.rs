@@ -56,7 +56,7 @@ static DECODER: LazyLock<[f32; 256]> =
 #[inline]
 #[must_use]
 pub fn encode(x: f32) -> u8 {
-    if !(x > 0.0) {
+    if x.is_nan() || x <= 0.0 {
         return 0;
     }
     if x >= 1.0 {
