@@ -15,9 +15,8 @@
 //!   every texel's radiance and density (one 16-byte record), so that the reads of a map of
 //!   megabytes overlap rather than wait one after another;
 //! - the frame's tangents and the Phong axis's basis are built once per surface point, and
-//!   closed-form lobes draw their cosine in `f32`, and every other lobe from its table
-//!   ([`specula::sampling::CosineTable32`], in `f32`), where the `f64` path iterates
-//!   Newton's method on the lobe's integral or searches its table.
+//!   closed-form lobes draw their cosine in `f32`, tabulated lobes from their table in `f32`
+//!   with a guide ([`specula::sampling::CosineTable32`]), where the `f64` path searches it.
 //!
 //! Random numbers come from [`specula::sampling::random_bits`] by (seed, draw, dimension),
 //! two 32-bit numbers from each, so an image is the same on any number of threads. The
@@ -48,13 +47,13 @@ pub(super) struct PacketSurface {
     specular: Vec3,
     /// The probability that a BRDF draw goes to the lobe rather than the cosine.
     share: f32,
-    /// `1 / (2 pi int_0^1 lobe)`: a closed-form lobe's value to its sampler's density about
-    /// its axis.
+    /// `1 / (2 pi int_0^1 lobe)`: the lobe's value to its sampler's density about its axis
+    /// (for a lobe with a closed-form integral).
     density_per_value: f32,
     lobe: Lobe,
     geometry: Geometry,
-    /// The table a lobe without a closed-form draw is drawn from and read in `f32`: Newton's
-    /// iterations of the integral in `f64` would cost more than the whole rest of a sample.
+    warp: Warp,
+    /// A tabulated lobe's table, drawn and read in `f32`.
     table: Option<CosineTable32>,
 }
 
@@ -67,8 +66,8 @@ impl PacketSurface {
             luminance(specular.as_dvec3()),
         );
         let scale = material.normalisation.constant_for(&material.lobe) as f32;
-        let analytic = material.lobe.warp() == Warp::Analytic;
-        let total = material.lobe.tail(0.0).filter(|_| analytic).unwrap_or(0.0);
+        let warp = material.lobe.warp();
+        let total = material.lobe.tail(0.0).unwrap_or(0.0);
         Self {
             diffuse: diffuse * FRAC_1_PI,
             specular: specular * scale,
@@ -84,7 +83,8 @@ impl PacketSurface {
             },
             lobe: material.lobe,
             geometry: material.geometry,
-            table: (!analytic).then(|| CosineTable32::of(&material.lobe)),
+            warp,
+            table: (warp == Warp::Table).then(|| CosineTable32::of(&material.lobe)),
         }
     }
 
@@ -108,9 +108,15 @@ impl PacketSurface {
 
     /// A cosine drawn from the lobe for the uniform `u`.
     fn draw_cosine(&self, u: f32) -> f32 {
-        match &self.table {
-            Some(table) => table.sample(u),
-            None => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
+        match (self.warp, &self.table) {
+            (_, Some(table)) => table.sample(u),
+            (Warp::Analytic, None) => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
+            // Newton on the lobe's own integral (a user's formula declares it for exact
+            // sampling), in `f64`.
+            _ => self
+                .lobe
+                .tail_inverse(f64::from(u))
+                .map_or(1.0, |inverted| inverted.x as f32),
         }
     }
 
