@@ -10,6 +10,7 @@
 
 pub mod c_twins;
 mod choice;
+mod costing;
 pub mod fpga_estimate;
 pub mod hardware;
 pub mod material;
@@ -17,10 +18,10 @@ pub mod rates;
 mod recommend;
 
 pub use choice::{Target, Zone};
+pub use costing::{lobe_rate, modelled_rate, rate_unit, FPGA_MATERIAL_REFUSAL};
 pub use hardware::{hardware_sweeps, sweeps};
 pub use recommend::{
-    lobe_rate, modelled_rate, pareto_front, rate_unit, recommend, recommend_each, versus_pow,
-    Candidate, Recommendation, Request, FPGA_MATERIAL_REFUSAL,
+    pareto_front, recommend, recommend_each, versus_pow, Candidate, Recommendation, Request,
 };
 
 use specula::{Exponent, LobeKind};

@@ -83,7 +83,7 @@ pub fn luminance(rgb: [f64; 3]) -> f64 {
 /// over the whole range of `n` (the fits search it) and the target refused if a material's
 /// verdict cannot take it: what a face calls before it loads any material.
 pub fn lobes_to_fit(extra: &[LobeKind], target: Target) -> Result<Vec<LobeKind>, String> {
-    crate::recommend::material_target(target)?;
+    crate::costing::material_target(target)?;
     crate::check_lobes(
         extra,
         &log_spaced(Exponent::new(1.0), Exponent::new(1000.0), 8),
@@ -101,7 +101,7 @@ pub fn assess(
     target: Target,
     margin: f64,
 ) -> Result<Assessment, String> {
-    crate::recommend::material_target(target)?;
+    crate::costing::material_target(target)?;
     if !(0.0..=1.0).contains(&margin) {
         return Err(format!(
             "the margin over pow's fit error must be a fraction in [0, 1], not {margin}"

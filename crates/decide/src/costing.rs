@@ -1,0 +1,194 @@
+//! What a lobe costs on a target (higher is cheaper): on the CPU, its SIMD kernel's measured
+//! rate on this machine ([`crate::rates::kernel_rate`]); on a GPU family, the modelled
+//! evaluations per clock of its exported shader; on the FPGA, the datapath
+//! [`cheapest_datapath`] picks at the width the error needs, synthesized (cached) or, without
+//! the tools, estimated. [`crate::recommend`] ranks by these; a material's verdict
+//! ([`crate::material`]) takes [`lobe_rate`], which refuses the FPGA.
+
+use specula::analysis::{error_figures, Precision};
+use specula::gpu_cost::GpuFamily;
+use specula::{Exponent, Lobe};
+use specula_hw::analysis::WidthSweep;
+
+use crate::hardware::{cheapest_datapath, hardware_sweeps, SWEEP_SAMPLES};
+use crate::{Target, Zone};
+
+/// How a target's costs are obtained.
+pub(crate) enum Costing {
+    /// Timed on this machine's CPU.
+    Measured,
+    /// The GPU cost model of one family.
+    Modelled(GpuFamily),
+    /// Estimated from the fixed-point datapaths' sweeps, per exponent (without Yosys).
+    Estimated(Vec<(Exponent, std::sync::Arc<Vec<WidthSweep>>)>),
+    /// Synthesized and placed (Yosys, nextpnr-ice40 on an iCE40 HX8K; cached), at the word
+    /// lengths the sweeps choose.
+    Synthesized(Vec<(Exponent, std::sync::Arc<Vec<WidthSweep>>)>),
+}
+
+/// Where the FPGA's costs are synthesized: every operator in LUTs, one area figure.
+pub(crate) const FPGA_TARGET: specula_synth::Target =
+    specula_synth::Target::Ice40(specula_synth::Ice40Device::Hx8k);
+
+/// One lobe at one exponent: its error, its cost figure (higher is cheaper), and on the FPGA
+/// the datapath costed.
+#[derive(Clone)]
+pub(crate) struct Point {
+    pub(crate) error: f64,
+    pub(crate) rate: f64,
+    pub(crate) datapath: Option<String>,
+}
+
+/// The integer exponent the datapaths take for `n`.
+fn datapath_exponent(n: Exponent) -> u32 {
+    n.get().round().clamp(1.0, 1000.0) as u32
+}
+
+impl Costing {
+    /// The costing of `target` at `exponents`, and a note for the user where the FPGA's tools
+    /// are missing.
+    pub(crate) fn new(
+        target: Target,
+        exponents: &[Exponent],
+    ) -> Result<(Self, Option<String>), String> {
+        let family = |id: &str| {
+            GpuFamily::find(id).ok_or_else(|| format!("no GPU family '{id}' in the model"))
+        };
+        Ok(match target {
+            Target::Cpu => (Costing::Measured, None),
+            Target::GpuNvidia => (Costing::Modelled(family("gpu-nvidia")?), None),
+            Target::GpuAmd => (Costing::Modelled(family("gpu-amd")?), None),
+            Target::Fpga => {
+                let sweeps = exponents
+                    .iter()
+                    .map(|&n| Ok((n, hardware_sweeps(datapath_exponent(n))?)))
+                    .collect::<Result<Vec<_>, String>>()?;
+                match specula_synth::ToolVersions::find(FPGA_TARGET) {
+                    Ok(_) => (Costing::Synthesized(sweeps), None),
+                    Err(missing) => (
+                        Costing::Estimated(sweeps),
+                        Some(format!(
+                            "{missing}; FPGA costs are the formula estimate instead"
+                        )),
+                    ),
+                }
+            }
+        })
+    }
+
+    pub(crate) fn unit(&self) -> &'static str {
+        match self {
+            Costing::Measured => "evals/s, 1 thread",
+            Costing::Modelled(_) => "evals/clock/multiprocessor (modelled)",
+            Costing::Estimated(_) => "evals/clock per 1000 logic cells (estimated)",
+            Costing::Synthesized(_) => "results/us per 1000 LUTs (synthesized, iCE40 HX8K)",
+        }
+    }
+
+    /// `lobe` at its exponent, or `None` where the target cannot run it (no datapath).
+    pub(crate) fn point(
+        &self,
+        lobe: &Lobe,
+        zone: Zone,
+        max_error: f64,
+    ) -> Result<Option<Point>, String> {
+        let float_error = || zone.error(&error_figures(lobe, &mut Precision::F64, SWEEP_SAMPLES));
+        Ok(match self {
+            Costing::Measured => Some(Point {
+                error: float_error(),
+                rate: crate::rates::kernel_rate(lobe),
+                datapath: None,
+            }),
+            Costing::Modelled(family) => Some(Point {
+                error: float_error(),
+                rate: modelled_rate(family, lobe)?,
+                datapath: None,
+            }),
+            Costing::Estimated(hardware) | Costing::Synthesized(hardware) => {
+                let Some(chosen) = hardware
+                    .iter()
+                    .find(|(at, _)| *at == lobe.exponent())
+                    .and_then(|(_, sweeps)| {
+                        cheapest_datapath(sweeps, lobe.kind(), zone, max_error)
+                    })
+                else {
+                    return Ok(None);
+                };
+                let mut datapath = format!("{} at {} bits", chosen.lobe.id(), chosen.bits);
+                let rate = match self {
+                    // A datapath that cannot reach the error is not worth the tools' minutes:
+                    // it is listed, with its error, as not meeting.
+                    Costing::Synthesized(_) if chosen.error > max_error => {
+                        datapath += " (not synthesized: short of the error)";
+                        0.0
+                    }
+                    Costing::Synthesized(_) => {
+                        let cache = specula_synth::cache::Cache::default_location();
+                        let synthesis = specula_synth::synthesize(
+                            chosen.lobe,
+                            chosen.bits,
+                            FPGA_TARGET,
+                            cache.as_ref(),
+                        )
+                        .map_err(|e| e.to_string())?;
+                        match synthesis.logic_ns_per_result() {
+                            Some(lut_ns) => 1e6 / lut_ns,
+                            // Placed nowhere: it does not fit the part (the note says why).
+                            None => {
+                                datapath += " (does not fit the iCE40 HX8K)";
+                                0.0
+                            }
+                        }
+                    }
+                    _ => 1e3 / chosen.cells as f64,
+                };
+                Some(Point {
+                    error: chosen.error,
+                    rate,
+                    datapath: Some(datapath),
+                })
+            }
+        })
+    }
+}
+
+/// Why a material's verdict refuses the FPGA.
+pub const FPGA_MATERIAL_REFUSAL: &str = "a material verdict cannot target fpga: the fixed-point datapaths take an integer n and a word length chosen for an error against t^n, which a material's fit does not give; valid targets: cpu, gpu-nvidia, gpu-amd";
+
+/// `lobe`'s evaluations per clock per multiprocessor on `family`, by the GPU cost model over
+/// the instructions of its exported shader (higher is cheaper).
+pub fn modelled_rate(family: &GpuFamily, lobe: &Lobe) -> Result<f64, String> {
+    let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
+    Ok(family.cost(&ops).evals_per_clock)
+}
+
+/// `target` if a material's verdict can be given on it: every target but the FPGA
+/// ([`FPGA_MATERIAL_REFUSAL`]).
+pub(crate) fn material_target(target: Target) -> Result<Target, String> {
+    match target {
+        Target::Fpga => Err(FPGA_MATERIAL_REFUSAL.to_owned()),
+        _ => Ok(target),
+    }
+}
+
+/// A lobe's rate on `target` for a material's verdict (higher is cheaper): measured on the
+/// CPU, modelled on a GPU; the FPGA is refused ([`FPGA_MATERIAL_REFUSAL`]) before any
+/// costing starts (costing it would run its sweeps).
+pub fn lobe_rate(target: Target, lobe: &Lobe) -> Result<f64, String> {
+    let target = material_target(target)?;
+    match Costing::new(target, &[lobe.exponent()])?.0 {
+        Costing::Measured => Ok(crate::rates::kernel_rate(lobe)),
+        Costing::Modelled(family) => modelled_rate(&family, lobe),
+        Costing::Estimated(_) | Costing::Synthesized(_) => Err(FPGA_MATERIAL_REFUSAL.to_owned()),
+    }
+}
+
+/// The unit of [`lobe_rate`] on `target` (empty for the FPGA, which it refuses).
+#[must_use]
+pub fn rate_unit(target: Target) -> &'static str {
+    match target {
+        // Costing the FPGA would run its sweeps; material verdicts refuse it anyway.
+        Target::Fpga => "",
+        _ => Costing::new(target, &[]).map_or("", |(costing, _)| costing.unit()),
+    }
+}
