@@ -227,6 +227,31 @@ fn environment(rows_on_poles: bool) -> specula_render::Image {
 }
 
 /// The environment scene's sphere alone, as `sphere.toml` for `specula render`.
+/// What `specula render` is lit by and renders: the scene file (the embedded scene if none),
+/// the environment, the lobe (the scene's if none), and `[width, height, spp]`.
+struct Lit<'a> {
+    scene: Option<&'a str>,
+    env: &'a str,
+    lobe: Option<&'a str>,
+    size: [u32; 3],
+}
+
+/// `specula render` of `lit` with `seed` into `output` (in `dir`), read back.
+fn render_lit(dir: &std::path::Path, lit: &Lit, seed: &str, output: &str) -> specula_render::Image {
+    let [width, height, spp] = lit.size.map(|v| v.to_string());
+    let mut args = vec!["render"];
+    args.extend(lit.scene);
+    args.extend(["--env", lit.env]);
+    if let Some(lobe) = lit.lobe {
+        args.extend(["--lobe", lobe]);
+    }
+    args.extend([
+        "--width", &width, "--height", &height, "--spp", &spp, "--seed", seed, "-o", output,
+    ]);
+    ok(dir, &args);
+    specula_render::read_image(&dir.join(output)).unwrap()
+}
+
 fn write_sphere_scene(dir: &std::path::Path) {
     let sphere_only = specula_render::IBL_SCENE
         .split("\n[[objects]]")
@@ -281,33 +306,19 @@ fn mitsuba_renders_the_environment_scene_as_specula_does() {
     write_sphere_scene(dir.path());
     mitsuba_scene(dir.path(), "sphere", 1, size);
     mitsuba_scene(dir.path(), "scene", 2, size);
-    let [width, height, spp] = size.map(|v| v.to_string());
     for kind in LobeKind::ALL {
         let (lobe, name) = (
             kind.id(),
             format!("specula_{}", kind.id().replace('-', "_")),
         );
         let render = |scene: Option<&str>, seed: &str, output: &str| {
-            let mut args = vec!["render"];
-            args.extend(scene);
-            args.extend([
-                "--env",
-                "specula-map.exr",
-                "--lobe",
-                lobe,
-                "--width",
-                &width,
-                "--height",
-                &height,
-                "--spp",
-                &spp,
-                "--seed",
-                seed,
-                "-o",
-                output,
-            ]);
-            ok(dir.path(), &args);
-            specula_render::read_image(&dir.path().join(output)).unwrap()
+            let lit = Lit {
+                scene,
+                env: "specula-map.exr",
+                lobe: Some(lobe),
+                size,
+            };
+            render_lit(dir.path(), &lit, seed, output)
         };
         let mitsuba = |scene: &str, output: &str| {
             run_python(
@@ -388,29 +399,13 @@ fn mitsuba_lit_by_the_written_sky_renders_as_env_sky() {
         .unwrap();
     write_sphere_scene(dir.path());
     export(dir.path(), "pow", 64.0, "pow.py");
-    let [width, height, spp] = size.map(|v| v.to_string());
-    let render = |seed: &str, output: &str| {
-        ok(
-            dir.path(),
-            &[
-                "render",
-                "sphere.toml",
-                "--env",
-                "sky",
-                "--width",
-                &width,
-                "--height",
-                &height,
-                "--spp",
-                &spp,
-                "--seed",
-                seed,
-                "-o",
-                output,
-            ],
-        );
-        specula_render::read_image(&dir.path().join(output)).unwrap()
+    let lit = Lit {
+        scene: Some("sphere.toml"),
+        env: "sky",
+        lobe: None,
+        size,
     };
+    let render = |seed: &str, output: &str| render_lit(dir.path(), &lit, seed, output);
     let (first, second) = (render("1", "a.exr"), render("2", "b.exr"));
     run_python(
         dir.path(),

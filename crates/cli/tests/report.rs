@@ -296,37 +296,37 @@ fn real_scans(document: &roxmltree::Document, text: &str, out: &std::path::Path)
             assert_eq!(row.len(), 4, "{row:?}");
             check_row(out, &prefix, &row[0], &row[1], &row[2], &row[3]);
         }
-        // The times: pow's frame alone, then every lobe's from one march.
-        let times = text
-            .split("pow alone ")
-            .skip(1)
-            .map(|rest| {
-                let ms = |field: &str| -> f64 {
-                    field
-                        .trim()
-                        .trim_end_matches("ms")
-                        .trim()
-                        .parse()
-                        .unwrap_or_else(|_| panic!("a time: {field:?}"))
-                };
-                let (alone, rest) = rest.split_once(';').expect("pow's time, then the march's");
-                let together = rest
-                    .split_once("from one march ")
-                    .and_then(|(_, t)| t.split_once(','))
-                    .map(|(t, _)| t)
-                    .expect("the march's time");
-                (ms(alone), ms(together))
-            })
-            .collect::<Vec<_>>();
-        assert!(
-            times.len() > shown.len()
-                && times
-                    .iter()
-                    .all(|&(alone, together)| alone > 0.0 && together > 0.0),
-            "{times:?}"
-        );
         shown.push((name, prefix));
     }
+    // Each scan's times: pow's frame alone, then every lobe's from one march.
+    let times = text
+        .split("pow alone ")
+        .skip(1)
+        .map(|rest| {
+            let ms = |field: &str| -> f64 {
+                field
+                    .trim()
+                    .trim_end_matches("ms")
+                    .trim()
+                    .parse()
+                    .unwrap_or_else(|_| panic!("a time: {field:?}"))
+            };
+            let (alone, rest) = rest.split_once(';').expect("pow's time, then the march's");
+            let together = rest
+                .split_once("from one march ")
+                .and_then(|(_, t)| t.split_once(','))
+                .map(|(t, _)| t)
+                .expect("the march's time");
+            (ms(alone), ms(together))
+        })
+        .collect::<Vec<_>>();
+    assert!(
+        times.len() == shown.len()
+            && times
+                .iter()
+                .all(|&(alone, together)| alone > 0.0 && together > 0.0),
+        "{times:?}"
+    );
     if shown.is_empty() {
         return;
     }

@@ -4,8 +4,8 @@
  * glibc's libmvec). Written independently of specula's kernels: the peer they are measured
  * against, and a second opinion on their values.
  *
- * Usage: c_twins N SECONDS ROUNDS. For every twin, prints one line: its id, its rate
- * (evaluations per second on one thread over the same 2048 cosines as `bench lobes`, best of
+ * Usage: c_twins N SECONDS ROUNDS < COSINES (2048, one a line). For every twin, prints one
+ * line: its id, its rate (evaluations per second on one thread over those cosines, best of
  * 3 runs of at least SECONDS each, reading the clock every ROUNDS rounds, as specula's
  * harness does), then its 2048 values. */
 #include <math.h>
@@ -74,10 +74,13 @@ int main(int argc, char **argv) {
     double seconds = strtod(argv[2], NULL);
     long rounds_per_clock = strtol(argv[3], NULL, 10);
     static float t[SIZE], out[SIZE];
-    /* The cosines of specula's `bench lobes` (decide::rates::cosines). */
+    /* The cosines of specula's `bench lobes` (decide::rates::cosines), one per line on
+     * standard input: read, not recomputed, since -ffast-math may contract the formula. */
     for (int i = 0; i < SIZE; i++) {
-        float f = (float)(i % 4093) / 4093.0f;
-        t[i] = 1.0f - 0.2f * (f * f);
+        if (scanf("%f", &t[i]) != 1) {
+            fprintf(stderr, "c_twins: expected %d cosines on standard input\n", SIZE);
+            return 2;
+        }
     }
     for (size_t k = 0; k < sizeof twins / sizeof twins[0]; k++) {
         double best = 0.0;

@@ -6,7 +6,8 @@
 //! the lobe's batch path is reported beside its speed.
 
 use std::path::Path;
-use std::process::Command;
+use std::io::Write;
+use std::process::{Command, Stdio};
 
 use serde::Serialize;
 use specula::simd::Level;
@@ -70,14 +71,26 @@ pub fn measure(n: Exponent, cc: &str) -> Result<CTwins, String> {
     std::fs::write(&source, SOURCE).map_err(|e| format!("C twins: {e}"))?;
     let program = dir.path().join("c_twins");
     compile(cc, &source, &program)?;
-    let output = Command::new(&program)
+    let running = |e: std::io::Error| format!("C twins: running them: {e}");
+    let mut child = Command::new(&program)
         .args([
             n.get().to_string(),
             MIN_SECONDS.to_string(),
             ROUNDS_PER_CLOCK.to_string(),
         ])
-        .output()
-        .map_err(|e| format!("C twins: running them: {e}"))?;
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(running)?;
+    // The cosines go in as text, shortest round-trip decimals, which `scanf` reads exactly.
+    let cosines: String = cosines(L1_SIZE).iter().map(|t| format!("{t:?}\n")).collect();
+    child
+        .stdin
+        .take()
+        .ok_or("C twins: no standard input")?
+        .write_all(cosines.as_bytes())
+        .map_err(running)?;
+    let output = child.wait_with_output().map_err(running)?;
     if !output.status.success() {
         return Err(format!("C twins: exited with {}", output.status));
     }

@@ -139,11 +139,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                 "transfer function bounds",
                 bytemuck::cast_slice(&tables.bounds),
             );
-            let clearance = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("brick clearance"),
-                contents: bytemuck::cast_slice(&clearance),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+            let clearance = storage("brick clearance", bytemuck::cast_slice(&clearance));
             let extent = wgpu::Extent3d {
                 width: dims[0] as u32,
                 height: dims[1] as u32,

@@ -112,6 +112,37 @@ pub fn render_grid(
     })
 }
 
+/// Refuses a grid of no lobes, or one too large to hold, before anything is rendered.
+pub fn check_grid(scene: &Scene, options: &GridOptions) -> Result<(), GridError> {
+    if options.lobes.is_empty() {
+        return Err(GridError::Empty);
+    }
+    let (width, height) = (scene.settings.width, scene.settings.height);
+    let pixels = 2 * options.lobes.len() as u64 * u64::from(width) * u64::from(height);
+    if pixels > MAX_PIXELS {
+        return Err(GridError::TooLarge {
+            lobes: options.lobes.len(),
+            width,
+            height,
+            pixels,
+        });
+    }
+    Ok(())
+}
+
+/// [`render_grid_with`]'s renderer over renders made beforehand, by index as
+/// [`grid_renders`] lists them: hands each out once.
+pub fn made_renders(
+    renders: &mut [Option<crate::Image>],
+) -> impl FnMut(&Scene, usize) -> Result<crate::Image, String> + '_ {
+    |_, index| {
+        renders
+            .get_mut(index)
+            .and_then(Option::take)
+            .ok_or_else(|| format!("no render {index} for the grid"))
+    }
+}
+
 /// The lobe of each render [`render_grid_with`] asks for, by index: the reference at 0,
 /// each other lobe at its column + 1 (`None` at the reference's own column, which the grid
 /// fills from render 0).
@@ -134,19 +165,7 @@ pub fn render_grid_with(
     options: &GridOptions,
     render: &mut dyn FnMut(&Scene, usize) -> Result<crate::Image, String>,
 ) -> Result<Srgb8Image, GridError> {
-    if options.lobes.is_empty() {
-        return Err(GridError::Empty);
-    }
-    let (width, height) = (scene.settings.width, scene.settings.height);
-    let pixels = 2 * options.lobes.len() as u64 * u64::from(width) * u64::from(height);
-    if pixels > MAX_PIXELS {
-        return Err(GridError::TooLarge {
-            lobes: options.lobes.len(),
-            width,
-            height,
-            pixels,
-        });
-    }
+    check_grid(scene, options)?;
     let mut with_lobe = |kind: LobeKind, index: usize| {
         let mut variant = scene.clone();
         variant.apply(&Overrides {

@@ -82,7 +82,7 @@ mod tests {
     use super::*;
 
     /// Every byte's threshold and its neighbours, and a stride through every float in
-    /// `[0, 1]` (and beyond, and NaN), encode as the formula does; every byte decodes so.
+    /// `[0, 1]` (and beyond, and NaN), encode as the formula does.
     #[test]
     fn the_tables_are_the_formula() {
         let mut checked = 0_u64;
@@ -112,11 +112,5 @@ mod tests {
             check(x);
         }
         assert!(checked > 1_000_000, "{checked}");
-        for b in 0..=255_u8 {
-            assert_eq!(
-                decode(b).to_bits(),
-                srgb_decode(f32::from(b) / 255.0).to_bits()
-            );
-        }
     }
 }

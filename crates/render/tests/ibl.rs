@@ -255,6 +255,15 @@ fn lobes_rendered_together_are_each_rendered_alone() {
             );
             assert!(mean_radiance(image) > 0.0, "{kind}: black");
         }
+        // Not vacuous: the lobes' images differ from one another.
+        let differ = together
+            .iter()
+            .filter(|image| image.pixels() != together[0].pixels())
+            .count();
+        assert!(
+            differ >= lobes.len() - 2,
+            "{differ} images differ from pow's"
+        );
     }
 }
 

@@ -124,6 +124,7 @@ pub(crate) struct RealScanSizes {
 }
 
 /// What a section works with: where files go, how much to compute, and what it wrote.
+#[derive(Clone)]
 pub(crate) struct Context {
     directory: PathBuf,
     sizes: Sizes,
@@ -143,12 +144,8 @@ impl Context {
     /// list of files (appended to the section's when the part is done).
     fn sibling(&self) -> Self {
         Self {
-            directory: self.directory.clone(),
-            sizes: self.sizes.clone(),
-            bench: self.bench,
             files: Vec::new(),
-            lobes: self.lobes.clone(),
-            materials: self.materials.clone(),
+            ..self.clone()
         }
     }
 
@@ -229,7 +226,10 @@ impl Context {
 type Section = (&'static str, fn(&mut Context) -> Result<String, String>);
 
 /// The sections that take longest, started first (the others in the order they are shown).
-const LONGEST_FIRST: [&str; 3] = ["Renders", "Medical volumes", "The thesis's claims"];
+const LONGEST_FIRST: [&str; 3] = [RENDERS, VOLUMES, CLAIMS];
+const RENDERS: &str = "Renders";
+const VOLUMES: &str = "Medical volumes";
+const CLAIMS: &str = "The thesis's claims";
 
 /// The sections that read the hardware sweeps.
 const HARDWARE_SECTIONS: [&str; 2] = [VERDICT, HARDWARE];
@@ -239,15 +239,15 @@ const HARDWARE: &str = "Hardware";
 /// The answer first (which lobe when), then the thesis's claims, then the details.
 const SECTIONS: [Section; 13] = [
     (VERDICT, verdict::verdict),
-    ("The thesis's claims", sections::claims),
+    (CLAIMS, sections::claims),
     ("Models", sections::models),
     ("Lobe shapes", sections::shapes),
     ("Error against the angle and against n", sections::errors),
     ("Energy and normalisation", energy::energy),
     ("Reciprocity and white furnace", energy::reciprocity),
-    ("Renders", renders::renders),
+    (RENDERS, renders::renders),
     ("Real materials", materials::materials),
-    ("Medical volumes", volumes::volumes),
+    (VOLUMES, volumes::volumes),
     ("Into other renderers", renderers::renderers),
     (sections::COST, sections::cost),
     (HARDWARE, hardware::hardware),

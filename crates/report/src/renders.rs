@@ -8,8 +8,8 @@ use specula_gpu::{Gpu, GpuRenderer};
 use specula_render::ibl::{render_ibl_grid, Environment, IblSettings, SKY_WIDTH};
 use specula_render::metrics::compare;
 use specula_render::{
-    render, render_grid_with, write_png_srgb8, Display, GridOptions, Image, Overrides, Scene,
-    Shading,
+    made_renders, render, render_grid_with, write_png_srgb8, Display, GridOptions, Image,
+    Overrides, Scene, Shading,
 };
 
 use super::html::{paragraph, table};
@@ -222,12 +222,7 @@ fn environment_lit(context: &mut Context) -> Result<String, String> {
         &base,
         "environment",
         "PSNR vs pow, lit by the sky (dB)",
-        &mut |_, index| {
-            images
-                .get_mut(index)
-                .and_then(Option::take)
-                .ok_or_else(|| format!("no environment render {index}"))
-        },
+        &mut made_renders(&mut images),
     )?;
     html += &table_html;
     Ok(html)

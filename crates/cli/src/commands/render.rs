@@ -10,8 +10,8 @@ use specula_render::ibl::{
     render_ibl, render_ibl_grid, Environment, IblSettings, Strategy, MAX_SPP,
 };
 use specula_render::{
-    check_output_path, render, render_grid_with, write_image, write_png_srgb8, GridOptions,
-    IlluminationModel, Image, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE,
+    check_output_path, made_renders, render, render_grid_with, write_image, write_png_srgb8,
+    GridOptions, IlluminationModel, Image, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE,
 };
 
 use super::CommandResult;
@@ -206,12 +206,8 @@ pub fn run(args: &Args) -> CommandResult {
                     let mut images =
                         render_ibl_grid(&scene, &options, environment, &ibl, &progress)
                             .map_err(|e| e.to_string())?;
-                    render_grid_with(&scene, &options, &mut |_, index| {
-                        images
-                            .get_mut(index)
-                            .and_then(Option::take)
-                            .ok_or_else(|| format!("no render {index} for the grid"))
-                    })
+                    let mut renders = made_renders(&mut images);
+                    render_grid_with(&scene, &options, &mut renders)
                 }
                 _ => render_grid_with(&scene, &options, &mut draw),
             }

@@ -20,9 +20,14 @@
 //! computes, and keeps every difference between two renders the lobe's. Primary visibility
 //! is the rasterizer's ([`crate::pipeline`]), so IBL renders line up pixel for pixel with the
 //! rasterized ones; a pixel's `spp` samples cycle through its `samples x samples` positions,
-//! which antialiases edges at no extra cost. Uniform numbers come from
-//! [`specula::sampling::uniform`] by (seed, pixel, sample), so an image is identical on any
-//! number of threads.
+//! which antialiases edges at no extra cost. Random numbers are a function of (seed, pixel
+//! sample, dimension), so an image is identical on any number of threads.
+//!
+//! Two estimators compute this: the plain one in `f64` (`trace.rs`, through
+//! [`Environment::sample`] and [`specula::sampling::SpecularSampler`], for any
+//! [`Reflectance`]: measured and fitted materials), and, for the scene's own materials, the
+//! same estimator over packets of samples in `f32` (`packet.rs`: the map drawn by its alias
+//! table, tabulated lobes from `f32` tables, several lobes' images from one pass).
 
 mod angles;
 mod environment;

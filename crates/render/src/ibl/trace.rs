@@ -10,7 +10,10 @@ use specula::sampling::{power_heuristic, uniform, SpecularSampler};
 use super::packet::{shade, Frame32, PacketSurface, Point};
 use super::{Environment, IblSettings, Strategy, MAX_SPP};
 use crate::pipeline::{surfaces, SurfacePoint};
-use crate::{grid_renders, GridOptions, Image, Material, Overrides, RenderError, Scene};
+use crate::{
+    check_grid, grid_renders, GridError, GridOptions, Image, Material, Overrides, RenderError,
+    Scene,
+};
 use specula::brdf::luminance;
 use specula::LobeKind;
 
@@ -229,14 +232,16 @@ pub fn render_ibl(
         .iter()
         .map(|object| vec![PacketSurface::new(&object.material)])
         .collect();
-    let mut images = render(
+    render_one(
         scene,
         environment,
         settings,
-        Shading::Packets(&surfaces),
+        Shading::Packets {
+            surfaces: &surfaces,
+            images: 1,
+        },
         progress,
-    )?;
-    Ok(images.remove(0))
+    )
 }
 
 /// [`render_ibl`] of `scene` with every material's lobe replaced by each of `lobes` in turn
@@ -278,24 +283,30 @@ pub fn render_ibl_lobes(
         &variants[0],
         environment,
         settings,
-        Shading::Packets(&surfaces),
+        Shading::Packets {
+            surfaces: &surfaces,
+            images: lobes.len(),
+        },
         progress,
     )
 }
 
 /// The renders a grid of `options`'s lobes asks for ([`crate::grid_renders`]), by index,
-/// from one pass of [`render_ibl_lobes`]: what `render_grid_with`'s callback hands out.
+/// from one pass of [`render_ibl_lobes`], for [`crate::made_renders`] to hand to
+/// `render_grid_with`; a grid it refuses ([`crate::check_grid`]) is refused first.
 pub fn render_ibl_grid(
     scene: &Scene,
     options: &GridOptions,
     environment: &Environment,
     settings: &IblSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<Vec<Option<Image>>, RenderError> {
+) -> Result<Vec<Option<Image>>, GridError> {
+    check_grid(scene, options)?;
     let asked = grid_renders(options);
     let kinds: Vec<LobeKind> = asked.iter().flatten().copied().collect();
-    let mut rendered =
-        render_ibl_lobes(scene, &kinds, environment, settings, progress)?.into_iter();
+    let mut rendered = render_ibl_lobes(scene, &kinds, environment, settings, progress)
+        .map_err(|e| GridError::Render(e.to_string()))?
+        .into_iter();
     Ok(asked
         .iter()
         .map(|kind| kind.and_then(|_| rendered.next()))
@@ -312,14 +323,13 @@ pub fn render_ibl_with(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Image, RenderError> {
     let reflectances = vec![reflectance; scene.objects.len()];
-    let mut images = render(
+    render_one(
         scene,
         environment,
         settings,
         Shading::Reflectances(&reflectances),
         progress,
-    )?;
-    Ok(images.remove(0))
+    )
 }
 
 /// How the visible surfaces are shaded: the scene's materials by the packet estimator (per
@@ -327,7 +337,12 @@ pub fn render_ibl_with(
 /// image).
 #[derive(Clone, Copy)]
 enum Shading<'a> {
-    Packets(&'a [Vec<PacketSurface>]),
+    Packets {
+        /// Per object, one surface per image.
+        surfaces: &'a [Vec<PacketSurface>],
+        /// Images made (also for a scene without objects).
+        images: usize,
+    },
     Reflectances(&'a [&'a dyn Reflectance]),
 }
 
@@ -335,10 +350,23 @@ impl Shading<'_> {
     /// How many images the shading makes.
     fn images(&self) -> usize {
         match self {
-            Shading::Packets(surfaces) => surfaces.first().map_or(1, Vec::len),
+            Shading::Packets { images, .. } => *images,
             Shading::Reflectances(_) => 1,
         }
     }
+}
+
+/// [`render`] of a shading that makes one image.
+fn render_one(
+    scene: &Scene,
+    environment: &Environment,
+    settings: &IblSettings,
+    shading: Shading,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Image, RenderError> {
+    debug_assert_eq!(shading.images(), 1);
+    let mut images = render(scene, environment, settings, shading, progress)?;
+    Ok(images.remove(0))
 }
 
 /// The render loop, object `i` shown with `shading`'s `i`th surface(s): one image per
@@ -390,7 +418,7 @@ fn render(
                         continue;
                     };
                     match shading {
-                        Shading::Packets(surfaces) => shade(
+                        Shading::Packets { surfaces, .. } => shade(
                             &Point {
                                 surfaces: &surfaces[point.object as usize],
                                 frame: frame.as_f32(),

@@ -284,6 +284,11 @@ fn render_images(
                 progress();
             }
         });
+    if images == 1 {
+        return Ok(vec![Image::from_pixels(width, height, pixels).ok_or_else(
+            || VolumeError("the image could not be assembled".into()),
+        )?]);
+    }
     (0..images)
         .map(|image| {
             let own = pixels.iter().skip(image).step_by(images).copied().collect();
