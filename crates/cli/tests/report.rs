@@ -298,8 +298,14 @@ fn real_scans(document: &roxmltree::Document, text: &str, out: &std::path::Path)
         }
         shown.push((name, prefix));
     }
-    // Each scan's times: pow's frame alone, then every lobe's from one march.
-    let times = text
+    // Each scan's times: pow's frame alone, then every lobe's from one march (read from the
+    // text nodes alone: `text` also holds each element's first text, so each sentence twice).
+    let prose: String = document
+        .descendants()
+        .filter(|n| n.is_text())
+        .filter_map(|n| n.text())
+        .collect();
+    let times = prose
         .split("pow alone ")
         .skip(1)
         .map(|rest| {

@@ -5,8 +5,8 @@
 //! values are a second opinion on specula's: each twin's largest relative difference from
 //! the lobe's batch path is reported beside its speed.
 
-use std::path::Path;
 use std::io::Write;
+use std::path::Path;
 use std::process::{Command, Stdio};
 
 use serde::Serialize;
@@ -83,7 +83,10 @@ pub fn measure(n: Exponent, cc: &str) -> Result<CTwins, String> {
         .spawn()
         .map_err(running)?;
     // The cosines go in as text, shortest round-trip decimals, which `scanf` reads exactly.
-    let cosines: String = cosines(L1_SIZE).iter().map(|t| format!("{t:?}\n")).collect();
+    let cosines: String = cosines(L1_SIZE)
+        .iter()
+        .map(|t| format!("{t:?}\n"))
+        .collect();
     child
         .stdin
         .take()
