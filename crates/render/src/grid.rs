@@ -8,7 +8,9 @@ use thiserror::Error;
 
 use crate::pipeline::MAX_PIXELS;
 
-use crate::metrics::compare;
+use rayon::prelude::*;
+
+use crate::metrics::{compare_srgb8, Difference};
 use crate::{render, Overrides, RenderError, Scene};
 
 /// What a grid shows.
@@ -165,6 +167,37 @@ pub fn render_grid_with(
     options: &GridOptions,
     render: &mut dyn FnMut(&Scene, usize) -> Result<crate::Image, String>,
 ) -> Result<Srgb8Image, GridError> {
+    render_grid_columns(scene, options, render).map(|grid| grid.image)
+}
+
+/// One column of a grid: its lobe's render as displayed and its difference from the
+/// reference's, both computed from those bytes.
+#[derive(Clone, Debug)]
+pub struct GridColumn {
+    /// The column's lobe.
+    pub lobe: LobeKind,
+    /// The render as displayed: 8-bit sRGB, three bytes per pixel (what a PNG of it holds).
+    pub srgb8: Vec<u8>,
+    /// PSNR, largest error and FLIP against the reference's bytes.
+    pub difference: Difference,
+}
+
+/// A grid and the columns it was made of.
+#[derive(Clone, Debug)]
+pub struct Grid {
+    /// The grid's image.
+    pub image: Srgb8Image,
+    /// The columns in `options.lobes`' order.
+    pub columns: Vec<GridColumn>,
+}
+
+/// [`render_grid_with`], keeping each column's bytes and its difference, so that a caller
+/// writing each lobe's image and its figures compares nothing twice.
+pub fn render_grid_columns(
+    scene: &Scene,
+    options: &GridOptions,
+    render: &mut dyn FnMut(&Scene, usize) -> Result<crate::Image, String>,
+) -> Result<Grid, GridError> {
     check_grid(scene, options)?;
     let mut with_lobe = |kind: LobeKind, index: usize| {
         let mut variant = scene.clone();
@@ -176,33 +209,61 @@ pub fn render_grid_with(
     };
     let reference = with_lobe(options.reference, 0)?;
     let (width, height) = (reference.width(), reference.height());
+    let reference_srgb8 = reference.to_srgb8(scene.display);
+    let mut renders = Vec::with_capacity(options.lobes.len());
+    for (column, &kind) in options.lobes.iter().enumerate() {
+        renders.push(if kind == options.reference {
+            None
+        } else {
+            Some(with_lobe(kind, column + 1)?)
+        });
+    }
+    // FLIP (the reference implementation, one thread) dominates; the columns in parallel.
+    let columns: Vec<GridColumn> = options
+        .lobes
+        .par_iter()
+        .zip(&renders)
+        .map(|(&lobe, image)| {
+            let srgb8 = image.as_ref().map_or_else(
+                || reference_srgb8.clone(),
+                |image| image.to_srgb8(scene.display),
+            );
+            if srgb8.len() != reference_srgb8.len() {
+                return Err(GridError::Render(format!(
+                    "the {lobe} render is not {width}x{height}"
+                )));
+            }
+            let difference = compare_srgb8(width, height, &reference_srgb8, &srgb8);
+            Ok(GridColumn {
+                lobe,
+                srgb8,
+                difference,
+            })
+        })
+        .collect::<Result<_, _>>()?;
     let mut grid = Srgb8Image {
         width: width * options.lobes.len() as u32,
         height: 2 * height,
         bytes: vec![0; 3 * (width * options.lobes.len() as u32 * 2 * height) as usize],
     };
-    for (column, &kind) in options.lobes.iter().enumerate() {
-        let image = if kind == options.reference {
-            reference.clone()
-        } else {
-            with_lobe(kind, column + 1)?
-        };
-        let difference = compare(&reference, &image, scene.display)
-            .expect("every render of one scene has the scene's size");
-        let x0 = column as u32 * width;
-        grid.blit(x0, 0, width, &image.to_srgb8(scene.display));
-        grid.blit(x0, height, width, &difference.heatmap_srgb8());
-        grid.label(x0, 0, &kind.to_string());
-        let caption = if kind == options.reference {
+    for (index, column) in columns.iter().enumerate() {
+        let x0 = index as u32 * width;
+        grid.blit(x0, 0, width, &column.srgb8);
+        grid.blit(x0, height, width, &column.difference.heatmap_srgb8());
+        grid.label(x0, 0, &column.lobe.to_string());
+        let caption = if column.lobe == options.reference {
             "reference".to_owned()
         } else {
             format!(
                 "FLIP {:.4} vs {}",
-                difference.mean_flip,
+                column.difference.mean_flip,
                 options.reference.id()
             )
         };
         grid.label(x0, height, &caption);
     }
-    Ok(grid)
+    Ok(Grid {
+        image: grid,
+        columns,
+    })
 }

@@ -47,8 +47,8 @@ pub mod volume;
 pub use camera::{Camera, InvalidCamera, Projection, MAX_COORDINATE};
 pub use description::{set_max_triangles, LoadedScene, SceneError, MAX_OBJECTS, MAX_TRIANGLES};
 pub use grid::{
-    check_grid, grid_renders, made_renders, render_grid, render_grid_with, GridError, GridOptions,
-    Srgb8Image,
+    check_grid, grid_renders, made_renders, render_grid, render_grid_columns, render_grid_with,
+    Grid, GridColumn, GridError, GridOptions, Srgb8Image,
 };
 pub use image::{
     check_output_path, encode_png_srgb8, is_linear_output, read_image, srgb_decode, srgb_encode,

@@ -270,4 +270,26 @@ fn the_grids_reference_column_is_the_plain_render() {
         heat_schlick.iter().any(|&c| c != magma_zero),
         "schlick differs from pow somewhere"
     );
+    // The columns the grid keeps: each lobe's bytes as displayed, and its difference from pow
+    // over them (none for pow itself; schlick's PSNR from its own squared byte errors).
+    let grid = specula_render::render_grid_columns(&s, &options, &mut |variant, _| {
+        render(variant, &|_, _| {}).map_err(|e| e.to_string())
+    })
+    .unwrap();
+    assert_eq!(grid.columns[0].srgb8, plain);
+    let pow = &grid.columns[0].difference;
+    assert!(pow.mean_flip == 0.0 && pow.max_abs_error == 0.0, "{pow:?}");
+    let schlick = &grid.columns[1];
+    let squared = plain
+        .iter()
+        .zip(&schlick.srgb8)
+        .map(|(&a, &b)| ((f64::from(a) - f64::from(b)) / 255.0).powi(2))
+        .sum::<f64>()
+        / plain.len() as f64;
+    assert!(
+        (schlick.difference.psnr_db + 10.0 * squared.log10()).abs() < 1e-9,
+        "{} against {squared}",
+        schlick.difference.psnr_db
+    );
+    assert!(schlick.difference.mean_flip > 0.0);
 }

@@ -16,7 +16,7 @@ use specula_render::volume::{self, vtk, Units, Volume};
 use specula_render::{read_image, srgb_encode, Display, Image};
 
 use super::html::{paragraph, table};
-use super::volumes::{shading, EXPONENT};
+use super::volumes::{march_times, shading, EXPONENT};
 use super::{Context, RealScanSizes};
 use crate::vtk_peer;
 
@@ -260,12 +260,7 @@ fn lobe_table(
     let images = render_dvr_lobes(volume, prepared, transfer, &settings, &shaded, &|| {})
         .map_err(|e| e.to_string())?;
     let together_ms = milliseconds(started);
-    html += &paragraph(&format!(
-        "One frame on {} threads: pow alone {alone_ms:.1} ms; all {} lobes' images from one march {together_ms:.1} ms, {:.1} ms a lobe beyond the first (each image bit for bit the one marched for its lobe alone).",
-        rayon::current_num_threads(),
-        lobes.len(),
-        (together_ms - alone_ms) / (lobes.len().max(2) - 1) as f64,
-    ));
+    html += &paragraph(&march_times(alone_ms, together_ms, lobes.len()));
     let mut rows = Vec::new();
     let mut figures = String::new();
     let mut reference: Option<Image> = None;

@@ -8,8 +8,8 @@ use specula_gpu::{Gpu, GpuRenderer};
 use specula_render::ibl::{render_ibl_grid, Environment, IblSettings, SKY_WIDTH};
 use specula_render::metrics::compare;
 use specula_render::{
-    made_renders, render, render_grid_with, write_png_srgb8, Display, GridOptions, Image,
-    Overrides, Scene, Shading,
+    made_renders, render, render_grid_columns, write_png_srgb8, GridOptions, Image, Overrides,
+    Scene, Shading,
 };
 
 use super::html::{paragraph, table};
@@ -34,9 +34,9 @@ fn cpu(scene: &Scene) -> Result<Image, String> {
 
 /// Every lobe's render of `base` by `draw`, as a grid with FLIP against pow below each tile,
 /// then a table whose rows each name their image file (`<prefix>-<lobe>.png`) and are
-/// computed from that file's pixels (8-bit sRGB, as written), so that
-/// `specula diff <prefix>-pow.png <prefix>-<lobe>.png` prints the same figures. Returns the
-/// HTML and the images, the reference first.
+/// computed from that file's pixels (8-bit sRGB, as written; the grid's own comparisons), so
+/// that `specula diff <prefix>-pow.png <prefix>-<lobe>.png` prints the same figures. Returns
+/// the HTML and the images, the reference first.
 fn lobe_table(
     context: &mut Context,
     base: &Scene,
@@ -48,7 +48,7 @@ fn lobe_table(
     // The grid draws the reference as render 0 and each other lobe as render `column + 1`;
     // keeping them by that index (not by arrival) ties every image to its lobe.
     let mut renders: Vec<Option<Image>> = vec![None; 1 + options.lobes.len()];
-    let grid = render_grid_with(base, &options, &mut |variant, index| {
+    let grid = render_grid_columns(base, &options, &mut |variant, index| {
         let image = draw(variant, index)?;
         renders[index] = Some(image.clone());
         Ok(image)
@@ -56,62 +56,41 @@ fn lobe_table(
     .map_err(|e| e.to_string())?;
     let mut html = context.png_srgb8(
         &format!("{prefix}s-lobes.png"),
-        grid.width,
-        grid.height,
-        &grid.bytes,
+        grid.image.width,
+        grid.image.height,
+        &grid.image.bytes,
         "every lobe, FLIP against pow below",
     )?;
-    // Each lobe's file written, read back and compared on its own thread.
+    // Each lobe's file written on its own thread.
+    let (width, height) = (base.settings.width, base.settings.height);
     let directory = &context.directory;
-    let written = options
-        .lobes
+    let names = grid
+        .columns
         .par_iter()
-        .enumerate()
-        .map(|(column, &kind)| {
-            let index = if kind == options.reference {
-                0
-            } else {
-                column + 1
-            };
-            let image = renders[index]
-                .as_ref()
-                .ok_or_else(|| format!("the grid did not render {kind}"))?;
-            let name = format!("{prefix}-{}.png", kind.id());
-            let bytes = image.to_srgb8(base.display);
-            write_png_srgb8(
-                &directory.join(&name),
-                image.width(),
-                image.height(),
-                &bytes,
-            )
-            .map_err(|e| e.to_string())?;
-            let decoded = Image::from_srgb8(image.width(), image.height(), &bytes)
-                .ok_or("inconsistent image size")?;
-            Ok((kind, name, decoded))
+        .map(|column| {
+            let name = format!("{prefix}-{}.png", column.lobe.id());
+            write_png_srgb8(&directory.join(&name), width, height, &column.srgb8)
+                .map_err(|e| e.to_string())?;
+            Ok(name)
         })
         .collect::<Result<Vec<_>, String>>()?;
-    context
-        .files
-        .extend(written.iter().map(|(_, name, _)| name.clone()));
-    let reference = written
+    context.files.extend(names.iter().cloned());
+    let rows: Vec<Vec<String>> = grid
+        .columns
         .iter()
-        .find(|(kind, ..)| *kind == options.reference)
-        .map(|(_, name, image)| (name.clone(), image.clone()))
-        .ok_or("no reference render")?;
-    let rows: Vec<Vec<String>> = written
-        .par_iter()
-        .filter(|(kind, ..)| *kind != options.reference)
-        .map(|(kind, name, image)| {
-            let d = compare(&reference.1, image, Display::default()).map_err(|e| e.to_string())?;
-            Ok(vec![
-                kind.to_string(),
+        .zip(&names)
+        .filter(|(column, _)| column.lobe != options.reference)
+        .map(|(column, name)| {
+            let d = &column.difference;
+            vec![
+                column.lobe.to_string(),
                 name.clone(),
                 format!("{:.1}", d.psnr_db.min(999.0)),
                 sig(d.max_abs_error),
                 format!("{:.5}", d.mean_flip),
-            ])
+            ]
         })
-        .collect::<Result<_, String>>()?;
+        .collect();
     html += &table(
         &["lobe", "image", header, "max abs error", "mean FLIP"],
         &rows,
