@@ -95,6 +95,19 @@ pub trait Real:
     /// ([`crate::expression`]) keeps both sides and a target evaluates the choice itself.
     #[must_use]
     fn select_less(self, bound: Self, then: Self, otherwise: Self) -> Self;
+    /// [`Real::select_less`] of two sides computed on demand: a float computes only the
+    /// side it takes (for a scalar solver that evaluates a model many times); a recording
+    /// or a count computes both, as `select_less` does.
+    #[must_use]
+    #[inline(always)]
+    fn branch_less(
+        self,
+        bound: Self,
+        then: impl FnOnce() -> Self,
+        otherwise: impl FnOnce() -> Self,
+    ) -> Self {
+        self.select_less(bound, then(), otherwise())
+    }
 }
 
 macro_rules! impl_real_for_float {
@@ -191,6 +204,19 @@ macro_rules! impl_real_for_float {
                     then
                 } else {
                     otherwise
+                }
+            }
+            #[inline(always)]
+            fn branch_less(
+                self,
+                bound: Self,
+                then: impl FnOnce() -> Self,
+                otherwise: impl FnOnce() -> Self,
+            ) -> Self {
+                if self < bound {
+                    then()
+                } else {
+                    otherwise()
                 }
             }
         }

@@ -99,23 +99,28 @@ impl AngleQuadratic {
         let [c, b, a]: [R; 3] = self.named_coeffs();
         let k = R::from_f64;
         let g = g.max(k(0.0)).min(self.cutoff_parameter());
-        let (sin, cos) = (g.sin(), g.cos());
         let one_minus_cos = k(2.0) * (k(0.5) * g).sin().square();
-        // int_0^g x sin x = sum_k (-1)^k g^(2k+3) / ((2k+1)! (2k+3)), and the x^2 moment with
-        // (2k+4) in place of (2k+3), where the closed forms cancel (below g = 1/2).
-        let mut term = g; // (-1)^k g^(2k+1) / (2k+1)!
-        let (mut first, mut second) = (k(0.0), k(0.0));
-        for j in 0..10 {
-            let j = f64::from(j);
-            first = first + term * g * g / k(2.0 * j + 3.0);
-            second = second + term * g * g * g / k(2.0 * j + 4.0);
-            term = term * (-g * g / k((2.0 * j + 2.0) * (2.0 * j + 3.0)));
-        }
-        let first = g.select_less(k(0.5), first, sin - g * cos);
-        let second = g.select_less(
+        // int_0^g x sin x = sum_j (-1)^j g^(2j+3) / ((2j+1)! (2j+3)), and the x^2 moment with
+        // (2j+4) in place of (2j+3), where the closed forms cancel (below g = 1/2).
+        let series = |moment: fn(R, R) -> R, offset: f64| {
+            let mut term = g; // (-1)^j g^(2j+1) / (2j+1)!
+            let mut sum = k(0.0);
+            for j in 0..10 {
+                let j = f64::from(j);
+                sum = sum + moment(term, g) / k(2.0 * j + offset);
+                term = term * (-g * g / k((2.0 * j + 2.0) * (2.0 * j + 3.0)));
+            }
+            sum
+        };
+        let first = g.branch_less(
             k(0.5),
-            second,
-            k(2.0) * g * sin + (k(2.0) - g * g) * cos - k(2.0),
+            || series(|term, g| term * g * g, 3.0),
+            || g.sin() - g * g.cos(),
+        );
+        let second = g.branch_less(
+            k(0.5),
+            || series(|term, g| term * g * g * g, 4.0),
+            || k(2.0) * g * g.sin() + (k(2.0) - g * g) * g.cos() - k(2.0),
         );
         c * one_minus_cos + b * first + a * second
     }

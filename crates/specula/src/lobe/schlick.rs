@@ -57,12 +57,16 @@ impl Schlick {
         let c = n - R::from_f64(1.0);
         let x = c * d;
         // (n / c^2) ln(1 + x) - d / c = d - n d^2 sum_k (-x)^k / (k + 2), where it cancels.
-        let series = (0..16).rev().fold(R::from_f64(0.0), |sum, k| {
-            sum * -x + R::from_f64(1.0 / f64::from(k + 2))
-        });
-        let near = d - n * d * d * series;
-        let far = n / (c * c) * x.ln_1p() - d / c;
-        x.select_less(R::from_f64(0.05), near, far)
+        x.branch_less(
+            R::from_f64(0.05),
+            || {
+                let series = (0..16).rev().fold(R::from_f64(0.0), |sum, k| {
+                    sum * -x + R::from_f64(1.0 / f64::from(k + 2))
+                });
+                d - n * d * d * series
+            },
+            || n / (c * c) * x.ln_1p() - d / c,
+        )
     }
 
     /// `int_t^1 schlick(s) ds`.
