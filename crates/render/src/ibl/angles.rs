@@ -27,19 +27,43 @@ pub fn sin_cos_turns(turns: f32) -> (f32, f32) {
     }
 }
 
+/// The polynomial of [`acos`] in `|x|`, lowest power first.
+pub(super) const ACOS: [f32; 8] = [
+    FRAC_PI_2,
+    -0.214_598_8,
+    0.088_978_87,
+    -0.050_174_3,
+    0.030_891_88,
+    -0.017_088_13,
+    0.006_670_09,
+    -0.001_262_491,
+];
+
+/// The polynomial of [`atan2`]'s arctangent on `[0, 1]` in `s^2`, lowest power first (times
+/// `s`).
+pub(super) const ATAN: [f32; 7] = [
+    0.999_996_1,
+    -0.333_173_7,
+    0.198_078_2,
+    -0.132_333_5,
+    0.079_623_7,
+    -0.033_604_2,
+    0.006_811_779,
+];
+
+/// `sum coefficients[i] x^i` by Horner's rule, unfused.
+#[inline(always)]
+fn horner(x: f32, coefficients: &[f32]) -> f32 {
+    coefficients.iter().rev().fold(0.0, |sum, &c| sum * x + c)
+}
+
 /// `acos(x)` for `x` in `[-1, 1]`: Abramowitz and Stegun's 4.4.46, `sqrt(1 - x)` times a
 /// polynomial of degree 7 (error below `2e-8` radians in exact arithmetic).
 #[must_use]
 #[inline]
 pub fn acos(x: f32) -> f32 {
     let a = x.abs().min(1.0);
-    let p = FRAC_PI_2
-        + a * (-0.214_598_8
-            + a * (0.088_978_87
-                + a * (-0.050_174_3
-                    + a * (0.030_891_88
-                        + a * (-0.017_088_13 + a * (0.006_670_09 - a * 0.001_262_491))))));
-    let r = (1.0 - a).sqrt() * p;
+    let r = (1.0 - a).sqrt() * horner(a, &ACOS);
     if x < 0.0 {
         PI - r
     } else {
@@ -58,13 +82,7 @@ pub fn atan2(y: f32, x: f32) -> f32 {
         return 0.0;
     }
     let s = small / large;
-    let s2 = s * s;
-    let mut r = s
-        * (0.999_996_1
-            + s2 * (-0.333_173_7
-                + s2 * (0.198_078_2
-                    + s2 * (-0.132_333_5
-                        + s2 * (0.079_623_7 + s2 * (-0.033_604_2 + s2 * 0.006_811_779))))));
+    let mut r = s * horner(s * s, &ATAN);
     if ay > ax {
         r = FRAC_PI_2 - r;
     }

@@ -31,6 +31,7 @@
 
 mod angles;
 mod environment;
+mod lanes;
 mod packet;
 mod sky;
 mod trace;

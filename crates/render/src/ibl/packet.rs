@@ -16,7 +16,12 @@
 //!   megabytes overlap rather than wait one after another;
 //! - the frame's tangents and the Phong axis's basis are built once per surface point, and
 //!   closed-form lobes draw their cosine in `f32`, tabulated lobes from their table in `f32`
-//!   with a guide ([`specula::sampling::CosineTable32`]), where the `f64` path searches it.
+//!   with a guide ([`specula::sampling::CosineTable32`]), where the `f64` path searches it;
+//!   Newton-sampled lobes start Newton from that table's draw (the same root, in about half
+//!   the iterations);
+//! - each variant's directions, their texels and the combination of its two draws run on
+//!   SIMD lanes ([`super::lanes`]: 8 with AVX2 and FMA), the same on every level to `f32`
+//!   roundings (tested).
 //!
 //! Random numbers come from [`specula::sampling::random_bits`] by (seed, draw, dimension),
 //! two 32-bit numbers from each, so an image is the same on any number of threads. The
@@ -31,7 +36,12 @@ use specula::lobe::Warp;
 use specula::sampling::{random_bits, unit_f32, CosineTable32};
 use specula::{Geometry, Lobe};
 
+use specula::simd::{dispatch, Level};
+
 use super::angles::sin_cos_turns;
+use super::lanes::{
+    Brdf, Columns3, Combine, Directions, Setting, SharedColumns, Source, VariantColumns,
+};
 use super::{Environment, Strategy};
 use crate::Material;
 
@@ -55,6 +65,8 @@ pub(super) struct PacketSurface {
     warp: Warp,
     /// A tabulated lobe's table, drawn and read in `f32`.
     table: Option<CosineTable32>,
+    /// A Newton-sampled lobe's table, whose draw starts Newton near its root.
+    newton_start: Option<CosineTable32>,
 }
 
 impl PacketSurface {
@@ -85,24 +97,7 @@ impl PacketSurface {
             geometry: material.geometry,
             warp,
             table: (warp == Warp::Table).then(|| CosineTable32::of(&material.lobe)),
-        }
-    }
-
-    /// The lobe's cosine `t` for `wi` (local), and for Blinn `wo . h` (the Jacobian's);
-    /// `t = 0` where the half vector is undefined.
-    fn cosine(&self, wo: Vec3, wi: Vec3) -> (f32, f32) {
-        match self.geometry {
-            Geometry::Phong => (Vec3::new(-wo.x, -wo.y, wo.z).dot(wi), 1.0),
-            Geometry::Blinn => {
-                let sum = wo + wi;
-                let length_squared = sum.length_squared();
-                if length_squared > 0.0 {
-                    let h = sum / length_squared.sqrt();
-                    (h.z, wo.dot(h))
-                } else {
-                    (0.0, 1.0)
-                }
-            }
+            newton_start: (warp == Warp::Newton).then(|| CosineTable32::of(&material.lobe)),
         }
     }
 
@@ -112,30 +107,18 @@ impl PacketSurface {
             (_, Some(table)) => table.sample(u),
             (Warp::Analytic, None) => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
             // Newton on the lobe's own integral (a user's formula declares it for exact
-            // sampling), in `f64`.
-            _ => self
-                .lobe
-                .tail_inverse(f64::from(u))
-                .map_or(1.0, |inverted| inverted.x as f32),
+            // sampling), in `f64`, from the table's draw: the same root in fewer steps.
+            _ => {
+                let u = f64::from(u);
+                match &self.newton_start {
+                    Some(start) => self
+                        .lobe
+                        .tail_inverse_near(u, f64::from(start.sample(u as f32))),
+                    None => self.lobe.tail_inverse(u),
+                }
+                .map_or(1.0, |inverted| inverted.x as f32)
+            }
         }
-    }
-
-    /// The BRDF and the BRDF strategy's density at `wi` (local, above the surface), from the
-    /// lobe's value `value` at its cosine `t` (and `wo . h` for Blinn).
-    fn f_and_pdf(&self, wi: Vec3, t: f32, half_cosine: f32, value: f32) -> (Vec3, f32) {
-        let density = match &self.table {
-            Some(table) => table.density(t) * (0.5 * FRAC_1_PI),
-            None => value * self.density_per_value,
-        };
-        let lobe_pdf = match self.geometry {
-            Geometry::Phong => density,
-            Geometry::Blinn if half_cosine > 0.0 => density / (4.0 * half_cosine),
-            Geometry::Blinn => 0.0,
-        };
-        (
-            self.diffuse + self.specular * value,
-            (1.0 - self.share) * wi.z * FRAC_1_PI + self.share * lobe_pdf,
-        )
     }
 }
 
@@ -169,54 +152,16 @@ impl Frame32 {
     }
 }
 
-/// The environment's draw of one sample (local), its density and radiance, and the texel it
-/// came from: the same for every variant of the surface.
-#[derive(Clone, Copy, Default)]
-struct LightDraw {
-    /// The draw's index in the stream.
-    draw: u64,
-    texel: Option<usize>,
-    within: [f32; 2],
-    /// `pdf` 0 when there is no draw above the surface.
-    wi: Vec3,
-    pdf: f32,
-    radiance: Vec3,
-}
-
-/// The BRDF's uniform numbers for one sample, and the cosine-weighted direction they give
-/// with what the environment sends along it: shared by every variant that draws the cosine.
-#[derive(Clone, Copy, Default)]
-struct BrdfDraw {
-    choice: f32,
-    u1: f32,
-    sin_phi: f32,
-    cos_phi: f32,
-    diffuse_wi: Vec3,
-    diffuse_texel: usize,
-    diffuse_sine: f32,
-    diffuse_radiance: Vec3,
-    diffuse_light_pdf: f32,
-}
-
-/// A packet's draws that every variant shares.
-struct SharedDraws {
-    lights: [LightDraw; LANES],
-    brdfs: [BrdfDraw; LANES],
-}
-
-/// One sample's BRDF direction for one variant (local), its half-vector cosine, and what the
-/// environment sends along it with the density it would have drawn it with.
-#[derive(Clone, Copy, Default)]
-struct Lane {
-    light_half_cosine: f32,
-    brdf_wi: Vec3,
-    /// `true` when above the surface.
-    brdf_ok: bool,
-    brdf_half_cosine: f32,
-    brdf_texel: usize,
-    brdf_sine: f32,
-    brdf_radiance: Vec3,
-    brdf_light_pdf: f32,
+/// The scalar half of a packet's shared draws: the stream's draw indices, and where the
+/// environment's and the cosine-weighted draws fall in the map.
+struct SharedScalars {
+    draw: [u64; LANES],
+    /// `usize::MAX` where there is no environment draw.
+    light_texel: [usize; LANES],
+    within: [[f32; 2]; LANES],
+    u1: [f32; LANES],
+    diffuse_texel: [usize; LANES],
+    diffuse_sine: [f32; LANES],
 }
 
 /// A surface point, prepared once for all its samples: one surface per variant of the
@@ -233,10 +178,11 @@ pub(super) struct Point<'a> {
 /// so every variant's environment draws, and the cosine-weighted BRDF draws of every
 /// variant that makes one, are computed once; each variant's sums are the ones it would
 /// have alone, bit for bit.
+/// `level` is where the per-variant arithmetic runs ([`Level::detect`]'s, but for tests).
 pub(super) fn shade(
     point: &Point,
     environment: &Environment,
-    strategy: Strategy,
+    (strategy, level): (Strategy, Level),
     seed: u64,
     draws: impl Iterator<Item = u64>,
     sums: &mut [glam::DVec3],
@@ -247,110 +193,138 @@ pub(super) fn shade(
         .map(|s| s.share)
         .fold(f32::INFINITY, f32::min);
     let mut draws = draws.peekable();
-    let mut shared = SharedDraws {
-        lights: [LightDraw::default(); LANES],
-        brdfs: [BrdfDraw::default(); LANES],
+    let mut scalars = SharedScalars {
+        draw: [0; LANES],
+        light_texel: [usize::MAX; LANES],
+        within: [[0.0; 2]; LANES],
+        u1: [0.0; LANES],
+        diffuse_texel: [0; LANES],
+        diffuse_sine: [0.0; LANES],
     };
-    let mut lanes = [Lane::default(); LANES];
-    let mut cosines = [0.0_f32; 2 * LANES];
-    let mut values = [0.0_f32; 2 * LANES];
+    let mut shared = SharedColumns {
+        light_wi: Columns3::ZERO,
+        light_pdf: [0.0; LANES],
+        light_radiance: Columns3::ZERO,
+        choice: [0.0; LANES],
+        sin_phi: [0.0; LANES],
+        cos_phi: [0.0; LANES],
+        diffuse_wi: Columns3::ZERO,
+        diffuse_radiance: Columns3::ZERO,
+        diffuse_light_pdf: [0.0; LANES],
+    };
+    let mut variant = VariantColumns::ZERO;
     while draws.peek().is_some() {
         // In passes over the packet rather than lane by lane: each pass's reads of the map
         // (megabytes, mostly out of cache) are independent of one another and overlap.
         let mut count = 0;
-        let SharedDraws { lights, brdfs } = &mut shared;
         // The environment's draws: random numbers and the alias table's texels.
         for (k, draw) in draws.by_ref().take(LANES).enumerate() {
             count = k + 1;
-            let light = &mut lights[k];
-            *light = LightDraw {
-                draw,
-                ..LightDraw::default()
-            };
+            scalars.draw[k] = draw;
+            scalars.light_texel[k] = usize::MAX;
             if strategy != Strategy::Brdf {
                 let bits = random_bits(seed, draw, 0);
                 let within = random_bits(seed, draw, 1);
-                light.texel =
-                    Some(environment.draw_texel(bits as u32, unit_f32((bits >> 32) as u32)));
-                light.within = [unit_f32(within as u32), unit_f32((within >> 32) as u32)];
+                scalars.light_texel[k] =
+                    environment.draw_texel(bits as u32, unit_f32((bits >> 32) as u32));
+                scalars.within[k] = [unit_f32(within as u32), unit_f32((within >> 32) as u32)];
             }
+        }
+        // A short packet's last lanes draw nothing: no environment draw, and a BRDF choice
+        // no lobe takes with no cosine-weighted direction.
+        for k in count..LANES {
+            scalars.light_texel[k] = usize::MAX;
+            shared.choice[k] = 2.0;
+            shared.diffuse_wi.set(k, Vec3::ZERO);
         }
         // The BRDF's numbers, and the cosine-weighted directions' texels.
         if strategy != Strategy::Environment {
-            for (light, brdf) in lights[..count].iter().zip(brdfs.iter_mut()) {
-                let bits = random_bits(seed, light.draw, 2);
-                let more = random_bits(seed, light.draw, 3);
-                brdf.choice = unit_f32(bits as u32);
-                brdf.u1 = unit_f32((bits >> 32) as u32);
-                (brdf.sin_phi, brdf.cos_phi) = sin_cos_turns(unit_f32(more as u32));
-                brdf.diffuse_wi = Vec3::ZERO;
-                if brdf.choice >= fewest_lobe_draws {
-                    let (sine, cosine) = (brdf.u1.sqrt(), (1.0 - brdf.u1).max(0.0).sqrt());
-                    let wi = Vec3::new(sine * brdf.cos_phi, sine * brdf.sin_phi, cosine);
+            for k in 0..count {
+                let bits = random_bits(seed, scalars.draw[k], 2);
+                let more = random_bits(seed, scalars.draw[k], 3);
+                let (choice, u1) = (unit_f32(bits as u32), unit_f32((bits >> 32) as u32));
+                let (sin_phi, cos_phi) = sin_cos_turns(unit_f32(more as u32));
+                (shared.choice[k], shared.sin_phi[k], shared.cos_phi[k]) =
+                    (choice, sin_phi, cos_phi);
+                scalars.u1[k] = u1;
+                let mut diffuse_wi = Vec3::ZERO;
+                if choice >= fewest_lobe_draws {
+                    let (sine, cosine) = (u1.sqrt(), (1.0 - u1).max(0.0).sqrt());
+                    let wi = Vec3::new(sine * cos_phi, sine * sin_phi, cosine);
                     if wi.z > 0.0 {
-                        brdf.diffuse_wi = wi;
-                        (brdf.diffuse_texel, brdf.diffuse_sine) =
+                        diffuse_wi = wi;
+                        (scalars.diffuse_texel[k], scalars.diffuse_sine[k]) =
                             environment.texel_of(point.frame.to_world(wi));
                     }
                 }
+                shared.diffuse_wi.set(k, diffuse_wi);
             }
         }
         // The texels' radiances and densities.
-        for (light, brdf) in lights[..count].iter_mut().zip(brdfs.iter_mut()) {
-            if let Some(texel) = light.texel {
-                if let Some((wi, pdf, radiance)) = environment.draw_in(texel, light.within) {
+        for k in 0..LANES {
+            shared.light_pdf[k] = 0.0;
+            let texel = scalars.light_texel[k];
+            if texel != usize::MAX {
+                if let Some((wi, pdf, radiance)) = environment.draw_in(texel, scalars.within[k]) {
                     let wi = point.frame.to_local(wi);
                     if wi.z > 0.0 {
-                        (light.wi, light.pdf, light.radiance) = (wi, pdf, radiance);
+                        shared.light_wi.set(k, wi);
+                        shared.light_pdf[k] = pdf;
+                        shared.light_radiance.set(k, radiance);
                     }
                 }
             }
-            if brdf.diffuse_wi.z > 0.0 {
-                (brdf.diffuse_radiance, brdf.diffuse_light_pdf) =
-                    environment.look_up_texel(brdf.diffuse_texel, brdf.diffuse_sine);
+            if shared.diffuse_wi.z[k] > 0.0 {
+                let (radiance, pdf) =
+                    environment.look_up_texel(scalars.diffuse_texel[k], scalars.diffuse_sine[k]);
+                shared.diffuse_radiance.set(k, radiance);
+                shared.diffuse_light_pdf[k] = pdf;
             }
         }
         for (surface, sum) in point.surfaces.iter().zip(sums.iter_mut()) {
-            let lanes = &mut lanes[..count];
-            variant_directions(
+            *sum += shade_variant(
                 point,
                 environment,
                 surface,
                 strategy,
-                &shared,
-                lanes,
-                &mut cosines,
-            );
-            for lane in lanes
-                .iter_mut()
-                .filter(|lane| lane.brdf_texel != usize::MAX)
-            {
-                (lane.brdf_radiance, lane.brdf_light_pdf) =
-                    environment.look_up_texel(lane.brdf_texel, lane.brdf_sine);
-            }
-            // The light's cosines then the BRDF's, `count` each: a packet of a pixel's
-            // position may be short of LANES.
-            surface
-                .lobe
-                .eval_batch(&cosines[..2 * count], &mut values[..2 * count]);
-            *sum += combine(surface, strategy, &shared.lights, lanes, &cosines, &values).as_dvec3();
+                level,
+                (&shared, &scalars.u1),
+                &mut variant,
+                count,
+            )
+            .as_dvec3();
         }
     }
 }
 
-/// One variant's cosines (of the `count = lanes.len()` lanes: the environment's draws' in
-/// `cosines[..count]`, the BRDF's in `cosines[count..2 count]`) and BRDF directions; a lane drawing from this variant's lobe leaves
-/// the texel its direction falls in (`usize::MAX` where it reads nothing new).
-fn variant_directions(
+/// One variant's estimates over a packet of `count` draws, summed: its lobe's cosine draws,
+/// then its directions and their texels on lanes, the texels' reads, the lobe's values (its
+/// SIMD kernel), a table's densities, and the combination on lanes.
+#[allow(clippy::too_many_arguments)]
+fn shade_variant(
     point: &Point,
     environment: &Environment,
     surface: &PacketSurface,
     strategy: Strategy,
-    shared: &SharedDraws,
-    lanes: &mut [Lane],
-    cosines: &mut [f32; 2 * LANES],
-) {
-    let (wo, count) = (point.wo, lanes.len());
+    level: Level,
+    (shared, u1): (&SharedColumns, &[f32; LANES]),
+    variant: &mut VariantColumns,
+    count: usize,
+) -> Vec3 {
+    let draws_lobe = strategy != Strategy::Environment;
+    for (k, (drawn, (&choice, &u))) in variant
+        .drawn
+        .iter_mut()
+        .zip(shared.choice.iter().zip(u1))
+        .enumerate()
+    {
+        *drawn = if k < count && draws_lobe && choice < surface.share {
+            surface.draw_cosine(u)
+        } else {
+            0.0
+        };
+    }
+    let wo = point.wo;
     // The basis the lobe's directions are drawn in: about the mirror direction (Phong) or
     // the normal (Blinn's half vector).
     let axis = match surface.geometry {
@@ -358,99 +332,136 @@ fn variant_directions(
         Geometry::Blinn => Vec3::Z,
     };
     let (b1, b2) = axis.any_orthonormal_pair();
-    for (k, lane) in lanes.iter_mut().enumerate() {
-        *lane = Lane {
-            brdf_texel: usize::MAX,
-            ..Lane::default()
+    let Frame32 {
+        tangent,
+        bitangent,
+        normal,
+    } = point.frame;
+    dispatch(
+        level,
+        Directions {
+            setting: Setting {
+                geometry: surface.geometry,
+                strategy,
+                wo,
+                frame: [tangent, bitangent, normal],
+                axis: [axis, b1, b2],
+                share: surface.share,
+                texels: (environment.image().width(), environment.image().height()),
+            },
+            shared,
+            variant: &mut *variant,
+        },
+    );
+    let width = environment.image().width() as usize;
+    for k in 0..count {
+        let (radiance, light_pdf) = match Source::of(variant.source[k]) {
+            Source::Lobe => environment.look_up_texel(
+                variant.texel_row[k] as usize * width + variant.texel_column[k] as usize,
+                variant.texel_sine[k],
+            ),
+            Source::Diffuse => (shared.diffuse_radiance.get(k), shared.diffuse_light_pdf[k]),
+            Source::None => (Vec3::ZERO, 0.0),
         };
-        cosines[k] = 0.0;
-        cosines[count + k] = 0.0;
-        let light = &shared.lights[k];
-        if light.pdf > 0.0 {
-            let (t, half_cosine) = surface.cosine(wo, light.wi);
-            lane.light_half_cosine = half_cosine;
-            cosines[k] = t;
+        variant.brdf_radiance.set(k, radiance);
+        variant.brdf_light_pdf[k] = light_pdf;
+    }
+    surface.lobe.eval_batch(
+        &variant.light_cosine[..count],
+        &mut variant.light_value[..count],
+    );
+    surface.lobe.eval_batch(
+        &variant.brdf_cosine[..count],
+        &mut variant.brdf_value[..count],
+    );
+    if let Some(table) = &surface.table {
+        for k in 0..count {
+            if shared.light_pdf[k] > 0.0 {
+                variant.light_density[k] =
+                    table.density(variant.light_cosine[k]) * (0.5 * FRAC_1_PI);
+            }
+            if Source::of(variant.source[k]) != Source::None {
+                variant.brdf_density[k] = table.density(variant.brdf_cosine[k]) * (0.5 * FRAC_1_PI);
+            }
         }
-        if strategy == Strategy::Environment {
-            continue;
-        }
-        let brdf = &shared.brdfs[k];
-        let (wi, t, half_cosine) = if brdf.choice < surface.share {
-            let t = surface.draw_cosine(brdf.u1);
-            let sine = (1.0 - t * t).max(0.0).sqrt();
-            let direction = (t * axis + sine * (brdf.cos_phi * b1 + brdf.sin_phi * b2)).normalize();
-            match surface.geometry {
-                Geometry::Phong => (direction, t, 1.0),
-                Geometry::Blinn => {
-                    let half_cosine = wo.dot(direction);
-                    let wi = (2.0 * half_cosine * direction - wo).normalize();
-                    (wi, if half_cosine > 0.0 { t } else { 0.0 }, half_cosine)
+    }
+    dispatch(
+        level,
+        Combine {
+            brdf: Brdf {
+                geometry: surface.geometry,
+                strategy,
+                diffuse: surface.diffuse,
+                specular: surface.specular,
+                share: surface.share,
+                density_per_value: surface.table.is_none().then_some(surface.density_per_value),
+            },
+            shared,
+            variant,
+        },
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+    use specula::{Exponent, LobeKind, Normalisation};
+
+    use super::*;
+
+    /// The packet estimator's sums are the same, to `f32` roundings, wherever its lanes run:
+    /// at the baseline level (one lane, unfused) and at the best this CPU has, for a lobe of
+    /// each sampler (closed form, Newton, table), Phong and Blinn, under each strategy.
+    #[test]
+    fn every_level_shades_the_same() {
+        let environment = Environment::sky(256);
+        let surfaces: Vec<PacketSurface> = [LobeKind::Pow, LobeKind::Schlick, LobeKind::Cheb2]
+            .into_iter()
+            .flat_map(|kind| {
+                [Geometry::Phong, Geometry::Blinn].map(|geometry| {
+                    PacketSurface::new(&Material {
+                        ka: 0.0,
+                        kd: 0.4,
+                        ks: 0.6,
+                        colour: Vec3::new(0.8, 0.5, 0.3),
+                        specular_colour: Vec3::ONE,
+                        lobe: Lobe::new(kind, Exponent::new(40.0)),
+                        geometry,
+                        normalisation: Normalisation::Lobe,
+                    })
+                })
+            })
+            .collect();
+        let tilt = Vec3::new(0.3, -0.2, 1.0).normalize();
+        let (tangent, bitangent) = tilt.any_orthonormal_pair();
+        let point = Point {
+            surfaces: &surfaces,
+            frame: Frame32::new(tangent, bitangent, tilt),
+            wo: Vec3::new(0.4, 0.1, 0.8).normalize(),
+        };
+        for strategy in [Strategy::Mis, Strategy::Brdf, Strategy::Environment] {
+            let sums_at = |level| {
+                let mut sums = vec![DVec3::ZERO; surfaces.len()];
+                shade(
+                    &point,
+                    &environment,
+                    (strategy, level),
+                    7,
+                    0..1000,
+                    &mut sums,
+                );
+                sums
+            };
+            let baseline = sums_at(Level::Baseline);
+            for level in Level::available() {
+                for (v, (a, b)) in sums_at(level).iter().zip(&baseline).enumerate() {
+                    assert!(
+                        a.cmpgt(DVec3::ZERO).all()
+                            && (*a - *b).abs().max_element() <= 1e-4 * b.max_element(),
+                        "{strategy:?} {level:?} variant {v}: {a} against {b}"
+                    );
                 }
             }
-        } else {
-            let wi = brdf.diffuse_wi;
-            let (t, half_cosine) = surface.cosine(wo, wi);
-            (wi, t, half_cosine)
-        };
-        if wi.z > 0.0 && half_cosine > 0.0 {
-            lane.brdf_wi = wi;
-            lane.brdf_ok = true;
-            lane.brdf_half_cosine = half_cosine;
-            cosines[count + k] = t;
-            if brdf.choice < surface.share {
-                (lane.brdf_texel, lane.brdf_sine) = environment.texel_of(point.frame.to_world(wi));
-            } else {
-                (lane.brdf_radiance, lane.brdf_light_pdf) =
-                    (brdf.diffuse_radiance, brdf.diffuse_light_pdf);
-            }
         }
     }
-}
-
-/// One variant's estimates over the packet, summed: each lane's environment draw and BRDF
-/// draw, combined by the power heuristic.
-fn combine(
-    surface: &PacketSurface,
-    strategy: Strategy,
-    lights: &[LightDraw; LANES],
-    lanes: &[Lane],
-    cosines: &[f32; 2 * LANES],
-    values: &[f32; 2 * LANES],
-) -> Vec3 {
-    let count = lanes.len();
-    let mut packet = Vec3::ZERO;
-    for (k, lane) in lanes.iter().enumerate() {
-        let light = &lights[k];
-        if light.pdf > 0.0 {
-            let (f, brdf_pdf) =
-                surface.f_and_pdf(light.wi, cosines[k], lane.light_half_cosine, values[k]);
-            let weight = match strategy {
-                Strategy::Mis => power_heuristic(light.pdf, brdf_pdf),
-                _ => 1.0,
-            };
-            packet += f * light.radiance * (light.wi.z * weight / light.pdf);
-        }
-        if lane.brdf_ok {
-            let (f, pdf) = surface.f_and_pdf(
-                lane.brdf_wi,
-                cosines[count + k],
-                lane.brdf_half_cosine,
-                values[count + k],
-            );
-            if pdf > 0.0 {
-                let weight = match strategy {
-                    Strategy::Mis => power_heuristic(pdf, lane.brdf_light_pdf),
-                    _ => 1.0,
-                };
-                packet += f * lane.brdf_radiance * (lane.brdf_wi.z * weight / pdf);
-            }
-        }
-    }
-    packet
-}
-
-/// Veach's power heuristic ([`specula::sampling::power_heuristic`], whose care for zero and
-/// infinite densities it keeps) on `f32` densities.
-fn power_heuristic(pdf: f32, other: f32) -> f32 {
-    specula::sampling::power_heuristic(f64::from(pdf), f64::from(other)) as f32
 }

@@ -394,6 +394,7 @@ fn render(
     // Row by row, each row holding the images' rows one after another.
     let row_length = width as usize * images;
     let mut rows = vec![Vec3::ZERO; row_length * height as usize];
+    let level = specula::simd::Level::detect();
     rows.par_chunks_mut(row_length)
         .enumerate()
         .for_each(|(y, row)| {
@@ -425,7 +426,7 @@ fn render(
                                 wo: wo.as_vec3(),
                             },
                             environment,
-                            settings.strategy,
+                            (settings.strategy, level),
                             settings.seed,
                             draws,
                             &mut sums,

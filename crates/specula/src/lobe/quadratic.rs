@@ -141,8 +141,9 @@ impl AngleQuadratic {
         R::parameter("cutoff", self.cutoff)
     }
 
-    /// The cosine whose tail is the fraction `u` of the whole, by Newton in the angle.
-    pub(crate) fn tail_inverse(&self, u: f64) -> Inverted {
+    /// The cosine whose tail is the fraction `u` of the whole, by Newton in the angle, from
+    /// the cosine `near` when given.
+    pub(crate) fn tail_inverse(&self, u: f64, near: Option<f64>) -> Inverted {
         let c = self.coeffs[0];
         let target = u * self.total.unwrap_or(0.0);
         let root = solve_increasing(
@@ -150,7 +151,10 @@ impl AngleQuadratic {
             |g: f64| self.tail_slope(g),
             target,
             (0.0, self.cutoff),
-            (2.0 * target / c.max(f64::MIN_POSITIVE)).sqrt(),
+            near.map_or_else(
+                || (2.0 * target / c.max(f64::MIN_POSITIVE)).sqrt(),
+                |t| t.clamp(-1.0, 1.0).acos(),
+            ),
         );
         Inverted {
             x: root.x.cos(),

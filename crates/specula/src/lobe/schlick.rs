@@ -74,14 +74,15 @@ impl Schlick {
         self.tail_from_peak(1.0 - t)
     }
 
-    /// The cosine whose tail is the fraction `u` of the whole, by Newton on the tail.
-    pub(crate) fn tail_inverse(&self, u: f64) -> Inverted {
+    /// The cosine whose tail is the fraction `u` of the whole, by Newton on the tail, from
+    /// the cosine `near` when given.
+    pub(crate) fn tail_inverse(&self, u: f64, near: Option<f64>) -> Inverted {
         let c = self.n - 1.0;
         let target = u * self.total;
-        let guess = if c > 0.0 {
-            (c * target).exp_m1() / c
-        } else {
-            target
+        let guess = match near {
+            Some(t) => 1.0 - t,
+            None if c > 0.0 => (c * target).exp_m1() / c,
+            None => target,
         };
         let root = solve_increasing(
             |d: f64| self.tail_from_peak(d),
