@@ -20,21 +20,30 @@ struct Params {
     to_index_z: vec4<f32>,
     // xyz = the world position of voxel (0, 0, 0); w = the gradient of full shading.
     origin: vec4<f32>,
-    // xyz = towards the light; w = the normalisation's constant.
+    // xyz = towards the light.
     light: vec4<f32>,
     // ka, kd, ks, and 1 when samples are shaded.
     weights: vec4<f32>,
     background: vec4<f32>,
     // width, height, the transfer function's control points, geometry id.
     size: vec4<u32>,
-    // nx, ny, nz.
+    // nx, ny, nz, and the images drawn: one per highlight (one when unshaded).
     dims: vec4<u32>,
     // Bricks (4^3 cells each) along x, y, z.
     bricks: vec4<u32>,
     // The classification table's lowest value, entries per unit of value, last entry.
     classify: vec4<f32>,
-    lobe: Lobe,
 }
+
+// A lobe whose highlight an image shows, and (x) what it is scaled by: ks N(n), the
+// normalisation's constant for that lobe.
+struct Highlight {
+    lobe: Lobe,
+    scale: vec4<f32>,
+}
+
+// The most highlights one march draws (the host splits longer lists).
+const MAX_HIGHLIGHTS: u32 = 16u;
 
 // A piece of the transfer function: (sigma, r, g, b) = at_start + slope * (value - start).
 struct Piece {
@@ -53,6 +62,7 @@ struct Piece {
 // Per brick, 0 where it holds a value with extinction, else how many bricks its empty
 // surroundings reach (Classification::clearance).
 @group(0) @binding(4) var<storage, read> clearance: array<u32>;
+@group(0) @binding(7) var<storage, read> highlights: array<Highlight>;
 
 // Where the ray grid_origin + grid_direction t leaves the cube of bricks within reach - 1
 // bricks of the one holding cell (PreparedVolume::clear_exit).
@@ -114,10 +124,18 @@ fn transfer(value: f32) -> vec4<f32> {
     return vec4<f32>(line.yzw, line.x);
 }
 
-fn shade(g: vec3<f32>, base: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+// A shaded sample: its colour without the highlight, the lobe's cosine there, and the
+// highlight's weight (the gradient's strength; 0 where there is no gradient).
+struct Shaded {
+    colour: vec3<f32>,
+    t: f32,
+    weight: f32,
+}
+
+fn shade(g: vec3<f32>, base: vec3<f32>, wo: vec3<f32>) -> Shaded {
     let strength = length(g);
     if !(strength > 0.0) {
-        return base;
+        return Shaded(base, 0.0, 0.0);
     }
     var normal = -g / strength;
     if dot(normal, wo) < 0.0 {
@@ -127,10 +145,9 @@ fn shade(g: vec3<f32>, base: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     let w = params.weights;
     let diffuse = max(dot(normal, wi), 0.0);
     let t = cos_lobe(params.size.w, normal, wo, wi);
-    let specular = w.z * params.light.w * lobe_eval(params.lobe, t);
-    let lit = base * (w.x + w.y * diffuse) + vec3<f32>(specular);
+    let lit = base * (w.x + w.y * diffuse);
     let weight = min(strength / params.origin.w, 1.0);
-    return base + (lit - base) * weight;
+    return Shaded(base + (lit - base) * weight, t, weight);
 }
 
 fn pixel_jitter(x: u32, y: u32) -> f32 {
@@ -182,8 +199,12 @@ fn march(@builtin(global_invocation_id) id: vec3<u32>) {
         far = min(far, max(a, b));
     }
     let index_of_pixel = id.y * width + id.x;
+    let images = params.dims.w;
+    let image_size = width * height;
     if missed || !(near < far) {
-        pixels[index_of_pixel] = vec4<f32>(params.background.xyz, 1.0);
+        for (var i = 0u; i < images; i++) {
+            pixels[i * image_size + index_of_pixel] = vec4<f32>(params.background.xyz, 1.0);
+        }
         return;
     }
     // Segment j > 0 ends at lattice + (j + 1) step, from j, so that a skip lands on the
@@ -195,6 +216,9 @@ fn march(@builtin(global_invocation_id) id: vec3<u32>) {
     let inverse_direction = select(1.0 / grid_direction, vec3<f32>(1e30), abs(grid_direction) < vec3<f32>(1e-12));
     let last_cell = vec3<i32>(params.dims.xyz) - vec3<i32>(2);
     var colour = vec3<f32>(0.0);
+    // Each image's highlights, summed apart from the colour they share.
+    var highlighted = array<f32, MAX_HIGHLIGHTS>();
+    let shaded_samples = params.weights.w > 0.5;
     var transmittance = 1.0;
     var t = near;
     var j = 0u;
@@ -226,12 +250,21 @@ fn march(@builtin(global_invocation_id) id: vec3<u32>) {
             continue;
         }
         let alpha = 1.0 - exp(-medium.w * span);
-        var shaded = medium.xyz;
-        if params.weights.w > 0.5 {
-            shaded = shade(field.yzw, medium.xyz, wo);
+        if shaded_samples {
+            let shaded = shade(field.yzw, medium.xyz, wo);
+            colour += transmittance * alpha * shaded.colour;
+            let weight = transmittance * alpha * shaded.weight;
+            for (var i = 0u; i < images; i++) {
+                let highlight = highlights[i];
+                highlighted[i] += weight * (highlight.scale.x * lobe_eval(highlight.lobe, shaded.t));
+            }
+        } else {
+            colour += transmittance * alpha * medium.xyz;
         }
-        colour += transmittance * alpha * shaded;
         transmittance *= 1.0 - alpha;
     }
-    pixels[index_of_pixel] = vec4<f32>(colour + transmittance * params.background.xyz, 1.0);
+    let behind = colour + transmittance * params.background.xyz;
+    for (var i = 0u; i < images; i++) {
+        pixels[i * image_size + index_of_pixel] = vec4<f32>(behind + vec3<f32>(highlighted[i]), 1.0);
+    }
 }

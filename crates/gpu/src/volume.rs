@@ -5,7 +5,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use specula_render::volume::march::{Classification, PreparedVolume};
-use specula_render::volume::raymarch::{DvrPlan, DvrSettings};
+use specula_render::volume::raymarch::{DvrPlan, DvrSettings, Lighting};
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::Volume;
 use specula_render::Image;
@@ -31,8 +31,19 @@ struct Params {
     dims: [u32; 4],
     bricks: [u32; 4],
     classify: [f32; 4],
-    lobe: LobeBlock,
 }
+
+/// `struct Highlight` of volume.wgsl (48 bytes): a lobe an image shows and its scale.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct HighlightBlock {
+    lobe: LobeBlock,
+    /// `ks N(n)` in `x`.
+    scale: [f32; 4],
+}
+
+/// `MAX_HIGHLIGHTS` of volume.wgsl: the most images one march draws.
+const MAX_HIGHLIGHTS: usize = 16;
 
 /// The compiled ray marcher.
 #[derive(Debug)]
@@ -77,6 +88,58 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
         settings: &DvrSettings,
     ) -> Result<Image, GpuError> {
         let plan = DvrPlan::new(volume, settings).map_err(|e| GpuError::Unsupported(e.0))?;
+        let highlights: Vec<HighlightBlock> = plan
+            .lighting
+            .iter()
+            .map(|lighting| highlight(lighting, &lighting.shading.lobe))
+            .collect();
+        self.march(volume, transfer, settings, &plan, &highlights)?
+            .pop()
+            .ok_or_else(|| GpuError::Unsupported("the march drew no image".into()))
+    }
+
+    /// [`GpuVolumeRenderer::render`] once for each of `lobes`, the settings' shading with its
+    /// lobe replaced by each in turn, as
+    /// [`specula_render::volume::raymarch::render_dvr_lobes`] does: up to 16 images a march,
+    /// the samples' colours and opacities computed once for them all, and each image the one
+    /// its lobe alone draws (one march's arithmetic, tested).
+    ///
+    /// # Errors
+    /// As [`GpuVolumeRenderer::render`]; and when the settings are unshaded.
+    pub fn render_lobes(
+        &self,
+        volume: &Volume,
+        transfer: &TransferFunction,
+        settings: &DvrSettings,
+        lobes: &[specula::Lobe],
+    ) -> Result<Vec<Image>, GpuError> {
+        let plan = DvrPlan::new(volume, settings).map_err(|e| GpuError::Unsupported(e.0))?;
+        let Some(lighting) = &plan.lighting else {
+            return Err(GpuError::Unsupported(
+                "an unshaded render has no lobe to vary: give it a shading".into(),
+            ));
+        };
+        let highlights: Vec<HighlightBlock> =
+            lobes.iter().map(|lobe| highlight(lighting, lobe)).collect();
+        let image_bytes = u64::from(settings.width) * u64::from(settings.height) * 16;
+        let fit = self.gpu.device.limits().max_storage_buffer_binding_size / image_bytes.max(1);
+        let per_march = (fit as usize).clamp(1, MAX_HIGHLIGHTS);
+        let mut images = Vec::with_capacity(lobes.len());
+        for some in highlights.chunks(per_march) {
+            images.extend(self.march(volume, transfer, settings, &plan, some)?);
+        }
+        Ok(images)
+    }
+
+    /// One march drawing an image per highlight (one image when there is none: unshaded).
+    fn march(
+        &self,
+        volume: &Volume,
+        transfer: &TransferFunction,
+        settings: &DvrSettings,
+        plan: &DvrPlan,
+        highlights: &[HighlightBlock],
+    ) -> Result<Vec<Image>, GpuError> {
         let device = &self.gpu.device;
         let limits = device.limits();
         let dims = volume.dims();
@@ -88,10 +151,12 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
             )));
         }
         let (width, height) = (settings.width, settings.height);
-        let output_bytes = u64::from(width) * u64::from(height) * 16;
+        let images = highlights.len().max(1);
+        let image_bytes = u64::from(width) * u64::from(height) * 16;
+        let output_bytes = image_bytes * images as u64;
         if output_bytes > limits.max_storage_buffer_binding_size {
             return Err(GpuError::Unsupported(format!(
-                "a {width} x {height} image needs {output_bytes} bytes; this GPU binds at most {} (use --backend cpu or a smaller image)",
+                "{images} image(s) of {width} x {height} need {output_bytes} bytes; this GPU binds at most {} (use --backend cpu or a smaller image)",
                 limits.max_storage_buffer_binding_size
             )));
         }
@@ -110,7 +175,8 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                 [start, 0.0, 0.0, 0.0, s0, s1, s2, s3, d0, d1, d2, d3]
             })
             .collect();
-        let mut params = params(volume, &prepared, transfer, settings, &plan);
+        let mut params = params(volume, &prepared, transfer, settings, plan);
+        params.dims[3] = images as u32;
         params.classify = [
             tables.lowest,
             tables.per_entry,
@@ -140,6 +206,16 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                 bytemuck::cast_slice(&tables.bounds),
             );
             let clearance = storage("brick clearance", bytemuck::cast_slice(&clearance));
+            // An unshaded march reads no highlight, but a binding holds at least one.
+            let none = [HighlightBlock::zeroed()];
+            let highlights = storage(
+                "highlights",
+                bytemuck::cast_slice(if highlights.is_empty() {
+                    &none
+                } else {
+                    highlights
+                }),
+            );
             let extent = wgpu::Extent3d {
                 width: dims[0] as u32,
                 height: dims[1] as u32,
@@ -210,6 +286,10 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                         binding: 6,
                         resource: bounds.as_entire_binding(),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 7,
+                        resource: highlights.as_entire_binding(),
+                    },
                 ],
             });
             let mut encoder =
@@ -225,17 +305,30 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
             readback
         })?;
         let bytes = self.gpu.read_buffer(&readback)?;
-        let pixels = bytes
-            .chunks_exact(16)
-            .map(|b| {
-                let channel = |c: usize| {
-                    f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])
-                };
-                glam::Vec3::new(channel(0), channel(1), channel(2))
+        bytes
+            .chunks_exact(image_bytes as usize)
+            .map(|image| {
+                let pixels = image
+                    .chunks_exact(16)
+                    .map(|b| {
+                        let channel = |c: usize| {
+                            f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])
+                        };
+                        glam::Vec3::new(channel(0), channel(1), channel(2))
+                    })
+                    .collect();
+                Image::from_pixels(width, height, pixels)
+                    .ok_or_else(|| GpuError::Unsupported("the image could not be assembled".into()))
             })
-            .collect();
-        Image::from_pixels(width, height, pixels)
-            .ok_or_else(|| GpuError::Unsupported("the image could not be assembled".into()))
+            .collect()
+    }
+}
+
+/// The block of `lobe`'s highlight under `lighting`.
+fn highlight(lighting: &Lighting, lobe: &specula::Lobe) -> HighlightBlock {
+    HighlightBlock {
+        lobe: LobeBlock::new(lobe),
+        scale: [lighting.highlight_scale(lobe), 0.0, 0.0, 0.0],
     }
 }
 
@@ -249,19 +342,17 @@ fn params(
     let camera = &plan.camera;
     let to_index = volume.to_index();
     let [nx, ny, nz] = volume.dims();
-    let (light, weights, gradient_reference, normalisation, geometry, lobe) = match &plan.lighting {
+    let (light, weights, gradient_reference, geometry) = match &plan.lighting {
         Some(lighting) => {
             let shading = &lighting.shading;
             (
                 lighting.light,
                 [shading.ka, shading.kd, shading.ks, 1.0],
                 lighting.gradient_reference,
-                lighting.normalisation,
                 geometry_id(shading.geometry),
-                LobeBlock::new(&shading.lobe),
             )
         }
-        None => (glam::Vec3::Z, [0.0; 4], 1.0, 0.0, 0, LobeBlock::default()),
+        None => (glam::Vec3::Z, [0.0; 4], 1.0, 0),
     };
     Params {
         eye: with_w(camera.eye, camera.half_height),
@@ -274,7 +365,7 @@ fn params(
             with_w(to_index.z_axis, 0.0),
         ],
         origin: with_w(volume.origin(), gradient_reference),
-        light: with_w(light, normalisation),
+        light: with_w(light, 0.0),
         weights,
         background: with_w(settings.background, 0.0),
         size: [
@@ -289,6 +380,5 @@ fn params(
             [bx as u32, by as u32, bz as u32, 0]
         },
         classify: [0.0; 4],
-        lobe,
     }
 }

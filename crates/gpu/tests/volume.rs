@@ -63,6 +63,42 @@ fn gpu_ray_marching_matches_the_cpu_for_every_lobe() {
     assert!(apart > 10.0 * agreement.max(1e-5), "{apart} vs {agreement}");
 }
 
+/// Every lobe's image from one march is the one its lobe alone draws, bit for bit, past
+/// the 16 images one march holds (20 lobes: two marches); an unshaded march has no lobe to
+/// vary and is refused.
+#[test]
+fn gpu_lobes_marched_together_are_each_marched_alone() {
+    let Some(gpu) = common::gpu() else { return };
+    let renderer = GpuVolumeRenderer::new(&gpu).unwrap();
+    let volume = phantom::shepp_logan(40).unwrap();
+    let transfer = TransferFunction::default_for(&volume).for_volume(&volume);
+    let kinds: Vec<LobeKind> = LobeKind::ALL.into_iter().cycle().take(20).collect();
+    let lobes: Vec<Lobe> = kinds.iter().map(|&kind| shading(kind).lobe).collect();
+    let settings = DvrSettings::new(64, 48, View::Anterior, Some(shading(LobeKind::Pow)));
+    let together = renderer
+        .render_lobes(&volume, &transfer, &settings, &lobes)
+        .unwrap();
+    assert_eq!(together.len(), lobes.len());
+    for (kind, image) in kinds.iter().zip(&together) {
+        let alone = renderer
+            .render(
+                &volume,
+                &transfer,
+                &DvrSettings::new(64, 48, View::Anterior, Some(shading(*kind))),
+            )
+            .unwrap();
+        assert!(alone.pixels() == image.pixels(), "{kind}");
+    }
+    assert!(
+        together[0].pixels() != together[1].pixels(),
+        "pow's and schlick's images differ"
+    );
+    let unshaded = DvrSettings::new(64, 48, View::Anterior, None);
+    assert!(renderer
+        .render_lobes(&volume, &transfer, &unshaded, &lobes)
+        .is_err());
+}
+
 #[test]
 fn gpu_isosurfaces_match_the_cpu() {
     let Some(gpu) = common::gpu() else { return };

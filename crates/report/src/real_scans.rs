@@ -16,7 +16,7 @@ use specula_render::volume::{self, vtk, Units, Volume};
 use specula_render::{read_image, srgb_encode, Display, Image};
 
 use super::html::{paragraph, table};
-use super::volumes::{march_times, shading, EXPONENT};
+use super::volumes::{cpu_threads, march_times, shading, EXPONENT};
 use super::{Context, RealScanSizes};
 use crate::vtk_peer;
 
@@ -260,7 +260,12 @@ fn lobe_table(
     let images = render_dvr_lobes(volume, prepared, transfer, &settings, &shaded, &|| {})
         .map_err(|e| e.to_string())?;
     let together_ms = milliseconds(started);
-    html += &paragraph(&march_times(alone_ms, together_ms, lobes.len()));
+    html += &paragraph(&march_times(
+        &cpu_threads(),
+        alone_ms,
+        together_ms,
+        lobes.len(),
+    ));
     let mut rows = Vec::new();
     let mut figures = String::new();
     let mut reference: Option<Image> = None;
