@@ -2,7 +2,7 @@
 //! and reciprocity are `energy.rs`). Every figure is computed here, during the run.
 
 use rayon::prelude::*;
-use specula::analysis::{error_figures, ErrorFigures, Precision};
+use specula::analysis::{error_figures, error_figures_on, ErrorFigures, Precision, ZoneSamples};
 use specula::claims::{evaluate_all, ClaimOptions, Verdict};
 use specula::zones::{bloom_angle, epicentre_angle};
 use specula::{Exponent, Lobe, LobeKind};
@@ -204,20 +204,22 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
         .copied()
         .filter(|&k| k != LobeKind::Pow)
         .collect();
-    let figures: Vec<Vec<(f64, ErrorFigures)>> = kinds
+    // Each exponent's zone samples (the cosines and pow there) taken once, for every lobe.
+    let by_exponent: Vec<Vec<ErrorFigures>> = grid
         .par_iter()
-        .map(|&kind| {
+        .map(|&n| {
+            let samples = ZoneSamples::new(n, sizes.samples_per_zone);
+            kinds
+                .iter()
+                .map(|&kind| error_figures_on(&Lobe::new(kind, n), &mut Precision::F64, &samples))
+                .collect()
+        })
+        .collect();
+    let figures: Vec<Vec<(f64, ErrorFigures)>> = (0..kinds.len())
+        .map(|k| {
             grid.iter()
-                .map(|&n| {
-                    (
-                        n.get(),
-                        error_figures(
-                            &Lobe::new(kind, n),
-                            &mut Precision::F64,
-                            sizes.samples_per_zone,
-                        ),
-                    )
-                })
+                .zip(&by_exponent)
+                .map(|(n, at_n)| (n.get(), at_n[k]))
                 .collect()
         })
         .collect();
