@@ -270,7 +270,7 @@ pub(super) struct VariantColumns {
     /// The lobe's values at `light_cosine` and `brdf_cosine`.
     pub(super) light_value: Column,
     pub(super) brdf_value: Column,
-    /// A tabulated lobe's sampler's densities there (per unit cosine, over `2 pi`).
+    /// A tabulated lobe's sampler's densities there, per unit cosine.
     pub(super) light_density: Column,
     pub(super) brdf_density: Column,
     pub(super) brdf_wi: Columns3,
@@ -462,12 +462,14 @@ impl Combine<'_> {
         (f, pdf)
     }
 
-    /// The lobe sampler's density per unit cosine (over `2 pi`) where its value is `value`.
+    /// The lobe sampler's density about its axis, per solid angle, where its value is
+    /// `value`: the value's share of the lobe's integral, or the table's density per unit
+    /// cosine over `2 pi`.
     #[inline(always)]
     fn density<V: Lanes>(&self, value: V, table: &Column, k: usize) -> V {
         match self.brdf.density_per_value {
             Some(per_value) => value * value.splat(per_value),
-            None => value.load(&table[k..k + V::WIDTH]),
+            None => value.load(&table[k..k + V::WIDTH]) * value.splat(0.5 * FRAC_1_PI),
         }
     }
 

@@ -113,7 +113,7 @@ impl PacketSurface {
                 match &self.newton_start {
                     Some(start) => self
                         .lobe
-                        .tail_inverse_near(u, f64::from(start.sample(u as f32))),
+                        .tail_inverse_f32(u, f64::from(start.sample(u as f32))),
                     None => self.lobe.tail_inverse(u),
                 }
                 .map_or(1.0, |inverted| inverted.x as f32)
@@ -375,15 +375,14 @@ fn shade_variant(
         &mut variant.brdf_value[..count],
     );
     if let Some(table) = &surface.table {
-        for k in 0..count {
-            if shared.light_pdf[k] > 0.0 {
-                variant.light_density[k] =
-                    table.density(variant.light_cosine[k]) * (0.5 * FRAC_1_PI);
-            }
-            if Source::of(variant.source[k]) != Source::None {
-                variant.brdf_density[k] = table.density(variant.brdf_cosine[k]) * (0.5 * FRAC_1_PI);
-            }
-        }
+        table.density_batch(
+            &variant.light_cosine[..count],
+            &mut variant.light_density[..count],
+        );
+        table.density_batch(
+            &variant.brdf_cosine[..count],
+            &mut variant.brdf_density[..count],
+        );
     }
     dispatch(
         level,

@@ -64,7 +64,11 @@ impl FormulaLobe {
 
     /// The cosine whose tail is the fraction `u` of the whole, by safeguarded Newton in
     /// `x = 1 - t`, where the tail `int_{1-x}^1 lobe` rises from 0 with slope `lobe(1 - x)`.
-    pub(crate) fn tail_inverse(&self, u: f64, near: Option<f64>) -> Option<Inverted> {
+    pub(crate) fn tail_inverse(
+        &self,
+        u: f64,
+        (near, resolution): (Option<f64>, f64),
+    ) -> Option<Inverted> {
         let total = self.tail(0.0)?;
         let rising = |x: f64| self.tail(1.0 - x).unwrap_or(f64::NAN);
         let found = super::invert::solve_increasing(
@@ -72,7 +76,7 @@ impl FormulaLobe {
             |x| self.eval(1.0 - x),
             u * total,
             (0.0, 1.0),
-            near.map_or(0.5, |t| 1.0 - t),
+            (near.map_or(0.5, |t| 1.0 - t), resolution),
         );
         Some(Inverted {
             x: 1.0 - found.x,

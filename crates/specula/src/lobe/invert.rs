@@ -6,6 +6,15 @@
 /// 80 reach `f64` resolution on any interval of length at most 2.
 const MAX_ITERATIONS: u32 = 80;
 
+/// How close a root is solved for, relative to it: [`F64_RESOLUTION`] for the `f64` paths,
+/// [`F32_RESOLUTION`] for a root an `f32` renderer rounds.
+pub const F64_RESOLUTION: f64 = 4.0 * f64::EPSILON;
+
+/// A quarter of `f32`'s rounding (`2^-26`): a root found to within this rounds to the
+/// same `f32` as the exact root but where the exact one lies within it of a rounding
+/// boundary.
+pub const F32_RESOLUTION: f64 = 1.0 / 67_108_864.0;
+
 /// A root found, and the iterations it took.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Inverted {
@@ -16,13 +25,13 @@ pub struct Inverted {
 }
 
 /// `x` in `[lo, hi]` with `f(x) = target`, for `f` non-decreasing with derivative `df`,
-/// starting from `guess`.
+/// starting from `guess`, stopping once a step moves `x` by at most `resolution` of it.
 pub fn solve_increasing(
     f: impl Fn(f64) -> f64,
     df: impl Fn(f64) -> f64,
     target: f64,
     (mut lo, mut hi): (f64, f64),
-    guess: f64,
+    (guess, resolution): (f64, f64),
 ) -> Inverted {
     let mut x = guess.clamp(lo, hi);
     for iteration in 1..=MAX_ITERATIONS {
@@ -45,7 +54,7 @@ pub fn solve_increasing(
         } else {
             0.5 * (lo + hi)
         };
-        if (next - x).abs() <= 4.0 * f64::EPSILON * x.abs().max(f64::MIN_POSITIVE) || hi <= lo {
+        if (next - x).abs() <= resolution * x.abs().max(f64::MIN_POSITIVE) || hi <= lo {
             return Inverted {
                 x: next,
                 iterations: iteration,
@@ -67,10 +76,22 @@ mod tests {
     #[test]
     fn finds_roots_from_any_start() {
         let cube = |x: f64| x * x * x;
-        let root = solve_increasing(cube, |x| 3.0 * x * x, 2.0, (0.0, 2.0), 0.0);
+        let root = solve_increasing(
+            cube,
+            |x| 3.0 * x * x,
+            2.0,
+            (0.0, 2.0),
+            (0.0, F64_RESOLUTION),
+        );
         assert!((root.x - 2f64.cbrt()).abs() < 1e-15, "{root:?}");
         assert!(root.iterations < 40, "{root:?}");
-        let far = solve_increasing(cube, |x| 3.0 * x * x, 2.0, (0.0, 2.0), 2.0);
+        let far = solve_increasing(
+            cube,
+            |x| 3.0 * x * x,
+            2.0,
+            (0.0, 2.0),
+            (2.0, F64_RESOLUTION),
+        );
         assert!((far.x - 2f64.cbrt()).abs() < 1e-15, "{far:?}");
     }
 }

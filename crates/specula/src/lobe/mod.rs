@@ -32,7 +32,7 @@ mod sg_karis;
 
 pub use cheb2_thesis::thesis_coefficients;
 pub use cosquad::CosQuad;
-pub use invert::Inverted;
+pub use invert::{Inverted, F32_RESOLUTION, F64_RESOLUTION};
 pub use kind::{FormulaId, LineStyle, LobeInfo, LobeKind, Origin, ParamInfo};
 pub use quadratic::AngleQuadratic;
 pub use sg_karis::KARIS_OFFSET;
@@ -257,27 +257,28 @@ impl Lobe {
     /// took (0 for a closed form); `None` for a lobe sampled from a table.
     #[must_use]
     pub fn tail_inverse(&self, u: f64) -> Option<Inverted> {
-        self.tail_inverse_from(u, None)
+        self.tail_inverse_from(u, (None, F64_RESOLUTION))
     }
 
-    /// [`Lobe::tail_inverse`], Newton starting from the cosine `near` (a table's draw for the
-    /// same `u`, say) rather than the model's own first guess: the same root to `f64`
-    /// resolution in fewer iterations. Closed forms ignore `near`.
+    /// [`Lobe::tail_inverse`] for a renderer that rounds the cosine to `f32`: Newton starts
+    /// from the cosine `near` (a table's draw for the same `u`, say) rather than the model's
+    /// own first guess, and stops once its step is below [`F32_RESOLUTION`] of the root, so
+    /// that it takes about half the iterations. Closed forms ignore `near`.
     #[must_use]
-    pub fn tail_inverse_near(&self, u: f64, near: f64) -> Option<Inverted> {
-        self.tail_inverse_from(u, Some(near))
+    pub fn tail_inverse_f32(&self, u: f64, near: f64) -> Option<Inverted> {
+        self.tail_inverse_from(u, (Some(near), F32_RESOLUTION))
     }
 
-    fn tail_inverse_from(&self, u: f64, near: Option<f64>) -> Option<Inverted> {
+    fn tail_inverse_from(&self, u: f64, start: (Option<f64>, f64)) -> Option<Inverted> {
         let u = u.clamp(0.0, 1.0);
         let exact = |x| Some(Inverted { x, iterations: 0 });
         match &self.model {
             Model::Pow(m) => exact(m.tail_inverse(u)),
             Model::Sg(m) => exact(m.tail_inverse(u)),
             Model::CosQuad(m) => exact(m.tail_inverse(u)),
-            Model::Schlick(m) => Some(m.tail_inverse(u, near)),
-            Model::AngleQuadratic(m) if m.has_closed_form_tail() => Some(m.tail_inverse(u, near)),
-            Model::Formula(m) => m.tail_inverse(u, near),
+            Model::Schlick(m) => Some(m.tail_inverse(u, start)),
+            Model::AngleQuadratic(m) if m.has_closed_form_tail() => Some(m.tail_inverse(u, start)),
+            Model::Formula(m) => m.tail_inverse(u, start),
             _ => None,
         }
     }

@@ -142,8 +142,8 @@ impl AngleQuadratic {
     }
 
     /// The cosine whose tail is the fraction `u` of the whole, by Newton in the angle, from
-    /// the cosine `near` when given.
-    pub(crate) fn tail_inverse(&self, u: f64, near: Option<f64>) -> Inverted {
+    /// the cosine `near` when given, to `resolution`.
+    pub(crate) fn tail_inverse(&self, u: f64, (near, resolution): (Option<f64>, f64)) -> Inverted {
         let c = self.coeffs[0];
         let target = u * self.total.unwrap_or(0.0);
         let root = solve_increasing(
@@ -151,9 +151,12 @@ impl AngleQuadratic {
             |g: f64| self.tail_slope(g),
             target,
             (0.0, self.cutoff),
-            near.map_or_else(
-                || (2.0 * target / c.max(f64::MIN_POSITIVE)).sqrt(),
-                |t| t.clamp(-1.0, 1.0).acos(),
+            (
+                near.map_or_else(
+                    || (2.0 * target / c.max(f64::MIN_POSITIVE)).sqrt(),
+                    |t| t.clamp(-1.0, 1.0).acos(),
+                ),
+                resolution,
             ),
         );
         Inverted {

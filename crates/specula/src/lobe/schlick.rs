@@ -75,8 +75,8 @@ impl Schlick {
     }
 
     /// The cosine whose tail is the fraction `u` of the whole, by Newton on the tail, from
-    /// the cosine `near` when given.
-    pub(crate) fn tail_inverse(&self, u: f64, near: Option<f64>) -> Inverted {
+    /// the cosine `near` when given, to `resolution`.
+    pub(crate) fn tail_inverse(&self, u: f64, (near, resolution): (Option<f64>, f64)) -> Inverted {
         let c = self.n - 1.0;
         let target = u * self.total;
         let guess = match near {
@@ -89,7 +89,7 @@ impl Schlick {
             |d: f64| self.eval(1.0 - d),
             target,
             (0.0, 1.0),
-            guess,
+            (guess, resolution),
         );
         Inverted {
             x: 1.0 - root.x,
