@@ -42,7 +42,8 @@ struct Highlight {
     scale: vec4<f32>,
 }
 
-// The most highlights one march draws (the host splits longer lists).
+// The most highlights one march draws (the host splits longer lists). The module that
+// includes this file defines add_highlights for its images' lobes (wgsl::volume_module).
 const MAX_HIGHLIGHTS: u32 = 16u;
 
 // A piece of the transfer function: (sigma, r, g, b) = at_start + slope * (value - start).
@@ -253,11 +254,7 @@ fn march(@builtin(global_invocation_id) id: vec3<u32>) {
         if shaded_samples {
             let shaded = shade(field.yzw, medium.xyz, wo);
             colour += transmittance * alpha * shaded.colour;
-            let weight = transmittance * alpha * shaded.weight;
-            for (var i = 0u; i < images; i++) {
-                let highlight = highlights[i];
-                highlighted[i] += weight * (highlight.scale.x * lobe_eval(highlight.lobe, shaded.t));
-            }
+            add_highlights(&highlighted, transmittance * alpha * shaded.weight, shaded.t);
         } else {
             colour += transmittance * alpha * medium.xyz;
         }

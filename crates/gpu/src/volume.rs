@@ -3,7 +3,10 @@
 //! gradient per voxel ([`PreparedVolume`], the CPU marcher's field) uploaded as an
 //! `rgba32float` 3D texture.
 
+use std::sync::{Arc, Mutex, PoisonError};
+
 use bytemuck::{Pod, Zeroable};
+use specula::{Lobe, LobeKind};
 use specula_render::volume::march::{Classification, PreparedVolume};
 use specula_render::volume::raymarch::{DvrPlan, DvrSettings, Lighting};
 use specula_render::volume::transfer::TransferFunction;
@@ -45,11 +48,12 @@ struct HighlightBlock {
 /// `MAX_HIGHLIGHTS` of volume.wgsl: the most images one march draws.
 const MAX_HIGHLIGHTS: usize = 16;
 
-/// The compiled ray marcher.
+/// The compiled ray marcher: one pipeline per list of highlights' lobe kinds, compiled when
+/// first asked for ([`wgsl::volume_module`]).
 #[derive(Debug)]
 pub struct GpuVolumeRenderer<'gpu> {
     gpu: &'gpu Gpu,
-    pipeline: wgpu::ComputePipeline,
+    pipelines: Mutex<Vec<(Vec<LobeKind>, Arc<wgpu::ComputePipeline>)>>,
 }
 
 fn with_w(v: glam::Vec3, w: f32) -> [f32; 4] {
@@ -57,27 +61,42 @@ fn with_w(v: glam::Vec3, w: f32) -> [f32; 4] {
 }
 
 impl<'gpu> GpuVolumeRenderer<'gpu> {
-    /// Compiles the shader for `gpu`.
+    /// The ray marcher for `gpu`; each list of lobes' pipeline is compiled when first used.
     pub fn new(gpu: &'gpu Gpu) -> Result<Self, GpuError> {
-        let source = wgsl::volume_module();
-        let pipeline = gpu.checked(|| {
-            let module = gpu
-                .device
-                .create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some("specula volume"),
-                    source: wgpu::ShaderSource::Wgsl(source.into()),
-                });
-            gpu.device
-                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some("specula volume"),
-                    layout: None,
-                    module: &module,
-                    entry_point: Some("march"),
-                    compilation_options: wgpu::PipelineCompilationOptions::default(),
-                    cache: None,
-                })
-        })?;
-        Ok(Self { gpu, pipeline })
+        Ok(Self {
+            gpu,
+            pipelines: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// The pipeline whose images' highlights are `kinds`' lobes, in order.
+    fn pipeline(&self, kinds: &[LobeKind]) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
+        let compiled = || {
+            self.pipelines
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+        };
+        if let Some((_, pipeline)) = compiled().iter().find(|(known, _)| known == kinds) {
+            return Ok(Arc::clone(pipeline));
+        }
+        let source = wgsl::volume_module(kinds);
+        let device = &self.gpu.device;
+        let pipeline = Arc::new(self.gpu.checked(|| {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("specula volume"),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("specula volume"),
+                layout: None,
+                module: &module,
+                entry_point: Some("march"),
+                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                cache: None,
+            })
+        })?);
+        compiled().push((kinds.to_vec(), Arc::clone(&pipeline)));
+        Ok(pipeline)
     }
 
     /// Renders as [`specula_render::volume::raymarch::render_dvr`] does.
@@ -88,12 +107,12 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
         settings: &DvrSettings,
     ) -> Result<Image, GpuError> {
         let plan = DvrPlan::new(volume, settings).map_err(|e| GpuError::Unsupported(e.0))?;
-        let highlights: Vec<HighlightBlock> = plan
+        let lobes: Vec<Lobe> = plan
             .lighting
             .iter()
-            .map(|lighting| highlight(lighting, &lighting.shading.lobe))
+            .map(|lighting| lighting.shading.lobe)
             .collect();
-        self.march(volume, transfer, settings, &plan, &highlights)?
+        self.march(volume, transfer, settings, &plan, &lobes)?
             .pop()
             .ok_or_else(|| GpuError::Unsupported("the march drew no image".into()))
     }
@@ -111,35 +130,44 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
         volume: &Volume,
         transfer: &TransferFunction,
         settings: &DvrSettings,
-        lobes: &[specula::Lobe],
+        lobes: &[Lobe],
     ) -> Result<Vec<Image>, GpuError> {
         let plan = DvrPlan::new(volume, settings).map_err(|e| GpuError::Unsupported(e.0))?;
-        let Some(lighting) = &plan.lighting else {
+        if plan.lighting.is_none() {
             return Err(GpuError::Unsupported(
                 "an unshaded render has no lobe to vary: give it a shading".into(),
             ));
-        };
-        let highlights: Vec<HighlightBlock> =
-            lobes.iter().map(|lobe| highlight(lighting, lobe)).collect();
+        }
         let image_bytes = u64::from(settings.width) * u64::from(settings.height) * 16;
         let fit = self.gpu.device.limits().max_storage_buffer_binding_size / image_bytes.max(1);
         let per_march = (fit as usize).clamp(1, MAX_HIGHLIGHTS);
         let mut images = Vec::with_capacity(lobes.len());
-        for some in highlights.chunks(per_march) {
+        for some in lobes.chunks(per_march) {
             images.extend(self.march(volume, transfer, settings, &plan, some)?);
         }
         Ok(images)
     }
 
-    /// One march drawing an image per highlight (one image when there is none: unshaded).
+    /// One march drawing an image per lobe's highlight (one image when there is none:
+    /// unshaded).
     fn march(
         &self,
         volume: &Volume,
         transfer: &TransferFunction,
         settings: &DvrSettings,
         plan: &DvrPlan,
-        highlights: &[HighlightBlock],
+        lobes: &[Lobe],
     ) -> Result<Vec<Image>, GpuError> {
+        let highlights: Vec<HighlightBlock> = match &plan.lighting {
+            Some(lighting) => lobes.iter().map(|lobe| highlight(lighting, lobe)).collect(),
+            None => Vec::new(),
+        };
+        let kinds: Vec<LobeKind> = lobes
+            .iter()
+            .take(highlights.len())
+            .map(Lobe::kind)
+            .collect();
+        let pipeline = self.pipeline(&kinds)?;
         let device = &self.gpu.device;
         let limits = device.limits();
         let dims = volume.dims();
@@ -213,7 +241,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                 bytemuck::cast_slice(if highlights.is_empty() {
                     &none
                 } else {
-                    highlights
+                    &highlights
                 }),
             );
             let extent = wgpu::Extent3d {
@@ -256,7 +284,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
             });
             let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("volume"),
-                layout: &self.pipeline.get_bind_group_layout(0),
+                layout: &pipeline.get_bind_group_layout(0),
                 entries: &[
                     wgpu::BindGroupEntry {
                         binding: 0,
@@ -296,7 +324,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                 device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
             {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(&pipeline);
                 pass.set_bind_group(0, &bind_group, &[]);
                 pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
             }
@@ -325,7 +353,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
 }
 
 /// The block of `lobe`'s highlight under `lighting`.
-fn highlight(lighting: &Lighting, lobe: &specula::Lobe) -> HighlightBlock {
+fn highlight(lighting: &Lighting, lobe: &Lobe) -> HighlightBlock {
     HighlightBlock {
         lobe: LobeBlock::new(lobe),
         scale: [lighting.highlight_scale(lobe), 0.0, 0.0, 0.0],

@@ -66,10 +66,35 @@ pub fn render_module() -> String {
     [lobes().as_str(), GEOMETRY, BRDF, RENDER].concat()
 }
 
-/// The volume ray marcher's source.
+/// The ray marcher's source for images whose highlights are `kinds`' lobes, in order:
+/// `add_highlights` calls each lobe's function directly (a driver that runs every case of a
+/// `switch` whose value it cannot prove uniform, as Mesa's lavapipe does, then evaluates one
+/// lobe per highlight, not every lobe).
 #[must_use]
-pub fn volume_module() -> String {
-    [lobes().as_str(), GEOMETRY, VOLUME].concat()
+pub fn volume_module(kinds: &[LobeKind]) -> String {
+    let mut sums = String::new();
+    for (i, &kind) in kinds.iter().enumerate() {
+        let call = if LobeKind::ALL.contains(&kind) {
+            format!("{}(highlights[{i}u].lobe, c)", lobe_function(kind))
+        } else {
+            format!("lobe_formula(highlights[{i}u].lobe, c)")
+        };
+        sums.push_str(&format!(
+            "    (*sums)[{i}u] += weight * (highlights[{i}u].scale.x * {call});\n"
+        ));
+    }
+    let add_highlights = format!(
+        "
+// Each image's highlight at the lobe's cosine `t` (lobe_eval's rules), weighted.
+fn add_highlights(sums: ptr<function, array<f32, MAX_HIGHLIGHTS>>, weight: f32, t: f32) {{
+    if !(t > 0.0) {{
+        return;
+    }}
+    let c = min(t, 1.0);
+{sums}}}
+"
+    );
+    [lobes().as_str(), GEOMETRY, VOLUME, &add_highlights].concat()
 }
 
 /// The compute module's source.

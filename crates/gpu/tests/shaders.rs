@@ -40,6 +40,21 @@ fn every_rust_lobe_has_its_wgsl_function_and_switch_case() {
     );
 }
 
+/// The ray marcher's module validates for any list of lobes: none (unshaded), every
+/// built-in lobe, the most one march holds, and a user's lobe.
+#[test]
+fn the_ray_marcher_validates_for_any_lobes() {
+    let formula = LobeKind::parse("=t^n").unwrap();
+    for kinds in [
+        Vec::new(),
+        LobeKind::ALL.to_vec(),
+        LobeKind::ALL.iter().copied().cycle().take(16).collect(),
+        vec![LobeKind::Pow, formula],
+    ] {
+        wgsl::validate(&wgsl::volume_module(&kinds)).unwrap_or_else(|e| panic!("{kinds:?}: {e}"));
+    }
+}
+
 fn tool(name: &str) -> Option<&str> {
     let found = Command::new(name).arg("--version").output().is_ok();
     if !found && std::env::var("CI").as_deref() == Ok("true") {
