@@ -137,6 +137,23 @@ pub struct FrameBlock {
     pub shading: u32,
 }
 
+/// The size WGSL's layout rules give each named struct of `source` (naga's own layout), for
+/// tests that the `Pod` mirrors match.
+#[cfg(test)]
+pub(crate) fn wgsl_size_of(source: &str) -> impl Fn(&str) -> usize {
+    let (module, _) = crate::wgsl::validate(source).unwrap();
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    move |name: &str| {
+        let (handle, _) = module
+            .types
+            .iter()
+            .find(|(_, ty)| ty.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("{name} not in the WGSL"));
+        layouter[handle].size as usize
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -144,18 +161,7 @@ mod tests {
     /// The sizes WGSL's layout rules give the structs (checked against naga's own layout).
     #[test]
     fn blocks_match_the_wgsl_layout() {
-        let source = crate::wgsl::render_module();
-        let (module, _) = crate::wgsl::validate(&source).unwrap();
-        let mut layouter = naga::proc::Layouter::default();
-        layouter.update(module.to_ctx()).unwrap();
-        let size_of = |name: &str| {
-            let (handle, _) = module
-                .types
-                .iter()
-                .find(|(_, ty)| ty.name.as_deref() == Some(name))
-                .unwrap_or_else(|| panic!("{name} not in the WGSL"));
-            layouter[handle].size as usize
-        };
+        let size_of = wgsl_size_of(&crate::wgsl::render_module());
         assert_eq!(size_of("Lobe"), size_of_val(&LobeBlock::default()));
         assert_eq!(size_of("Material"), size_of_val(&MaterialBlock::default()));
         assert_eq!(size_of("Light"), size_of_val(&LightBlock::default()));

@@ -410,3 +410,16 @@ fn params(
         classify: [0.0; 4],
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `Params` and `Highlight` have the sizes WGSL's layout rules give them.
+    #[test]
+    fn blocks_match_the_wgsl_layout() {
+        let wgsl_size = crate::uniforms::wgsl_size_of(&wgsl::volume_module(&[LobeKind::Pow]));
+        assert_eq!(wgsl_size("Params"), size_of::<Params>());
+        assert_eq!(wgsl_size("Highlight"), size_of::<HighlightBlock>());
+    }
+}
