@@ -298,8 +298,9 @@ fn real_scans(document: &roxmltree::Document, text: &str, out: &std::path::Path)
         }
         shown.push((name, prefix));
     }
-    // The phantom's and each scan's times: pow's frame alone, then every lobe's from one march (read from the
-    // text nodes alone: `text` also holds each element's first text, so each sentence twice).
+    // The phantom's and each scan's times: pow's frame alone, then every lobe's from one
+    // march (read from the text nodes alone: `text` also holds each element's first text, so
+    // each sentence twice).
     let prose: String = document
         .descendants()
         .filter(|n| n.is_text())

@@ -42,9 +42,9 @@ struct Highlight {
     scale: vec4<f32>,
 }
 
-// The most highlights one march draws (the host splits longer lists). The module that
-// includes this file defines add_highlights for its images' lobes (wgsl::volume_module).
-const MAX_HIGHLIGHTS: u32 = 16u;
+// The module that includes this file defines MAX_HIGHLIGHTS, the most highlights one march
+// draws (the host splits longer lists), and add_highlights for its images' lobes
+// (wgsl::volume_module).
 
 // A piece of the transfer function: (sigma, r, g, b) = at_start + slope * (value - start).
 struct Piece {

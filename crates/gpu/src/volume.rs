@@ -45,9 +45,6 @@ struct HighlightBlock {
     scale: [f32; 4],
 }
 
-/// `MAX_HIGHLIGHTS` of volume.wgsl: the most images one march draws.
-const MAX_HIGHLIGHTS: usize = 16;
-
 /// The compiled ray marcher: one pipeline per list of highlights' lobe kinds, compiled when
 /// first asked for ([`wgsl::volume_module`]).
 #[derive(Debug)]
@@ -61,12 +58,29 @@ fn with_w(v: glam::Vec3, w: f32) -> [f32; 4] {
 }
 
 impl<'gpu> GpuVolumeRenderer<'gpu> {
-    /// The ray marcher for `gpu`; each list of lobes' pipeline is compiled when first used.
-    pub fn new(gpu: &'gpu Gpu) -> Result<Self, GpuError> {
-        Ok(Self {
+    /// The ray marcher for `gpu`; each list of lobes' pipeline is compiled when first used
+    /// (or by [`GpuVolumeRenderer::prepare`]).
+    #[must_use]
+    pub fn new(gpu: &'gpu Gpu) -> Self {
+        Self {
             gpu,
             pipelines: Mutex::new(Vec::new()),
-        })
+        }
+    }
+
+    /// Compiles beforehand the pipelines that [`GpuVolumeRenderer::render_lobes`] of `lobes`
+    /// uses (its marches of up to [`wgsl::MAX_HIGHLIGHTS`] lobes), so that a timed frame
+    /// does not include compiling them; [`GpuVolumeRenderer::render`]'s for a lobe is that of
+    /// a list of one.
+    ///
+    /// # Errors
+    /// When the driver refuses the shader.
+    pub fn prepare(&self, lobes: &[Lobe]) -> Result<(), GpuError> {
+        let kinds: Vec<LobeKind> = lobes.iter().map(Lobe::kind).collect();
+        for some in kinds.chunks(wgsl::MAX_HIGHLIGHTS) {
+            self.pipeline(some)?;
+        }
+        Ok(())
     }
 
     /// The pipeline whose images' highlights are `kinds`' lobes, in order.
@@ -95,7 +109,12 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
                 cache: None,
             })
         })?);
-        compiled().push((kinds.to_vec(), Arc::clone(&pipeline)));
+        // Another thread may have compiled the same list meanwhile: the first one is kept.
+        let mut compiled = compiled();
+        if let Some((_, known)) = compiled.iter().find(|(known, _)| known == kinds) {
+            return Ok(Arc::clone(known));
+        }
+        compiled.push((kinds.to_vec(), Arc::clone(&pipeline)));
         Ok(pipeline)
     }
 
@@ -140,7 +159,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
         }
         let image_bytes = u64::from(settings.width) * u64::from(settings.height) * 16;
         let fit = self.gpu.device.limits().max_storage_buffer_binding_size / image_bytes.max(1);
-        let per_march = (fit as usize).clamp(1, MAX_HIGHLIGHTS);
+        let per_march = (fit as usize).clamp(1, wgsl::MAX_HIGHLIGHTS);
         let mut images = Vec::with_capacity(lobes.len());
         for some in lobes.chunks(per_march) {
             images.extend(self.march(volume, transfer, settings, &plan, some)?);

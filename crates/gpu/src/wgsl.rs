@@ -66,12 +66,23 @@ pub fn render_module() -> String {
     [lobes().as_str(), GEOMETRY, BRDF, RENDER].concat()
 }
 
+/// The most images (one per lobe's highlight) one march of the ray marcher draws.
+pub const MAX_HIGHLIGHTS: usize = 16;
+
 /// The ray marcher's source for images whose highlights are `kinds`' lobes, in order:
 /// `add_highlights` calls each lobe's function directly (a driver that runs every case of a
 /// `switch` whose value it cannot prove uniform, as Mesa's lavapipe does, then evaluates one
 /// lobe per highlight, not every lobe).
+///
+/// # Panics
+/// If there are more than [`MAX_HIGHLIGHTS`] kinds.
 #[must_use]
 pub fn volume_module(kinds: &[LobeKind]) -> String {
+    assert!(
+        kinds.len() <= MAX_HIGHLIGHTS,
+        "{} highlights in one march, above {MAX_HIGHLIGHTS}",
+        kinds.len()
+    );
     let mut sums = String::new();
     for (i, &kind) in kinds.iter().enumerate() {
         let call = if LobeKind::ALL.contains(&kind) {
@@ -85,6 +96,8 @@ pub fn volume_module(kinds: &[LobeKind]) -> String {
     }
     let add_highlights = format!(
         "
+const MAX_HIGHLIGHTS: u32 = {MAX_HIGHLIGHTS}u;
+
 // Each image's highlight at the lobe's cosine `t` (lobe_eval's rules), weighted.
 fn add_highlights(sums: ptr<function, array<f32, MAX_HIGHLIGHTS>>, weight: f32, t: f32) {{
     if !(t > 0.0) {{

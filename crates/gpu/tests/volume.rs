@@ -29,7 +29,7 @@ fn shading(kind: LobeKind) -> Shading {
 #[test]
 fn gpu_ray_marching_matches_the_cpu_for_every_lobe() {
     let Some(gpu) = common::gpu() else { return };
-    let renderer = GpuVolumeRenderer::new(&gpu).unwrap();
+    let renderer = GpuVolumeRenderer::new(&gpu);
     let volume = phantom::shepp_logan(48).unwrap();
     let transfer = TransferFunction::default_for(&volume).for_volume(&volume);
     let mut parity = Parity::new(MAX_MEAN_FLIP, MIN_PSNR_DB);
@@ -69,7 +69,7 @@ fn gpu_ray_marching_matches_the_cpu_for_every_lobe() {
 #[test]
 fn gpu_lobes_marched_together_are_each_marched_alone() {
     let Some(gpu) = common::gpu() else { return };
-    let renderer = GpuVolumeRenderer::new(&gpu).unwrap();
+    let renderer = GpuVolumeRenderer::new(&gpu);
     let volume = phantom::shepp_logan(40).unwrap();
     let transfer = TransferFunction::default_for(&volume).for_volume(&volume);
     let kinds: Vec<LobeKind> = LobeKind::ALL.into_iter().cycle().take(20).collect();

@@ -3,14 +3,12 @@
 //! FLIP written on it.
 
 use font8x8::UnicodeFonts;
+use rayon::prelude::*;
 use specula::LobeKind;
 use thiserror::Error;
 
-use crate::pipeline::MAX_PIXELS;
-
-use rayon::prelude::*;
-
 use crate::metrics::{compare_srgb8, Difference};
+use crate::pipeline::MAX_PIXELS;
 use crate::{render, Overrides, RenderError, Scene};
 
 /// What a grid shows.
@@ -210,37 +208,35 @@ pub fn render_grid_columns(
     let reference = with_lobe(options.reference, 0)?;
     let (width, height) = (reference.width(), reference.height());
     let reference_srgb8 = reference.to_srgb8(scene.display);
-    let mut renders = Vec::with_capacity(options.lobes.len());
-    for (column, &kind) in options.lobes.iter().enumerate() {
-        renders.push(if kind == options.reference {
-            None
+    drop(reference);
+    // Each render kept as displayed (a quarter of its floats' memory), then compared.
+    let mut displayed = Vec::with_capacity(options.lobes.len());
+    for (column, &lobe) in options.lobes.iter().enumerate() {
+        let srgb8 = if lobe == options.reference {
+            reference_srgb8.clone()
         } else {
-            Some(with_lobe(kind, column + 1)?)
-        });
-    }
-    // FLIP (the reference implementation, one thread) dominates; the columns in parallel.
-    let columns: Vec<GridColumn> = options
-        .lobes
-        .par_iter()
-        .zip(&renders)
-        .map(|(&lobe, image)| {
-            let srgb8 = image.as_ref().map_or_else(
-                || reference_srgb8.clone(),
-                |image| image.to_srgb8(scene.display),
-            );
-            if srgb8.len() != reference_srgb8.len() {
+            let image = with_lobe(lobe, column + 1)?;
+            if (image.width(), image.height()) != (width, height) {
                 return Err(GridError::Render(format!(
-                    "the {lobe} render is not {width}x{height}"
+                    "the {lobe} render is {}x{}, the {} render {width}x{height}",
+                    image.width(),
+                    image.height(),
+                    options.reference
                 )));
             }
-            let difference = compare_srgb8(width, height, &reference_srgb8, &srgb8);
-            Ok(GridColumn {
-                lobe,
-                srgb8,
-                difference,
-            })
+            image.to_srgb8(scene.display)
+        };
+        displayed.push((lobe, srgb8));
+    }
+    // FLIP (the reference implementation, one thread) dominates; the columns in parallel.
+    let columns: Vec<GridColumn> = displayed
+        .into_par_iter()
+        .map(|(lobe, srgb8)| GridColumn {
+            lobe,
+            difference: compare_srgb8(width, height, &reference_srgb8, &srgb8),
+            srgb8,
         })
-        .collect::<Result<_, _>>()?;
+        .collect();
     let mut grid = Srgb8Image {
         width: width * options.lobes.len() as u32,
         height: 2 * height,

@@ -266,7 +266,7 @@ pub fn run(args: &Args) -> CommandResult {
             }
             let image = match &gpu {
                 Some(gpu) => GpuVolumeRenderer::new(gpu)
-                    .and_then(|renderer| renderer.render(&volume, &transfer, &settings))
+                    .render(&volume, &transfer, &settings)
                     .map_err(|e| e.to_string())?,
                 None => {
                     bar.set_message("ray marching");

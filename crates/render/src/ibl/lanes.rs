@@ -11,8 +11,8 @@
 //!   packet's sum.
 //!
 //! Lanes past the packet's draws hold no draw (`light_pdf = 0`, source [`Source::None`]), so
-//! every job runs over all [`LANES`] lanes and masks with selects, never with a multiply by 0
-//! (a masked lane may hold an infinity or a NaN).
+//! every job runs over all [`LANES`] lanes (a multiple of every level's width) and masks with
+//! selects, never with a multiply by 0 (a masked lane may hold an infinity or a NaN).
 
 use core::f32::consts::{FRAC_1_PI, PI, TAU};
 
@@ -26,6 +26,9 @@ use super::Strategy;
 
 /// `LANES` values of one quantity.
 pub(super) type Column = [f32; LANES];
+
+// Every level's vectors tile a packet (1 or 8 lanes).
+const _: () = assert!(LANES.is_multiple_of(8));
 
 /// `LANES` vectors, by component.
 #[derive(Clone, Copy)]
@@ -46,6 +49,7 @@ impl Columns3 {
         (self.x[k], self.y[k], self.z[k]) = (v.x, v.y, v.z);
     }
 
+    #[must_use]
     pub(super) fn get(&self, k: usize) -> Vec3 {
         Vec3::new(self.x[k], self.y[k], self.z[k])
     }
@@ -63,6 +67,7 @@ pub(super) enum Source {
 }
 
 impl Source {
+    #[must_use]
     pub(super) fn of(lane: f32) -> Self {
         if lane == 1.0 {
             Source::Lobe
@@ -386,7 +391,8 @@ impl Job for Directions<'_> {
             let wi = lobe_wi.select(from_lobe, diffuse_wi);
             let t = lobe_t.select(from_lobe, diffuse_t);
             let half = lobe_half.select(from_lobe, diffuse_half);
-            let above = wi.z.min(half).gt(zero);
+            // Above the surface with a defined half vector (false for NaN in either).
+            let above = half.keep(wi.z.gt(zero)).gt(zero);
             let source = lanes
                 .splat(Source::Lobe as u8 as f32)
                 .select(from_lobe, lanes.splat(Source::Diffuse as u8 as f32))
@@ -475,19 +481,22 @@ impl Combine<'_> {
 
     /// The weight of a draw of density `pdf` against the other strategy's `other`: Veach's
     /// power heuristic under MIS ([`specula::sampling::power_heuristic`]'s rules for zero and
-    /// infinite densities), 1 otherwise.
+    /// infinite densities), 1 otherwise. Squared in `f32` (one division; the ratio form
+    /// takes two, 4 % of the environment grid's time): a density whose square overflows
+    /// (above `1.8e19`) weighs as an infinite one, one whose square vanishes (below `1e-22`)
+    /// as 0.
     #[inline(always)]
     fn weight<V: Lanes>(&self, pdf: V, other: V) -> V {
         let one = pdf.splat(1.0);
         if self.brdf.strategy != Strategy::Mis {
             return one;
         }
+        let (zero, infinity) = (pdf.splat(0.0), pdf.splat(f32::INFINITY));
         let (a, b) = (pdf * pdf, other * other);
-        let infinity = pdf.splat(f32::INFINITY);
         (a / (a + b))
             .select(a.lt(infinity), one)
             .keep(b.lt(infinity))
-            .keep(a.gt(pdf.splat(0.0)))
+            .keep(a.gt(zero))
     }
 }
 

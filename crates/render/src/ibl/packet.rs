@@ -34,9 +34,8 @@ use glam::Vec3;
 use specula::brdf::luminance;
 use specula::lobe::Warp;
 use specula::sampling::{random_bits, unit_f32, CosineTable32};
-use specula::{Geometry, Lobe};
-
 use specula::simd::{dispatch, Level};
+use specula::{Geometry, Lobe};
 
 use super::angles::sin_cos_turns;
 use super::lanes::{
@@ -62,11 +61,18 @@ pub(super) struct PacketSurface {
     density_per_value: f32,
     lobe: Lobe,
     geometry: Geometry,
-    warp: Warp,
-    /// A tabulated lobe's table, drawn and read in `f32`.
-    table: Option<CosineTable32>,
-    /// A Newton-sampled lobe's table, whose draw starts Newton near its root.
-    newton_start: Option<CosineTable32>,
+    sampler: CosineSampler,
+}
+
+/// How a surface's lobe draws its cosine in the packet estimator.
+enum CosineSampler {
+    /// By the lobe's closed-form inverse, in `f32`.
+    ClosedForm,
+    /// By Newton on the lobe's own integral (a user's formula declares it for exact
+    /// sampling), in `f64` to `f32` resolution, from the table's draw.
+    Newton(CosineTable32),
+    /// From the table, whose density is then the sampler's.
+    Table(CosineTable32),
 }
 
 impl PacketSurface {
@@ -78,7 +84,7 @@ impl PacketSurface {
             luminance(specular.as_dvec3()),
         );
         let scale = material.normalisation.constant_for(&material.lobe) as f32;
-        let warp = material.lobe.warp();
+        let table = || CosineTable32::of(&material.lobe);
         let total = material.lobe.tail(0.0).unwrap_or(0.0);
         Self {
             diffuse: diffuse * FRAC_1_PI,
@@ -95,29 +101,31 @@ impl PacketSurface {
             },
             lobe: material.lobe,
             geometry: material.geometry,
-            warp,
-            table: (warp == Warp::Table).then(|| CosineTable32::of(&material.lobe)),
-            newton_start: (warp == Warp::Newton).then(|| CosineTable32::of(&material.lobe)),
+            sampler: match material.lobe.warp() {
+                Warp::Analytic => CosineSampler::ClosedForm,
+                Warp::Newton => CosineSampler::Newton(table()),
+                Warp::Table => CosineSampler::Table(table()),
+            },
+        }
+    }
+
+    /// A tabulated lobe's table, whose density is its sampler's.
+    fn density_table(&self) -> Option<&CosineTable32> {
+        match &self.sampler {
+            CosineSampler::Table(table) => Some(table),
+            _ => None,
         }
     }
 
     /// A cosine drawn from the lobe for the uniform `u`.
     fn draw_cosine(&self, u: f32) -> f32 {
-        match (self.warp, &self.table) {
-            (_, Some(table)) => table.sample(u),
-            (Warp::Analytic, None) => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
-            // Newton on the lobe's own integral (a user's formula declares it for exact
-            // sampling), in `f64`, from the table's draw: the same root in fewer steps.
-            _ => {
-                let u = f64::from(u);
-                match &self.newton_start {
-                    Some(start) => self
-                        .lobe
-                        .tail_inverse_f32(u, f64::from(start.sample(u as f32))),
-                    None => self.lobe.tail_inverse(u),
-                }
-                .map_or(1.0, |inverted| inverted.x as f32)
-            }
+        match &self.sampler {
+            CosineSampler::ClosedForm => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
+            CosineSampler::Newton(start) => self
+                .lobe
+                .tail_inverse_f32(f64::from(u), f64::from(start.sample(u)))
+                .map_or(1.0, |inverted| inverted.x as f32),
+            CosineSampler::Table(table) => table.sample(u),
         }
     }
 }
@@ -178,6 +186,7 @@ pub(super) struct Point<'a> {
 /// so every variant's environment draws, and the cosine-weighted BRDF draws of every
 /// variant that makes one, are computed once; each variant's sums are the ones it would
 /// have alone, bit for bit.
+///
 /// `level` is where the per-variant arithmetic runs ([`Level::detect`]'s, but for tests).
 pub(super) fn shade(
     point: &Point,
@@ -281,36 +290,48 @@ pub(super) fn shade(
                 shared.diffuse_light_pdf[k] = pdf;
             }
         }
+        let packet = Packet {
+            point,
+            environment,
+            strategy,
+            level,
+            shared: &shared,
+            u1: &scalars.u1,
+            count,
+        };
         for (surface, sum) in point.surfaces.iter().zip(sums.iter_mut()) {
-            *sum += shade_variant(
-                point,
-                environment,
-                surface,
-                strategy,
-                level,
-                (&shared, &scalars.u1),
-                &mut variant,
-                count,
-            )
-            .as_dvec3();
+            *sum += shade_variant(packet, surface, &mut variant).as_dvec3();
         }
     }
+}
+
+/// A packet's shared draws, as every variant reads them.
+#[derive(Clone, Copy)]
+struct Packet<'a> {
+    point: &'a Point<'a>,
+    environment: &'a Environment,
+    strategy: Strategy,
+    level: Level,
+    shared: &'a SharedColumns,
+    /// The uniform number each lane's lobe draw takes.
+    u1: &'a [f32; LANES],
+    /// The packet's draws (its first lanes).
+    count: usize,
 }
 
 /// One variant's estimates over a packet of `count` draws, summed: its lobe's cosine draws,
 /// then its directions and their texels on lanes, the texels' reads, the lobe's values (its
 /// SIMD kernel), a table's densities, and the combination on lanes.
-#[allow(clippy::too_many_arguments)]
-fn shade_variant(
-    point: &Point,
-    environment: &Environment,
-    surface: &PacketSurface,
-    strategy: Strategy,
-    level: Level,
-    (shared, u1): (&SharedColumns, &[f32; LANES]),
-    variant: &mut VariantColumns,
-    count: usize,
-) -> Vec3 {
+fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantColumns) -> Vec3 {
+    let Packet {
+        point,
+        environment,
+        strategy,
+        level,
+        shared,
+        u1,
+        count,
+    } = packet;
     let draws_lobe = strategy != Strategy::Environment;
     for (k, (drawn, (&choice, &u))) in variant
         .drawn
@@ -374,7 +395,7 @@ fn shade_variant(
         &variant.brdf_cosine[..count],
         &mut variant.brdf_value[..count],
     );
-    if let Some(table) = &surface.table {
+    if let Some(table) = surface.density_table() {
         table.density_batch(
             &variant.light_cosine[..count],
             &mut variant.light_density[..count],
@@ -393,7 +414,10 @@ fn shade_variant(
                 diffuse: surface.diffuse,
                 specular: surface.specular,
                 share: surface.share,
-                density_per_value: surface.table.is_none().then_some(surface.density_per_value),
+                density_per_value: surface
+                    .density_table()
+                    .is_none()
+                    .then_some(surface.density_per_value),
             },
             shared,
             variant,

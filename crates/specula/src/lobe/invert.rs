@@ -10,9 +10,10 @@ const MAX_ITERATIONS: u32 = 80;
 /// [`F32_RESOLUTION`] for a root an `f32` renderer rounds.
 pub const F64_RESOLUTION: f64 = 4.0 * f64::EPSILON;
 
-/// A quarter of `f32`'s rounding (`2^-26`): a root found to within this rounds to the
-/// same `f32` as the exact root but where the exact one lies within it of a rounding
-/// boundary.
+/// `2^-26`, a quarter of `f32`'s relative rounding: Newton stopped once its step is this
+/// small a part of the solver's variable (for the lobes, `1 - t` or the angle, not the
+/// cosine itself) is, by its quadratic convergence, far closer than that to the root, and
+/// the cosine rounds to the exact root's `f32` (tested for every Newton-sampled lobe).
 pub const F32_RESOLUTION: f64 = 1.0 / 67_108_864.0;
 
 /// A root found, and the iterations it took.

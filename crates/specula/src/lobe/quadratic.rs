@@ -99,30 +99,32 @@ impl AngleQuadratic {
         let [c, b, a]: [R; 3] = self.named_coeffs();
         let k = R::from_f64;
         let g = g.max(k(0.0)).min(self.cutoff_parameter());
-        let one_minus_cos = k(2.0) * (k(0.5) * g).sin().square();
-        // int_0^g x sin x = sum_j (-1)^j g^(2j+3) / ((2j+1)! (2j+3)), and the x^2 moment with
-        // (2j+4) in place of (2j+3), where the closed forms cancel (below g = 1/2).
-        let series = |moment: fn(R, R) -> R, offset: f64| {
-            let mut term = g; // (-1)^j g^(2j+1) / (2j+1)!
-            let mut sum = k(0.0);
-            for j in 0..10 {
-                let j = f64::from(j);
-                sum = sum + moment(term, g) / k(2.0 * j + offset);
-                term = term * (-g * g / k((2.0 * j + 2.0) * (2.0 * j + 3.0)));
-            }
-            sum
-        };
-        let first = g.branch_less(
+        // C (1 - cos g), as 2 C sin^2(g / 2): no cancellation near the peak.
+        let constant = c * (k(2.0) * (k(0.5) * g).sin().square());
+        // One choice for both moments, so that a recording keeps one `sin`, one `cos` and one
+        // series, and a float computes only the side it takes.
+        g.branch_less(
             k(0.5),
-            || series(|term, g| term * g * g, 3.0),
-            || g.sin() - g * g.cos(),
-        );
-        let second = g.branch_less(
-            k(0.5),
-            || series(|term, g| term * g * g * g, 4.0),
-            || k(2.0) * g * g.sin() + (k(2.0) - g * g) * g.cos() - k(2.0),
-        );
-        c * one_minus_cos + b * first + a * second
+            || {
+                // int_0^g x sin x = sum_j (-1)^j g^(2j+3) / ((2j+1)! (2j+3)), and the x^2
+                // moment with (2j+4) in place of (2j+3), where the closed forms cancel.
+                let mut term = g; // (-1)^j g^(2j+1) / (2j+1)!
+                let (mut first, mut second) = (k(0.0), k(0.0));
+                for j in 0..10 {
+                    let j = f64::from(j);
+                    first = first + term * g * g / k(2.0 * j + 3.0);
+                    second = second + term * g * g * g / k(2.0 * j + 4.0);
+                    term = term * (-g * g / k((2.0 * j + 2.0) * (2.0 * j + 3.0)));
+                }
+                constant + b * first + a * second
+            },
+            || {
+                let (sin, cos) = (g.sin(), g.cos());
+                let first = sin - g * cos;
+                let second = k(2.0) * g * sin + (k(2.0) - g * g) * cos - k(2.0);
+                constant + b * first + a * second
+            },
+        )
     }
 
     /// `int_t^1 lobe(s) ds` (valid when [`Self::has_closed_form_tail`]).

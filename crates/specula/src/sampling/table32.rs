@@ -205,8 +205,8 @@ mod tests {
     /// A Newton-sampled lobe drawn for an `f32` renderer, Newton starting from its table's
     /// draw and stopping at `f32` resolution, gives the `f32` its exact draw rounds to, in
     /// fewer than 2.5 iterations on average where the `f64` draw from the model's guess
-    /// takes more (a root at the seam of a tail's series and closed form takes either
-    /// bisections).
+    /// takes more (a root at the seam of a tail's series and its closed form takes
+    /// bisections from either start).
     #[test]
     fn newton_from_the_tables_draw_is_the_exact_draw_in_f32() {
         let mut lobes = 0;

@@ -22,7 +22,7 @@ fn classic(lighting: &Lighting, gradient: Vec3, base: Vec3, wo: Vec3) -> Vec3 {
     }
     let (shading, wi) = (&lighting.shading, lighting.light);
     let t = shading.geometry.cos_lobe_f32(normal, wo, wi);
-    let specular = shading.ks * lighting.normalisation * shading.lobe.eval(t);
+    let specular = lighting.highlight_scale(&shading.lobe) * shading.lobe.eval(t);
     let lit = base * (shading.ka + shading.kd * normal.dot(wi).max(0.0)) + Vec3::splat(specular);
     base.lerp(lit, (strength / lighting.gradient_reference).min(1.0))
 }

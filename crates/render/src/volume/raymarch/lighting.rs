@@ -78,8 +78,6 @@ impl Shading {
 pub struct Lighting {
     /// The material.
     pub shading: Shading,
-    /// The normalisation's constant for the lobe.
-    pub normalisation: f32,
     /// `wi`: towards the light.
     pub light: Vec3,
     /// The gradient magnitude at which a sample is fully shaded: 2 % of the value range per
@@ -101,7 +99,6 @@ impl Lighting {
         };
         Self {
             shading,
-            normalisation: shading.normalisation.constant_for(&shading.lobe) as f32,
             light,
             gradient_reference,
             per_gradient_reference: 1.0 / gradient_reference,
