@@ -19,9 +19,11 @@ use std::path::Path;
 
 use glam::{DVec3, Vec3};
 use specula::sampling::{AliasTable, Distribution2D};
+use specula::simd::Lanes;
 use thiserror::Error;
 
 use super::angles;
+use super::lane_geometry::{acos, atan2, V3};
 use crate::{read_image, Image, ImageError};
 
 /// Rec. 709 luminance weights: how bright a linear RGB radiance looks (the map's sampling
@@ -262,6 +264,26 @@ impl Environment {
         (
             (row * width + column) as usize,
             (1.0 - z * z).max(0.0).sqrt(),
+        )
+    }
+
+    /// [`Environment::texel_of`] on SIMD lanes: each lane's column and row (whole numbers,
+    /// as floats) and `sin theta`, for unit directions `wi`.
+    #[inline(always)]
+    pub(super) fn texel_lanes<V: Lanes>(&self, wi: V3<V>) -> (V, V, V) {
+        let (zero, one) = (wi.z.splat(0.0), wi.z.splat(1.0));
+        let z = wi.z.max(wi.z.splat(-1.0)).min(one);
+        let y = acos(z) * z.splat(core::f32::consts::FRAC_1_PI);
+        let x = atan2(wi.y, wi.x).neg_mul_add(z.splat(1.0 / core::f32::consts::TAU), z.splat(0.75));
+        let x = x.select(x.lt(one), x - one);
+        let (width, height) = (self.image.width() as f32, self.image.height() as f32);
+        // Clamped before the conversion, which a NaN also leaves in range.
+        let column = (x * z.splat(width)).min(z.splat(width - 1.0)).max(zero);
+        let row = (y * z.splat(height)).min(z.splat(height - 1.0)).max(zero);
+        (
+            column.float_to_int().int_to_float(),
+            row.float_to_int().int_to_float(),
+            z.neg_mul_add(z, one).max(zero).sqrt(),
         )
     }
 

@@ -14,46 +14,15 @@
 //! every job runs over all [`LANES`] lanes (a multiple of every level's width) and masks with
 //! selects, never with a multiply by 0 (a masked lane may hold an infinity or a NaN).
 
-use core::f32::consts::{FRAC_1_PI, PI, TAU};
+use core::f32::consts::FRAC_1_PI;
 
 use glam::Vec3;
 use specula::simd::{Job, Lanes};
 use specula::Geometry;
 
-use super::angles::{ACOS, ATAN};
+use super::lane_geometry::{cosine, Column, Columns3, V3};
 use super::packet::LANES;
-use super::Strategy;
-
-/// `LANES` values of one quantity.
-pub(super) type Column = [f32; LANES];
-
-// Every level's vectors tile a packet (1 or 8 lanes).
-const _: () = assert!(LANES.is_multiple_of(8));
-
-/// `LANES` vectors, by component.
-#[derive(Clone, Copy)]
-pub(super) struct Columns3 {
-    pub(super) x: Column,
-    pub(super) y: Column,
-    pub(super) z: Column,
-}
-
-impl Columns3 {
-    pub(super) const ZERO: Self = Self {
-        x: [0.0; LANES],
-        y: [0.0; LANES],
-        z: [0.0; LANES],
-    };
-
-    pub(super) fn set(&mut self, k: usize, v: Vec3) {
-        (self.x[k], self.y[k], self.z[k]) = (v.x, v.y, v.z);
-    }
-
-    #[must_use]
-    pub(super) fn get(&self, k: usize) -> Vec3 {
-        Vec3::new(self.x[k], self.y[k], self.z[k])
-    }
-}
+use super::{Environment, Strategy};
 
 /// Where a lane's BRDF direction came from, as a lane value.
 #[derive(Clone, Copy, PartialEq)]
@@ -75,178 +44,6 @@ impl Source {
             Source::Diffuse
         } else {
             Source::None
-        }
-    }
-}
-
-/// A vector of 3-vectors.
-#[derive(Clone, Copy)]
-struct V3<V> {
-    x: V,
-    y: V,
-    z: V,
-}
-
-impl<V: Lanes> V3<V> {
-    #[inline(always)]
-    fn load(lanes: V, columns: &Columns3, k: usize) -> Self {
-        let w = V::WIDTH;
-        Self {
-            x: lanes.load(&columns.x[k..k + w]),
-            y: lanes.load(&columns.y[k..k + w]),
-            z: lanes.load(&columns.z[k..k + w]),
-        }
-    }
-
-    #[inline(always)]
-    fn store(self, columns: &mut Columns3, k: usize) {
-        let w = V::WIDTH;
-        self.x.store(&mut columns.x[k..k + w]);
-        self.y.store(&mut columns.y[k..k + w]);
-        self.z.store(&mut columns.z[k..k + w]);
-    }
-
-    #[inline(always)]
-    fn splat(lanes: V, v: Vec3) -> Self {
-        Self {
-            x: lanes.splat(v.x),
-            y: lanes.splat(v.y),
-            z: lanes.splat(v.z),
-        }
-    }
-
-    #[inline(always)]
-    fn dot(self, other: Self) -> V {
-        self.x
-            .mul_add(other.x, self.y.mul_add(other.y, self.z * other.z))
-    }
-
-    /// `self * s + other`.
-    #[inline(always)]
-    fn scale_add(self, s: V, other: Self) -> Self {
-        Self {
-            x: self.x.mul_add(s, other.x),
-            y: self.y.mul_add(s, other.y),
-            z: self.z.mul_add(s, other.z),
-        }
-    }
-
-    #[inline(always)]
-    fn scale(self, s: V) -> Self {
-        Self {
-            x: self.x * s,
-            y: self.y * s,
-            z: self.z * s,
-        }
-    }
-
-    #[inline(always)]
-    fn add(self, other: Self) -> Self {
-        Self {
-            x: self.x + other.x,
-            y: self.y + other.y,
-            z: self.z + other.z,
-        }
-    }
-
-    /// Componentwise.
-    #[inline(always)]
-    fn mul(self, other: Self) -> Self {
-        Self {
-            x: self.x * other.x,
-            y: self.y * other.y,
-            z: self.z * other.z,
-        }
-    }
-
-    #[inline(always)]
-    fn sub(self, other: Self) -> Self {
-        Self {
-            x: self.x - other.x,
-            y: self.y - other.y,
-            z: self.z - other.z,
-        }
-    }
-
-    #[inline(always)]
-    fn normalize(self) -> Self {
-        let one = self.x.splat(1.0);
-        self.scale(one / self.dot(self).sqrt())
-    }
-
-    #[inline(always)]
-    fn select(self, mask: V::Mask, other: Self) -> Self {
-        Self {
-            x: self.x.select(mask, other.x),
-            y: self.y.select(mask, other.y),
-            z: self.z.select(mask, other.z),
-        }
-    }
-}
-
-/// `sum coefficients[i] x^i` by Horner's rule, fused.
-#[inline(always)]
-fn horner<V: Lanes>(x: V, coefficients: &[f32]) -> V {
-    let mut sum = x.splat(0.0);
-    for &c in coefficients.iter().rev() {
-        sum = sum.mul_add(x, x.splat(c));
-    }
-    sum
-}
-
-/// `|x|`.
-#[inline(always)]
-fn abs<V: Lanes>(x: V) -> V {
-    x.bits_and(0x7fff_ffff)
-}
-
-/// [`super::angles::acos`] on every lane.
-#[inline(always)]
-fn acos<V: Lanes>(x: V) -> V {
-    let (zero, one) = (x.splat(0.0), x.splat(1.0));
-    let a = abs(x).min(one);
-    let r = (one - a).sqrt() * horner(a, &ACOS);
-    (x.splat(PI) - r).select(x.lt(zero), r)
-}
-
-/// [`super::angles::atan2`] on every lane.
-#[inline(always)]
-fn atan2<V: Lanes>(y: V, x: V) -> V {
-    let zero = x.splat(0.0);
-    let (ax, ay) = (abs(x), abs(y));
-    let (small, large) = (ax.min(ay), ax.max(ay));
-    let s = small / large;
-    let r = s * horner(s * s, &ATAN);
-    let r = (x.splat(core::f32::consts::FRAC_PI_2) - r).select(ay.gt(ax), r);
-    let r = (x.splat(PI) - r).select(x.lt(zero), r);
-    let r = (zero - r).select(y.lt(zero), r);
-    r.keep(large.gt(zero))
-}
-
-/// The lobe's cosine `t` for `wi` and, for Blinn, `wo . h` (1 for Phong); `t = 0` where the
-/// half vector is undefined ([`super::packet`]'s scalar rule, on lanes).
-#[inline(always)]
-fn cosine<V: Lanes>(geometry: Geometry, wo: V3<V>, wi: V3<V>) -> (V, V) {
-    let (zero, one) = (wi.x.splat(0.0), wi.x.splat(1.0));
-    match geometry {
-        Geometry::Phong => {
-            let mirror = V3 {
-                x: zero - wo.x,
-                y: zero - wo.y,
-                z: wo.z,
-            };
-            (mirror.dot(wi), one)
-        }
-        Geometry::Blinn => {
-            let sum = V3 {
-                x: wo.x + wi.x,
-                y: wo.y + wi.y,
-                z: wo.z + wi.z,
-            };
-            let length_squared = sum.dot(sum);
-            let defined = length_squared.gt(zero);
-            let h = sum.scale(one / length_squared.sqrt());
-            (h.z.keep(defined), wo.dot(h).select(defined, one))
         }
     }
 }
@@ -325,13 +122,12 @@ pub(super) struct Setting {
     pub(super) axis: [Vec3; 3],
     /// The probability that a BRDF draw goes to the lobe.
     pub(super) share: f32,
-    /// The environment map's width and height in texels.
-    pub(super) texels: (u32, u32),
 }
 
 /// One variant's cosines, BRDF directions and their texels (see the module docs).
 pub(super) struct Directions<'a> {
     pub(super) setting: Setting,
+    pub(super) environment: &'a Environment,
     pub(super) shared: &'a SharedColumns,
     pub(super) variant: &'a mut VariantColumns,
 }
@@ -348,9 +144,8 @@ impl Job for Directions<'_> {
             frame,
             axis,
             share,
-            texels: (width, height),
         } = self.setting;
-        let (shared, variant) = (self.shared, self.variant);
+        let (environment, shared, variant) = (self.environment, self.shared, self.variant);
         let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
         let wo = V3::splat(lanes, wo);
         let w = V::WIDTH;
@@ -401,29 +196,15 @@ impl Job for Directions<'_> {
             wi.store(&mut variant.brdf_wi, k);
             t.keep(above).store(&mut variant.brdf_cosine[k..k + w]);
             half.store(&mut variant.brdf_half_cosine[k..k + w]);
-            // The texel a lobe-drawn direction falls in ([`super::Environment::texel_of`]).
+            // The texel a lobe-drawn direction falls in.
             let world = V3::splat(lanes, frame[0]).scale_add(
                 wi.x,
                 V3::splat(lanes, frame[1]).scale_add(wi.y, V3::splat(lanes, frame[2]).scale(wi.z)),
             );
-            let z = world.z.max(lanes.splat(-1.0)).min(one);
-            let y = acos(z) * lanes.splat(FRAC_1_PI);
-            let x = atan2(world.y, world.x).neg_mul_add(lanes.splat(1.0 / TAU), lanes.splat(0.75));
-            let x = x.select(x.lt(one), x - one);
-            let (w_f, h_f) = (width as f32, height as f32);
-            let column = (x * lanes.splat(w_f)).min(lanes.splat(w_f - 1.0)).max(zero);
-            let row = (y * lanes.splat(h_f)).min(lanes.splat(h_f - 1.0)).max(zero);
-            column
-                .float_to_int()
-                .int_to_float()
-                .store(&mut variant.texel_column[k..k + w]);
-            row.float_to_int()
-                .int_to_float()
-                .store(&mut variant.texel_row[k..k + w]);
-            z.neg_mul_add(z, one)
-                .max(zero)
-                .sqrt()
-                .store(&mut variant.texel_sine[k..k + w]);
+            let (column, row, sine) = environment.texel_lanes(world);
+            column.store(&mut variant.texel_column[k..k + w]);
+            row.store(&mut variant.texel_row[k..k + w]);
+            sine.store(&mut variant.texel_sine[k..k + w]);
         }
     }
 }
@@ -546,67 +327,5 @@ impl Job for Combine<'_> {
         let mut columns = Columns3::ZERO;
         sum.store(&mut columns, 0);
         (0..w).fold(Vec3::ZERO, |total, k| total + columns.get(k))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use specula::simd::{dispatch, Level};
-
-    use super::*;
-
-    /// `acos` and `atan2` on lanes, at every level this CPU has, are the scalar ones of
-    /// [`super::super::angles`] to a few `f32` roundings (the fused multiply-adds).
-    #[test]
-    fn the_lane_angles_are_the_scalar_ones() {
-        struct Angles<'a>(
-            &'a [f32; LANES],
-            &'a [f32; LANES],
-            &'a mut [[f32; LANES]; 2],
-        );
-        impl Job for Angles<'_> {
-            type Output = ();
-            #[inline(always)]
-            fn run<V: Lanes>(self, lanes: V) {
-                for k in (0..LANES).step_by(V::WIDTH) {
-                    let (x, y) = (
-                        lanes.load(&self.0[k..k + V::WIDTH]),
-                        lanes.load(&self.1[k..k + V::WIDTH]),
-                    );
-                    acos(x).store(&mut self.2[0][k..k + V::WIDTH]);
-                    atan2(y, x).store(&mut self.2[1][k..k + V::WIDTH]);
-                }
-            }
-        }
-        for level in Level::available() {
-            for round in 0..200 {
-                let xs: [f32; LANES] = core::array::from_fn(|k| {
-                    ((round * LANES + k) as f32 * 0.618_034).fract() * 2.0 - 1.0
-                });
-                let ys: [f32; LANES] =
-                    core::array::from_fn(|k| (k as f32 * 0.37 + round as f32).sin());
-                let mut out = [[0.0; LANES]; 2];
-                dispatch(level, Angles(&xs, &ys, &mut out));
-                for k in 0..LANES {
-                    let (x, y) = (xs[k], ys[k]);
-                    let acos = super::super::angles::acos(x);
-                    let atan2 = super::super::angles::atan2(y, x);
-                    assert!(
-                        (out[0][k] - acos).abs() <= 1e-6,
-                        "{level:?} acos({x}): {} against {acos}",
-                        out[0][k]
-                    );
-                    assert!(
-                        (out[1][k] - atan2).abs() <= 1e-6,
-                        "{level:?} atan2({y}, {x}): {} against {atan2}",
-                        out[1][k]
-                    );
-                }
-            }
-            let zero = [0.0; LANES];
-            let mut out = [[1.0; LANES]; 2];
-            dispatch(level, Angles(&zero, &zero, &mut out));
-            assert!(out[1].iter().all(|&a| a == 0.0), "atan2(0, 0) on {level:?}");
-        }
     }
 }

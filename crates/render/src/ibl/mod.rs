@@ -31,6 +31,7 @@
 
 mod angles;
 mod environment;
+mod lane_geometry;
 mod lanes;
 mod packet;
 mod sky;

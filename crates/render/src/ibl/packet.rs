@@ -38,9 +38,8 @@ use specula::simd::{dispatch, Level};
 use specula::{Geometry, Lobe};
 
 use super::angles::sin_cos_turns;
-use super::lanes::{
-    Brdf, Columns3, Combine, Directions, Setting, SharedColumns, Source, VariantColumns,
-};
+use super::lane_geometry::Columns3;
+use super::lanes::{Brdf, Combine, Directions, Setting, SharedColumns, Source, VariantColumns};
 use super::{Environment, Strategy};
 use crate::Material;
 
@@ -57,8 +56,8 @@ pub(super) struct PacketSurface {
     /// The probability that a BRDF draw goes to the lobe rather than the cosine.
     share: f32,
     /// `1 / (2 pi int_0^1 lobe)`: the lobe's value to its sampler's density about its axis
-    /// (for a lobe with a closed-form integral).
-    density_per_value: f32,
+    /// (for a lobe with a closed-form integral; see [`PacketSurface::density_per_value`]).
+    value_to_density: f32,
     lobe: Lobe,
     geometry: Geometry,
     sampler: CosineSampler,
@@ -94,7 +93,7 @@ impl PacketSurface {
             } else {
                 0.0
             },
-            density_per_value: if total > 0.0 {
+            value_to_density: if total > 0.0 {
                 (1.0 / (core::f64::consts::TAU * total)) as f32
             } else {
                 0.0
@@ -106,6 +105,15 @@ impl PacketSurface {
                 Warp::Newton => CosineSampler::Newton(table()),
                 Warp::Table => CosineSampler::Table(table()),
             },
+        }
+    }
+
+    /// The lobe's value to its sampler's density about its axis, or `None` for a tabulated
+    /// lobe, whose sampler's density is its table's.
+    fn density_per_value(&self) -> Option<f32> {
+        match self.sampler {
+            CosineSampler::Table(_) => None,
+            _ => Some(self.value_to_density),
         }
     }
 
@@ -368,8 +376,8 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
                 frame: [tangent, bitangent, normal],
                 axis: [axis, b1, b2],
                 share: surface.share,
-                texels: (environment.image().width(), environment.image().height()),
             },
+            environment,
             shared,
             variant: &mut *variant,
         },
@@ -414,10 +422,7 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
                 diffuse: surface.diffuse,
                 specular: surface.specular,
                 share: surface.share,
-                density_per_value: surface
-                    .density_table()
-                    .is_none()
-                    .then_some(surface.density_per_value),
+                density_per_value: surface.density_per_value(),
             },
             shared,
             variant,

@@ -12,6 +12,7 @@
 //! - **Sampling**: Newton on the formula's own tail where it gives one, else a table.
 
 use super::batch::LobeKernel;
+use super::invert::NewtonStart;
 use super::{Inverted, NewtonForm};
 use crate::formula::batch::Rules;
 use crate::formula::{registry, Instance, MAX_SLOTS};
@@ -67,7 +68,7 @@ impl FormulaLobe {
     pub(crate) fn tail_inverse(
         &self,
         u: f64,
-        (near, resolution): (Option<f64>, f64),
+        NewtonStart { near, resolution }: NewtonStart,
     ) -> Option<Inverted> {
         let total = self.tail(0.0)?;
         let rising = |x: f64| self.tail(1.0 - x).unwrap_or(f64::NAN);

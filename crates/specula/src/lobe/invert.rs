@@ -16,6 +16,15 @@ pub const F64_RESOLUTION: f64 = 4.0 * f64::EPSILON;
 /// the cosine rounds to the exact root's `f32` (tested for every Newton-sampled lobe).
 pub const F32_RESOLUTION: f64 = 1.0 / 67_108_864.0;
 
+/// Where a lobe's Newton starts and how close it stops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct NewtonStart {
+    /// A cosine near the root (a table's draw), or `None` for the model's own first guess.
+    pub near: Option<f64>,
+    /// [`F64_RESOLUTION`] or [`F32_RESOLUTION`].
+    pub resolution: f64,
+}
+
 /// A root found, and the iterations it took.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Inverted {

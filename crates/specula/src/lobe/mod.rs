@@ -32,6 +32,7 @@ mod sg_karis;
 
 pub use cheb2_thesis::thesis_coefficients;
 pub use cosquad::CosQuad;
+use invert::NewtonStart;
 pub use invert::{Inverted, F32_RESOLUTION, F64_RESOLUTION};
 pub use kind::{FormulaId, LineStyle, LobeInfo, LobeKind, Origin, ParamInfo};
 pub use quadratic::AngleQuadratic;
@@ -257,7 +258,13 @@ impl Lobe {
     /// took (0 for a closed form); `None` for a lobe sampled from a table.
     #[must_use]
     pub fn tail_inverse(&self, u: f64) -> Option<Inverted> {
-        self.tail_inverse_from(u, (None, F64_RESOLUTION))
+        self.tail_inverse_from(
+            u,
+            NewtonStart {
+                near: None,
+                resolution: F64_RESOLUTION,
+            },
+        )
     }
 
     /// [`Lobe::tail_inverse`] for a renderer that rounds the cosine to `f32`: Newton starts
@@ -266,10 +273,16 @@ impl Lobe {
     /// that it takes about half the iterations. Closed forms ignore `near`.
     #[must_use]
     pub fn tail_inverse_f32(&self, u: f64, near: f64) -> Option<Inverted> {
-        self.tail_inverse_from(u, (Some(near), F32_RESOLUTION))
+        self.tail_inverse_from(
+            u,
+            NewtonStart {
+                near: Some(near),
+                resolution: F32_RESOLUTION,
+            },
+        )
     }
 
-    fn tail_inverse_from(&self, u: f64, start: (Option<f64>, f64)) -> Option<Inverted> {
+    fn tail_inverse_from(&self, u: f64, start: NewtonStart) -> Option<Inverted> {
         let u = u.clamp(0.0, 1.0);
         let exact = |x| Some(Inverted { x, iterations: 0 });
         match &self.model {

@@ -13,7 +13,7 @@
 //! overshoots 1 (clamped, so no longer the quadratic) is sampled from a table instead.
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
-use super::invert::{solve_increasing, Inverted};
+use super::invert::{solve_increasing, Inverted, NewtonStart};
 use crate::real::Real;
 use crate::simd::math::{acos, ACOS};
 use crate::simd::tally::{Class, Instructions};
@@ -145,7 +145,11 @@ impl AngleQuadratic {
 
     /// The cosine whose tail is the fraction `u` of the whole, by Newton in the angle, from
     /// the cosine `near` when given, to `resolution`.
-    pub(crate) fn tail_inverse(&self, u: f64, (near, resolution): (Option<f64>, f64)) -> Inverted {
+    pub(crate) fn tail_inverse(
+        &self,
+        u: f64,
+        NewtonStart { near, resolution }: NewtonStart,
+    ) -> Inverted {
         let c = self.coeffs[0];
         let target = u * self.total.unwrap_or(0.0);
         let root = solve_increasing(

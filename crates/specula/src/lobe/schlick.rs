@@ -20,7 +20,7 @@
 //! - **Source**: C. Schlick, "A customizable reflectance model for everyday rendering" (1993).
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
-use super::invert::{solve_increasing, Inverted};
+use super::invert::{solve_increasing, Inverted, NewtonStart};
 use crate::real::Real;
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
@@ -76,7 +76,11 @@ impl Schlick {
 
     /// The cosine whose tail is the fraction `u` of the whole, by Newton on the tail, from
     /// the cosine `near` when given, to `resolution`.
-    pub(crate) fn tail_inverse(&self, u: f64, (near, resolution): (Option<f64>, f64)) -> Inverted {
+    pub(crate) fn tail_inverse(
+        &self,
+        u: f64,
+        NewtonStart { near, resolution }: NewtonStart,
+    ) -> Inverted {
         let c = self.n - 1.0;
         let target = u * self.total;
         let guess = match near {
