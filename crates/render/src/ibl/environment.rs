@@ -348,6 +348,80 @@ mod tests {
         }
     }
 
+    /// The texel a direction falls in on SIMD lanes, at every level this CPU has, is the one
+    /// the `f64` mapping (`to_square`) puts it in, but within a polynomial's error of a texel
+    /// border (then a neighbour), and `sin theta` there is `f64`'s.
+    #[test]
+    fn texels_on_lanes_are_the_f64_mappings() {
+        use specula::simd::{dispatch, Job, Level};
+
+        struct Texels<'a>(&'a Environment, &'a [Vec3], &'a mut Vec<[f32; 3]>);
+        impl Job for Texels<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<V: Lanes>(self, lanes: V) {
+                let w = V::WIDTH;
+                for chunk in self.1.chunks_exact(w) {
+                    let column = |f: fn(&Vec3) -> f32| chunk.iter().map(f).collect::<Vec<f32>>();
+                    let wi = V3 {
+                        x: lanes.load(&column(|v| v.x)),
+                        y: lanes.load(&column(|v| v.y)),
+                        z: lanes.load(&column(|v| v.z)),
+                    };
+                    let (c, r, s) = self.0.texel_lanes(wi);
+                    let mut out = [vec![0.0; w], vec![0.0; w], vec![0.0; w]];
+                    c.store(&mut out[0]);
+                    r.store(&mut out[1]);
+                    s.store(&mut out[2]);
+                    self.2
+                        .extend((0..w).map(|k| [out[0][k], out[1][k], out[2][k]]));
+                }
+            }
+        }
+        let environment = Environment::from_image(Image::new(512, 256, Vec3::ONE), "m").unwrap();
+        let (width, height) = (512.0, 256.0);
+        // A golden spiral over the sphere, 4096 directions.
+        let directions: Vec<Vec3> = (0..4096)
+            .map(|i| {
+                let z = 1.0 - (f64::from(i) + 0.5) / 2048.0;
+                let phi = f64::from(i) * 2.399_963_229_728_653;
+                let r = (1.0 - z * z).sqrt();
+                DVec3::new(r * phi.cos(), r * phi.sin(), z).as_vec3()
+            })
+            .collect();
+        for level in Level::available() {
+            let mut texels = Vec::new();
+            dispatch(level, Texels(&environment, &directions, &mut texels));
+            let mut exact = 0;
+            for (wi, &[column, row, sine]) in directions.iter().zip(&texels) {
+                let [x, y] = to_square(wi.as_dvec3());
+                let (expected_column, expected_row) = ((x * width).floor(), (y * height).floor());
+                let off = |a: f32, b: f64, period: f64| {
+                    let d = (f64::from(a) - b).abs();
+                    d.min(period - d)
+                };
+                let (dc, dr) = (
+                    off(column, expected_column, width),
+                    off(row, expected_row, f64::INFINITY),
+                );
+                assert!(
+                    dc <= 1.0 && dr <= 1.0,
+                    "{level:?} {wi}: ({column}, {row}) against ({expected_column}, {expected_row})"
+                );
+                exact += usize::from(dc == 0.0 && dr == 0.0);
+                let theta_sine = wi.as_dvec3().truncate().length();
+                assert!(
+                    (f64::from(sine) - theta_sine).abs() < 1e-6,
+                    "{level:?} {wi}: sine {sine}"
+                );
+            }
+            assert!(
+                exact >= 4090,
+                "{level:?}: only {exact} of 4096 in the f64 mapping's texel"
+            );
+        }
+    }
+
     #[test]
     fn bad_maps_are_refused_by_name() {
         let mut image = Image::new(4, 2, Vec3::ONE);
