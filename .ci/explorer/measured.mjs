@@ -1,9 +1,10 @@
-// Drives the explorer's measured-materials view (`specula serve --data DIR`) in Debian's
-// Chromium: choosing a material fills the fits table, the three polar plots and the render;
-// checking a fit redraws them and the address; the address restores the view; an unknown
-// material in the address is said, and a server without a folder says how to give one. The
-// console must stay silent. Saves a screenshot.
-// Usage: node measured.mjs SPECULA_BINARY DATA_DIR SCREENSHOT.png
+// Drives the explorer's measured-materials view in Debian's Chromium: a server without a
+// folder offers the five bundled materials, `--data DIR` adds DIR's files to them; choosing a
+// material fills the fits table, the three polar plots and the render; checking a fit redraws
+// them and the address; the address restores the view; an unknown material in the address is
+// said. The console must stay silent. Saves a screenshot.
+// Usage: node measured.mjs SPECULA_BINARY DATA_DIR SCREENSHOT.png (DATA_DIR: one .bsdf file,
+// named like no bundled material)
 import { spawn } from "node:child_process";
 import { chromium } from "playwright-core";
 
@@ -23,7 +24,8 @@ try {
   const page = await browser.newPage({ viewport: { width: 1500, height: 1400 } });
   watch(page);
   await page.goto(url);
-  await page.waitForFunction(() => document.querySelectorAll("#material option").length === 6, null, { timeout: 30000 });
+  // The five bundled materials, the folder's one and the prompt.
+  await page.waitForFunction(() => document.querySelectorAll("#material option").length === 7, null, { timeout: 30000 });
   const settled = () => page.waitForFunction(() => document.body.dataset.drawn === location.search, null, { timeout: 60000 });
   const t0 = Date.now();
   await page.locator("#material").selectOption(process.env.MATERIAL ?? "paper_white_rgb");
@@ -70,12 +72,14 @@ try {
   await wrong.goto(url + "?material=../x");
   await wrong.waitForFunction(() => document.getElementById("measured-status").textContent.includes("not offered"), null, { timeout: 30000 });
   await wrong.waitForFunction(() => document.body.dataset.drawn === location.search && !location.search.includes("material="), null, { timeout: 60000 });
-  // Without --data the view says how to give a folder.
-  const none = await browser.newPage();
-  watch(none);
-  await none.goto(bareUrl);
-  await none.waitForFunction(() => document.getElementById("measured-status").textContent.includes("specula serve --data DIR"), null, { timeout: 30000 });
-  if (!(await none.evaluate(() => document.getElementById("measured-controls").hidden))) failures.push("controls shown without data");
+  // Without --data the view offers the bundled materials.
+  const bundled = await browser.newPage();
+  watch(bundled);
+  await bundled.goto(bareUrl);
+  await bundled.waitForFunction(() => document.querySelectorAll("#material option").length === 6, null, { timeout: 30000 });
+  const offered = await bundled.evaluate(() => [...document.querySelectorAll("#material option")].map((o) => o.value).filter((v) => v));
+  if (offered.join(",") !== "cc_ibiza_sunset_rgb,cc_iris_purple_gem_rgb,colodur_napoli_4f_rgb,paper_white_rgb,vch_golden_yellow_rgb") failures.push(`bundled materials offered: ${offered}`);
+  if (await bundled.evaluate(() => document.getElementById("measured-controls").hidden)) failures.push("controls hidden without --data");
   await page.locator("#measured-scale").check();
   await page.locator("#measured-view").screenshot({ path: screenshot });
   if (messages.length) failures.push(...messages.map((m) => `console: ${m}`));

@@ -220,7 +220,7 @@ fn main() -> ExitCode {
         // The server shuts down on its own signal handling; everything else removes its
         // temporary files and exits.
         let _ = ctrlc::set_handler(|| {
-            specula_render::remove_temporaries();
+            specula_temporaries::remove_all();
             eprintln!("interrupted");
             std::process::exit(INTERRUPTED);
         });

@@ -12,7 +12,7 @@ use serde_json::Value;
 
 fn rgl(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/rgl")
+        .join("../../data/rgl")
         .join(format!("{name}.bsdf"))
 }
 

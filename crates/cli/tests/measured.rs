@@ -14,7 +14,7 @@ use specula_render::measured::load_measured;
 
 /// The real RGL files (isotropic RGB), outside the repository.
 fn rgl_folder() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/rgl")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/rgl")
 }
 
 /// The folder's `.bsdf` files, sorted.

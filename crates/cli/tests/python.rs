@@ -3,8 +3,10 @@
 //! then its pytest suite on the installed wheel, which compares the package with this
 //! build's `specula` binary.
 //!
-//! The wheel is built in a target folder of its own (`target/python-wheel`): `cargo test`
-//! holds the workspace's, and a build inside it would wait forever for its lock.
+//! The wheel is built in the workspace's target folder in the profile the tests run in (`dev`,
+//! optimised; `cargo test` releases the folder's lock before it runs the tests), so it reuses
+//! the crates the tests were built from rather than building every dependency again in
+//! release.
 
 use std::path::Path;
 use std::process::Command;
@@ -75,7 +77,7 @@ fn the_package_installs_offline_and_its_tests_pass() {
                 "./crates/python",
             ])
             .env("PATH", &path)
-            .env("CARGO_TARGET_DIR", root.join("target/python-wheel"))
+            .env("MATURIN_PEP517_ARGS", "--profile dev")
             .env("CARGO_NET_OFFLINE", "true"),
     );
     let scratch = tempfile::tempdir().expect("scratch folder");

@@ -2,7 +2,7 @@
 //! and no number is NaN or infinite; with the real scans (Debian's `invesalius-examples` and
 //! `mricron-data`) and VTK (the `vtk` wheel in the test's Python), the medical section's real
 //! CT and MRI and its comparison with VTK's CPU ray caster; with `--materials` the five RGL
-//! materials in `shared/data/rgl`, each with its fits, polar plot and renders scored by FLIP;
+//! materials in `data/rgl`, each with its fits, polar plot and renders scored by FLIP;
 //! and one answer everywhere: every cell of "Which lobe when" is what `specula recommend`
 //! answers for its target, exponent and bound (on the FPGA, synthesized with Yosys and
 //! nextpnr, which `CI=true` requires).
@@ -28,7 +28,7 @@ const REAL_SCANS: [(&str, &str, &str); 2] = [
 /// The lobes `--quick` renders the real scans with.
 const QUICK_REAL_SCAN_LOBES: [&str; 3] = ["pow", "schlick", "cosquad"];
 
-/// The measured materials in `shared/data/rgl`, by name.
+/// The measured materials in `data/rgl`, by name.
 const MATERIALS: [&str; 5] = [
     "cc_ibiza_sunset_rgb",
     "cc_iris_purple_gem_rgb",
@@ -39,7 +39,7 @@ const MATERIALS: [&str; 5] = [
 
 /// The folder of RGL materials the repository shares.
 fn rgl() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/rgl")
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/rgl")
 }
 
 #[test]

@@ -237,7 +237,7 @@ fn a_new_lobe_goes_through_every_command() {
     std::fs::create_dir(&materials).unwrap();
     std::os::unix::fs::symlink(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../../shared/data/rgl/paper_white_rgb.bsdf"),
+            .join("../../data/rgl/paper_white_rgb.bsdf"),
         materials.join("paper_white_rgb.bsdf"),
     )
     .unwrap();

@@ -1,4 +1,4 @@
-/* specula's C twins: each lobe's formula (SPEC.md section 2) as the plain C loop a C
+/* specula's C twins: each lobe's formula (docs/spec.md section 2) as the plain C loop a C
  * programmer would write, compiled by `specula bench lobes` with
  * `-O3 -ffast-math -mavx2 -mfma` (gcc vectorises the loops, and the exp/log calls through
  * glibc's libmvec). Written independently of specula's kernels: the peer they are measured

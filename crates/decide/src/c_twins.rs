@@ -66,7 +66,8 @@ pub fn measure(n: Exponent, cc: &str) -> Result<CTwins, String> {
         .ok_or_else(|| {
             format!("no C compiler `{cc}` (install gcc: apt-get install gcc, or set CC)")
         })?;
-    let dir = tempfile::tempdir().map_err(|e| format!("C twins: a temporary folder: {e}"))?;
+    let dir = specula_temporaries::dir("c-twins-")
+        .map_err(|e| format!("C twins: a temporary folder: {e}"))?;
     let source = dir.path().join("c_twins.c");
     std::fs::write(&source, SOURCE).map_err(|e| format!("C twins: {e}"))?;
     let program = dir.path().join("c_twins");

@@ -58,7 +58,7 @@ pub use load::{load_mesh, parse_mesh, LoadError, LoadedMesh, MeshFormat, MESH_EX
 pub use material::{IlluminationModel, Light, Material, Shader, Shading};
 pub use mesh::{Mesh, MeshError};
 pub use mitsuba::write_mitsuba_scene;
-pub use output::{remove_temporaries, write_atomically, SeekWrite};
+pub use output::{write_atomically, SeekWrite};
 pub use pipeline::{
     overdraw, render, surfaces, RenderError, SurfacePoint, MAX_PIXELS, MAX_SAMPLES,
 };

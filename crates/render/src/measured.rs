@@ -26,6 +26,27 @@ use crate::{Image, Overrides, Scene};
 /// The largest material file read: 64 MiB (the RGL RGB files are 0.7 to 10 MiB).
 pub const MAX_MATERIAL_BYTES: u64 = 64 << 20;
 
+/// `(name, bytes)` of the file `data/rgl/<name>.bsdf` (the name is the file's stem).
+macro_rules! bundled {
+    ($name:literal) => {
+        (
+            $name,
+            include_bytes!(concat!("../../../data/rgl/", $name, ".bsdf")),
+        )
+    };
+}
+
+/// The measured materials specula carries (`data/rgl`: five isotropic RGB files of the RGL
+/// database, CC0, their provenance in its README), embedded so that every build offers them
+/// without a folder: each material's name (the file's stem) and the file's bytes.
+pub const BUNDLED_MATERIALS: [(&str, &[u8]); 5] = [
+    bundled!("cc_ibiza_sunset_rgb"),
+    bundled!("cc_iris_purple_gem_rgb"),
+    bundled!("colodur_napoli_4f_rgb"),
+    bundled!("paper_white_rgb"),
+    bundled!("vch_golden_yellow_rgb"),
+];
+
 /// Reads the measured material at `path`; every refusal is one line naming the file.
 pub fn load_measured(path: &Path) -> Result<MeasuredBrdf, String> {
     let named = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());

@@ -9,54 +9,19 @@
 //!   and `-` means standard output. Their contents are encoded in memory first, since
 //!   encoders may seek and these cannot.
 //!
-//! Temporary files are named `.specula-<pid>-<random>.tmp`. They are registered while they
-//! exist, so that a signal handler can remove them ([`remove_temporaries`]); and a write
-//! removes the ones in its directory whose process is gone (a run killed by `SIGKILL`).
+//! Temporary files are named `.specula-<pid>-<random>.tmp` and made through
+//! `specula_temporaries`, registered in the same step, so that a signal handler removes every
+//! one that exists ([`specula_temporaries::remove_all`]); a write removes the ones in its
+//! directory whose process is gone (a run killed by `SIGKILL`).
 
 use std::io::{BufWriter, Cursor, Seek, Write};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 use crate::image::ImageError;
 
 /// A writer an encoder may also seek in.
 pub trait SeekWrite: Write + Seek {}
 impl<T: Write + Seek> SeekWrite for T {}
-
-/// The temporary files (and staging folders) that exist now.
-static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
-
-/// The prefix of this process's temporary files.
-fn prefix() -> String {
-    format!(".specula-{}-", std::process::id())
-}
-
-/// Removes every temporary file this process has open: for a `SIGINT` or `SIGTERM` handler,
-/// which then exits.
-pub fn remove_temporaries() {
-    let paths = match TEMPORARIES.lock() {
-        Ok(paths) => paths.clone(),
-        Err(poisoned) => poisoned.into_inner().clone(),
-    };
-    for path in paths {
-        if std::fs::remove_file(&path).is_err() {
-            let _ = std::fs::remove_dir_all(&path);
-        }
-    }
-}
-
-/// Adds `path` to (or, once it is gone or kept, removes it from) what an interrupted run
-/// deletes.
-pub(crate) fn register(path: &Path, present: bool) {
-    let mut paths = TEMPORARIES
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    if present {
-        paths.push(path.to_owned());
-    } else {
-        paths.retain(|p| p != path);
-    }
-}
 
 /// The most symlinks followed, as the kernel's `ELOOP` limit.
 const MAX_LINKS: usize = 40;
@@ -127,16 +92,9 @@ pub fn write_atomically(
         Some(parent) if !parent.as_os_str().is_empty() => parent.to_owned(),
         _ => PathBuf::from("."),
     };
-    remove_stale_temporaries(&directory);
-    let mut builder = tempfile::Builder::new();
-    let prefix = prefix();
-    builder.prefix(&prefix).suffix(".tmp");
-    // A temporary file is private (0600); a new output gets the usual mode (0666 less the
-    // umask), as if created directly, and an existing one keeps its own.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut file = builder.tempfile_in(&directory).map_err(io)?;
-    register(file.path(), true);
+    // A new output gets the usual mode (0666 less the umask), as if created directly, and an
+    // existing one keeps its own.
+    let mut file = specula_temporaries::file_in(&directory, ".tmp", Some(0o666)).map_err(io)?;
     let result = (|| {
         {
             let mut writer = BufWriter::new(file.as_file_mut());
@@ -150,51 +108,7 @@ pub fn write_atomically(
         }
         file.as_file().sync_all().map_err(io)
     })();
-    let temporary = file.path().to_owned();
-    let persisted =
-        result.and_then(|()| file.persist(&target).map(|_| ()).map_err(|e| io(e.error)));
-    register(&temporary, false);
-    persisted
-}
-
-/// Removes `.specula-<pid>-*.tmp` files in `directory` whose process no longer runs (read
-/// from `/proc`; elsewhere nothing is removed, since liveness is unknown). Once per directory
-/// and process: a report writes sixty files into one folder.
-fn remove_stale_temporaries(directory: &Path) {
-    static CLEANED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
-    {
-        let mut cleaned = CLEANED
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if cleaned.iter().any(|d| d == directory) {
-            return;
-        }
-        cleaned.push(directory.to_owned());
-    }
-    if !Path::new("/proc/self").exists() {
-        return;
-    }
-    let Ok(entries) = std::fs::read_dir(directory) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let name = entry.file_name();
-        let Some(name) = name.to_str() else {
-            continue;
-        };
-        let Some(pid) = name
-            .strip_prefix(".specula-")
-            .and_then(|rest| rest.strip_suffix(".tmp"))
-            .and_then(|rest| rest.split_once('-'))
-            .and_then(|(pid, _)| pid.parse::<u32>().ok())
-        else {
-            continue;
-        };
-        let is_file = entry.file_type().is_ok_and(|t| t.is_file());
-        if is_file && pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
-            let _ = std::fs::remove_file(entry.path());
-        }
-    }
+    result.and_then(|()| file.persist(&target).map_err(io))
 }
 
 #[cfg(test)]
@@ -210,23 +124,15 @@ mod tests {
         names
     }
 
-    /// While a write is under way its temporary file is registered (what a signal handler's
-    /// `remove_temporaries` removes) and afterwards it is not; a temporary file removed
-    /// under the write makes it fail and leaves nothing. (Other tests write concurrently, so
-    /// this one removes only its own file.)
+    /// While a write is under way its temporary file is registered (what a signal handler
+    /// removes) and afterwards it is not; a temporary file removed under the write makes it
+    /// fail and leaves nothing.
     #[test]
     fn temporary_files_are_registered_while_they_exist() {
         let directory = tempfile::tempdir().expect("temporary directory");
-        let ours = |paths: &[PathBuf]| -> Vec<PathBuf> {
-            paths
-                .iter()
-                .filter(|p| p.starts_with(directory.path()))
-                .cloned()
-                .collect()
-        };
         let result = write_atomically(&directory.path().join("out.txt"), |writer| {
             writer.write_all(b"partial").map_err(|e| e.to_string())?;
-            let registered = ours(&TEMPORARIES.lock().expect("registry"));
+            let registered = specula_temporaries::registered_under(directory.path());
             assert_eq!(registered.len(), 1, "the temporary file is registered");
             assert!(registered[0].exists());
             std::fs::remove_file(&registered[0]).map_err(|e| e.to_string())
@@ -236,7 +142,7 @@ mod tests {
             "the temporary file was removed under the write"
         );
         assert!(entries(directory.path()).is_empty());
-        assert!(ours(&TEMPORARIES.lock().expect("registry")).is_empty());
+        assert!(specula_temporaries::registered_under(directory.path()).is_empty());
     }
 
     #[test]

@@ -63,7 +63,7 @@ fn furnace(reflectance: &dyn Reflectance, theta_o: f64, strategy: Strategy) -> (
 
 #[test]
 fn a_measured_material_reflects_its_albedo_by_every_strategy() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/rgl");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/rgl");
     for (name, theta_o) in [
         ("paper_white_rgb", 0.0_f64),
         ("cc_iris_purple_gem_rgb", 40.0),

@@ -41,7 +41,7 @@ const POLAR_HEADROOM: f64 = 1.25;
 const GGX_GREY: plotters::style::RGBColor = plotters::style::RGBColor(150, 150, 150);
 
 /// How to get the section, shown without `--materials`.
-const HOW_TO: &str = "Not computed: run specula report --materials DIR, with DIR holding measured materials as the RGL database's isotropic RGB .bsdf files (the '_rgb.bsdf' ones; for example the five in shared/data/rgl), to see each fitted with every lobe and GGX: the verdict on which lobe to ship, the fits' errors, polar plots of the measurement against the fits and renders under the sky scored by FLIP.";
+const HOW_TO: &str = "Not computed: run specula report --materials DIR, with DIR holding measured materials as the RGL database's isotropic RGB .bsdf files (the '_rgb.bsdf' ones; for example the five specula carries in data/rgl), to see each fitted with every lobe and GGX: the verdict on which lobe to ship, the fits' errors, polar plots of the measurement against the fits and renders under the sky scored by FLIP.";
 
 /// The `.bsdf` files in `directory` sorted by name, at most [`MAX_MATERIALS`], and how many
 /// more there were.

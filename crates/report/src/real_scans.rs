@@ -121,7 +121,7 @@ pub fn real_scans(context: &mut Context) -> Result<String, String> {
     }
     // VTK's Python starts first and imports VTK while specula reads the scans; it then
     // renders while specula does.
-    let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let scratch = specula_temporaries::dir("scans-").map_err(|e| e.to_string())?;
     let running = vtk_peer::start(rayon::current_num_threads(), scratch.path());
     // Each file is read (and decompressed) on a thread of its own.
     let loaded: Vec<Result<Loaded, String>> = std::thread::scope(|scope| {

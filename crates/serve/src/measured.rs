@@ -1,12 +1,14 @@
-//! The explorer's measured-materials view: the `.bsdf` files of the `--data` folder, every
-//! lobe and GGX fitted to each (the library's fit, `specula fit --material`'s), and the polar
-//! plots of the material against its fits.
+//! The explorer's measured-materials view: the five materials specula carries (embedded in the
+//! binary) and the `.bsdf` files of the `--data` folder, every lobe and GGX fitted to each (the
+//! library's fit, `specula fit --material`'s), and the polar plots of the material against its
+//! fits.
 //!
-//! **Names, never paths.** The folder is listed once, at start-up ([`Materials::from_folder`]):
+//! **Names, never paths.** The folder is listed once, at start-up ([`Materials::with_folder`]):
 //! the `*.bsdf` entries directly in it whose final target is a regular file (as every file the
-//! renderer reads), at most [`MAX_MATERIALS`]. A request names a material by its stem from
-//! that list (`paper_white_rgb`); anything else, a path included, is refused with the valid
-//! names, so no request reaches a file that was not listed.
+//! renderer reads), at most [`MAX_MATERIALS`]; a file named like a bundled material takes its
+//! place (the user's measurement wins). A request names a material by its stem from that list
+//! (`paper_white_rgb`); anything else, a path included, is refused with the valid names, so no
+//! request reaches a file that was not listed.
 //!
 //! **Computed once.** A material's fits take seconds (27 shared-`n` fits: 13 lobes in both
 //! geometries and GGX), so each material's result is computed at its first request, through
@@ -36,6 +38,7 @@ use specula::{Exponent, Lobe, LobeKind};
 use specula_render::ibl::{render_ibl_with, IblSettings, Reflectance, Strategy};
 use specula_render::measured::{
     load_measured, material_scene, FittedReflectance, MeasuredBrdf, MeasuredReflectance,
+    BUNDLED_MATERIALS,
 };
 
 use super::api::{
@@ -57,8 +60,8 @@ pub const MAX_MATERIAL_RENDER_SPP: u32 = 64;
 /// What a material render shows besides its fits: the measurement itself.
 pub const MEASURED: &str = "measured";
 
-/// The measured materials the server offers: the files of its `--data` folder, each with its
-/// fits once computed.
+/// The measured materials the server offers: the bundled ones and the files of its `--data`
+/// folder, each with its fits once computed.
 #[derive(Debug, Default)]
 pub struct Materials {
     entries: Vec<Entry>,
@@ -69,8 +72,27 @@ pub struct Materials {
 #[derive(Debug)]
 struct Entry {
     name: String,
-    path: PathBuf,
+    source: Source,
     assessment: OnceLock<Result<Arc<Assessment>, String>>,
+}
+
+/// Where a material's bytes come from.
+#[derive(Debug)]
+enum Source {
+    /// Embedded in the binary ([`BUNDLED_MATERIALS`]).
+    Bundled(&'static [u8]),
+    /// A file of the `--data` folder.
+    File(PathBuf),
+}
+
+impl Entry {
+    fn new(name: String, source: Source) -> Self {
+        Self {
+            name,
+            source,
+            assessment: OnceLock::new(),
+        }
+    }
 }
 
 /// A material's shared-`n` fits (in `fit_all`'s order) and the view's JSON of them.
@@ -89,22 +111,40 @@ impl Assessment {
 }
 
 impl Materials {
-    /// No folder: the view says how to give one.
+    /// No material: the view says how to give one.
     #[must_use]
     pub fn none() -> Self {
         Self::default()
     }
 
-    /// The `*.bsdf` files directly in `folder` whose final target is a regular file, by name.
-    /// Refused, in a line: a folder that cannot be listed, one with no such file, or one with
-    /// more than [`MAX_MATERIALS`]. Entries whose names are not UTF-8 are left out and said in
-    /// the second value, one line each.
+    /// The five materials specula carries ([`BUNDLED_MATERIALS`]), read from the binary.
+    #[must_use]
+    pub fn bundled() -> Self {
+        Self::from_entries(
+            BUNDLED_MATERIALS
+                .iter()
+                .map(|&(name, bytes)| Entry::new(name.to_owned(), Source::Bundled(bytes)))
+                .collect(),
+        )
+    }
+
+    /// The `*.bsdf` files directly in `folder` whose final target is a regular file, by name,
+    /// alone.
     pub fn from_folder(folder: &Path) -> Result<(Self, Vec<String>), String> {
+        Self::none().with_folder(folder)
+    }
+
+    /// These materials and the `*.bsdf` files directly in `folder` whose final target is a
+    /// regular file, by name; a file named like one of these takes its place. Refused, in a
+    /// line: a folder that cannot be listed, one with no such file, or one with more than
+    /// [`MAX_MATERIALS`]. Entries whose names are not UTF-8 are left out, and files that take a
+    /// bundled material's place said, in the second value, one line each.
+    pub fn with_folder(self, folder: &Path) -> Result<(Self, Vec<String>), String> {
         let shown = folder.display();
         let listing = std::fs::read_dir(folder)
             .map_err(|e| format!("--data {shown}: cannot list the folder: {e}"))?;
-        let mut entries = Vec::new();
-        let mut skipped = Vec::new();
+        let mut found = Vec::new();
+        let mut notes = Vec::new();
         for item in listing {
             let item = item.map_err(|e| format!("--data {shown}: cannot list the folder: {e}"))?;
             let path = item.path();
@@ -115,34 +155,48 @@ impl Materials {
                 continue;
             }
             let Some(name) = path.file_stem().and_then(|s| s.to_str()) else {
-                skipped.push(format!(
+                notes.push(format!(
                     "{}: left out, its name is not UTF-8",
                     path.display()
                 ));
                 continue;
             };
-            if entries.len() == MAX_MATERIALS {
+            if found.len() == MAX_MATERIALS {
                 return Err(format!(
                     "--data {shown} holds more than {MAX_MATERIALS} .bsdf files; the explorer offers at most {MAX_MATERIALS}: pass a folder with fewer (links to the files will do)"
                 ));
             }
-            entries.push(Entry {
-                name: name.to_owned(),
-                path: path.clone(),
-                assessment: OnceLock::new(),
-            });
+            found.push(Entry::new(name.to_owned(), Source::File(path.clone())));
         }
-        if entries.is_empty() {
+        if found.is_empty() {
             return Err(format!(
                 "--data {shown} holds no .bsdf file (measured materials are read from the folder itself, not its subfolders)"
             ));
         }
+        let mut entries = self.entries;
+        for entry in found {
+            if let Some(at) = entries.iter().position(|e| e.name == entry.name) {
+                if let Source::File(path) = &entry.source {
+                    notes.push(format!(
+                        "{}: offered as `{}` instead of the bundled material of that name",
+                        path.display(),
+                        entry.name
+                    ));
+                }
+                entries[at] = entry;
+            } else {
+                entries.push(entry);
+            }
+        }
+        Ok((Self::from_entries(entries), notes))
+    }
+
+    fn from_entries(mut entries: Vec<Entry>) -> Self {
         entries.sort_by(|a, b| a.name.cmp(&b.name));
-        let materials = Self {
+        Self {
             entries,
             loaded: Mutex::new(None),
-        };
-        Ok((materials, skipped))
+        }
     }
 
     /// The names offered, sorted.
@@ -181,7 +235,7 @@ impl Materials {
             .clone()
     }
 
-    /// The material at `index`, read from its file unless it was the last one read.
+    /// The material at `index`, read from its bytes unless it was the last one read.
     fn load(&self, index: usize) -> Result<Arc<MeasuredBrdf>, String> {
         let mut loaded = self.loaded.lock().unwrap_or_else(|e| e.into_inner());
         if let Some((at, material)) = loaded.as_ref() {
@@ -190,12 +244,18 @@ impl Materials {
             }
         }
         let entry = &self.entries[index];
-        let material = Arc::new(load_measured(&entry.path).map_err(|message| {
-            // The file's folder is the server's business; its name is the material's.
-            let prefix = format!("{}: ", entry.path.display());
-            let reason = message.strip_prefix(&prefix).unwrap_or(&message);
-            format!("the material `{}` cannot be read: {reason}", entry.name)
-        })?);
+        let read = match &entry.source {
+            Source::Bundled(bytes) => MeasuredBrdf::from_bytes(bytes).map_err(|e| e.to_string()),
+            Source::File(path) => load_measured(path).map_err(|message| {
+                // The file's folder is the server's business; its name is the material's.
+                let prefix = format!("{}: ", path.display());
+                message.strip_prefix(&prefix).unwrap_or(&message).to_owned()
+            }),
+        };
+        let material =
+            Arc::new(read.map_err(|reason| {
+                format!("the material `{}` cannot be read: {reason}", entry.name)
+            })?);
         *loaded = Some((index, Arc::clone(&material)));
         Ok(material)
     }
@@ -453,7 +513,7 @@ fn material(params: &Params, materials: &Materials) -> Result<usize, ApiError> {
 }
 
 /// What the view says when the server has no materials.
-const NO_DATA: &str = "the server offers no measured materials: start it with `specula serve --data DIR`, DIR a folder of RGL .bsdf files";
+const NO_DATA: &str = "the server offers no measured materials: start it with `specula serve` (the five bundled ones) or `specula serve --data DIR`, DIR a folder of RGL .bsdf files";
 
 /// The material's fits: the cached ones at once, or computed in a turn of the queue.
 async fn assessment(state: &AppState, index: usize) -> Result<Arc<Assessment>, Response> {

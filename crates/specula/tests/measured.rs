@@ -197,7 +197,7 @@ fn malformed_files_are_refused_in_one_line() {
 
 /// The real RGL files (isotropic RGB), outside the repository, sorted.
 fn rgl_files() -> Vec<PathBuf> {
-    let folder = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/rgl");
+    let folder = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/rgl");
     let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
         .unwrap_or_else(|e| panic!("{folder}: {e}"))
         .map(|entry| entry.unwrap().path())

@@ -87,10 +87,9 @@ impl Cache {
             result: result.clone(),
         };
         let text = serde_json::to_string_pretty(&entry).map_err(std::io::Error::other)?;
-        let mut file = tempfile::NamedTempFile::new_in(&self.directory)?;
-        file.write_all(text.as_bytes())?;
-        file.persist(self.path(key)).map_err(|e| e.error)?;
-        Ok(())
+        let mut file = specula_temporaries::file_in(&self.directory, ".tmp", Some(0o666))?;
+        file.as_file_mut().write_all(text.as_bytes())?;
+        file.persist(&self.path(key))
     }
 }
 

@@ -268,7 +268,7 @@ pub fn synthesize_or(
     if on_miss == OnMiss::Skip {
         return Ok(None);
     }
-    let scratch = tempfile::tempdir()?;
+    let scratch = specula_temporaries::dir("synth-")?;
     let design = format!("{} at {bits} bits for {}", lobe.id(), target.name());
     std::fs::write(scratch.path().join(SOURCE), &source)?;
     std::fs::write(scratch.path().join(HARNESS_SOURCE), timing_harness)?;
@@ -383,7 +383,7 @@ fn report_error(tool: Tool, design: &str, problem: String) -> SynthError {
 pub fn generic_netlist(lobe: HwLobe, bits: u32) -> Result<String, SynthError> {
     let datapath = lobe.build(bits)?;
     ToolVersions::find(Target::Generic)?;
-    let scratch = tempfile::tempdir()?;
+    let scratch = specula_temporaries::dir("synth-")?;
     std::fs::write(
         scratch.path().join(SOURCE),
         verilog::module(&datapath, lobe, bits),

@@ -22,9 +22,10 @@ pub struct Args {
     /// Open the explorer in the default browser.
     #[arg(long)]
     open: bool,
-    /// A folder of measured materials (RGL isotropic RGB `.bsdf` files) for the explorer's
-    /// measured-materials view: the files directly in it, listed at start-up (at most 64),
-    /// offered by name; each is fitted at its first request (seconds) and kept.
+    /// A folder of measured materials (RGL isotropic RGB `.bsdf` files) that the explorer's
+    /// measured-materials view offers beside the five bundled ones: the files directly in it,
+    /// listed at start-up (at most 64), offered by name (a file named like a bundled material
+    /// takes its place); each is fitted at its first request (seconds) and kept.
     #[arg(long, value_name = "DIR")]
     data: Option<PathBuf>,
 }
@@ -33,22 +34,24 @@ pub struct Args {
 pub fn run(args: &Args) -> CommandResult {
     let materials = match &args.data {
         Some(folder) => {
-            let (materials, skipped) = Materials::from_folder(folder)?;
-            for line in skipped {
-                eprintln!("warning: {line}");
+            let (materials, notes) = Materials::bundled().with_folder(folder)?;
+            for line in notes {
+                eprintln!("note: {line}");
             }
-            let names: Vec<&str> = materials.names().collect();
-            println!(
-                "{} measured material{} from {}: {}",
-                names.len(),
-                if names.len() == 1 { "" } else { "s" },
-                folder.display(),
-                names.join(", ")
-            );
             materials
         }
-        None => Materials::none(),
+        None => Materials::bundled(),
     };
+    let names: Vec<&str> = materials.names().collect();
+    println!(
+        "{} measured materials (the bundled ones{}): {}",
+        names.len(),
+        args.data
+            .as_ref()
+            .map(|folder| format!(" and {}", folder.display()))
+            .unwrap_or_default(),
+        names.join(", ")
+    );
     specula_serve::serve(
         SocketAddr::new(args.bind, args.port),
         args.open,

@@ -252,7 +252,7 @@ pub fn write(volume: &Volume, path: &Path) -> Result<(), VolumeError> {
         xyzt_units: 2,
         ..NiftiHeader::default()
     };
-    let staging = tempfile::tempdir().map_err(|e| fail(e.to_string()))?;
+    let staging = specula_temporaries::dir("nifti-").map_err(|e| fail(e.to_string()))?;
     let name = if is_gz(path) {
         "volume.nii.gz"
     } else {

@@ -1,6 +1,6 @@
-//! The measured-materials view through the router: the `--data` folder's listing, the fits of
-//! a real RGL material against the library's, the cache, and refusals of anything but a
-//! listed name.
+//! The measured-materials view through the router: the bundled materials, the `--data`
+//! folder's listing, the fits of a real RGL material against the library's, the cache, and
+//! refusals of anything but a listed name.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -20,8 +20,8 @@ use crate::api::AppState;
 use crate::measured::{Materials, MAX_MATERIALS, POLAR_POINTS};
 use crate::router_with;
 
-/// The real RGL files (isotropic RGB), outside the repository.
-const RGL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/rgl");
+/// The real RGL files (isotropic RGB) the repository carries, read as files.
+const RGL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/rgl");
 
 const NAMES: [&str; 5] = [
     "cc_ibiza_sunset_rgb",
@@ -31,12 +31,9 @@ const NAMES: [&str; 5] = [
     "vch_golden_yellow_rgb",
 ];
 
-/// The router offering the RGL folder's materials.
+/// The router offering the bundled materials (the binary's copies of the RGL files).
 fn with_rgl() -> Router {
-    let (materials, skipped) =
-        Materials::from_folder(Path::new(RGL)).unwrap_or_else(|e| panic!("{RGL}: {e}"));
-    assert!(skipped.is_empty(), "{skipped:?}");
-    router_with(AppState::default().with_materials(materials))
+    router_with(AppState::default().with_materials(Materials::bundled()))
 }
 
 async fn json_from(app: &Router, uri: &str) -> (StatusCode, Value) {
@@ -307,6 +304,47 @@ async fn a_real_materials_fits_are_the_librarys_and_computed_once() {
 
 /// The folder's listing: `*.bsdf` regular files (or links to them) directly in it, by stem;
 /// anything else left out; an empty folder, a missing one and one over the bound refused.
+#[test]
+fn the_bundled_materials_are_the_repositorys_files_byte_for_byte() {
+    let materials = Materials::bundled();
+    assert_eq!(materials.names().collect::<Vec<_>>(), NAMES);
+    for (name, bytes) in specula_render::measured::BUNDLED_MATERIALS {
+        let file = std::fs::read(Path::new(RGL).join(format!("{name}.bsdf"))).expect("file");
+        assert!(
+            file == bytes,
+            "{name}: the embedded bytes differ from the file's"
+        );
+    }
+    let folder_only = Materials::from_folder(Path::new(RGL)).expect("listed").0;
+    assert_eq!(folder_only.names().collect::<Vec<_>>(), NAMES);
+}
+
+#[test]
+fn a_folder_adds_to_the_bundled_materials_and_its_namesakes_take_their_place() {
+    let scratch = Scratch::new("beside");
+    std::fs::write(scratch.0.join("mine.bsdf"), b"not a material").expect("write");
+    std::fs::write(scratch.0.join("paper_white_rgb.bsdf"), b"not paper").expect("write");
+    let (materials, notes) = Materials::bundled()
+        .with_folder(&scratch.0)
+        .expect("listed");
+    let mut expected = NAMES.to_vec();
+    expected.push("mine");
+    expected.sort_unstable();
+    assert_eq!(materials.names().collect::<Vec<_>>(), expected);
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(notes[0].contains("paper_white_rgb"), "{notes:?}");
+    // The user's file is the one read: it is no material.
+    let costs = AppState::default().costs;
+    let paper = materials.find("paper_white_rgb").expect("listed");
+    let error = materials
+        .assess(paper, &costs)
+        .expect_err("the user's file");
+    assert!(
+        error.starts_with("the material `paper_white_rgb` cannot be read"),
+        "{error}"
+    );
+}
+
 #[test]
 fn the_folder_is_listed_once_with_regular_bsdf_files_only() {
     let scratch = Scratch::new("listing");

@@ -231,7 +231,7 @@ fn time_mitsuba(
 pub fn run(args: &Args) -> CommandResult {
     let spp = args.spp;
     let sky = Environment::sky(SKY_WIDTH);
-    let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let scratch = specula_temporaries::dir("bench-").map_err(|e| e.to_string())?;
     write_image(
         &scratch.path().join("sky.exr"),
         sky.image(),

@@ -40,7 +40,7 @@ pub fn run(args: &Args) -> CommandResult {
         args.frames as usize,
     )?;
     let threads = rayon::current_num_threads();
-    let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let scratch = specula_temporaries::dir("bench-").map_err(|e| e.to_string())?;
     let vtk_output = scratch.path().join("vtk.png");
     let vtk =
         vtk_peer::nifti_file(Path::new(&args.input), &volume, scratch.path()).and_then(|file| {

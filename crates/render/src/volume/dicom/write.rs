@@ -10,7 +10,6 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::LPS_TO_RAS;
-use crate::output::register;
 use crate::volume::{Units, Volume, VolumeError};
 
 /// Writes `volume` into the new (or empty) folder `dir` as a series of 16-bit slices, one per
@@ -43,12 +42,9 @@ pub fn write_series(volume: &Volume, dir: &Path) -> Result<(), VolumeError> {
         Some(parent) if !parent.as_os_str().is_empty() => parent.to_owned(),
         _ => PathBuf::from("."),
     };
-    let staging = tempfile::Builder::new()
-        .prefix(".specula-series-")
-        .tempdir_in(&parent)
-        .map_err(|e| fail(e.to_string()))?;
     // Registered, so that an interrupted run's signal handler removes it.
-    register(staging.path(), true);
+    let staging =
+        specula_temporaries::dir_in(&parent, "series-").map_err(|e| fail(e.to_string()))?;
     let [nx, ny, nz] = volume.dims();
     let (lo, hi) = volume.range();
     let (slope, intercept, modality, class) = match volume.units() {
@@ -146,13 +142,9 @@ pub fn write_series(volume: &Volume, dir: &Path) -> Result<(), VolumeError> {
         )
     });
     // rename(2) replaces an empty folder, so an existing empty target needs no removal.
-    let staged = staging.keep();
-    let result = written.and_then(|()| std::fs::rename(&staged, dir).map_err(|e| e.to_string()));
-    if result.is_err() {
-        let _ = std::fs::remove_dir_all(&staged);
-    }
-    register(&staged, false);
-    result.map_err(fail)
+    written
+        .and_then(|()| staging.persist(dir).map_err(|e| e.to_string()))
+        .map_err(fail)
 }
 
 fn write_slice(object: &DefaultDicomObject, path: &Path) -> Result<(), String> {
