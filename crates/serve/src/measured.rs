@@ -166,7 +166,7 @@ impl Materials {
                     "--data {shown} holds more than {MAX_MATERIALS} .bsdf files; the explorer offers at most {MAX_MATERIALS}: pass a folder with fewer (links to the files will do)"
                 ));
             }
-            found.push(Entry::new(name.to_owned(), Source::File(path.clone())));
+            found.push((name.to_owned(), path.clone()));
         }
         if found.is_empty() {
             return Err(format!(
@@ -174,18 +174,18 @@ impl Materials {
             ));
         }
         let mut entries = self.entries;
-        for entry in found {
-            if let Some(at) = entries.iter().position(|e| e.name == entry.name) {
-                if let Source::File(path) = &entry.source {
-                    notes.push(format!(
-                        "{}: offered as `{}` instead of the bundled material of that name",
-                        path.display(),
-                        entry.name
-                    ));
-                }
-                entries[at] = entry;
-            } else {
-                entries.push(entry);
+        for (name, path) in found {
+            let at = entries.iter().position(|e| e.name == name);
+            if at.is_some() {
+                notes.push(format!(
+                    "{}: offered as `{name}` instead of the material of that name already offered",
+                    path.display()
+                ));
+            }
+            let entry = Entry::new(name, Source::File(path));
+            match at {
+                Some(at) => entries[at] = entry,
+                None => entries.push(entry),
             }
         }
         Ok((Self::from_entries(entries), notes))
