@@ -131,14 +131,9 @@ impl Costing {
                             cache.as_ref(),
                         )
                         .map_err(|e| e.to_string())?;
-                        match synthesis.logic_ns_per_result() {
-                            Some(lut_ns) => 1e6 / lut_ns,
-                            // Placed nowhere: it does not fit the part (the note says why).
-                            None => {
-                                datapath += " (does not fit the iCE40 HX8K)";
-                                0.0
-                            }
-                        }
+                        let (rate, unfit) = synthesized_rate(&synthesis);
+                        datapath += unfit.unwrap_or_default();
+                        rate
                     }
                     _ => 1e3 / chosen.cells as f64,
                 };
@@ -149,6 +144,16 @@ impl Costing {
                 })
             }
         })
+    }
+}
+
+/// A synthesized datapath's rate in results per microsecond per 1000 LUTs, and what its name
+/// gains where nextpnr placed it nowhere: it does not fit the part (the synthesis's note says
+/// why), and a rate of 0 keeps it from meeting any request.
+fn synthesized_rate(synthesis: &specula_synth::Synthesis) -> (f64, Option<&'static str>) {
+    match synthesis.logic_ns_per_result() {
+        Some(lut_ns) => (1e6 / lut_ns, None),
+        None => (0.0, Some(" (does not fit the iCE40 HX8K)")),
     }
 }
 
@@ -190,5 +195,43 @@ pub fn rate_unit(target: Target) -> &'static str {
         // Costing the FPGA would run its sweeps; material verdicts refuse it anyway.
         Target::Fpga => "",
         _ => Costing::new(target, &[]).map_or("", |(costing, _)| costing.unit()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn synthesis(fmax_mhz: Option<f64>) -> specula_synth::Synthesis {
+        specula_synth::Synthesis {
+            lobe: "schlick-mod".to_owned(),
+            bits: 16,
+            target: FPGA_TARGET,
+            tools: specula_synth::ToolVersions {
+                yosys: "Yosys 0.23".to_owned(),
+                nextpnr: Some("nextpnr-ice40 0.4".to_owned()),
+            },
+            cells: specula_synth::report::Cells {
+                logic: 2000,
+                ..Default::default()
+            },
+            fmax_mhz,
+            fmax_note: fmax_mhz
+                .is_none()
+                .then(|| "does not fit the HX8K once packed".to_owned()),
+            logic_cells_placed: None,
+            latency: 11,
+        }
+    }
+
+    /// 2000 LUTs at 10 MHz cost 2000 x 100 ns = 200,000 LUT x ns per result: 5 results per
+    /// microsecond per 1000 LUTs. Placed nowhere, the datapath costs nothing it could run.
+    #[test]
+    fn a_placed_datapath_is_costed_by_its_area_and_clock_and_an_unplaced_one_not_at_all() {
+        let (rate, unfit) = synthesized_rate(&synthesis(Some(10.0)));
+        assert!((rate - 5.0).abs() < 1e-12 && unfit.is_none(), "{rate}");
+        let (rate, unfit) = synthesized_rate(&synthesis(None));
+        assert_eq!(rate, 0.0);
+        assert!(unfit.unwrap().contains("does not fit the iCE40 HX8K"));
     }
 }

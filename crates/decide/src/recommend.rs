@@ -393,6 +393,37 @@ mod tests {
         assert_eq!(pareto_front(&points), [true, true, false, false]);
     }
 
+    /// A datapath nextpnr could not place (rate 0, named "does not fit") does not meet even
+    /// within the error, and ranks below one that was placed.
+    #[test]
+    fn a_datapath_that_does_not_fit_the_part_does_not_meet() {
+        let tally = |kind: LobeKind, rate: f64, datapath: &str| {
+            let mut tally = Tally {
+                kind: Some(kind),
+                ..Tally::default()
+            };
+            tally.add(Some(Point {
+                error: 0.03,
+                rate,
+                datapath: Some(datapath.to_owned()),
+            }));
+            tally.candidate("unit", 0.05, false)
+        };
+        let unfit = tally(
+            LobeKind::SchlickMod,
+            0.0,
+            "schlick-mod at 16 bits (does not fit the iCE40 HX8K)",
+        );
+        let placed = tally(LobeKind::Sg, 2.5, "sg at 14 bits");
+        let answer = rank(vec![unfit, placed], "unit", None, Target::Fpga, 0.05);
+        let [first, second] = answer.candidates.as_slice() else {
+            panic!("two candidates: {:?}", answer.candidates);
+        };
+        assert!(first.meets && first.lobe == LobeKind::Sg.id(), "{first:?}");
+        assert!(!second.meets && second.rate == 0.0, "{second:?}");
+        assert!(second.datapath.as_deref().unwrap().contains("does not fit"));
+    }
+
     #[test]
     fn bad_requests_are_refused_in_one_line() {
         let n = vec![Exponent::new(64.0)];

@@ -1,6 +1,6 @@
 """Shared fixtures: the CLI binary the package must agree with, and the data folders.
 
-The runner (crates/cli/tests/python.rs) sets SPECULA_BIN to the `specula` it built; the
+The runner (crates/cli/tests/suite/python.rs) sets SPECULA_BIN to the `specula` it built; the
 shared data folder and the Debian data packages are where .ci/run puts them.
 """
 
@@ -29,7 +29,7 @@ def cli():
     """Runs the `specula` command; returns (exit code, stdout, stderr)."""
     binary = os.environ.get("SPECULA_BIN") or shutil.which("specula")
     if not binary:
-        required("the specula binary", "set SPECULA_BIN (crates/cli/tests/python.rs does)")
+        required("the specula binary", "set SPECULA_BIN (crates/cli/tests/suite/python.rs does)")
 
     def run(*args: str):
         done = subprocess.run(

@@ -5,7 +5,7 @@
 //! Both are needed: the CT (Debian's `invesalius-examples`) and the Python with nibabel (the
 //! virtual environment `.ci/run` makes in `target/venv`, or `$SPECULA_PYTHON`). Without one a
 //! run prints `skipped: ...`, except under `CI=true`, where `.ci/run` installs both and a
-//! missing one is a failure (the conventions of `crates/cli/tests/common/mod.rs`).
+//! missing one is a failure (the conventions of `crates/cli/tests/suite/common.rs/mod.rs`).
 
 use std::path::{Path, PathBuf};
 

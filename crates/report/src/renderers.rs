@@ -100,17 +100,17 @@ pub fn renderers(context: &mut Context) -> Result<String, String> {
             vec![
                 "Blender Cycles (OSL)".into(),
                 "script node: Lobe output, the exact specular term as emission, GGX closure at the fitted alpha; n an input".into(),
-                "every lobe's node compiles in Blender 5.0's OSL compiler; Cycles renders every lobe on a sphere within 1 % of specula's render of the same scene (crates/cli/tests/blender.rs)".into(),
+                "every lobe's node compiles in Blender 5.0's OSL compiler; Cycles renders every lobe on a sphere within 1 % of specula's render of the same scene (crates/cli/tests/suite/blender.rs)".into(),
             ],
             vec![
                 "MaterialX".into(),
                 "the lobe as a node graph of standard nodes; a BSDF exact under each light in GLSL, ESSL and MSL, GGX at the fitted roughness in OSL and MDL".into(),
-                "every lobe's document validates and MaterialX 1.39 generates GLSL, ESSL, MSL, OSL and MDL; glslangValidator accepts the GLSL and ESSL, an OSL compiler the OSL (MSL and MDL are generated, not compiled); the lobe's node graph, evaluated as MaterialX defines its nodes, is the lobe within 1e-4 (crates/cli/tests/materialx.rs)".into(),
+                "every lobe's document validates and MaterialX 1.39 generates GLSL, ESSL, MSL, OSL and MDL; glslangValidator accepts the GLSL and ESSL, an OSL compiler the OSL (MSL and MDL are generated, not compiled); the lobe's node graph, evaluated as MaterialX defines its nodes, is the lobe within 1e-4 (crates/cli/tests/suite/materialx.rs)".into(),
             ],
             vec![
                 "Mitsuba 3".into(),
                 "Python BSDF plugin in Dr.Jit: eval, pdf, sample, eval_pdf, specula's normalisations; the cosine drawn as specula draws it: the recorded closed-form inverse (pow, sg, sg-karis, cosquad), safeguarded Newton on the recorded tail (schlick, cheb2-thesis), specula's table (the rest)".into(),
-                "Mitsuba's chi-square test passes for every lobe at n = 8, 64, 512, both geometries, three angles; Mitsuba's direct integrator renders the environment scene's sphere within the noise of specula's (crates/cli/tests/mitsuba.rs)".into(),
+                "Mitsuba's chi-square test passes for every lobe at n = 8, 64, 512, both geometries, three angles; Mitsuba's direct integrator renders the environment scene's sphere within the noise of specula's (crates/cli/tests/suite/mitsuba.rs)".into(),
             ],
         ],
     ));

@@ -1,5 +1,5 @@
 //! The measured-material reader on its own (no Python; Mitsuba's side is
-//! `crates/cli/tests/measured.rs`): what `MeasuredBrdf::from_bytes` refuses, built byte by
+//! `crates/cli/tests/suite/measured.rs`): what `MeasuredBrdf::from_bytes` refuses, built byte by
 //! byte here, and on the real RGL files two consistency checks by independent means: the
 //! sampler's density and value against `pdf` and `f`, and its importance-sampled albedo
 //! against a deterministic quadrature of `f_cos`.

@@ -79,6 +79,23 @@ impl Cache {
         (entry.key == key).then_some(entry.result)
     }
 
+    /// Holds `key` until the returned file is dropped: another process (or thread) asking for
+    /// the same design waits here and then finds the first one's result, rather than running
+    /// the tools on the same work at the same time (tests side by side, two reports at once).
+    /// The lock is the operating system's (`flock`), so a killed holder releases it. The
+    /// small lock files stay: removing one another process has open would let a third lock a
+    /// new file of the same name.
+    pub fn hold(&self, key: &str) -> std::io::Result<std::fs::File> {
+        std::fs::create_dir_all(&self.directory)?;
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(self.directory.join(format!("{key}.lock")))?;
+        file.lock()?;
+        Ok(file)
+    }
+
     /// Stores `result` under `key`, atomically.
     pub fn store(&self, key: &str, result: &Synthesis) -> std::io::Result<()> {
         std::fs::create_dir_all(&self.directory)?;
@@ -96,6 +113,31 @@ impl Cache {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// While one holder has a key, a second waits; once the first is dropped it proceeds.
+    #[test]
+    fn a_held_key_makes_the_next_holder_wait() {
+        let directory = tempfile::tempdir().unwrap();
+        let cache = Cache::new(directory.path());
+        let first = cache.hold("k").unwrap();
+        let waited = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let second = {
+            let (cache, waited) = (cache.clone(), waited.clone());
+            std::thread::spawn(move || {
+                let _held = cache.hold("k").unwrap();
+                waited.load(std::sync::atomic::Ordering::SeqCst)
+            })
+        };
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        waited.store(true, std::sync::atomic::Ordering::SeqCst);
+        drop(first);
+        assert!(
+            second.join().unwrap(),
+            "the second holder did not wait for the first"
+        );
+        let other = cache.hold("other");
+        assert!(other.is_ok(), "another key is not held");
+    }
 
     #[test]
     fn keys_separate_their_parts_and_are_stable() {

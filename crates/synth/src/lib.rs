@@ -105,12 +105,15 @@ impl Target {
     }
 
     /// The Yosys script, run in the scratch directory, that synthesizes `top` from
-    /// [`SOURCE`] and writes `stat -json` to [`STAT`]; for iCE40 it then synthesizes the
-    /// timing harness around it ([`harness`]) into the netlist nextpnr reads, [`NETLIST`].
+    /// [`SOURCE`] and writes `stat -json` to [`STAT`]; for iCE40 it then places that same
+    /// mapped datapath in the timing harness ([`harness`]) and writes the netlist nextpnr
+    /// reads, [`NETLIST`]. The datapath is synthesized once: the harness is synthesized
+    /// around it as a black box (a shift register and an XOR, under a second), and the mapped
+    /// datapath is copied in, so nextpnr times exactly the netlist the resources count.
     fn yosys_script(self, top: &str) -> String {
-        let ice40 = |device: Ice40Device, top: &str| {
+        let ice40 = |device: Ice40Device, options: &str, top: &str| {
             format!(
-                "synth_ice40 -top {top}{}",
+                "synth_ice40{options} -top {top}{}",
                 if device == Ice40Device::Up5k {
                     " -dsp"
                 } else {
@@ -120,14 +123,18 @@ impl Target {
         };
         let synth = match self {
             Target::Generic => format!("synth -flatten -top {top}"),
-            Target::Ice40(device) => ice40(device, top),
+            Target::Ice40(device) => ice40(device, "", top),
             Target::Xilinx => format!("synth_xilinx -top {top} -family xc7"),
         };
         let stat = format!("read_verilog {SOURCE}; {synth}; tee -q -o {STAT} stat -json");
         match self {
             Target::Ice40(device) => format!(
-                "{stat}; design -reset; read_verilog {SOURCE} {HARNESS_SOURCE}; {} -json {NETLIST}",
-                ice40(device, harness::HARNESS)
+                "{stat}; design -stash datapath; \
+                 read_verilog -lib {SOURCE}; read_verilog {HARNESS_SOURCE}; {}; \
+                 delete ={top}; design -copy-from datapath {top}; \
+                 hierarchy -top {}; flatten; write_json {NETLIST}",
+                ice40(device, " -noflatten", harness::HARNESS),
+                harness::HARNESS
             ),
             Target::Generic | Target::Xilinx => stat,
         }
@@ -267,6 +274,11 @@ pub fn synthesize_or(
     }
     if on_miss == OnMiss::Skip {
         return Ok(None);
+    }
+    // Whoever held the key before us may have stored the result while we waited.
+    let _held = cache.map(|cache| cache.hold(&key)).transpose()?;
+    if let Some(hit) = cache.and_then(|cache| cache.load(&key)) {
+        return Ok(Some(hit));
     }
     let scratch = specula_temporaries::dir("synth-")?;
     let design = format!("{} at {bits} bits for {}", lobe.id(), target.name());

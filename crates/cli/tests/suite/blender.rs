@@ -10,11 +10,11 @@
 //! antialiasing alone): the largest difference and the RMS difference, in units of the
 //! highlight's peak.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 
-use common::{export_lobe, have_python_module, ok, run_python, sphere_obj};
+use crate::common::{export_lobe, have_python_module, ok, run_python, sphere_obj};
 use specula::LobeKind;
 
 const WIDTH: u32 = 160;

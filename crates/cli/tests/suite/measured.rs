@@ -3,11 +3,9 @@
 //! Mitsuba's `eval` and `MeasuredBrdf::pdf` its `pdf`, for every file of the shared RGL folder;
 //! and a file with one table altered disagrees, so the comparison can fail.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{have_python_module, run_python};
+use crate::common::{have_python_module, run_python};
 use glam::DVec3;
 use rand::{RngExt, SeedableRng};
 use specula_render::measured::load_measured;

@@ -1,11 +1,11 @@
 //! `specula render`, `diff` and `bench`: files written whole or not at all, figures from
 //! closed forms, bad input answered with a message and exit code 2.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 
-use common::{ok, specula};
+use crate::common::{ok, specula};
 use serde_json::Value;
 
 fn png_size(path: &Path) -> (u32, u32) {

@@ -1,7 +1,7 @@
 //! Bad real-world files: one line each, nothing written.
 
+use super::setup::{real_scans, scans, text};
 use crate::common::specula;
-use crate::setup::{real_scans, scans, text};
 
 /// The CT series with its slice at position rank 54 left out, the series with one slice's
 /// Pixel Spacing 0.5\0.5 (`real_scans.py bad-dicom`) and pydicom-data's emri_small.dcm (ten

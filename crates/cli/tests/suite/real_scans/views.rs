@@ -5,7 +5,7 @@ use std::path::Path;
 use serde_json::Value;
 use specula_render::Image;
 
-use crate::setup::{grid_box, real_scans_json, render, scans, text};
+use super::setup::{grid_box, real_scans_json, render, scans, text};
 
 /// How each view shows the patient (the views' definitions, `View`'s documentation): the
 /// world (RAS) directions of the image's right and up.

@@ -1,6 +1,5 @@
 //! Running the `specula` binary in a directory of the test's own, and the tools some tests
-//! need. Each test file compiles this module on its own and uses part of it.
-#![allow(dead_code)]
+//! need.
 
 use std::path::Path;
 

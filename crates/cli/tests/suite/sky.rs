@@ -1,9 +1,7 @@
 //! `specula sky`: the built-in sky written as a file is the sky `--env sky` lights with,
 //! pixel for pixel, and a render lit by the file is the render lit by `--env sky`.
 
-mod common;
-
-use common::{ok, specula};
+use crate::common::{ok, specula};
 
 #[test]
 fn the_written_sky_is_the_built_in_one() {

@@ -2,11 +2,9 @@
 //! head as NIfTI and as a DICOM series, drawn on the CPU and the GPU, by ray marching and as
 //! an isosurface; bad input refused in one line.
 
-mod common;
-
 use std::path::Path;
 
-use common::{have_gpu, ok, specula};
+use crate::common::{have_gpu, ok, specula};
 use specula_render::metrics::compare;
 use specula_render::{read_image, Display};
 

@@ -1,10 +1,10 @@
 //! The presets on the real CT and MRI: the CT as NIfTI and as a DICOM series (Hounsfield
 //! units recognised), and the presets against the voxels' silhouettes.
 
-use crate::common::python;
-use crate::setup::{
+use super::setup::{
     count, covered, dilate, fraction_in, iou, mean_abs, projection, render, rgb, scans, text,
 };
+use crate::common::python;
 
 /// The CT converted to NIfTI (int16 HU, no hint of units: recognised as CT by its value
 /// range, `Units::from_values`) and to a DICOM CT series (Modality CT, files in shuffled order,

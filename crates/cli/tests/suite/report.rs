@@ -7,9 +7,9 @@
 //! answers for its target, exponent and bound (on the FPGA, synthesized with Yosys and
 //! nextpnr, which `CI=true` requires).
 
-mod common;
+use crate::common;
 
-use common::{have_python_module, have_tool, ok, python};
+use crate::common::{have_python_module, have_tool, ok, python};
 
 /// The real scans the medical section shows, and the Debian packages that install them.
 const REAL_SCANS: [(&str, &str, &str); 2] = [

@@ -4,8 +4,8 @@ use std::path::Path;
 
 use specula_render::read_image;
 
+use super::setup::{count, grid_box, iou, mean_abs, render, rgb, scans, text, Pixels, Scans};
 use crate::common::{have_gpu, have_python_module, ok, python};
-use crate::setup::{count, grid_box, iou, mean_abs, render, rgb, scans, text, Pixels, Scans};
 
 /// An 8-bit PNG's values as written (VTK's framebuffer: linear values, no gamma), read through
 /// [`read_image`] (which decodes sRGB) and encoded back: exact for every byte (checked).

@@ -3,9 +3,9 @@
 //! MDL from it (the material, and a probe of the exact lobe node), glslangValidator accepts
 //! the GLSL and ESSL stages, and Blender's OSL compiler the OSL.
 
-mod common;
+use crate::common;
 
-use common::{export_lobe, have_python_module, have_tool, run_python};
+use crate::common::{export_lobe, have_python_module, have_tool, run_python};
 use specula::{Lobe, LobeKind};
 
 const TARGETS: [&str; 5] = ["glsl", "essl", "msl", "osl", "mdl"];

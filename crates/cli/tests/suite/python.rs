@@ -11,9 +11,7 @@
 use std::path::Path;
 use std::process::Command;
 
-mod common;
-
-use common::{have_python_module, python};
+use crate::common::{have_python_module, python};
 
 fn root() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")

@@ -3,9 +3,9 @@
 //! geometries and incidence angles 0, 35 and 70 degrees; the same file passes in
 //! `scalar_rgb`; and a plugin whose density is wrong fails, so the test can.
 
-mod common;
+use crate::common;
 
-use common::{export_lobe, have_python_module, ok, run_python};
+use crate::common::{export_lobe, have_python_module, ok, run_python};
 use specula::{Lobe, LobeKind};
 use specula_render::metrics::{mean_radiance, rms_difference};
 

@@ -9,15 +9,9 @@
 //! `specula bench volume`. Nothing is downloaded: without the packages a test prints
 //! `skipped: ...`, and under `CI=true` it fails.
 
-mod common;
-#[path = "real_scans/setup.rs"]
 mod setup;
 
-#[path = "real_scans/peers.rs"]
 mod peers;
-#[path = "real_scans/presets.rs"]
 mod presets;
-#[path = "real_scans/refusals.rs"]
 mod refusals;
-#[path = "real_scans/views.rs"]
 mod views;

@@ -3,11 +3,9 @@
 //! one, the verdict within the margin of pow's best and the cheapest such, GGX without
 //! `ks`); the table's verdict; and bad files refused in one line before any output.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{ok, specula};
+use crate::common::{ok, specula};
 use serde_json::Value;
 
 fn rgl(name: &str) -> PathBuf {

@@ -1,8 +1,6 @@
 //! `specula hw`: tables, Verilog and diagrams from the command line, and its refusals.
 
-mod common;
-
-use common::{have_tool, ok, specula};
+use crate::common::{have_tool, ok, specula};
 
 /// A command line's words.
 fn words(line: &str) -> Vec<&str> {

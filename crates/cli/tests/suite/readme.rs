@@ -2,7 +2,7 @@
 //! the two set-up commands lead the README and are what CI runs, and the reference is what
 //! `--help` prints.
 //!
-//! `UPDATE_REFERENCE=1 cargo test -p specula-cli --test readme` rewrites the reference from
+//! `UPDATE_REFERENCE=1 cargo test -p specula-cli --test suite readme::` rewrites the reference from
 //! `--help` after a command changes.
 
 use std::io::{BufRead, BufReader, Read, Write};
@@ -10,9 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
-
-use common::have_tool;
+use crate::common::have_tool;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -261,7 +259,7 @@ fn reference() -> (String, String) {
     let mut table = String::from("| command | what it does |\n|---|---|\n");
     let mut pages = String::from(
         "# Reference\n\nEvery command's `--help`, as it prints it (generated; \
-         `crates/cli/tests/readme.rs` checks it).\n",
+         `crates/cli/tests/suite/readme.rs` checks it).\n",
     );
     let mut add = |args: Vec<&str>, about: &str| {
         let name = format!("specula {}", args.join(" "));
@@ -283,7 +281,7 @@ fn reference() -> (String, String) {
 }
 
 const TABLE_START: &str =
-    "<!-- reference: generated from --help by crates/cli/tests/readme.rs -->\n";
+    "<!-- reference: generated from --help by crates/cli/tests/suite/readme.rs -->\n";
 const TABLE_END: &str = "<!-- end of reference -->";
 
 #[test]
@@ -302,10 +300,10 @@ fn the_reference_is_what_help_prints() {
     }
     assert!(
         readme == expected_readme,
-        "the README's command table differs from --help; run UPDATE_REFERENCE=1 cargo test -p specula-cli --test readme"
+        "the README's command table differs from --help; run UPDATE_REFERENCE=1 cargo test -p specula-cli --test suite readme::"
     );
     assert!(
         read("docs/reference.md") == pages,
-        "docs/reference.md differs from --help; run UPDATE_REFERENCE=1 cargo test -p specula-cli --test readme"
+        "docs/reference.md differs from --help; run UPDATE_REFERENCE=1 cargo test -p specula-cli --test suite readme::"
     );
 }

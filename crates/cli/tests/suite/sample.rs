@@ -2,9 +2,7 @@
 //! density of `t^n` about the mirror direction, the chi-square suite's line and images, and
 //! bad requests refused in one line.
 
-mod common;
-
-use common::{ok, specula};
+use crate::common::{ok, specula};
 
 /// `pow` in Phong form draws `wi` with density `(n + 1) / (2 pi) (r.wi)^n` about the mirror
 /// direction `r`: every printed pdf is that, and with the lobe's normalisation the value is

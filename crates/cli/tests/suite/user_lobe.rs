@@ -4,9 +4,9 @@
 //! every command with figures its closed forms predict, and bad formulas must be refused in
 //! one line each, before any work.
 
-mod common;
+use crate::common;
 
-use common::{ok, specula};
+use crate::common::{ok, specula};
 use serde_json::Value;
 
 fn lobe_file(name: &str) -> String {

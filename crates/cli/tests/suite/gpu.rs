@@ -2,10 +2,8 @@
 //! Tests that need an adapter are skipped without one, except under CI (`CI=true`), where
 //! `.ci/run` installs Mesa's lavapipe and a missing adapter is a failure.
 
-mod common;
-
+use crate::common::{have_gpu, have_tool, ok, specula};
 use assert_cmd::Command;
-use common::{have_gpu, have_tool, ok, specula};
 use serde_json::Value;
 
 #[test]

@@ -4,11 +4,9 @@
 //! and `emri_small.dcm` (an enhanced MR of ten frames without any functional groups) is
 //! refused in one line.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{have_python_module, ok, python, specula};
+use crate::common::{have_python_module, ok, python, specula};
 
 /// Whether the Python has pydicom, its test data and nibabel (under `CI=true`, it must).
 fn have_packages() -> bool {

@@ -3,13 +3,11 @@
 //! command-line values, inputs that are nasty but valid, and outputs that must survive a
 //! failed or interrupted render.
 
-mod common;
-
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
 
-use common::{ok, specula};
+use crate::common::{ok, specula};
 
 /// A copy of the corpus in a fresh directory, so that nothing is written into the sources.
 fn corpus_copy() -> tempfile::TempDir {

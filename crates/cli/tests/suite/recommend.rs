@@ -1,9 +1,7 @@
 //! `specula recommend`: its answer is confirmed by `specula analyze`, its front is a front,
 //! and bad requests are refused in one line.
 
-mod common;
-
-use common::{ok, specula};
+use crate::common::{ok, specula};
 use serde_json::Value;
 
 /// A command line's JSON answer (`line` split at spaces).
@@ -93,7 +91,7 @@ fn an_impossible_accuracy_leaves_the_exact_lobe_and_bad_requests_are_refused() {
 /// length costed, and the datapath's error is what `specula hw table` measures there.
 #[test]
 fn fpga_answers_come_from_the_datapaths() {
-    let rows = json("recommend --target fpga --n 64 --max-error 1% --format json");
+    let rows = json("recommend --target fpga --n 64 --max-error 2% --format json");
     let best = &rows[0];
     assert_eq!(best["meets"], true, "{best}");
     let datapath = best["datapath"].as_str().expect("a datapath is named");
