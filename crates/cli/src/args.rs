@@ -85,6 +85,17 @@ pub fn parse_cosine(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A margin over pow's fit error: a percentage in `[0, 100]`.
+pub fn parse_margin(text: &str) -> Result<f64, String> {
+    let number = text.trim().trim_end_matches('%');
+    match number.parse::<f64>() {
+        Ok(value) if (0.0..=100.0).contains(&value) => Ok(value / 100.0),
+        _ => Err(format!(
+            "'{text}' is not a margin in [0, 100] %; write it as 5% or 2.5"
+        )),
+    }
+}
+
 /// Parses an angle in degrees (any finite value; the lobe is symmetric and 0 past 90).
 pub fn parse_degrees(text: &str) -> Result<f64, String> {
     text.trim()

@@ -13,9 +13,9 @@ use specula_decide::material::{
 use specula_decide::Target;
 use specula_render::measured::{load_measured, material_name};
 
-use super::recommend::parse_margin;
 use super::CommandResult;
 use crate::args::described;
+use crate::args::parse_margin;
 use crate::output::Table;
 
 /// How `fit` prints.

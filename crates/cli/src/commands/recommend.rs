@@ -8,7 +8,7 @@ use specula_decide::material::{assess, lobes_to_fit, ranking, DEFAULT_MARGIN};
 use specula_decide::{recommend, versus_pow, Request, Target, Zone};
 
 use super::CommandResult;
-use crate::args::described;
+use crate::args::{described, parse_margin};
 use crate::output::Table;
 
 /// Arguments of `specula recommend`.
@@ -53,17 +53,6 @@ pub struct Exponents(Vec<Exponent>);
 
 fn parse_exponents(text: &str) -> Result<Exponents, String> {
     specula_decide::parse_exponents(text).map(Exponents)
-}
-
-/// A margin over pow's fit error: a percentage in `[0, 100]`.
-pub(crate) fn parse_margin(text: &str) -> Result<f64, String> {
-    let number = text.trim().trim_end_matches('%');
-    match number.parse::<f64>() {
-        Ok(value) if (0.0..=100.0).contains(&value) => Ok(value / 100.0),
-        _ => Err(format!(
-            "'{text}' is not a margin in [0, 100] %; write it as 5% or 2.5"
-        )),
-    }
 }
 
 fn parse_percent(text: &str) -> Result<f64, String> {
