@@ -341,7 +341,9 @@ fn alike_setup(
     )
     .map_err(|e| e.to_string())?;
     let folder = scratch.join(scan.key);
-    std::fs::create_dir_all(&folder).map_err(|e| e.to_string())?;
+    // Not `create_dir_all`: after an interrupt has removed the scratch folder, this must fail
+    // rather than make it again outside the temporaries' registry.
+    std::fs::create_dir(&folder).map_err(|e| format!("{}: {e}", folder.display()))?;
     let file = vtk_peer::nifti_file(Path::new(scan.path), volume, &folder)?;
     let job = vtk::job(
         volume,
