@@ -1,5 +1,5 @@
-//! Replays the API and formula fuzzers' seeds and every crash input they found
-//! (`fuzz/regressions/{api,formula}/`) through the fuzz targets' own checks, so that CI needs
+//! Replays the API, formula and analysis fuzzers' seeds and every crash input they found
+//! (`fuzz/regressions/{api,formula,analysis}/`) through the fuzz targets' own checks, so that CI needs
 //! no fuzzer.
 
 use std::path::Path;
@@ -8,6 +8,8 @@ use std::path::Path;
 mod api;
 #[path = "../../../fuzz/fuzz_targets/checks/formula.rs"]
 mod formula;
+#[path = "../../../fuzz/fuzz_targets/checks/analysis.rs"]
+mod analysis;
 
 /// Every seed and regression input of `target`, run through `check`; how many there were.
 fn replay(target: &str, check: fn(&[u8])) -> usize {
@@ -42,5 +44,13 @@ fn fuzz_formulas_are_lobes_in_range_or_one_line_refusals() {
     assert!(
         replay("formula", formula::check_formula) >= 5,
         "the formula seeds are missing"
+    );
+}
+
+#[test]
+fn fuzz_formulas_are_analysed_in_bounded_time() {
+    assert!(
+        replay("analysis", analysis::check_analysis) >= 3,
+        "the analysis seeds are missing"
     );
 }

@@ -19,7 +19,7 @@ use core::f64::consts::PI;
 use serde::Serialize;
 
 use crate::error::{parse_choice, Error, Result};
-use crate::quadrature::integrate_pieces;
+use crate::quadrature::{integral_of_pieces, Integral};
 use crate::real::Real;
 use crate::{zones, Exponent, Lobe};
 
@@ -122,10 +122,18 @@ impl core::str::FromStr for Normalisation {
 /// only to `1e-12` rad, which leaves a jump straddling a panel that no refinement resolves.
 #[must_use]
 pub fn lobe_integral(lobe: &Lobe) -> f64 {
+    lobe_integral_estimate(lobe).value
+}
+
+/// [`lobe_integral`] with its error estimate and whether it met its tolerance within the
+/// quadrature's budget ([`crate::quadrature::MAX_PANELS`]): a formula whose `f64` values carry
+/// cancellation noise may not.
+#[must_use]
+pub fn lobe_integral_estimate(lobe: &Lobe) -> Integral {
     let scale = 1.0 / (lobe.exponent().get() + 1.0);
     let kinks = lobe.kinks();
     if kinks.is_empty() {
-        return integrate_pieces(
+        return integral_of_pieces(
             |g| lobe.eval_angle(g) * g.sin(),
             &zones::breakpoints(lobe),
             1e-13 * scale,
@@ -134,7 +142,7 @@ pub fn lobe_integral(lobe: &Lobe) -> f64 {
     let n = lobe.exponent();
     let mut cuts = vec![0.0, zones::bloom_cos(n), zones::epicentre_cos(n), 1.0];
     cuts.extend(kinks);
-    integrate_pieces(|t| lobe.eval(t), &cuts, 1e-13 * scale)
+    integral_of_pieces(|t| lobe.eval(t), &cuts, 1e-13 * scale)
 }
 
 /// The constant that makes `lobe` integrate to 1 over the hemisphere around its axis:

@@ -77,7 +77,7 @@ pub fn check_formula(data: &[u8]) {
 }
 
 /// The lobe `text` defines, or `None` when it is refused (with a one-line message).
-fn lobe(text: &str) -> Option<LobeKind> {
+pub(crate) fn lobe(text: &str) -> Option<LobeKind> {
     static DEFINED: Mutex<Option<HashMap<String, LobeKind>>> = Mutex::new(None);
     static NEXT: AtomicUsize = AtomicUsize::new(1);
     let mut defined = DEFINED

@@ -68,6 +68,14 @@ pub fn run(args: &Args) -> CommandResult {
         }
     };
     progress.finish_and_clear();
+    for r in reports.iter().filter(|r| !r.energy_converged) {
+        eprintln!(
+            "note: {} at n = {}: the energy's integral did not converge within {} panels (the lobe's f64 values are noisy there); its figure is the estimate",
+            r.lobe,
+            r.n,
+            specula::quadrature::MAX_PANELS
+        );
+    }
     if args.format == Format::Json {
         return print_json(&reports);
     }
@@ -92,7 +100,11 @@ pub fn run(args: &Args) -> CommandResult {
             sig(r.errors.bloom_max_abs),
             sig(r.errors.tail_max_abs),
             sig(r.errors.rms),
-            sig(r.energy_ratio),
+            if r.energy_converged {
+                sig(r.energy_ratio)
+            } else {
+                format!("~{}", sig(r.energy_ratio))
+            },
             sig(r.max_albedo),
             r.ops.to_string(),
         ]);

@@ -35,6 +35,10 @@ pub struct LobeReport {
     pub errors: ErrorFigures,
     /// `int_0^{pi/2} lobe(cos g) sin g dg / (1/(n+1))`: 1 means energy-matched to `t^n`.
     pub energy_ratio: f64,
+    /// Whether the energy's integral met its tolerance (a formula whose `f64` values carry
+    /// cancellation noise may not, within the quadrature's budget: the figure is then its
+    /// estimate).
+    pub energy_converged: bool,
     /// The constant that makes this lobe integrate to 1 (`lobe` normalisation, numeric).
     pub lobe_norm_numeric: f64,
     /// `(n+1)/(2 pi)`, the analytic constant of `t^n`, for comparison.
@@ -60,12 +64,14 @@ pub fn analyze(kind: LobeKind, n: Exponent, evaluator: &mut dyn Evaluator) -> Lo
         Normalisation::Lobe,
     );
     let (theta, max_albedo) = max_directional_albedo(&brdf);
+    let energy = crate::normalisation::lobe_integral_estimate(&lobe);
     LobeReport {
         lobe: kind,
         n: n.get(),
         precision: evaluator.name(),
         errors: error_figures(&lobe, evaluator, DEFAULT_SAMPLES_PER_ZONE),
-        energy_ratio: energy_ratio(&lobe),
+        energy_ratio: energy.value * (n.get() + 1.0),
+        energy_converged: energy.converged,
         lobe_norm_numeric: lobe_constant(&lobe),
         lobe_norm_analytic: Normalisation::Lobe.analytic(n),
         max_albedo,
