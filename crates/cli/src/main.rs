@@ -34,6 +34,15 @@ enum Command {
                             specula recommend --material paper_white_rgb.bsdf --target gpu-nvidia --margin 5%"
     )]
     Recommend(commands::recommend::Args),
+    /// Design the cheapest lobe for a target, a range of n and an accuracy: families the
+    /// formula language writes, fitted across the range, verified by the analysis, costed as
+    /// recommend costs, written as a lobe file.
+    #[command(
+        after_help = "Examples:\n  specula design --target gpu-nvidia --n 8..512 --max-error 0.1% -o designed.toml\n  \
+                            specula design --target cpu --n 8..512 --max-error 0.1%\n  \
+                            specula design --target gpu-amd --n 64 --max-error 1% --energy-tolerance 0.5% --no-transcendentals"
+    )]
+    Design(commands::design::Args),
     /// Fit every lobe (and GGX) to measured materials (RGL isotropic RGB `.bsdf` files): the
     /// parameters, the fit errors against pow's and GGX's, the energy, and the lobe to ship.
     #[command(
@@ -228,6 +237,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Models(args) => commands::models::run(&args),
         Command::Recommend(args) => commands::recommend::run(&args),
+        Command::Design(args) => commands::design::run(&args),
         Command::Fit(args) => commands::fit::run(&args),
         Command::Eval(args) => commands::eval::run(&args),
         Command::Analyze(args) => commands::analyze::run(&args),

@@ -11,6 +11,7 @@
 pub mod c_twins;
 mod choice;
 mod costing;
+pub mod design;
 pub mod fpga_estimate;
 pub mod hardware;
 pub mod material;

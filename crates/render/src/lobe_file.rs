@@ -99,6 +99,24 @@ pub fn read_definition(path: &Path) -> Result<Definition, String> {
     parse_definition(&text, &shown.to_string())
 }
 
+/// A lobe file's text for `definition` (no parameters), after `comments` as `#` lines: what
+/// `specula design` writes, and [`parse_definition`] reads back to the same definition.
+#[must_use]
+pub fn lobe_file_text(definition: &Definition, comments: &[String]) -> String {
+    let quoted = |text: &str| toml::Value::String(text.to_owned()).to_string();
+    let mut text: String = comments.iter().map(|c| format!("# {c}\n")).collect();
+    text += &format!("name = {}\n", quoted(&definition.name));
+    if let Some(description) = &definition.description {
+        text += &format!("description = {}\n", quoted(description));
+    }
+    // Literal multi-line strings: a formula has no backslash escapes and no triple quote.
+    text += &format!("formula = '''\n{}'''\n", definition.formula);
+    if let Some(tail) = &definition.tail {
+        text += &format!("tail = '''\n{tail}'''\n");
+    }
+    text
+}
+
 /// Parses a lobe file's text; `label` names it in the one-line error.
 pub fn parse_definition(text: &str, label: &str) -> Result<Definition, String> {
     let shown = label;

@@ -3,6 +3,7 @@
 pub mod analyze;
 pub mod bench;
 pub mod claims;
+pub mod design;
 pub mod diff;
 pub mod eval;
 pub mod fit;

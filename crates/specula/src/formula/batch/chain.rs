@@ -135,11 +135,15 @@ impl Chain {
 /// (NaN to 0), and the zero where `t <= 0` or NaN. Both are needed unless the formula is a
 /// chain from `t` whose range over `[0, 1]` is within `[0, 1]` and whose value at 0 is +0
 /// (then the clamp of `t` on the way in already sends `t <= 0` and NaN to that 0), as
-/// `cosquad`'s kernel skips its mask when its slope is at least 1.
+/// `cosquad`'s kernel skips its mask when its slope is at least 1. And whether the chain's
+/// polynomials (`exp2`, `log2`, `acos`) need their inputs checked lane by lane: not where the
+/// range analysis puts every input inside the polynomial's domain, as `sg`'s kernel calls
+/// `exp2` on `r (t - 1) <= 0` unchecked.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Rules {
     pub clamp: bool,
     pub mask: bool,
+    pub checked: bool,
 }
 
 impl Rules {
@@ -147,13 +151,17 @@ impl Rules {
     pub(crate) const ALL: Rules = Rules {
         clamp: true,
         mask: true,
+        checked: true,
     };
 }
 
 impl Chain {
     /// The rules the chain's output needs, from `[0, 1]` in, with the batch's `values`: its
     /// range by evaluating monotone links at the interval's ends in `f32` (each rounded
-    /// monotone operation keeps the order of its inputs), any other link needing both.
+    /// monotone operation keeps the order of its inputs; a polynomial is monotone on its
+    /// domain, and proven there when the interval lies inside it), any other link needing
+    /// every rule. After a polynomial the ends are the library's, which the vector polynomial
+    /// matches only to a few ulps, so the clamp stays.
     pub(super) fn rules(&self, values: &[f32]) -> Rules {
         // Rust's min and max ignore a NaN that the vector instructions return: with one
         // among the constants, the scalar ends prove nothing.
@@ -161,6 +169,7 @@ impl Chain {
             return Rules::ALL;
         }
         let (mut low, mut high) = (0.0_f32, 1.0_f32);
+        let mut approximate = false;
         for &link in &self.links {
             let monotone = match link {
                 Link::Add(_) | Link::Sub(_) | Link::SubFrom(_) | Link::Min(_) | Link::Max(_) => {
@@ -171,11 +180,15 @@ impl Chain {
                 Link::DivInto(_) => low > 0.0 || high < 0.0,
                 Link::Sqrt => low >= 0.0,
                 Link::Squarings(_) | Link::Abs | Link::Powi(_) => low >= 0.0,
-                _ => false,
+                Link::Exp2(scale) => EXP2_DOMAIN.holds(low * scale, high * scale),
+                Link::Log2 | Link::Ln | Link::Pow(_) => LOG2_DOMAIN.holds(low, high),
+                Link::Acos => ACOS_DOMAIN.holds(low, high),
+                Link::Lane(_) => false,
             };
             if !monotone {
                 return Rules::ALL;
             }
+            approximate |= link.checked();
             let (a, b) = (link.scalar(low, values), link.scalar(high, values));
             if a.is_nan() || b.is_nan() {
                 return Rules::ALL;
@@ -190,8 +203,9 @@ impl Chain {
             .iter()
             .fold(0.0_f32, |v, link| link.scalar(v, values));
         Rules {
-            clamp: !(low >= 0.0 && high <= 1.0),
+            clamp: approximate || !(low >= 0.0 && high <= 1.0),
             mask: at_zero.to_bits() != 0,
+            checked: false,
         }
     }
 }
@@ -289,9 +303,10 @@ pub(super) fn run_whole<V: Lanes>(
     }
 }
 
-/// Whether a chain can run as [`run_whole`]: arithmetic links only.
-pub(super) fn is_arithmetic(chain: &Chain) -> bool {
-    !chain.checked && !chain.lane_only
+/// Whether a chain can run as [`run_whole`] under `rules`: every link has a vector form and
+/// no polynomial needs its inputs checked.
+pub(super) fn runs_whole(chain: &Chain, rules: Rules) -> bool {
+    !chain.lane_only && (!chain.checked || !rules.checked)
 }
 
 #[inline(always)]
@@ -473,7 +488,7 @@ fn apply<V: Lanes>(lanes: V, link: Link, values: &[f32], x: &mut [V; GROUP], ok:
     }
 }
 
-/// One arithmetic link over the group (a chain without polynomials).
+/// One link over the group, unchecked: arithmetic, or a polynomial proven in its domain.
 #[inline(always)]
 fn apply_arithmetic<V: Lanes>(lanes: V, link: Link, values: &[f32], x: &mut [V; GROUP]) {
     let s = |index: usize| lanes.splat(values[index]);
@@ -537,7 +552,26 @@ fn apply_arithmetic<V: Lanes>(lanes: V, link: Link, values: &[f32], x: &mut [V; 
         Link::Sqrt => {
             each!(x, |v| v.sqrt());
         }
-        _ => unreachable!("a chain with polynomials runs apply"),
+        // Polynomials whose inputs the range analysis proved inside their domains.
+        Link::Pow(i) => {
+            let c = s(i);
+            each!(x, |v| math::exp2(c * math::log2(v)));
+        }
+        Link::Log2 => {
+            each!(x, |v| math::log2(v));
+        }
+        Link::Ln => {
+            let scale = lanes.splat(core::f32::consts::LN_2);
+            each!(x, |v| math::log2(v) * scale);
+        }
+        Link::Exp2(scale) => {
+            let scale = lanes.splat(scale);
+            each!(x, |v| math::exp2(v * scale));
+        }
+        Link::Acos => {
+            each!(x, |v| math::acos(v));
+        }
+        Link::Lane(_) => unreachable!("a chain with a lane-only link runs lane by lane"),
     }
 }
 

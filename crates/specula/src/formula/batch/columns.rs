@@ -96,6 +96,16 @@ map!(Inside, 1, |x, scale: f32, low: f32, high: f32| {
         .select(y.lt(y.splat(high)), zero)
 });
 
+impl Inside {
+    /// Whether every value between `a` and `b` (either order) passes, by the same strict
+    /// bounds as the lanes' test.
+    pub(super) fn holds(self, a: f32, b: f32) -> bool {
+        let (a, b) = (a * self.scale, b * self.scale);
+        let (low, high) = (a.min(b), a.max(b));
+        self.low < low && high < self.high
+    }
+}
+
 /// `op` over every vector of the block: reads the operand columns, writes column `out`
 /// (never one of them: the planner gives every result a register of its own at that step).
 #[inline(always)]

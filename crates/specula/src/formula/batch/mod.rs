@@ -330,7 +330,7 @@ impl Plan {
             };
         }
         if let [Step::Chain(chain, End::Batch, End::Batch)] = self.steps.as_slice() {
-            if chain::is_arithmetic(chain) {
+            if chain::runs_whole(chain, rules) {
                 chain::run_whole(lanes, chain, values, rules, ts, out);
                 FILE.with(|cell| cell.replace(storage));
                 return;

@@ -1,0 +1,196 @@
+//! `specula design`: the cheapest lobe for a target, a range of `n` and an accuracy, searched
+//! for in the formula language. The search is `specula_decide::design::design`; this module
+//! parses, prints and writes the lobe file.
+
+use std::path::PathBuf;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use specula_decide::design::{design, Bounds, Design, DesignRequest, DEFAULT_WHOLE_ERROR};
+use specula_decide::{versus_pow, Target};
+
+use super::CommandResult;
+use crate::args::described;
+use crate::output::Table;
+
+/// Arguments of `specula design`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Where the lobe will run (the FPGA costs only the built-ins' datapaths).
+    #[arg(long, value_parser = described(&Target::ALL, Target::id, Target::summary))]
+    target: Target,
+    /// The exponent, or a range `LOW..HIGH` the lobe must hold over.
+    #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = parse_range)]
+    n: Range,
+    /// The epicentre's largest relative error, as a percentage (`0.1%` or `0.1`): the error
+    /// `recommend` counts.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_percent)]
+    max_error: f64,
+    /// The whole lobe's largest absolute error, as a percentage of the peak [default: 1%].
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_percent)]
+    max_whole_error: Option<f64>,
+    /// Also match t^n's energy within this percentage at every n.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_percent)]
+    energy_tolerance: Option<f64>,
+    /// Only lobes without a transcendental operation per evaluation (polynomial-only
+    /// targets).
+    #[arg(long)]
+    no_transcendentals: bool,
+    /// Write the cheapest designed lobe meeting the request as a lobe file (TOML), for
+    /// `--lobe @FILE` everywhere.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
+    format: crate::args::Format,
+}
+
+/// The range of exponents, its ends.
+#[derive(Clone, Copy, Debug)]
+pub struct Range(specula::Exponent, specula::Exponent);
+
+fn parse_range(text: &str) -> Result<Range, String> {
+    let ends = specula_decide::parse_exponent_range(text, 1)?;
+    Ok(Range(ends[0], ends[ends.len() - 1]))
+}
+
+fn parse_percent(text: &str) -> Result<f64, String> {
+    let number = text.trim().trim_end_matches('%');
+    match number.parse::<f64>() {
+        Ok(value) if value > 0.0 && value <= 100.0 => Ok(value / 100.0),
+        _ => Err(format!(
+            "'{text}' is not an error in (0, 100] %; write it as 0.1% or 0.1"
+        )),
+    }
+}
+
+/// Searches, prints, and writes the lobe.
+pub fn run(args: &Args) -> CommandResult {
+    let request = DesignRequest {
+        target: args.target,
+        range: (args.n.0, args.n.1),
+        bounds: Bounds {
+            epicentre: args.max_error,
+            whole: args.max_whole_error.unwrap_or(DEFAULT_WHOLE_ERROR),
+            energy: args.energy_tolerance,
+        },
+        no_transcendentals: args.no_transcendentals,
+    };
+    let progress = ProgressBar::new(0).with_style(
+        ProgressStyle::with_template("designing {bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let answer = design(&request, &progress)?;
+    if let Some(note) = &answer.note {
+        eprintln!("note: {note}");
+    }
+    if let Some(path) = &args.output {
+        write_lobe(&answer, &request, path)?;
+    }
+    if args.format == crate::args::Format::Json {
+        return super::print_json(&answer);
+    }
+    println!("{}", answer.verdict);
+    print_table(&answer, args.format);
+    Ok(())
+}
+
+/// Every designed lobe, then the built-ins, with the Pareto front over both.
+fn print_table(answer: &Design, format: crate::args::Format) {
+    let mut table = Table::new(&[
+        "lobe",
+        "kind",
+        "meets",
+        "epicentre",
+        "whole lobe",
+        "cost",
+        "vs pow",
+        "pareto",
+        "why",
+    ]);
+    let error = |e: f64| {
+        if e.is_finite() {
+            format!("{:.4} %", 100.0 * e)
+        } else {
+            "-".to_owned()
+        }
+    };
+    let cost = |rate: f64| {
+        if rate > 0.0 {
+            format!("{rate:.3e}")
+        } else {
+            "-".to_owned()
+        }
+    };
+    for d in &answer.designed {
+        table.push(vec![
+            d.name.clone(),
+            "designed".to_owned(),
+            if d.meets { "yes" } else { "no" }.to_owned(),
+            error(d.epicentre_error),
+            error(d.whole_error),
+            cost(d.rate),
+            if d.rate > 0.0 {
+                versus_pow(d.rate, answer.pow_rate)
+            } else {
+                "-".to_owned()
+            },
+            if d.pareto { "front" } else { "" }.to_owned(),
+            d.why.clone(),
+        ]);
+    }
+    for c in &answer.builtins {
+        table.push(vec![
+            c.lobe.clone(),
+            "built-in".to_owned(),
+            if c.meets { "yes" } else { "no" }.to_owned(),
+            error(c.error),
+            "".to_owned(),
+            cost(c.rate),
+            versus_pow(c.rate, answer.pow_rate),
+            if c.pareto { "front" } else { "" }.to_owned(),
+            c.why.clone(),
+        ]);
+    }
+    table.print(format);
+    eprintln!(
+        "costs in {}; designed lobes verified at {} exponents of the range by the f64 analysis",
+        answer.unit, answer.exponents_verified
+    );
+}
+
+/// Writes the cheapest designed lobe that meets the request, or refuses (nothing written).
+fn write_lobe(answer: &Design, request: &DesignRequest, path: &std::path::Path) -> CommandResult {
+    let Some(best) = answer.best() else {
+        return Err(format!(
+            "nothing written to {}: {}",
+            path.display(),
+            answer.verdict
+        ));
+    };
+    let (low, high) = request.range;
+    let comments = vec![
+        format!(
+            "Designed by specula design --target {} --n {low}..{high}: {}",
+            request.target.id(),
+            answer.verdict
+        ),
+        format!(
+            "Verified at {} exponents: epicentre error {:.4} %, whole lobe {:.4} % of the peak.",
+            answer.exponents_verified,
+            100.0 * best.epicentre_error,
+            100.0 * best.whole_error
+        ),
+    ];
+    let text = specula_render::lobe_file::lobe_file_text(&best.definition(), &comments);
+    specula_render::write_atomically(path, |writer| {
+        std::io::Write::write_all(writer, text.as_bytes()).map_err(|e| e.to_string())
+    })
+    .map_err(|e| e.to_string())?;
+    eprintln!(
+        "wrote {}: the lobe '{}'; use it as --lobe @{}",
+        path.display(),
+        best.name,
+        path.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,243 @@
+//! The families `specula design` searches: shapes the formula language writes, each with a
+//! few global coefficients `beta` from which every per-material constant is a closed form of
+//! `n` (a shader computes them). With `u = 1 - t`, `t^n = exp(n ln(1 - u))`:
+//!
+//! - **`exp2-linear`, `exp2-quadratic`, `exp2-cubic`**: `exp(-u (k1 + k2 u + k3 u^2))`, the
+//!   series `-ln(1 - u) = u + u^2/2 + u^3/3 + ...` truncated, its coefficients nudged by
+//!   `beta` (`k1 = n + beta0 / n`, `k2 = n / 2 + beta1`, `k3 = n / 3 + beta2`; `k1 = n + beta0`
+//!   alone for the linear one, the form of `sg-karis`). One `exp2`; positive coefficients make
+//!   the lobe fall monotonically from 1 at `t = 1`.
+//! - **`linear-powM`**: `max(0, 1 - s u)^M`, `M` a power of two (`cosquad`'s shape), with
+//!   `s = beta0 n + beta1`: squarings only.
+//! - **`quadratic-powM`**: `(1 - s v + c v^2)^M` with `v = min(u, u_stop)`, the quadratic's
+//!   Taylor form of `t^(n/M)` (`s = beta0 n + beta1 / n`, `c = (beta2 s - beta3) s`) cut
+//!   where it stops falling: at its first root when it has one, else at its vertex, so the
+//!   lobe is monotone and in `[0, 1]` at every `n`. Written in Horner form, which stays exact
+//!   where `c` crosses 0 (the vertex form's constants there run to infinity and cancel).
+//!
+//! [`Family::eval`] is the formula's own arithmetic in `f64`, operation for operation, so that
+//! the fit sees what [`Family::formula`]'s text computes; the verification then runs the text
+//! through the analysis.
+
+use core::f64::consts::{LN_2, LOG2_E};
+
+/// A family, its structure fixed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Family {
+    /// `exp2` of a polynomial of `u` without constant term.
+    Exp2Poly {
+        /// 1 to 3.
+        degree: u8,
+    },
+    /// A polynomial of `u`, cut where it stops falling, raised to `2^squarings`.
+    PolyPow {
+        /// 1 or 2.
+        degree: u8,
+        /// The power is `2^squarings`.
+        squarings: u8,
+    },
+}
+
+impl Family {
+    /// Every family searched, the transcendental-free ones last.
+    #[must_use]
+    pub fn all() -> Vec<Family> {
+        let mut all: Vec<Family> = (1..=3).map(|degree| Family::Exp2Poly { degree }).collect();
+        all.extend((2..=7).map(|squarings| Family::PolyPow {
+            degree: 1,
+            squarings,
+        }));
+        all.extend((1..=5).map(|squarings| Family::PolyPow {
+            degree: 2,
+            squarings,
+        }));
+        all
+    }
+
+    /// The id tables show: `exp2-quadratic`, `linear-pow64`, `quadratic-pow8`.
+    #[must_use]
+    pub fn id(self) -> String {
+        match self {
+            Family::Exp2Poly { degree } => format!("exp2-{}", degree_name(degree)),
+            Family::PolyPow { degree, squarings } => {
+                format!("{}-pow{}", degree_name(degree), 1u32 << squarings)
+            }
+        }
+    }
+
+    /// Whether an evaluation calls a transcendental function (`exp2`); the constants'
+    /// `sqrt` is per material, not per evaluation.
+    #[must_use]
+    pub fn transcendental(self) -> bool {
+        matches!(self, Family::Exp2Poly { .. })
+    }
+
+    /// The coefficients the fit starts from: the truncated series, nudged by nothing.
+    #[must_use]
+    pub fn start(self) -> Vec<f64> {
+        match self {
+            Family::Exp2Poly { degree } => vec![0.0; usize::from(degree)],
+            Family::PolyPow { degree, squarings } => {
+                let m = f64::from(1u32 << squarings);
+                if degree == 1 {
+                    vec![1.0 / m, 0.0]
+                } else {
+                    vec![1.0 / m, 0.0, 0.5, 0.5]
+                }
+            }
+        }
+    }
+
+    /// The lobe at `u = 1 - t` for `n`, with the formula's operations in its order.
+    #[must_use]
+    pub fn eval(self, beta: &[f64], n: f64, u: f64) -> f64 {
+        match self {
+            Family::Exp2Poly { degree } => {
+                let [a1, a2, a3] = exp2_coefficients(degree, beta, n);
+                match degree {
+                    1 => (a1 * u).exp2(),
+                    2 => (u * (a1 + u * a2)).exp2(),
+                    _ => (u * (a1 + u * (a2 + u * a3))).exp2(),
+                }
+            }
+            Family::PolyPow { degree, squarings } => {
+                let base = if degree == 1 {
+                    let s = beta[0] * n + beta[1];
+                    (1.0 - s * u).max(0.0)
+                } else {
+                    let (s, c, stop) = quadratic_constants(beta, n);
+                    let v = u.min(stop);
+                    1.0 - v * (s - c * v)
+                };
+                (0..squarings).fold(base, |x, _| x * x)
+            }
+        }
+    }
+
+    /// The lobe as formula text, `beta` written out (shortest round-trip decimals).
+    #[must_use]
+    pub fn formula(self, beta: &[f64]) -> String {
+        match self {
+            Family::Exp2Poly { degree: 1 } => format!(
+                "let a1 = -{LOG2_E} * (n {});\nexp2(a1 * (1 - t))",
+                signed(beta[0])
+            ),
+            Family::Exp2Poly { degree } => {
+                let mut text = format!("let a1 = -{LOG2_E} * (n {} / n);\n", signed(beta[0]));
+                text += &format!("let a2 = -{LOG2_E} * (n / 2 {});\n", signed(beta[1]));
+                if degree == 3 {
+                    text += &format!("let a3 = -{LOG2_E} * (n / 3 {});\n", signed(beta[2]));
+                }
+                text += "let u = 1 - t;\n";
+                text += if degree == 3 {
+                    "exp2(u * (a1 + u * (a2 + u * a3)))"
+                } else {
+                    "exp2(u * (a1 + u * a2))"
+                };
+                text
+            }
+            Family::PolyPow {
+                degree: 1,
+                squarings,
+            } => format!(
+                "let s = {} * n {};\nmax(0, 1 - s * (1 - t)) ^ {}",
+                beta[0],
+                signed(beta[1]),
+                1u32 << squarings
+            ),
+            Family::PolyPow { squarings, .. } => format!(
+                "let s = {} * n {} / n;\n\
+                 let c = ({} * s {}) * s;\n\
+                 let disc = s * s - 4 * c;\n\
+                 let stop = select(disc < 0, s / (2 * c), 2 / (s + sqrt(max(disc, 0))));\n\
+                 let v = min(1 - t, stop);\n\
+                 (1 - v * (s - c * v)) ^ {}",
+                beta[0],
+                signed(beta[1]),
+                beta[2],
+                signed(-beta[3]),
+                1u32 << squarings
+            ),
+        }
+    }
+
+    /// `int_t^1 lobe(x) dx` as formula text, where it has a closed form in the language.
+    #[must_use]
+    pub fn tail(self, _beta: &[f64]) -> Option<String> {
+        match self {
+            Family::Exp2Poly { degree: 1 } => Some(format!(
+                "(1 - exp2(a1 * (1 - t))) / (-a1 * {LN_2})"
+            )),
+            Family::PolyPow {
+                degree: 1,
+                squarings,
+            } => {
+                let m1 = (1u32 << squarings) + 1;
+                Some(format!(
+                    "(1 - pow(max(0, 1 - s * (1 - t)), {m1})) / (s * {m1})"
+                ))
+            }
+            _ => None,
+        }
+    }
+
+    /// One line on the family, for the lobe file's description.
+    #[must_use]
+    pub fn description(self) -> String {
+        match self {
+            Family::Exp2Poly { degree } => format!(
+                "exp2 of a {} polynomial of 1 - t (the series of n ln t, its coefficients fitted)",
+                degree_name(degree)
+            ),
+            Family::PolyPow { degree, squarings } => format!(
+                "a {} polynomial of 1 - t raised to {} (squarings), cut where it stops falling",
+                degree_name(degree),
+                1u32 << squarings
+            ),
+        }
+    }
+}
+
+fn degree_name(degree: u8) -> &'static str {
+    match degree {
+        1 => "linear",
+        2 => "quadratic",
+        _ => "cubic",
+    }
+}
+
+/// `+ x` or `- |x|`, for a coefficient written after an operand.
+fn signed(x: f64) -> String {
+    if x.is_sign_negative() {
+        format!("- {}", -x)
+    } else {
+        format!("+ {x}")
+    }
+}
+
+/// `a1, a2, a3` of an `exp2` family at `n` (log2 units), as the formula's `let`s compute them.
+fn exp2_coefficients(degree: u8, beta: &[f64], n: f64) -> [f64; 3] {
+    if degree == 1 {
+        return [-LOG2_E * (n + beta[0]), 0.0, 0.0];
+    }
+    let third = if degree == 3 {
+        -LOG2_E * (n / 3.0 + beta[2])
+    } else {
+        0.0
+    };
+    [-LOG2_E * (n + beta[0] / n), -LOG2_E * (n / 2.0 + beta[1]), third]
+}
+
+/// `s`, `c` and the cut `stop` of a quadratic family at `n`, as the formula's `let`s compute
+/// them.
+fn quadratic_constants(beta: &[f64], n: f64) -> (f64, f64, f64) {
+    let s = beta[0] * n + beta[1] / n;
+    let c = (beta[2] * s - beta[3]) * s;
+    let disc = s * s - 4.0 * c;
+    let stop = if disc < 0.0 {
+        s / (2.0 * c)
+    } else {
+        2.0 / (s + disc.max(0.0).sqrt())
+    };
+    (s, c, stop)
+}

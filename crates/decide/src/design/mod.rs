@@ -1,0 +1,490 @@
+//! `specula design`: the cheapest lobe for a target, a range of `n` and an accuracy, searched
+//! for in the formula language and proven by the analysis.
+//!
+//! Each family of [`families`] has its coefficients fitted across the range ([`fit`]), is
+//! written as a formula, and is then verified by the same `f64` analysis as `specula analyze`
+//! at [`VERIFY_STEPS`]` + 1` log-spaced exponents and `recommend`'s sampled ones: the
+//! epicentre's largest relative error and the whole lobe's largest absolute error within
+//! their bounds (zone edges solved exactly, [`SWEEP_SAMPLES`] angles per zone), a lobe by the
+//! rules ([`specula::Lobe::checked`]: finite, in `[0, 1]`), 1 at `t = 1`, non-decreasing in
+//! `t`, and, where asked, its energy within a tolerance of `t^n`'s. The verified ones are
+//! costed with the built-ins by [`crate::recommend`] itself (the recorded expression's shader
+//! on the GPU models, the compiled batch kernel measured on the CPU), so a designed lobe and a
+//! built-in are ranked by one measure.
+
+pub mod families;
+mod fit;
+
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+use serde::Serialize;
+use specula::analysis::{energy_ratio, error_figures, Precision};
+use specula::formula::{define, instance, Definition, Naming};
+use specula::{Exponent, Lobe, LobeKind};
+
+pub use families::Family;
+pub use fit::Bounds;
+
+use crate::hardware::SWEEP_SAMPLES;
+use crate::recommend::{pareto_front, recommend, Candidate, Request};
+use crate::{log_spaced, sample_exponents, Target, Zone};
+
+/// The whole lobe's largest absolute error allowed by default: 1 % of the peak, under three
+/// 8-bit steps, so that no bloom or tail a display shows is invented.
+pub const DEFAULT_WHOLE_ERROR: f64 = 0.01;
+
+/// Log-spaced steps of the verification's exponents (beside `recommend`'s).
+pub const VERIFY_STEPS: u32 = 48;
+
+/// Log-spaced steps of the fit's exponents.
+const FIT_STEPS: u32 = 16;
+
+/// What to design.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DesignRequest {
+    /// Where the lobe will run.
+    pub target: Target,
+    /// The exponents the lobe must hold over, from the first to the second.
+    pub range: (Exponent, Exponent),
+    /// The bounds: the epicentre's (the error `recommend` counts), the whole lobe's, and the
+    /// energy's where asked.
+    pub bounds: Bounds,
+    /// Only families without a transcendental operation per evaluation (FPGA- and
+    /// polynomial-only targets).
+    pub no_transcendentals: bool,
+}
+
+/// One family's designed lobe and its figures.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DesignedLobe {
+    /// The family's id.
+    pub family: String,
+    /// The lobe's name (a formula lobe's id).
+    pub name: String,
+    /// One line on what it is.
+    pub description: String,
+    /// The formula, coefficients written out.
+    pub formula: String,
+    /// `int_t^1 lobe`, where the family has a closed form.
+    pub tail: Option<String>,
+    /// The fitted global coefficients.
+    pub coefficients: Vec<f64>,
+    /// The worst epicentre relative error over the verification's exponents.
+    pub epicentre_error: f64,
+    /// The worst whole-lobe absolute error (fraction of the peak).
+    pub whole_error: f64,
+    /// The worst `|energy ratio - 1|`.
+    pub energy_deviation: f64,
+    /// Whether it passed every check at every exponent.
+    pub verified: bool,
+    /// Its cost on the target in [`Design::unit`] (0 where not costed).
+    pub rate: f64,
+    /// Meets every bound and was costed.
+    pub meets: bool,
+    /// No lobe, designed or built in, is at least as accurate and as cheap, better in one.
+    pub pareto: bool,
+    /// Why it stands where it does.
+    pub why: String,
+    #[serde(skip)]
+    kind: Option<LobeKind>,
+}
+
+impl DesignedLobe {
+    /// The lobe as the formula registry holds it (`None` where the text was refused).
+    #[must_use]
+    pub fn kind(&self) -> Option<LobeKind> {
+        self.kind
+    }
+
+    /// The lobe file's fields.
+    #[must_use]
+    pub fn definition(&self) -> Definition {
+        Definition {
+            name: self.name.clone(),
+            description: Some(self.description.clone()),
+            formula: self.formula.clone(),
+            tail: self.tail.clone(),
+            parameters: Default::default(),
+        }
+    }
+}
+
+/// The answer: every designed lobe (those that meet first, cheapest first), the built-ins
+/// ranked beside them, and the verdict.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Design {
+    /// The unit of every rate.
+    pub unit: &'static str,
+    /// How many exponents each lobe was verified at.
+    pub exponents_verified: usize,
+    /// The designed lobes.
+    pub designed: Vec<DesignedLobe>,
+    /// The built-ins as `recommend` ranks them on the same target and bound.
+    pub builtins: Vec<Candidate>,
+    /// `pow`'s rate, what "vs pow" compares with.
+    pub pow_rate: f64,
+    /// One line: what the search found against the built-ins.
+    pub verdict: String,
+    /// What the face should tell its user about the costs, if anything.
+    pub note: Option<String>,
+}
+
+impl Design {
+    /// The cheapest designed lobe that meets the request, if any does.
+    #[must_use]
+    pub fn best(&self) -> Option<&DesignedLobe> {
+        self.designed.first().filter(|d| d.meets)
+    }
+
+    /// The cheapest built-in that meets the request, if any does.
+    #[must_use]
+    pub fn best_builtin(&self) -> Option<&Candidate> {
+        self.builtins.first().filter(|c| c.meets)
+    }
+}
+
+/// Why the FPGA cannot rank a designed lobe.
+pub const FPGA_DESIGN_REFUSAL: &str = "design cannot target fpga: the FPGA's costs are the synthesized fixed-point datapaths, which exist for the built-in lobes only (a designed formula has none); rank those with specula recommend --target fpga; valid targets: cpu, gpu-nvidia, gpu-amd";
+
+fn check(request: &DesignRequest) -> Result<(), String> {
+    let fraction = |what: &str, value: f64| {
+        if value.is_finite() && value > 0.0 && value <= 1.0 {
+            Ok(())
+        } else {
+            Err(format!("{what} must be a fraction in (0, 1], not {value}"))
+        }
+    };
+    fraction("the epicentre's largest error", request.bounds.epicentre)?;
+    fraction("the whole lobe's largest error", request.bounds.whole)?;
+    if let Some(energy) = request.bounds.energy {
+        fraction("the energy tolerance", energy)?;
+    }
+    if request.range.0.get() > request.range.1.get() {
+        return Err(format!(
+            "the range of n is empty ({}..{}): give LOW..HIGH with LOW <= HIGH in [1, 1000]",
+            request.range.0, request.range.1
+        ));
+    }
+    if request.target == Target::Fpga {
+        return Err(FPGA_DESIGN_REFUSAL.to_owned());
+    }
+    Ok(())
+}
+
+/// The exponents a designed lobe is verified at: [`VERIFY_STEPS`]` + 1` log-spaced ones and
+/// `recommend`'s, increasing, once each.
+#[must_use]
+pub fn verification_exponents(low: Exponent, high: Exponent) -> Vec<Exponent> {
+    let mut all: Vec<f64> = if low == high {
+        vec![low.get()]
+    } else {
+        log_spaced(low, high, VERIFY_STEPS)
+            .into_iter()
+            .map(Exponent::get)
+            .collect()
+    };
+    all.extend(sample_exponents(low, high).into_iter().map(Exponent::get));
+    all.sort_by(f64::total_cmp);
+    all.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    all.into_iter().map(Exponent::new).collect()
+}
+
+/// Searches every family for the cheapest lobe on the target within the bounds over the
+/// range; `progress` counts the families fitted, then the lobes costed (pass
+/// [`ProgressBar::hidden`] for none).
+pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design, String> {
+    check(request)?;
+    let (low, high) = request.range;
+    let families: Vec<Family> = Family::all()
+        .into_iter()
+        .filter(|f| !(request.no_transcendentals && f.transcendental()))
+        .collect();
+    let fit_exponents: Vec<f64> = if low == high {
+        vec![low.get()]
+    } else {
+        log_spaced(low, high, FIT_STEPS)
+            .into_iter()
+            .map(Exponent::get)
+            .collect()
+    };
+    let verify = verification_exponents(low, high);
+    progress.set_length(families.len() as u64);
+    progress.set_message("fitting and verifying");
+    let mut designed: Vec<DesignedLobe> = families
+        .par_iter()
+        .map(|&family| {
+            let (beta, _) = fit::fit(family, &fit_exponents, request.bounds);
+            let lobe = verified(family, &beta, request, &verify);
+            progress.inc(1);
+            lobe
+        })
+        .collect();
+    let kinds: Vec<LobeKind> = designed
+        .iter()
+        .filter(|d| d.verified)
+        .filter_map(DesignedLobe::kind)
+        .collect();
+    let mut lobes = LobeKind::ALL.to_vec();
+    lobes.extend(&kinds);
+    progress.reset();
+    let ranking = recommend(
+        &Request {
+            target: request.target,
+            exponents: sample_exponents(low, high),
+            max_error: request.bounds.epicentre,
+            zone: Zone::Epicentre,
+            energy_conserving: false,
+            lobes,
+        },
+        progress,
+    )?;
+    let pow_rate = ranking.pow_rate();
+    for lobe in &mut designed {
+        let costed = ranking.candidates.iter().find(|c| c.lobe == lobe.name);
+        if let Some(costed) = costed {
+            lobe.rate = costed.rate;
+            lobe.meets = lobe.verified && costed.meets;
+            if lobe.meets {
+                lobe.why = format!(
+                    "meets every bound at {:.2}x pow's rate",
+                    costed.rate / pow_rate
+                );
+            } else if !costed.meets {
+                lobe.why.clone_from(&costed.why);
+            }
+        }
+    }
+    let builtins: Vec<Candidate> = ranking
+        .candidates
+        .iter()
+        .filter(|c| LobeKind::ALL.iter().any(|k| k.id() == c.lobe))
+        .cloned()
+        .collect();
+    mark_front(&mut designed, &builtins);
+    designed.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
+    let mut answer = Design {
+        unit: ranking.unit,
+        exponents_verified: verify.len(),
+        designed,
+        builtins,
+        pow_rate,
+        verdict: String::new(),
+        note: ranking.note,
+    };
+    answer.verdict = verdict(&answer, request);
+    Ok(answer)
+}
+
+/// Marks the designed lobes no lobe (designed or built in) dominates in error and rate.
+fn mark_front(designed: &mut [DesignedLobe], builtins: &[Candidate]) {
+    let points: Vec<(f64, f64)> = designed
+        .iter()
+        .filter(|d| d.rate > 0.0)
+        .map(|d| (d.epicentre_error, d.rate))
+        .chain(builtins.iter().map(|c| (c.error, c.rate)))
+        .collect();
+    let front = pareto_front(&points);
+    let mut on_front = front.into_iter();
+    for lobe in designed.iter_mut().filter(|d| d.rate > 0.0) {
+        lobe.pareto = on_front.next().unwrap_or(false);
+    }
+}
+
+/// The answer in one line.
+fn verdict(design: &Design, request: &DesignRequest) -> String {
+    let (low, high) = request.range;
+    let within = format!(
+        "within {} in the epicentre (whole lobe {}{}) at n from {low} to {high} on {}",
+        percent(request.bounds.epicentre),
+        percent(request.bounds.whole),
+        request
+            .bounds
+            .energy
+            .map_or(String::new(), |e| format!(", energy {}", percent(e))),
+        request.target.id()
+    );
+    let builtin = design.best_builtin().map_or_else(
+        || "no built-in lobe meets it".to_owned(),
+        |c| {
+            format!(
+                "the cheapest built-in is {} at {:.2}x pow",
+                c.lobe,
+                c.rate / design.pow_rate
+            )
+        },
+    );
+    match design.best() {
+        Some(best) => {
+            let versus = match design.best_builtin() {
+                Some(c) if c.rate > best.rate => format!(
+                    "; {builtin}, cheaper than every design: ship the built-in"
+                ),
+                _ => format!("; {builtin}"),
+            };
+            format!(
+                "{}: the cheapest designed lobe {within}, at {:.2}x pow's rate{versus}",
+                best.name,
+                best.rate / design.pow_rate
+            )
+        }
+        None => {
+            let closest = design
+                .designed
+                .iter()
+                .min_by(|a, b| a.epicentre_error.total_cmp(&b.epicentre_error));
+            format!(
+                "no designed lobe {within}: searched {} families ({}); the closest, {}, reached {} in the epicentre and {} over the whole lobe; {builtin}",
+                design.designed.len(),
+                design
+                    .designed
+                    .iter()
+                    .map(|d| d.family.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                closest.map_or("none", |d| d.family.as_str()),
+                closest.map_or("-".to_owned(), |d| percent(d.epicentre_error)),
+                closest.map_or("-".to_owned(), |d| percent(d.whole_error)),
+            )
+        }
+    }
+}
+
+/// A fraction as a percentage with four significant digits (`0.1 %`, `0.03115 %`).
+fn percent(fraction: f64) -> String {
+    if !fraction.is_finite() || fraction == 0.0 {
+        return format!("{} %", fraction * 100.0);
+    }
+    let digits = (3 - (fraction * 100.0).abs().log10().floor() as i32).max(0) as usize;
+    let text = format!("{:.digits$}", fraction * 100.0);
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &text
+    };
+    format!("{text} %")
+}
+
+/// The family with `beta` written as a formula, registered, and verified at `exponents`.
+fn verified(
+    family: Family,
+    beta: &[f64],
+    request: &DesignRequest,
+    exponents: &[Exponent],
+) -> DesignedLobe {
+    let (low, high) = request.range;
+    let mut lobe = DesignedLobe {
+        family: family.id(),
+        name: family.id(),
+        description: format!(
+            "{}; designed by specula for n in [{low}, {high}]",
+            family.description()
+        ),
+        formula: family.formula(beta),
+        tail: family.tail(beta),
+        coefficients: beta.to_vec(),
+        epicentre_error: f64::INFINITY,
+        whole_error: f64::INFINITY,
+        energy_deviation: f64::INFINITY,
+        verified: false,
+        rate: 0.0,
+        meets: false,
+        pareto: false,
+        why: String::new(),
+        kind: None,
+    };
+    let kind = define(lobe.definition(), Naming::Unique)
+        .map_err(|e| e.to_string())
+        .and_then(|formula| {
+            lobe.name = formula.name().to_owned();
+            instance(formula, &[]).map_err(|e| e.to_string())
+        });
+    let kind = match kind {
+        Ok(kind) => kind,
+        Err(error) => {
+            lobe.why = format!("its formula was refused: {error}");
+            return lobe;
+        }
+    };
+    lobe.kind = Some(kind);
+    match check_lobe(kind, exponents, request.bounds, &mut lobe) {
+        Ok(()) => {
+            lobe.verified = true;
+            lobe.why = format!("verified at {} exponents", exponents.len());
+        }
+        Err(why) => lobe.why = why,
+    }
+    lobe
+}
+
+/// Measures `kind` at every exponent into `lobe`'s figures; `Err` names the first rule or
+/// bound broken, and where.
+fn check_lobe(
+    kind: LobeKind,
+    exponents: &[Exponent],
+    bounds: Bounds,
+    lobe: &mut DesignedLobe,
+) -> Result<(), String> {
+    let (mut epicentre, mut whole, mut energy) = (0.0_f64, 0.0_f64, 0.0_f64);
+    let mut broken: Option<String> = None;
+    for &n in exponents {
+        let checked = Lobe::checked(kind, n).map_err(|e| e.to_string())?;
+        let peak = checked.eval(1.0_f64);
+        if (peak - 1.0).abs() > 1e-12 {
+            return Err(format!("at n = {n} its peak is {peak}, not 1"));
+        }
+        if let Some(t) = decreasing_at(&checked) {
+            return Err(format!("at n = {n} it falls as t rises, at t = {t}"));
+        }
+        let figures = error_figures(&checked, &mut Precision::F64, SWEEP_SAMPLES);
+        let here = figures
+            .epicentre_max_abs
+            .max(figures.bloom_max_abs)
+            .max(figures.tail_max_abs);
+        epicentre = epicentre.max(figures.epicentre_max_rel);
+        whole = whole.max(here);
+        if bounds.energy.is_some() {
+            energy = energy.max((energy_ratio(&checked) - 1.0).abs());
+        }
+        if broken.is_none() {
+            if figures.epicentre_max_rel > bounds.epicentre {
+                broken = Some(format!(
+                    "epicentre error {} exceeds {} at n = {n}",
+                    percent(figures.epicentre_max_rel),
+                    percent(bounds.epicentre)
+                ));
+            } else if here > bounds.whole {
+                broken = Some(format!(
+                    "whole-lobe error {} exceeds {} at n = {n}",
+                    percent(here),
+                    percent(bounds.whole)
+                ));
+            } else if bounds.energy.is_some_and(|e| energy > e) {
+                broken = Some(format!(
+                    "energy ratio off by {} at n = {n}",
+                    percent(energy)
+                ));
+            }
+        }
+    }
+    lobe.epicentre_error = epicentre;
+    lobe.whole_error = whole;
+    lobe.energy_deviation = energy;
+    broken.map_or(Ok(()), Err)
+}
+
+/// A cosine at which `lobe` falls as `t` rises (by more than rounding), if any: checked on
+/// 4000 steps of `w = n (1 - t)` over the lobe's width and 1000 over `[0, 1]`.
+fn decreasing_at(lobe: &Lobe) -> Option<f64> {
+    let n = lobe.exponent().get();
+    let mut ts: Vec<f64> = (0..=4000)
+        .map(|k| (1.0 - 40.0 * f64::from(k) / 4000.0 / n).max(0.0))
+        .chain((0..=1000).map(|k| f64::from(k) / 1000.0))
+        .collect();
+    ts.sort_by(f64::total_cmp);
+    let values: Vec<f64> = ts.iter().map(|&t| lobe.eval(t)).collect();
+    values
+        .windows(2)
+        .zip(&ts)
+        .find(|(pair, _)| pair[1] < pair[0] - 1e-14)
+        .map(|(_, &t)| t)
+}
