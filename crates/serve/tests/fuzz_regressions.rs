@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
+#[path = "../../../fuzz/fuzz_targets/checks/analysis.rs"]
+mod analysis;
 #[path = "../../../fuzz/fuzz_targets/checks/api.rs"]
 mod api;
 #[path = "../../../fuzz/fuzz_targets/checks/formula.rs"]
 mod formula;
-#[path = "../../../fuzz/fuzz_targets/checks/analysis.rs"]
-mod analysis;
 
 /// Every seed and regression input of `target`, run through `check`; how many there were.
 fn replay(target: &str, check: fn(&[u8])) -> usize {

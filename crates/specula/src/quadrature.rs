@@ -193,7 +193,11 @@ mod tests {
         };
         let integral = integral_of_pieces(noisy, &[0.0, 1.0], 1e-15);
         assert!(!integral.converged);
-        assert!(calls.get() <= 15 * (2 * MAX_PANELS + 1), "{} calls", calls.get());
+        assert!(
+            calls.get() <= 15 * (2 * MAX_PANELS + 1),
+            "{} calls",
+            calls.get()
+        );
         assert!((integral.value - 0.5).abs() <= integral.error.max(1e-9));
         let smooth = integral_of_pieces(|x| x * x, &[0.0, 1.0], 1e-15);
         assert!(smooth.converged && (smooth.value - 1.0 / 3.0).abs() < 1e-15);

@@ -10,6 +10,7 @@ mod common;
 mod bad_inputs;
 mod blender;
 mod cli;
+mod design;
 mod enhanced_dicom;
 mod fit;
 mod gpu;

@@ -165,9 +165,9 @@ impl Family {
     #[must_use]
     pub fn tail(self, _beta: &[f64]) -> Option<String> {
         match self {
-            Family::Exp2Poly { degree: 1 } => Some(format!(
-                "(1 - exp2(a1 * (1 - t))) / (-a1 * {LN_2})"
-            )),
+            Family::Exp2Poly { degree: 1 } => {
+                Some(format!("(1 - exp2(a1 * (1 - t))) / (-a1 * {LN_2})"))
+            }
             Family::PolyPow {
                 degree: 1,
                 squarings,
@@ -225,7 +225,11 @@ fn exp2_coefficients(degree: u8, beta: &[f64], n: f64) -> [f64; 3] {
     } else {
         0.0
     };
-    [-LOG2_E * (n + beta[0] / n), -LOG2_E * (n / 2.0 + beta[1]), third]
+    [
+        -LOG2_E * (n + beta[0] / n),
+        -LOG2_E * (n / 2.0 + beta[1]),
+        third,
+    ]
 }
 
 /// `s`, `c` and the cut `stop` of a quadratic family at `n`, as the formula's `let`s compute

@@ -142,8 +142,13 @@ impl CostFunction for Objective<'_> {
     type Output = f64;
 
     fn cost(&self, beta: &Vec<f64>) -> Result<f64, argmin::core::Error> {
-        let score = figures(self.family, beta, self.exponents, self.bounds.energy.is_some())
-            .score(self.bounds);
+        let score = figures(
+            self.family,
+            beta,
+            self.exponents,
+            self.bounds.energy.is_some(),
+        )
+        .score(self.bounds);
         // Nelder-Mead compares scores: an infinite one is a wall, kept finite so that the
         // simplex's centroid stays a number.
         Ok(score.min(1e12))

@@ -316,9 +316,9 @@ fn verdict(design: &Design, request: &DesignRequest) -> String {
     match design.best() {
         Some(best) => {
             let versus = match design.best_builtin() {
-                Some(c) if c.rate > best.rate => format!(
-                    "; {builtin}, cheaper than every design: ship the built-in"
-                ),
+                Some(c) if c.rate > best.rate => {
+                    format!("; {builtin}, cheaper than every design: ship the built-in")
+                }
                 _ => format!("; {builtin}"),
             };
             format!(

@@ -1,0 +1,186 @@
+//! `specula design`: the lobe it writes meets its bounds by NumPy and SciPy's measure (not
+//! specula's), is a lobe everywhere a lobe goes, and is cheaper than `pow` where the issue
+//! asks; bad requests are refused in one line with nothing written.
+
+use crate::common::{have_python_module, ok, python, renderer_script, specula};
+
+/// The GPU cost model is arithmetic on the exported shader's instruction counts, so the
+/// designed lobe's modelled rate against pow's is a property of its formula, not a timing.
+#[test]
+fn the_designed_gpu_lobe_meets_its_bounds_by_numpy_and_beats_pow() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let output = ok(
+        dir.path(),
+        &[
+            "design",
+            "--target",
+            "gpu-nvidia",
+            "--n",
+            "8..512",
+            "--max-error",
+            "0.1%",
+            "-o",
+            "designed.toml",
+            "--format",
+            "json",
+        ],
+    );
+    let answer: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    let best = &answer["designed"][0];
+    assert_eq!(best["meets"], true, "{answer}");
+    let versus_pow = best["rate"].as_f64().unwrap() / answer["pow_rate"].as_f64().unwrap();
+    assert!(versus_pow >= 1.5, "modelled at {versus_pow}x pow: {answer}");
+    // The lobe file goes where every lobe goes.
+    let file = dir.path().join("designed.toml");
+    let analysed = ok(
+        dir.path(),
+        &[
+            "analyze",
+            "--lobe",
+            "@designed.toml",
+            "--n",
+            "8,512",
+            "--format",
+            "json",
+        ],
+    );
+    let rows: serde_json::Value = serde_json::from_slice(&analysed.stdout).expect("JSON");
+    assert_eq!(rows.as_array().map(Vec::len), Some(2), "{rows}");
+    ok(
+        dir.path(),
+        &[
+            "shader",
+            "--lobe",
+            "@designed.toml",
+            "--n",
+            "64",
+            "--lang",
+            "wgsl",
+        ],
+    );
+    ok(
+        dir.path(),
+        &[
+            "sample",
+            "--lobe",
+            "@designed.toml",
+            "--n",
+            "64",
+            "--count",
+            "4",
+        ],
+    );
+    if !have_python_module("scipy", "scipy") {
+        return;
+    }
+    // NumPy and SciPy on the written text, at exponents of their own (37 log-spaced).
+    let exponents: Vec<String> = (0..=36)
+        .map(|k| format!("{}", 8.0 * 64f64.powf(f64::from(k) / 36.0)))
+        .collect();
+    let checked = std::process::Command::new(python())
+        .arg(renderer_script("designed_lobe_check.py"))
+        .arg(&file)
+        .args(["0.001", "0.01"])
+        .args(&exponents)
+        .output()
+        .expect("python runs");
+    assert!(
+        checked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&checked.stderr)
+    );
+    let figures: serde_json::Value = serde_json::from_slice(&checked.stdout).expect("JSON");
+    // specula's own worst epicentre error agrees with NumPy's to the grids' resolution.
+    let ours = best["epicentre_error"].as_f64().unwrap();
+    let theirs = figures["epicentre"]["error"].as_f64().unwrap();
+    assert!(
+        (ours - theirs).abs() <= 0.02 * theirs.max(1e-9),
+        "specula {ours}, NumPy {theirs}"
+    );
+}
+
+/// Without transcendentals, on the CPU: a polynomial lobe, or a one-line verdict saying why
+/// none; at one n the search and its costing are quick.
+#[test]
+fn a_polynomial_design_on_the_cpu_is_a_polynomial() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let output = ok(
+        dir.path(),
+        &[
+            "design",
+            "--target",
+            "cpu",
+            "--n",
+            "64",
+            "--max-error",
+            "0.5%",
+            "--no-transcendentals",
+            "--format",
+            "json",
+        ],
+    );
+    let answer: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    let designed = answer["designed"].as_array().expect("designed lobes");
+    assert!(!designed.is_empty());
+    for lobe in designed {
+        let formula = lobe["formula"].as_str().unwrap();
+        assert!(!formula.contains("exp2"), "{formula}");
+    }
+    assert_eq!(designed[0]["meets"], true, "{answer}");
+    assert!(answer["verdict"].as_str().unwrap().contains("on cpu"));
+}
+
+#[test]
+fn bad_design_requests_are_refused_in_one_line_and_nothing_is_written() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let cases: [(&[&str], &str); 4] = [
+        (
+            &[
+                "--target",
+                "gpu-nvidia",
+                "--n",
+                "512..8",
+                "--max-error",
+                "1%",
+            ],
+            "LOW < HIGH",
+        ),
+        (
+            &["--target", "fpga", "--n", "64", "--max-error", "1%"],
+            "valid targets",
+        ),
+        (
+            &["--target", "gpu-nvidia", "--n", "64", "--max-error", "0%"],
+            "(0, 100]",
+        ),
+        // Nothing in the search space reaches a millionth of a per cent over this range.
+        (
+            &[
+                "--target",
+                "gpu-nvidia",
+                "--n",
+                "8..512",
+                "--max-error",
+                "0.000001%",
+            ],
+            "searched",
+        ),
+    ];
+    for (args, expected) in cases {
+        let mut all = vec!["design"];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&["-o", "lobe.toml"]);
+        let output = specula(dir.path(), &all);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{all:?} succeeded");
+        let message = stderr
+            .lines()
+            .find(|l| l.starts_with("error"))
+            .unwrap_or_default();
+        assert!(message.contains(expected), "{all:?}: {stderr}");
+        assert!(
+            !dir.path().join("lobe.toml").exists(),
+            "{all:?} wrote a file"
+        );
+    }
+}
