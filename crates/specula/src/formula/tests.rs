@@ -266,6 +266,22 @@ fn columns_match_the_scalar_path_for_every_function() {
         // Two multiplies meeting in one add (one of them fused); a chain whose head a
         // column reads after the chain starts (its register must outlive both).
         ("col-two-products", "(t * t + t * t) * 0.5"),
+        // A chain's value meeting a value saved earlier in it (Horner's rule): from t
+        // itself, nested twice, subtracted either way round.
+        ("col-saved-t", "t * (0.5 + t * 0.5)"),
+        (
+            "col-saved-cubic",
+            "let u = 1 - t; exp2(u * (-n - u * (n / 2 + u * n / 3)) * 1.4427)",
+        ),
+        (
+            "col-saved-quadratic-pow",
+            "let s = n / 8; let c = (0.48 * s - 0.47) * s; let v = min(1 - t, 0.9); \
+             max(0, 1 - v * (s - c * v)) ^ 8",
+        ),
+        (
+            "col-saved-sub",
+            "let u = 1 - t; max(0, 1 - (u * 3 - u) * 0.5 - u)",
+        ),
         (
             "col-head-read-later",
             "let c = t * t; let p = c * 2; let d = c + t; let q = d * t; (p + 1) * q / 6",
@@ -290,6 +306,35 @@ fn columns_match_the_scalar_path_for_every_function() {
             }
         }
     }
+}
+
+/// A polynomial of one value inside a chain (the designed lobes' Horner forms) compiles to
+/// one chain, not to columns.
+#[test]
+fn horner_forms_are_one_chain() {
+    for (name, text) in [
+        (
+            "one-chain-exp2",
+            "let u = 1 - t; exp2(u * (-n - u * n / 2))",
+        ),
+        (
+            "one-chain-pow",
+            "let v = min(1 - t, 0.9); (1 - v * (n / 8 - 0.1 * v)) ^ 8",
+        ),
+    ] {
+        let LobeKind::Formula(id) = kind_of(definition(name, text)) else {
+            unreachable!("a formula")
+        };
+        assert!(
+            super::registry::get(id).formula().plan.is_one_chain(),
+            "{text}"
+        );
+    }
+    let kind = kind_of(definition("two-values", "t * t + (1 - t) * (1 - t) * 0"));
+    let LobeKind::Formula(id) = kind else {
+        unreachable!("a formula")
+    };
+    assert!(!super::registry::get(id).formula().plan.is_one_chain());
 }
 
 /// Inline formulas get numbered names; the same text is the same lobe.

@@ -44,6 +44,63 @@ pub(super) enum Link {
     Acos,
     /// A function without a vector form: the chain goes lane by lane.
     Lane(LaneFunction),
+    /// Keeps the value, which a later link of the chain reads again (`u` in
+    /// `u * (a + b * u)`): the chain's one saved value, held in registers beside it.
+    Save,
+    /// The value and the saved one combined: a polynomial of one value (Horner's rule)
+    /// stays a chain.
+    Saved(SavedOp),
+}
+
+/// How a chain's value meets its saved value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum SavedOp {
+    /// `x + saved`.
+    Add,
+    /// `x * saved`.
+    Mul,
+    /// `x - saved`.
+    Sub,
+    /// `saved - x`.
+    SubFrom,
+}
+
+impl SavedOp {
+    #[inline(always)]
+    fn apply<V: Lanes>(self, x: V, saved: V) -> V {
+        match self {
+            SavedOp::Add => x + saved,
+            SavedOp::Mul => x * saved,
+            SavedOp::Sub => x - saved,
+            SavedOp::SubFrom => saved - x,
+        }
+    }
+
+    fn scalar(self, x: f32, saved: f32) -> f32 {
+        match self {
+            SavedOp::Add => x + saved,
+            SavedOp::Mul => x * saved,
+            SavedOp::Sub => x - saved,
+            SavedOp::SubFrom => saved - x,
+        }
+    }
+
+    /// The range of the result, from the ranges of the value and the saved value (every
+    /// corner, each rounded as the lanes round it; rounding is monotone, so the rounded
+    /// results of values inside lie between the rounded corners).
+    fn range(self, (low, high): (f32, f32), (s_low, s_high): (f32, f32)) -> (f32, f32) {
+        let corners = [
+            self.scalar(low, s_low),
+            self.scalar(low, s_high),
+            self.scalar(high, s_low),
+            self.scalar(high, s_high),
+        ];
+        corners
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &c| {
+                (a.min(c), b.max(c))
+            })
+    }
 }
 
 impl Link {
@@ -55,9 +112,15 @@ impl Link {
         )
     }
 
-    /// The link in scalar `f32`, as the formula's scalar path computes it.
-    fn scalar(self, x: f32, values: &[f32]) -> f32 {
+    /// The link in scalar `f32`, as the formula's scalar path computes it; `saved` is the
+    /// chain's saved value ([`Link::Save`] sets it).
+    fn scalar(self, x: f32, saved: &mut f32, values: &[f32]) -> f32 {
         match self {
+            Link::Save => {
+                *saved = x;
+                x
+            }
+            Link::Saved(op) => op.scalar(x, *saved),
             Link::Add(s) => x + values[s],
             Link::Sub(s) => x - values[s],
             Link::SubFrom(s) => values[s] - x,
@@ -87,6 +150,9 @@ impl Link {
         let one = |class| Instructions::of(&[(class, 1)]);
         match self {
             Link::Add(_) | Link::Sub(_) | Link::SubFrom(_) => one(Class::Add),
+            Link::Save => Instructions::NONE,
+            Link::Saved(SavedOp::Mul) => one(Class::Mul),
+            Link::Saved(_) => one(Class::Add),
             Link::Mul(_) | Link::Neg => one(Class::Mul),
             Link::Squarings(m) => Instructions::of(&[(Class::Mul, m)]),
             Link::Affine(..) => Instructions::of(&[(Class::Add, 1), (Class::Fma, 1)]),
@@ -169,27 +235,44 @@ impl Chain {
             return Rules::ALL;
         }
         let (mut low, mut high) = (0.0_f32, 1.0_f32);
+        let mut saved_range = (0.0_f32, 1.0_f32);
         let mut approximate = false;
         for &link in &self.links {
-            let monotone = match link {
-                Link::Add(_) | Link::Sub(_) | Link::SubFrom(_) | Link::Min(_) | Link::Max(_) => {
-                    true
+            let (a, b) = match link {
+                Link::Save => {
+                    saved_range = (low, high);
+                    continue;
                 }
-                Link::Mul(_) | Link::Fma(..) | Link::Affine(..) | Link::Neg => true,
-                Link::Div(s) => values[s] != 0.0,
-                Link::DivInto(_) => low > 0.0 || high < 0.0,
-                Link::Sqrt => low >= 0.0,
-                Link::Squarings(_) | Link::Abs | Link::Powi(_) => low >= 0.0,
-                Link::Exp2(scale) => EXP2_DOMAIN.holds(low * scale, high * scale),
-                Link::Log2 | Link::Ln | Link::Pow(_) => LOG2_DOMAIN.holds(low, high),
-                Link::Acos => ACOS_DOMAIN.holds(low, high),
-                Link::Lane(_) => false,
+                Link::Saved(op) => op.range((low, high), saved_range),
+                link => {
+                    let monotone = match link {
+                        Link::Add(_)
+                        | Link::Sub(_)
+                        | Link::SubFrom(_)
+                        | Link::Min(_)
+                        | Link::Max(_) => true,
+                        Link::Mul(_) | Link::Fma(..) | Link::Affine(..) | Link::Neg => true,
+                        Link::Div(s) => values[s] != 0.0,
+                        Link::DivInto(_) => low > 0.0 || high < 0.0,
+                        Link::Sqrt => low >= 0.0,
+                        Link::Squarings(_) | Link::Abs | Link::Powi(_) => low >= 0.0,
+                        Link::Exp2(scale) => EXP2_DOMAIN.holds(low * scale, high * scale),
+                        Link::Log2 | Link::Ln | Link::Pow(_) => LOG2_DOMAIN.holds(low, high),
+                        Link::Acos => ACOS_DOMAIN.holds(low, high),
+                        Link::Lane(_) | Link::Save | Link::Saved(_) => false,
+                    };
+                    if !monotone {
+                        return Rules::ALL;
+                    }
+                    approximate |= link.checked();
+                    // A monotone link's ends; the saved value plays no part.
+                    let mut unused = 0.0;
+                    (
+                        link.scalar(low, &mut unused, values),
+                        link.scalar(high, &mut unused, values),
+                    )
+                }
             };
-            if !monotone {
-                return Rules::ALL;
-            }
-            approximate |= link.checked();
-            let (a, b) = (link.scalar(low, values), link.scalar(high, values));
             if a.is_nan() || b.is_nan() {
                 return Rules::ALL;
             }
@@ -198,10 +281,11 @@ impl Chain {
                 return Rules::ALL;
             }
         }
+        let mut saved = 0.0;
         let at_zero = self
             .links
             .iter()
-            .fold(0.0_f32, |v, link| link.scalar(v, values));
+            .fold(0.0_f32, |v, link| link.scalar(v, &mut saved, values));
         Rules {
             clamp: approximate || !(low >= 0.0 && high <= 1.0),
             mask: at_zero.to_bits() != 0,
@@ -259,10 +343,11 @@ pub(super) fn run<V: Lanes>(
     if chain.checked || chain.lane_only {
         while at < block {
             let mut x = load_group(lanes, buffers, ends.0, at);
+            let mut saved = x;
             let mut ok = lanes.splat(1.0);
             if !chain.lane_only {
                 for &link in &chain.links {
-                    apply(lanes, link, buffers.values, &mut x, &mut ok);
+                    apply(lanes, link, buffers.values, (&mut x, &mut saved), &mut ok);
                 }
             }
             if chain.lane_only || !all_set(ok) {
@@ -275,8 +360,9 @@ pub(super) fn run<V: Lanes>(
         // Without polynomials or a fallback the group's values never leave registers.
         while at < block {
             let mut x = load_group(lanes, buffers, ends.0, at);
+            let mut saved = x;
             for &link in &chain.links {
-                apply_arithmetic(lanes, link, buffers.values, &mut x);
+                apply_arithmetic(lanes, link, buffers.values, (&mut x, &mut saved));
             }
             store_group(lanes, buffers, ends.1, at, x);
             at += GROUP * V::WIDTH;
@@ -350,8 +436,9 @@ fn whole_group<V: Lanes, const CLAMP: bool, const MASK: bool>(
             .min(lanes.load(&t[k * width..(k + 1) * width]))
             .max(zero);
     }
+    let mut saved = x;
     for &link in links {
-        apply_arithmetic(lanes, link, values, &mut x);
+        apply_arithmetic(lanes, link, values, (&mut x, &mut saved));
     }
     for (k, value) in x.into_iter().enumerate() {
         let mut value = value;
@@ -435,8 +522,9 @@ fn lane_by_lane<V: Lanes>(
                 },
                 End::Register(r) => buffers.file[r + start + lane],
             };
+            let mut saved = v;
             for &link in &chain.links {
-                v = link.scalar(v, values);
+                v = link.scalar(v, &mut saved, values);
             }
             *slot = v;
         }
@@ -446,7 +534,13 @@ fn lane_by_lane<V: Lanes>(
 
 /// One link over the group; `ok` keeps 1 in the lanes where every polynomial was in range.
 #[inline(always)]
-fn apply<V: Lanes>(lanes: V, link: Link, values: &[f32], x: &mut [V; GROUP], ok: &mut V) {
+fn apply<V: Lanes>(
+    lanes: V,
+    link: Link,
+    values: &[f32],
+    (x, saved): (&mut [V; GROUP], &mut [V; GROUP]),
+    ok: &mut V,
+) {
     let s = |index: usize| lanes.splat(values[index]);
     match link {
         Link::Pow(i) => {
@@ -484,15 +578,26 @@ fn apply<V: Lanes>(lanes: V, link: Link, values: &[f32], x: &mut [V; GROUP], ok:
             }
         }
         Link::Lane(_) => {}
-        _ => apply_arithmetic(lanes, link, values, x),
+        _ => apply_arithmetic(lanes, link, values, (x, saved)),
     }
 }
 
 /// One link over the group, unchecked: arithmetic, or a polynomial proven in its domain.
 #[inline(always)]
-fn apply_arithmetic<V: Lanes>(lanes: V, link: Link, values: &[f32], x: &mut [V; GROUP]) {
+fn apply_arithmetic<V: Lanes>(
+    lanes: V,
+    link: Link,
+    values: &[f32],
+    (x, saved): (&mut [V; GROUP], &mut [V; GROUP]),
+) {
     let s = |index: usize| lanes.splat(values[index]);
     match link {
+        Link::Save => *saved = *x,
+        Link::Saved(op) => {
+            for (v, &kept) in x.iter_mut().zip(saved.iter()) {
+                *v = op.apply(*v, kept);
+            }
+        }
         Link::Add(i) => {
             let c = s(i);
             each!(x, |v| v + c);

@@ -20,7 +20,7 @@ use super::compile::Op;
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::Lanes;
 pub(crate) use chain::Rules;
-use chain::{Chain, End, Link};
+use chain::{Chain, End, Link, SavedOp};
 use columns::{binary, run_step, Binary, Inside, LaneFunction, Map, ACOS_DOMAIN, LOG2_DOMAIN};
 
 /// Vectors per block: 16 vectors of 8 lanes keep a register in 512 bytes, so a formula's
@@ -102,10 +102,20 @@ impl Plan {
             };
             roles.push(role);
         }
-        // A link continues into its one reader when that reader is a link taking it.
-        let continues = |index: usize| {
-            uses[index] == 1 && matches!(roles[last_use[index]], Role::Link(x, _) if x == index)
-        };
+        let saved_refs = save_values(tape, &mut roles, &uses);
+        // The link reading each value as its chain's value, where exactly one does.
+        let mut chain_reader: Vec<Option<usize>> = vec![None; tape.len()];
+        let mut link_readers = vec![0usize; tape.len()];
+        for (index, role) in roles.iter().enumerate() {
+            if let Role::Link(x, _) = *role {
+                link_readers[x] += 1;
+                chain_reader[x] = Some(index);
+            }
+        }
+        // A link continues into its one reader when that reader is a link taking it (and
+        // its other readers are the chain's later links that read it saved).
+        let continues =
+            |index: usize| link_readers[index] == 1 && uses[index] == 1 + saved_refs[index];
         // A multiply read only by an add is fused into it: the add's first such operand.
         let fusible = |index: usize| {
             matches!(roles[index], Role::Column)
@@ -129,7 +139,7 @@ impl Plan {
             let mut at = index;
             if matches!(roles[at], Role::Link(..)) {
                 while continues(at) {
-                    at = last_use[at];
+                    at = chain_reader[at].unwrap_or(at);
                 }
             } else if fused_into_add(at) {
                 at = last_use[at];
@@ -175,6 +185,9 @@ impl Plan {
                 Role::Link(x, l) => {
                     // Extend the chain ending at `x`, or start one from `x`.
                     let (head, mut links) = chains[x].take().unwrap_or((x, Vec::new()));
+                    if saved_refs[x] > 0 {
+                        links.push(Link::Save);
+                    }
                     push_fused(&mut links, l);
                     if continues(index) {
                         chains[index] = Some((head, links));
@@ -250,6 +263,15 @@ impl Plan {
             needs_t,
             result,
         }
+    }
+
+    /// Whether the whole tape is one chain from `t` to the output.
+    #[cfg(test)]
+    pub(crate) fn is_one_chain(&self) -> bool {
+        matches!(
+            self.steps.as_slice(),
+            [Step::Chain(_, End::Batch, End::Batch)]
+        )
     }
 
     /// The rules a batch's output needs with these per-material constants (see [`Rules`]).
@@ -456,6 +478,56 @@ fn push_fused(links: &mut Vec<Link>, link: Link) {
             link => links.push(link),
         },
     }
+}
+
+/// Turns into links the operations where a chain's value meets a value earlier in the same
+/// chain (`u * (a + b * u)`: the product reads `u`, and the chain from `u`), with that value
+/// saved; returns how many saved reads each value has. Such a value's readers are then its
+/// chain's next link and the saved reads, and every value between is read once, so one
+/// chain carries it all.
+fn save_values(tape: &[Op], roles: &mut [Role], uses: &[usize]) -> Vec<usize> {
+    let mut saved_refs = vec![0usize; tape.len()];
+    let mut saves: Vec<Option<usize>> = vec![None; tape.len()];
+    for index in 0..tape.len() {
+        if roles[index] != Role::Column {
+            continue;
+        }
+        let (a, b, kind) = match tape[index] {
+            Op::Add(a, b) => (a, b, [SavedOp::Add, SavedOp::Add]),
+            Op::Mul(a, b) => (a, b, [SavedOp::Mul, SavedOp::Mul]),
+            // a - b: with b's chain from a, saved - x; with a's chain from b, x - saved.
+            Op::Sub(a, b) => (a, b, [SavedOp::SubFrom, SavedOp::Sub]),
+            _ => continue,
+        };
+        // From `from`, back along single-reader links (or saved reads of `to`), to `to`.
+        let reaches = |from: usize, to: usize| {
+            let mut at = from;
+            loop {
+                if at == to {
+                    return true;
+                }
+                match roles[at] {
+                    Role::Link(x, _) if uses[at] == 1 && saves[at].is_none_or(|s| s == to) => {
+                        at = x;
+                    }
+                    _ => return false,
+                }
+            }
+        };
+        let shape = if a != b && reaches(b, a) {
+            Some((b, a, kind[0]))
+        } else if a != b && reaches(a, b) {
+            Some((a, b, kind[1]))
+        } else {
+            None
+        };
+        if let Some((x, saved, op)) = shape {
+            roles[index] = Role::Link(x, Link::Saved(op));
+            saves[index] = Some(saved);
+            saved_refs[saved] += 1;
+        }
+    }
+    saved_refs
 }
 
 /// `op` as a link: its one varying operand and the link, when its other operands are
