@@ -1,5 +1,6 @@
-//! The decision and the report: `specula recommend`'s rows, one lobe's cost on a target, and
-//! the report, each one call into `specula-decide` or `specula-report`.
+//! The decision and the report: `specula recommend`'s rows, `specula design`'s answer, one
+//! lobe's cost on a target, and the report, each one call into `specula-decide` or
+//! `specula-report`.
 
 use std::path::PathBuf;
 use std::str::FromStr;
@@ -7,7 +8,10 @@ use std::str::FromStr;
 use indicatif::ProgressBar;
 use pyo3::prelude::*;
 use specula::LobeKind;
-use specula_decide::{lobe_rate, parse_exponents, rate_unit, recommend, Request, Target, Zone};
+use specula_decide::design::{design, Bounds, DesignRequest};
+use specula_decide::{
+    lobe_rate, parse_exponent_range, parse_exponents, rate_unit, recommend, Request, Target, Zone,
+};
 
 use crate::errors::{guarded, value_error};
 use crate::lobe::{lobe_kind, Lobe};
@@ -42,6 +46,43 @@ pub fn recommend_json(
             .detach(|| recommend(&request, &ProgressBar::hidden()))
             .map_err(value_error)?;
         let reply = serde_json::json!({ "note": answer.note, "candidates": answer.candidates });
+        Ok(reply.to_string())
+    })
+}
+
+/// `specula design --format json`'s answer (every designed lobe, the built-ins beside them,
+/// the verdict), with the cheapest designed lobe's file text as `toml` (or `null`).
+#[pyfunction]
+#[pyo3(signature = (target, n, max_error, max_whole_error, energy_tolerance, no_transcendentals))]
+pub fn design_json(
+    py: Python<'_>,
+    target: &str,
+    n: &str,
+    max_error: f64,
+    max_whole_error: f64,
+    energy_tolerance: Option<f64>,
+    no_transcendentals: bool,
+) -> PyResult<String> {
+    guarded(|| {
+        let ends = parse_exponent_range(n, 1).map_err(value_error)?;
+        let request = DesignRequest {
+            target: Target::from_str(target).map_err(value_error)?,
+            range: (ends[0], ends[ends.len() - 1]),
+            bounds: Bounds {
+                epicentre: max_error,
+                whole: max_whole_error,
+                energy: energy_tolerance,
+            },
+            no_transcendentals,
+        };
+        let answer = py
+            .detach(|| design(&request, &ProgressBar::hidden()))
+            .map_err(value_error)?;
+        let toml = answer
+            .best()
+            .map(|best| specula_render::lobe_file::lobe_file_text(&best.definition(), &[]));
+        let mut reply = serde_json::to_value(&answer).map_err(|e| value_error(e.to_string()))?;
+        reply["toml"] = serde_json::json!(toml);
         Ok(reply.to_string())
     })
 }

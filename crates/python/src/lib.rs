@@ -30,6 +30,7 @@ fn _specula(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(analysis::analyze_json, module)?)?;
     module.add_function(wrap_pyfunction!(analysis::claims_json, module)?)?;
     module.add_function(wrap_pyfunction!(decide::recommend_json, module)?)?;
+    module.add_function(wrap_pyfunction!(decide::design_json, module)?)?;
     module.add_function(wrap_pyfunction!(decide::cost_json, module)?)?;
     module.add_function(wrap_pyfunction!(decide::report, module)?)?;
     module.add_function(wrap_pyfunction!(render::render, module)?)?;

@@ -4,6 +4,7 @@ same answer the CLI gives (one library under both faces)."""
 import json
 import math
 
+import numpy as np
 import pytest
 
 import specula
@@ -83,3 +84,37 @@ def test_the_report_is_written_from_python(tmp_path):
     assert len(images) > 10
     for name in images:
         assert (tmp_path / "report" / name).exists(), name
+
+
+def test_design_gives_the_clis_answer_and_a_lobe_every_call_takes(cli, tmp_path):
+    answer = specula.design("gpu-nvidia", n="8..512", max_error=0.001)
+    code, out, err = cli(
+        "design", "--target", "gpu-nvidia", "--n", "8..512", "--max-error", "0.1%",
+        "--format", "json",
+    )
+    assert code == 0, err
+    theirs = json.loads(out)
+    assert [d["formula"] for d in answer["designed"]] == [d["formula"] for d in theirs["designed"]]
+    assert answer["verdict"] == theirs["verdict"]
+    best = answer["designed"][0]
+    assert best["meets"] and answer["lobe"] == best["name"]
+    # The designed lobe is a lobe: evaluated here against t^n at the epicentre's edge, by
+    # NumPy, within the bound the design met.
+    lobe = specula.Lobe(answer["lobe"], 64)
+    edge = 2.0 ** (-1.0 / 64)
+    ts = np.linspace(edge, 1.0, 1001)
+    values = np.asarray(lobe(ts), dtype=np.float64)
+    assert np.max(np.abs(values / ts**64 - 1.0)) <= 0.001
+    # Its file reads back as the same formula, under CLI and Python alike.
+    path = tmp_path / "designed.toml"
+    path.write_text(answer["toml"])
+    assert specula.Lobe(f"@{path}", 64).eval(0.99) == lobe.eval(0.99)
+
+
+def test_bad_design_requests_raise_the_clis_message(cli):
+    with pytest.raises(ValueError, match=r"valid targets: cpu, gpu-nvidia, gpu-amd") as raised:
+        specula.design("fpga", n=64, max_error=0.01)
+    code, _, err = cli("design", "--target", "fpga", "--n", "64", "--max-error", "1%")
+    assert code != 0 and str(raised.value) in err
+    with pytest.raises(ValueError, match=r"\(0, 1\]"):
+        specula.design("gpu-amd", n=64, max_error=0.0)

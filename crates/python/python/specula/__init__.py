@@ -43,6 +43,7 @@ __all__ = [
     "lobe_ids",
     "models",
     "recommend",
+    "design",
     "render",
     "report",
     "render_volume",
@@ -180,6 +181,58 @@ def recommend(
     if reply["note"]:
         _warnings.warn(reply["note"], stacklevel=2)
     return reply["candidates"]
+
+
+def design(
+    target: str,
+    n: Union[float, str] = "8..512",
+    max_error: float = 0.001,
+    max_whole_error: float = 0.01,
+    energy_tolerance: Optional[float] = None,
+    no_transcendentals: bool = False,
+) -> Dict[str, Any]:
+    """The cheapest lobe for ``target`` over a range of ``n`` within an accuracy, designed:
+    ``specula design --format json``'s answer.
+
+    Parameters
+    ----------
+    target : {"cpu", "gpu-nvidia", "gpu-amd"}
+    n : float or str
+        An exponent, or a range ``"LOW..HIGH"`` the lobe must hold over.
+    max_error : float
+        The epicentre's largest relative error, as a fraction (0.001 is 0.1 %).
+    max_whole_error : float
+        The whole lobe's largest absolute error, as a fraction of the peak.
+    energy_tolerance : float, optional
+        Also match ``t^n``'s energy within this fraction at every ``n``.
+    no_transcendentals : bool
+        Only lobes without a transcendental operation per evaluation.
+
+    Returns
+    -------
+    dict
+        ``lobe`` (the cheapest designed lobe that meets the request, as an id every function
+        here takes, or None), ``toml`` (its lobe file's text, or None), ``verdict`` (one
+        line), ``designed`` (each family's lobe: ``formula``, ``coefficients``,
+        ``epicentre_error``, ``whole_error``, ``rate``, ``meets``, ``pareto``, ``why``, the
+        ones that meet first, cheapest first), ``builtins`` (``recommend``'s rows on the same
+        target and bound), ``pow_rate`` and ``unit``.
+    """
+    reply = _json.loads(
+        _specula.design_json(
+            target,
+            str(n),
+            float(max_error),
+            float(max_whole_error),
+            None if energy_tolerance is None else float(energy_tolerance),
+            bool(no_transcendentals),
+        )
+    )
+    if reply["note"]:
+        _warnings.warn(reply["note"], stacklevel=2)
+    best = reply["designed"][0] if reply["designed"] and reply["designed"][0]["meets"] else None
+    reply["lobe"] = best["name"] if best else None
+    return reply
 
 
 def cost(target: str, lobe: Lobe) -> Dict[str, Any]:

@@ -89,6 +89,14 @@ def claims_json(
 def recommend_json(
     target: str, n: str, max_error: float, zone: str, energy_conserving: bool, lobes: List[str]
 ) -> str: ...
+def design_json(
+    target: str,
+    n: str,
+    max_error: float,
+    max_whole_error: float,
+    energy_tolerance: Optional[float],
+    no_transcendentals: bool,
+) -> str: ...
 def cost_json(target: str, lobe: Lobe) -> str: ...
 def report(
     out: str, quick: bool, bench: bool, lobes: List[str], materials: Optional[str]
