@@ -8,7 +8,7 @@ use std::str::FromStr;
 use indicatif::ProgressBar;
 use pyo3::prelude::*;
 use specula::LobeKind;
-use specula_decide::design::{design, Bounds, DesignRequest};
+use specula_decide::design::{default_whole_error, design, Bounds, DesignRequest};
 use specula_decide::{
     lobe_rate, parse_exponent_range, parse_exponents, rate_unit, recommend, Request, Target, Zone,
 };
@@ -59,7 +59,7 @@ pub fn design_json(
     target: &str,
     n: &str,
     max_error: f64,
-    max_whole_error: f64,
+    max_whole_error: Option<f64>,
     energy_tolerance: Option<f64>,
     no_transcendentals: bool,
 ) -> PyResult<String> {
@@ -70,7 +70,7 @@ pub fn design_json(
             range: (ends[0], ends[ends.len() - 1]),
             bounds: Bounds {
                 epicentre: max_error,
-                whole: max_whole_error,
+                whole: max_whole_error.unwrap_or_else(|| default_whole_error(max_error)),
                 energy: energy_tolerance,
             },
             no_transcendentals,

@@ -9,6 +9,7 @@
 //! is written atomically, and the page last, so an interrupted run never leaves a page that
 //! points at missing images.
 
+mod designed;
 mod energy;
 pub mod format;
 mod hardware;
@@ -108,6 +109,8 @@ pub(crate) struct Sizes {
     /// Whether the hardware claim's designs are synthesized when the cache lacks them (the
     /// first time, minutes) or only read from it.
     pub synthesis: specula_synth::OnMiss,
+    /// The epicentre bounds the designed lobes are searched for.
+    pub design_bounds: &'static [f64],
 }
 
 /// How much the medical section does with the real scans.
@@ -237,8 +240,9 @@ const VERDICT: &str = "Which lobe when";
 const HARDWARE: &str = "Hardware";
 
 /// The answer first (which lobe when), then the thesis's claims, then the details.
-const SECTIONS: [Section; 13] = [
+const SECTIONS: [Section; 14] = [
     (VERDICT, verdict::verdict),
+    ("Designed lobes", designed::designed),
     (CLAIMS, sections::claims),
     ("Models", sections::models),
     ("Lobe shapes", sections::shapes),

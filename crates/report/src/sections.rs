@@ -456,6 +456,7 @@ pub fn sizes(quick: bool) -> Sizes {
             },
             hardware_exponents: &[64],
             synthesis: OnMiss::Skip,
+            design_bounds: &[0.001],
         }
     } else {
         Sizes {
@@ -475,6 +476,7 @@ pub fn sizes(quick: bool) -> Sizes {
             },
             hardware_exponents: &[8, 64, 512],
             synthesis: OnMiss::Synthesize,
+            design_bounds: &[0.001, 0.005, 0.02],
         }
     }
 }

@@ -23,7 +23,7 @@ const ACCURACIES: [f64; 3] = [0.005, 0.02, 0.10];
 /// The exponent of the Pareto plots.
 const PLOTTED: f64 = 64.0;
 /// Where exact `pow` is drawn on the log axis.
-const EXACT_FLOOR: f64 = 1e-6;
+pub(crate) const EXACT_FLOOR: f64 = 1e-6;
 
 /// `specula recommend --target TARGET --n N --max-error BOUND` over the report's lobes.
 fn answers(lobes: &[LobeKind], target: Target, n: f64) -> Result<Vec<Recommendation>, String> {
@@ -59,6 +59,51 @@ fn fpga_cell(answer: &Recommendation) -> String {
         };
         format!("{named}: {} {}", sig(best.rate), answer.unit)
     })
+}
+
+/// Error against modelled cost: a marker per lobe in its colour, the grey line through the
+/// points flagged as the Pareto front, then `extra` series; log axes from the exact floor.
+pub(crate) fn pareto_chart(
+    title: String,
+    points: &[(LobeKind, (f64, f64), bool)],
+    extra: Vec<Series>,
+) -> Chart {
+    let mut front: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(_, _, on)| *on)
+        .map(|&(_, p, _)| p)
+        .collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut series_list: Vec<Series> = points
+        .iter()
+        .map(|&(kind, point, _)| Series {
+            markers: true,
+            ..series(kind, vec![point])
+        })
+        .collect();
+    series_list.push(Series {
+        name: "Pareto front".into(),
+        points: front,
+        colour: plotters::style::RGBColor(150, 150, 150),
+        width: 1,
+        markers: false,
+        dashed: false,
+    });
+    series_list.extend(extra);
+    let most = points.iter().map(|p| p.1 .1).fold(0.0, f64::max);
+    Chart {
+        title,
+        x_label: format!("epicentre max relative error (pow, exact, at {EXACT_FLOOR:e})"),
+        y_label: "modelled evaluations per clock per multiprocessor".into(),
+        // Room on the right, past any error, for the legend.
+        x: (EXACT_FLOOR / 2.0, 1e3),
+        y: (0.1, most * 2.0),
+        log_x: true,
+        log_y: true,
+        series: series_list,
+        legend_below: true,
+        ..Chart::default()
+    }
 }
 
 pub fn verdict(context: &mut Context) -> Result<String, String> {
@@ -160,47 +205,15 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
                 Some((kind, candidate))
             })
             .collect();
-        let plotted: Vec<(f64, f64)> = candidates
+        let points: Vec<(LobeKind, (f64, f64), bool)> = candidates
             .iter()
-            .map(|(_, c)| (c.error.max(EXACT_FLOOR), c.rate))
+            .map(|(kind, c)| (*kind, (c.error.max(EXACT_FLOOR), c.rate), c.pareto))
             .collect();
-        let mut front: Vec<(f64, f64)> = candidates
-            .iter()
-            .zip(&plotted)
-            .filter(|((_, c), _)| c.pareto)
-            .map(|(_, p)| *p)
-            .collect();
-        front.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut series_list: Vec<Series> = candidates
-            .iter()
-            .zip(&plotted)
-            .map(|((kind, _), &point)| Series {
-                markers: true,
-                ..series(*kind, vec![point])
-            })
-            .collect();
-        series_list.push(Series {
-            name: "Pareto front".into(),
-            points: front,
-            colour: plotters::style::RGBColor(150, 150, 150),
-            width: 1,
-            markers: false,
-            dashed: false,
-        });
-        let most = plotted.iter().map(|p| p.1).fold(0.0, f64::max);
-        let chart = Chart {
-            title: format!("{name}: epicentre error against modelled cost, n = {PLOTTED}"),
-            x_label: format!("epicentre max relative error (pow, exact, at {EXACT_FLOOR:e})"),
-            y_label: "modelled evaluations per clock per multiprocessor".into(),
-            // Room on the right, past any error, for the legend.
-            x: (EXACT_FLOOR / 2.0, 1e3),
-            y: (0.1, most * 2.0),
-            log_x: true,
-            log_y: true,
-            series: series_list,
-            legend_below: true,
-            ..Chart::default()
-        };
+        let chart = pareto_chart(
+            format!("{name}: epicentre error against modelled cost, n = {PLOTTED}"),
+            &points,
+            Vec::new(),
+        );
         html += &context.svg(
             &format!("verdict-{}.svg", target.id()),
             &chart,

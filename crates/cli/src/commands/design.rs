@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use specula_decide::design::{design, Bounds, Design, DesignRequest, DEFAULT_WHOLE_ERROR};
+use specula_decide::design::{default_whole_error, design, Bounds, Design, DesignRequest};
 use specula_decide::{versus_pow, Target};
 
 use super::CommandResult;
@@ -25,7 +25,8 @@ pub struct Args {
     /// `recommend` counts.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_percent)]
     max_error: f64,
-    /// The whole lobe's largest absolute error, as a percentage of the peak [default: 1%].
+    /// The whole lobe's largest absolute error, as a percentage of the peak [default: 1%, or
+    /// --max-error where that is larger].
     #[arg(long, allow_hyphen_values = true, value_parser = parse_percent)]
     max_whole_error: Option<f64>,
     /// Also match t^n's energy within this percentage at every n.
@@ -70,7 +71,9 @@ pub fn run(args: &Args) -> CommandResult {
         range: (args.n.0, args.n.1),
         bounds: Bounds {
             epicentre: args.max_error,
-            whole: args.max_whole_error.unwrap_or(DEFAULT_WHOLE_ERROR),
+            whole: args
+                .max_whole_error
+                .unwrap_or_else(|| default_whole_error(args.max_error)),
             energy: args.energy_tolerance,
         },
         no_transcendentals: args.no_transcendentals,

@@ -74,7 +74,7 @@ fn the_quick_report_is_complete_and_well_formed() {
         .descendants()
         .filter(|n| n.has_tag_name("section"))
         .count();
-    assert_eq!(sections, 13);
+    assert_eq!(sections, 14);
     // Into other renderers: every lobe's record and its lowering give the lobe's own bits.
     let renderers = page
         .find("Into other renderers")
@@ -88,6 +88,15 @@ fn the_quick_report_is_complete_and_well_formed() {
     let verdict = page.find("Which lobe when").expect("a verdict section");
     let claims = page.find("The thesis's claims").expect("a claims section");
     assert!(verdict < claims && claims < page.find("Models").expect("a models section"));
+    // The designed lobes stand beside the verdict, each with its formula (a lobe file's
+    // text, which `specula design` would write).
+    let heading = |name: &str| page.find(&format!("{name}</h2>")).expect(name);
+    let designed = heading("Designed lobes");
+    assert!(heading("Which lobe when") < designed && designed < heading("The thesis's claims"));
+    assert!(
+        page[designed..heading("The thesis's claims")].contains("<pre>let "),
+        "no designed formula"
+    );
     let sources: Vec<&str> = document
         .descendants()
         .filter(|n| n.has_tag_name("img"))

@@ -60,20 +60,43 @@ const EPICENTRE_POINTS: usize = 48;
 const WHOLE_POINTS: usize = 96;
 const ENERGY_INTERVALS: usize = 256;
 
-/// The family's figures at `n`.
-fn figures_at(family: Family, beta: &[f64], n: f64, energy: bool) -> Figures {
-    let u_half = 1.0 - 2f64.powf(-1.0 / n);
+/// The points one exponent's figures are taken at, with `t^n` there (computed once per fit,
+/// not per evaluation of the objective).
+pub struct Grid {
+    n: f64,
+    epicentre: Vec<(f64, f64)>,
+    whole: Vec<(f64, f64)>,
+}
+
+impl Grid {
+    /// The grid of `n`.
+    #[must_use]
+    pub fn new(n: f64) -> Self {
+        let exact = |u: f64| (u, (1.0 - u).powf(n));
+        let u_half = 1.0 - 2f64.powf(-1.0 / n);
+        Self {
+            n,
+            epicentre: (0..=EPICENTRE_POINTS)
+                .map(|k| exact(u_half * k as f64 / EPICENTRE_POINTS as f64))
+                .collect(),
+            whole: (0..=WHOLE_POINTS)
+                .map(|k| (30.0 * k as f64 / WHOLE_POINTS as f64 / n).min(1.0))
+                .chain([0.25, 0.5, 0.75, 1.0])
+                .map(exact)
+                .collect(),
+        }
+    }
+}
+
+/// The family's figures on `grid`.
+fn figures_at(family: Family, beta: &[f64], grid: &Grid, energy: bool) -> Figures {
+    let n = grid.n;
     let mut epicentre = 0.0_f64;
-    for k in 0..=EPICENTRE_POINTS {
-        let u = u_half * k as f64 / EPICENTRE_POINTS as f64;
-        let exact = (1.0 - u).powf(n);
+    for &(u, exact) in &grid.epicentre {
         epicentre = epicentre.max((family.eval(beta, n, u) / exact - 1.0).abs());
     }
     let mut whole = 0.0_f64;
-    let whole_points = (0..=WHOLE_POINTS)
-        .map(|k| (30.0 * k as f64 / WHOLE_POINTS as f64 / n).min(1.0))
-        .chain([0.25, 0.5, 0.75, 1.0]);
-    for u in whole_points {
+    for &(u, exact) in &grid.whole {
         let value = family.eval(beta, n, u);
         if !(0.0..=1.0).contains(&value) {
             return Figures {
@@ -82,7 +105,7 @@ fn figures_at(family: Family, beta: &[f64], n: f64, energy: bool) -> Figures {
                 energy: f64::INFINITY,
             };
         }
-        whole = whole.max((value - (1.0 - u).powf(n)).abs());
+        whole = whole.max((value - exact).abs());
     }
     let energy = if energy {
         // (n + 1) int_0^1 lobe(1 - u) du by Simpson's rule over u in [0, min(1, 40 / n)],
@@ -111,17 +134,17 @@ fn figures_at(family: Family, beta: &[f64], n: f64, energy: bool) -> Figures {
     }
 }
 
-/// The family's figures, the worst over `exponents`.
+/// The family's figures, the worst over the grids.
 #[must_use]
-pub fn figures(family: Family, beta: &[f64], exponents: &[f64], energy: bool) -> Figures {
-    exponents.iter().fold(
+pub fn figures(family: Family, beta: &[f64], grids: &[Grid], energy: bool) -> Figures {
+    grids.iter().fold(
         Figures {
             epicentre: 0.0,
             whole: 0.0,
             energy: 0.0,
         },
-        |worst, &n| {
-            let at = figures_at(family, beta, n, energy);
+        |worst, grid| {
+            let at = figures_at(family, beta, grid, energy);
             Figures {
                 epicentre: worst.epicentre.max(at.epicentre),
                 whole: worst.whole.max(at.whole),
@@ -133,7 +156,7 @@ pub fn figures(family: Family, beta: &[f64], exponents: &[f64], energy: bool) ->
 
 struct Objective<'a> {
     family: Family,
-    exponents: &'a [f64],
+    grids: &'a [Grid],
     bounds: Bounds,
 }
 
@@ -142,13 +165,8 @@ impl CostFunction for Objective<'_> {
     type Output = f64;
 
     fn cost(&self, beta: &Vec<f64>) -> Result<f64, argmin::core::Error> {
-        let score = figures(
-            self.family,
-            beta,
-            self.exponents,
-            self.bounds.energy.is_some(),
-        )
-        .score(self.bounds);
+        let score =
+            figures(self.family, beta, self.grids, self.bounds.energy.is_some()).score(self.bounds);
         // Nelder-Mead compares scores: an infinite one is a wall, kept finite so that the
         // simplex's centroid stays a number.
         Ok(score.min(1e12))
@@ -160,13 +178,13 @@ impl CostFunction for Objective<'_> {
 const RESTARTS: usize = 3;
 const ITERATIONS: u64 = 600;
 
-/// The family's coefficients fitted over `exponents` against `bounds`, and their score (at
+/// The family's coefficients fitted over the exponents of `grids` against `bounds`, and their score (at
 /// most 1 where the coarse grids meet every bound).
 #[must_use]
-pub fn fit(family: Family, exponents: &[f64], bounds: Bounds) -> (Vec<f64>, f64) {
+pub fn fit(family: Family, grids: &[Grid], bounds: Bounds) -> (Vec<f64>, f64) {
     let objective = || Objective {
         family,
-        exponents,
+        grids,
         bounds,
     };
     let mut best = family.start();

@@ -187,7 +187,7 @@ def design(
     target: str,
     n: Union[float, str] = "8..512",
     max_error: float = 0.001,
-    max_whole_error: float = 0.01,
+    max_whole_error: Optional[float] = None,
     energy_tolerance: Optional[float] = None,
     no_transcendentals: bool = False,
 ) -> Dict[str, Any]:
@@ -201,8 +201,9 @@ def design(
         An exponent, or a range ``"LOW..HIGH"`` the lobe must hold over.
     max_error : float
         The epicentre's largest relative error, as a fraction (0.001 is 0.1 %).
-    max_whole_error : float
-        The whole lobe's largest absolute error, as a fraction of the peak.
+    max_whole_error : float, optional
+        The whole lobe's largest absolute error, as a fraction of the peak (by default
+        0.01, or ``max_error`` where that is larger).
     energy_tolerance : float, optional
         Also match ``t^n``'s energy within this fraction at every ``n``.
     no_transcendentals : bool
@@ -223,7 +224,7 @@ def design(
             target,
             str(n),
             float(max_error),
-            float(max_whole_error),
+            None if max_whole_error is None else float(max_whole_error),
             None if energy_tolerance is None else float(energy_tolerance),
             bool(no_transcendentals),
         )

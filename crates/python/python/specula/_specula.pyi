@@ -93,7 +93,7 @@ def design_json(
     target: str,
     n: str,
     max_error: float,
-    max_whole_error: float,
+    max_whole_error: Optional[float],
     energy_tolerance: Optional[float],
     no_transcendentals: bool,
 ) -> str: ...

@@ -1,0 +1,182 @@
+//! "Designed lobes", beside "Which lobe when": for each GPU family of the cost model, the
+//! lobe `specula design` searches out over `n` from 8 to 512 at a few epicentre bounds, next
+//! to the cheapest built-in that meets the same bound, with its formula and figures, and the
+//! Pareto plot of both kinds at the tightest bound. Every figure is
+//! [`specula_decide::design::design`]'s answer (the command's library call), so the page and
+//! `specula design` cannot disagree. The CPU's costs are timed, so its designs are left to
+//! `specula design --target cpu` on a quiet machine.
+
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+use specula::{Exponent, LobeKind};
+use specula_decide::design::{
+    default_whole_error, design, percent, Bounds, Design, DesignRequest, DEFAULT_WHOLE_ERROR,
+};
+use specula_decide::{versus_pow, Target};
+
+use super::html::{escape, paragraph, table};
+use super::plot::Series;
+use super::verdict::{pareto_chart, EXACT_FLOOR};
+use super::Context;
+
+const FAMILIES: [(Target, &str); 2] = [(Target::GpuNvidia, "NVIDIA"), (Target::GpuAmd, "AMD RDNA")];
+const RANGE: (f64, f64) = (8.0, 512.0);
+
+fn request(target: Target, bound: f64) -> DesignRequest {
+    DesignRequest {
+        target,
+        range: (Exponent::new(RANGE.0), Exponent::new(RANGE.1)),
+        bounds: Bounds {
+            epicentre: bound,
+            whole: default_whole_error(bound),
+            energy: None,
+        },
+        no_transcendentals: false,
+    }
+}
+
+pub fn designed(context: &mut Context) -> Result<String, String> {
+    let bounds = context.sizes.design_bounds;
+    let jobs: Vec<(Target, &str, f64)> = FAMILIES
+        .iter()
+        .flat_map(|&(target, name)| bounds.iter().map(move |&b| (target, name, b)))
+        .collect();
+    let answers: Vec<Design> = jobs
+        .par_iter()
+        .map(|&(target, _, bound)| design(&request(target, bound), &ProgressBar::hidden()))
+        .collect::<Result<_, _>>()?;
+    let mut html = paragraph(&format!(
+        "The thesis designed its lobes by hand; specula design searches the families the \
+         formula language writes (exp2 of a polynomial of 1 - t; a linear or quadratic \
+         polynomial of 1 - t, cut where it stops falling, raised to a power of two), fits \
+         each one's global coefficients across n from {} to {} (every per-material constant \
+         a closed form of n), verifies the fitted formula with the f64 analysis at {} \
+         exponents of the range (epicentre error within the bound, whole-lobe error within \
+         {} of the peak or the epicentre's bound where larger, 1 at t = 1, non-decreasing, in [0, 1]) and costs it as recommend \
+         does. Each row is specula design --target TARGET --n {}..{} --max-error BOUND.",
+        RANGE.0,
+        RANGE.1,
+        answers.first().map_or(0, |a| a.exponents_verified),
+        percent(DEFAULT_WHOLE_ERROR),
+        RANGE.0,
+        RANGE.1
+    ));
+    let mut rows = Vec::new();
+    let mut formulas = String::new();
+    for ((_, name, bound), answer) in jobs.iter().zip(&answers) {
+        let builtin = answer.best_builtin().map_or("-".to_owned(), |c| {
+            format!("{} ({} pow)", c.lobe, versus_pow(c.rate, answer.pow_rate))
+        });
+        let row = match answer.best() {
+            Some(best) => {
+                formulas += &format!(
+                    "<p>{name}, within {}: <code>{}</code></p>\n<pre>{}</pre>\n",
+                    escape(&percent(*bound)),
+                    escape(&best.name),
+                    escape(&best.formula)
+                );
+                vec![
+                    (*name).to_owned(),
+                    percent(*bound),
+                    best.name.clone(),
+                    percent(best.epicentre_error),
+                    percent(best.whole_error),
+                    versus_pow(best.rate, answer.pow_rate),
+                    builtin,
+                ]
+            }
+            None => vec![
+                (*name).to_owned(),
+                percent(*bound),
+                "-".to_owned(),
+                "-".to_owned(),
+                "-".to_owned(),
+                "-".to_owned(),
+                builtin,
+            ],
+        };
+        rows.push(row);
+    }
+    html += &table(
+        &[
+            "target",
+            "epicentre bound",
+            "designed lobe",
+            "its epicentre error",
+            "its whole-lobe error",
+            "designed vs pow",
+            "cheapest built-in (vs pow)",
+        ],
+        &rows,
+    );
+    for ((_, name, bound), answer) in jobs.iter().zip(&answers) {
+        html += &paragraph(&format!(
+            "{name}, within {}: {}",
+            percent(*bound),
+            answer.verdict
+        ));
+    }
+    html += &formulas;
+    for (k, (target, name)) in FAMILIES.iter().enumerate() {
+        // The tightest bound's answer for this family.
+        let answer = &answers[k * bounds.len()];
+        html += &pareto_plot(context, *target, name, bounds[0], answer)?;
+    }
+    Ok(html)
+}
+
+/// Error against modelled cost, the designed lobes and the built-ins, with their joint
+/// Pareto front.
+fn pareto_plot(
+    context: &mut Context,
+    target: Target,
+    name: &str,
+    bound: f64,
+    answer: &Design,
+) -> Result<String, String> {
+    let mut points: Vec<(LobeKind, (f64, f64), bool)> = answer
+        .designed
+        .iter()
+        .filter(|d| d.verified && d.rate > 0.0)
+        .filter_map(|d| {
+            Some((
+                d.kind()?,
+                (d.epicentre_error.max(EXACT_FLOOR), d.rate),
+                false,
+            ))
+        })
+        .collect();
+    points.extend(answer.builtins.iter().filter_map(|c| {
+        let kind = LobeKind::ALL.into_iter().find(|k| k.id() == c.lobe)?;
+        Some((kind, (c.error.max(EXACT_FLOOR), c.rate), false))
+    }));
+    // The front over both kinds together.
+    let plain: Vec<(f64, f64)> = points.iter().map(|&(_, p, _)| p).collect();
+    for (point, on) in points.iter_mut().zip(specula_decide::pareto_front(&plain)) {
+        point.2 = on;
+    }
+    let bound_line = Series {
+        name: format!("the bound, {}", percent(bound)),
+        points: vec![(bound, 0.1), (bound, 1e3)],
+        colour: plotters::style::RGBColor(200, 60, 60),
+        width: 1,
+        markers: false,
+        dashed: true,
+    };
+    let chart = pareto_chart(
+        format!(
+            "{name}: designed and built-in lobes, worst epicentre error over n = {}..{} against modelled cost",
+            RANGE.0, RANGE.1
+        ),
+        &points,
+        vec![bound_line],
+    );
+    context.svg(
+        &format!("designed-{}.svg", target.id()),
+        &chart,
+        &format!(
+            "{name}: the designed lobes (within {}) and the built-ins, error against cost; higher left is better, the grey line joins the Pareto front over both, the red line is the bound",
+            percent(bound)
+        ),
+    )
+}
