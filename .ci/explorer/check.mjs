@@ -166,6 +166,22 @@ try {
   const cleared = await labels();
   if (cleared.error || cleared.legend.includes("formula")) failures.push(`clearing the formula: ${JSON.stringify(cleared)}`);
 
+  // The design panel: specula design's verdict under its button, and the designed lobe put in
+  // the formula box, where it is drawn like a typed one.
+  await page.locator("#design-panel summary").click();
+  await page.locator("#design-error").fill("0.1");
+  const beforeDesign = await snapshot();
+  await page.locator("#design-run").click();
+  await page.waitForFunction(() => document.getElementById("formula").value.includes("exp2"), null, { timeout: 120000 });
+  const designedFormula = await page.evaluate(() => document.getElementById("formula").value);
+  await drawn("formula", designedFormula);
+  const designedView = await snapshot();
+  const verdict = await page.evaluate(() => document.getElementById("design-result").textContent);
+  if (!/the cheapest designed lobe within 0\.1 %/.test(verdict)) failures.push(`the design's verdict: '${verdict}'`);
+  if (designedView.plots[0] === beforeDesign.plots[0]) failures.push("the designed lobe was not drawn");
+  const afterDesign = await labels();
+  if (afterDesign.error || !afterDesign.legend.includes("formula")) failures.push(`the designed formula: ${JSON.stringify(afterDesign)}`);
+
   // Axis ticks are round numbers, counted by hand: 1, 2 or 5 times a power of ten.
   const ticks = await page.evaluate(() => [[0, 21.4], [-0.129, 0.129], [0, 1.05], [0, 90]].map(([lo, hi]) => niceTicks(lo, hi).map(([, label]) => label).join(" ")));
   const expected = ["0 5 10 15 20", "-0.10 -0.05 0.00 0.05 0.10", "0.0 0.2 0.4 0.6 0.8 1.0", "0 20 40 60 80"];
@@ -181,4 +197,4 @@ if (failures.length) {
   console.error("explorer check failed:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`explorer check: loaded, moved n, changed lobes (and the environment view), changed the volume's lobe and volume, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, typed a formula (drawn and rendered) and two refused ones (their errors beside the box), round ticks; no console message; screenshot ${screenshot}`);
+console.log(`explorer check: loaded, moved n, changed lobes (and the environment view), changed the volume's lobe and volume, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, typed a formula (drawn and rendered) and two refused ones (their errors beside the box), ran a design (its lobe drawn from the box), round ticks; no console message; screenshot ${screenshot}`);

@@ -82,6 +82,7 @@ pub fn cpu_cost(lobe: &Lobe) -> TargetCost {
 pub struct AppState {
     computations: Limiter,
     pub(crate) costs: CostModel,
+    pub(crate) designer: Option<crate::design::DesignModel>,
     hosts: Hosts,
     pub(crate) materials: Arc<Materials>,
 }
@@ -93,6 +94,7 @@ impl AppState {
         Self {
             computations: Limiter::default(),
             costs,
+            designer: None,
             hosts: Hosts::default(),
             materials: Arc::new(Materials::none()),
         }
@@ -103,6 +105,15 @@ impl AppState {
     pub fn with_materials(self, materials: Materials) -> Self {
         Self {
             materials: Arc::new(materials),
+            ..self
+        }
+    }
+
+    /// The state answering `/api/design` with `designer`.
+    #[must_use]
+    pub fn with_designer(self, designer: crate::design::DesignModel) -> Self {
+        Self {
+            designer: Some(designer),
             ..self
         }
     }
@@ -148,6 +159,15 @@ impl ApiError {
             error,
             parameter: Some(parameter.to_owned()),
             valid: Some(valid),
+        }
+    }
+
+    pub(crate) fn unavailable(error: String) -> Self {
+        Self {
+            status: StatusCode::SERVICE_UNAVAILABLE,
+            error,
+            parameter: None,
+            valid: None,
         }
     }
 
@@ -355,7 +375,7 @@ pub async fn not_found() -> ApiError {
         error: "no such page or endpoint".into(),
         parameter: None,
         valid: Some(
-            "/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume, /api/environment, /api/materials, /api/fits, /api/material-render"
+            "/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume, /api/environment, /api/materials, /api/fits, /api/material-render, /api/design"
                 .into(),
         ),
     }

@@ -13,6 +13,7 @@
 //! given at start-up, named by their stems (`measured.rs`).
 
 mod api;
+mod design;
 mod environment;
 mod explorer;
 mod guard;
@@ -25,6 +26,7 @@ mod volume;
 use std::net::SocketAddr;
 
 pub use api::{cpu_cost, AppState, CostModel, TargetCost, MAX_RENDER_SIZE};
+pub use design::{DesignModel, DesignQuery, DESIGN_TARGETS};
 pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
 pub use listen::{max_waiting, CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT};
@@ -88,6 +90,7 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/materials", get(measured::list))
         .route("/api/fits", get(measured::fits))
         .route("/api/material-render", get(measured::render_material))
+        .route("/api/design", get(design::design))
         .fallback(api::not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
         .layer(axum::middleware::from_fn_with_state(
@@ -98,13 +101,14 @@ pub fn router_with(state: api::AppState) -> Router {
 }
 
 /// Serves on `address` until Ctrl-C, printing the URL; `open` also opens it in a browser;
-/// `costs` prices each lobe on each target; `materials` are the measured materials offered
-/// (`--data`).
+/// `costs` prices each lobe on each target; `designer` answers `/api/design`; `materials` are
+/// the measured materials offered (`--data`).
 /// Anything but a loopback address is warned about: the explorer has no authentication.
 pub fn serve(
     address: SocketAddr,
     open: bool,
     costs: api::CostModel,
+    designer: design::DesignModel,
     materials: Materials,
 ) -> Result<(), String> {
     if !address.ip().is_loopback() {
@@ -126,6 +130,7 @@ pub fn serve(
             open_browser(&url);
         }
         let state = api::AppState::with_costs(costs)
+            .with_designer(designer)
             .with_materials(materials)
             .answering(Hosts::new(Some(local.ip()), Some(local.port())));
         listen::serve(listener, router_with(state), async {

@@ -4,9 +4,15 @@ use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+use indicatif::ProgressBar;
 use specula::gpu_cost::GpuFamily;
-use specula::Lobe;
-use specula_serve::{cpu_cost, Materials, TargetCost};
+use specula::{Exponent, Lobe};
+use specula_decide::design::{default_whole_error, design, Bounds, DesignRequest};
+use specula_decide::Target;
+use specula_serve::{cpu_cost, DesignModel, DesignQuery, Materials, TargetCost};
 
 use super::CommandResult;
 
@@ -56,8 +62,49 @@ pub fn run(args: &Args) -> CommandResult {
         SocketAddr::new(args.bind, args.port),
         args.open,
         Arc::new(costs),
+        designer(),
         materials,
     )
+}
+
+/// The most designs a server runs: each registers its families' formulas for the life of
+/// the process (the formula registry is bounded), so a design asked again is answered from
+/// memory, and new ones beyond this are refused.
+const MAX_DESIGNS: usize = 64;
+
+/// `specula design`'s answer as JSON for the explorer, each query designed once.
+fn designer() -> DesignModel {
+    let answered: Mutex<HashMap<String, serde_json::Value>> = Mutex::new(HashMap::new());
+    Arc::new(move |query: &DesignQuery| {
+        let key = format!("{query:?}");
+        if let Some(answer) = answered.lock().map_err(|e| e.to_string())?.get(&key) {
+            return Ok(answer.clone());
+        }
+        if answered.lock().map_err(|e| e.to_string())?.len() >= MAX_DESIGNS {
+            return Err(format!(
+                "this server has designed {MAX_DESIGNS} lobes, its limit; ask one of those again, or restart specula serve"
+            ));
+        }
+        let target: Target = query.target.parse().map_err(|e: String| e)?;
+        let n = |value: f64| Exponent::try_new(value).map_err(|e| e.to_string());
+        let request = DesignRequest {
+            target,
+            range: (n(query.range.0)?, n(query.range.1)?),
+            bounds: Bounds {
+                epicentre: query.max_error,
+                whole: default_whole_error(query.max_error),
+                energy: None,
+            },
+            no_transcendentals: false,
+        };
+        let answer = design(&request, &ProgressBar::hidden())?;
+        let value = serde_json::to_value(&answer).map_err(|e| e.to_string())?;
+        answered
+            .lock()
+            .map_err(|e| e.to_string())?
+            .insert(key, value.clone());
+        Ok(value)
+    })
 }
 
 /// A lobe's costs: the CPU's counted SIMD instructions and the GPU families' modelled rates.

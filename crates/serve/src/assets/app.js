@@ -509,6 +509,7 @@ async function start() {
   });
   document.querySelectorAll("#controls input, #controls select, #volume-controls select").forEach((el) => el.addEventListener("input", schedule));
   $("lobes").addEventListener("change", schedule);
+  $("design-run").addEventListener("click", runDesign);
   // Typing in the formula makes it the lobe the renders and the volume show; a pause sends it.
   $("formula").addEventListener("input", () => {
     if (formulaText()) {
@@ -521,6 +522,27 @@ async function start() {
     pending = setTimeout(update, FORMULA_DEBOUNCE_MS);
   });
   await update();
+}
+
+// `specula design` through /api/design: its verdict under the button, and the cheapest
+// designed lobe that meets the bound put in the formula box, where it is drawn and rendered.
+async function runDesign() {
+  const query = new URLSearchParams({ target: $("design-target").value, low: $("design-low").value, high: $("design-high").value, max_error: $("design-error").value });
+  $("design-run").disabled = true;
+  $("design-result").textContent = "designing...";
+  try {
+    const answer = await getJson("/api/design?" + query);
+    const best = answer.designed.find((lobe) => lobe.meets);
+    $("design-result").textContent = answer.verdict;
+    if (best) {
+      $("formula").value = best.formula;
+      $("formula").dispatchEvent(new Event("input"));
+    }
+  } catch (error) {
+    $("design-result").textContent = error.message;
+  } finally {
+    $("design-run").disabled = false;
+  }
 }
 
 start().catch((error) => { $("status").textContent = error.message; });

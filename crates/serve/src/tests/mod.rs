@@ -439,3 +439,50 @@ async fn the_catalogue_carries_each_lobes_line_style() {
         }
     }
 }
+
+/// `/api/design` checks its query, hands the search the request as asked (the bound as a
+/// fraction), answers with the search's JSON, and says so when the server has no search.
+#[tokio::test]
+async fn a_design_request_reaches_the_search_as_asked() {
+    let (status, body) = json("/api/design?target=gpu-nvidia").await;
+    assert_eq!(status, StatusCode::SERVICE_UNAVAILABLE, "{body}");
+    let model: crate::DesignModel = std::sync::Arc::new(|query: &crate::DesignQuery| {
+        if query.max_error < 1e-6 {
+            return Err("no designed lobe within 1e-8 %".to_owned());
+        }
+        Ok(serde_json::json!({
+            "target": query.target,
+            "range": [query.range.0, query.range.1],
+            "max_error": query.max_error,
+        }))
+    });
+    let app = crate::router_with(crate::AppState::default().with_designer(model));
+    let ask = |uri: &'static str| {
+        let app = app.clone();
+        async move {
+            let (status, bytes) = get_from(&app, uri).await;
+            (
+                status,
+                serde_json::from_slice::<Value>(&bytes).expect("json"),
+            )
+        }
+    };
+    let (status, body) = ask("/api/design?target=gpu-amd&low=16&high=256&max_error=0.5").await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    assert_eq!(body["target"], "gpu-amd");
+    assert_eq!(body["range"], serde_json::json!([16.0, 256.0]));
+    assert!((body["max_error"].as_f64().unwrap() - 0.005).abs() < 1e-15);
+    for (uri, parameter) in [
+        ("/api/design?target=cpu", "target"),
+        ("/api/design?target=fpga", "target"),
+        ("/api/design?low=512&high=8", "high"),
+        ("/api/design?max_error=0", "max_error"),
+        ("/api/design?max_error=nan", "max_error"),
+        ("/api/design?n=64", "n"),
+        ("/api/design?max_error=0.000001", "max_error"),
+    ] {
+        let (status, body) = ask(uri).await;
+        assert_eq!(status, StatusCode::BAD_REQUEST, "{uri}: {body}");
+        assert_eq!(body["parameter"], parameter, "{uri}: {body}");
+    }
+}
