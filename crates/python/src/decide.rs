@@ -53,7 +53,7 @@ pub fn recommend_json(
 /// `specula design --format json`'s answer (every designed lobe, the built-ins beside them,
 /// the verdict), with the cheapest designed lobe's file text as `toml` (or `null`).
 #[pyfunction]
-#[pyo3(signature = (target, n, max_error, max_whole_error, energy_tolerance, no_transcendentals))]
+#[pyo3(signature = (target, n, max_error, max_whole_error, energy_tolerance, no_transcendentals, extra_lobes))]
 pub fn design_json(
     py: Python<'_>,
     target: &str,
@@ -62,6 +62,7 @@ pub fn design_json(
     max_whole_error: Option<f64>,
     energy_tolerance: Option<f64>,
     no_transcendentals: bool,
+    extra_lobes: Vec<String>,
 ) -> PyResult<String> {
     guarded(|| {
         let ends = parse_exponent_range(n, 1).map_err(value_error)?;
@@ -74,6 +75,7 @@ pub fn design_json(
                 energy: energy_tolerance,
             },
             no_transcendentals,
+            also: lobes(&extra_lobes)?,
         };
         let answer = py
             .detach(|| design(&request, &ProgressBar::hidden()))

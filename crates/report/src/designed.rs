@@ -22,7 +22,7 @@ use super::Context;
 const FAMILIES: [(Target, &str); 2] = [(Target::GpuNvidia, "NVIDIA"), (Target::GpuAmd, "AMD RDNA")];
 const RANGE: (f64, f64) = (8.0, 512.0);
 
-fn request(target: Target, bound: f64) -> DesignRequest {
+fn request(target: Target, bound: f64, also: &[LobeKind]) -> DesignRequest {
     DesignRequest {
         target,
         range: (Exponent::new(RANGE.0), Exponent::new(RANGE.1)),
@@ -32,18 +32,26 @@ fn request(target: Target, bound: f64) -> DesignRequest {
             energy: None,
         },
         no_transcendentals: false,
+        also: also.to_vec(),
     }
 }
 
 pub fn designed(context: &mut Context) -> Result<String, String> {
     let bounds = context.sizes.design_bounds;
+    // The user's lobes are ranked beside the built-ins and the designs.
+    let yours: Vec<LobeKind> = context
+        .lobes
+        .iter()
+        .copied()
+        .filter(|kind| !LobeKind::ALL.contains(kind))
+        .collect();
     let jobs: Vec<(Target, &str, f64)> = FAMILIES
         .iter()
         .flat_map(|&(target, name)| bounds.iter().map(move |&b| (target, name, b)))
         .collect();
     let answers: Vec<Design> = jobs
         .par_iter()
-        .map(|&(target, _, bound)| design(&request(target, bound), &ProgressBar::hidden()))
+        .map(|&(target, _, bound)| design(&request(target, bound, &yours), &ProgressBar::hidden()))
         .collect::<Result<_, _>>()?;
     let mut html = paragraph(&format!(
         "The thesis designed its lobes by hand; specula design searches the families the \
@@ -64,7 +72,7 @@ pub fn designed(context: &mut Context) -> Result<String, String> {
     let mut rows = Vec::new();
     let mut formulas = String::new();
     for ((_, name, bound), answer) in jobs.iter().zip(&answers) {
-        let builtin = answer.best_builtin().map_or("-".to_owned(), |c| {
+        let builtin = answer.best_compared().map_or("-".to_owned(), |c| {
             format!("{} ({} pow)", c.lobe, versus_pow(c.rate, answer.pow_rate))
         });
         let row = match answer.best() {
@@ -105,7 +113,7 @@ pub fn designed(context: &mut Context) -> Result<String, String> {
             "its epicentre error",
             "its whole-lobe error",
             "designed vs pow",
-            "cheapest built-in (vs pow)",
+            "cheapest other lobe (vs pow)",
         ],
         &rows,
     );
@@ -146,8 +154,12 @@ fn pareto_plot(
             ))
         })
         .collect();
-    points.extend(answer.builtins.iter().filter_map(|c| {
-        let kind = LobeKind::ALL.into_iter().find(|k| k.id() == c.lobe)?;
+    points.extend(answer.compared.iter().filter_map(|c| {
+        let kind = context
+            .lobes
+            .iter()
+            .copied()
+            .find(|k| k.to_string() == c.lobe)?;
         Some((kind, (c.error.max(EXACT_FLOOR), c.rate), false))
     }));
     // The front over both kinds together.

@@ -36,6 +36,10 @@ pub struct Args {
     /// targets).
     #[arg(long)]
     no_transcendentals: bool,
+    /// Also rank these lobes beside the built-ins and the designs: your own (`@FILE.toml`,
+    /// `=FORMULA`) or a built-in with other parameters (`cosquad:v=5`); comma separated.
+    #[arg(long, value_parser = crate::args::LobeListParser)]
+    lobe: Vec<crate::args::LobeList>,
     /// Write the cheapest designed lobe meeting the request as a lobe file (TOML), for
     /// `--lobe @FILE` everywhere.
     #[arg(short, long)]
@@ -77,6 +81,7 @@ pub fn run(args: &Args) -> CommandResult {
             energy: args.energy_tolerance,
         },
         no_transcendentals: args.no_transcendentals,
+        also: crate::args::flatten(&args.lobe),
     };
     let progress = ProgressBar::new(0).with_style(
         ProgressStyle::with_template("designing {bar:30} {pos}/{len} {msg}")
@@ -141,10 +146,15 @@ fn print_table(answer: &Design, format: crate::args::Format) {
             d.why.clone(),
         ]);
     }
-    for c in &answer.builtins {
+    for c in &answer.compared {
         table.push(vec![
             c.lobe.clone(),
-            "built-in".to_owned(),
+            if specula::LobeKind::ALL.iter().any(|k| k.id() == c.lobe) {
+                "built-in"
+            } else {
+                "given"
+            }
+            .to_owned(),
             if c.meets { "yes" } else { "no" }.to_owned(),
             error(c.error),
             "".to_owned(),

@@ -96,6 +96,7 @@ fn designer() -> DesignModel {
                 energy: None,
             },
             no_transcendentals: false,
+            also: Vec::new(),
         };
         let answer = design(&request, &ProgressBar::hidden())?;
         let value = serde_json::to_value(&answer).map_err(|e| e.to_string())?;

@@ -65,6 +65,8 @@ pub struct DesignRequest {
     /// Only families without a transcendental operation per evaluation (FPGA- and
     /// polynomial-only targets).
     pub no_transcendentals: bool,
+    /// Lobes ranked beside the built-ins and the designs (a user's own).
+    pub also: Vec<LobeKind>,
 }
 
 /// One family's designed lobe and its figures.
@@ -132,8 +134,9 @@ pub struct Design {
     pub exponents_verified: usize,
     /// The designed lobes.
     pub designed: Vec<DesignedLobe>,
-    /// The built-ins as `recommend` ranks them on the same target and bound.
-    pub builtins: Vec<Candidate>,
+    /// The built-ins (and the request's other lobes) as `recommend` ranks them on the same
+    /// target and bound.
+    pub compared: Vec<Candidate>,
     /// `pow`'s rate, what "vs pow" compares with.
     pub pow_rate: f64,
     /// One line: what the search found against the built-ins.
@@ -149,10 +152,11 @@ impl Design {
         self.designed.first().filter(|d| d.meets)
     }
 
-    /// The cheapest built-in that meets the request, if any does.
+    /// The cheapest lobe not designed here (built in, or given) that meets the request, if
+    /// any does.
     #[must_use]
-    pub fn best_builtin(&self) -> Option<&Candidate> {
-        self.builtins.first().filter(|c| c.meets)
+    pub fn best_compared(&self) -> Option<&Candidate> {
+        self.compared.first().filter(|c| c.meets)
     }
 }
 
@@ -241,7 +245,8 @@ pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design,
         .filter(|d| d.verified)
         .filter_map(DesignedLobe::kind)
         .collect();
-    let mut lobes = LobeKind::ALL.to_vec();
+    let mut lobes = crate::candidates(&request.also);
+    let compared_ids: Vec<String> = lobes.iter().map(LobeKind::to_string).collect();
     lobes.extend(&kinds);
     progress.reset();
     let ranking = recommend(
@@ -271,19 +276,19 @@ pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design,
             }
         }
     }
-    let builtins: Vec<Candidate> = ranking
+    let compared: Vec<Candidate> = ranking
         .candidates
         .iter()
-        .filter(|c| LobeKind::ALL.iter().any(|k| k.id() == c.lobe))
+        .filter(|c| compared_ids.contains(&c.lobe))
         .cloned()
         .collect();
-    mark_front(&mut designed, &builtins);
+    mark_front(&mut designed, &compared);
     designed.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
     let mut answer = Design {
         unit: ranking.unit,
         exponents_verified: verify.len(),
         designed,
-        builtins,
+        compared,
         pow_rate,
         verdict: String::new(),
         note: ranking.note,
@@ -293,12 +298,12 @@ pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design,
 }
 
 /// Marks the designed lobes no lobe (designed or built in) dominates in error and rate.
-fn mark_front(designed: &mut [DesignedLobe], builtins: &[Candidate]) {
+fn mark_front(designed: &mut [DesignedLobe], compared: &[Candidate]) {
     let points: Vec<(f64, f64)> = designed
         .iter()
         .filter(|d| d.rate > 0.0)
         .map(|d| (d.epicentre_error, d.rate))
-        .chain(builtins.iter().map(|c| (c.error, c.rate)))
+        .chain(compared.iter().map(|c| (c.error, c.rate)))
         .collect();
     let front = pareto_front(&points);
     let mut on_front = front.into_iter();
@@ -320,11 +325,16 @@ fn verdict(design: &Design, request: &DesignRequest) -> String {
             .map_or(String::new(), |e| format!(", energy {}", percent(e))),
         request.target.id()
     );
-    let builtin = design.best_builtin().map_or_else(
-        || "no built-in lobe meets it".to_owned(),
+    let others = if request.also.is_empty() {
+        "built-in"
+    } else {
+        "built-in or given lobe"
+    };
+    let builtin = design.best_compared().map_or_else(
+        || format!("no {others} meets it"),
         |c| {
             format!(
-                "the cheapest built-in is {} at {:.2}x pow",
+                "the cheapest {others} is {} at {:.2}x pow",
                 c.lobe,
                 c.rate / design.pow_rate
             )
@@ -332,7 +342,7 @@ fn verdict(design: &Design, request: &DesignRequest) -> String {
     );
     match design.best() {
         Some(best) => {
-            let versus = match design.best_builtin() {
+            let versus = match design.best_compared() {
                 Some(c) if c.rate > best.rate => {
                     format!("; {builtin}, cheaper than every design: ship the built-in")
                 }

@@ -190,6 +190,7 @@ def design(
     max_whole_error: Optional[float] = None,
     energy_tolerance: Optional[float] = None,
     no_transcendentals: bool = False,
+    lobes: Sequence[str] = (),
 ) -> Dict[str, Any]:
     """The cheapest lobe for ``target`` over a range of ``n`` within an accuracy, designed:
     ``specula design --format json``'s answer.
@@ -208,6 +209,8 @@ def design(
         Also match ``t^n``'s energy within this fraction at every ``n``.
     no_transcendentals : bool
         Only lobes without a transcendental operation per evaluation.
+    lobes : sequence of str
+        More lobes ranked beside the built-ins and the designs (``"=t^n"``, ``"@lobe.toml"``).
 
     Returns
     -------
@@ -216,7 +219,7 @@ def design(
         here takes, or None), ``toml`` (its lobe file's text, or None), ``verdict`` (one
         line), ``designed`` (each family's lobe: ``formula``, ``coefficients``,
         ``epicentre_error``, ``whole_error``, ``rate``, ``meets``, ``pareto``, ``why``, the
-        ones that meet first, cheapest first), ``builtins`` (``recommend``'s rows on the same
+        ones that meet first, cheapest first), ``compared`` (``recommend``'s rows for the built-ins on the same
         target and bound), ``pow_rate`` and ``unit``.
     """
     reply = _json.loads(
@@ -227,6 +230,7 @@ def design(
             None if max_whole_error is None else float(max_whole_error),
             None if energy_tolerance is None else float(energy_tolerance),
             bool(no_transcendentals),
+            [lobes] if isinstance(lobes, str) else list(lobes),
         )
     )
     if reply["note"]:

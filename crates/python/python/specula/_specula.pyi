@@ -96,6 +96,7 @@ def design_json(
     max_whole_error: Optional[float],
     energy_tolerance: Optional[float],
     no_transcendentals: bool,
+    lobes: List[str],
 ) -> str: ...
 def cost_json(target: str, lobe: Lobe) -> str: ...
 def report(
