@@ -54,6 +54,7 @@ pub fn recommend_json(
 /// the verdict), with the cheapest designed lobe's file text as `toml` (or `null`).
 #[pyfunction]
 #[pyo3(signature = (target, n, max_error, max_whole_error, energy_tolerance, no_transcendentals, extra_lobes))]
+#[allow(clippy::too_many_arguments)] // one per keyword of `specula.design`
 pub fn design_json(
     py: Python<'_>,
     target: &str,

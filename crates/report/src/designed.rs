@@ -39,12 +39,7 @@ fn request(target: Target, bound: f64, also: &[LobeKind]) -> DesignRequest {
 pub fn designed(context: &mut Context) -> Result<String, String> {
     let bounds = context.sizes.design_bounds;
     // The user's lobes are ranked beside the built-ins and the designs.
-    let yours: Vec<LobeKind> = context
-        .lobes
-        .iter()
-        .copied()
-        .filter(|kind| !LobeKind::ALL.contains(kind))
-        .collect();
+    let yours = context.yours();
     let jobs: Vec<(Target, &str, f64)> = FAMILIES
         .iter()
         .flat_map(|&(target, name)| bounds.iter().map(move |&b| (target, name, b)))

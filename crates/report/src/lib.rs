@@ -143,6 +143,15 @@ pub(crate) struct Context {
 type HardwareSweeps = Vec<(u32, Arc<Vec<WidthSweep>>)>;
 
 impl Context {
+    /// The user's lobes (every lobe shown that is not built in).
+    fn yours(&self) -> Vec<LobeKind> {
+        self.lobes
+            .iter()
+            .copied()
+            .filter(|kind| !LobeKind::ALL.contains(kind))
+            .collect()
+    }
+
     /// A context for part of a section run beside the rest: the same settings, its own
     /// list of files (appended to the section's when the part is done).
     fn sibling(&self) -> Self {

@@ -101,12 +101,7 @@ pub fn materials(context: &mut Context) -> Result<String, String> {
         return Ok(paragraph(HOW_TO));
     };
     let (files, more) = material_files(&directory)?;
-    let yours: Vec<LobeKind> = context
-        .lobes
-        .iter()
-        .copied()
-        .filter(|kind| !LobeKind::ALL.contains(kind))
-        .collect();
+    let yours = context.yours();
     let kinds = lobes_to_fit(&yours, TARGET)?;
     let sky = Environment::sky(SKY_WIDTH);
     let mut shown = String::new();
