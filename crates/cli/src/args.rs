@@ -85,6 +85,17 @@ pub fn parse_cosine(text: &str) -> Result<f64, String> {
     }
 }
 
+/// An error bound: a percentage in `(0, 100]` (`1%` or `1`), as a fraction.
+pub fn parse_percent(text: &str) -> Result<f64, String> {
+    let number = text.trim().trim_end_matches('%');
+    match number.parse::<f64>() {
+        Ok(value) if value > 0.0 && value <= 100.0 => Ok(value / 100.0),
+        _ => Err(format!(
+            "'{text}' is not an error in (0, 100] %; write it as 1% or 0.5"
+        )),
+    }
+}
+
 /// A margin over pow's fit error: a percentage in `[0, 100]`.
 pub fn parse_margin(text: &str) -> Result<f64, String> {
     let number = text.trim().trim_end_matches('%');

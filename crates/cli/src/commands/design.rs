@@ -23,14 +23,14 @@ pub struct Args {
     n: Range,
     /// The epicentre's largest relative error, as a percentage (`0.1%` or `0.1`): the error
     /// `recommend` counts.
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_percent)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::parse_percent)]
     max_error: f64,
     /// The whole lobe's largest absolute error, as a percentage of the peak [default: 1%, or
     /// --max-error where that is larger].
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_percent)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::parse_percent)]
     max_whole_error: Option<f64>,
     /// Also match t^n's energy within this percentage at every n.
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_percent)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::parse_percent)]
     energy_tolerance: Option<f64>,
     /// Only lobes without a transcendental operation per evaluation (polynomial-only
     /// targets).
@@ -56,16 +56,6 @@ pub struct Range(specula::Exponent, specula::Exponent);
 fn parse_range(text: &str) -> Result<Range, String> {
     let ends = specula_decide::parse_exponent_range(text, 1)?;
     Ok(Range(ends[0], ends[ends.len() - 1]))
-}
-
-fn parse_percent(text: &str) -> Result<f64, String> {
-    let number = text.trim().trim_end_matches('%');
-    match number.parse::<f64>() {
-        Ok(value) if value > 0.0 && value <= 100.0 => Ok(value / 100.0),
-        _ => Err(format!(
-            "'{text}' is not an error in (0, 100] %; write it as 0.1% or 0.1"
-        )),
-    }
 }
 
 /// Searches, prints, and writes the lobe.

@@ -21,7 +21,7 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = parse_exponents)]
     n: Exponents,
     /// The largest error allowed, as a percentage (`1%` or `1`).
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_percent, required_unless_present = "material")]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::parse_percent, required_unless_present = "material")]
     max_error: Option<f64>,
     /// Rank by the fit to a measured material instead (an RGL isotropic RGB `.bsdf`): the
     /// cheapest lobe whose fit error is within `--margin` of pow's (see `specula fit`).
@@ -53,16 +53,6 @@ pub struct Exponents(Vec<Exponent>);
 
 fn parse_exponents(text: &str) -> Result<Exponents, String> {
     specula_decide::parse_exponents(text).map(Exponents)
-}
-
-fn parse_percent(text: &str) -> Result<f64, String> {
-    let number = text.trim().trim_end_matches('%');
-    match number.parse::<f64>() {
-        Ok(value) if value > 0.0 && value <= 100.0 => Ok(value / 100.0),
-        _ => Err(format!(
-            "'{text}' is not an error in (0, 100] %; write it as 1% or 0.5"
-        )),
-    }
 }
 
 /// Measures, ranks and prints.
@@ -154,6 +144,7 @@ pub fn run(args: &Args) -> CommandResult {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::args::parse_percent;
 
     #[test]
     fn reversed_ranges_are_refused_and_errors_are_percentages() {
