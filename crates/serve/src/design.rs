@@ -9,7 +9,8 @@ use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 
-use crate::api::{compute, pairs, ApiError, AppState, Params, QueryPairs};
+use crate::api::{compute, AppState};
+use crate::query::{pairs, ApiError, Params, QueryPairs};
 
 /// What a design request asks for.
 #[derive(Clone, Debug, PartialEq)]

@@ -19,6 +19,7 @@ mod explorer;
 mod guard;
 mod listen;
 mod measured;
+mod query;
 #[cfg(test)]
 mod tests;
 mod volume;

@@ -41,9 +41,8 @@ use specula_render::measured::{
     BUNDLED_MATERIALS,
 };
 
-use super::api::{
-    compute, pairs, png, ApiError, AppState, CostModel, Params, QueryPairs, TargetCost,
-};
+use super::api::{compute, png, AppState, CostModel, TargetCost};
+use super::query::{pairs, ApiError, Params, QueryPairs};
 
 /// The most materials a `--data` folder may hold.
 pub const MAX_MATERIALS: usize = 64;

@@ -3,7 +3,7 @@
 //! runs a group of [`GROUP`] vectors through all its links in registers, so the value never
 //! goes through memory between operations and a link's choice is paid once per group.
 
-use super::{Inside, LaneFunction, Map, ACOS_DOMAIN, LOG2_DOMAIN, MAX_WIDTH};
+use super::{Inside, LaneFunction, Map, Rules, ACOS_DOMAIN, LOG2_DOMAIN, MAX_WIDTH};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{math, Lanes};
 
@@ -76,7 +76,7 @@ impl SavedOp {
         }
     }
 
-    fn scalar(self, x: f32, saved: f32) -> f32 {
+    pub(super) fn scalar(self, x: f32, saved: f32) -> f32 {
         match self {
             SavedOp::Add => x + saved,
             SavedOp::Mul => x * saved,
@@ -84,28 +84,11 @@ impl SavedOp {
             SavedOp::SubFrom => saved - x,
         }
     }
-
-    /// The range of the result, from the ranges of the value and the saved value (every
-    /// corner, each rounded as the lanes round it; rounding is monotone, so the rounded
-    /// results of values inside lie between the rounded corners).
-    fn range(self, (low, high): (f32, f32), (s_low, s_high): (f32, f32)) -> (f32, f32) {
-        let corners = [
-            self.scalar(low, s_low),
-            self.scalar(low, s_high),
-            self.scalar(high, s_low),
-            self.scalar(high, s_high),
-        ];
-        corners
-            .iter()
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &c| {
-                (a.min(c), b.max(c))
-            })
-    }
 }
 
 impl Link {
     /// Whether the link's polynomial holds only on part of its inputs.
-    fn checked(self) -> bool {
+    pub(super) fn checked(self) -> bool {
         matches!(
             self,
             Link::Log2 | Link::Ln | Link::Pow(_) | Link::Exp2(_) | Link::Acos
@@ -114,7 +97,7 @@ impl Link {
 
     /// The link in scalar `f32`, as the formula's scalar path computes it; `saved` is the
     /// chain's saved value ([`Link::Save`] sets it).
-    fn scalar(self, x: f32, saved: &mut f32, values: &[f32]) -> f32 {
+    pub(super) fn scalar(self, x: f32, saved: &mut f32, values: &[f32]) -> f32 {
         match self {
             Link::Save => {
                 *saved = x;
@@ -193,103 +176,6 @@ impl Chain {
             checked: links.iter().any(|l| l.checked()),
             lane_only: links.iter().any(|l| matches!(l, Link::Lane(_))),
             links,
-        }
-    }
-}
-
-/// Which of the shared rules a batch's output needs: the clamp of the value to `[0, 1]`
-/// (NaN to 0), and the zero where `t <= 0` or NaN. Both are needed unless the formula is a
-/// chain from `t` whose range over `[0, 1]` is within `[0, 1]` and whose value at 0 is +0
-/// (then the clamp of `t` on the way in already sends `t <= 0` and NaN to that 0), as
-/// `cosquad`'s kernel skips its mask when its slope is at least 1. And whether the chain's
-/// polynomials (`exp2`, `log2`, `acos`) need their inputs checked lane by lane: not where the
-/// range analysis puts every input inside the polynomial's domain, as `sg`'s kernel calls
-/// `exp2` on `r (t - 1) <= 0` unchecked.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Rules {
-    pub clamp: bool,
-    pub mask: bool,
-    pub checked: bool,
-}
-
-impl Rules {
-    /// Every rule.
-    pub(crate) const ALL: Rules = Rules {
-        clamp: true,
-        mask: true,
-        checked: true,
-    };
-}
-
-impl Chain {
-    /// The rules the chain's output needs, from `[0, 1]` in, with the batch's `values`: its
-    /// range by evaluating monotone links at the interval's ends in `f32` (each rounded
-    /// monotone operation keeps the order of its inputs; a polynomial is monotone on its
-    /// domain, and proven there when the interval lies inside it), any other link needing
-    /// every rule. After a polynomial the ends are the library's, which the vector polynomial
-    /// matches only to a few ulps, so the clamp stays.
-    pub(super) fn rules(&self, values: &[f32]) -> Rules {
-        // Rust's min and max ignore a NaN that the vector instructions return: with one
-        // among the constants, the scalar ends prove nothing.
-        if values.iter().any(|v| !v.is_finite()) {
-            return Rules::ALL;
-        }
-        let (mut low, mut high) = (0.0_f32, 1.0_f32);
-        let mut saved_range = (0.0_f32, 1.0_f32);
-        let mut approximate = false;
-        for &link in &self.links {
-            let (a, b) = match link {
-                Link::Save => {
-                    saved_range = (low, high);
-                    continue;
-                }
-                Link::Saved(op) => op.range((low, high), saved_range),
-                link => {
-                    let monotone = match link {
-                        Link::Add(_)
-                        | Link::Sub(_)
-                        | Link::SubFrom(_)
-                        | Link::Min(_)
-                        | Link::Max(_) => true,
-                        Link::Mul(_) | Link::Fma(..) | Link::Affine(..) | Link::Neg => true,
-                        Link::Div(s) => values[s] != 0.0,
-                        Link::DivInto(_) => low > 0.0 || high < 0.0,
-                        Link::Sqrt => low >= 0.0,
-                        Link::Squarings(_) | Link::Abs | Link::Powi(_) => low >= 0.0,
-                        Link::Exp2(scale) => EXP2_DOMAIN.holds(low * scale, high * scale),
-                        Link::Log2 | Link::Ln | Link::Pow(_) => LOG2_DOMAIN.holds(low, high),
-                        Link::Acos => ACOS_DOMAIN.holds(low, high),
-                        Link::Lane(_) | Link::Save | Link::Saved(_) => false,
-                    };
-                    if !monotone {
-                        return Rules::ALL;
-                    }
-                    approximate |= link.checked();
-                    // A monotone link's ends; the saved value plays no part.
-                    let mut unused = 0.0;
-                    (
-                        link.scalar(low, &mut unused, values),
-                        link.scalar(high, &mut unused, values),
-                    )
-                }
-            };
-            if a.is_nan() || b.is_nan() {
-                return Rules::ALL;
-            }
-            (low, high) = (a.min(b), a.max(b));
-            if !(low.is_finite() && high.is_finite()) {
-                return Rules::ALL;
-            }
-        }
-        let mut saved = 0.0;
-        let at_zero = self
-            .links
-            .iter()
-            .fold(0.0_f32, |v, link| link.scalar(v, &mut saved, values));
-        Rules {
-            clamp: approximate || !(low >= 0.0 && high <= 1.0),
-            mask: at_zero.to_bits() != 0,
-            checked: false,
         }
     }
 }
@@ -681,7 +567,7 @@ fn apply_arithmetic<V: Lanes>(
 }
 
 /// `(-inf, 0]`, NaN excluded: where the `exp2` polynomial holds (0 below -127).
-const EXP2_DOMAIN: Inside = Inside {
+pub(super) const EXP2_DOMAIN: Inside = Inside {
     scale: 1.0,
     low: -f32::MAX,
     high: f32::MIN_POSITIVE,
