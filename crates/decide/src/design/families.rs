@@ -161,9 +161,10 @@ impl Family {
         }
     }
 
-    /// `int_t^1 lobe(x) dx` as formula text, where it has a closed form in the language.
+    /// `int_t^1 lobe(x) dx` as formula text, where it has a closed form in the language (it
+    /// reads the formula's `let`s, so the coefficients are not written again).
     #[must_use]
-    pub fn tail(self, _beta: &[f64]) -> Option<String> {
+    pub fn tail(self) -> Option<String> {
         match self {
             Family::Exp2Poly { degree: 1 } => {
                 Some(format!("(1 - exp2(a1 * (1 - t))) / (-a1 * {LN_2})"))

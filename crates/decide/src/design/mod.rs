@@ -403,7 +403,7 @@ fn unmeasured(family: Family, beta: &[f64], request: &DesignRequest) -> Designed
             family.description()
         ),
         formula: family.formula(beta),
-        tail: family.tail(beta),
+        tail: family.tail(),
         coefficients: beta.to_vec(),
         epicentre_error: f64::INFINITY,
         whole_error: f64::INFINITY,
