@@ -1,13 +1,15 @@
 //! What a lobe costs on a target (higher is cheaper): on the CPU, its SIMD kernel's measured
-//! rate on this machine ([`crate::rates::kernel_rate`]); on a GPU family, the modelled
+//! rate on this machine (every candidate timed beside the others, [`crate::rates::kernel_rates`]);
+//! on a GPU family, the modelled
 //! evaluations per clock of its exported shader; on the FPGA, the datapath
 //! [`cheapest_datapath`] picks at the width the error needs, synthesized (cached) or, without
 //! the tools, estimated. [`crate::recommend`] ranks by these; a material's verdict
 //! ([`crate::material`]) takes [`lobe_rate`], which refuses the FPGA.
 
+use indicatif::ProgressBar;
 use specula::analysis::{error_figures, Precision};
 use specula::gpu_cost::GpuFamily;
-use specula::{Exponent, Lobe};
+use specula::{Exponent, Lobe, LobeKind};
 use specula_hw::analysis::WidthSweep;
 
 use crate::hardware::{cheapest_datapath, hardware_sweeps, SWEEP_SAMPLES};
@@ -15,8 +17,9 @@ use crate::{Target, Zone};
 
 /// How a target's costs are obtained.
 pub(crate) enum Costing {
-    /// Timed on this machine's CPU.
-    Measured,
+    /// Timed on this machine's CPU: the rates [`Costing::time_kernels`] took, each lobe's
+    /// against every other's in one measurement, and any other lobe timed when costed.
+    Measured(Vec<TimedRate>),
     /// The GPU cost model of one family.
     Modelled(GpuFamily),
     /// Estimated from the fixed-point datapaths' sweeps, per exponent (without Yosys).
@@ -24,6 +27,13 @@ pub(crate) enum Costing {
     /// Synthesized and placed (Yosys, nextpnr-ice40 on an iCE40 HX8K; cached), at the word
     /// lengths the sweeps choose.
     Synthesized(Vec<(Exponent, std::sync::Arc<Vec<WidthSweep>>)>),
+}
+
+/// A kernel's rate timed beside the others' ([`crate::rates::kernel_rates`]).
+pub(crate) struct TimedRate {
+    kind: LobeKind,
+    n: Exponent,
+    rate: f64,
 }
 
 /// Where the FPGA's costs are synthesized: every operator in LUTs, one area figure.
@@ -55,7 +65,7 @@ impl Costing {
             GpuFamily::find(id).ok_or_else(|| format!("no GPU family '{id}' in the model"))
         };
         Ok(match target {
-            Target::Cpu => (Costing::Measured, None),
+            Target::Cpu => (Costing::Measured(Vec::new()), None),
             Target::GpuNvidia => (Costing::Modelled(family("gpu-nvidia")?), None),
             Target::GpuAmd => (Costing::Modelled(family("gpu-amd")?), None),
             Target::Fpga => {
@@ -76,9 +86,41 @@ impl Costing {
         })
     }
 
+    /// On the CPU, times every one of `lobes` at every one of `exponents` together
+    /// ([`crate::rates::kernel_rates`]), so that their rates compare like with like; elsewhere
+    /// nothing. `progress` is set to count the passes.
+    pub(crate) fn time_kernels(
+        &mut self,
+        lobes: &[LobeKind],
+        exponents: &[Exponent],
+        progress: &ProgressBar,
+    ) {
+        let Costing::Measured(timed) = self else {
+            return;
+        };
+        progress.set_length((lobes.len() * crate::rates::PASSES) as u64);
+        progress.set_message("timing the kernels");
+        let prepared: Vec<Vec<Lobe>> = lobes
+            .iter()
+            .map(|&kind| exponents.iter().map(|&n| Lobe::new(kind, n)).collect())
+            .collect();
+        let rates = crate::rates::kernel_rates(&prepared, progress);
+        *timed = lobes
+            .iter()
+            .zip(rates)
+            .flat_map(|(&kind, rates)| {
+                exponents
+                    .iter()
+                    .zip(rates)
+                    .map(move |(&n, rate)| TimedRate { kind, n, rate })
+            })
+            .collect();
+        progress.reset();
+    }
+
     pub(crate) fn unit(&self) -> &'static str {
         match self {
-            Costing::Measured => "evals/s, 1 thread",
+            Costing::Measured(_) => "evals/s, 1 thread",
             Costing::Modelled(_) => "evals/clock/multiprocessor (modelled)",
             Costing::Estimated(_) => "evals/clock per 1000 logic cells (estimated)",
             Costing::Synthesized(_) => "results/us per 1000 LUTs (synthesized, iCE40 HX8K)",
@@ -94,9 +136,12 @@ impl Costing {
     ) -> Result<Option<Point>, String> {
         let float_error = || zone.error(&error_figures(lobe, &mut Precision::F64, SWEEP_SAMPLES));
         Ok(match self {
-            Costing::Measured => Some(Point {
+            Costing::Measured(timed) => Some(Point {
                 error: float_error(),
-                rate: crate::rates::kernel_rate(lobe),
+                rate: timed
+                    .iter()
+                    .find(|r| r.kind == lobe.kind() && r.n == lobe.exponent())
+                    .map_or_else(|| crate::rates::kernel_rate(lobe), |r| r.rate),
                 datapath: None,
             }),
             Costing::Modelled(family) => Some(Point {
@@ -182,7 +227,7 @@ pub(crate) fn material_target(target: Target) -> Result<Target, String> {
 pub fn lobe_rate(target: Target, lobe: &Lobe) -> Result<f64, String> {
     let target = material_target(target)?;
     match Costing::new(target, &[lobe.exponent()])?.0 {
-        Costing::Measured => Ok(crate::rates::kernel_rate(lobe)),
+        Costing::Measured(_) => Ok(crate::rates::kernel_rate(lobe)),
         Costing::Modelled(family) => modelled_rate(&family, lobe),
         Costing::Estimated(_) | Costing::Synthesized(_) => Err(FPGA_MATERIAL_REFUSAL.to_owned()),
     }

@@ -1,8 +1,9 @@
 //! This machine's lobe rates: every lobe's explicit SIMD kernel against its bound (the
 //! machine's measured peaks and the instructions the kernel executes), its plain loop, `powf`
 //! and the fast pow, with its error, all from one run ([`measure`]: `specula bench lobes`
-//! prints it, the report's cost section shows it); and one kernel's rate ([`kernel_rate`]),
-//! the CPU's cost in [`crate::recommend`] and a material's verdict.
+//! prints it, the report's cost section shows it); the rates of lobes timed together
+//! ([`kernel_rates`]), the CPU's costs in [`crate::recommend`]; and one kernel's rate
+//! ([`kernel_rate`]), a material's verdict's.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -113,23 +114,97 @@ pub(crate) fn kernel_rate(lobe: &Lobe) -> f64 {
     })
 }
 
-/// Evaluations per second of `work` over an L1-sized buffer, on one thread (best of 3).
-fn l1_rate(work: &(dyn Fn(&[f32], &mut [f32]) + Sync)) -> f64 {
-    let ts = cosines(L1_SIZE);
-    let mut out = vec![0.0; L1_SIZE];
-    let mut best = 0.0_f64;
-    for _ in 0..3 {
-        let started = Instant::now();
-        let mut rounds = 0_u64;
-        while started.elapsed().as_secs_f64() < MIN_SECONDS {
-            for _ in 0..ROUNDS_PER_CLOCK {
-                work(black_box(&ts), black_box(&mut out));
+/// Passes of [`kernel_rates`] over every lobe.
+pub(crate) const PASSES: usize = 5;
+/// Seconds one lobe at one exponent is timed in one pass of [`kernel_rates`].
+const PASS_SECONDS: f64 = 0.02;
+
+/// The kernel rates of `lobes[i]` at each of its exponents, L1-resident, one thread, timed so
+/// that lobes compare like with like on a machine whose speed drifts (this project's shared
+/// virtual machine slows by up to 40 % for a second or more at a time): in [`PASSES`] passes
+/// over every lobe, each pass timing each lobe at all its exponents, on one pinned CPU, and
+/// each rate the best of its passes. A slow spell then costs a lobe one pass at the
+/// exponents it covered, not its rate, and every lobe is timed in every part of the run.
+/// `progress` ticks once a pass per lobe.
+#[must_use]
+pub(crate) fn kernel_rates(lobes: &[Vec<Lobe>], progress: &ProgressBar) -> Vec<Vec<f64>> {
+    let level = Level::detect();
+    let _pinned = Pinned::to_current_cpu();
+    let mut best: Vec<Vec<f64>> = lobes.iter().map(|at| vec![0.0; at.len()]).collect();
+    for _ in 0..PASSES {
+        for (at, best) in lobes.iter().zip(&mut best) {
+            for (lobe, best) in at.iter().zip(best.iter_mut()) {
+                let rate = timed_rate(PASS_SECONDS, &|t: &[f32], o: &mut [f32]| {
+                    lobe.eval_batch_with(level, BatchLoop::Explicit, t, o);
+                });
+                *best = best.max(rate);
             }
-            rounds += ROUNDS_PER_CLOCK;
+            progress.inc(1);
         }
-        best = best.max(rounds as f64 * L1_SIZE as f64 / started.elapsed().as_secs_f64());
     }
     best
+}
+
+/// The calling thread held on the CPU it runs on until dropped, then allowed its former CPUs
+/// again (Linux; elsewhere nothing): a thread that moves between cores mid-measurement
+/// measures two of them.
+struct Pinned {
+    #[cfg(target_os = "linux")]
+    former: Option<nix::sched::CpuSet>,
+}
+
+impl Pinned {
+    fn to_current_cpu() -> Self {
+        #[cfg(target_os = "linux")]
+        {
+            use nix::sched::{sched_getaffinity, sched_getcpu, sched_setaffinity, CpuSet};
+            use nix::unistd::Pid;
+            let former = sched_getaffinity(Pid::from_raw(0)).ok();
+            let pinned = sched_getcpu().ok().and_then(|cpu| {
+                let mut one = CpuSet::new();
+                one.set(cpu).ok()?;
+                sched_setaffinity(Pid::from_raw(0), &one).ok()
+            });
+            Self {
+                former: former.filter(|_| pinned.is_some()),
+            }
+        }
+        #[cfg(not(target_os = "linux"))]
+        Self {}
+    }
+}
+
+impl Drop for Pinned {
+    fn drop(&mut self) {
+        #[cfg(target_os = "linux")]
+        if let Some(former) = &self.former {
+            // Nothing to do if it fails: the thread stays where it is, still correct.
+            let _ = nix::sched::sched_setaffinity(nix::unistd::Pid::from_raw(0), former);
+        }
+    }
+}
+
+/// Evaluations per second of `work` over an L1-sized buffer, on one thread (best of 3).
+fn l1_rate(work: &(dyn Fn(&[f32], &mut [f32]) + Sync)) -> f64 {
+    (0..3)
+        .map(|_| timed_rate(MIN_SECONDS, work))
+        .fold(0.0, f64::max)
+}
+
+/// Evaluations per second of `work` over an L1-sized buffer, on one thread, timed for at
+/// least `seconds`.
+fn timed_rate(seconds: f64, work: &(dyn Fn(&[f32], &mut [f32]) + Sync)) -> f64 {
+    let ts = cosines(L1_SIZE);
+    let mut out = vec![0.0; L1_SIZE];
+    let started = Instant::now();
+    let mut rounds = 0_u64;
+    while started.elapsed().as_secs_f64() < seconds {
+        for _ in 0..ROUNDS_PER_CLOCK {
+            work(black_box(&ts), black_box(&mut out));
+        }
+        rounds += ROUNDS_PER_CLOCK;
+    }
+    rounds as f64 * L1_SIZE as f64 / started.elapsed().as_secs_f64()
 }
 
 /// Evaluations per second streaming `ts` into `out`, one thread and all (best of 3 each).
@@ -221,5 +296,52 @@ pub fn measure(n: Exponent, stream: bool, progress: &ProgressBar) -> Measured {
         powf,
         copy_stream,
         lobes,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Timing pins the thread to one CPU and gives it back its CPUs afterwards.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn pinning_restores_the_affinity() {
+        use nix::sched::{sched_getaffinity, CpuSet};
+        use nix::unistd::Pid;
+        let count = |set: &CpuSet| {
+            (0..CpuSet::count())
+                .filter(|&cpu| set.is_set(cpu).unwrap_or(false))
+                .count()
+        };
+        let before = sched_getaffinity(Pid::from_raw(0)).unwrap();
+        {
+            let _pinned = Pinned::to_current_cpu();
+            assert_eq!(count(&sched_getaffinity(Pid::from_raw(0)).unwrap()), 1);
+        }
+        assert_eq!(sched_getaffinity(Pid::from_raw(0)).unwrap(), before);
+    }
+
+    /// Every lobe gets a rate at each of its exponents, in the order given, and the progress
+    /// counts a tick per lobe per pass.
+    #[test]
+    fn every_lobe_is_timed_at_each_exponent() {
+        let lobes: Vec<Vec<Lobe>> = [LobeKind::Pow, LobeKind::Schlick]
+            .into_iter()
+            .map(|kind| {
+                [8.0, 64.0, 512.0]
+                    .into_iter()
+                    .map(|n| Lobe::new(kind, Exponent::new(n)))
+                    .collect()
+            })
+            .collect();
+        let progress = ProgressBar::hidden();
+        let rates = kernel_rates(&lobes, &progress);
+        assert_eq!(progress.position(), (2 * PASSES) as u64);
+        assert_eq!(rates.len(), 2);
+        for lobe in &rates {
+            assert_eq!(lobe.len(), 3);
+            assert!(lobe.iter().all(|&r| r.is_finite() && r > 0.0), "{lobe:?}");
+        }
     }
 }

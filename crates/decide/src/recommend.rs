@@ -195,7 +195,8 @@ pub fn recommend_each(
             ..*request
         })?;
     }
-    let (costing, note) = Costing::new(request.target, &request.exponents)?;
+    let (mut costing, note) = Costing::new(request.target, &request.exponents)?;
+    costing.time_kernels(&request.lobes, &request.exponents, progress);
     let per_bound = matches!(costing, Costing::Estimated(_) | Costing::Synthesized(_));
     if let Costing::Synthesized(hardware) = &costing {
         for &max_error in bounds {

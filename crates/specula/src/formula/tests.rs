@@ -337,6 +337,45 @@ fn horner_forms_are_one_chain() {
     assert!(!super::registry::get(id).formula().plan.is_one_chain());
 }
 
+/// A Horner step of a falling polynomial (`s - c * v`, then `1 - v * (...)`) is one fused
+/// link each, so the designed quadratics cost a dispatch per step, not two.
+#[test]
+fn horner_steps_are_one_link_each() {
+    let kind = kind_of(definition(
+        "horner-steps",
+        "let v = min(1 - t, 0.9); (1 - v * (n / 8 - 0.1 * v)) ^ 8",
+    ));
+    let LobeKind::Formula(id) = kind else {
+        unreachable!("a formula")
+    };
+    // 1 - t, min, keep v, n/8 - 0.1 v, 1 - v (...), three squarings: six links for the
+    // formula's nine operations.
+    assert_eq!(
+        super::registry::get(id).formula().plan.one_chain_links(),
+        Some(6)
+    );
+    // And the fused steps compute what the formula says, at every level.
+    let lobe = Lobe::new(kind, Exponent::new(40.0));
+    let ts = cosines();
+    for level in Level::available() {
+        let mut out = vec![0.0; ts.len()];
+        lobe.eval_batch_with(level, BatchLoop::Explicit, &ts, &mut out);
+        for (&t, &value) in ts.iter().zip(&out) {
+            let v = (1.0 - f64::from(t)).min(0.9);
+            // The shared rules: the value clamped to [0, 1], and 0 where t <= 0.
+            let exact = if t > 0.0 {
+                (1.0 - v * (5.0 - 0.1 * v)).powi(8).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            assert!(
+                (f64::from(value) - exact).abs() <= 1e-5,
+                "t = {t}: {value} vs {exact}"
+            );
+        }
+    }
+}
+
 /// Inline formulas get numbered names; the same text is the same lobe.
 #[test]
 fn inline_formulas_are_named_and_shared() {

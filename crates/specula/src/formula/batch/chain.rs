@@ -3,162 +3,17 @@
 //! runs a group of [`GROUP`] vectors through all its links in registers, so the value never
 //! goes through memory between operations and a link's choice is paid once per group.
 
-use super::{Inside, LaneFunction, Map, Rules, ACOS_DOMAIN, LOG2_DOMAIN, MAX_WIDTH};
-use crate::simd::tally::{Class, Instructions};
+use super::links::{Link, SavedOp};
+use super::{Inside, Map, Rules, ACOS_DOMAIN, LOG2_DOMAIN, MAX_WIDTH};
 use crate::simd::{math, Lanes};
 
-/// Vectors a chain carries through its links at once (in registers).
+/// Vectors a chain carries through its links at once, in registers.
 pub(super) const GROUP: usize = 8;
 
-/// One link: the value `x` and scalars (indices into the batch's constants).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Link {
-    Add(usize),
-    /// `x - s`.
-    Sub(usize),
-    /// `s - x`.
-    SubFrom(usize),
-    Mul(usize),
-    Div(usize),
-    /// `s / x`.
-    DivInto(usize),
-    Min(usize),
-    Max(usize),
-    /// `x * a + b`, fused.
-    Fma(usize, usize),
-    Powi(i32),
-    /// `x` squared this many times (an integer power of two, as `cosquad` computes it).
-    Squarings(u32),
-    /// `(x - c) * a + b`, the multiply-add fused: a subtraction and the multiply-add that
-    /// reads it, in one link.
-    Affine(usize, usize, usize),
-    /// `x^s` as `exp2(s log2 x)`.
-    Pow(usize),
-    Neg,
-    Abs,
-    Sqrt,
-    Log2,
-    Ln,
-    /// `exp2(scale x)`.
-    Exp2(f32),
-    Acos,
-    /// A function without a vector form: the chain goes lane by lane.
-    Lane(LaneFunction),
-    /// Keeps the value, which a later link of the chain reads again (`u` in
-    /// `u * (a + b * u)`): the chain's one saved value, held in registers beside it.
-    Save,
-    /// The value and the saved one combined: a polynomial of one value (Horner's rule)
-    /// stays a chain.
-    Saved(SavedOp),
-}
-
-/// How a chain's value meets its saved value.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum SavedOp {
-    /// `x + saved`.
-    Add,
-    /// `x * saved`.
-    Mul,
-    /// `x - saved`.
-    Sub,
-    /// `saved - x`.
-    SubFrom,
-}
-
-impl SavedOp {
-    #[inline(always)]
-    fn apply<V: Lanes>(self, x: V, saved: V) -> V {
-        match self {
-            SavedOp::Add => x + saved,
-            SavedOp::Mul => x * saved,
-            SavedOp::Sub => x - saved,
-            SavedOp::SubFrom => saved - x,
-        }
-    }
-
-    pub(super) fn scalar(self, x: f32, saved: f32) -> f32 {
-        match self {
-            SavedOp::Add => x + saved,
-            SavedOp::Mul => x * saved,
-            SavedOp::Sub => x - saved,
-            SavedOp::SubFrom => saved - x,
-        }
-    }
-}
-
-impl Link {
-    /// Whether the link's polynomial holds only on part of its inputs.
-    pub(super) fn checked(self) -> bool {
-        matches!(
-            self,
-            Link::Log2 | Link::Ln | Link::Pow(_) | Link::Exp2(_) | Link::Acos
-        )
-    }
-
-    /// The link in scalar `f32`, as the formula's scalar path computes it; `saved` is the
-    /// chain's saved value ([`Link::Save`] sets it).
-    pub(super) fn scalar(self, x: f32, saved: &mut f32, values: &[f32]) -> f32 {
-        match self {
-            Link::Save => {
-                *saved = x;
-                x
-            }
-            Link::Saved(op) => op.scalar(x, *saved),
-            Link::Add(s) => x + values[s],
-            Link::Sub(s) => x - values[s],
-            Link::SubFrom(s) => values[s] - x,
-            Link::Mul(s) => x * values[s],
-            Link::Div(s) => x / values[s],
-            Link::DivInto(s) => values[s] / x,
-            Link::Min(s) => x.min(values[s]),
-            Link::Max(s) => x.max(values[s]),
-            Link::Fma(a, b) => x.mul_add(values[a], values[b]),
-            Link::Powi(k) => crate::formula::program::powi(x, k),
-            Link::Squarings(m) => (0..m).fold(x, |v, _| v * v),
-            Link::Affine(c, a, b) => (x - values[c]).mul_add(values[a], values[b]),
-            Link::Pow(s) => x.powf(values[s]),
-            Link::Neg => -x,
-            Link::Abs => x.max(-x),
-            Link::Sqrt => x.sqrt(),
-            Link::Log2 => x.log2(),
-            Link::Ln => x.log2() * core::f32::consts::LN_2,
-            Link::Exp2(scale) => (x * scale).exp2(),
-            Link::Acos => x.acos(),
-            Link::Lane(f) => f.get()(x),
-        }
-    }
-
-    /// The instructions one vector costs.
-    pub(super) fn instructions(self) -> Instructions {
-        let one = |class| Instructions::of(&[(class, 1)]);
-        match self {
-            Link::Add(_) | Link::Sub(_) | Link::SubFrom(_) => one(Class::Add),
-            Link::Save => Instructions::NONE,
-            Link::Saved(SavedOp::Mul) => one(Class::Mul),
-            Link::Saved(_) => one(Class::Add),
-            Link::Mul(_) | Link::Neg => one(Class::Mul),
-            Link::Squarings(m) => Instructions::of(&[(Class::Mul, m)]),
-            Link::Affine(..) => Instructions::of(&[(Class::Add, 1), (Class::Fma, 1)]),
-            Link::Div(_) | Link::DivInto(_) => one(Class::Div),
-            Link::Min(_) | Link::Max(_) => one(Class::MinMax),
-            Link::Fma(..) => one(Class::Fma),
-            Link::Powi(k) => {
-                let bits = 32 - k.unsigned_abs().leading_zeros();
-                let multiplies = bits.saturating_sub(1) + k.unsigned_abs().count_ones().max(1) - 1;
-                Instructions::of(&[(Class::Mul, multiplies), (Class::Div, u32::from(k < 0))])
-            }
-            Link::Pow(_) => math::LOG2.and(math::EXP2).plus(Class::Mul, 1),
-            Link::Abs => Instructions::of(&[(Class::Mul, 1), (Class::MinMax, 1)]),
-            Link::Sqrt => one(Class::Sqrt),
-            Link::Log2 => math::LOG2,
-            Link::Ln => math::LOG2.plus(Class::Mul, 1),
-            Link::Exp2(_) => math::EXP2.plus(Class::Mul, 1),
-            Link::Acos => math::ACOS,
-            // A call per lane, counted as a division's worth each.
-            Link::Lane(_) => Instructions::of(&[(Class::Div, 8)]),
-        }
-    }
-}
+/// Vectors a chain that keeps a saved value carries: the values and the saved ones then fill
+/// 8 of AVX2's 16 vector registers, where 8 and 8 with the links' constants went through the
+/// stack at every link.
+pub(super) const SAVING_GROUP: usize = 4;
 
 /// A chain, and where its value starts and ends.
 #[derive(Clone, Debug, PartialEq)]
@@ -168,6 +23,8 @@ pub(super) struct Chain {
     pub checked: bool,
     /// Whether a link has no vector form.
     pub lane_only: bool,
+    /// Whether a link keeps a saved value (Horner's rule).
+    pub saves: bool,
 }
 
 impl Chain {
@@ -175,6 +32,7 @@ impl Chain {
         Self {
             checked: links.iter().any(|l| l.checked()),
             lane_only: links.iter().any(|l| matches!(l, Link::Lane(_))),
+            saves: links.contains(&Link::Save),
             links,
         }
     }
@@ -192,9 +50,9 @@ pub(super) enum End {
 /// Applies `$body` (an expression of `$v`) to every vector of the group.
 macro_rules! each {
     ($x:ident, |$v:ident| $body:expr) => {
-        for k in 0..GROUP {
-            let $v = $x[k];
-            $x[k] = $body;
+        for value in $x.iter_mut() {
+            let $v = *value;
+            *value = $body;
         }
     };
 }
@@ -216,9 +74,26 @@ pub(super) struct Buffers<'a> {
     pub out: &'a mut [f32],
 }
 
-/// Runs `chain` over one block (`block` floats): from `input` to `output`.
+/// Runs `chain` over one block (`block` floats, a whole number of groups): from `input` to
+/// `output`.
 #[inline(always)]
 pub(super) fn run<V: Lanes>(
+    lanes: V,
+    chain: &Chain,
+    buffers: &mut Buffers<'_>,
+    ends: (End, End),
+    block: usize,
+) {
+    if chain.saves {
+        run_groups::<V, SAVING_GROUP>(lanes, chain, buffers, ends, block);
+    } else {
+        run_groups::<V, GROUP>(lanes, chain, buffers, ends, block);
+    }
+}
+
+/// [`run`] with `G` vectors a group.
+#[inline(always)]
+fn run_groups<V: Lanes, const G: usize>(
     lanes: V,
     chain: &Chain,
     buffers: &mut Buffers<'_>,
@@ -228,7 +103,7 @@ pub(super) fn run<V: Lanes>(
     let mut at = 0;
     if chain.checked || chain.lane_only {
         while at < block {
-            let mut x = load_group(lanes, buffers, ends.0, at);
+            let mut x = load_group::<V, G>(lanes, buffers, ends.0, at);
             let mut saved = x;
             let mut ok = lanes.splat(1.0);
             if !chain.lane_only {
@@ -240,24 +115,27 @@ pub(super) fn run<V: Lanes>(
                 lane_by_lane(chain, buffers, ends.0, at, &mut x);
             }
             store_group(lanes, buffers, ends.1, at, x);
-            at += GROUP * V::WIDTH;
+            at += G * V::WIDTH;
         }
     } else {
         // Without polynomials or a fallback the group's values never leave registers.
         while at < block {
-            let mut x = load_group(lanes, buffers, ends.0, at);
+            let mut x = load_group::<V, G>(lanes, buffers, ends.0, at);
             let mut saved = x;
             for &link in &chain.links {
-                apply_arithmetic(lanes, link, buffers.values, (&mut x, &mut saved));
+                apply_arithmetic::<V, G, false>(lanes, link, buffers.values, (&mut x, &mut saved));
             }
             store_group(lanes, buffers, ends.1, at, x);
-            at += GROUP * V::WIDTH;
+            at += G * V::WIDTH;
         }
     }
 }
 
-/// A whole formula that is one arithmetic chain, over the whole batch: no blocks and no
-/// register file, the shared rules picked once (as `cosquad`'s kernel picks its mask).
+/// A whole formula that is one chain run unchecked, over the whole batch: no blocks and no
+/// register file, the shared rules picked once (as `cosquad`'s kernel picks its mask). Each
+/// shape of chain is its own loop: a chain that saves a value carries fewer vectors, and one
+/// without polynomials is compiled without their arms, whose constants would otherwise hold
+/// registers the group needs.
 #[inline(always)]
 pub(super) fn run_whole<V: Lanes>(
     lanes: V,
@@ -267,11 +145,13 @@ pub(super) fn run_whole<V: Lanes>(
     ts: &[f32],
     out: &mut [f32],
 ) {
-    match (rules.clamp, rules.mask) {
-        (false, false) => whole::<V, false, false>(lanes, &chain.links, values, ts, out),
-        (false, true) => whole::<V, false, true>(lanes, &chain.links, values, ts, out),
-        (true, false) => whole::<V, true, false>(lanes, &chain.links, values, ts, out),
-        (true, true) => whole::<V, true, true>(lanes, &chain.links, values, ts, out),
+    let polynomial = chain.links.iter().any(|l| l.checked());
+    let run = (lanes, chain.links.as_slice(), values, ts, out);
+    match (chain.saves, polynomial) {
+        (false, false) => whole_with_rules::<V, GROUP, false>(run, rules),
+        (false, true) => whole_with_rules::<V, GROUP, true>(run, rules),
+        (true, false) => whole_with_rules::<V, SAVING_GROUP, false>(run, rules),
+        (true, true) => whole_with_rules::<V, SAVING_GROUP, true>(run, rules),
     }
 }
 
@@ -281,33 +161,48 @@ pub(super) fn runs_whole(chain: &Chain, rules: Rules) -> bool {
     !chain.lane_only && (!chain.checked || !rules.checked)
 }
 
+/// What [`whole`] runs: the lanes, the links, the batch's constants, cosines and outputs.
+type Whole<'a, V> = (V, &'a [Link], &'a [f32], &'a [f32], &'a mut [f32]);
+
 #[inline(always)]
-fn whole<V: Lanes, const CLAMP: bool, const MASK: bool>(
-    lanes: V,
-    links: &[Link],
-    values: &[f32],
-    ts: &[f32],
-    out: &mut [f32],
+fn whole_with_rules<V: Lanes, const G: usize, const POLY: bool>(run: Whole<'_, V>, rules: Rules) {
+    match (rules.clamp, rules.mask) {
+        (false, false) => whole::<V, G, POLY, false, false>(run),
+        (false, true) => whole::<V, G, POLY, false, true>(run),
+        (true, false) => whole::<V, G, POLY, true, false>(run),
+        (true, true) => whole::<V, G, POLY, true, true>(run),
+    }
+}
+
+#[inline(always)]
+fn whole<V: Lanes, const G: usize, const POLY: bool, const CLAMP: bool, const MASK: bool>(
+    (lanes, links, values, ts, out): Whole<'_, V>,
 ) {
-    let step = GROUP * V::WIDTH;
+    let step = G * V::WIDTH;
     let mut t_groups = ts.chunks_exact(step);
     let mut o_groups = out.chunks_exact_mut(step);
     for (t, o) in (&mut t_groups).zip(&mut o_groups) {
-        whole_group::<V, CLAMP, MASK>(lanes, links, values, t, o);
+        whole_group::<V, G, POLY, CLAMP, MASK>(lanes, links, values, t, o);
     }
     let (t, o) = (t_groups.remainder(), o_groups.into_remainder());
     if !t.is_empty() {
         let mut padded = [1.0_f32; GROUP * MAX_WIDTH];
         padded[..t.len()].copy_from_slice(t);
         let mut result = [0.0_f32; GROUP * MAX_WIDTH];
-        whole_group::<V, CLAMP, MASK>(lanes, links, values, &padded[..step], &mut result[..step]);
+        whole_group::<V, G, POLY, CLAMP, MASK>(
+            lanes,
+            links,
+            values,
+            &padded[..step],
+            &mut result[..step],
+        );
         o.copy_from_slice(&result[..o.len()]);
     }
 }
 
 /// One group of [`whole`] (a function, not a closure: see [`super::Map`]).
 #[inline(always)]
-fn whole_group<V: Lanes, const CLAMP: bool, const MASK: bool>(
+fn whole_group<V: Lanes, const G: usize, const POLY: bool, const CLAMP: bool, const MASK: bool>(
     lanes: V,
     links: &[Link],
     values: &[f32],
@@ -316,7 +211,7 @@ fn whole_group<V: Lanes, const CLAMP: bool, const MASK: bool>(
 ) {
     let width = V::WIDTH;
     let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
-    let mut x = [zero; GROUP];
+    let mut x = [zero; G];
     for (k, value) in x.iter_mut().enumerate() {
         *value = one
             .min(lanes.load(&t[k * width..(k + 1) * width]))
@@ -324,7 +219,7 @@ fn whole_group<V: Lanes, const CLAMP: bool, const MASK: bool>(
     }
     let mut saved = x;
     for &link in links {
-        apply_arithmetic(lanes, link, values, (&mut x, &mut saved));
+        apply_arithmetic::<V, G, POLY>(lanes, link, values, (&mut x, &mut saved));
     }
     for (k, value) in x.into_iter().enumerate() {
         let mut value = value;
@@ -340,10 +235,15 @@ fn whole_group<V: Lanes, const CLAMP: bool, const MASK: bool>(
 
 /// The group's inputs: the batch's cosines clamped to `[0, 1]`, or a register's values.
 #[inline(always)]
-fn load_group<V: Lanes>(lanes: V, buffers: &Buffers<'_>, input: End, at: usize) -> [V; GROUP] {
+fn load_group<V: Lanes, const G: usize>(
+    lanes: V,
+    buffers: &Buffers<'_>,
+    input: End,
+    at: usize,
+) -> [V; G] {
     let width = V::WIDTH;
     let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
-    let mut x = [zero; GROUP];
+    let mut x = [zero; G];
     for (k, value) in x.iter_mut().enumerate() {
         let start = at + k * width;
         *value = match input {
@@ -358,12 +258,12 @@ fn load_group<V: Lanes>(lanes: V, buffers: &Buffers<'_>, input: End, at: usize) 
 
 /// The group's results: into a register, or the batch's outputs with the shared rules.
 #[inline(always)]
-fn store_group<V: Lanes>(
+fn store_group<V: Lanes, const G: usize>(
     lanes: V,
     buffers: &mut Buffers<'_>,
     output: End,
     at: usize,
-    x: [V; GROUP],
+    x: [V; G],
 ) {
     let width = V::WIDTH;
     let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
@@ -388,12 +288,12 @@ fn store_group<V: Lanes>(
 /// The group recomputed lane by lane in scalar `f32` (a link's polynomial met a lane outside
 /// its range, or a link has no vector form).
 #[inline(never)]
-fn lane_by_lane<V: Lanes>(
+fn lane_by_lane<V: Lanes, const G: usize>(
     chain: &Chain,
     buffers: &Buffers<'_>,
     input: End,
     at: usize,
-    x: &mut [V; GROUP],
+    x: &mut [V; G],
 ) {
     let (width, values) = (V::WIDTH, buffers.values);
     let mut lanes = [0.0_f32; 64];
@@ -420,11 +320,11 @@ fn lane_by_lane<V: Lanes>(
 
 /// One link over the group; `ok` keeps 1 in the lanes where every polynomial was in range.
 #[inline(always)]
-fn apply<V: Lanes>(
+fn apply<V: Lanes, const G: usize>(
     lanes: V,
     link: Link,
     values: &[f32],
-    (x, saved): (&mut [V; GROUP], &mut [V; GROUP]),
+    (x, saved): (&mut [V; G], &mut [V; G]),
     ok: &mut V,
 ) {
     let s = |index: usize| lanes.splat(values[index]);
@@ -464,25 +364,34 @@ fn apply<V: Lanes>(
             }
         }
         Link::Lane(_) => {}
-        _ => apply_arithmetic(lanes, link, values, (x, saved)),
+        _ => apply_arithmetic::<V, G, false>(lanes, link, values, (x, saved)),
     }
 }
 
-/// One link over the group, unchecked: arithmetic, or a polynomial proven in its domain.
+/// One link over the group, unchecked: arithmetic, or (with `POLY`) a polynomial proven in its
+/// domain. Without `POLY` the polynomials' arms are not compiled in.
 #[inline(always)]
-fn apply_arithmetic<V: Lanes>(
+fn apply_arithmetic<V: Lanes, const G: usize, const POLY: bool>(
     lanes: V,
     link: Link,
     values: &[f32],
-    (x, saved): (&mut [V; GROUP], &mut [V; GROUP]),
+    (x, saved): (&mut [V; G], &mut [V; G]),
 ) {
     let s = |index: usize| lanes.splat(values[index]);
     match link {
         Link::Save => *saved = *x,
-        Link::Saved(op) => {
-            for (v, &kept) in x.iter_mut().zip(saved.iter()) {
-                *v = op.apply(*v, kept);
-            }
+        // Each operation its own loop: one choice per group, not one per vector.
+        Link::Saved(SavedOp::Add) => with_saved(x, saved, |v, kept| v + kept),
+        Link::Saved(SavedOp::Mul) => with_saved(x, saved, |v, kept| v * kept),
+        Link::Saved(SavedOp::Sub) => with_saved(x, saved, |v, kept| v - kept),
+        Link::Saved(SavedOp::SubFrom) => with_saved(x, saved, |v, kept| kept - v),
+        Link::Saved(SavedOp::MulAdd(b)) => {
+            let b = s(b);
+            with_saved(x, saved, |v, kept| v.mul_add(kept, b));
+        }
+        Link::Saved(SavedOp::NegMulAdd(b)) => {
+            let b = s(b);
+            with_saved(x, saved, |v, kept| v.neg_mul_add(kept, b));
         }
         Link::Add(i) => {
             let c = s(i);
@@ -520,6 +429,10 @@ fn apply_arithmetic<V: Lanes>(
             let (a, b) = (s(a), s(b));
             each!(x, |v| v.mul_add(a, b));
         }
+        Link::NegFma(a, b) => {
+            let (a, b) = (s(a), s(b));
+            each!(x, |v| v.neg_mul_add(a, b));
+        }
         Link::Powi(k) => {
             each!(x, |v| super::columns::powi(v, k));
         }
@@ -543,6 +456,9 @@ fn apply_arithmetic<V: Lanes>(
         Link::Sqrt => {
             each!(x, |v| v.sqrt());
         }
+        Link::Pow(_) | Link::Log2 | Link::Ln | Link::Exp2(_) | Link::Acos if !POLY => {
+            unreachable!("a chain with a polynomial runs with its arms")
+        }
         // Polynomials whose inputs the range analysis proved inside their domains.
         Link::Pow(i) => {
             let c = s(i);
@@ -563,6 +479,14 @@ fn apply_arithmetic<V: Lanes>(
             each!(x, |v| math::acos(v));
         }
         Link::Lane(_) => unreachable!("a chain with a lane-only link runs lane by lane"),
+    }
+}
+
+/// Each value of the group combined with its saved value by `op`.
+#[inline(always)]
+fn with_saved<V: Lanes, const G: usize>(x: &mut [V; G], saved: &[V; G], op: impl Fn(V, V) -> V) {
+    for (v, &kept) in x.iter_mut().zip(saved.iter()) {
+        *v = op(*v, kept);
     }
 }
 

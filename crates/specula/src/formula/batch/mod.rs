@@ -21,9 +21,9 @@ mod ranges;
 use super::compile::Op;
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::Lanes;
-use chain::{Chain, End, Link};
-use columns::{binary, run_step, Binary, Inside, LaneFunction, Map, ACOS_DOMAIN, LOG2_DOMAIN};
-use links::{link, push_fused, save_values};
+use chain::{Chain, End};
+use columns::{binary, run_step, Binary, Inside, Map, ACOS_DOMAIN, LOG2_DOMAIN};
+use links::{link, push_fused, save_values, Link};
 
 /// Which of the shared rules a batch's output needs: the clamp of the value to `[0, 1]`
 /// (NaN to 0), and the zero where `t <= 0` or NaN. Both are needed unless the formula is a
@@ -298,6 +298,15 @@ impl Plan {
             self.steps.as_slice(),
             [Step::Chain(_, End::Batch, End::Batch)]
         )
+    }
+
+    /// The links of the whole tape's one chain, if it is one.
+    #[cfg(test)]
+    pub(crate) fn one_chain_links(&self) -> Option<usize> {
+        match self.steps.as_slice() {
+            [Step::Chain(chain, End::Batch, End::Batch)] => Some(chain.links.len()),
+            _ => None,
+        }
     }
 
     /// The rules a batch's output needs with these per-material constants (see [`Rules`]).

@@ -1,7 +1,8 @@
 //! The range analysis of a chain: which of the shared rules ([`Rules`]) its output needs, from `[0, 1]`
 //! in, by interval ends evaluated as the lanes round them.
 
-use super::chain::{Chain, Link, SavedOp, EXP2_DOMAIN};
+use super::chain::{Chain, EXP2_DOMAIN};
+use super::links::{Link, SavedOp};
 use super::{Rules, ACOS_DOMAIN, LOG2_DOMAIN};
 
 impl Chain {
@@ -26,7 +27,7 @@ impl Chain {
                     saved_range = (low, high);
                     continue;
                 }
-                Link::Saved(op) => op.range((low, high), saved_range),
+                Link::Saved(op) => op.range((low, high), saved_range, values),
                 link => {
                     let monotone = match link {
                         Link::Add(_)
@@ -34,7 +35,11 @@ impl Chain {
                         | Link::SubFrom(_)
                         | Link::Min(_)
                         | Link::Max(_) => true,
-                        Link::Mul(_) | Link::Fma(..) | Link::Affine(..) | Link::Neg => true,
+                        Link::Mul(_)
+                        | Link::Fma(..)
+                        | Link::NegFma(..)
+                        | Link::Affine(..)
+                        | Link::Neg => true,
                         Link::Div(s) => values[s] != 0.0,
                         Link::DivInto(_) => low > 0.0 || high < 0.0,
                         Link::Sqrt => low >= 0.0,
@@ -81,12 +86,18 @@ impl SavedOp {
     /// The range of the result, from the ranges of the value and the saved value (every
     /// corner, each rounded as the lanes round it; rounding is monotone, so the rounded
     /// results of values inside lie between the rounded corners).
-    fn range(self, (low, high): (f32, f32), (s_low, s_high): (f32, f32)) -> (f32, f32) {
+    /// A product plus a constant is monotone in each operand, so its extremes are corners too.
+    fn range(
+        self,
+        (low, high): (f32, f32),
+        (s_low, s_high): (f32, f32),
+        values: &[f32],
+    ) -> (f32, f32) {
         let corners = [
-            self.scalar(low, s_low),
-            self.scalar(low, s_high),
-            self.scalar(high, s_low),
-            self.scalar(high, s_high),
+            self.scalar(low, s_low, values),
+            self.scalar(low, s_high, values),
+            self.scalar(high, s_low, values),
+            self.scalar(high, s_high, values),
         ];
         corners
             .iter()
