@@ -99,8 +99,8 @@ fn the_designed_gpu_lobe_meets_its_bounds_by_numpy_and_beats_pow() {
     );
 }
 
-/// Without transcendentals, on the CPU: a polynomial lobe, or a one-line verdict saying why
-/// none; at one n the search and its costing are quick.
+/// Without transcendentals, on the CPU: a polynomial lobe, whose written file NumPy finds
+/// within the bounds; at one n the search and its costing are quick.
 #[test]
 fn a_polynomial_design_on_the_cpu_is_a_polynomial() {
     let dir = tempfile::tempdir().expect("temporary folder");
@@ -115,6 +115,8 @@ fn a_polynomial_design_on_the_cpu_is_a_polynomial() {
             "--max-error",
             "0.5%",
             "--no-transcendentals",
+            "-o",
+            "polynomial.toml",
             "--format",
             "json",
         ],
@@ -128,6 +130,21 @@ fn a_polynomial_design_on_the_cpu_is_a_polynomial() {
     }
     assert_eq!(designed[0]["meets"], true, "{answer}");
     assert!(answer["verdict"].as_str().unwrap().contains("on cpu"));
+    if !have_python_module("scipy", "scipy") {
+        return;
+    }
+    // The epicentre's 0.5 % and the whole lobe's default 1 %, by NumPy on the written text.
+    let checked = std::process::Command::new(python())
+        .arg(renderer_script("designed_lobe_check.py"))
+        .arg(dir.path().join("polynomial.toml"))
+        .args(["0.005", "0.01", "64"])
+        .output()
+        .expect("python runs");
+    assert!(
+        checked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&checked.stderr)
+    );
 }
 
 #[test]
