@@ -29,6 +29,54 @@ fn run(what: &str, command: &mut Command) {
     assert!(output.status.success(), "{what} failed:\n{text}");
 }
 
+/// Each dependency's features as `cargo tree` resolves them for `selection`, by package,
+/// without the `pyo3` crates (the wheel alone adds their `extension-module`, as it must).
+fn resolved_features(selection: &[&str]) -> std::collections::BTreeMap<String, String> {
+    let output = Command::new(env!("CARGO"))
+        .current_dir(root())
+        .args(["tree", "--locked", "--offline", "--prefix", "none"])
+        .args(["-f", "{p} [{f}]"])
+        .args(selection)
+        .output()
+        .expect("cargo tree runs");
+    assert!(
+        output.status.success(),
+        "cargo tree {selection:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .filter_map(|line| {
+            // `NAME vX (PATH) [FEATURES]`, then ` (*)` where the tree was shown before.
+            let (package, rest) = line.split_once(" [")?;
+            let (features, _) = rest.rsplit_once(']')?;
+            (!package.starts_with("pyo3")).then(|| (package.to_owned(), features.to_owned()))
+        })
+        .collect()
+}
+
+/// The wheel's build (`cargo rustc -p specula-python`, features resolved for that crate
+/// alone) enables in every dependency the features the workspace's build enables, so it
+/// reuses the tests' crates instead of building most of the tree again.
+#[test]
+fn the_wheel_resolves_the_features_the_workspace_does() {
+    let wheel = resolved_features(&["-p", "specula-python", "-e", "normal,build"]);
+    // Every target's build, the tests' dependencies included, as `cargo test` builds.
+    let workspace = resolved_features(&["--workspace", "-e", "normal,build,dev"]);
+    let differing: Vec<String> = wheel
+        .iter()
+        .filter(|(package, features)| workspace.get(*package).is_some_and(|w| w != *features))
+        .map(|(package, features)| {
+            format!("{package}: wheel [{features}], workspace [{}]", workspace[package])
+        })
+        .collect();
+    assert!(
+        differing.is_empty(),
+        "name these features in crates/python/Cargo.toml:\n{}",
+        differing.join("\n")
+    );
+}
+
 #[test]
 fn the_package_installs_offline_and_its_tests_pass() {
     for (module, package) in [
