@@ -67,7 +67,10 @@ fn the_wheel_resolves_the_features_the_workspace_does() {
         .iter()
         .filter(|(package, features)| workspace.get(*package).is_some_and(|w| w != *features))
         .map(|(package, features)| {
-            format!("{package}: wheel [{features}], workspace [{}]", workspace[package])
+            format!(
+                "{package}: wheel [{features}], workspace [{}]",
+                workspace[package]
+            )
         })
         .collect();
     assert!(

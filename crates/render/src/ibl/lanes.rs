@@ -11,8 +11,9 @@
 //!   packet's sum.
 //!
 //! Lanes past the packet's draws hold no draw (`light_pdf = 0`, source [`Source::None`]), so
-//! every job runs over all [`LANES`] lanes (a multiple of every level's width) and masks with
-//! selects, never with a multiply by 0 (a masked lane may hold an infinity or a NaN).
+//! every job runs over the packet's draws rounded up to the level's width (`used`: a packet of
+//! 16 draws costs 16 lanes, not [`LANES`]) and masks with selects, never with a multiply by 0
+//! (a masked lane may hold an infinity or a NaN).
 
 use core::f32::consts::FRAC_1_PI;
 
@@ -127,6 +128,8 @@ pub(super) struct Setting {
 /// One variant's cosines, BRDF directions and their texels (see the module docs).
 pub(super) struct Directions<'a> {
     pub(super) setting: Setting,
+    /// The lanes to run: the packet's draws rounded up to the level's width.
+    pub(super) used: usize,
     pub(super) environment: &'a Environment,
     pub(super) shared: &'a SharedColumns,
     pub(super) variant: &'a mut VariantColumns,
@@ -149,7 +152,7 @@ impl Job for Directions<'_> {
         let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
         let wo = V3::splat(lanes, wo);
         let w = V::WIDTH;
-        for k in (0..LANES).step_by(w) {
+        for k in (0..self.used).step_by(w) {
             let light = V3::load(lanes, &shared.light_wi, k);
             let has_light = lanes.load(&shared.light_pdf[k..k + w]).gt(zero);
             let (t, half_cosine) = cosine(geometry, wo, light);
@@ -227,6 +230,8 @@ pub(super) struct Brdf {
 /// One variant's estimates over a packet, summed (see the module docs).
 pub(super) struct Combine<'a> {
     pub(super) brdf: Brdf,
+    /// The lanes to run: the packet's draws rounded up to the level's width.
+    pub(super) used: usize,
     pub(super) shared: &'a SharedColumns,
     pub(super) variant: &'a VariantColumns,
 }
@@ -291,7 +296,7 @@ impl Job for Combine<'_> {
         let nothing = V3::splat(lanes, Vec3::ZERO);
         let w = V::WIDTH;
         let mut sum = nothing;
-        for k in (0..LANES).step_by(w) {
+        for k in (0..self.used).step_by(w) {
             // The environment's draw.
             let light_pdf = lanes.load(&shared.light_pdf[k..k + w]);
             let light = V3::load(lanes, &shared.light_wi, k);

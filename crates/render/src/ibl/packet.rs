@@ -277,8 +277,11 @@ pub(super) fn shade(
                 shared.diffuse_wi.set(k, diffuse_wi);
             }
         }
+        // The lanes the jobs run: the draws rounded up to the level's width, so that a pixel
+        // of 16 samples pays for 16 lanes, not 64 (the lanes past the draws draw nothing).
+        let used = count.next_multiple_of(level.lanes());
         // The texels' radiances and densities.
-        for k in 0..LANES {
+        for k in 0..used {
             shared.light_pdf[k] = 0.0;
             let texel = scalars.light_texel[k];
             if texel != usize::MAX {
@@ -306,6 +309,7 @@ pub(super) fn shade(
             shared: &shared,
             u1: &scalars.u1,
             count,
+            used,
         };
         for (surface, sum) in point.surfaces.iter().zip(sums.iter_mut()) {
             *sum += shade_variant(packet, surface, &mut variant).as_dvec3();
@@ -325,6 +329,8 @@ struct Packet<'a> {
     u1: &'a [f32; LANES],
     /// The packet's draws (its first lanes).
     count: usize,
+    /// The lanes the jobs run ([`super::lanes`]).
+    used: usize,
 }
 
 /// One variant's estimates over a packet of `count` draws, summed: its lobe's cosine draws,
@@ -339,12 +345,14 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
         shared,
         u1,
         count,
+        used,
     } = packet;
     let draws_lobe = strategy != Strategy::Environment;
     for (k, (drawn, (&choice, &u))) in variant
         .drawn
         .iter_mut()
         .zip(shared.choice.iter().zip(u1))
+        .take(used)
         .enumerate()
     {
         *drawn = if k < count && draws_lobe && choice < surface.share {
@@ -369,6 +377,7 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
     dispatch(
         level,
         Directions {
+            used,
             setting: Setting {
                 geometry: surface.geometry,
                 strategy,
@@ -416,6 +425,7 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
     dispatch(
         level,
         Combine {
+            used,
             brdf: Brdf {
                 geometry: surface.geometry,
                 strategy,
