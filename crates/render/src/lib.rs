@@ -62,6 +62,6 @@ pub use output::{write_atomically, SeekWrite};
 pub use pipeline::{
     overdraw, render, surfaces, RenderError, SurfacePoint, MAX_PIXELS, MAX_SAMPLES,
 };
-pub use scene::{Object, Overrides, Scene, Settings, DEFAULT_SCENE, IBL_SCENE};
+pub use scene::{Analytic, Object, Overrides, Scene, Settings, DEFAULT_SCENE, IBL_SCENE};
 pub use shapes::{plane, sphere, torus};
 pub use teapot::{teapot, BezierPatch, TEAPOT_PATCHES};

@@ -1,14 +1,16 @@
-//! A scene described for Mitsuba 3: each object's mesh as an OBJ file (its vertices and
-//! normals, so both renderers shade the same triangles) and a JSON file with the materials,
-//! the camera and the environment, in the layout `mitsuba_check.py render` reads (the
-//! harness in `crates/cli/tests/renderers/`, compiled into `specula bench environment`).
+//! A scene described for Mitsuba 3 as its users would write it: a sphere as Mitsuba's own
+//! `sphere` shape, every other object's mesh as an OBJ file (its vertices and normals, so both
+//! renderers shade the same triangles), and a JSON file with the materials, the camera and
+//! the environment, in the layout `mitsuba_check.py render` reads (the harness in
+//! `crates/cli/tests/renderers/`, compiled into `specula bench environment`).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::{Projection, Scene};
+use crate::{Analytic, Projection, Scene};
 
-/// Writes `scene` into `directory` as `<name>.json` and `<name>-object<i>.obj`, lit by the
+/// Writes `scene` into `directory` as `<name>.json` and `<name>-object<i>.obj` (for the
+/// objects without an exact shape), lit by the
 /// environment file `environment` (relative to `directory`), rendered at `spp` samples per
 /// pixel from `seed`; returns the JSON file's path. Mitsuba's film has the scene's pixels
 /// (its box filter averages within each, as specula's positions within a pixel do).
@@ -31,27 +33,31 @@ pub fn write_mitsuba_scene(
     };
     let mut meshes = Vec::new();
     for (index, object) in scene.objects.iter().enumerate() {
-        let mut obj = String::new();
-        for (p, n) in object.mesh.positions().iter().zip(object.mesh.normals()) {
-            let _ = writeln!(obj, "v {} {} {}\nvn {} {} {}", p.x, p.y, p.z, n.x, n.y, n.z);
-        }
-        for [a, b, c] in object.mesh.triangles() {
-            let [a, b, c] = [a + 1, b + 1, c + 1];
-            let _ = writeln!(obj, "f {a}//{a} {b}//{b} {c}//{c}");
-        }
-        let file = format!("{name}-object{index}.obj");
-        std::fs::write(directory.join(&file), obj)
-            .map_err(|e| format!("{}: {e}", directory.join(&file).display()))?;
         let m = &object.material;
         let (kd, ks) = (m.kd * m.colour, m.ks * m.specular_colour);
-        meshes.push(serde_json::json!({
-            "obj": file,
+        let mut shape = serde_json::json!({
             "n": m.lobe.exponent().get(),
             "kd": kd.to_array(),
             "ks": ks.to_array(),
             "geometry": m.geometry.id(),
             "normalisation": m.normalisation.id(),
-        }));
+        });
+        // A sphere as Mitsuba's own shape, as its users draw one (traced exactly, where
+        // specula rasterizes its tessellation); anything else as its triangles.
+        match object.analytic {
+            Some(Analytic::Sphere { centre, radius }) => {
+                shape["sphere"] = serde_json::json!({
+                    "centre": centre.to_array(),
+                    "radius": radius,
+                });
+            }
+            None => {
+                let file = format!("{name}-object{index}.obj");
+                write_obj(&object.mesh, &directory.join(&file))?;
+                shape["obj"] = file.into();
+            }
+        }
+        meshes.push(shape);
     }
     let camera = scene.camera;
     let json = serde_json::json!({
@@ -71,4 +77,17 @@ pub fn write_mitsuba_scene(
     let path = directory.join(format!("{name}.json"));
     std::fs::write(&path, json.to_string()).map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(path)
+}
+
+/// `mesh` as an OBJ file: positions, normals, and triangles indexing both.
+fn write_obj(mesh: &crate::Mesh, path: &Path) -> Result<(), String> {
+    let mut obj = String::new();
+    for (p, n) in mesh.positions().iter().zip(mesh.normals()) {
+        let _ = writeln!(obj, "v {} {} {}\nvn {} {} {}", p.x, p.y, p.z, n.x, n.y, n.z);
+    }
+    for [a, b, c] in mesh.triangles() {
+        let [a, b, c] = [a + 1, b + 1, c + 1];
+        let _ = writeln!(obj, "f {a}//{a} {b}//{b} {c}//{c}");
+    }
+    std::fs::write(path, obj).map_err(|e| format!("{}: {e}", path.display()))
 }

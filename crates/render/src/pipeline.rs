@@ -16,7 +16,7 @@ use crate::clip::{clip_triangle, ClipVertex, Varyings, MAX_SIDE};
 use crate::material::{Shader, Shading};
 use crate::phong;
 use crate::raster::{Culling, EdgeWeights, PixelRect, ScreenVertex, Setup};
-use crate::{Image, Scene, Settings};
+use crate::{Analytic, Image, Scene, Settings};
 
 /// Output pixels per tile side.
 const TILE: u32 = 32;
@@ -122,7 +122,8 @@ pub fn render(
 pub struct SurfacePoint {
     /// World position.
     pub position: Vec3,
-    /// Unit shading normal (the face's where the interpolated one vanishes).
+    /// Unit shading normal: a sphere's own at the point, or else the vertex normals
+    /// interpolated (the face's where that vanishes).
     pub normal: Vec3,
     /// The object's index in `scene.objects`.
     pub object: u32,
@@ -170,11 +171,23 @@ pub fn surfaces(scene: &Scene) -> Result<Vec<Option<SurfacePoint>>, RenderError>
                         );
                         let edges = primitive.setup.edge_weights_near(rect.x0, rect.y0);
                         let weights = perspective_weights(primitive, edges.at(x, y));
-                        let point = SurfacePoint {
-                            position: blend(primitive, weights, |v| v.position),
-                            normal: blend(primitive, weights, |v| v.normal)
+                        let position = blend(primitive, weights, |v| v.position);
+                        let interpolated = || {
+                            blend(primitive, weights, |v| v.normal)
                                 .try_normalize()
-                                .unwrap_or(primitive.face_normal),
+                                .unwrap_or(primitive.face_normal)
+                        };
+                        // A sphere is shaded with its own normal at the point, as a ray
+                        // tracer given the exact shape shades it, not its tessellation's.
+                        let normal = match scene.objects[primitive.shader as usize].analytic {
+                            Some(Analytic::Sphere { centre, .. }) => (position - centre)
+                                .try_normalize()
+                                .unwrap_or_else(interpolated),
+                            None => interpolated(),
+                        };
+                        let point = SurfacePoint {
+                            position,
+                            normal,
                             object: primitive.shader,
                         };
                         ((y * width + x) as usize, point)

@@ -53,8 +53,23 @@ impl Default for Settings {
 pub struct Object {
     /// The geometry, already transformed to world space.
     pub mesh: Mesh,
+    /// The exact shape the mesh tessellates, where it has one: what a ray tracer given the
+    /// scene ([`crate::write_mitsuba_scene`]) draws instead of the triangles.
+    pub analytic: Option<Analytic>,
     /// The material.
     pub material: Material,
+}
+
+/// An exact shape, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Analytic {
+    /// A sphere.
+    Sphere {
+        /// Its centre.
+        centre: Vec3,
+        /// Its radius.
+        radius: f32,
+    },
 }
 
 /// Everything a render needs.

@@ -42,6 +42,7 @@ fn sphere_scene(shading: Shading, geometry: Geometry, n: f64) -> (Scene, Vec3, M
         ambient: Vec3::splat(0.1),
         objects: vec![Object {
             mesh: sphere(1.0, 512, 256),
+            analytic: None,
             material,
         }],
         settings: Settings {

@@ -31,6 +31,7 @@ fn scene(camera: Camera, mesh: Mesh, width: u32, height: u32, samples: u32) -> S
         ambient: Vec3::splat(0.1),
         objects: vec![Object {
             mesh,
+            analytic: None,
             material: material(),
         }],
         settings: Settings {

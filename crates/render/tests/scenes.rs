@@ -4,7 +4,7 @@ use std::path::Path;
 
 use glam::Vec3;
 use specula::LobeKind;
-use specula_render::{load_mesh, Light, Scene, DEFAULT_SCENE};
+use specula_render::{load_mesh, Analytic, Light, Scene, DEFAULT_SCENE};
 
 fn parse(text: &str) -> Result<Scene, String> {
     Scene::from_toml(text, "test.toml", None)
@@ -66,6 +66,31 @@ fn transforms_place_the_object() {
 }
 
 /// Each malformed scene names the file, the line, the key and (for a choice) the valid values.
+/// A sphere keeps its exact shape beside its tessellation: the centre its translation and
+/// the radius its scaled radius, on which every vertex of the mesh lies; other shapes have
+/// none.
+#[test]
+fn a_sphere_keeps_its_exact_shape() {
+    let text = format!(
+        "{CAMERA}[[objects]]\nshape = \"sphere\"\nradius = 0.9\nscale = 2.0\n\
+         translate = [1.0, -2.0, 3.0]\nrotate = [10.0, 20.0, 30.0]\n\
+         [[objects]]\nshape = \"torus\"\n"
+    );
+    let scene = parse(&text).unwrap();
+    let Some(Analytic::Sphere { centre, radius }) = scene.objects[0].analytic else {
+        panic!(
+            "the sphere has no exact shape: {:?}",
+            scene.objects[0].analytic
+        );
+    };
+    assert_eq!(centre, Vec3::new(1.0, -2.0, 3.0));
+    assert!((radius - 1.8).abs() < 1e-6, "{radius}");
+    for &p in scene.objects[0].mesh.positions() {
+        assert!(((p - centre).length() - radius).abs() < 1e-5, "{p}");
+    }
+    assert_eq!(scene.objects[1].analytic, None);
+}
+
 #[test]
 fn malformed_scenes_name_file_line_and_key() {
     let cases: [(&str, usize, &[&str]); 8] = [

@@ -28,7 +28,8 @@ SCENE.json (paths relative to the JSON file):
 
 A mesh's kd and ks are a number or rgb (default 0 and 1), n defaults to 64, geometry to
 "phong", normalisation to "lobe"; "face_normals": true shades flat (else the OBJ's normals,
-or smooth ones Mitsuba computes). The environment is an EXR or HDR in specula's layout.
+or smooth ones Mitsuba computes). In place of "obj", "sphere": {"centre": [x, y, z],
+"radius": r} is Mitsuba's own analytic sphere. The environment is an EXR or HDR in specula's layout.
 
 Conventions, matched to specula's renderer (world right-handed, z up):
 - specula's lat-long map has z up and its middle column looking along +y; Mitsuba's
@@ -335,10 +336,15 @@ def sensor_dict(mi, camera, spp, seed):
 
 
 def mesh_dict(mesh, bsdf, base):
-    shape = {"type": "obj", "filename": os.path.join(base, mesh["obj"]),
-             "bsdf": bsdf_dict(bsdf, mesh.get("n", 64), mesh.get("geometry", "phong"),
-                               mesh.get("kd", 0.0), mesh.get("ks", 1.0),
-                               mesh.get("normalisation", "lobe"))}
+    if "sphere" in mesh:
+        # Mitsuba's own sphere, traced exactly, as a Mitsuba user draws one.
+        shape = {"type": "sphere", "center": mesh["sphere"]["centre"],
+                 "radius": float(mesh["sphere"]["radius"])}
+    else:
+        shape = {"type": "obj", "filename": os.path.join(base, mesh["obj"])}
+    shape["bsdf"] = bsdf_dict(bsdf, mesh.get("n", 64), mesh.get("geometry", "phong"),
+                              mesh.get("kd", 0.0), mesh.get("ks", 1.0),
+                              mesh.get("normalisation", "lobe"))
     if mesh.get("face_normals"):
         shape["face_normals"] = True
     return shape

@@ -17,7 +17,7 @@ use crate::camera::{in_scene_range, Projection, MAX_COORDINATE};
 use crate::load::load_mesh;
 use crate::material::{Light, Material};
 use crate::scene::Object;
-use crate::{plane, sphere, teapot, torus, Camera, Mesh, TEAPOT_PATCHES};
+use crate::{plane, sphere, teapot, torus, Analytic, Camera, Mesh, TEAPOT_PATCHES};
 
 pub(super) fn build_camera(
     locate: &Locator,
@@ -156,12 +156,15 @@ pub(super) fn build_object(
             .charge(triangles)
             .map_err(|message| locate.error(object.span(), message))
     };
+    // The sphere's radius before the object's scale, for its exact shape.
+    let mut sphere_radius = None;
     let mesh = match o.shape {
         ShapeKind::Sphere => {
             let radius = length("radius", &o.radius, 1.0)?;
             let segments = count("segments", &o.segments, 96, 3..4097)?;
             let rings = count("rings", &o.rings, 48, 2..4097)?;
             charge(2 * u64::from(segments) * u64::from(rings))?;
+            sphere_radius = Some(radius);
             sphere(radius, segments, rings)
         }
         ShapeKind::Torus => {
@@ -222,8 +225,14 @@ pub(super) fn build_object(
     }
     let rotation = Mat3::from_euler(EulerRot::ZYX, r[2], r[1], r[0]);
     let mesh = transform(&mesh, rotation, scale, translate);
+    // A rotation, uniform scale and translation keep a sphere a sphere.
+    let analytic = sphere_radius.map(|radius| Analytic::Sphere {
+        centre: translate,
+        radius: scale * radius,
+    });
     Ok(Object {
         mesh,
+        analytic,
         material: build_material(locate, &o.material)?,
     })
 }

@@ -235,7 +235,11 @@ pub fn iso_scene(
             intensity: Vec3::ONE,
         }],
         ambient: Vec3::ONE,
-        objects: vec![Object { mesh, material }],
+        objects: vec![Object {
+            mesh,
+            analytic: None,
+            material,
+        }],
         settings: Settings {
             width: settings.width,
             height: settings.height,
