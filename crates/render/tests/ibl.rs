@@ -360,8 +360,7 @@ fn the_alias_draws_carry_the_maps_density() {
     for index in 0..count {
         let (bits, within) = (random_bits(3, index, 0), random_bits(3, index, 1));
         let Some((wi, pdf, radiance)) = sky.draw(
-            bits as u32,
-            unit_f32((bits >> 32) as u32),
+            bits,
             [unit_f32(within as u32), unit_f32((within >> 32) as u32)],
         ) else {
             continue;

@@ -18,8 +18,9 @@ use core::f64::consts::{PI, TAU};
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
-use specula::sampling::{AliasTable, Distribution2D};
+use specula::sampling::{Distribution2D, GroupedAliasTable};
 use specula::simd::Lanes;
+use specula::simd::Prefetch;
 use thiserror::Error;
 
 use super::angles;
@@ -78,8 +79,8 @@ pub struct Environment {
     image: Image,
     distribution: Distribution2D,
     /// The same distribution over texels for the `f32` renderer: drawn by alias in constant
-    /// time ([`Environment::draw`]).
-    alias: AliasTable,
+    /// time, a row and then a texel of it ([`Environment::draw_texel`]).
+    alias: GroupedAliasTable,
     /// Per texel, its radiance and its density on the unit square (its weight over the mean
     /// weight, as `distribution` gives it) side by side: what a draw or a look-up reads, one
     /// cache line's worth from a map of megabytes, not two.
@@ -124,7 +125,7 @@ impl Environment {
             .then(|| Distribution2D::new(&weights, width as usize))
             .flatten()
             .ok_or_else(shape)?;
-        let alias = AliasTable::new(&weights).ok_or_else(shape)?;
+        let alias = GroupedAliasTable::new(&weights, width as usize).ok_or_else(shape)?;
         let total: f64 = weights.iter().sum();
         let cells = weights.len() as f64;
         let texels = weights
@@ -214,11 +215,26 @@ impl Environment {
 
 impl Environment {
     /// [`Environment::sample`]'s distribution for the `f32` renderer, drawn by alias: the
-    /// texel for 32 random bits and a uniform `keep` (then [`Environment::draw_in`]).
+    /// texel for 64 random bits (then [`Environment::draw_in`]).
     #[must_use]
     #[inline]
-    pub fn draw_texel(&self, bits: u32, keep: f32) -> usize {
-        self.alias.sample(bits, keep)
+    pub fn draw_texel(&self, bits: u64) -> usize {
+        self.alias.sample(bits)
+    }
+
+    /// Asks for what [`Environment::draw_texel`] will read for these bits.
+    #[inline]
+    pub(super) fn prefetch_draw(&self, bits: u64, prefetch: Prefetch) {
+        self.alias.prefetch(bits, prefetch);
+    }
+
+    /// Asks for what [`Environment::draw_in`] and [`Environment::look_up_texel`] will read
+    /// of `texel`.
+    #[inline]
+    pub(super) fn prefetch_texel(&self, texel: usize, prefetch: Prefetch) {
+        if let Some(record) = self.texels.get(texel) {
+            prefetch.line(record);
+        }
     }
 
     /// The point `within` the drawn `texel`: the unit direction, its density per solid angle
@@ -245,8 +261,8 @@ impl Environment {
     /// [`Environment::draw_texel`] then [`Environment::draw_in`].
     #[must_use]
     #[inline]
-    pub fn draw(&self, bits: u32, keep: f32, within: [f32; 2]) -> Option<(Vec3, f32, Vec3)> {
-        self.draw_in(self.draw_texel(bits, keep), within)
+    pub fn draw(&self, bits: u64, within: [f32; 2]) -> Option<(Vec3, f32, Vec3)> {
+        self.draw_in(self.draw_texel(bits), within)
     }
 
     /// The texel the unit direction `wi` falls in, and `sin theta` there (then

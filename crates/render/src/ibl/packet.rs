@@ -34,7 +34,7 @@ use glam::Vec3;
 use specula::brdf::luminance;
 use specula::lobe::Warp;
 use specula::sampling::{random_bits, unit_f32, CosineTable32};
-use specula::simd::{dispatch, Level};
+use specula::simd::{dispatch, Level, Prefetch};
 use specula::{Geometry, Lobe};
 
 use super::angles::sin_cos_turns;
@@ -172,6 +172,8 @@ impl Frame32 {
 /// environment's and the cosine-weighted draws fall in the map.
 struct SharedScalars {
     draw: [u64; LANES],
+    /// The random bits of each environment draw's texel.
+    texel_bits: [u64; LANES],
     /// `usize::MAX` where there is no environment draw.
     light_texel: [usize; LANES],
     within: [[f32; 2]; LANES],
@@ -210,8 +212,10 @@ pub(super) fn shade(
         .map(|s| s.share)
         .fold(f32::INFINITY, f32::min);
     let mut draws = draws.peekable();
+    let prefetch = Prefetch::new();
     let mut scalars = SharedScalars {
         draw: [0; LANES],
+        texel_bits: [0; LANES],
         light_texel: [usize::MAX; LANES],
         within: [[0.0; 2]; LANES],
         u1: [0.0; LANES],
@@ -234,16 +238,23 @@ pub(super) fn shade(
         // In passes over the packet rather than lane by lane: each pass's reads of the map
         // (megabytes, mostly out of cache) are independent of one another and overlap.
         let mut count = 0;
-        // The environment's draws: random numbers and the alias table's texels.
+        // The environment's draws: random numbers, and the hints for the alias entries they
+        // read, then the entries' texels and the hints for those texels' records.
         for (k, draw) in draws.by_ref().take(LANES).enumerate() {
             count = k + 1;
             scalars.draw[k] = draw;
+            if strategy != Strategy::Brdf {
+                scalars.texel_bits[k] = random_bits(seed, draw, 0);
+                environment.prefetch_draw(scalars.texel_bits[k], prefetch);
+            }
+        }
+        for k in 0..count {
             scalars.light_texel[k] = usize::MAX;
             if strategy != Strategy::Brdf {
-                let bits = random_bits(seed, draw, 0);
-                let within = random_bits(seed, draw, 1);
-                scalars.light_texel[k] =
-                    environment.draw_texel(bits as u32, unit_f32((bits >> 32) as u32));
+                let texel = environment.draw_texel(scalars.texel_bits[k]);
+                environment.prefetch_texel(texel, prefetch);
+                let within = random_bits(seed, scalars.draw[k], 1);
+                scalars.light_texel[k] = texel;
                 scalars.within[k] = [unit_f32(within as u32), unit_f32((within >> 32) as u32)];
             }
         }
@@ -270,8 +281,9 @@ pub(super) fn shade(
                     let wi = Vec3::new(sine * cos_phi, sine * sin_phi, cosine);
                     if wi.z > 0.0 {
                         diffuse_wi = wi;
-                        (scalars.diffuse_texel[k], scalars.diffuse_sine[k]) =
-                            environment.texel_of(point.frame.to_world(wi));
+                        let (texel, sine) = environment.texel_of(point.frame.to_world(wi));
+                        environment.prefetch_texel(texel, prefetch);
+                        (scalars.diffuse_texel[k], scalars.diffuse_sine[k]) = (texel, sine);
                     }
                 }
                 shared.diffuse_wi.set(k, diffuse_wi);
@@ -310,6 +322,7 @@ pub(super) fn shade(
             u1: &scalars.u1,
             count,
             used,
+            prefetch,
         };
         for (surface, sum) in point.surfaces.iter().zip(sums.iter_mut()) {
             *sum += shade_variant(packet, surface, &mut variant).as_dvec3();
@@ -331,6 +344,7 @@ struct Packet<'a> {
     count: usize,
     /// The lanes the jobs run ([`super::lanes`]).
     used: usize,
+    prefetch: Prefetch,
 }
 
 /// One variant's estimates over a packet of `count` draws, summed: its lobe's cosine draws,
@@ -346,6 +360,7 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
         u1,
         count,
         used,
+        prefetch,
     } = packet;
     let draws_lobe = strategy != Strategy::Environment;
     for (k, (drawn, (&choice, &u))) in variant
@@ -392,12 +407,19 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
         },
     );
     let width = environment.image().width() as usize;
+    let lobe_texel = |variant: &VariantColumns, k: usize| {
+        variant.texel_row[k] as usize * width + variant.texel_column[k] as usize
+    };
+    for k in 0..count {
+        if Source::of(variant.source[k]) == Source::Lobe {
+            environment.prefetch_texel(lobe_texel(variant, k), prefetch);
+        }
+    }
     for k in 0..count {
         let (radiance, light_pdf) = match Source::of(variant.source[k]) {
-            Source::Lobe => environment.look_up_texel(
-                variant.texel_row[k] as usize * width + variant.texel_column[k] as usize,
-                variant.texel_sine[k],
-            ),
+            Source::Lobe => {
+                environment.look_up_texel(lobe_texel(variant, k), variant.texel_sine[k])
+            }
             Source::Diffuse => (shared.diffuse_radiance.get(k), shared.diffuse_light_pdf[k]),
             Source::None => (Vec3::ZERO, 0.0),
         };

@@ -5,6 +5,13 @@
 //! Cell `i` is kept when the draw's second number falls below `threshold[i]` and gives way
 //! to `alias[i]` otherwise, so cell `i` is drawn with probability
 //! `(threshold[i] + sum over j with alias[j] = i of (1 - threshold[j])) / n = w[i] / sum w`.
+//!
+//! [`GroupedAliasTable`] draws in two levels, a group of consecutive cells (an environment
+//! map's row) and then a cell of it, each by alias: the same probabilities, but where the one
+//! table's draw reads a slot anywhere in it (over a map of megabytes, a cache miss per draw,
+//! whatever the cell drawn), the grouped one reads the groups' small table, which stays in
+//! cache, and then a slot of the drawn group, which stays in cache when the draws favour a
+//! few groups (the sun's rows of a sky).
 
 /// One cell of an [`AliasTable`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,18 +81,88 @@ impl AliasTable {
         self.entries.len()
     }
 
-    /// The cell for 32 uniform bits (which pick a slot) and a uniform number in `[0, 1)`
-    /// (which keeps it or takes its alias).
+    /// The cell for 32 uniform bits: their product with the number of cells picks a slot
+    /// (its whole part) and keeps it or takes its alias (its fraction, 24 bits of it).
     #[must_use]
     #[inline]
-    pub fn sample(&self, bits: u32, keep: f32) -> usize {
-        let slot = ((u64::from(bits) * self.entries.len() as u64) >> 32) as usize;
-        let entry = self.entries[slot];
-        if keep < entry.threshold {
-            slot
-        } else {
-            entry.alias as usize
+    pub fn sample(&self, bits: u32) -> usize {
+        draw(&self.entries, 0, bits)
+    }
+}
+
+/// The cell `entries` (the slots from `first` on) draw for 32 uniform bits.
+#[inline]
+fn draw(entries: &[Entry], first: usize, bits: u32) -> usize {
+    let wide = u64::from(bits) * entries.len() as u64;
+    let slot = (wide >> 32) as usize;
+    let keep = super::unit_f32(wide as u32);
+    let entry = entries[slot];
+    if keep < entry.threshold {
+        first + slot
+    } else {
+        entry.alias as usize
+    }
+}
+
+/// An [`AliasTable`] over groups of `group` consecutive cells, then one per group (see the
+/// module's documentation): the same draw's probabilities, fewer cache misses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupedAliasTable {
+    groups: AliasTable,
+    /// Each group's table in turn, its aliases the cells' own indices.
+    cells: Vec<Entry>,
+    group: usize,
+}
+
+impl GroupedAliasTable {
+    /// The table of these weights in groups of `group` (which divides their number), or
+    /// `None` where it does not or [`AliasTable::new`] refuses them. All-zero weights draw
+    /// every cell alike.
+    #[must_use]
+    pub fn new(weights: &[f64], group: usize) -> Option<Self> {
+        if group == 0 || !weights.len().is_multiple_of(group) {
+            return None;
         }
+        // Checked as a whole first: a sum that overflows is refused, not its parts'.
+        AliasTable::new(weights)?;
+        let sums: Vec<f64> = weights.chunks(group).map(|g| g.iter().sum()).collect();
+        let groups = AliasTable::new(&sums)?;
+        let mut cells = Vec::with_capacity(weights.len());
+        for (index, weights) in weights.chunks(group).enumerate() {
+            let first = (index * group) as u32;
+            cells.extend(
+                AliasTable::new(weights)?
+                    .entries
+                    .into_iter()
+                    .map(|e| Entry {
+                        alias: first + e.alias,
+                        ..e
+                    }),
+            );
+        }
+        Some(Self {
+            groups,
+            cells,
+            group,
+        })
+    }
+
+    /// The cell for 64 uniform bits: the high 32 draw the group, the low 32 the cell in it
+    /// (each as [`AliasTable::sample`]).
+    #[must_use]
+    #[inline]
+    pub fn sample(&self, bits: u64) -> usize {
+        let first = self.groups.sample((bits >> 32) as u32) * self.group;
+        draw(&self.cells[first..first + self.group], first, bits as u32)
+    }
+
+    /// Asks for the cache line [`GroupedAliasTable::sample`] will read in the drawn group for
+    /// these bits (the groups' table is small enough to stay in cache).
+    #[inline]
+    pub fn prefetch(&self, bits: u64, prefetch: crate::simd::Prefetch) {
+        let first = self.groups.sample((bits >> 32) as u32) * self.group;
+        let slot = ((u64::from(bits as u32) * self.group as u64) >> 32) as usize;
+        prefetch.line(&self.cells[first + slot]);
     }
 }
 
@@ -96,25 +173,74 @@ mod tests {
     /// The probability the table draws each cell with, from its entries: what a draw
     /// keeps, plus what every slot aliased to it gives away.
     fn probabilities(table: &AliasTable) -> Vec<f64> {
-        let n = table.entries.len() as f64;
-        let mut p = vec![0.0; table.entries.len()];
-        for (i, entry) in table.entries.iter().enumerate() {
+        slot_probabilities(&table.entries, 0, table.entries.len())
+    }
+
+    /// The same for the slots `entries` (the cells from `first` on) among `cells`.
+    fn slot_probabilities(entries: &[Entry], first: usize, cells: usize) -> Vec<f64> {
+        let n = entries.len() as f64;
+        let mut p = vec![0.0; cells];
+        for (i, entry) in entries.iter().enumerate() {
             let kept = f64::from(entry.threshold).min(1.0);
-            p[i] += kept / n;
+            p[first + i] += kept / n;
             p[entry.alias as usize] += (1.0 - kept) / n;
         }
         p
     }
 
-    #[test]
-    fn each_cell_is_drawn_in_proportion_to_its_weight() {
-        let weights: Vec<f64> = (0..1000)
+    /// Weights of every kind: zeros, a range of sizes, one cell far above the rest.
+    fn weights() -> Vec<f64> {
+        (0..1000)
             .map(|i| match i % 7 {
                 0 => 0.0,
                 k => f64::from(k * k) * (1.0 + f64::from(i) / 100.0),
             })
-            .chain([5e4])
-            .collect();
+            .chain([5e4, 0.0, 0.0, 1.0, 2.0, 3.0, 4.0, 5.0])
+            .collect()
+    }
+
+    /// In two levels each cell is drawn with its group's probability times its own in the
+    /// group: its weight over the total; and a zero-weight cell never, whatever the bits.
+    #[test]
+    fn grouped_cells_are_drawn_in_proportion_to_their_weights() {
+        let weights = weights();
+        let total: f64 = weights.iter().sum();
+        let group = 12;
+        let table = GroupedAliasTable::new(&weights, group).unwrap();
+        let groups = probabilities(&table.groups);
+        let mut p = vec![0.0; weights.len()];
+        for (g, chunk) in table.cells.chunks(group).enumerate() {
+            let within = slot_probabilities(chunk, g * group, weights.len());
+            for (p, q) in p.iter_mut().zip(within) {
+                *p += groups[g] * q;
+            }
+        }
+        for (i, (p, w)) in p.iter().zip(&weights).enumerate() {
+            assert!(
+                (p - w / total).abs() < 1e-7,
+                "cell {i}: {p} against {}",
+                w / total
+            );
+        }
+        let mut drawn = vec![0u32; weights.len()];
+        for k in 0..200_000_u64 {
+            let bits = k.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (k << 17);
+            let cell = table.sample(bits);
+            assert!(weights[cell] > 0.0, "bits {bits:x} drew {cell}");
+            drawn[cell] += 1;
+        }
+        // The heaviest cell's share of the draws, within 5 binomial sigmas.
+        let (heaviest, share) = (1000, 5e4 / total);
+        let sigma = (share * (1.0 - share) / 200_000.0).sqrt();
+        let seen = f64::from(drawn[heaviest]) / 200_000.0;
+        assert!((seen - share).abs() < 5.0 * sigma, "{seen} against {share}");
+        assert!(GroupedAliasTable::new(&weights, 5).is_none());
+        assert!(GroupedAliasTable::new(&weights, 0).is_none());
+    }
+
+    #[test]
+    fn each_cell_is_drawn_in_proportion_to_its_weight() {
+        let weights = weights();
         let total: f64 = weights.iter().sum();
         let table = AliasTable::new(&weights).unwrap();
         for (i, (p, w)) in probabilities(&table).iter().zip(&weights).enumerate() {
@@ -124,12 +250,15 @@ mod tests {
                 w / total
             );
         }
-        // A zero-weight cell is never drawn, whatever the numbers.
-        for slot in 0..weights.len() as u64 {
-            let bits = ((slot << 32) / weights.len() as u64 + 1) as u32;
-            for keep in [0.0, 0.5, 0.999_999] {
-                let cell = table.sample(bits, keep);
-                assert!(weights[cell] > 0.0, "slot {slot} keep {keep} drew {cell}");
+        // A zero-weight cell is never drawn, whatever the numbers: each slot's first,
+        // middle and last bits.
+        let n = weights.len() as u64;
+        for slot in 0..n {
+            let first = (slot << 32).div_ceil(n);
+            let last = (((slot + 1) << 32) - 1) / n;
+            for bits in [first, (first + last) / 2, last] {
+                let cell = table.sample(bits as u32);
+                assert!(weights[cell] > 0.0, "slot {slot} bits {bits} drew {cell}");
             }
         }
     }

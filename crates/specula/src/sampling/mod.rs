@@ -24,7 +24,7 @@ mod cosine;
 mod distribution;
 mod table32;
 
-pub use alias::AliasTable;
+pub use alias::{AliasTable, GroupedAliasTable};
 pub use cosine::{CosineDistribution, TABLE_BINS};
 pub use distribution::{power_heuristic, Distribution1D, Distribution2D, Draw1D, Draw2D};
 pub use table32::CosineTable32;

@@ -171,6 +171,46 @@ impl Level {
     }
 }
 
+/// A hint to the CPU to bring a value's cache line in before it is read, so that reads of a
+/// table of megabytes at random places (an environment map's) overlap rather than wait one
+/// after another: issue the hints for a pass's reads first, then read. A hint changes no
+/// result; where the CPU has none (not x86-64), it does nothing.
+#[derive(Clone, Copy, Debug)]
+pub struct Prefetch {
+    #[cfg(target_arch = "x86_64")]
+    sse: Option<pulp::core_arch::x86::Sse>,
+}
+
+impl Prefetch {
+    /// The CPU's prefetch, if it has one.
+    #[must_use]
+    pub fn new() -> Self {
+        Self {
+            #[cfg(target_arch = "x86_64")]
+            sse: pulp::core_arch::x86::Sse::try_new(),
+        }
+    }
+
+    /// Asks for `item`'s cache line, into every level of cache.
+    #[inline(always)]
+    pub fn line<T>(self, item: &T) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(sse) = self.sse {
+            sse._mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(
+                core::ptr::from_ref(item).cast(),
+            );
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = item;
+    }
+}
+
+impl Default for Prefetch {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 /// Work generic over the lane type, run with the level's target features enabled.
 pub trait Job {
     /// What the work returns.
