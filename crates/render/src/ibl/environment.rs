@@ -24,7 +24,7 @@ use specula::simd::Prefetch;
 use thiserror::Error;
 
 use super::angles;
-use super::lane_geometry::{acos, atan2, V3};
+use super::lane_geometry::{acos, atan2, sin_cos_turns, V3};
 use crate::{read_image, Image, ImageError};
 
 /// Rec. 709 luminance weights: how bright a linear RGB radiance looks (the map's sampling
@@ -220,6 +220,51 @@ impl Environment {
     #[inline]
     pub fn draw_texel(&self, bits: u64) -> usize {
         self.alias.sample(bits)
+    }
+
+    /// [`Environment::draw_texel`]'s texel as its row and column.
+    #[must_use]
+    #[inline]
+    pub(super) fn draw_cell(&self, bits: u64) -> (u32, u32) {
+        let (row, column) = self.alias.sample_in_group(bits);
+        (row as u32, column as u32)
+    }
+
+    /// The radiance and density on the unit square of the texel at `row` and `column`.
+    #[must_use]
+    #[inline]
+    pub(super) fn record(&self, row: u32, column: u32) -> [f32; 4] {
+        self.texels[row as usize * self.image.width() as usize + column as usize]
+    }
+
+    /// Asks for what [`Environment::record`] will read.
+    #[inline]
+    pub(super) fn prefetch_record(&self, row: u32, column: u32, prefetch: Prefetch) {
+        let texel = row as usize * self.image.width() as usize + column as usize;
+        self.prefetch_texel(texel, prefetch);
+    }
+
+    /// [`Environment::draw_in`]'s direction on SIMD lanes: the point `within` (two columns
+    /// of uniform numbers) the texels at `column` and `row` (whole numbers, as floats),
+    /// turned to a unit direction (world space), and its `sin theta`.
+    #[inline(always)]
+    pub(super) fn direction_lanes<V: Lanes>(
+        &self,
+        (column, row): (V, V),
+        within: (V, V),
+    ) -> (V3<V>, V) {
+        let (width, height) = (self.image.width() as f32, self.image.height() as f32);
+        let x = (column + within.0) * column.splat(1.0 / width);
+        let y = (row + within.1) * row.splat(1.0 / height);
+        let (sine, cosine) = sin_cos_turns(y * y.splat(0.5));
+        // phi = 3 pi / 2 - 2 pi x, in turns.
+        let (sin_phi, cos_phi) = sin_cos_turns(x.splat(0.75) - x);
+        let wi = V3 {
+            x: sine * cos_phi,
+            y: sine * sin_phi,
+            z: cosine,
+        };
+        (wi, sine)
     }
 
     /// Asks for what [`Environment::draw_texel`] will read for these bits.

@@ -30,6 +30,7 @@
 //! table, tabulated lobes from `f32` tables, several lobes' images from one pass).
 
 mod angles;
+mod draws;
 mod environment;
 mod lane_geometry;
 mod lanes;

@@ -28,7 +28,7 @@
 //! images agree with the `f64` path's within Monte Carlo noise (tested), not bit for bit:
 //! the draws map the numbers to directions differently.
 
-use core::f32::consts::FRAC_1_PI;
+use core::f32::consts::{FRAC_1_PI, PI};
 
 use glam::Vec3;
 use specula::brdf::luminance;
@@ -37,7 +37,7 @@ use specula::sampling::{random_bits, unit_f32, CosineTable32};
 use specula::simd::{dispatch, Level, Prefetch};
 use specula::{Geometry, Lobe};
 
-use super::angles::sin_cos_turns;
+use super::draws::{Draws, SharedDraws};
 use super::lane_geometry::Columns3;
 use super::lanes::{Brdf, Combine, Directions, Setting, SharedColumns, Source, VariantColumns};
 use super::{Environment, Strategy};
@@ -154,32 +154,13 @@ impl Frame32 {
             normal,
         }
     }
-
-    fn to_local(self, v: Vec3) -> Vec3 {
-        Vec3::new(
-            v.dot(self.tangent),
-            v.dot(self.bitangent),
-            v.dot(self.normal),
-        )
-    }
-
-    fn to_world(self, v: Vec3) -> Vec3 {
-        self.tangent * v.x + self.bitangent * v.y + self.normal * v.z
-    }
 }
 
-/// The scalar half of a packet's shared draws: the stream's draw indices, and where the
-/// environment's and the cosine-weighted draws fall in the map.
+/// The scalar half of a packet's shared draws: the stream's draw indices, and the random
+/// bits of each environment draw's texel.
 struct SharedScalars {
     draw: [u64; LANES],
-    /// The random bits of each environment draw's texel.
     texel_bits: [u64; LANES],
-    /// `usize::MAX` where there is no environment draw.
-    light_texel: [usize; LANES],
-    within: [[f32; 2]; LANES],
-    u1: [f32; LANES],
-    diffuse_texel: [usize; LANES],
-    diffuse_sine: [f32; LANES],
 }
 
 /// A surface point, prepared once for all its samples: one surface per variant of the
@@ -216,12 +197,8 @@ pub(super) fn shade(
     let mut scalars = SharedScalars {
         draw: [0; LANES],
         texel_bits: [0; LANES],
-        light_texel: [usize::MAX; LANES],
-        within: [[0.0; 2]; LANES],
-        u1: [0.0; LANES],
-        diffuse_texel: [0; LANES],
-        diffuse_sine: [0.0; LANES],
     };
+    let mut numbers = Draws::ZERO;
     let mut shared = SharedColumns {
         light_wi: Columns3::ZERO,
         light_pdf: [0.0; LANES],
@@ -234,84 +211,105 @@ pub(super) fn shade(
         diffuse_light_pdf: [0.0; LANES],
     };
     let mut variant = VariantColumns::ZERO;
+    let (light, brdf) = (
+        strategy != Strategy::Brdf,
+        strategy != Strategy::Environment,
+    );
     while draws.peek().is_some() {
         // In passes over the packet rather than lane by lane: each pass's reads of the map
-        // (megabytes, mostly out of cache) are independent of one another and overlap.
+        // (megabytes, mostly out of cache) are asked for a pass before they are made, and
+        // are independent of one another, so they overlap.
         let mut count = 0;
         // The environment's draws: random numbers, and the hints for the alias entries they
-        // read, then the entries' texels and the hints for those texels' records.
+        // read.
         for (k, draw) in draws.by_ref().take(LANES).enumerate() {
             count = k + 1;
             scalars.draw[k] = draw;
-            if strategy != Strategy::Brdf {
-                scalars.texel_bits[k] = random_bits(seed, draw, 0);
-                environment.prefetch_draw(scalars.texel_bits[k], prefetch);
-            }
-        }
-        for k in 0..count {
-            scalars.light_texel[k] = usize::MAX;
-            if strategy != Strategy::Brdf {
-                let texel = environment.draw_texel(scalars.texel_bits[k]);
-                environment.prefetch_texel(texel, prefetch);
-                let within = random_bits(seed, scalars.draw[k], 1);
-                scalars.light_texel[k] = texel;
-                scalars.within[k] = [unit_f32(within as u32), unit_f32((within >> 32) as u32)];
-            }
-        }
-        // A short packet's last lanes draw nothing: no environment draw, and a BRDF choice
-        // no lobe takes with no cosine-weighted direction.
-        for k in count..LANES {
-            scalars.light_texel[k] = usize::MAX;
-            shared.choice[k] = 2.0;
-            shared.diffuse_wi.set(k, Vec3::ZERO);
-        }
-        // The BRDF's numbers, and the cosine-weighted directions' texels.
-        if strategy != Strategy::Environment {
-            for k in 0..count {
-                let bits = random_bits(seed, scalars.draw[k], 2);
-                let more = random_bits(seed, scalars.draw[k], 3);
-                let (choice, u1) = (unit_f32(bits as u32), unit_f32((bits >> 32) as u32));
-                let (sin_phi, cos_phi) = sin_cos_turns(unit_f32(more as u32));
-                (shared.choice[k], shared.sin_phi[k], shared.cos_phi[k]) =
-                    (choice, sin_phi, cos_phi);
-                scalars.u1[k] = u1;
-                let mut diffuse_wi = Vec3::ZERO;
-                if choice >= fewest_lobe_draws {
-                    let (sine, cosine) = (u1.sqrt(), (1.0 - u1).max(0.0).sqrt());
-                    let wi = Vec3::new(sine * cos_phi, sine * sin_phi, cosine);
-                    if wi.z > 0.0 {
-                        diffuse_wi = wi;
-                        let (texel, sine) = environment.texel_of(point.frame.to_world(wi));
-                        environment.prefetch_texel(texel, prefetch);
-                        (scalars.diffuse_texel[k], scalars.diffuse_sine[k]) = (texel, sine);
-                    }
-                }
-                shared.diffuse_wi.set(k, diffuse_wi);
-            }
+            scalars.texel_bits[k] = random_bits(seed, draw, 0);
+            environment.prefetch_draw(scalars.texel_bits[k], prefetch);
         }
         // The lanes the jobs run: the draws rounded up to the level's width, so that a pixel
-        // of 16 samples pays for 16 lanes, not 64 (the lanes past the draws draw nothing).
+        // of 16 samples pays for 16 lanes, not 64.
         let used = count.next_multiple_of(level.lanes());
-        // The texels' radiances and densities.
+        // The drawn texels (and the hints for their records), the points within them, and
+        // the BRDF's numbers. The lanes past the draws draw nothing: no environment draw
+        // and, with a choice no lobe takes, no cosine-weighted one (u1 = 1).
         for k in 0..used {
-            shared.light_pdf[k] = 0.0;
-            let texel = scalars.light_texel[k];
-            if texel != usize::MAX {
-                if let Some((wi, pdf, radiance)) = environment.draw_in(texel, scalars.within[k]) {
-                    let wi = point.frame.to_local(wi);
-                    if wi.z > 0.0 {
-                        shared.light_wi.set(k, wi);
-                        shared.light_pdf[k] = pdf;
-                        shared.light_radiance.set(k, radiance);
-                    }
-                }
+            let (row, column) = if k < count {
+                environment.draw_cell(scalars.texel_bits[k])
+            } else {
+                (0, 0)
+            };
+            environment.prefetch_record(row, column, prefetch);
+            (numbers.light_row[k], numbers.light_column[k]) = (row as f32, column as f32);
+            let (within, bits, more) = if k < count {
+                let draw = scalars.draw[k];
+                (
+                    random_bits(seed, draw, 1),
+                    random_bits(seed, draw, 2),
+                    random_bits(seed, draw, 3),
+                )
+            } else {
+                (0, u64::MAX, 0)
+            };
+            numbers.within_x[k] = unit_f32(within as u32);
+            numbers.within_y[k] = unit_f32((within >> 32) as u32);
+            shared.choice[k] = if k < count {
+                unit_f32(bits as u32)
+            } else {
+                2.0
+            };
+            numbers.u1[k] = if k < count && brdf {
+                unit_f32((bits >> 32) as u32)
+            } else {
+                1.0
+            };
+            numbers.azimuth[k] = unit_f32(more as u32);
+        }
+        // The environment's directions and the cosine-weighted ones on lanes.
+        dispatch(
+            level,
+            SharedDraws {
+                frame: [
+                    point.frame.tangent,
+                    point.frame.bitangent,
+                    point.frame.normal,
+                ],
+                light,
+                fewest_lobe_draws,
+                used,
+                environment,
+                draws: &mut numbers,
+                shared: &mut shared,
+            },
+        );
+        for k in 0..used {
+            environment.prefetch_record(
+                numbers.diffuse_row[k] as u32,
+                numbers.diffuse_column[k] as u32,
+                prefetch,
+            );
+        }
+        // The texels' radiances and densities: every lane reads one, and a lane without a
+        // draw (its sine 0) gets density 0.
+        let pdf_of = |density: f32, sine: f32| {
+            if sine > 0.0 {
+                density / (2.0 * PI * PI * sine)
+            } else {
+                0.0
             }
-            if shared.diffuse_wi.z[k] > 0.0 {
-                let (radiance, pdf) =
-                    environment.look_up_texel(scalars.diffuse_texel[k], scalars.diffuse_sine[k]);
-                shared.diffuse_radiance.set(k, radiance);
-                shared.diffuse_light_pdf[k] = pdf;
-            }
+        };
+        for k in 0..used {
+            let [r, g, b, density] =
+                environment.record(numbers.light_row[k] as u32, numbers.light_column[k] as u32);
+            shared.light_pdf[k] = pdf_of(density, numbers.light_sine[k]);
+            shared.light_radiance.set(k, Vec3::new(r, g, b));
+            let [r, g, b, density] = environment.record(
+                numbers.diffuse_row[k] as u32,
+                numbers.diffuse_column[k] as u32,
+            );
+            shared.diffuse_light_pdf[k] = pdf_of(density, numbers.diffuse_sine[k]);
+            shared.diffuse_radiance.set(k, Vec3::new(r, g, b));
         }
         let packet = Packet {
             point,
@@ -319,7 +317,7 @@ pub(super) fn shade(
             strategy,
             level,
             shared: &shared,
-            u1: &scalars.u1,
+            u1: &numbers.u1,
             count,
             used,
             prefetch,

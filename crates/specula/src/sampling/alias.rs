@@ -90,18 +90,16 @@ impl AliasTable {
     }
 }
 
-/// The cell `entries` (the slots from `first` on) draw for 32 uniform bits.
+/// The cell `entries` (the slots from `first` on) draw for 32 uniform bits: the slot or its
+/// alias chosen by a mask, not a branch (random, and mispredicted as often as not).
 #[inline]
 fn draw(entries: &[Entry], first: usize, bits: u32) -> usize {
     let wide = u64::from(bits) * entries.len() as u64;
     let slot = (wide >> 32) as usize;
     let keep = super::unit_f32(wide as u32);
     let entry = entries[slot];
-    if keep < entry.threshold {
-        first + slot
-    } else {
-        entry.alias as usize
-    }
+    let kept = usize::from(keep < entry.threshold).wrapping_neg();
+    ((first + slot) & kept) | (entry.alias as usize & !kept)
 }
 
 /// An [`AliasTable`] over groups of `group` consecutive cells, then one per group (see the
@@ -152,8 +150,19 @@ impl GroupedAliasTable {
     #[must_use]
     #[inline]
     pub fn sample(&self, bits: u64) -> usize {
-        let first = self.groups.sample((bits >> 32) as u32) * self.group;
-        draw(&self.cells[first..first + self.group], first, bits as u32)
+        let (group, cell) = self.sample_in_group(bits);
+        group * self.group + cell
+    }
+
+    /// [`GroupedAliasTable::sample`]'s cell as its group and its place in the group (an
+    /// environment map's row and column, without a division).
+    #[must_use]
+    #[inline]
+    pub fn sample_in_group(&self, bits: u64) -> (usize, usize) {
+        let group = self.groups.sample((bits >> 32) as u32);
+        let first = group * self.group;
+        let cells = &self.cells[first..first + self.group];
+        (group, draw(cells, first, bits as u32) - first)
     }
 
     /// Asks for the cache line [`GroupedAliasTable::sample`] will read in the drawn group for
