@@ -384,10 +384,20 @@ fn to_square(wi: DVec3) -> [f64; 2] {
 }
 
 /// The unit direction of a point of the unit square, and `sin theta` there.
-pub(super) fn from_square([x, y]: [f64; 2]) -> (DVec3, f64) {
-    let (sine, cosine) = (PI * y).sin_cos();
-    let (sin_phi, cos_phi) = (1.5 * PI - TAU * x).sin_cos();
+fn from_square([x, y]: [f64; 2]) -> (DVec3, f64) {
+    let (sine, cosine) = theta_of_square(y);
+    let (sin_phi, cos_phi) = phi_of_square(x);
     (DVec3::new(sine * cos_phi, sine * sin_phi, cosine), sine)
+}
+
+/// `(sin theta, cos theta)` of the square's row coordinate `y`.
+pub(super) fn theta_of_square(y: f64) -> (f64, f64) {
+    (PI * y).sin_cos()
+}
+
+/// `(sin phi, cos phi)` of the square's column coordinate `x`.
+pub(super) fn phi_of_square(x: f64) -> (f64, f64) {
+    (1.5 * PI - TAU * x).sin_cos()
 }
 
 #[cfg(test)]

@@ -125,15 +125,29 @@ impl PacketSurface {
         }
     }
 
-    /// A cosine drawn from the lobe for the uniform `u`.
-    fn draw_cosine(&self, u: f32) -> f32 {
-        match &self.sampler {
-            CosineSampler::ClosedForm => self.lobe.closed_form_sampling(u).map_or(1.0, |(t, _)| t),
-            CosineSampler::Newton(start) => self
-                .lobe
-                .tail_inverse_f32(f64::from(u), f64::from(start.sample(u)))
-                .map_or(1.0, |inverted| inverted.x as f32),
-            CosineSampler::Table(table) => table.sample(u),
+    /// The cosines drawn from the lobe for the uniforms `us`, into `drawn`, where `takes(k)`
+    /// (0 elsewhere): a closed-form inverse on `level`'s lanes for every lane (cheaper than
+    /// choosing), Newton or the table lane by lane for the lanes that take one.
+    fn draw_cosines(
+        &self,
+        level: Level,
+        us: &[f32],
+        takes: impl Fn(usize) -> bool,
+        drawn: &mut [f32],
+    ) {
+        if let CosineSampler::ClosedForm = self.sampler {
+            self.lobe.tail_inverse_batch(level, us, drawn);
+        }
+        for (k, (drawn, &u)) in drawn.iter_mut().zip(us).enumerate() {
+            *drawn = match &self.sampler {
+                _ if !takes(k) => 0.0,
+                CosineSampler::ClosedForm => *drawn,
+                CosineSampler::Newton(start) => self
+                    .lobe
+                    .tail_inverse_f32(f64::from(u), f64::from(start.sample(u)))
+                    .map_or(1.0, |inverted| inverted.x as f32),
+                CosineSampler::Table(table) => table.sample(u),
+            };
         }
     }
 }
@@ -163,6 +177,41 @@ struct SharedScalars {
     texel_bits: [u64; LANES],
 }
 
+/// The columns a packet's passes write and read: made once per thread and reused for every
+/// pixel (filling some 20 kB with zeros per pixel cost more than a sample). Every pass
+/// writes the lanes it runs before any reads them, so what a pixel leaves behind is never
+/// read by the next.
+pub(super) struct Scratch {
+    scalars: SharedScalars,
+    numbers: Draws,
+    shared: SharedColumns,
+    variant: VariantColumns,
+}
+
+impl Scratch {
+    pub(super) fn new() -> Box<Self> {
+        Box::new(Self {
+            scalars: SharedScalars {
+                draw: [0; LANES],
+                texel_bits: [0; LANES],
+            },
+            numbers: Draws::ZERO,
+            shared: SharedColumns {
+                light_wi: Columns3::ZERO,
+                light_pdf: [0.0; LANES],
+                light_radiance: Columns3::ZERO,
+                choice: [0.0; LANES],
+                sin_phi: [0.0; LANES],
+                cos_phi: [0.0; LANES],
+                diffuse_wi: Columns3::ZERO,
+                diffuse_radiance: Columns3::ZERO,
+                diffuse_light_pdf: [0.0; LANES],
+            },
+            variant: VariantColumns::ZERO,
+        })
+    }
+}
+
 /// A surface point, prepared once for all its samples: one surface per variant of the
 /// image (one lobe each, when every lobe is rendered under the same light).
 pub(super) struct Point<'a> {
@@ -185,7 +234,7 @@ pub(super) fn shade(
     (strategy, level): (Strategy, Level),
     seed: u64,
     draws: impl Iterator<Item = u64>,
-    sums: &mut [glam::DVec3],
+    (scratch, sums): (&mut Scratch, &mut [glam::DVec3]),
 ) {
     let fewest_lobe_draws = point
         .surfaces
@@ -194,23 +243,12 @@ pub(super) fn shade(
         .fold(f32::INFINITY, f32::min);
     let mut draws = draws.peekable();
     let prefetch = Prefetch::new();
-    let mut scalars = SharedScalars {
-        draw: [0; LANES],
-        texel_bits: [0; LANES],
-    };
-    let mut numbers = Draws::ZERO;
-    let mut shared = SharedColumns {
-        light_wi: Columns3::ZERO,
-        light_pdf: [0.0; LANES],
-        light_radiance: Columns3::ZERO,
-        choice: [0.0; LANES],
-        sin_phi: [0.0; LANES],
-        cos_phi: [0.0; LANES],
-        diffuse_wi: Columns3::ZERO,
-        diffuse_radiance: Columns3::ZERO,
-        diffuse_light_pdf: [0.0; LANES],
-    };
-    let mut variant = VariantColumns::ZERO;
+    let Scratch {
+        scalars,
+        numbers,
+        shared,
+        variant,
+    } = scratch;
     let (light, brdf) = (
         strategy != Strategy::Brdf,
         strategy != Strategy::Environment,
@@ -279,8 +317,8 @@ pub(super) fn shade(
                 fewest_lobe_draws,
                 used,
                 environment,
-                draws: &mut numbers,
-                shared: &mut shared,
+                draws: numbers,
+                shared,
             },
         );
         for k in 0..used {
@@ -316,14 +354,14 @@ pub(super) fn shade(
             environment,
             strategy,
             level,
-            shared: &shared,
+            shared,
             u1: &numbers.u1,
             count,
             used,
             prefetch,
         };
         for (surface, sum) in point.surfaces.iter().zip(sums.iter_mut()) {
-            *sum += shade_variant(packet, surface, &mut variant).as_dvec3();
+            *sum += shade_variant(packet, surface, variant).as_dvec3();
         }
     }
 }
@@ -361,19 +399,12 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
         prefetch,
     } = packet;
     let draws_lobe = strategy != Strategy::Environment;
-    for (k, (drawn, (&choice, &u))) in variant
-        .drawn
-        .iter_mut()
-        .zip(shared.choice.iter().zip(u1))
-        .take(used)
-        .enumerate()
-    {
-        *drawn = if k < count && draws_lobe && choice < surface.share {
-            surface.draw_cosine(u)
-        } else {
-            0.0
-        };
-    }
+    surface.draw_cosines(
+        level,
+        &u1[..used],
+        |k| k < count && draws_lobe && shared.choice[k] < surface.share,
+        &mut variant.drawn[..used],
+    );
     let wo = point.wo;
     // The basis the lobe's directions are drawn in: about the mirror direction (Phong) or
     // the normal (Blinn's half vector).
@@ -506,7 +537,7 @@ mod tests {
                     (strategy, level),
                     7,
                     0..1000,
-                    &mut sums,
+                    (&mut Scratch::new(), &mut sums),
                 );
                 sums
             };

@@ -60,18 +60,23 @@ impl Environment {
         let height = (width / 2).max(1);
         let sun = sun_direction();
         const SUB: u32 = 4;
+        // The directions are separable: a sub-row fixes theta, a sub-column phi, so each
+        // sine and cosine is computed once per sub-row or sub-column, not per point.
+        let at = |index: u32, count: u32| (f64::from(index) + 0.5) / f64::from(count);
+        let thetas: Vec<(f64, f64)> = (0..height * SUB)
+            .map(|y| super::environment::theta_of_square(at(y, height * SUB)))
+            .collect();
+        let phis: Vec<(f64, f64)> = (0..width * SUB)
+            .map(|x| super::environment::phi_of_square(at(x, width * SUB)))
+            .collect();
         let pixels: Vec<Vec3> = (0..width * height)
             .into_par_iter()
             .map(|index| {
                 let (x, y) = (index % width, index / width);
                 let mut sum = Vec3::ZERO;
-                for sy in 0..SUB {
-                    for sx in 0..SUB {
-                        let point = [
-                            (f64::from(x * SUB + sx) + 0.5) / f64::from(width * SUB),
-                            (f64::from(y * SUB + sy) + 0.5) / f64::from(height * SUB),
-                        ];
-                        let (wi, _) = super::environment::from_square(point);
+                for &(sine, cosine) in &thetas[(y * SUB) as usize..((y + 1) * SUB) as usize] {
+                    for &(sin_phi, cos_phi) in &phis[(x * SUB) as usize..((x + 1) * SUB) as usize] {
+                        let wi = glam::DVec3::new(sine * cos_phi, sine * sin_phi, cosine);
                         sum += radiance(wi.as_vec3(), sun);
                     }
                 }

@@ -7,7 +7,7 @@ use glam::{DVec3, Vec3, Vec4};
 use rayon::prelude::*;
 use specula::sampling::{power_heuristic, uniform, SpecularSampler};
 
-use super::packet::{shade, Frame32, PacketSurface, Point};
+use super::packet::{shade, Frame32, PacketSurface, Point, Scratch};
 use super::{Environment, IblSettings, Strategy, MAX_SPP};
 use crate::pipeline::{surfaces, SurfacePoint};
 use crate::{
@@ -400,6 +400,7 @@ fn render(
         .for_each(|(y, row)| {
             let y = y as u32;
             let mut sums = vec![DVec3::ZERO; images];
+            let mut scratch = Scratch::new();
             for x in 0..width {
                 let first = u64::from(y * width + x) * u64::from(settings.spp);
                 sums.fill(DVec3::ZERO);
@@ -429,7 +430,7 @@ fn render(
                             (settings.strategy, level),
                             settings.seed,
                             draws,
-                            &mut sums,
+                            (&mut scratch, &mut sums),
                         ),
                         Shading::Reflectances(surfaces) => {
                             sums[0] += draws

@@ -23,7 +23,9 @@
 //! - **Source**: the thesis, slide "A model based on a cosine-quadratic function".
 
 use super::batch::LobeKernel;
+use super::draw_batch::remaining_share;
 use crate::real::Real;
+use crate::simd::math::{exp2, log2};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
@@ -116,6 +118,37 @@ impl CosQuad {
         let floor: R = self.floor();
         let log_base = (-u * (one - floor)).ln_1p() / power;
         (one + log_base.exp_m1() / R::parameter("slope", self.a)).max(R::from_f64(0.0))
+    }
+}
+
+/// The closed-form draw on lanes: the base `x = (1 - u (1 - x_0^(m+1)))^(1/(m+1))` as
+/// `exp2(log2((1 - u) + u x_0^(m+1)) / (m + 1))`, then `t = max(0, 1 + (x - 1) / a)`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CosQuadDraw {
+    floor: f32,
+    inverse_power: f32,
+    inverse_slope: f32,
+}
+
+impl CosQuad {
+    pub(crate) fn draw_kernel(&self) -> CosQuadDraw {
+        CosQuadDraw {
+            floor: self.floor::<f64>() as f32,
+            inverse_power: (1.0 / self.power_plus_one()) as f32,
+            inverse_slope: (1.0 / self.a) as f32,
+        }
+    }
+}
+
+impl Kernel for CosQuadDraw {
+    #[inline(always)]
+    fn apply<V: Lanes>(self, u: V) -> V {
+        let one = u.splat(1.0);
+        let remaining = remaining_share(u, self.floor);
+        let base = exp2(log2(remaining) * u.splat(self.inverse_power));
+        (base - one)
+            .mul_add(u.splat(self.inverse_slope), one)
+            .max(u.splat(0.0))
     }
 }
 

@@ -15,6 +15,7 @@ mod batch;
 mod cheb2;
 mod cheb2_thesis;
 mod cosquad;
+mod draw_batch;
 mod fasterpow;
 mod fastpow;
 mod formula;

@@ -15,6 +15,7 @@
 //! - **Source**: B. T. Phong (1975); J. F. Blinn (1977); the thesis's reference function.
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::draw_batch::remaining_share;
 use crate::real::Real;
 use crate::simd::math::{exp2, log2, EXP2, LOG2};
 use crate::simd::tally::{Class, Instructions};
@@ -65,6 +66,27 @@ pub(crate) struct PowKernel {
 impl Pow {
     pub(crate) fn kernel(&self) -> PowKernel {
         PowKernel { n: self.n as f32 }
+    }
+}
+
+/// The closed-form draw on lanes: `(1 - u)^(1/(n+1))` as `exp2(log2(1 - u) / (n + 1))`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PowDraw {
+    inverse_power: f32,
+}
+
+impl Pow {
+    pub(crate) fn draw_kernel(&self) -> PowDraw {
+        PowDraw {
+            inverse_power: (1.0 / (self.n + 1.0)) as f32,
+        }
+    }
+}
+
+impl Kernel for PowDraw {
+    #[inline(always)]
+    fn apply<V: Lanes>(self, u: V) -> V {
+        exp2(log2(remaining_share(u, 0.0)) * u.splat(self.inverse_power))
     }
 }
 

@@ -22,8 +22,9 @@
 //!   specular.
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::draw_batch::remaining_share;
 use crate::real::Real;
-use crate::simd::math::{exp2, EXP2};
+use crate::simd::math::{exp2, log2, EXP2};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
@@ -86,6 +87,34 @@ impl Sg {
         SgKernel {
             rate: self.rate as f32,
         }
+    }
+}
+
+/// The closed-form draw on lanes: `1 + ln(1 + u expm1(-k)) / k` as
+/// `1 + log2((1 - u) + u 2^-r) / r` (`k = r ln 2`), clamped to `[0, 1]`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SgDraw {
+    floor: f32,
+    inverse_rate: f32,
+}
+
+impl Sg {
+    pub(crate) fn draw_kernel(&self) -> SgDraw {
+        SgDraw {
+            floor: (-self.rate).exp2() as f32,
+            inverse_rate: (1.0 / self.rate) as f32,
+        }
+    }
+}
+
+impl Kernel for SgDraw {
+    #[inline(always)]
+    fn apply<V: Lanes>(self, u: V) -> V {
+        let one = u.splat(1.0);
+        let remaining = remaining_share(u, self.floor);
+        log2(remaining)
+            .mul_add(u.splat(self.inverse_rate), one)
+            .max(u.splat(0.0))
     }
 }
 
