@@ -1,33 +1,35 @@
 //! `specula bench environment`: the environment-lit renderer's shaded samples per second on
 //! two views lit by the built-in sky, beside Mitsuba 3 rendering the same views when the
-//! `mitsuba` wheel is present.
+//! `mitsuba` wheel is present ([`super::mitsuba_peer`]).
 //!
-//! The work is made equal: the same triangles (each mesh written as OBJ), camera, map (the
-//! sky written as EXR, which both read), resolution and samples per pixel; Mitsuba's
-//! `llvm_ad_rgb` variant with the `direct` integrator (one emitter and one BSDF sample per
-//! camera sample, MIS by the power heuristic, as specula's) and specula's own Mitsuba
-//! plugin of the same lobe (`specula shader --lang mitsuba`). What differs, and is said in
-//! the output: Mitsuba traces rays (the camera's, and a shadow ray per emitter sample) where
-//! specula rasterizes and leaves the environment unoccluded, and it interpolates the map
-//! bilinearly where specula takes the nearest texel.
+//! The work is made equal: the same shapes (spheres exact in both, the teapot's triangles
+//! written as OBJ), camera, map (the sky written as EXR, which both read), resolution and
+//! samples per pixel; Mitsuba's `llvm_ad_rgb` variant with the `direct` integrator (one
+//! emitter and one BSDF sample per camera sample, MIS by the power heuristic, as specula's)
+//! and specula's own Mitsuba plugin of the same lobe. Each is timed three ways: a warm
+//! render (specula's in this process; Mitsuba's after its first frame, the scene loaded and
+//! the kernels compiled), specula's whole process (`specula render`: the sky, the raster,
+//! the render, the file) against Mitsuba's warm render, and both from a cold start to the
+//! first image written. What differs, and is said in the output: Mitsuba traces rays (the
+//! camera's, and a shadow ray per emitter sample) where specula rasterizes and leaves the
+//! environment unoccluded, and it interpolates the map bilinearly where specula takes the
+//! nearest texel.
 
 use std::path::Path;
+use std::process::Command;
 use std::time::Instant;
 
 use specula::LobeKind;
-use specula_gpu::export::{Format, Options};
 use specula_render::ibl::{render_ibl, Environment, IblSettings, SKY_WIDTH};
 use specula_render::metrics::{mean_radiance, rms_difference};
-use specula_render::{read_image, write_image, write_mitsuba_scene, Display, Image, Overrides};
+use specula_render::{write_image, Display, Image, Overrides};
 use specula_render::{Scene, IBL_SCENE};
 use specula_report::vtk_peer;
 
+use super::mitsuba_peer::{time_mitsuba, MitsubaRun};
 use super::Args;
 use crate::commands::CommandResult;
 use crate::output::Table;
-
-/// The Mitsuba harness (`mitsuba_check.py render --frames`), compiled in.
-const MITSUBA_SCRIPT: &str = include_str!("../../../tests/renderers/mitsuba_check.py");
 
 /// The lobes measured: `pow` and the cheapest of the thesis's approximations.
 const LOBES: [LobeKind; 2] = [LobeKind::Pow, LobeKind::CosQuad { v: 4 }];
@@ -57,10 +59,11 @@ n = 64
 normalisation = "lobe"
 "#;
 
-/// A view: its name and scene.
+/// A view: its name, its scene and the scene's text (for `specula render`).
 struct View {
     name: &'static str,
     scene: Scene,
+    text: &'static str,
 }
 
 fn views() -> Result<[View; 2], String> {
@@ -79,18 +82,20 @@ fn views() -> Result<[View; 2], String> {
     }
     Ok([
         View {
-            name: "embedded scene (960 x 540)",
+            name: "embedded scene 960 x 540",
             scene: embedded,
+            text: IBL_SCENE,
         },
         View {
-            name: "close-up, sphere fills the frame (512 x 512)",
+            name: "close-up 512 x 512",
             scene: close_up,
+            text: CLOSE_UP,
         },
     ])
 }
 
 /// The median of `values`.
-fn median(mut values: Vec<f64>) -> f64 {
+pub(super) fn median(mut values: Vec<f64>) -> f64 {
     values.sort_by(f64::total_cmp);
     values[values.len() / 2]
 }
@@ -129,107 +134,78 @@ fn time_specula(
     })
 }
 
-/// What Mitsuba measured: median seconds per frame, its first image, its version.
-struct MitsubaRun {
-    seconds: f64,
-    image: Image,
-    version: String,
-}
-
-/// Renders `scene` in Mitsuba (`llvm_ad_rgb`) with specula's plugin of its first object's
-/// lobe, `frames` timed frames on `threads` threads after a first one.
-fn time_mitsuba(
-    scene: &Scene,
-    directory: &Path,
+/// specula's whole process, `specula render` of `scene_file` with `kind` on `threads`
+/// threads: the median wall time of `frames` runs, seconds.
+fn time_process(
+    scene_file: &Path,
+    kind: LobeKind,
     spp: u32,
     frames: u32,
     threads: usize,
-) -> Result<MitsubaRun, String> {
-    let material = &scene.objects[0].material;
-    let plugin = Format::parse("mitsuba")?
-        .write(
-            &material.lobe,
-            material.geometry,
-            material.normalisation,
-            Options::default(),
-        )?
-        .to_bytes();
-    let script = directory.join("mitsuba_check.py");
-    std::fs::write(&script, MITSUBA_SCRIPT).map_err(|e| e.to_string())?;
-    std::fs::write(directory.join("plugin.py"), plugin).map_err(|e| e.to_string())?;
-    let scene_file = write_mitsuba_scene(scene, directory, "scene", "sky.exr", spp, 1)?;
-    let name = format!("specula_{}", material.lobe.kind().id().replace('-', "_"));
-    // Dr.Jit 1.5 deadlocks in its first render with a single worker thread (as
-    // `set_thread_count(1)` or on one allowed core), so Mitsuba's one core is two workers
-    // pinned to one core with `taskset`.
-    let mut command = if threads == 1 {
-        let mut command = std::process::Command::new("taskset");
-        command.args(["-c", "0"]).arg(vtk_peer::python());
-        command
-    } else {
-        std::process::Command::new(vtk_peer::python())
-    };
-    let workers = threads.max(2);
-    let output = command
-        .current_dir(directory)
-        .arg(&script)
-        .args([
-            "render",
-            "--plugin",
-            "plugin.py",
-            "--bsdf",
-            &name,
-            "--scene",
-        ])
-        .arg(&scene_file)
-        .args(["--output", "mitsuba.exr", "--variant", "llvm_ad_rgb"])
-        .args([
-            "--frames",
-            &frames.to_string(),
-            "--threads",
-            &workers.to_string(),
-        ])
-        .output()
-        .map_err(|e| format!("{}: {e}", vtk_peer::python().display()))?;
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    if !output.status.success() {
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        let last = |text: &str| {
-            text.lines()
-                .rev()
-                .find(|l| !l.trim().is_empty())
-                .map(str::to_owned)
-        };
-        let why = last(&stderr).or_else(|| last(&stdout));
-        return Err(why.map_or_else(
-            || "mitsuba_check.py failed".to_owned(),
-            |w| w.trim().to_owned(),
-        ));
-    }
-    let report: serde_json::Value = stdout
-        .lines()
-        .rev()
-        .find_map(|line| serde_json::from_str(line).ok())
-        .ok_or("mitsuba_check.py printed no timings")?;
-    let seconds = report["seconds"]
-        .as_array()
-        .map(|s| {
-            s.iter()
-                .filter_map(serde_json::Value::as_f64)
-                .collect::<Vec<_>>()
+) -> Result<f64, String> {
+    let executable = std::env::current_exe().map_err(|e| e.to_string())?;
+    let output = scene_file.with_file_name("specula.exr");
+    let seconds = (0..frames)
+        .map(|_| {
+            let started = Instant::now();
+            let result = Command::new(&executable)
+                .arg("render")
+                .arg(scene_file)
+                .args(["--env", "sky", "--samples", "1", "--lobe", kind.id()])
+                .args(["--spp", &spp.to_string(), "--seed", "1", "-o"])
+                .arg(&output)
+                .env("RAYON_NUM_THREADS", threads.to_string())
+                .output()
+                .map_err(|e| format!("{}: {e}", executable.display()))?;
+            let seconds = started.elapsed().as_secs_f64();
+            if !result.status.success() {
+                return Err(format!(
+                    "specula render failed: {}",
+                    String::from_utf8_lossy(&result.stderr).trim()
+                ));
+            }
+            Ok(seconds)
         })
-        .filter(|s| !s.is_empty())
-        .ok_or("mitsuba_check.py printed no timings")?;
-    Ok(MitsubaRun {
-        seconds: median(seconds),
-        image: read_image(&directory.join("mitsuba.exr")).map_err(|e| e.to_string())?,
-        version: report["mitsuba"].as_str().unwrap_or("?").to_owned(),
-    })
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok(median(seconds))
+}
+
+/// The columns comparing one configuration's measures with Mitsuba's, or dashes without it.
+fn compared(
+    measured: &Measured,
+    mitsuba: Option<&MitsubaRun>,
+    samples: f64,
+    (image, second): (&Image, &Image),
+) -> Vec<String> {
+    let Some(run) = mitsuba else {
+        return vec!["-".to_owned(); 7];
+    };
+    vec![
+        format!("{:.2}", samples / run.warm / 1e6),
+        format!("{:.2}x", run.warm / measured.render),
+        format!("{:.3}", run.warm),
+        format!("{:.2}x", run.warm / measured.process),
+        format!("{:.2}", run.cold),
+        format!("{:.2}x", run.cold / measured.process),
+        format!(
+            "{:.2} / {:+.2} %",
+            rms_difference(image, &run.image) / rms_difference(image, second),
+            100.0 * (mean_radiance(&run.image) / mean_radiance(image) - 1.0)
+        ),
+    ]
+}
+
+/// specula's times for one configuration, seconds.
+struct Measured {
+    /// The median warm render, in this process.
+    render: f64,
+    /// The median whole process.
+    process: f64,
 }
 
 /// Measures and prints.
 pub fn run(args: &Args) -> CommandResult {
-    let spp = args.spp;
+    let spps: Vec<u32> = args.spp.map_or_else(|| vec![16, 64], |spp| vec![spp]);
     let sky = Environment::sky(SKY_WIDTH);
     let scratch = specula_temporaries::dir("bench-").map_err(|e| e.to_string())?;
     write_image(
@@ -241,95 +217,105 @@ pub fn run(args: &Args) -> CommandResult {
     let all = rayon::current_num_threads();
     let threads: Vec<usize> = if all > 1 { vec![1, all] } else { vec![1] };
     println!(
-        "lit by the built-in sky ({SKY_WIDTH} x {}), {spp} samples per pixel, each view's own exponents; median of {} frames \
-         after one; samples/s = pixels x spp / seconds per frame",
+        "lit by the built-in sky ({SKY_WIDTH} x {}), each view's own exponents; warm renders: the median of {} \
+         frames after one; samples/s = pixels x spp / seconds per frame; x: how many times faster specula is",
         SKY_WIDTH / 2,
         args.frames
     );
     println!(
         "Mitsuba: llvm_ad_rgb, direct integrator (1 emitter + 1 BSDF sample, MIS), specula's plugin of the lobe, \
-         the same OBJ meshes, camera and sky.exr; it also traces camera and shadow rays and interpolates the map bilinearly; \
+         spheres as Mitsuba's own sphere shape and the teapot as the same OBJ triangles, the same camera and sky.exr; \
          on 1 thread it runs two Dr.Jit workers pinned to one core (taskset; one worker deadlocks)"
+    );
+    println!(
+        "specula process: `specula render` from start to the image written (the sky, the raster, the render, the EXR), \
+         the median of {} runs; Mitsuba cold: from starting Python to its first image written (the import, the \
+         scene's loading, the kernels' compilation, the render)",
+        args.frames
     );
     let mut table = Table::new(&[
         "view",
         "lobe",
+        "spp",
         "threads",
         "specula Msamples/s",
         "Mitsuba Msamples/s",
-        "specula / Mitsuba",
-        "images: RMS diff / noise",
-        "means differ",
+        "warm render x",
+        "specula process s",
+        "Mitsuba warm s",
+        "process vs warm x",
+        "Mitsuba cold s",
+        "cold start x",
+        "images: RMS / noise, means",
     ]);
     let mut missing = None;
+    let mut version = None;
     for view in views()? {
-        let settings = &view.scene.settings;
-        let samples = f64::from(settings.width * settings.height * spp);
+        let scene_file = scratch.path().join("view.toml");
+        std::fs::write(&scene_file, view.text).map_err(|e| e.to_string())?;
+        let pixels = f64::from(view.scene.settings.width * view.scene.settings.height);
         for kind in LOBES {
             let mut scene = view.scene.clone();
             scene.apply(&Overrides {
                 lobe: Some(kind),
                 ..Overrides::default()
             });
-            // A second seed of specula's: the noise the images' difference is held to.
-            let settings = IblSettings {
-                spp,
-                seed: 99,
-                ..IblSettings::default()
-            };
-            let second =
-                render_ibl(&scene, &sky, &settings, &|_, _| {}).map_err(|e| e.to_string())?;
-            for &count in &threads {
-                let (seconds, image) = time_specula(&scene, &sky, spp, args.frames, count)?;
-                let mitsuba = match missing {
-                    Some(_) => None,
-                    None => time_mitsuba(&scene, scratch.path(), spp, args.frames, count)
-                        .map_err(|why| missing = Some(why))
-                        .ok(),
+            for &spp in &spps {
+                // A second seed of specula's: the noise the images' difference is held to.
+                let settings = IblSettings {
+                    spp,
+                    seed: 99,
+                    ..IblSettings::default()
                 };
-                let compared = mitsuba.map_or_else(
-                    || vec!["-".to_owned(); 4],
-                    |run| {
-                        vec![
-                            format!(
-                                "{:.2} (Mitsuba {})",
-                                samples / run.seconds / 1e6,
-                                run.version
-                            ),
-                            format!("{:.2}x", run.seconds / seconds),
-                            format!(
-                                "{:.2}",
-                                rms_difference(&image, &run.image)
-                                    / rms_difference(&image, &second)
-                            ),
-                            format!(
-                                "{:+.2} %",
-                                100.0 * (mean_radiance(&run.image) / mean_radiance(&image) - 1.0)
-                            ),
-                        ]
-                    },
-                );
-                let mut row = vec![
-                    view.name.to_owned(),
-                    kind.id().to_owned(),
-                    count.to_string(),
-                    format!("{:.2}", samples / seconds / 1e6),
-                ];
-                row.extend(compared);
-                table.push(row);
+                let second =
+                    render_ibl(&scene, &sky, &settings, &|_, _| {}).map_err(|e| e.to_string())?;
+                let samples = pixels * f64::from(spp);
+                for &count in &threads {
+                    let (render, image) = time_specula(&scene, &sky, spp, args.frames, count)?;
+                    let process = time_process(&scene_file, kind, spp, args.frames, count)?;
+                    let mitsuba = match missing {
+                        Some(_) => None,
+                        None => time_mitsuba(&scene, scratch.path(), spp, args.frames, count)
+                            .map_err(|why| missing = Some(why))
+                            .ok(),
+                    };
+                    if let Some(run) = &mitsuba {
+                        version = Some(run.version.clone());
+                    }
+                    let measured = Measured { render, process };
+                    let mut row = vec![
+                        view.name.to_owned(),
+                        kind.id().to_owned(),
+                        spp.to_string(),
+                        count.to_string(),
+                        format!("{:.2}", samples / render / 1e6),
+                    ];
+                    let mut rest =
+                        compared(&measured, mitsuba.as_ref(), samples, (&image, &second));
+                    rest.insert(2, format!("{process:.3}"));
+                    row.extend(rest);
+                    table.push(row);
+                }
             }
         }
     }
     table.print(crate::args::Format::Table);
     println!(
         "images: the RMS difference between specula's and Mitsuba's first frames over that between two of specula's \
-         (seeds 1 and 99): about 1 where they differ by noise alone, above where they differ"
+         (seeds 1 and 99), about 1 where they differ by noise alone; and how far Mitsuba's mean is from specula's"
     );
-    if let Some(why) = missing {
-        println!(
+    println!(
+        "what still differs: Mitsuba traces a camera ray and a shadow ray per sample (the scenes have nothing to \
+         occlude the sky, so the shadow rays change no pixel) and interpolates the map bilinearly where specula takes \
+         the nearest texel (a smooth sky: within noise)"
+    );
+    match (missing, version) {
+        (Some(why), _) => println!(
             "Mitsuba not measured: {why} (install the mitsuba and drjit wheels and Debian's libllvm19 for {})",
             vtk_peer::python().display()
-        );
+        ),
+        (None, Some(version)) => println!("Mitsuba {version}"),
+        (None, None) => {}
     }
     Ok(())
 }

@@ -12,6 +12,7 @@ use crate::output::Table;
 
 pub mod environment;
 pub mod lobes;
+mod mitsuba_peer;
 pub mod volume;
 
 /// What to measure.
@@ -50,9 +51,9 @@ pub struct Args {
     /// Frame height (1080, or 512 for `bench volume`).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     height: Option<u32>,
-    /// Samples per pixel (`bench environment`).
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=i64::from(specula_render::ibl::MAX_SPP)))]
-    spp: u32,
+    /// Samples per pixel (`bench environment`; by default 16, then 64).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(specula_render::ibl::MAX_SPP)))]
+    spp: Option<u32>,
     /// Timed frames per method (after one untimed warm-up frame).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     frames: u32,
