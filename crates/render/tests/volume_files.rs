@@ -475,3 +475,29 @@ fn volumes_written_as_nifti_and_dicom_read_back_in_place() {
         assert!(again.unwrap_err().0.contains("not an empty folder"));
     }
 }
+
+/// NIfTI keeps a scan's whole numbers as 16-bit integers (as scanners store a CT, and as a
+/// reader such as VTK then takes it) and anything else as 32-bit floats, both exactly.
+#[test]
+fn nifti_voxels_are_int16_when_every_sample_is_a_whole_i16() {
+    use nifti::NiftiObject;
+    let directory = tempfile::tempdir().unwrap();
+    let dims = [4, 3, 2];
+    let count = dims[0] * dims[1] * dims[2];
+    let whole: Vec<f32> = (0..count).map(|v| v as f32 * 100.0 - 1024.0).collect();
+    let cases = [
+        ("whole", whole.clone(), 4),
+        ("fraction", whole.iter().map(|v| v + 0.5).collect(), 16),
+        ("beyond i16", whole.iter().map(|v| v + 40_000.0).collect(), 16),
+    ];
+    for (name, samples, datatype) in cases {
+        let original =
+            Volume::try_new(dims, Mat3::IDENTITY, Vec3::ZERO, samples, Units::Hounsfield)
+                .unwrap();
+        let path = directory.path().join(format!("{name}.nii"));
+        volume::write(&original, &path).unwrap();
+        let header = nifti::ReaderOptions::new().read_file(&path).unwrap();
+        assert_eq!(header.header().datatype, datatype, "{name}");
+        assert_eq!(volume::read(&path).unwrap().samples(), original.samples(), "{name}");
+    }
+}

@@ -44,7 +44,7 @@ const SCANS: [Scan; 2] = [
         path: "/usr/share/doc/invesalius-examples/examples/Cranium.inv3",
         package: "invesalius-examples",
         transfer: "ct-bone",
-        vtk_reads: "for the CT a float32 copy that specula writes (so VTK takes its general gradient path, not its 8- and 16-bit one)",
+        vtk_reads: "for the CT a 16-bit integer copy that specula writes (the scan's own type, as a VTK user reads it)",
     },
     Scan {
         key: "mri",

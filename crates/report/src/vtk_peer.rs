@@ -55,9 +55,16 @@ pub struct VtkTimes {
     pub median_draw: f64,
     /// VTK's version.
     pub version: String,
+    /// Seconds from starting its process to its first frame drawn (Python, the imports, the
+    /// file read, the mapper's gradients and tables, the ray cast).
+    pub first_image: Option<f64>,
+    /// The process's peak resident memory, bytes.
+    pub peak_bytes: Option<u64>,
 }
 
-fn times(report: &serde_json::Value) -> Result<VtkTimes, String> {
+/// The times in `report`; the first image's counted from `spawned_unix` when the process was
+/// started for this one job (a process that renders several has no such start).
+fn times(report: &serde_json::Value, spawned_unix: Option<f64>) -> Result<VtkTimes, String> {
     if let Some(error) = report["error"].as_str() {
         return Err(error.to_owned());
     }
@@ -66,7 +73,19 @@ fn times(report: &serde_json::Value) -> Result<VtkTimes, String> {
             .as_f64()
             .ok_or("vtk_volume.py reported no median_draw")?,
         version: report["vtk"].as_str().unwrap_or("?").to_owned(),
+        first_image: report["first_image_unix"]
+            .as_f64()
+            .zip(spawned_unix)
+            .map(|(at, spawned)| at - spawned),
+        peak_bytes: report["peak_bytes"].as_u64(),
     })
+}
+
+/// The wall clock now, seconds since the Unix epoch.
+fn unix_now() -> f64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0.0, |elapsed| elapsed.as_secs_f64())
 }
 
 /// The last line a failed run printed (on stderr, else on stdout: the script says there that
@@ -97,6 +116,7 @@ pub fn run(job: &vtk::VtkJob, scratch: &Path) -> Result<VtkTimes, String> {
         &job_file,
         &serde_json::to_vec(job).map_err(|e| e.to_string())?,
     )?;
+    let spawned = unix_now();
     let output = Command::new(python())
         .arg(&script)
         .arg(&job_file)
@@ -107,7 +127,7 @@ pub fn run(job: &vtk::VtkJob, scratch: &Path) -> Result<VtkTimes, String> {
     }
     let report: serde_json::Value = serde_json::from_slice(&output.stdout)
         .map_err(|e| format!("vtk_volume.py printed no JSON ({e})"))?;
-    times(&report)
+    times(&report, Some(spawned))
 }
 
 /// VTK started ahead of its jobs ([`start`]).
@@ -196,7 +216,7 @@ impl Running {
             .map(|line| {
                 serde_json::from_slice(line)
                     .map_err(|e| format!("vtk_volume.py printed no JSON ({e})"))
-                    .and_then(|report| times(&report))
+                    .and_then(|report| times(&report, None))
             })
             .collect())
     }

@@ -58,7 +58,9 @@ written to `output` as PNG (vtkWindowToImageFilter, ReadFrontBufferOff, vtkPNGWr
 
 Prints one JSON line: {"vtk": version, "mapper": class, "window": class, "scalar_type": ...,
 "render_seconds": [...], "draw_seconds": [...], "median_render": s, "median_draw": s,
-"light": {...}, "two_sided_lighting": bool, "clipping_range": [near, far]}.
+"light": {...}, "two_sided_lighting": bool, "clipping_range": [near, far],
+"first_image_unix": the wall clock when the first frame was drawn, "peak_bytes": the process's
+peak resident memory (Python, nibabel's array, VTK's copy, gradients and all)}.
 Any failure prints `vtk_volume.py: error: ...` on stderr (one line) and exits 1; without the
 vtk package it prints `skipped vtk: ...` and exits 3.
 """
@@ -293,8 +295,11 @@ def render(job):
     window.AddRenderer(renderer)
     window_class = window.GetClassName()
 
+    first_image_unix = None
     for _ in range(job["warmup"]):
         window.Render()
+        if first_image_unix is None:
+            first_image_unix = time.time()
     lights = renderer.GetLights()
     if lights.GetNumberOfItems() != 1:
         raise Failure(f"expected VTK's one automatic light, found {lights.GetNumberOfItems()}")
@@ -355,7 +360,16 @@ def render(job):
         "two_sided_lighting": bool(renderer.GetTwoSidedLighting()),
         "clipping_range": list(camera.GetClippingRange()),
         "threads": mapper.GetNumberOfThreads(),
+        "first_image_unix": first_image_unix,
+        "peak_bytes": peak_bytes(),
     }
+
+
+def peak_bytes():
+    """The process's peak resident memory so far (Linux reports ru_maxrss in KiB)."""
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
 def main():

@@ -218,16 +218,45 @@ fn placement(header: &NiftiHeader) -> Result<(Mat3, Vec3), String> {
     Ok((Mat3::from_diagonal(spacing * scale), Vec3::ZERO))
 }
 
-/// Writes `volume` as NIfTI-1 with 32-bit float voxels and its placement as the `sform`
-/// (code 2, aligned to an anatomical frame), atomically; `.nii.gz` is compressed.
+/// Writes `volume` as NIfTI-1 with its placement as the `sform` (code 2, aligned to an
+/// anatomical frame), atomically; `.nii.gz` is compressed. The voxels are 16-bit integers
+/// when every sample is a whole number in `i16`'s range (a CT in Hounsfield units, as
+/// scanners store it, and as a reader such as VTK then takes it), 32-bit floats otherwise.
 pub fn write(volume: &Volume, path: &Path) -> Result<(), VolumeError> {
     let fail = |what: String| VolumeError(format!("{}: {what}", path.display()));
+    let samples = volume.samples();
+    let whole = samples
+        .iter()
+        .all(|&v| v == v.trunc() && (f32::from(i16::MIN)..=f32::from(i16::MAX)).contains(&v));
     let [nx, ny, nz] = volume.dims();
-    let array = ndarray::Array3::from_shape_vec(
-        ndarray::ShapeBuilder::f((nx, ny, nz)),
-        volume.samples().to_vec(),
-    )
-    .map_err(|e| fail(e.to_string()))?;
+    let shape = ndarray::ShapeBuilder::f((nx, ny, nz));
+    if whole {
+        let values: Vec<i16> = samples.iter().map(|&v| v as i16).collect();
+        let array =
+            ndarray::Array3::from_shape_vec(shape, values).map_err(|e| fail(e.to_string()))?;
+        write_with(volume, path, |staged, header| {
+            nifti::writer::WriterOptions::new(staged)
+                .reference_header(header)
+                .write_nifti(&array)
+        })
+    } else {
+        let array = ndarray::Array3::from_shape_vec(shape, samples.to_vec())
+            .map_err(|e| fail(e.to_string()))?;
+        write_with(volume, path, |staged, header| {
+            nifti::writer::WriterOptions::new(staged)
+                .reference_header(header)
+                .write_nifti(&array)
+        })
+    }
+    .map_err(fail)
+}
+
+/// [`write`] with the voxels written by `write_array` (to the staged file, with the header).
+fn write_with(
+    volume: &Volume,
+    path: &Path,
+    write_array: impl FnOnce(&Path, &NiftiHeader) -> nifti::Result<()>,
+) -> Result<(), String> {
     let linear = volume.to_world();
     let origin = volume.origin();
     let row = |r: usize| {
@@ -252,22 +281,19 @@ pub fn write(volume: &Volume, path: &Path) -> Result<(), VolumeError> {
         xyzt_units: 2,
         ..NiftiHeader::default()
     };
-    let staging = specula_temporaries::dir("nifti-").map_err(|e| fail(e.to_string()))?;
+    let staging = specula_temporaries::dir("nifti-").map_err(|e| e.to_string())?;
     let name = if is_gz(path) {
         "volume.nii.gz"
     } else {
         "volume.nii"
     };
     let staged = staging.path().join(name);
-    nifti::writer::WriterOptions::new(&staged)
-        .reference_header(&header)
-        .write_nifti(&array)
-        .map_err(|e| fail(e.to_string()))?;
+    write_array(&staged, &header).map_err(|e| e.to_string())?;
     write_atomically(path, |writer| {
         let mut file = std::fs::File::open(&staged).map_err(|e| e.to_string())?;
         std::io::copy(&mut file, writer)
             .map(|_| ())
             .map_err(|e| e.to_string())
     })
-    .map_err(|e| fail(e.to_string()))
+    .map_err(|e| e.to_string())
 }

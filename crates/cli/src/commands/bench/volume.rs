@@ -6,6 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use specula_render::volume::march::PreparedVolume;
+use specula_render::volume::raymarch::render_dvr_prepared;
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::vtk;
 use specula_render::{write_image, Display};
@@ -19,6 +20,7 @@ use crate::output::Table;
 /// Measures and prints.
 pub fn run(args: &Args) -> CommandResult {
     let source = Source::new(&args.input);
+    let loading = Instant::now();
     let volume = load(&source)?;
     let transfer = match &args.transfer {
         Some(name) => TransferFunction::preset(name).map_err(|e| e.to_string())?,
@@ -32,6 +34,11 @@ pub fn run(args: &Args) -> CommandResult {
     let started = Instant::now();
     let prepared = PreparedVolume::new(&volume);
     let preparation = started.elapsed().as_secs_f64();
+    let first_frame = Instant::now();
+    render_dvr_prepared(&volume, &prepared, &transfer, &settings, &|| {})
+        .map_err(|e| e.to_string())?;
+    let first_image = loading.elapsed().as_secs_f64();
+    let first_frame = first_frame.elapsed().as_secs_f64();
     let (image, specula) = vtk_peer::time_specula(
         &volume,
         &prepared,
@@ -39,6 +46,9 @@ pub fn run(args: &Args) -> CommandResult {
         &settings,
         args.frames as usize,
     )?;
+    // This process's peak so far: the volume, its preparation and the frames (VTK runs in
+    // its own process, measured by itself).
+    let specula_peak = peak_resident_bytes();
     let threads = rayon::current_num_threads();
     let scratch = specula_temporaries::dir("bench-").map_err(|e| e.to_string())?;
     let vtk_output = scratch.path().join("vtk.png");
@@ -59,37 +69,72 @@ pub fn run(args: &Args) -> CommandResult {
     let [nx, ny, nz] = volume.dims();
     println!(
         "{} ({nx} x {ny} x {nz}), {} view, {width} x {height}, {} mm between samples, {threads} threads; \
-         median of {} frames after one warm-up; specula's gradients and bricks took {:.0} ms once",
+         median of {} frames after one warm-up; specula's gradients and bricks took {:.0} ms once, its first frame {:.0} ms",
         args.input,
         view.id(),
         args.sample_distance,
         args.frames,
-        preparation * 1e3
+        preparation * 1e3,
+        first_frame * 1e3
     );
-    let mut table = Table::new(&["renderer", "median ms/frame", "frames/s", "specula vs VTK"]);
-    let row = |name: String, seconds: f64, ratio: String| {
-        vec![
-            name,
-            format!("{:.1}", seconds * 1e3),
-            format!("{:.2}", 1.0 / seconds),
-            ratio,
-        ]
+    println!(
+        "first image: specula from reading the file to its first frame (in this process, started a few ms before); \
+         VTK from starting Python to its first frame (the imports, nibabel's read, VTK's copy, the mapper's gradients, \
+         the ray cast); peak: each process's peak resident memory (VTK's: Python, nibabel, VTK together)"
+    );
+    let voxels = (nx * ny * nz) as f64;
+    let mut table = Table::new(&[
+        "renderer",
+        "median ms/frame",
+        "frames/s",
+        "frame: specula x",
+        "first image s",
+        "first image: specula x",
+        "peak MB",
+        "peak bytes/voxel",
+    ]);
+    let peak = |bytes: Option<u64>| {
+        bytes.map_or_else(
+            || ("-".to_owned(), "-".to_owned()),
+            |b| {
+                (
+                    format!("{:.0}", b as f64 / 1e6),
+                    format!("{:.1}", b as f64 / voxels),
+                )
+            },
+        )
     };
+    let seconds = |value: Option<f64>| value.map_or_else(|| "-".to_owned(), |s| format!("{s:.2}"));
+    let ratio = |ours: f64, theirs: Option<f64>| {
+        theirs.map_or_else(|| "-".to_owned(), |theirs| format!("{:.2}x", theirs / ours))
+    };
+    let against = vtk.as_ref().ok();
+    let (megabytes, per_voxel) = peak(specula_peak);
+    table.push(vec![
+        "specula (CPU)".into(),
+        format!("{:.1}", specula * 1e3),
+        format!("{:.2}", 1.0 / specula),
+        ratio(specula, against.map(|t| t.median_draw)),
+        seconds(Some(first_image)),
+        ratio(first_image, against.and_then(|t| t.first_image)),
+        megabytes,
+        per_voxel,
+    ]);
     match &vtk {
         Ok(times) => {
-            table.push(row(
-                "specula (CPU)".into(),
-                specula,
-                format!("{:.2}x", times.median_draw / specula),
-            ));
-            table.push(row(
+            let (megabytes, per_voxel) = peak(times.peak_bytes);
+            table.push(vec![
                 format!("VTK {} vtkFixedPointVolumeRayCastMapper", times.version),
-                times.median_draw,
+                format!("{:.1}", times.median_draw * 1e3),
+                format!("{:.2}", 1.0 / times.median_draw),
                 "1.00x".into(),
-            ));
+                seconds(times.first_image),
+                "1.00x".into(),
+                megabytes,
+                per_voxel,
+            ]);
         }
         Err(why) => {
-            table.push(row("specula (CPU)".into(), specula, "-".into()));
             println!(
                 "VTK not measured: {why} (install the vtk and nibabel wheels for {})",
                 vtk_peer::python().display()
@@ -111,4 +156,12 @@ pub fn run(args: &Args) -> CommandResult {
         );
     }
     Ok(())
+}
+
+/// This process's peak resident memory (Linux's `VmHWM`), bytes; `None` elsewhere.
+fn peak_resident_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|line| line.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }
