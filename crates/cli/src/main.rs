@@ -139,7 +139,8 @@ enum Command {
     #[command(
         after_help = "Examples:\n  specula volume-convert --input phantom -o head.nii.gz\n  \
                             specula volume-convert --input phantom -o head-dicom\n  \
-                            specula volume-convert --input ct-series/ -o ct.nii.gz"
+                            specula volume-convert --input ct-series/ -o ct.nii.gz\n  \
+                            specula volume-convert --input Cranium.inv3 --resample 512x512x432 -o clinical-ct.nii"
     )]
     VolumeConvert(commands::volume::ConvertArgs),
     /// Write the built-in sky (`--env sky`) as an EXR or HDR map, for other renderers.

@@ -488,16 +488,23 @@ fn nifti_voxels_are_int16_when_every_sample_is_a_whole_i16() {
     let cases = [
         ("whole", whole.clone(), 4),
         ("fraction", whole.iter().map(|v| v + 0.5).collect(), 16),
-        ("beyond i16", whole.iter().map(|v| v + 40_000.0).collect(), 16),
+        (
+            "beyond i16",
+            whole.iter().map(|v| v + 40_000.0).collect(),
+            16,
+        ),
     ];
     for (name, samples, datatype) in cases {
         let original =
-            Volume::try_new(dims, Mat3::IDENTITY, Vec3::ZERO, samples, Units::Hounsfield)
-                .unwrap();
+            Volume::try_new(dims, Mat3::IDENTITY, Vec3::ZERO, samples, Units::Hounsfield).unwrap();
         let path = directory.path().join(format!("{name}.nii"));
         volume::write(&original, &path).unwrap();
         let header = nifti::ReaderOptions::new().read_file(&path).unwrap();
         assert_eq!(header.header().datatype, datatype, "{name}");
-        assert_eq!(volume::read(&path).unwrap().samples(), original.samples(), "{name}");
+        assert_eq!(
+            volume::read(&path).unwrap().samples(),
+            original.samples(),
+            "{name}"
+        );
     }
 }

@@ -366,10 +366,17 @@ def render(job):
 
 
 def peak_bytes():
-    """The process's peak resident memory so far (Linux reports ru_maxrss in KiB)."""
-    import resource
-
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    """The process's peak resident memory: Linux's VmHWM, which starts afresh with the
+    program (ru_maxrss would carry over the high-water mark of the process that started
+    Python); None where there is no /proc."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        return None
+    return None
 
 
 def main():

@@ -139,9 +139,32 @@ impl Source {
 pub struct ConvertArgs {
     #[command(flatten)]
     source: Source,
+    /// Resample onto a grid of this many voxels (`NXxNYxNZ`, e.g. `512x512x432`) over the same
+    /// extent, trilinearly; a scan of whole numbers (a CT) stays whole.
+    #[arg(long, value_parser = parse_grid)]
+    resample: Option<[usize; 3]>,
     /// Where to write: a .nii or .nii.gz file, or else a new folder for a DICOM series.
     #[arg(short, long)]
     output: PathBuf,
+}
+
+/// A grid size written `NXxNYxNZ`, checked as a volume's grid is.
+fn parse_grid(text: &str) -> Result<[usize; 3], String> {
+    let sides: Vec<Option<usize>> = text
+        .split('x')
+        .map(|side| side.trim().parse().ok())
+        .collect();
+    match sides.as_slice() {
+        [Some(x), Some(y), Some(z)] => {
+            let dims = [*x, *y, *z];
+            Volume::check_dims(dims).map_err(|e| e.to_string())?;
+            Ok(dims)
+        }
+        _ => Err(format!(
+            "'{}' is not a grid size; write three whole numbers as NXxNYxNZ, e.g. 512x512x432",
+            specula::excerpt(text)
+        )),
+    }
 }
 
 fn parse_finite(text: &str) -> Result<f32, String> {
@@ -346,7 +369,10 @@ fn iso(
 
 /// Writes the volume as NIfTI or a DICOM series.
 pub fn convert(args: &ConvertArgs) -> CommandResult {
-    let volume = load(&args.source)?;
+    let mut volume = load(&args.source)?;
+    if let Some(dims) = args.resample {
+        volume = volume.resampled(dims).map_err(|e| e.to_string())?;
+    }
     volume::write(&volume, &args.output).map_err(|e| e.to_string())?;
     let [nx, ny, nz] = volume.dims();
     eprintln!(

@@ -175,6 +175,14 @@ fn bad_volume_requests_are_refused_in_one_line() {
         ),
         (vec!["volume", "--eye", "1,2"], "three finite numbers"),
         (vec!["volume", "--size", "100000"], "8..=512"),
+        (
+            vec!["volume-convert", "--resample", "512x5", "-o", "r.nii"],
+            "write three whole numbers as NXxNYxNZ",
+        ),
+        (
+            vec!["volume-convert", "--resample", "1x64x64", "-o", "r.nii"],
+            "every side must be 2 to",
+        ),
     ] {
         let output = specula(d, &args);
         let stderr = String::from_utf8_lossy(&output.stderr);
@@ -183,4 +191,23 @@ fn bad_volume_requests_are_refused_in_one_line() {
         assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
     }
     assert!(!d.join("volume.png").exists());
+}
+
+/// `--resample` writes the volume on the grid asked for, over the same corners.
+#[test]
+fn volume_convert_resamples_onto_the_grid_asked_for() {
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    let base = ["volume-convert", "--input", "phantom", "--size", "16"];
+    ok(d, &[&base[..], &["-o", "small.nii"]].concat());
+    ok(
+        d,
+        &[&base[..], &["--resample", "24x20x18", "-o", "large.nii"]].concat(),
+    );
+    let small = specula_render::volume::read(&d.join("small.nii")).unwrap();
+    let large = specula_render::volume::read(&d.join("large.nii")).unwrap();
+    assert_eq!(large.dims(), [24, 20, 18]);
+    for (a, b) in large.corners().iter().zip(small.corners()) {
+        assert!((*a - b).length() < 1e-3, "{a} {b}");
+    }
 }

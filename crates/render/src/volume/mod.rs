@@ -26,6 +26,7 @@ pub mod march;
 pub mod nifti;
 pub mod phantom;
 pub mod raymarch;
+mod resample;
 pub mod transfer;
 pub mod vtk;
 
