@@ -15,8 +15,9 @@
 //!   every texel's radiance and density (one 16-byte record), so that the reads of a map of
 //!   megabytes overlap rather than wait one after another;
 //! - the frame's tangents and the Phong axis's basis are built once per surface point, and
-//!   closed-form lobes draw their cosine in `f32`, tabulated lobes from their table in `f32`
-//!   with a guide ([`specula::sampling::CosineTable32`]), where the `f64` path searches it;
+//!   closed-form lobes draw their cosines on SIMD lanes ([`specula::Lobe::tail_inverse_batch`]),
+//!   tabulated lobes from their table in `f32` with a guide
+//!   ([`specula::sampling::CosineTable32`]), where the `f64` path searches it;
 //!   Newton-sampled lobes start Newton from that table's draw (the same root, in about half
 //!   the iterations);
 //! - each variant's directions, their texels and the combination of its two draws run on
