@@ -280,7 +280,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
             });
             self.gpu.queue.write_texture(
                 texture.as_image_copy(),
-                bytemuck::cast_slice(prepared.voxels()),
+                bytemuck::cast_slice(&prepared.voxels()),
                 wgpu::TexelCopyBufferLayout {
                     offset: 0,
                     bytes_per_row: Some(16 * dims[0] as u32),

@@ -3,9 +3,10 @@
 //! - **Gradients once per volume.** Central differences one voxel apart of the trilinear field
 //!   are the trilinear interpolation of the voxels' own central differences (interpolation is
 //!   linear in the data and commutes with a whole-voxel shift), so [`PreparedVolume`] stores
-//!   each voxel's value and world gradient side by side (16 bytes) and a sample reads 8
-//!   neighbours instead of 48. Only the last voxel layer differs: there the reference clamps
-//!   the outer sample of the difference, the prepared field the voxel's.
+//!   each voxel's value and world gradient side by side (16 bytes, or 8 for a volume too
+//!   large for that: [`Layout`]) and a sample reads 8 neighbours instead of 48. Only the last
+//!   voxel layer differs: there the reference clamps the outer sample of the difference, the
+//!   prepared field the voxel's.
 //! - **Empty space skipped exactly.** The grid is cut into bricks of [`BRICK`]^3 cells with
 //!   each brick's smallest and largest value; a render marks the bricks whose whole value
 //!   range has no extinction and finds, for each, how far the empty space around it reaches
@@ -16,6 +17,8 @@
 //!   of the transfer function a value falls in, whose line then gives extinction and colour
 //!   exactly as the function does.
 
+use std::borrow::Cow;
+
 use glam::{IVec3, Vec3, Vec4};
 use rayon::prelude::*;
 
@@ -25,6 +28,10 @@ use super::Volume;
 pub(super) mod ray;
 #[cfg(test)]
 mod tests;
+mod voxels;
+
+pub use voxels::Layout;
+use voxels::Voxels;
 
 /// The flag of a table entry within which a control point lies.
 const HOLDS_A_BOUND: u16 = 1 << 15;
@@ -51,8 +58,8 @@ pub const CLASSIFICATION_ENTRIES: usize = 4096;
 pub struct PreparedVolume {
     dims: [usize; 3],
     /// `(value, gradient in value per mm)` per voxel, four numbers each, `i` fastest: a
-    /// voxel and its neighbour along `i` are eight numbers in a row (one 256-bit load).
-    voxels: Vec<[f32; 4]>,
+    /// voxel and its neighbour along `i` are eight numbers in a row ([`Layout`]).
+    voxels: Voxels,
     /// The largest cell index along each axis (`dims - 2`).
     last_cell: IVec3,
     last_index: Vec3,
@@ -63,35 +70,27 @@ pub struct PreparedVolume {
 }
 
 impl PreparedVolume {
-    /// Computes the gradients and the bricks' ranges (in parallel over slices).
+    /// Computes the gradients and the bricks' ranges (in parallel over slices), in the layout
+    /// [`Layout::for_voxels`] picks for the volume's size.
     #[must_use]
     pub fn new(volume: &Volume) -> Self {
+        Self::with_layout(volume, Layout::for_voxels(volume.samples().len()))
+    }
+
+    /// [`PreparedVolume::new`] in a chosen layout.
+    #[must_use]
+    pub fn with_layout(volume: &Volume, layout: Layout) -> Self {
         let dims = volume.dims();
         let [nx, ny, nz] = dims;
         let samples = volume.samples();
-        let to_world_gradient = volume.to_index().transpose();
         let at = |i: usize, j: usize, k: usize| samples[i + nx * (j + ny * k)];
-        let mut voxels = vec![[0.0; 4]; samples.len()];
-        voxels
-            .par_chunks_mut(nx * ny)
-            .enumerate()
-            .for_each(|(k, slice)| {
-                let (k0, k1) = (k.saturating_sub(1), (k + 1).min(nz - 1));
-                for j in 0..ny {
-                    let (j0, j1) = (j.saturating_sub(1), (j + 1).min(ny - 1));
-                    for i in 0..nx {
-                        let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nx - 1));
-                        let along_index = 0.5
-                            * Vec3::new(
-                                at(i1, j, k) - at(i0, j, k),
-                                at(i, j1, k) - at(i, j0, k),
-                                at(i, j, k1) - at(i, j, k0),
-                            );
-                        let g = to_world_gradient * along_index;
-                        slice[i + nx * j] = [at(i, j, k), g.x, g.y, g.z];
-                    }
-                }
-            });
+        let voxels = Voxels::new(
+            samples,
+            dims,
+            volume.to_index().transpose(),
+            volume.range(),
+            layout,
+        );
         let bricks = dims.map(|d| (d - 1).div_ceil(BRICK));
         let brick_ranges = (0..bricks[0] * bricks[1] * bricks[2])
             .into_par_iter()
@@ -132,11 +131,18 @@ impl PreparedVolume {
         self.dims
     }
 
-    /// `(value, world gradient)` per voxel, `i` fastest: what the GPU's marcher uploads, so
-    /// that it reads a sample's 8 corners, not the 48 of six differenced samples.
+    /// `(value, world gradient)` per voxel, `i` fastest, as `f32`: what the GPU's marcher
+    /// uploads, so that it reads a sample's 8 corners, not the 48 of six differenced samples.
     #[must_use]
-    pub fn voxels(&self) -> &[[f32; 4]] {
-        &self.voxels
+    pub fn voxels(&self) -> Cow<'_, [[f32; 4]]> {
+        self.voxels.exact()
+    }
+
+    /// The largest difference between a stored value and the volume's, and between a stored
+    /// gradient's world components and the exact ones (0 in the exact layout).
+    #[must_use]
+    pub fn quantisation_error(&self) -> (f32, Vec3) {
+        self.voxels.quantisation_error()
     }
 
     /// Bricks along each axis ([`BRICK`]^3 cells each, the last ones possibly partial).
@@ -184,25 +190,11 @@ impl PreparedVolume {
         cell[0] + nx * (cell[1] + ny * cell[2])
     }
 
-    /// The trilinear value and gradient at `f` in the cell whose first voxel is `at`. The
-    /// cell's corners are four pairs of neighbours along `i`, each pair eight numbers in a
-    /// row: they are interpolated pairwise along `y`, then `z` (eight lanes at a time), and
-    /// the pair's two ends along `x` last.
+    /// The trilinear value and gradient at `f` in the cell whose first voxel is `at`.
     #[inline(always)]
     fn sample_at(&self, at: usize, f: Vec3) -> Vec4 {
         let (nx, nxy) = (self.dims[0], self.dims[0] * self.dims[1]);
-        let pair = |voxel: usize| -> [f32; 8] {
-            *self.voxels[voxel..]
-                .as_flattened()
-                .first_chunk()
-                .expect("a cell's corners lie inside the grid")
-        };
-        let near = lerp8(pair(at), pair(at + nx), f.y);
-        let far = lerp8(pair(at + nxy), pair(at + nxy + nx), f.y);
-        let ends = lerp8(near, far, f.z);
-        let low = Vec4::from_slice(&ends[..4]);
-        let high = Vec4::from_slice(&ends[4..]);
-        low + (high - low) * f.x
+        self.voxels.trilinear(at, f, nx, nxy)
     }
 
     /// The index of the brick holding `cell` (`i32` arithmetic, as [`Self::voxel`]).
@@ -223,16 +215,6 @@ impl PreparedVolume {
         let c = (high - origin) * inverse_direction;
         a.max(c).min_element()
     }
-}
-
-/// `a + (b - a) t`, lane by lane.
-#[inline(always)]
-fn lerp8(a: [f32; 8], b: [f32; 8], t: f32) -> [f32; 8] {
-    let mut out = a;
-    for lane in 0..8 {
-        out[lane] = a[lane] + (b[lane] - a[lane]) * t;
-    }
-    out
 }
 
 /// A transfer function arranged for one volume: its pieces as `value -> (sigma, r, g, b)`
