@@ -255,8 +255,9 @@ pub fn time_specula(
     Ok((image, median(times)))
 }
 
-/// The median of `values` (at least one).
-fn median(mut values: Vec<f64>) -> f64 {
+/// The median of `values` (at least one): of an even count, the mean of the middle two.
+#[must_use]
+pub fn median(mut values: Vec<f64>) -> f64 {
     values.sort_by(f64::total_cmp);
     let middle = values.len() / 2;
     if values.len() % 2 == 1 {

@@ -1,7 +1,7 @@
 //! The draws every variant of a packet shares, on SIMD lanes: each environment draw's
 //! direction (the point drawn within its texel, turned to a direction in the surface's
 //! frame) and each cosine-weighted BRDF draw's direction with the texel it falls in, and
-//! the azimuth every BRDF draw turns by. What stays scalar around it ([`super::packet`]): the
+//! the azimuth every BRDF draw turns by. What stays scalar around it (`packet.rs`): the
 //! random numbers and the alias table's draws before it, the texels' records after (reads at
 //! random places of the map). Scalar, these were the packet's most costly part: three
 //! sines and cosines, an arccosine and an arctangent per sample.
@@ -9,7 +9,7 @@
 use glam::Vec3;
 use specula::simd::{Job, Lanes};
 
-use super::lane_geometry::{sin_cos_turns, Column, V3};
+use super::lane_geometry::{sin_cos_turns, Column, LANES, V3};
 use super::lanes::SharedColumns;
 use super::Environment;
 
@@ -36,16 +36,16 @@ pub(super) struct Draws {
 
 impl Draws {
     pub(super) const ZERO: Self = Self {
-        light_column: [0.0; super::packet::LANES],
-        light_row: [0.0; super::packet::LANES],
-        within_x: [0.0; super::packet::LANES],
-        within_y: [0.0; super::packet::LANES],
-        u1: [0.0; super::packet::LANES],
-        azimuth: [0.0; super::packet::LANES],
-        light_sine: [0.0; super::packet::LANES],
-        diffuse_column: [0.0; super::packet::LANES],
-        diffuse_row: [0.0; super::packet::LANES],
-        diffuse_sine: [0.0; super::packet::LANES],
+        light_column: [0.0; LANES],
+        light_row: [0.0; LANES],
+        within_x: [0.0; LANES],
+        within_y: [0.0; LANES],
+        u1: [0.0; LANES],
+        azimuth: [0.0; LANES],
+        light_sine: [0.0; LANES],
+        diffuse_column: [0.0; LANES],
+        diffuse_row: [0.0; LANES],
+        diffuse_sine: [0.0; LANES],
     };
 }
 

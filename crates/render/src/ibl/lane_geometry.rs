@@ -1,5 +1,5 @@
 //! 3-vectors and angles on SIMD lanes ([`specula::simd::Lanes`]), for the packet
-//! estimator's per-variant jobs ([`super::lanes`]) and the map's texels
+//! estimator's per-variant jobs (`lanes.rs`) and the map's texels
 //! ([`super::Environment::texel_lanes`]): a packet's quantities stored by component in
 //! [`LANES`]-long columns, loaded a vector at a time. `acos` and `atan2` evaluate the scalar
 //! functions' polynomials ([`super::angles`]), fused.
@@ -11,9 +11,12 @@ use specula::simd::Lanes;
 use specula::Geometry;
 
 use super::angles::{ACOS, ATAN};
-use super::packet::LANES;
 
 /// `LANES` values of one quantity.
+/// Samples per packet (`packet.rs`): enough for the lobe's kernel to run at full
+/// width, few enough to live on the stack.
+pub(super) const LANES: usize = 64;
+
 pub(super) type Column = [f32; LANES];
 
 // Every level's vectors tile a packet (1 or 8 lanes).

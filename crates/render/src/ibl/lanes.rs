@@ -21,8 +21,7 @@ use glam::Vec3;
 use specula::simd::{Job, Lanes};
 use specula::Geometry;
 
-use super::lane_geometry::{cosine, Column, Columns3, V3};
-use super::packet::LANES;
+use super::lane_geometry::{cosine, Column, Columns3, LANES, V3};
 use super::{Environment, Strategy};
 
 /// Where a lane's BRDF direction came from, as a lane value.

@@ -1,9 +1,9 @@
-//! The estimator of [`super::trace`] for the scene's own materials, run over packets of
+//! The estimator of `trace.rs` for the scene's own materials, run over packets of
 //! samples in `f32`: what Mitsuba 3's LLVM backend does with wide vectors, arranged so that
 //! the expensive parts vectorise or vanish.
 //!
 //! A packet is up to [`LANES`] samples of one surface point (one view, one frame, one `wo`).
-//! The estimator is the same as [`super::trace`]'s, one environment draw and one BRDF draw
+//! The estimator is the same as `trace.rs`'s, one environment draw and one BRDF draw
 //! combined by the power heuristic; what differs is how it is computed:
 //! - the lobe is evaluated **once per direction**, for all the packet's directions in one
 //!   call of its SIMD kernel ([`specula::Lobe::eval_batch`]), and that one value gives both
@@ -21,7 +21,7 @@
 //!   Newton-sampled lobes start Newton from that table's draw (the same root, in about half
 //!   the iterations);
 //! - each variant's directions, their texels and the combination of its two draws run on
-//!   SIMD lanes ([`super::lanes`]: 8 with AVX2 and FMA), the same on every level to `f32`
+//!   SIMD lanes (`lanes.rs`: 8 with AVX2 and FMA), the same on every level to `f32`
 //!   roundings (tested).
 //!
 //! Random numbers come from [`specula::sampling::random_bits`] by (seed, draw, dimension),
@@ -39,14 +39,10 @@ use specula::simd::{dispatch, Level, Prefetch};
 use specula::{Geometry, Lobe};
 
 use super::draws::{Draws, SharedDraws};
-use super::lane_geometry::Columns3;
+use super::lane_geometry::{Columns3, LANES};
 use super::lanes::{Brdf, Combine, Directions, Setting, SharedColumns, Source, VariantColumns};
 use super::{Environment, Strategy};
 use crate::Material;
-
-/// Samples per packet: enough for the lobe's kernel to run at full width, few enough to live
-/// on the stack.
-pub(super) const LANES: usize = 64;
 
 /// A scene material prepared for the packet estimator: `f = diffuse + specular lobe(t)`.
 pub(super) struct PacketSurface {
@@ -379,7 +375,7 @@ struct Packet<'a> {
     u1: &'a [f32; LANES],
     /// The packet's draws (its first lanes).
     count: usize,
-    /// The lanes the jobs run ([`super::lanes`]).
+    /// The lanes the jobs run (`lanes.rs`).
     used: usize,
     prefetch: Prefetch,
 }

@@ -181,6 +181,13 @@ impl Volume {
         )
     }
 
+    /// Whether every sample is a whole number (a CT in Hounsfield units, an integer MRI), so
+    /// that integers can hold the volume exactly.
+    #[must_use]
+    pub fn whole_numbers(&self) -> bool {
+        self.samples.iter().all(|&v| v == v.trunc())
+    }
+
     /// The grid's size.
     #[must_use]
     pub fn dims(&self) -> [usize; 3] {

@@ -239,9 +239,8 @@ fn placement(header: &NiftiHeader) -> Result<(Mat3, Vec3), String> {
 pub fn write(volume: &Volume, path: &Path) -> Result<(), VolumeError> {
     let fail = |what: String| VolumeError(format!("{}: {what}", path.display()));
     let samples = volume.samples();
-    let whole = samples
-        .iter()
-        .all(|&v| v == v.trunc() && (f32::from(i16::MIN)..=f32::from(i16::MAX)).contains(&v));
+    let (lo, hi) = volume.range();
+    let whole = volume.whole_numbers() && lo >= f32::from(i16::MIN) && hi <= f32::from(i16::MAX);
     let [nx, ny, nz] = volume.dims();
     let shape = ndarray::ShapeBuilder::f((nx, ny, nz));
     if whole {

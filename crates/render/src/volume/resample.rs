@@ -18,7 +18,7 @@ impl Volume {
         // Index along each axis of the new grid to index of this one.
         let step =
             Vec3::from_array([0, 1, 2].map(|a| (old[a] - 1) as f32 / (dims[a] - 1).max(1) as f32));
-        let whole = self.samples().iter().all(|&v| v == v.trunc());
+        let whole = self.whole_numbers();
         let mut samples = vec![0.0_f32; voxels];
         samples
             .par_chunks_mut(dims[0] * dims[1])

@@ -24,7 +24,7 @@ use specula_render::ibl::{render_ibl, Environment, IblSettings, SKY_WIDTH};
 use specula_render::metrics::{mean_radiance, rms_difference};
 use specula_render::{write_image, Display, Image, Overrides};
 use specula_render::{Scene, IBL_SCENE};
-use specula_report::vtk_peer;
+use specula_report::vtk_peer::{self, median};
 
 use super::mitsuba_peer::{time_mitsuba, MitsubaRun};
 use super::Args;
@@ -92,12 +92,6 @@ fn views() -> Result<[View; 2], String> {
             text: CLOSE_UP,
         },
     ])
-}
-
-/// The median of `values`.
-pub(super) fn median(mut values: Vec<f64>) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
 }
 
 /// specula's median seconds per frame on `threads` threads, and its first frame.

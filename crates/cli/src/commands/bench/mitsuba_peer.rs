@@ -10,9 +10,7 @@ use std::time::Instant;
 
 use specula_gpu::export::{Format, Options};
 use specula_render::{read_image, write_mitsuba_scene, Image, Scene};
-use specula_report::vtk_peer;
-
-use super::environment::median;
+use specula_report::vtk_peer::{self, median};
 
 /// The Mitsuba harness (`mitsuba_check.py render --frames`), compiled in.
 const MITSUBA_SCRIPT: &str = include_str!("../../../tests/renderers/mitsuba_check.py");

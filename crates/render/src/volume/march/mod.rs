@@ -25,6 +25,8 @@ use rayon::prelude::*;
 use super::transfer::TransferFunction;
 use super::Volume;
 
+#[cfg(test)]
+mod prepared_tests;
 pub(super) mod ray;
 #[cfg(test)]
 mod tests;
@@ -84,13 +86,7 @@ impl PreparedVolume {
         let [nx, ny, nz] = dims;
         let samples = volume.samples();
         let at = |i: usize, j: usize, k: usize| samples[i + nx * (j + ny * k)];
-        let voxels = Voxels::new(
-            samples,
-            dims,
-            volume.to_index().transpose(),
-            volume.range(),
-            layout,
-        );
+        let voxels = Voxels::new(volume, layout);
         let bricks = dims.map(|d| (d - 1).div_ceil(BRICK));
         let brick_ranges = (0..bricks[0] * bricks[1] * bricks[2])
             .into_par_iter()

@@ -17,8 +17,10 @@
 
 use std::borrow::Cow;
 
-use glam::{Mat3, Vec3, Vec4};
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
+
+use crate::volume::Volume;
 
 /// How the prepared voxels are held (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,17 +54,12 @@ pub(super) enum Voxels {
 }
 
 impl Voxels {
-    /// The voxels of `samples` on a grid of `dims` (`i` fastest), gradients by central
-    /// differences one voxel apart (the outer sample clamped to the grid), turned to world
-    /// axes by `to_world_gradient`.
-    pub(super) fn new(
-        samples: &[f32],
-        dims: [usize; 3],
-        to_world_gradient: Mat3,
-        range: (f32, f32),
-        layout: Layout,
-    ) -> Self {
-        let [nx, ny, nz] = dims;
+    /// `volume`'s voxels in `layout`, gradients by central differences one voxel apart (the
+    /// outer sample clamped to the grid), turned to world axes.
+    pub(super) fn new(volume: &Volume, layout: Layout) -> Self {
+        let (samples, range) = (volume.samples(), volume.range());
+        let to_world_gradient = volume.to_index().transpose();
+        let [nx, ny, nz] = volume.dims();
         let at = |i: usize, j: usize, k: usize| samples[i + nx * (j + ny * k)];
         let gradient = |i: usize, j: usize, k: usize| {
             let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nx - 1));
@@ -96,7 +93,7 @@ impl Voxels {
                     rows.y_axis.abs().element_sum(),
                     rows.z_axis.abs().element_sum(),
                 ) * half_range;
-                let quantised = Quantised::new(samples, range, steepest);
+                let quantised = Quantised::new(volume.whole_numbers(), range, steepest);
                 let mut voxels = vec![[0_i16; 4]; samples.len()];
                 fill(&mut voxels, nx * ny, nx, |i, j, k| {
                     quantised.encode(at(i, j, k), gradient(i, j, k))
@@ -216,8 +213,7 @@ pub(super) struct Quantised {
 impl Quantised {
     const LARGEST: f32 = 32_767.0;
 
-    fn new(samples: &[f32], (lo, hi): (f32, f32), steepest: Vec3) -> Self {
-        let whole = samples.iter().all(|&v| v == v.trunc());
+    fn new(whole: bool, (lo, hi): (f32, f32), steepest: Vec3) -> Self {
         let (value_scale, value_offset) = if whole && lo >= -Self::LARGEST && hi <= Self::LARGEST {
             (1.0, 0.0)
         } else if hi > lo {

@@ -1,0 +1,94 @@
+//! The prepared field: its samples are the volume's trilinear values and gradients, and the
+//! compact layout is the exact one within its quantisation steps.
+
+use super::tests::padded_head;
+use super::*;
+use crate::volume::phantom::BuiltIn;
+use crate::volume::raymarch::{render_dvr_prepared, DvrSettings, Shading, View};
+use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+
+/// `count` points of the unit cube spread evenly by three irrational steps.
+fn spread_fractions(count: usize) -> impl Iterator<Item = Vec3> {
+    (0..count).map(|k| {
+        Vec3::new(
+            (k as f32 * 0.618_034).fract(),
+            (k as f32 * 0.414_214).fract(),
+            (k as f32 * 0.732_051).fract(),
+        )
+    })
+}
+
+#[test]
+fn prepared_samples_are_the_volumes_trilinear_values_and_gradients() {
+    let volume = BuiltIn::SheppLogan.make(24).unwrap();
+    let prepared = PreparedVolume::new(&volume);
+    let last = volume.last_index();
+    for fraction in spread_fractions(500) {
+        // Points at least a voxel inside the grid, where both gradients see the same
+        // neighbours.
+        let p = Vec3::ONE + fraction * (last - 2.0);
+        let sample = prepared.sample(p);
+        assert!((sample.x - volume.sample(p)).abs() < 1e-5, "{p}");
+        let gradient = Vec3::new(sample.y, sample.z, sample.w);
+        assert!(
+            (gradient - volume.gradient(p)).length() <= 1e-4 * (1.0 + gradient.length()),
+            "{p}: {gradient} against {}",
+            volume.gradient(p)
+        );
+    }
+}
+
+/// The compact layout holds each value and gradient within half its quantisation step
+/// (the Shepp-Logan head's values are not whole numbers, so both are quantised), and marches
+/// the image the exact layout does within the reference test's bounds.
+#[test]
+fn the_compact_layout_is_the_exact_one_within_its_steps() {
+    let volume = padded_head(24);
+    let exact = PreparedVolume::with_layout(&volume, Layout::Exact);
+    let compact = PreparedVolume::with_layout(&volume, Layout::Compact);
+    assert_eq!(exact.quantisation_error(), (0.0, Vec3::ZERO));
+    let (value_error, gradient_error) = compact.quantisation_error();
+    assert!(value_error > 0.0 && gradient_error.min_element() > 0.0);
+    let last = volume.last_index();
+    for fraction in spread_fractions(500) {
+        let p = fraction * last;
+        let (a, b) = (exact.sample(p), compact.sample(p));
+        // Half a step, plus the f32 roundings of interpolating and scaling.
+        let slack = 1e-5 * (1.0 + a.abs());
+        assert!((a.x - b.x).abs() <= value_error + slack.x, "{p}: {a} {b}");
+        for (c, step) in gradient_error.to_array().into_iter().enumerate() {
+            assert!(
+                (a[c + 1] - b[c + 1]).abs() <= step + slack[c + 1],
+                "{p}: {a} {b}"
+            );
+        }
+    }
+    let transfer = TransferFunction::preset("mr").unwrap().for_volume(&volume);
+    let lobe = Lobe::new(LobeKind::Pow, Exponent::new(24.0));
+    let settings = DvrSettings::new(
+        40,
+        36,
+        View::Anterior,
+        Some(Shading::new(lobe, Geometry::Blinn, Normalisation::None)),
+    );
+    let draw = |prepared: &PreparedVolume| {
+        render_dvr_prepared(&volume, prepared, &transfer, &settings, &|| {}).unwrap()
+    };
+    let (a, b) = (draw(&exact), draw(&compact));
+    let errors: Vec<f32> = a
+        .pixels()
+        .iter()
+        .zip(b.pixels())
+        .map(|(x, y)| (*x - *y).abs().max_element())
+        .collect();
+    let worst = errors.iter().copied().fold(0.0, f32::max);
+    let mean = errors.iter().sum::<f32>() / errors.len() as f32;
+    assert!(worst < 2e-3 && mean < 2e-4, "worst {worst}, mean {mean}");
+}
+
+/// The layout follows the volume's size.
+#[test]
+fn large_volumes_are_prepared_compact() {
+    assert_eq!(Layout::for_voxels(256 * 256 * 108), Layout::Exact);
+    assert_eq!(Layout::for_voxels(512 * 512 * 432), Layout::Compact);
+}
