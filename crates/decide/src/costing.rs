@@ -3,8 +3,8 @@
 //! on a GPU family, the modelled
 //! evaluations per clock of its exported shader; on the FPGA, the datapath
 //! [`cheapest_datapath`] picks at the width the error needs, synthesized (cached) or, without
-//! the tools, estimated. [`crate::recommend`] ranks by these; a material's verdict
-//! ([`crate::material`]) takes [`lobe_rate`], which refuses the FPGA.
+//! the tools, estimated. `recommend.rs` ranks by these; a material's verdict
+//! (`material.rs`) takes [`lobe_rate`], which refuses the FPGA.
 
 use indicatif::ProgressBar;
 use specula::analysis::{error_figures, Precision};

@@ -2,7 +2,7 @@
 //! machine's measured peaks and the instructions the kernel executes), its plain loop, `powf`
 //! and the fast pow, with its error, all from one run ([`measure`]: `specula bench lobes`
 //! prints it, the report's cost section shows it); the rates of lobes timed together
-//! ([`kernel_rates`]), the CPU's costs in [`crate::recommend`]; and one kernel's rate
+//! ([`kernel_rates`]), the CPU's costs in `recommend.rs`; and one kernel's rate
 //! ([`kernel_rate`]), a material's verdict's.
 
 use std::hint::black_box;
