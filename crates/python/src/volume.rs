@@ -65,9 +65,9 @@ impl Volume {
     fn data(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         guarded(|| {
             let [nx, ny, nz] = self.volume.dims();
-            let array =
-                numpy::ndarray::ArrayView3::from_shape((nx, ny, nz).f(), self.volume.samples())
-                    .map_err(|e| value_error(e.to_string()))?;
+            let samples = self.volume.samples().to_f32();
+            let array = numpy::ndarray::ArrayView3::from_shape((nx, ny, nz).f(), &samples)
+                .map_err(|e| value_error(e.to_string()))?;
             Ok(array.to_pyarray(py).into_any().unbind())
         })
     }

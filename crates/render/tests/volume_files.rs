@@ -445,7 +445,7 @@ fn volumes_written_as_nifti_and_dicom_read_back_in_place() {
             let worst = read
                 .samples()
                 .iter()
-                .zip(original.samples())
+                .zip(original.samples().iter())
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f32::max);
             // 16-bit DICOM keeps a 65000th of the range; NIfTI keeps f32 exactly.

@@ -116,7 +116,7 @@ pub fn marching_cubes(volume: &Volume, iso: f32) -> Result<Mesh, VolumeError> {
     let table = case_table();
     let edges = edges();
     let [nx, ny, nz] = volume.dims();
-    let value = |p: [usize; 3]| volume.samples()[p[0] + nx * (p[1] + ny * p[2])];
+    let value = |p: [usize; 3]| volume.samples().get(p[0] + nx * (p[1] + ny * p[2]));
     let mut vertex_of_edge: HashMap<(usize, usize), u32> = HashMap::new();
     let mut positions = Vec::new();
     let mut triangles = Vec::new();

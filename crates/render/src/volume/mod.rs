@@ -1,7 +1,8 @@
 //! Volumes: scalar fields on a regular grid, as medical scanners write them, and their
 //! rendering.
 //!
-//! A [`Volume`] holds `f32` samples on an `nx x ny x nz` grid (`i` fastest), and the affine
+//! A [`Volume`] holds samples on an `nx x ny x nz` grid (`i` fastest; whole numbers as `i16`,
+//! others as `f32`: [`Samples`]), and the affine
 //! map from grid indices to world millimetres in the patient's RAS frame, as NIfTI counts it
 //! (`+x` towards the patient's Right, `+y` Anterior, `+z` Superior). Sampling is trilinear; gradients are central differences of the trilinear
 //! field, one voxel apart, taken to world units by the inverse transpose of the map.
@@ -19,6 +20,8 @@ use std::path::Path;
 use glam::{Mat3, Vec3};
 use thiserror::Error;
 
+pub use samples::{Sample, Samples};
+
 pub mod dicom;
 pub mod invesalius;
 pub mod isosurface;
@@ -27,6 +30,7 @@ pub mod nifti;
 pub mod phantom;
 pub mod raymarch;
 mod resample;
+mod samples;
 pub mod transfer;
 pub mod vtk;
 
@@ -49,7 +53,7 @@ pub struct Volume {
     to_world: Mat3,
     origin: Vec3,
     to_index: Mat3,
-    samples: Vec<f32>,
+    samples: Samples,
     units: Units,
     /// The smallest and largest sample, found once: every render's transfer function and
     /// lighting read it.
@@ -74,14 +78,14 @@ impl Units {
     /// the voxels are air (within 100 of -1000); otherwise arbitrary. MR magnitudes and the
     /// built-in volumes are never negative, so they are never taken for CT.
     #[must_use]
-    pub fn from_values(samples: &[f32]) -> Self {
-        let smallest = samples.iter().copied().fold(f32::INFINITY, f32::min);
+    pub fn from_values(samples: &Samples) -> Self {
+        let smallest = samples.iter().fold(f32::INFINITY, f32::min);
         if !(-3100.0..=-900.0).contains(&smallest) {
             return Units::Arbitrary;
         }
         let air = samples
             .iter()
-            .filter(|&&v| (-1100.0..=-900.0).contains(&v))
+            .filter(|v| (-1100.0..=-900.0).contains(v))
             .count();
         if air * 100 >= samples.len() {
             Units::Hounsfield
@@ -122,6 +126,17 @@ impl Volume {
         samples: Vec<f32>,
         units: Units,
     ) -> Result<Self, VolumeError> {
+        Self::from_samples(dims, to_world, origin, Samples::new(samples), units)
+    }
+
+    /// [`Volume::try_new`] with samples already in their form (integers read from a file).
+    pub fn from_samples(
+        dims: [usize; 3],
+        to_world: Mat3,
+        origin: Vec3,
+        samples: Samples,
+        units: Units,
+    ) -> Result<Self, VolumeError> {
         let voxels = Self::check_dims(dims)?;
         if samples.len() != voxels {
             return Err(VolumeError(format!(
@@ -132,11 +147,14 @@ impl Volume {
                 dims[2]
             )));
         }
-        if let Some(at) = samples.iter().position(|v| !v.is_finite()) {
-            return Err(VolumeError(format!(
-                "voxel {at} is {}; every sample must be finite",
-                samples[at]
-            )));
+        // Integers are always finite: only `f32` samples need looking at.
+        if let Samples::Float(values) = &samples {
+            if let Some(at) = values.iter().position(|v| !v.is_finite()) {
+                return Err(VolumeError(format!(
+                    "voxel {at} is {}; every sample must be finite",
+                    values[at]
+                )));
+            }
         }
         let determinant = to_world.determinant();
         if !(to_world.is_finite() && origin.is_finite() && determinant.abs() > 1e-12) {
@@ -146,7 +164,7 @@ impl Volume {
         }
         let range = samples
             .iter()
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| {
                 (lo.min(v), hi.max(v))
             });
         Ok(Self {
@@ -185,7 +203,10 @@ impl Volume {
     /// that integers can hold the volume exactly.
     #[must_use]
     pub fn whole_numbers(&self) -> bool {
-        self.samples.iter().all(|&v| v == v.trunc())
+        match &self.samples {
+            Samples::Whole(_) => true,
+            Samples::Float(values) => values.iter().all(|&v| v == v.trunc()),
+        }
     }
 
     /// The grid's size.
@@ -196,7 +217,7 @@ impl Volume {
 
     /// The samples, `i` fastest.
     #[must_use]
-    pub fn samples(&self) -> &[f32] {
+    pub fn samples(&self) -> &Samples {
         &self.samples
     }
 
@@ -287,7 +308,7 @@ impl Volume {
             clamp(j, self.dims[1]),
             clamp(k, self.dims[2]),
         );
-        self.samples[i + self.dims[0] * (j + self.dims[1] * k)]
+        self.samples.get(i + self.dims[0] * (j + self.dims[1] * k))
     }
 
     /// The trilinear interpolation at a fractional grid index (clamped to the grid).

@@ -16,7 +16,7 @@ use std::path::Path;
 use glam::{Mat3, Vec3};
 use nifti::{IntoNdArray, NiftiHeader, NiftiObject, NiftiType, ReaderOptions, Unit};
 
-use super::{Units, Volume, VolumeError};
+use super::{Samples, Units, Volume, VolumeError};
 use crate::input;
 use crate::output::write_atomically;
 
@@ -37,16 +37,36 @@ pub fn read(path: &Path) -> Result<Volume, VolumeError> {
     let object = ReaderOptions::new()
         .read_file(path)
         .map_err(|e| fail(read_error(&e)))?;
+    // Integers of at most 16 bits, unscaled (a CT as scanners store it), are read as the
+    // `i16` they are; anything else as `f32` (whole numbers then still held as `i16`).
+    let integers = matches!(
+        header.data_type(),
+        Ok(NiftiType::Int16 | NiftiType::Int8 | NiftiType::Uint8)
+    ) && (header.scl_slope == 0.0 || header.scl_slope == 1.0)
+        && header.scl_inter == 0.0;
+    let samples = if integers {
+        Samples::whole(voxels_in_file_order::<i16>(object).map_err(fail)?)
+    } else {
+        Samples::new(voxels_in_file_order::<f32>(object).map_err(fail)?)
+    };
+    let units = stated_units(&header).unwrap_or_else(|| Units::from_values(&samples));
+    Volume::from_samples(dims, to_world, origin, samples, units).map_err(|e| fail(e.0))
+}
+
+/// The file's voxels as `T`, `i` fastest.
+fn voxels_in_file_order<T: nifti::DataElement + Clone>(
+    object: nifti::InMemNiftiObject,
+) -> Result<Vec<T>, String> {
     let array = object
         .into_volume()
-        .into_ndarray::<f32>()
-        .map_err(|e| fail(read_error(&e)))?;
+        .into_ndarray::<T>()
+        .map_err(|e| read_error(&e))?;
     // The array is indexed `[i, j, k]`; its transpose, read in logical order, runs `i` fastest.
     // NIfTI stores `i` fastest, so the transpose is usually the array's own memory, taken
     // without a copy (a clinical CT's 450 MB copy was a tenth of its first image).
     let transposed = array.reversed_axes();
     let count = transposed.len();
-    let samples: Vec<f32> = if transposed.is_standard_layout() {
+    Ok(if transposed.is_standard_layout() {
         match transposed.into_raw_vec_and_offset() {
             (samples, None | Some(0)) if samples.len() == count => samples,
             (samples, offset) => {
@@ -55,10 +75,8 @@ pub fn read(path: &Path) -> Result<Volume, VolumeError> {
             }
         }
     } else {
-        transposed.iter().copied().collect()
-    };
-    let units = stated_units(&header).unwrap_or_else(|| Units::from_values(&samples));
-    Volume::try_new(dims, to_world, origin, samples, units).map_err(|e| fail(e.0))
+        transposed.iter().cloned().collect()
+    })
 }
 
 /// What the header says the values are: Hounsfield units when its description or intent
@@ -233,35 +251,33 @@ fn placement(header: &NiftiHeader) -> Result<(Mat3, Vec3), String> {
 }
 
 /// Writes `volume` as NIfTI-1 with its placement as the `sform` (code 2, aligned to an
-/// anatomical frame), atomically; `.nii.gz` is compressed. The voxels are 16-bit integers
-/// when every sample is a whole number in `i16`'s range (a CT in Hounsfield units, as
-/// scanners store it, and as a reader such as VTK then takes it), 32-bit floats otherwise.
+/// anatomical frame), atomically; `.nii.gz` is compressed. The voxels are written in the
+/// form the volume holds them ([`Samples`]): 16-bit integers when every sample is a whole
+/// number in `i16`'s range (a CT in Hounsfield units, as scanners store it, and as a reader
+/// such as VTK then takes it), 32-bit floats otherwise.
 pub fn write(volume: &Volume, path: &Path) -> Result<(), VolumeError> {
     let fail = |what: String| VolumeError(format!("{}: {what}", path.display()));
-    let samples = volume.samples();
-    let (lo, hi) = volume.range();
-    let whole = volume.whole_numbers() && lo >= f32::from(i16::MIN) && hi <= f32::from(i16::MAX);
-    let [nx, ny, nz] = volume.dims();
-    let shape = ndarray::ShapeBuilder::f((nx, ny, nz));
-    if whole {
-        let values: Vec<i16> = samples.iter().map(|&v| v as i16).collect();
-        let array =
-            ndarray::Array3::from_shape_vec(shape, values).map_err(|e| fail(e.to_string()))?;
-        write_with(volume, path, |staged, header| {
-            nifti::writer::WriterOptions::new(staged)
-                .reference_header(header)
-                .write_nifti(&array)
-        })
-    } else {
-        let array = ndarray::Array3::from_shape_vec(shape, samples.to_vec())
-            .map_err(|e| fail(e.to_string()))?;
-        write_with(volume, path, |staged, header| {
-            nifti::writer::WriterOptions::new(staged)
-                .reference_header(header)
-                .write_nifti(&array)
-        })
+    match volume.samples() {
+        Samples::Whole(values) => write_values(volume, path, values),
+        Samples::Float(values) => write_values(volume, path, values),
     }
     .map_err(fail)
+}
+
+/// [`write`] with `values`, the volume's samples as held.
+fn write_values<A: nifti::DataElement + bytemuck::Pod>(
+    volume: &Volume,
+    path: &Path,
+    values: &[A],
+) -> Result<(), String> {
+    let [nx, ny, nz] = volume.dims();
+    let shape = ndarray::ShapeBuilder::f((nx, ny, nz));
+    let array = ndarray::ArrayView3::from_shape(shape, values).map_err(|e| e.to_string())?;
+    write_with(volume, path, |staged, header| {
+        nifti::writer::WriterOptions::new(staged)
+            .reference_header(header)
+            .write_nifti(&array)
+    })
 }
 
 /// [`write`] with the voxels written by `write_array` (to the staged file, with the header).

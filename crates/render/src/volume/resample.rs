@@ -72,7 +72,7 @@ mod tests {
         for (a, b) in resampled.corners().iter().zip(original.corners()) {
             assert!((*a - b).length() < 1e-4, "{a} {b}");
         }
-        for (n, &value) in resampled.samples().iter().enumerate() {
+        for (n, value) in resampled.samples().iter().enumerate() {
             let index = Vec3::new((n % 11) as f32, (n / 11 % 7) as f32, (n / 77) as f32);
             let expected = field(resampled.world(index));
             assert!((value - expected).abs() < 1e-4, "{n}: {value} {expected}");
@@ -85,7 +85,7 @@ mod tests {
     fn whole_numbers_stay_whole_and_bad_grids_are_refused() {
         let original = linear([5, 4, 3], |p| (3.0 * p.x).round());
         let resampled = original.resampled([9, 9, 9]).unwrap();
-        assert!(resampled.samples().iter().all(|v| *v == v.trunc()));
+        assert!(resampled.samples().iter().all(|v| v == v.trunc()));
         assert_eq!(
             original.resampled([5, 4, 3]).unwrap().samples(),
             original.samples()

@@ -63,9 +63,10 @@ pub fn write_series(volume: &Volume, dir: &Path) -> Result<(), VolumeError> {
     let orientation = [to_lps(row.normalize()), to_lps(column.normalize())];
     let written: Result<(), String> = (0..nz).into_par_iter().try_for_each(|k| {
         let position = to_lps(volume.world(Vec3::new(0.0, 0.0, k as f32)));
-        let stored: Vec<u16> = volume.samples()[k * nx * ny..(k + 1) * nx * ny]
-            .iter()
-            .map(|&v| {
+        let samples = volume.samples();
+        let stored: Vec<u16> = (k * nx * ny..(k + 1) * nx * ny)
+            .map(|n| samples.get(n))
+            .map(|v| {
                 ((f64::from(v) - intercept) / slope)
                     .round()
                     .clamp(-32768.0, 32767.0) as i16 as u16

@@ -59,7 +59,7 @@ use std::path::Path;
 
 use glam::{Mat3, Vec3};
 
-use super::{Units, Volume, VolumeError};
+use super::{Samples, Units, Volume, VolumeError};
 use crate::input;
 use archive::{base_name, walk, Walk};
 use project::Project;
@@ -133,10 +133,11 @@ fn read_within(path: &Path, limit: u64) -> Result<Volume, VolumeError> {
 impl Project {
     /// The volume: `raw` (the voxel file) as samples, placed as the module describes.
     fn volume(&self, raw: &[u8]) -> Result<Volume, String> {
-        let samples: Vec<f32> = raw
-            .chunks_exact(self.dtype.bytes())
-            .map(|element| self.dtype.value(element))
-            .collect();
+        let samples = Samples::new(
+            raw.chunks_exact(self.dtype.bytes())
+                .map(|element| self.dtype.value(element))
+                .collect(),
+        );
         let [sx, sy, sz] = self.spacing;
         let to_world = Mat3::from_diagonal(Vec3::new(-sx, sy, sz));
         let last = Vec3::new(
@@ -146,6 +147,6 @@ impl Project {
         );
         let origin = -0.5 * (to_world * last);
         let units = self.units.unwrap_or_else(|| Units::from_values(&samples));
-        Volume::try_new(self.dims, to_world, origin, samples, units).map_err(|e| e.0)
+        Volume::from_samples(self.dims, to_world, origin, samples, units).map_err(|e| e.0)
     }
 }

@@ -183,7 +183,7 @@ fn the_units_follow_the_modality_then_the_values() {
     ))
     .expect("uint16");
     assert_eq!(
-        volume.samples(),
+        volume.samples().iter().collect::<Vec<_>>(),
         (0..24).map(|v| v as f32).collect::<Vec<_>>()
     );
     assert_eq!(volume.units(), Units::Arbitrary);

@@ -18,12 +18,13 @@
 //!   exactly as the function does.
 
 use std::borrow::Cow;
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use glam::{IVec3, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::transfer::TransferFunction;
-use super::Volume;
+use super::{Sample, Samples, Volume};
 
 #[cfg(test)]
 mod prepared_tests;
@@ -69,6 +70,24 @@ pub struct PreparedVolume {
     /// Smallest and largest value of each brick's voxels (its cells' corners).
     brick_ranges: Vec<(f32, f32)>,
     range: (f32, f32),
+    last_classification: LastClassification,
+}
+
+/// The classification a prepared volume was last asked for, with its transfer function.
+#[derive(Debug, Default)]
+struct LastClassification(Mutex<Option<(TransferFunction, Arc<Classification>)>>);
+
+impl Clone for LastClassification {
+    fn clone(&self) -> Self {
+        Self(Mutex::new(self.kept().clone()))
+    }
+}
+
+impl LastClassification {
+    fn kept(&self) -> MutexGuard<'_, Option<(TransferFunction, Arc<Classification>)>> {
+        // A render that panicked left a whole classification or none: the value stays good.
+        self.0.lock().unwrap_or_else(PoisonError::into_inner)
+    }
 }
 
 impl PreparedVolume {
@@ -83,33 +102,12 @@ impl PreparedVolume {
     #[must_use]
     pub fn with_layout(volume: &Volume, layout: Layout) -> Self {
         let dims = volume.dims();
-        let [nx, ny, nz] = dims;
-        let samples = volume.samples();
-        let at = |i: usize, j: usize, k: usize| samples[i + nx * (j + ny * k)];
         let voxels = Voxels::new(volume, layout);
         let bricks = dims.map(|d| (d - 1).div_ceil(BRICK));
-        let brick_ranges = (0..bricks[0] * bricks[1] * bricks[2])
-            .into_par_iter()
-            .map(|b| {
-                let (bi, bj, bk) = (
-                    b % bricks[0],
-                    b / bricks[0] % bricks[1],
-                    b / (bricks[0] * bricks[1]),
-                );
-                let span =
-                    |brick: usize, d: usize| brick * BRICK..=((brick + 1) * BRICK).min(d - 1);
-                let mut range = (f32::INFINITY, f32::NEG_INFINITY);
-                for k in span(bk, nz) {
-                    for j in span(bj, ny) {
-                        for i in span(bi, nx) {
-                            let v = at(i, j, k);
-                            range = (range.0.min(v), range.1.max(v));
-                        }
-                    }
-                }
-                range
-            })
-            .collect();
+        let brick_ranges = match volume.samples() {
+            Samples::Whole(values) => brick_ranges(values, dims, bricks),
+            Samples::Float(values) => brick_ranges(values, dims, bricks),
+        };
         Self {
             dims,
             voxels,
@@ -118,7 +116,25 @@ impl PreparedVolume {
             bricks,
             brick_ranges,
             range: volume.range(),
+            last_classification: LastClassification::default(),
         }
+    }
+
+    /// `transfer` arranged for this volume ([`Classification::new`]). The last one asked for
+    /// is kept: a view re-rendered with one transfer function, frame after frame, arranges it
+    /// once (a clinical-size CT's bricks take about 15 ms), as VTK's mapper keeps its
+    /// space-leaping flags until the function changes.
+    #[must_use]
+    pub fn classification(&self, transfer: &TransferFunction) -> Arc<Classification> {
+        let mut kept = self.last_classification.kept();
+        if let Some((function, classification)) = kept.as_ref() {
+            if function == transfer {
+                return Arc::clone(classification);
+            }
+        }
+        let classification = Arc::new(Classification::new(self, transfer));
+        *kept = Some((transfer.clone(), Arc::clone(&classification)));
+        classification
     }
 
     /// The grid's size.
@@ -213,6 +229,34 @@ impl PreparedVolume {
     }
 }
 
+/// The smallest and largest of `samples` (a grid of `dims`) over each of `bricks` bricks'
+/// voxels (its cells' corners), in parallel over bricks.
+fn brick_ranges<T: Sample>(samples: &[T], dims: [usize; 3], bricks: [usize; 3]) -> Vec<(f32, f32)> {
+    let [nx, ny, nz] = dims;
+    let at = |i: usize, j: usize, k: usize| -> f32 { samples[i + nx * (j + ny * k)].into() };
+    (0..bricks[0] * bricks[1] * bricks[2])
+        .into_par_iter()
+        .map(|b| {
+            let (bi, bj, bk) = (
+                b % bricks[0],
+                b / bricks[0] % bricks[1],
+                b / (bricks[0] * bricks[1]),
+            );
+            let span = |brick: usize, d: usize| brick * BRICK..=((brick + 1) * BRICK).min(d - 1);
+            let mut range = (f32::INFINITY, f32::NEG_INFINITY);
+            for k in span(bk, nz) {
+                for j in span(bj, ny) {
+                    for i in span(bi, nx) {
+                        let v = at(i, j, k);
+                        range = (range.0.min(v), range.1.max(v));
+                    }
+                }
+            }
+            range
+        })
+        .collect()
+}
+
 /// A transfer function arranged for one volume: its pieces as `value -> (sigma, r, g, b)`
 /// lines, a table that finds a value's piece, and the bricks it leaves empty.
 #[derive(Clone, Debug)]
@@ -277,7 +321,7 @@ impl Classification {
             .collect();
         let occupied: Vec<bool> = volume
             .brick_ranges
-            .iter()
+            .par_iter()
             .map(|&(lo, hi)| {
                 transfer.at(lo).0 > 0.0
                     || transfer.at(hi).0 > 0.0
@@ -368,8 +412,19 @@ fn chessboard_distance(occupied: &[bool], [nx, ny, nz]: [usize; 3]) -> Vec<u8> {
     let (px, py) = (nx + 2, ny + 2);
     let padded = |i: usize, j: usize, k: usize| (i + 1) + px * ((j + 1) + py * (k + 1));
     let mut distance = vec![MOST_CLEARANCE; px * py * (nz + 2)];
-    for (b, _) in occupied.iter().enumerate().filter(|(_, &o)| o) {
-        distance[padded(b % nx, b / nx % ny, b / (nx * ny))] = 0;
+    // Row by row between the grid and its padding: no division per brick.
+    let rows = (0..nz)
+        .flat_map(|k| (0..ny).map(move |j| (j, k)))
+        .map(|(j, k)| (nx * (j + ny * k), padded(0, j, k)));
+    for (row, start) in rows.clone() {
+        for (d, &o) in distance[start..start + nx]
+            .iter_mut()
+            .zip(&occupied[row..row + nx])
+        {
+            if o {
+                *d = 0;
+            }
+        }
     }
     // The 12 neighbours in the slice and the row before a brick, as distances back from it
     // in the padded grid (the 13th, the brick before it in its row, is the sweep's).
@@ -394,13 +449,13 @@ fn chessboard_distance(occupied: &[bool], [nx, ny, nz]: [usize; 3]) -> Vec<u8> {
                     (ny - 1 - jj, nz - 1 - kk)
                 };
                 let start = padded(0, j, k);
-                for (i, nearest) in nearest.iter_mut().enumerate().take(nx) {
-                    let at = start + i;
-                    let mut least = MOST_CLEARANCE;
-                    for &back in &earlier {
-                        least = least.min(distance[if forward { at - back } else { at + back }]);
+                // Neighbour by neighbour, the whole row at once (bytes side by side in vectors).
+                nearest.fill(MOST_CLEARANCE);
+                for &back in &earlier {
+                    let from = if forward { start - back } else { start + back };
+                    for (nearest, &there) in nearest.iter_mut().zip(&distance[from..from + nx]) {
+                        *nearest = (*nearest).min(there);
                     }
-                    *nearest = least;
                 }
                 let mut before = MOST_CLEARANCE;
                 for ii in 0..nx {
@@ -415,7 +470,9 @@ fn chessboard_distance(occupied: &[bool], [nx, ny, nz]: [usize; 3]) -> Vec<u8> {
             }
         }
     }
-    (0..nx * ny * nz)
-        .map(|b| distance[padded(b % nx, b / nx % ny, b / (nx * ny))])
-        .collect()
+    let mut clearance = vec![0; nx * ny * nz];
+    for (row, start) in rows {
+        clearance[row..row + nx].copy_from_slice(&distance[start..start + nx]);
+    }
+    clearance
 }

@@ -92,3 +92,61 @@ fn large_volumes_are_prepared_compact() {
     assert_eq!(Layout::for_voxels(256 * 256 * 108), Layout::Exact);
     assert_eq!(Layout::for_voxels(512 * 512 * 432), Layout::Compact);
 }
+
+/// A volume of whole numbers keeps them: the compact layout reads the volume's own integers
+/// (the same allocation, not a copy), so its values are the exact layout's bit for bit and
+/// only its gradients are quantised.
+#[test]
+fn whole_number_volumes_share_their_integers_with_the_compact_layout() {
+    let head = padded_head(24);
+    let thousandths: Vec<f32> = head
+        .samples()
+        .iter()
+        .map(|v| (v * 1000.0).round())
+        .collect();
+    let volume = Volume::try_new(
+        head.dims(),
+        head.to_world(),
+        head.origin(),
+        thousandths,
+        head.units(),
+    )
+    .unwrap();
+    let Samples::Whole(held) = volume.samples() else {
+        panic!("whole numbers within i16 are held as i16");
+    };
+    let compact = PreparedVolume::with_layout(&volume, Layout::Compact);
+    let Voxels::Compact { values, .. } = &compact.voxels else {
+        panic!("the compact layout was asked for");
+    };
+    assert!(std::sync::Arc::ptr_eq(held, values));
+    assert_eq!(compact.quantisation_error().0, 0.0);
+    let exact = PreparedVolume::with_layout(&volume, Layout::Exact);
+    let last = volume.last_index();
+    for fraction in spread_fractions(500) {
+        let p = fraction * last;
+        assert_eq!(exact.sample(p).x, compact.sample(p).x, "{p}");
+    }
+}
+
+/// The classification last asked for is kept: the same transfer function gets the same one
+/// back; another gets its own (the one `Classification::new` arranges), which is then kept.
+#[test]
+fn the_last_classification_is_kept_for_its_transfer_function() {
+    let volume = padded_head(16);
+    let prepared = PreparedVolume::new(&volume);
+    let mr = TransferFunction::preset("mr").unwrap().for_volume(&volume);
+    let surface = TransferFunction::preset("surface")
+        .unwrap()
+        .for_volume(&volume);
+    let first = prepared.classification(&mr);
+    assert!(Arc::ptr_eq(&first, &prepared.classification(&mr)));
+    let other = prepared.classification(&surface);
+    assert!(!Arc::ptr_eq(&first, &other));
+    assert_eq!(
+        other.clearance(),
+        Classification::new(&prepared, &surface).clearance()
+    );
+    assert!(Arc::ptr_eq(&other, &prepared.classification(&surface)));
+    assert_ne!(first.clearance(), other.clearance());
+}

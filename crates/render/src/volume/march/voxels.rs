@@ -4,23 +4,26 @@
 //!   256-bit read. Fastest while the march is bound by its instructions (measured on the real
 //!   CT and MRI, about 7 million voxels each: the compact layout's conversions cost the MRI,
 //!   nearly every sample shaded, 5-9 % a frame).
-//! - [`Layout::Compact`]: four `i16` (8 bytes) with a scale and offset per component. Half
-//!   the memory, and half the traffic once the volume outgrows the caches (a 512 x 512 x 432
-//!   CT: 17 % faster frames, peak 2.3 -> 1.4 GB). A scan of whole numbers within `i16` (a CT
-//!   in Hounsfield units, an 8-bit MRI) keeps its values exactly; gradients are spread over
-//!   the integers by the steepest a central difference can be along each axis (half the
-//!   value range through the grid's map), so each is within half a step
+//! - [`Layout::Compact`]: integers with a scale and offset per component: the value (2
+//!   bytes; for a scan of whole numbers within `i16`, a CT in Hounsfield units, the volume's
+//!   own [`Samples::Whole`], shared, not copied) and the gradient (three `i16`, 6 bytes) in
+//!   two arrays. Half the memory, and half the traffic once the volume outgrows the caches (a
+//!   512 x 512 x 432 CT: 17 % faster frames; volume and prepared voxels 8 bytes a voxel
+//!   where `f32` samples and exact voxels take 20). Gradients are spread over the integers
+//!   by the steepest a central difference can be along each axis (half the value range
+//!   through the grid's map), so each is within half a step
 //!   ([`Voxels::quantisation_error`]). The integers are interpolated and scaled once: the
 //!   interpolation is linear, so scaling the result is scaling the corners.
 //!
 //! [`Layout::for_voxels`] picks the compact layout above [`Layout::COMPACT_ABOVE`] voxels.
 
 use std::borrow::Cow;
+use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use crate::volume::Volume;
+use crate::volume::{Sample, Samples, Volume};
 
 /// How the prepared voxels are held (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -50,17 +53,32 @@ impl Layout {
 #[derive(Clone, Debug)]
 pub(super) enum Voxels {
     Exact(Vec<[f32; 4]>),
-    Compact(Vec<[i16; 4]>, Quantised),
+    /// The values as integers (the volume's own when it holds them so, [`Samples::Whole`])
+    /// and the gradients beside them, three integers a voxel and one voxel's more at the end
+    /// (a pair's six integers are read eight at a time, with the values put in the last two).
+    Compact {
+        values: Arc<Vec<i16>>,
+        gradients: Vec<[i16; 3]>,
+        quantised: Quantised,
+    },
 }
 
 impl Voxels {
     /// `volume`'s voxels in `layout`, gradients by central differences one voxel apart (the
     /// outer sample clamped to the grid), turned to world axes.
     pub(super) fn new(volume: &Volume, layout: Layout) -> Self {
-        let (samples, range) = (volume.samples(), volume.range());
+        match volume.samples() {
+            Samples::Whole(values) => Self::of(volume, values, layout),
+            Samples::Float(values) => Self::of(volume, values, layout),
+        }
+    }
+
+    /// [`Voxels::new`] over the volume's `samples`.
+    fn of<T: Sample>(volume: &Volume, samples: &[T], layout: Layout) -> Self {
+        let range = volume.range();
         let to_world_gradient = volume.to_index().transpose();
         let [nx, ny, nz] = volume.dims();
-        let at = |i: usize, j: usize, k: usize| samples[i + nx * (j + ny * k)];
+        let at = |i: usize, j: usize, k: usize| -> f32 { samples[i + nx * (j + ny * k)].into() };
         let gradient = |i: usize, j: usize, k: usize| {
             let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nx - 1));
             let (j0, j1) = (j.saturating_sub(1), (j + 1).min(ny - 1));
@@ -93,12 +111,30 @@ impl Voxels {
                     rows.y_axis.abs().element_sum(),
                     rows.z_axis.abs().element_sum(),
                 ) * half_range;
-                let quantised = Quantised::new(volume.whole_numbers(), range, steepest);
-                let mut voxels = vec![[0_i16; 4]; samples.len()];
-                fill(&mut voxels, nx * ny, nx, |i, j, k| {
-                    quantised.encode(at(i, j, k), gradient(i, j, k))
+                let held = match volume.samples() {
+                    Samples::Whole(values) => Some(values),
+                    Samples::Float(_) => None,
+                };
+                let quantised = Quantised::new(held.is_some(), range, steepest);
+                let values = held.map_or_else(
+                    || {
+                        let mut values = vec![0_i16; samples.len()];
+                        fill(&mut values, nx * ny, nx, |i, j, k| {
+                            quantised.encode_value(at(i, j, k))
+                        });
+                        Arc::new(values)
+                    },
+                    Arc::clone,
+                );
+                let mut gradients = vec![[0_i16; 3]; samples.len() + 1];
+                fill(&mut gradients[..samples.len()], nx * ny, nx, |i, j, k| {
+                    quantised.encode_gradient(gradient(i, j, k))
                 });
-                Voxels::Compact(voxels, quantised)
+                Voxels::Compact {
+                    values,
+                    gradients,
+                    quantised,
+                }
             }
         }
     }
@@ -116,15 +152,28 @@ impl Voxels {
                     .first_chunk()
                     .expect("a cell's corners lie inside the grid")
             }),
-            Voxels::Compact(voxels, quantised) => {
-                let stored = trilinear(at, f, nx, nxy, |voxel| {
-                    let pair: &[i16; 8] = voxels[voxel..]
+            Voxels::Compact {
+                values,
+                gradients,
+                quantised,
+            } => {
+                // Lanes `[x0, y0, z0, x1, y1, z1, v0, v1]`: one 16-byte read of the pair's
+                // gradients (and two integers past them), its last two lanes the values.
+                let lanes = trilinear_lanes(at, nx, nxy, f, |voxel| {
+                    let mut pair = *gradients[voxel..]
                         .as_flattened()
+                        .first_chunk::<8>()
+                        .expect("a cell's corners lie inside the grid");
+                    let [v0, v1] = *values[voxel..]
                         .first_chunk()
                         .expect("a cell's corners lie inside the grid");
+                    pair[6] = v0;
+                    pair[7] = v1;
                     pair.map(f32::from)
                 });
-                quantised.decode(stored)
+                let low = Vec4::new(lanes[6], lanes[0], lanes[1], lanes[2]);
+                let high = Vec4::new(lanes[7], lanes[3], lanes[4], lanes[5]);
+                quantised.decode(low + (high - low) * f.x)
             }
         }
     }
@@ -133,12 +182,17 @@ impl Voxels {
     pub(super) fn exact(&self) -> Cow<'_, [[f32; 4]]> {
         match self {
             Voxels::Exact(voxels) => Cow::Borrowed(voxels),
-            Voxels::Compact(voxels, quantised) => Cow::Owned(
-                voxels
+            Voxels::Compact {
+                values,
+                gradients,
+                quantised,
+            } => Cow::Owned(
+                values
                     .iter()
-                    .map(|voxel| {
+                    .zip(gradients)
+                    .map(|(&value, &[x, y, z])| {
                         quantised
-                            .decode(Vec4::from_array(voxel.map(f32::from)))
+                            .decode(Vec4::from_array([value, x, y, z].map(f32::from)))
                             .to_array()
                     })
                     .collect(),
@@ -148,13 +202,18 @@ impl Voxels {
 
     /// The largest difference between a stored value and the volume's, and between a stored
     /// gradient's components and the exact ones: 0 for the exact layout, half a step for
-    /// the compact one.
+    /// the compact one (0 for values it reads from the volume's own integers).
     pub(super) fn quantisation_error(&self) -> (f32, Vec3) {
         match self {
             Voxels::Exact(_) => (0.0, Vec3::ZERO),
-            Voxels::Compact(_, quantised) => {
+            Voxels::Compact { quantised, .. } => {
                 let [value, x, y, z] = quantised.scale;
-                (0.5 * value, 0.5 * Vec3::new(x, y, z))
+                let value = if quantised.exact_values {
+                    0.0
+                } else {
+                    0.5 * value
+                };
+                (value, 0.5 * Vec3::new(x, y, z))
             }
         }
     }
@@ -180,15 +239,29 @@ fn fill<T: Send>(
         });
 }
 
-/// [`Voxels::trilinear`] over pairs read by `pair`.
+/// [`Voxels::trilinear`] over pairs read by `pair`, laid out `[v0, x0, y0, z0, v1, x1, y1,
+/// z1]`.
 #[inline(always)]
 fn trilinear(at: usize, f: Vec3, nx: usize, nxy: usize, pair: impl Fn(usize) -> [f32; 8]) -> Vec4 {
-    let near = lerp8(pair(at), pair(at + nx), f.y);
-    let far = lerp8(pair(at + nxy), pair(at + nxy + nx), f.y);
-    let ends = lerp8(near, far, f.z);
+    let ends = trilinear_lanes(at, nx, nxy, f, pair);
     let low = Vec4::from_slice(&ends[..4]);
     let high = Vec4::from_slice(&ends[4..]);
     low + (high - low) * f.x
+}
+
+/// The cell's four pairs read by `pair`, interpolated along `y` and `z`, lane by lane: what
+/// is left is the pair's two ends along `x`.
+#[inline(always)]
+fn trilinear_lanes(
+    at: usize,
+    nx: usize,
+    nxy: usize,
+    f: Vec3,
+    pair: impl Fn(usize) -> [f32; 8],
+) -> [f32; 8] {
+    let near = lerp8(pair(at), pair(at + nx), f.y);
+    let far = lerp8(pair(at + nxy), pair(at + nxy + nx), f.y);
+    lerp8(near, far, f.z)
 }
 
 /// `a + (b - a) t`, lane by lane.
@@ -208,13 +281,17 @@ pub(super) struct Quantised {
     scale: [f32; 4],
     inverse_scale: [f32; 4],
     offset: [f32; 4],
+    /// Whether the stored values are the volume's own (its integers, or its one value).
+    exact_values: bool,
 }
 
 impl Quantised {
     const LARGEST: f32 = 32_767.0;
 
-    fn new(whole: bool, (lo, hi): (f32, f32), steepest: Vec3) -> Self {
-        let (value_scale, value_offset) = if whole && lo >= -Self::LARGEST && hi <= Self::LARGEST {
+    /// Integers for values in `[lo, hi]` (the volume's own when `integers`: scale 1, offset
+    /// 0) and for gradients up to `steepest` along each world axis.
+    fn new(integers: bool, (lo, hi): (f32, f32), steepest: Vec3) -> Self {
+        let (value_scale, value_offset) = if integers {
             (1.0, 0.0)
         } else if hi > lo {
             ((hi - lo) / (2.0 * Self::LARGEST), 0.5 * (lo + hi))
@@ -238,21 +315,35 @@ impl Quantised {
             scale,
             inverse_scale: scale.map(|s| 1.0 / s),
             offset: [value_offset, 0.0, 0.0, 0.0],
+            exact_values: integers || hi <= lo,
         }
     }
 
-    /// A voxel's value and world gradient as integers: the nearest, rounded by adding and
-    /// taking away `1.5 * 2^23` (the sum's spacing is 1), which needs no library call on a
-    /// baseline CPU where `f32::round` does.
+    /// A value as an integer: the nearest, rounded by adding and taking away `1.5 * 2^23`
+    /// (the sum's spacing is 1), which needs no library call on a baseline CPU where
+    /// `f32::round` does.
     #[inline(always)]
-    fn encode(&self, value: f32, gradient: Vec3) -> [i16; 4] {
+    fn encode_value(&self, value: f32) -> i16 {
+        self.encode(0, value)
+    }
+
+    /// A world gradient as integers ([`Quantised::encode_value`]'s rounding).
+    #[inline(always)]
+    fn encode_gradient(&self, gradient: Vec3) -> [i16; 3] {
+        [
+            self.encode(1, gradient.x),
+            self.encode(2, gradient.y),
+            self.encode(3, gradient.z),
+        ]
+    }
+
+    /// Component `c`'s `number` as its nearest integer.
+    #[inline(always)]
+    fn encode(&self, c: usize, number: f32) -> i16 {
         const ROUND: f32 = 12_582_912.0;
-        let numbers = [value, gradient.x, gradient.y, gradient.z];
-        core::array::from_fn(|c| {
-            let scaled = ((numbers[c] - self.offset[c]) * self.inverse_scale[c])
-                .clamp(-Self::LARGEST, Self::LARGEST);
-            ((scaled + ROUND) - ROUND) as i16
-        })
+        let scaled = ((number - self.offset[c]) * self.inverse_scale[c])
+            .clamp(-Self::LARGEST, Self::LARGEST);
+        ((scaled + ROUND) - ROUND) as i16
     }
 
     /// A voxel's (or an interpolation of voxels') value and gradient from its integers.

@@ -22,7 +22,7 @@ pub use lighting::{Light, Lighting, RayView, Shading};
 pub use view::{surface_camera, RayCamera, View};
 
 use super::march::ray::{march_rays, Highlight, Lit, Ray};
-use super::march::{Classification, PreparedVolume};
+use super::march::PreparedVolume;
 use super::transfer::TransferFunction;
 use super::{Volume, VolumeError};
 use crate::image::Image;
@@ -199,7 +199,7 @@ fn render_images(
         step,
         lighting,
     } = DvrPlan::new(volume, settings)?;
-    let classification = Classification::new(prepared, transfer);
+    let classification = prepared.classification(transfer);
     let level = specula::simd::Level::detect();
     let highlights: Vec<Highlight> = match (&lighting, lobes) {
         (None, _) => Vec::new(),
