@@ -20,7 +20,7 @@
 use std::borrow::Cow;
 use std::sync::Arc;
 
-use glam::{Vec3, Vec4};
+use glam::{Mat3, Vec3, Vec4};
 use rayon::prelude::*;
 
 use crate::volume::{Sample, Samples, Volume};
@@ -77,26 +77,12 @@ impl Voxels {
     fn of<T: Sample>(volume: &Volume, samples: &[T], layout: Layout) -> Self {
         let range = volume.range();
         let to_world_gradient = volume.to_index().transpose();
-        let [nx, ny, nz] = volume.dims();
-        let at = |i: usize, j: usize, k: usize| -> f32 { samples[i + nx * (j + ny * k)].into() };
-        let gradient = |i: usize, j: usize, k: usize| {
-            let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nx - 1));
-            let (j0, j1) = (j.saturating_sub(1), (j + 1).min(ny - 1));
-            let (k0, k1) = (k.saturating_sub(1), (k + 1).min(nz - 1));
-            let along_index = 0.5
-                * Vec3::new(
-                    at(i1, j, k) - at(i0, j, k),
-                    at(i, j1, k) - at(i, j0, k),
-                    at(i, j, k1) - at(i, j, k0),
-                );
-            to_world_gradient * along_index
-        };
+        let dims = volume.dims();
         match layout {
             Layout::Exact => {
                 let mut voxels = vec![[0.0; 4]; samples.len()];
-                fill(&mut voxels, nx * ny, nx, |i, j, k| {
-                    let g = gradient(i, j, k);
-                    [at(i, j, k), g.x, g.y, g.z]
+                fill_gradients(samples, dims, to_world_gradient, &mut voxels, |value, g| {
+                    [value, g.x, g.y, g.z]
                 });
                 Voxels::Exact(voxels)
             }
@@ -118,18 +104,22 @@ impl Voxels {
                 let quantised = Quantised::new(held.is_some(), range, steepest);
                 let values = held.map_or_else(
                     || {
-                        let mut values = vec![0_i16; samples.len()];
-                        fill(&mut values, nx * ny, nx, |i, j, k| {
-                            quantised.encode_value(at(i, j, k))
-                        });
-                        Arc::new(values)
+                        let encoded = samples
+                            .par_iter()
+                            .map(|&v| quantised.encode_value(v.into()))
+                            .collect();
+                        Arc::new(encoded)
                     },
                     Arc::clone,
                 );
                 let mut gradients = vec![[0_i16; 3]; samples.len() + 1];
-                fill(&mut gradients[..samples.len()], nx * ny, nx, |i, j, k| {
-                    quantised.encode_gradient(gradient(i, j, k))
-                });
+                fill_gradients(
+                    samples,
+                    dims,
+                    to_world_gradient,
+                    &mut gradients[..samples.len()],
+                    |_, g| quantised.encode_gradient(g),
+                );
                 Voxels::Compact {
                     values,
                     gradients,
@@ -219,21 +209,37 @@ impl Voxels {
     }
 }
 
-/// Sets every voxel of `voxels` (slices of `slice` voxels, rows of `nx`) to `voxel(i, j, k)`,
-/// in parallel over slices.
-fn fill<T: Send>(
-    voxels: &mut [T],
-    slice: usize,
-    nx: usize,
-    voxel: impl Fn(usize, usize, usize) -> T + Sync,
+/// Sets `out[v]` to `voxel(value, gradient)` for every voxel `v` of `samples` (a grid of
+/// `dims`), the gradient by central differences one voxel apart (the outer sample clamped to
+/// the grid) turned to world axes by `to_world_gradient`. Row by row, in parallel over
+/// slices: a row and its four neighbours along `j` and `k` are read side by side, with no
+/// index arithmetic per voxel (against a closure over `(i, j, k)`: a clinical-size CT's
+/// compact voxels 1.6 -> 0.49 s, the real CT's exact ones 47 -> 31 ms).
+fn fill_gradients<T: Sample, O: Send>(
+    samples: &[T],
+    [nx, ny, nz]: [usize; 3],
+    to_world_gradient: Mat3,
+    out: &mut [O],
+    voxel: impl Fn(f32, Vec3) -> O + Sync,
 ) {
-    voxels
-        .par_chunks_mut(slice)
+    let row = |j: usize, k: usize| &samples[nx * (j + ny * k)..][..nx];
+    out.par_chunks_mut(nx * ny)
         .enumerate()
-        .for_each(|(k, voxels)| {
-            for (j, row) in voxels.chunks_exact_mut(nx).enumerate() {
-                for (i, out) in row.iter_mut().enumerate() {
-                    *out = voxel(i, j, k);
+        .for_each(|(k, slice)| {
+            let (k0, k1) = (k.saturating_sub(1), (k + 1).min(nz - 1));
+            for (j, out) in slice.chunks_exact_mut(nx).enumerate() {
+                let (j0, j1) = (j.saturating_sub(1), (j + 1).min(ny - 1));
+                let (here, before_j, after_j, before_k, after_k) =
+                    (row(j, k), row(j0, k), row(j1, k), row(j, k0), row(j, k1));
+                for (i, out) in out.iter_mut().enumerate() {
+                    let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nx - 1));
+                    let difference = |a: T, b: T| 0.5 * (a.into() - b.into());
+                    let along_index = Vec3::new(
+                        difference(here[i1], here[i0]),
+                        difference(after_j[i], before_j[i]),
+                        difference(after_k[i], before_k[i]),
+                    );
+                    *out = voxel(here[i].into(), to_world_gradient * along_index);
                 }
             }
         });
