@@ -209,6 +209,20 @@ impl PreparedVolume {
         self.voxels.trilinear(at, f, nx, nxy)
     }
 
+    /// Whether the voxels are too many for the caches (held in the compact layout), so that
+    /// the march fetches them ahead of its samples.
+    #[must_use]
+    fn outgrows_caches(&self) -> bool {
+        self.voxels.layout() == Layout::Compact
+    }
+
+    /// Asks for the cache lines of the cell whose first voxel is `at` (within the grid).
+    #[inline(always)]
+    fn prefetch(&self, at: usize, prefetch: specula::simd::Prefetch) {
+        let nxy = self.dims[0] * self.dims[1];
+        self.voxels.prefetch(at, nxy, prefetch);
+    }
+
     /// The index of the brick holding `cell` (`i32` arithmetic, as [`Self::voxel`]).
     #[inline(always)]
     fn brick(&self, cell: [i32; 3]) -> i32 {

@@ -20,7 +20,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use glam::{IVec3, Vec3};
-use specula::simd::{dispatch, exp2_nonpositive, Job, Lanes, Level};
+use specula::simd::{dispatch, exp2_nonpositive, Job, Lanes, Level, Prefetch};
 
 use super::{Classification, PreparedVolume};
 use crate::volume::raymarch::lighting::LanesView;
@@ -40,6 +40,12 @@ pub(crate) struct Ray {
 /// Rays a packet marches side by side: one AVX2 vector of `f32` (a multiple of every
 /// level's width).
 pub(crate) const LANES: usize = 8;
+
+/// Steps ahead of each sample that a volume larger than the caches is fetched into them: the
+/// march otherwise waits on memory at every sample (a clinical-size CT: frames 15 % faster
+/// with it; on the real CT, whose voxels the caches hold, the extra work made frames 4 %
+/// slower, so it is left out there).
+const LOOKAHEAD: usize = 3;
 
 /// Highlights gathered before their lobe is evaluated together.
 const HIGHLIGHTS: usize = 64;
@@ -103,29 +109,43 @@ pub(crate) fn march_rays(
     if let Some(lit) = lit {
         assert_eq!(rays.len(), lit.views.len(), "march_rays: one view per ray");
     }
-    dispatch(
-        level,
-        Packet {
-            volume,
-            classification,
-            lit,
-            rays,
-            step,
-            opacity_cutoff,
-            images,
-            out,
-        },
-    );
+    let lookahead = LOOKAHEAD as f32 * step;
+    macro_rules! packet {
+        ($fetch:literal) => {
+            Packet::<$fetch> {
+                volume,
+                classification,
+                lit,
+                rays,
+                step,
+                opacity_cutoff,
+                prefetch: Prefetch::new(),
+                lookahead,
+                images,
+                out,
+            }
+        };
+    }
+    if volume.outgrows_caches() {
+        dispatch(level, packet!(true));
+    } else {
+        dispatch(level, packet!(false));
+    }
 }
 
-/// [`march_rays`]'s work, as the instruction-set dispatch takes it.
-struct Packet<'a> {
+/// [`march_rays`]'s work, as the instruction-set dispatch takes it; `FETCH`: with the voxels
+/// fetched into the cache [`LOOKAHEAD`] steps ahead of each sample (a parameter, so that each
+/// form is compiled apart: a test per lane would keep the segment loop from vectorising).
+struct Packet<'a, const FETCH: bool> {
     volume: &'a PreparedVolume,
     classification: &'a Classification,
     lit: Option<Lit<'a>>,
     rays: &'a [Ray],
     step: f32,
     opacity_cutoff: f32,
+    prefetch: Prefetch,
+    /// How far ahead of each sample (mm along the ray) the voxels are fetched when `FETCH`.
+    lookahead: f32,
     /// Results per ray: ray `r`'s for image `i` is `out[r * images + i]`.
     images: usize,
     out: &'a mut [Marched],
@@ -163,6 +183,8 @@ struct Turn {
     cell: [Lane<i32>; 3],
     /// The cell's first voxel, and the brick holding it.
     voxel: Lane<i32>,
+    /// Where the cell [`LOOKAHEAD`] steps further on starts, when the volume is prefetched.
+    ahead: Lane<i32>,
     brick: Lane<i32>,
     /// The midpoint's place in its cell.
     fraction: [Lane<f32>; 3],
@@ -202,6 +224,7 @@ impl Turn {
     const EMPTY: Self = Self {
         cell: [[0; LANES]; 3],
         voxel: [0; LANES],
+        ahead: [0; LANES],
         brick: [0; LANES],
         fraction: [[0.0; LANES]; 3],
         length: [0.0; LANES],
@@ -265,7 +288,7 @@ fn load3<V: Lanes>(lanes: V, arrays: &[Lane<f32>; 3], at: usize) -> [V; 3] {
     ]
 }
 
-impl Job for Packet<'_> {
+impl<const FETCH: bool> Job for Packet<'_, FETCH> {
     type Output = ();
 
     #[inline(always)]
@@ -330,7 +353,7 @@ impl Job for Packet<'_> {
     }
 }
 
-impl Packet<'_> {
+impl<const FETCH: bool> Packet<'_, FETCH> {
     /// Lane `k` takes ray `next` of the list (its result cleared) and `next` moves on, or the
     /// lane idles when the list has run out.
     #[inline(always)]
@@ -407,6 +430,8 @@ impl Packet<'_> {
         let length = next.min(marching.end[k]) - marching.t[k];
         turn.length[k] = length;
         let middle = marching.t[k] + 0.5 * length;
+        let further = middle + self.lookahead;
+        let mut ahead = [0; 3];
         for axis in 0..3 {
             let p = (marching.origin[axis][k] + marching.direction[axis][k] * middle)
                 .max(0.0)
@@ -414,10 +439,19 @@ impl Packet<'_> {
             let (cell, fraction) = PreparedVolume::cell_along(p, volume.last_cell[axis]);
             turn.cell[axis][k] = cell;
             turn.fraction[axis][k] = fraction;
+            if FETCH {
+                let q = (marching.origin[axis][k] + marching.direction[axis][k] * further)
+                    .max(0.0)
+                    .min(volume.last_index[axis]);
+                ahead[axis] = PreparedVolume::cell_along(q, volume.last_cell[axis]).0;
+            }
         }
         let cell = [turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]];
         turn.voxel[k] = volume.voxel(cell);
         turn.brick[k] = volume.brick(cell);
+        if FETCH {
+            turn.ahead[k] = volume.voxel(ahead);
+        }
         marching.t[k] = next;
         marching.j[k] = j + 1;
     }
@@ -432,6 +466,9 @@ impl Packet<'_> {
                 let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
                 self.skip(marching, k, cell, clearance);
             } else {
+                if FETCH {
+                    self.volume.prefetch(turn.ahead[k] as usize, self.prefetch);
+                }
                 self.read(turn, k);
             }
         }

@@ -23,6 +23,8 @@ use std::sync::Arc;
 use glam::{Mat3, Vec3, Vec4};
 use rayon::prelude::*;
 
+use specula::simd::Prefetch;
+
 use crate::volume::{Sample, Samples, Volume};
 
 /// How the prepared voxels are held (see the module docs).
@@ -164,6 +166,35 @@ impl Voxels {
                 let low = Vec4::new(lanes[6], lanes[0], lanes[1], lanes[2]);
                 let high = Vec4::new(lanes[7], lanes[3], lanes[4], lanes[5]);
                 quantised.decode(low + (high - low) * f.x)
+            }
+        }
+    }
+
+    /// The layout.
+    pub(super) fn layout(&self) -> Layout {
+        match self {
+            Voxels::Exact(_) => Layout::Exact,
+            Voxels::Compact { .. } => Layout::Compact,
+        }
+    }
+
+    /// Asks for the cache lines where the cell whose first voxel is `at` (on a grid of `nxy`
+    /// voxels to a slice) starts in each of its two slices: its rows further along `j` are
+    /// the next samples' first rows, already asked for when the march steps along `j`.
+    #[inline(always)]
+    pub(super) fn prefetch(&self, at: usize, nxy: usize, prefetch: Prefetch) {
+        match self {
+            Voxels::Exact(voxels) => {
+                prefetch.line(&voxels[at]);
+                prefetch.line(&voxels[at + nxy]);
+            }
+            Voxels::Compact {
+                values, gradients, ..
+            } => {
+                prefetch.line(&values[at]);
+                prefetch.line(&values[at + nxy]);
+                prefetch.line(&gradients[at]);
+                prefetch.line(&gradients[at + nxy]);
             }
         }
     }
