@@ -1,10 +1,13 @@
 //! `specula lobe`: start a lobe file of your own, and check one before using it.
 
+use std::collections::BTreeSet;
 use std::path::PathBuf;
 
+use specula::analysis::{self, Shape};
 use specula::{Lobe, LobeKind};
 
 use super::CommandResult;
+use crate::args::Format;
 use crate::output::Table;
 
 /// Arguments of `specula lobe`.
@@ -18,8 +21,9 @@ pub struct Args {
 enum LobeCommand {
     /// Write a lobe file to start from: the thesis's K_4 written as a formula, commented.
     New(NewArgs),
-    /// Check a lobe (a file or a formula) at every exponent of a range, and show what it
-    /// compiles to: its constants, operations and sampling.
+    /// Check a lobe (a file or a formula) at every exponent of a range: its peak and where it
+    /// lies, its value at t = 1, its epicentre error against t^n and its energy at five of
+    /// them, and what it compiles to (constants, operations, sampling).
     Check(CheckArgs),
 }
 
@@ -37,6 +41,9 @@ struct CheckArgs {
     /// The exponents to check at: one, or `LOW..HIGH` (31 steps, logarithmic).
     #[arg(long, default_value = "1..1000", allow_hyphen_values = true)]
     n: String,
+    /// Output format: `csv` and `json` give the shape at five exponents, numbers only.
+    #[arg(long, value_enum, default_value_t)]
+    format: Format,
 }
 
 /// The worked example a new lobe file starts as.
@@ -100,6 +107,44 @@ fn check(args: &CheckArgs) -> CommandResult {
     }
     let (first, last) = (exponents[0], exponents[exponents.len() - 1]);
     let lobe = Lobe::new(args.lobe, first);
+    // Its shape at five exponents spread over the range (the ends, the quarters, the middle).
+    let picks: BTreeSet<usize> = [0, 1, 2, 3, 4]
+        .map(|quarter| quarter * (exponents.len() - 1) / 4)
+        .into_iter()
+        .collect();
+    let shapes: Vec<Shape> = picks
+        .iter()
+        .map(|&i| analysis::shape(&Lobe::new(args.lobe, exponents[i])))
+        .collect();
+    warn_of(&shapes);
+    let rows: Vec<ShapeRow> = shapes.iter().map(ShapeRow::from).collect();
+    if args.format == Format::Json {
+        return super::print_json(&rows);
+    }
+    let mut table = Table::new(&[
+        "n",
+        "peak",
+        "peak at t",
+        "peak angle from the mirror direction (degrees)",
+        "at t = 1",
+        "epicentre error against t^n (%)",
+        "energy ratio (1 = t^n's)",
+    ]);
+    for row in &rows {
+        table.push(vec![
+            significant(row.n),
+            format!("{:.6}", row.peak),
+            format!("{:.6}", row.peak_t),
+            format!("{:.3}", row.peak_degrees),
+            format!("{:.6}", row.at_t_1),
+            format!("{:.4}", row.epicentre_error_percent),
+            format!("{:.4}", row.energy_ratio),
+        ]);
+    }
+    if args.format == Format::Csv {
+        table.print(Format::Csv);
+        return Ok(());
+    }
     println!(
         "{}: a lobe in [0, 1] at every n checked ({} from {first} to {last}); sampled by {}",
         args.lobe,
@@ -107,6 +152,7 @@ fn check(args: &CheckArgs) -> CommandResult {
         lobe.warp().id()
     );
     println!("operations per evaluation: {}", lobe.ops());
+    table.print(Format::Table);
     let mut table = Table::new(&["constant", &format!("n = {first}"), &format!("n = {last}")]);
     let at_last = Lobe::new(args.lobe, last);
     for parameter in lobe.parameters() {
@@ -122,6 +168,78 @@ fn check(args: &CheckArgs) -> CommandResult {
             value_at(&at_last),
         ]);
     }
-    table.print(crate::args::Format::Table);
+    table.print(Format::Table);
     Ok(())
+}
+
+/// One exponent's shape as `lobe check` prints it, with the units its names say.
+#[derive(Debug, serde::Serialize)]
+struct ShapeRow {
+    n: f64,
+    peak: f64,
+    /// The cosine where the peak lies.
+    peak_t: f64,
+    peak_degrees: f64,
+    at_t_1: f64,
+    epicentre_error_percent: f64,
+    energy_ratio: f64,
+}
+
+impl From<&Shape> for ShapeRow {
+    fn from(shape: &Shape) -> Self {
+        Self {
+            n: shape.n,
+            peak: shape.peak,
+            peak_t: shape.peak_cos,
+            peak_degrees: shape.peak_angle_degrees(),
+            at_t_1: shape.at_one,
+            epicentre_error_percent: 100.0 * shape.epicentre_max_rel,
+            energy_ratio: shape.energy_ratio,
+        }
+    }
+}
+
+/// Warns, on stderr, of a lobe that is not 1 at `t = 1` or that peaks elsewhere, at the
+/// first exponent where it happens.
+fn warn_of(shapes: &[Shape]) {
+    if let Some(shape) = shapes.iter().find(|shape| !shape.reaches_one()) {
+        let change = if shape.at_one < 1.0 {
+            "dims"
+        } else {
+            "brightens"
+        };
+        let remedy = if shape.at_one > 0.0 {
+            "; divide the formula by its value at t = 1"
+        } else {
+            ""
+        };
+        eprintln!(
+            "warning: the lobe is {:.6} at t = 1 (n = {}), not 1: it {change} every highlight{remedy}",
+            shape.at_one,
+            significant(shape.n)
+        );
+    }
+    if let Some(shape) = shapes
+        .iter()
+        .find(|shape| shape.peak > shape.at_one + Shape::REACHES_ONE)
+    {
+        eprintln!(
+            "warning: the lobe peaks at {:.6} where t = {:.6} ({:.2} degrees from the mirror direction, n = {}), above its value at t = 1: its highlights move off the mirror direction",
+            shape.peak,
+            shape.peak_cos,
+            shape.peak_angle_degrees(),
+            significant(shape.n)
+        );
+    }
+}
+
+/// `n` to five significant digits, without trailing zeros.
+fn significant(n: f64) -> String {
+    let digits = (4 - n.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    let text = format!("{n:.digits$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_owned()
+    } else {
+        text
+    }
 }

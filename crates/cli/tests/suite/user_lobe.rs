@@ -279,6 +279,89 @@ fn a_new_lobe_goes_through_every_command() {
 
 /// Bad formulas, files and values: exit code 2, one line naming the problem, before any
 /// work (a 10 MB formula and a 10,000-deep one are refused at once).
+/// `lobe check` states a lobe's shape with figures its closed form gives: `t^n / (1 + t)`
+/// peaks at 1/2 where `t = 1`, lies `t / (1 + t)` below `t^n` relatively (1/2 at the
+/// mirror direction, the epicentre's worst), and carries `(n + 1) int_0^1 t^n / (1 + t) dt`
+/// of `t^n`'s energy (here by the midpoint rule); it warns that the lobe does not reach 1.
+/// `t^n` itself gets no warning. The CSV is numbers under one header, nothing before it.
+#[test]
+fn lobe_check_states_the_peak_the_error_and_the_energy() {
+    let directory = tempfile::tempdir().unwrap();
+    let dir = directory.path();
+    let output = ok(
+        dir,
+        &[
+            "lobe",
+            "check",
+            "=t^n/(1+t)",
+            "--n",
+            "8",
+            "--format",
+            "json",
+        ],
+    );
+    let rows: Vec<Value> = serde_json::from_slice(&output.stdout).expect("JSON");
+    let [row] = rows.as_slice() else {
+        panic!("one exponent, one row: {rows:?}");
+    };
+    let number = |field: &str| {
+        row[field]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{field}: {row}"))
+    };
+    assert_eq!(number("n"), 8.0);
+    assert!((number("peak") - 0.5).abs() < 1e-9, "{row}");
+    assert!(number("peak_degrees") < 1e-3, "{row}");
+    assert!((number("at_t_1") - 0.5).abs() < 1e-12, "{row}");
+    assert!(
+        (number("epicentre_error_percent") - 50.0).abs() < 0.1,
+        "{row}"
+    );
+    let steps = 100_000;
+    let energy = 9.0
+        * (0..steps)
+            .map(|i| {
+                let t = (f64::from(i) + 0.5) / f64::from(steps);
+                t.powi(8) / (1.0 + t)
+            })
+            .sum::<f64>()
+        / f64::from(steps);
+    assert!(
+        (number("energy_ratio") - energy).abs() < 1e-5,
+        "{row} {energy}"
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("warning: the lobe is 0.500000 at t = 1 (n = 8), not 1: it dims"),
+        "{stderr}"
+    );
+    let plain = ok(
+        dir,
+        &["lobe", "check", "=t^n", "--n", "1..100", "--format", "csv"],
+    );
+    assert!(
+        plain.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&plain.stderr)
+    );
+    let csv = String::from_utf8_lossy(&plain.stdout);
+    let mut lines = csv.lines();
+    assert!(lines.next().unwrap().starts_with("n,peak,"), "{csv}");
+    let rows: Vec<Vec<f64>> = lines
+        .map(|line| {
+            line.split(',')
+                .map(|cell| cell.parse().expect(cell))
+                .collect()
+        })
+        .collect();
+    assert_eq!(rows.len(), 5, "{csv}");
+    for row in rows {
+        // Peak 1 at the mirror direction, no error, t^n's own energy.
+        assert_eq!(&row[1..6], &[1.0, 1.0, 0.0, 1.0, 0.0], "{csv}");
+        assert!((row[6] - 1.0).abs() < 1e-4, "{csv}");
+    }
+}
+
 #[test]
 fn bad_formulas_get_one_line_each() {
     let directory = tempfile::tempdir().unwrap();

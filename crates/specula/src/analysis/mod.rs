@@ -6,6 +6,7 @@
 pub mod albedo;
 pub mod error;
 pub mod reciprocity;
+pub mod shape;
 
 use glam::DVec3;
 use serde::Serialize;
@@ -16,6 +17,7 @@ pub use error::{
     DEFAULT_SAMPLES_PER_ZONE,
 };
 pub use reciprocity::max_reciprocity_error;
+pub use shape::{shape, Shape};
 
 use crate::normalisation::{lobe_constant, lobe_integral};
 use crate::ops::OpCounts;
