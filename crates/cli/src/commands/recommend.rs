@@ -99,18 +99,51 @@ pub fn run(args: &Args) -> CommandResult {
     let (zone, target) = (args.zone, args.target);
     // Off the FPGA, pow is exact, keeps t^n's energy and so always meets the request; the
     // FPGA has no datapath for it, so there nothing may meet it.
-    match answer.best_candidate().map(|c| &c.lobe) {
-        Some(lobe) => println!(
+    let verdict = match answer.best_candidate().map(|c| &c.lobe) {
+        Some(lobe) => format!(
             "{lobe}: the cheapest lobe within {} % ({zone} error) at {span} on {target}",
             100.0 * max_error
         ),
-        None => println!(
+        None => format!(
             "no lobe is within {} % ({zone} error) at {span} on {target}; every lobe is listed, \
              with the Pareto front marked",
             100.0 * max_error
         ),
-    }
+    };
     let pow_rate = answer.pow_rate();
+    if args.format == crate::args::Format::Csv {
+        // Data alone on stdout: numbers, ids and booleans under a header that names the
+        // units; the verdict goes to stderr.
+        eprintln!("{verdict}");
+        let rate = format!("rate ({})", answer.unit);
+        let mut table = Table::new(&[
+            "lobe",
+            "meets",
+            "error (%)",
+            &rate,
+            "throughput vs pow (x; higher is cheaper)",
+            "energy ratio",
+            "pareto",
+        ]);
+        for c in &answer.candidates {
+            table.push(vec![
+                c.lobe.clone(),
+                c.meets.to_string(),
+                if c.error.is_finite() {
+                    format!("{}", 100.0 * c.error)
+                } else {
+                    String::new()
+                },
+                format!("{}", c.rate),
+                format!("{}", c.rate / pow_rate),
+                format!("{}", c.energy_ratio),
+                c.pareto.to_string(),
+            ]);
+        }
+        table.print(args.format);
+        return Ok(());
+    }
+    println!("{verdict}");
     let mut table = Table::new(&[
         "lobe",
         "meets",
