@@ -3,6 +3,13 @@
 
 pub use specula_report::format::{percent, sig};
 
+/// A number as data: every digit `f64` holds (the shortest text that reads back as the same
+/// number), in exponent form where it is very small or large.
+#[must_use]
+pub fn number(value: f64) -> String {
+    format!("{value:?}")
+}
+
 /// A table of strings with a header row.
 pub struct Table {
     header: Vec<String>,

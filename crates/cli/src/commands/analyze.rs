@@ -3,12 +3,13 @@
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use specula::analysis::{analyze, analyze_all, LobeReport, DEFAULT_EXPONENTS};
+use specula::ops::OpCounts;
 use specula::{Exponent, LobeKind};
 use specula_gpu::{Gpu, GpuEvaluator, LobeEvaluator};
 
 use super::{print_json, CommandResult};
 use crate::args::{parse_exponent, BackendArg, Format};
-use crate::output::{percent, sig, Table};
+use crate::output::{number, percent, sig, Table};
 
 /// Arguments of `specula analyze`.
 #[derive(Debug, clap::Args)]
@@ -79,6 +80,10 @@ pub fn run(args: &Args) -> CommandResult {
     if args.format == Format::Json {
         return print_json(&reports);
     }
+    if args.format == Format::Csv {
+        print_csv(&reports);
+        return Ok(());
+    }
     let mut table = Table::new(&[
         "lobe",
         "n",
@@ -111,4 +116,46 @@ pub fn run(args: &Args) -> CommandResult {
     }
     table.print(args.format);
     Ok(())
+}
+
+/// The reports as data alone: the table's figures as numbers (the epicentre's relative error
+/// in %, as the table gives it), whether the energy's integral converged, and one column of
+/// operations per kind.
+fn print_csv(reports: &[LobeReport]) {
+    let ops = OpCounts::default()
+        .entries()
+        .map(|(name, _)| format!("ops {name}"));
+    let mut header = vec![
+        "lobe",
+        "n",
+        "epicentre max rel (%)",
+        "epicentre max abs",
+        "bloom max abs",
+        "tail max abs",
+        "rms",
+        "energy ratio",
+        "energy converged",
+        "max albedo",
+        "max albedo theta (degrees)",
+    ];
+    header.extend(ops.iter().map(String::as_str));
+    let mut table = Table::new(&header);
+    for r in reports {
+        let mut row = vec![
+            r.lobe.to_string(),
+            r.n.to_string(),
+            number(100.0 * r.errors.epicentre_max_rel),
+            number(r.errors.epicentre_max_abs),
+            number(r.errors.bloom_max_abs),
+            number(r.errors.tail_max_abs),
+            number(r.errors.rms),
+            number(r.energy_ratio),
+            r.energy_converged.to_string(),
+            number(r.max_albedo),
+            number(r.max_albedo_theta_deg),
+        ];
+        row.extend(r.ops.entries().map(|(_, count)| count.to_string()));
+        table.push(row);
+    }
+    table.print(Format::Csv);
 }

@@ -9,7 +9,7 @@ use specula_decide::{recommend, versus_pow, Request, Target, Zone};
 
 use super::CommandResult;
 use crate::args::{described, parse_margin};
-use crate::output::Table;
+use crate::output::{number, Table};
 
 /// Arguments of `specula recommend`.
 #[derive(Debug, clap::Args)]
@@ -130,13 +130,13 @@ pub fn run(args: &Args) -> CommandResult {
                 c.lobe.clone(),
                 c.meets.to_string(),
                 if c.error.is_finite() {
-                    format!("{}", 100.0 * c.error)
+                    number(100.0 * c.error)
                 } else {
                     String::new()
                 },
-                format!("{}", c.rate),
-                format!("{}", c.rate / pow_rate),
-                format!("{}", c.energy_ratio),
+                number(c.rate),
+                number(c.rate / pow_rate),
+                number(c.energy_ratio),
                 c.pareto.to_string(),
             ]);
         }

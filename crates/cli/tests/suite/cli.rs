@@ -263,3 +263,52 @@ fn bad_input_is_a_one_line_error_with_exit_code_two() {
         assert!(output.stdout.is_empty(), "{args:?} wrote output");
     }
 }
+
+/// `analyze --format csv` is data alone: a header, then every figure of the JSON as a number
+/// with all its digits (the epicentre's relative error in %, as the table gives it), the
+/// energy's convergence as a boolean and one column per kind of operation. (Equal within
+/// 1e-14: `serde_json` reads floats to within an ulp, not always to the nearest.)
+#[test]
+fn analyze_csv_carries_the_json_figures_as_numbers() {
+    let args = ["analyze", "--lobe", "schlick,cosquad", "--n", "16,256"];
+    let output = specula(&[&args[..], &["--format", "csv"]].concat());
+    assert!(output.status.success());
+    let csv = String::from_utf8(output.stdout).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|line| line.split(',').collect()).collect();
+    let reports = json(&[&args[..], &["--format", "json"]].concat());
+    let reports = reports.as_array().unwrap();
+    assert_eq!(rows.len(), reports.len());
+    for (row, report) in rows.iter().zip(reports) {
+        assert_eq!(row.len(), header.len());
+        let cell = |name: &str| row[header.iter().position(|h| *h == name).unwrap()];
+        let number = |name: &str| cell(name).parse::<f64>().unwrap();
+        assert_eq!(cell("lobe"), report["lobe"].as_str().unwrap());
+        assert_eq!(number("n"), report["n"].as_f64().unwrap());
+        let near = |a: f64, b: f64| (a - b).abs() <= 1e-14 * b.abs();
+        let relative = report["epicentre_max_rel"].as_f64().unwrap();
+        assert!(near(number("epicentre max rel (%)"), 100.0 * relative));
+        for (column, field) in [
+            ("epicentre max abs", "epicentre_max_abs"),
+            ("rms", "rms"),
+            ("energy ratio", "energy_ratio"),
+            ("max albedo", "max_albedo"),
+        ] {
+            let expected = report[field].as_f64().unwrap();
+            assert!(near(number(column), expected), "{column}: {expected}");
+        }
+        assert_eq!(
+            cell("energy converged"),
+            report["energy_converged"].to_string()
+        );
+        let ops = &report["ops"];
+        for name in ["add", "mul", "square", "cmp"] {
+            assert_eq!(
+                number(&format!("ops {name}")),
+                ops[name].as_f64().unwrap(),
+                "{name}"
+            );
+        }
+    }
+}
