@@ -11,7 +11,7 @@ use specula_report::format::resource_cells;
 
 use super::{print_json, synth, CommandResult};
 use crate::args::Format;
-use crate::output::{percent, sig, Table};
+use crate::output::{number, percent, sig, Table};
 
 /// Arguments of `specula hw`.
 #[derive(Debug, clap::Args)]
@@ -224,10 +224,16 @@ fn table(args: &TableArgs) -> CommandResult {
     if args.format == Format::Json {
         return print_json(&results);
     }
+    // CSV is data: the error in % as a number, with all its digits.
+    let csv = args.format == Format::Csv;
     let mut table = Table::new(&[
         "datapath",
         "bits",
-        "epicentre max rel",
+        if csv {
+            "epicentre max rel (%)"
+        } else {
+            "epicentre max rel"
+        },
         "bloom max abs",
         "multipliers",
         "squarers",
@@ -243,8 +249,16 @@ fn table(args: &TableArgs) -> CommandResult {
             let mut cells = vec![
                 result.lobe.id().to_owned(),
                 row.bits.to_string(),
-                percent(row.errors.epicentre_max_rel),
-                sig(row.errors.bloom_max_abs),
+                if csv {
+                    number(100.0 * row.errors.epicentre_max_rel)
+                } else {
+                    percent(row.errors.epicentre_max_rel)
+                },
+                if csv {
+                    number(row.errors.bloom_max_abs)
+                } else {
+                    sig(row.errors.bloom_max_abs)
+                },
             ];
             cells.extend(resource_cells(&row.resources));
             table.push(cells);

@@ -45,7 +45,11 @@ pub fn run(args: &Args) -> CommandResult {
         .collect();
     match args.format {
         Format::Json => print_json(&rows),
-        Format::Table | Format::Csv => {
+        Format::Csv => {
+            print_csv(&rows);
+            Ok(())
+        }
+        Format::Table => {
             let ops_header = format!("ops at n = {}", args.n);
             let mut table = Table::new(&[
                 "id",
@@ -82,4 +86,34 @@ pub fn run(args: &Args) -> CommandResult {
             Ok(())
         }
     }
+}
+
+/// The registry as data: the ids and texts, then one column per kind of operation (at the
+/// exponent asked for) and their total, numbers where the table writes a list.
+fn print_csv(rows: &[ModelRow]) {
+    let ops = OpCounts::default()
+        .entries()
+        .map(|(name, _)| format!("ops {name}"));
+    let mut header = vec!["id", "origin", "input", "formula", "ops at n"];
+    header.extend(ops.iter().map(String::as_str));
+    header.push("ops total");
+    let mut table = Table::new(&header);
+    for row in rows {
+        let mut cells = vec![
+            row.info.id.to_owned(),
+            row.info.origin.name().to_owned(),
+            if row.info.takes_angle {
+                "angle"
+            } else {
+                "cosine"
+            }
+            .to_owned(),
+            row.info.formula.to_owned(),
+            row.ops_at_n.to_string(),
+        ];
+        cells.extend(row.ops.entries().map(|(_, count)| count.to_string()));
+        cells.push(row.ops_total.to_string());
+        table.push(cells);
+    }
+    table.print(Format::Csv);
 }

@@ -312,3 +312,92 @@ fn analyze_csv_carries_the_json_figures_as_numbers() {
         }
     }
 }
+
+/// Every table a script may read as `--format csv` is data alone: its header is the first
+/// line, and each cell below is a number, `true`/`false`, an id (no spaces, no `%`) or empty;
+/// only a model's formula is text.
+#[test]
+fn csv_tables_hold_data_alone() {
+    let commands: [&[&str]; 5] = [
+        &["analyze", "--lobe", "cosquad,sg", "--n", "8,512"],
+        &[
+            "recommend",
+            "--target",
+            "gpu-amd",
+            "--n",
+            "64",
+            "--max-error",
+            "2%",
+        ],
+        &["models"],
+        &["lobe", "check", "=t^n"],
+        &[
+            "sample",
+            "--lobe",
+            "cosquad",
+            "--n",
+            "64",
+            "--theta-o",
+            "30",
+            "--count",
+            "3",
+        ],
+    ];
+    let identifier = |cell: &str| {
+        !cell.is_empty()
+            && cell
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-_.:=@^".contains(c))
+    };
+    for command in commands {
+        let output = specula(&[command, &["--format", "csv"]].concat());
+        assert!(output.status.success(), "{command:?}");
+        let csv = String::from_utf8(output.stdout).unwrap();
+        let mut lines = csv.lines();
+        let header = lines.next().unwrap_or_default();
+        let columns = csv_cells(header);
+        assert!(
+            columns
+                .iter()
+                .all(|c| !c.is_empty() && c.parse::<f64>().is_err()),
+            "{command:?}: the first line is not a header: {header}"
+        );
+        let mut rows = 0;
+        for line in lines {
+            rows += 1;
+            let cells = csv_cells(line);
+            assert_eq!(cells.len(), columns.len(), "{command:?}: {line}");
+            for (column, cell) in columns.iter().zip(&cells) {
+                let data = cell.is_empty()
+                    || cell.parse::<f64>().is_ok()
+                    || cell == "true"
+                    || cell == "false"
+                    || identifier(cell);
+                assert!(
+                    column == "formula" || (data && !cell.contains('%')),
+                    "{command:?}: {column} = {cell:?} in {line}"
+                );
+            }
+        }
+        assert!(rows > 0, "{command:?}: no rows");
+    }
+}
+
+/// A CSV line's cells (RFC 4180: a quoted cell may hold commas, `""` is a quote).
+fn csv_cells(line: &str) -> Vec<String> {
+    let (mut cells, mut cell, mut quoted) = (Vec::new(), String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                cell.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => cells.push(std::mem::take(&mut cell)),
+            _ => cell.push(c),
+        }
+    }
+    cells.push(cell);
+    cells
+}
