@@ -67,20 +67,14 @@ pub fn run(args: &Args) -> CommandResult {
                     .iter()
                     .map(|p| format!("{}={} [{}..{}]", p.name, p.default, p.min, p.max))
                     .collect();
-                table.push(vec![
-                    row.info.id.to_owned(),
-                    row.info.origin.name().to_owned(),
-                    if row.info.takes_angle {
-                        "angle"
-                    } else {
-                        "cosine"
-                    }
-                    .to_owned(),
+                let mut cells = identity(row.info).to_vec();
+                cells.extend([
                     params.join(" "),
                     row.info.formula.to_owned(),
                     row.ops.to_string(),
                     row.ops_total.to_string(),
                 ]);
+                table.push(cells);
             }
             table.print(args.format);
             Ok(())
@@ -99,21 +93,21 @@ fn print_csv(rows: &[ModelRow]) {
     header.push("ops total");
     let mut table = Table::new(&header);
     for row in rows {
-        let mut cells = vec![
-            row.info.id.to_owned(),
-            row.info.origin.name().to_owned(),
-            if row.info.takes_angle {
-                "angle"
-            } else {
-                "cosine"
-            }
-            .to_owned(),
-            row.info.formula.to_owned(),
-            row.ops_at_n.to_string(),
-        ];
+        let mut cells = identity(row.info).to_vec();
+        cells.extend([row.info.formula.to_owned(), row.ops_at_n.to_string()]);
         cells.extend(row.ops.entries().map(|(_, count)| count.to_string()));
         cells.push(row.ops_total.to_string());
         table.push(cells);
     }
     table.print(Format::Csv);
+}
+
+/// A model's id, origin and input (`angle` or `cosine`), as both tables begin.
+fn identity(info: &LobeInfo) -> [String; 3] {
+    let input = if info.takes_angle { "angle" } else { "cosine" };
+    [
+        info.id.to_owned(),
+        info.origin.name().to_owned(),
+        input.to_owned(),
+    ]
 }
