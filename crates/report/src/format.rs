@@ -30,6 +30,17 @@ pub fn percent(ratio: f64) -> String {
     format!("{}%", sig(ratio * 100.0))
 }
 
+/// A PSNR in dB with one decimal, or `identical` where there is no error to measure (an
+/// infinite PSNR: no number stands in for it).
+#[must_use]
+pub fn psnr(db: f64) -> String {
+    if db.is_finite() {
+        format!("{db:.1}")
+    } else {
+        "identical".to_owned()
+    }
+}
+
 /// A datapath's resources, a cell each: multipliers, squarers, adders, dividers, shifters
 /// (their widths), ROM bits, register bits, latency.
 #[must_use]
@@ -61,6 +72,12 @@ pub fn resource_cells(r: &Resources) -> [String; 8] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_infinite_psnr_reads_identical() {
+        assert_eq!(psnr(f64::INFINITY), "identical");
+        assert_eq!(psnr(41.26), "41.3");
+    }
 
     #[test]
     fn significant_digits() {

@@ -18,6 +18,7 @@ use specula_render::{read_image, srgb_encode, Display, Image};
 use super::html::{paragraph, table};
 use super::volumes::{cpu_threads, march_times, shading, EXPONENT};
 use super::{Context, RealScanSizes};
+use crate::format::psnr;
 use crate::vtk_peer;
 
 /// A real scan a Debian package installs.
@@ -287,7 +288,7 @@ fn lobe_table(
         rows.push(vec![
             kind.to_string(),
             name,
-            format!("{:.1}", against_pow.psnr_db.min(999.0)),
+            psnr(against_pow.psnr_db),
             format!("{:.5}", against_pow.mean_flip),
         ]);
     }

@@ -14,7 +14,7 @@ use specula_render::{
 
 use super::html::{paragraph, table};
 use super::Context;
-use crate::format::sig;
+use crate::format::{psnr, sig};
 
 fn scene(context: &Context, overrides: Overrides) -> Scene {
     let (width, height, samples) = context.sizes.render;
@@ -86,7 +86,7 @@ fn lobe_table(
             vec![
                 column.lobe.to_string(),
                 name.clone(),
-                format!("{:.1}", d.psnr_db.min(999.0)),
+                psnr(d.psnr_db),
                 sig(d.max_abs_error),
                 format!("{:.5}", d.mean_flip),
             ]
@@ -157,8 +157,12 @@ fn default_scene(context: &mut Context) -> Result<String, String> {
         Ok((adapter, image)) => {
             let d = compare(&reference_image, &image, base.display).map_err(|e| e.to_string())?;
             html += &paragraph(&format!(
-                "CPU against GPU ({adapter}): PSNR {:.1} dB, max abs error {}, mean FLIP {:.2e}.",
-                d.psnr_db.min(999.0),
+                "CPU against GPU ({adapter}): PSNR {}, max abs error {}, mean FLIP {:.2e}.",
+                if d.psnr_db.is_finite() {
+                    format!("{} dB", psnr(d.psnr_db))
+                } else {
+                    psnr(d.psnr_db)
+                },
                 sig(d.max_abs_error),
                 d.mean_flip
             ));

@@ -21,7 +21,7 @@ use specula_render::{Display, Image};
 
 use super::html::{paragraph, table};
 use super::Context;
-use crate::format::sig;
+use crate::format::{psnr, sig};
 
 /// The exponent of every lobe in the section (VTK's specular power in the comparison).
 pub(crate) const EXPONENT: f64 = 32.0;
@@ -192,7 +192,7 @@ fn phantom(context: &mut Context) -> Result<String, String> {
         rows.push(vec![
             kind.to_string(),
             name.clone(),
-            format!("{:.1}", against_pow.psnr_db.min(999.0)),
+            psnr(against_pow.psnr_db),
             format!("{:.5}", against_pow.mean_flip),
             parity,
         ]);
