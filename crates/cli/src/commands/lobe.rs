@@ -8,7 +8,7 @@ use specula::{Lobe, LobeKind};
 
 use super::CommandResult;
 use crate::args::Format;
-use crate::output::Table;
+use crate::output::{sig, Table};
 
 /// Arguments of `specula lobe`.
 #[derive(Debug, clap::Args)]
@@ -132,7 +132,7 @@ fn check(args: &CheckArgs) -> CommandResult {
     ]);
     for row in &rows {
         table.push(vec![
-            significant(row.n),
+            sig(row.n),
             format!("{:.6}", row.peak),
             format!("{:.6}", row.peak_t),
             format!("{:.3}", row.peak_degrees),
@@ -216,7 +216,7 @@ fn warn_of(shapes: &[Shape]) {
         eprintln!(
             "warning: the lobe is {:.6} at t = 1 (n = {}), not 1: it {change} every highlight{remedy}",
             shape.at_one,
-            significant(shape.n)
+            sig(shape.n)
         );
     }
     if let Some(shape) = shapes
@@ -228,18 +228,7 @@ fn warn_of(shapes: &[Shape]) {
             shape.peak,
             shape.peak_cos,
             shape.peak_angle_degrees(),
-            significant(shape.n)
+            sig(shape.n)
         );
-    }
-}
-
-/// `n` to five significant digits, without trailing zeros.
-fn significant(n: f64) -> String {
-    let digits = (4 - n.abs().log10().floor() as i32).clamp(0, 12) as usize;
-    let text = format!("{n:.digits$}");
-    if text.contains('.') {
-        text.trim_end_matches('0').trim_end_matches('.').to_owned()
-    } else {
-        text
     }
 }

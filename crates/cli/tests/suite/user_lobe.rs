@@ -332,7 +332,7 @@ fn lobe_check_states_the_peak_the_error_and_the_energy() {
     );
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(
-        stderr.contains("warning: the lobe is 0.500000 at t = 1 (n = 8), not 1: it dims"),
+        stderr.contains("warning: the lobe is 0.500000 at t = 1 (n = 8.000), not 1: it dims"),
         "{stderr}"
     );
     let plain = ok(
