@@ -212,7 +212,7 @@ pub fn verdict_line(a: &Assessment) -> String {
     let chosen = &a.fits[a.chosen];
     let pow_rate = pow_rate(a);
     format!(
-        "{}, n = {}: the cheapest lobe on {} whose fit is within {} % of pow's (E = {:.4}, {:.3}x pow's best; {:.2}x pow's rate)",
+        "{}, n = {}: the cheapest lobe on {} whose fit is within {} % of pow's (E = {:.4}, {:.3}x pow's best; {:.2}x pow's throughput)",
         chosen.fit.specular.label(),
         parameter_text(&chosen.fit),
         a.target,
@@ -263,11 +263,14 @@ pub fn ranking(a: &Assessment) -> Vec<Ranked> {
             let rate = row.rate.unwrap_or(0.0);
             let why = if i == a.chosen {
                 format!(
-                    "cheapest within the margin, {:.2}x pow's rate",
+                    "cheapest within the margin, {:.2}x pow's throughput",
                     rate / pow_rate
                 )
             } else if row.meets {
-                format!("within the margin, {:.2}x pow's rate", rate / pow_rate)
+                format!(
+                    "within the margin, {:.2}x pow's throughput",
+                    rate / pow_rate
+                )
             } else {
                 format!(
                     "fit error {:.1} % above pow's best",

@@ -354,7 +354,7 @@ fn why(c: &Candidate, best: Option<&str>, pow_rate: f64, target: Target, max_err
     let relative = if speed == "-" {
         String::new()
     } else {
-        format!(" at {speed} pow's rate")
+        format!(" at {speed} pow's throughput")
     };
     if !c.meets {
         if target == Target::Fpga && c.datapath.is_none() {

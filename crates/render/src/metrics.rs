@@ -121,6 +121,15 @@ impl Difference {
     pub fn heatmap_srgb8(&self) -> Vec<u8> {
         magma_srgb8(&self.flip_map)
     }
+
+    /// The FLIP map over `scale` (the FLIP value drawn at the map's bright end; values above
+    /// it drawn there too), in FLIP's magma map: a scale below 1 shows small differences that
+    /// FLIP's own scale leaves black.
+    #[must_use]
+    pub fn heatmap_srgb8_scaled(&self, scale: f32) -> Vec<u8> {
+        let scaled: Vec<f32> = self.flip_map.iter().map(|&v| v / scale).collect();
+        magma_srgb8(&scaled)
+    }
 }
 
 /// Each value in `[0, 1]` (clamped) in FLIP's magma colour map, as 8-bit sRGB bytes.

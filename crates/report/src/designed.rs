@@ -68,7 +68,11 @@ pub fn designed(context: &mut Context) -> Result<String, String> {
     let mut formulas = String::new();
     for ((_, name, bound), answer) in jobs.iter().zip(&answers) {
         let builtin = answer.best_compared().map_or("-".to_owned(), |c| {
-            format!("{} ({} pow)", c.lobe, versus_pow(c.rate, answer.pow_rate))
+            format!(
+                "{} ({} pow's throughput)",
+                c.lobe,
+                versus_pow(c.rate, answer.pow_rate)
+            )
         });
         let row = match answer.best() {
             Some(best) => {

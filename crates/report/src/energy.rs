@@ -28,14 +28,28 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
                 .collect()
         })
         .collect();
-    let high = ratios.iter().flatten().map(|p| p.1).fold(1.2, f64::max);
+    let finite = || ratios.iter().flatten().map(|p| p.1).filter(|r| *r > 0.0);
+    let high = finite().fold(1.2, f64::max);
+    let low = finite().fold(0.8, f64::min);
+    // One lobe far from 1 (fasterpow's tens) would flatten the others into a line: a log
+    // axis keeps a ratio of 2 the same height above 1 as a half below it.
+    let log_y = high / low > 4.0;
     let chart = Chart {
         title: "energy relative to t^n".into(),
         x_label: "n".into(),
-        y_label: "(n + 1) int lobe(cos g) sin g dg".into(),
+        y_label: if log_y {
+            "(n + 1) int lobe(cos g) sin g dg (log scale)".into()
+        } else {
+            "(n + 1) int lobe(cos g) sin g dg".into()
+        },
         x: (1.0, 1000.0),
-        y: (0.0, high * 1.05),
+        y: if log_y {
+            (low / 1.2, high * 1.2)
+        } else {
+            (0.0, high * 1.05)
+        },
         log_x: true,
+        log_y,
         series: kinds
             .iter()
             .zip(ratios)

@@ -41,6 +41,16 @@ pub fn psnr(db: f64) -> String {
     }
 }
 
+/// A PSNR with its unit (`34.2 dB`), or `identical`.
+#[must_use]
+pub fn psnr_db(db: f64) -> String {
+    if db.is_finite() {
+        format!("{} dB", psnr(db))
+    } else {
+        psnr(db)
+    }
+}
+
 /// A datapath's resources, a cell each: multipliers, squarers, adders, dividers, shifters
 /// (their widths), ROM bits, register bits, latency.
 #[must_use]

@@ -29,7 +29,10 @@ fn arithmetic(r: &Resources) -> String {
 
 /// Claim 8 by synthesis: every datapath at equal error, through Yosys and nextpnr (cached),
 /// or, without the tools or a cached result, the formula estimate, labelled as such.
-fn synthesized(context: &Context, all: &[(u32, Arc<Vec<WidthSweep>>)]) -> Result<String, String> {
+fn synthesized(
+    context: &mut Context,
+    all: &[(u32, Arc<Vec<WidthSweep>>)],
+) -> Result<String, String> {
     let sweeps = all
         .iter()
         .find(|(n, _)| *n == CLAIM_N)
@@ -62,7 +65,13 @@ fn synthesized(context: &Context, all: &[(u32, Arc<Vec<WidthSweep>>)]) -> Result
     });
     let Some(claim) = complete else {
         let why = match &claim {
-            Err(problem) => problem.to_string(),
+            Err(problem) => {
+                context.machine_note(format!(
+                    "The hardware claim's designs were not synthesized: {problem}."
+                ));
+                "the designs could not be synthesized here (see the notes on this machine)"
+                    .to_owned()
+            }
             Ok(_) => "not every design is in the synthesis cache (a quick report does not synthesize; run the full report or `specula claims`)".to_owned(),
         };
         let (target, designs) = claim::designs(sweeps);

@@ -12,6 +12,11 @@ pub fn escape(text: &str) -> String {
 
 /// A table with a header row; cells are escaped.
 pub fn table(header: &[&str], rows: &[Vec<String>]) -> String {
+    table_with_files(header, rows, &[])
+}
+
+/// A table whose cells in `file_columns` name files beside the page, each a link to its file.
+pub fn table_with_files(header: &[&str], rows: &[Vec<String>], file_columns: &[usize]) -> String {
     let mut html = String::from("<table><thead><tr>");
     for h in header {
         let _ = write!(html, "<th>{}</th>", escape(h));
@@ -19,8 +24,13 @@ pub fn table(header: &[&str], rows: &[Vec<String>]) -> String {
     html.push_str("</tr></thead><tbody>");
     for row in rows {
         html.push_str("<tr>");
-        for cell in row {
-            let _ = write!(html, "<td>{}</td>", escape(cell));
+        for (column, cell) in row.iter().enumerate() {
+            let cell = escape(cell);
+            if file_columns.contains(&column) {
+                let _ = write!(html, "<td><a href=\"{cell}\">{cell}</a></td>");
+            } else {
+                let _ = write!(html, "<td>{cell}</td>");
+            }
         }
         html.push_str("</tr>");
     }
@@ -31,7 +41,7 @@ pub fn table(header: &[&str], rows: &[Vec<String>]) -> String {
 /// A large image shown at page width, linked to itself at full size.
 pub fn linked_figure(file: &str, caption: &str) -> String {
     format!(
-        "<figure><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"/></a><figcaption>{1} (select it for full size)</figcaption></figure>\n",
+        "<figure class=\"wide\"><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"/></a><figcaption>{1} (select it for full size)</figcaption></figure>\n",
         escape(file),
         escape(caption)
     )
@@ -47,16 +57,117 @@ pub fn figure(file: &str, caption: &str) -> String {
     )
 }
 
+/// Figures side by side, as many to a row as the page's width holds at `min_width` pixels
+/// each (small multiples).
+pub fn multiples(figures: &str, min_width: u32) -> String {
+    format!(
+        "<div class=\"multiples\" style=\"grid-template-columns:repeat(auto-fill,minmax({min_width}px,1fr))\">\n{figures}</div>\n"
+    )
+}
+
+/// One image of a comparison: a lobe's render and, below it, its difference from the
+/// reference, each a link to its full-size file.
+#[derive(Clone, Debug)]
+pub struct Tile {
+    /// What the tile shows (a lobe's id).
+    pub label: String,
+    /// The label's colour swatch (the lobe's plot colour).
+    pub colour: [u8; 3],
+    /// The image's file.
+    pub image: String,
+    /// The difference map's file, if any (none for the reference).
+    pub difference: Option<String>,
+    /// The figures under the images.
+    pub caption: String,
+}
+
+/// Tiles in a grid that wraps at the page's width.
+pub fn tiles(tiles: &[Tile]) -> String {
+    let mut html = String::from("<div class=\"tiles\">\n");
+    for tile in tiles {
+        let [r, g, b] = tile.colour;
+        let _ = write!(
+            html,
+            "<figure class=\"tile\"><figcaption><span class=\"swatch\" style=\"background:rgb({r},{g},{b})\"></span>{}</figcaption>",
+            escape(&tile.label)
+        );
+        for (file, what) in std::iter::once((&tile.image, ""))
+            .chain(tile.difference.iter().map(|file| (file, " difference")))
+        {
+            let _ = write!(
+                html,
+                "<a href=\"{0}\"><img src=\"{0}\" alt=\"{1}{what}\" loading=\"lazy\"/></a>",
+                escape(file),
+                escape(&tile.label)
+            );
+        }
+        let _ = writeln!(html, "<p>{}</p></figure>", escape(&tile.caption));
+    }
+    html.push_str("</div>\n");
+    html
+}
+
+/// A horizontal colour bar for difference maps: `stops` evenly spaced colours from 0 to
+/// `scale`, labelled at both ends and the middle, with what it measures; `id` names its
+/// gradient (unique on the page).
+pub fn colour_bar(id: &str, stops: &[[u8; 3]], scale: f64, what: &str) -> String {
+    let mut gradient = String::new();
+    let last = stops.len().saturating_sub(1).max(1);
+    for (k, [r, g, b]) in stops.iter().enumerate() {
+        let _ = write!(
+            gradient,
+            "<stop offset=\"{:.3}\" stop-color=\"rgb({r},{g},{b})\"/>",
+            k as f64 / last as f64
+        );
+    }
+    format!(
+        "<figure class=\"colour-bar\" id=\"{id}\" data-scale=\"{scale}\"><svg xmlns=\"http://www.w3.org/2000/svg\" width=\"320\" height=\"34\" role=\"img\" aria-label=\"{what}: 0 to {max}\">\
+<defs><linearGradient id=\"{id}-gradient\">{gradient}</linearGradient></defs>\
+<rect x=\"10\" y=\"0\" width=\"300\" height=\"14\" fill=\"url(#{id}-gradient)\" stroke=\"#888\"/>\
+<text x=\"10\" y=\"30\" font-size=\"12\" text-anchor=\"start\">0</text>\
+<text x=\"160\" y=\"30\" font-size=\"12\" text-anchor=\"middle\">{mid}</text>\
+<text x=\"310\" y=\"30\" font-size=\"12\" text-anchor=\"end\">{max} or more</text></svg>\
+<figcaption>{what}</figcaption></figure>\n",
+        id = escape(id),
+        what = escape(what),
+        mid = scale / 2.0,
+        max = scale,
+    )
+}
+
 /// A paragraph of escaped text.
 pub fn paragraph(text: &str) -> String {
     format!("<p>{}</p>\n", escape(text))
 }
 
-const STYLE: &str = "body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}\
+/// The answer a section leads with: short lines, set apart.
+pub fn answer(lines: &[String]) -> String {
+    let mut html = String::from("<div class=\"answer\"><ul>");
+    for line in lines {
+        let _ = write!(html, "<li>{}</li>", escape(line));
+    }
+    html.push_str("</ul></div>\n");
+    html
+}
+
+const STYLE: &str = "body{font-family:system-ui,sans-serif;margin:0;color:#222;line-height:1.45}\
+.layout{display:grid;grid-template-columns:14rem minmax(0,1fr);gap:2rem;max-width:1500px;margin:0 auto;padding:0 1rem}\
+nav.toc{position:sticky;top:0;align-self:start;max-height:100vh;overflow:auto;padding:1.5rem 0;font-size:0.9em}\
+nav.toc ol{padding-left:2.2em;margin:0.5em 0}nav.toc li{margin:0.2em 0}\
+@media (max-width:900px){.layout{grid-template-columns:minmax(0,1fr)}nav.toc{position:static;max-height:none}}\
+main{padding-bottom:3em}h2{border-bottom:1px solid #ddd;padding-bottom:0.2em;margin-top:2em}\
 table{border-collapse:collapse;margin:1em 0;font-size:0.9em}\
 th,td{border:1px solid #ccc;padding:0.25em 0.6em;text-align:left}\
-th{background:#f2f2f2}figure{display:inline-block;margin:0.5em;vertical-align:top}\
-img{max-width:100%}figcaption{font-size:0.85em;color:#555}code{background:#f5f5f5}\
+th{background:#f2f2f2;position:sticky;top:0}figure{display:inline-block;margin:0.5em;vertical-align:top}\
+figure.wide{display:block}img{max-width:100%;height:auto}figcaption{font-size:0.85em;color:#555}code{background:#f5f5f5}\
+.multiples{display:grid;gap:0.75rem;margin:1em 0}.multiples figure{margin:0;display:block}.multiples img{width:100%}\
+.tiles{display:grid;grid-template-columns:repeat(auto-fill,minmax(200px,1fr));gap:0.75rem;margin:1em 0}\
+.tile{margin:0;display:block;border:1px solid #ddd;border-radius:4px;padding:0.4em;background:#fafafa}\
+.tile img{display:block;width:100%;margin:0.2em 0}.tile p{margin:0.2em 0;font-size:0.8em;color:#444}\
+.tile figcaption{font-size:0.95em;color:#222;font-weight:600}\
+.swatch{display:inline-block;width:0.85em;height:0.85em;border-radius:2px;margin-right:0.4em;vertical-align:-0.05em}\
+.colour-bar{display:block}.answer{border-left:5px solid #1a7f37;background:#f3faf5;padding:0.3em 1em;margin:1em 0;font-size:1.05em}\
+.answer li{margin:0.3em 0}.notes li{margin:0.4em 0}\
 .holds{color:#1a7f37}.qualified{color:#9a6700}.fails{color:#cf222e}footer{margin-top:3em;font-size:0.85em;color:#666}";
 
 /// Reports on the browser's console any image that failed to load or decode (a moved page, a
@@ -67,12 +178,13 @@ Array.prototype.forEach.call(document.images, function (img) { \
 if (!img.complete || img.naturalWidth === 0) { console.error('image failed to load: ' + img.getAttribute('src')); } \
 }); });";
 
-/// The whole page.
+/// The whole page: a table of contents that stays at hand beside the sections, then the
+/// footer.
 pub fn page(title: &str, sections: &[(String, String)], footer: &str) -> String {
     let mut html = format!(
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"/><title>{}</title>\
-         <style>{STYLE}</style></head><body>\n<h1>{}</h1>\n<nav><ol>",
-        escape(title),
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"/>\
+         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/><title>{0}</title>\
+         <style>{STYLE}</style></head><body>\n<div class=\"layout\">\n<nav class=\"toc\"><strong>{0}</strong><ol>",
         escape(title)
     );
     for (k, (heading, _)) in sections.iter().enumerate() {
@@ -83,7 +195,7 @@ pub fn page(title: &str, sections: &[(String, String)], footer: &str) -> String 
             escape(heading)
         );
     }
-    html.push_str("</ol></nav>\n");
+    let _ = write!(html, "</ol></nav>\n<main>\n<h1>{}</h1>\n", escape(title));
     for (k, (heading, body)) in sections.iter().enumerate() {
         let _ = write!(
             html,
@@ -95,7 +207,7 @@ pub fn page(title: &str, sections: &[(String, String)], footer: &str) -> String 
     }
     let _ = write!(
         html,
-        "<footer>{footer}</footer>\n<script>{CHECK_IMAGES}</script>\n</body></html>\n"
+        "<footer>{footer}</footer>\n</main>\n</div>\n<script>{CHECK_IMAGES}</script>\n</body></html>\n"
     );
     html
 }

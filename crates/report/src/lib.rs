@@ -9,6 +9,7 @@
 //! is written atomically, and the page last, so an interrupted run never leaves a page that
 //! points at missing images.
 
+mod comparison;
 mod designed;
 mod energy;
 pub mod format;
@@ -137,6 +138,9 @@ pub(crate) struct Context {
     lobes: Vec<LobeKind>,
     /// The folder of measured materials (`--materials`).
     materials: Option<PathBuf>,
+    /// What this machine lacked (a tool, a GPU adapter, a scan), a sentence each: shown
+    /// once, at the page's end, not in the answers.
+    notes: Vec<String>,
 }
 
 /// Every datapath's sweeps over word lengths, per hardware exponent.
@@ -157,8 +161,21 @@ impl Context {
     fn sibling(&self) -> Self {
         Self {
             files: Vec::new(),
+            notes: Vec::new(),
             ..self.clone()
         }
+    }
+
+    /// Takes a sibling's files and notes once its part is done.
+    fn absorb(&mut self, mut sibling: Self) {
+        self.files.append(&mut sibling.files);
+        self.notes.append(&mut sibling.notes);
+    }
+
+    /// A note about this machine (a missing tool, no GPU adapter): the page gathers them at
+    /// its end, each once.
+    fn machine_note(&mut self, note: impl Into<String>) {
+        self.notes.push(note.into());
     }
 
     /// The hardware sweeps at the hardware exponents, which the hardware section shows and
@@ -185,7 +202,18 @@ impl Context {
 
     /// Writes a chart and returns its figure.
     fn svg(&mut self, name: &str, chart: &plot::Chart, caption: &str) -> Result<String, String> {
-        let svg = chart.to_svg(580, 360)?;
+        self.svg_sized(name, chart, caption, (580, 360))
+    }
+
+    /// Writes a chart drawn at `size` pixels (a small multiple's) and returns its figure.
+    fn svg_sized(
+        &mut self,
+        name: &str,
+        chart: &plot::Chart,
+        caption: &str,
+        (width, height): (u32, u32),
+    ) -> Result<String, String> {
+        let svg = chart.to_svg(width, height)?;
         self.write(name, svg.as_bytes())?;
         Ok(html::figure(name, caption))
     }
@@ -247,6 +275,8 @@ const CLAIMS: &str = "The thesis's claims";
 const HARDWARE_SECTIONS: [&str; 2] = [VERDICT, HARDWARE];
 const VERDICT: &str = "Which lobe when";
 const HARDWARE: &str = "Hardware";
+/// The page's last section, after every section's.
+pub const NOTES: &str = "Notes on this machine";
 
 /// The answer first (which lobe when), then the thesis's claims, then the details.
 const SECTIONS: [Section; 14] = [
@@ -303,6 +333,7 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
         bench: options.bench,
         files: Vec::new(),
         materials: options.materials.clone(),
+        notes: Vec::new(),
     };
     let bar = ProgressBar::new(SECTIONS.len() as u64).with_style(
         ProgressStyle::with_template("report {bar:30} {pos}/{len} sections {elapsed}")
@@ -313,7 +344,7 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
         let begun = Instant::now();
         let body = section(&mut own);
         bar.inc(1);
-        body.map(|body| (heading, body, begun.elapsed(), own.files))
+        body.map(|body| (heading, body, begun.elapsed(), own.files, own.notes))
     };
     let alone = |(heading, _): &&Section| options.bench && *heading == sections::COST;
     // The hardware sweeps run beside the sections that do not need them (waiting for them
@@ -372,11 +403,18 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
     let mut files = Vec::new();
     let mut bodies = Vec::new();
     let mut timings = Vec::new();
-    for (heading, body, took, written) in done {
+    let mut notes: Vec<String> = Vec::new();
+    for (heading, body, took, written, noted) in done {
         timings.push(format!("{heading} {:.1} s", took.as_secs_f64()));
         bodies.push((heading.to_owned(), body));
         files.extend(written);
+        for note in noted {
+            if !notes.contains(&note) {
+                notes.push(note);
+            }
+        }
     }
+    bodies.push((NOTES.to_owned(), machine_notes(&notes)));
     timings.push(format!(
         "hardware sweeps (shared by two sections) {:.1} s",
         sweeps_took.as_secs_f64()
@@ -395,6 +433,20 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
         took: started.elapsed(),
         timings,
     })
+}
+
+/// The last section: what this machine lacked, a sentence each.
+fn machine_notes(notes: &[String]) -> String {
+    if notes.is_empty() {
+        return html::paragraph("Nothing: every tool, scan and adapter the report uses was here.");
+    }
+    let items: String = notes
+        .iter()
+        .map(|note| format!("<li>{}</li>", html::escape(note)))
+        .collect();
+    html::paragraph(
+        "What this machine lacked, and what the report did instead. None of it changes an answer above; each says what to install to see the missing part.",
+    ) + &format!("<ul class=\"notes\">{items}</ul>\n")
 }
 
 fn footer(options: &Options, started: Instant, timings: &str) -> String {

@@ -184,18 +184,32 @@ impl Chart {
                 .filter(|(x, y)| x.is_finite() && y.is_finite())
                 .map(|&(x, y)| (x.clamp(self.x.0, self.x.1), y.clamp(self.y.0, self.y.1)));
             let drawn = if series.markers {
-                let name = series.name.clone();
-                chart.draw_series(clipped.map(|p| {
-                    EmptyElement::at(p)
-                        + Circle::new((0, 0), px(5), series.colour.filled())
-                        + Text::new(name.clone(), (offset(8), offset(-6)), font(12))
-                }))
+                chart.draw_series(clipped.map(|p| Circle::new(p, px(5), series.colour.filled())))
             } else if series.dashed {
                 chart.draw_series(DashedLineSeries::new(clipped, px(7), px(4), style))
             } else {
                 chart.draw_series(LineSeries::new(clipped, style))
             };
             drawn.map_err(error)?;
+        }
+        // The markers' names, each where it overlaps no other name nor marker.
+        let markers: Vec<(String, (i32, i32))> = self
+            .series
+            .iter()
+            .filter(|series| series.markers)
+            .flat_map(|series| {
+                series
+                    .points
+                    .iter()
+                    .filter(|(x, y)| x.is_finite() && y.is_finite())
+                    .map(|&(x, y)| {
+                        let at = (x.clamp(self.x.0, self.x.1), y.clamp(self.y.0, self.y.1));
+                        (series.name.clone(), chart.backend_coord(&at))
+                    })
+            })
+            .collect();
+        for (name, at) in place_labels(&markers) {
+            root.draw(&Text::new(name, at, font(12))).map_err(error)?;
         }
         // The legend, drawn beside the plotting area (plotters keeps its own inside, on the
         // data): one row per band and series, a swatch and the name.
@@ -252,6 +266,46 @@ impl Chart {
         }
         Ok(())
     }
+}
+
+/// Where each marker's name goes (its top-left corner, drawn pixels): the first of a few
+/// places around the marker where the name's box overlaps no name already placed and no
+/// marker, else the first place (12-point text about 7 pixels a character, 14 high).
+fn place_labels(markers: &[(String, (i32, i32))]) -> Vec<(String, (i32, i32))> {
+    type Box = (i32, i32, i32, i32);
+    let overlaps = |a: Box, b: Box| a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3;
+    let radius = offset(6);
+    let dots: Vec<Box> = markers
+        .iter()
+        .map(|(_, (x, y))| (x - radius, y - radius, x + radius, y + radius))
+        .collect();
+    let mut placed: Vec<Box> = Vec::new();
+    let mut labels = Vec::new();
+    for (name, (x, y)) in markers {
+        let (width, height) = (offset(7) * name.chars().count() as i32, offset(14));
+        let places = [
+            (offset(8), -height / 2),
+            (-offset(8) - width, -height / 2),
+            (offset(6), -offset(6) - height),
+            (offset(6), offset(6)),
+            (-width / 2, -offset(8) - 2 * height),
+            (-width / 2, offset(8) + height),
+            (offset(8), -offset(6) - 2 * height),
+            (offset(8), offset(6) + height),
+        ];
+        let boxed = |(dx, dy): (i32, i32)| (x + dx, y + dy, x + dx + width, y + dy + height);
+        let free = places.iter().copied().find(|&place| {
+            let candidate = boxed(place);
+            !placed
+                .iter()
+                .chain(&dots)
+                .any(|&other| overlaps(candidate, other))
+        });
+        let (dx, dy) = free.unwrap_or(places[0]);
+        placed.push(boxed((dx, dy)));
+        labels.push((name.clone(), (x + dx, y + dy)));
+    }
+    labels
 }
 
 /// A dashed line's pattern in displayed pixels: dash, gap (the charts' dashes).
@@ -495,6 +549,41 @@ impl Polar {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Markers at one place and close by (sg and sg-karis share a point; the quadratics
+    /// nearly do): no two names' boxes overlap, nor a name a marker.
+    #[test]
+    fn marker_names_do_not_overlap() {
+        let names = ["sg", "sg-karis", "minimax2", "cheb2", "cheb2-thesis", "pow"];
+        let at = [
+            (400, 300),
+            (400, 300),
+            (480, 380),
+            (490, 380),
+            (500, 382),
+            (900, 900),
+        ];
+        let markers: Vec<(String, (i32, i32))> = names
+            .iter()
+            .zip(at)
+            .map(|(name, (x, y))| ((*name).to_owned(), (x * 4, y * 4)))
+            .collect();
+        let placed = place_labels(&markers);
+        let boxed =
+            |(name, (x, y)): &(String, (i32, i32))| (*x, *y, x + 28 * name.len() as i32, y + 56);
+        let overlaps = |a: (i32, i32, i32, i32), b: (i32, i32, i32, i32)| {
+            a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3
+        };
+        for (k, a) in placed.iter().enumerate() {
+            for b in &placed[k + 1..] {
+                assert!(!overlaps(boxed(a), boxed(b)), "{} and {} overlap", a.0, b.0);
+            }
+            for (_, (x, y)) in &markers {
+                let dot = (x - 24, y - 24, x + 24, y + 24);
+                assert!(!overlaps(boxed(a), dot), "{} covers a marker", a.0);
+            }
+        }
+    }
 
     /// A diagonal drawn at 580 x 360 must resolve finer than whole pixels: with whole-pixel
     /// coordinates its 2,000 points could take at most one height per displayed pixel row.

@@ -112,12 +112,13 @@ pub fn real_scans(context: &mut Context) -> Result<String, String> {
         .filter(|scan| Path::new(scan.path).is_file())
         .collect();
     for scan in SCANS.iter().filter(|scan| !Path::new(scan.path).is_file()) {
-        html += &paragraph(&format!(
+        context.machine_note(format!(
             "The real {} is not here: it is {} at {}, which the Debian package {} installs (apt-get install {}).",
             scan.name, scan.what, scan.path, scan.package, scan.package
         ));
     }
     if present.is_empty() {
+        html += &paragraph("No real scan is on this machine (see the notes on this machine).");
         return Ok(html);
     }
     // VTK's Python starts first and imports VTK while specula reads the scans; it then
@@ -391,7 +392,8 @@ fn against_vtk(
     let vtk_runs = match theirs {
         Ok(runs) => runs,
         Err(why) => {
-            html += &paragraph(&format!(
+            html += &paragraph("VTK was not run here (see the notes on this machine).");
+            context.machine_note(format!(
                 "VTK was not run ({why}): the comparison needs the vtk wheel, with nibabel, in {} (pip install vtk nibabel; SPECULA_PYTHON names another Python).",
                 vtk_peer::python().display()
             ));

@@ -12,9 +12,10 @@ use specula_render::{
     Scene, Shading,
 };
 
-use super::html::{paragraph, table};
+use super::comparison::{self, Compared};
+use super::html::{paragraph, table_with_files};
 use super::Context;
-use crate::format::{psnr, sig};
+use crate::format::{psnr, psnr_db, sig};
 
 fn scene(context: &Context, overrides: Overrides) -> Scene {
     let (width, height, samples) = context.sizes.render;
@@ -55,12 +56,13 @@ fn lobe_table(
         Ok(image)
     })
     .map_err(|e| e.to_string())?;
-    let mut html = context.png_srgb8(
-        &format!("{prefix}s-lobes.png"),
+    // The whole grid, one image to download; the page shows the lobes as tiles.
+    let strip = format!("{prefix}s-lobes.png");
+    context.write_png_file(
+        &strip,
         grid.image.width,
         grid.image.height,
         &grid.image.bytes,
-        "every lobe, FLIP against pow below",
     )?;
     // Each lobe's file written on its own thread.
     let (width, height) = (base.settings.width, base.settings.height);
@@ -76,6 +78,32 @@ fn lobe_table(
         })
         .collect::<Result<Vec<_>, String>>()?;
     context.files.extend(names.iter().cloned());
+    let compared: Vec<Compared> = grid
+        .columns
+        .iter()
+        .zip(&names)
+        .map(|(column, name)| {
+            let reference = column.lobe == options.reference;
+            Compared {
+                lobe: column.lobe,
+                file: name.clone(),
+                difference: (!reference).then_some(&column.difference),
+                caption: if reference {
+                    "the reference".to_owned()
+                } else {
+                    format!(
+                        "PSNR {}, mean FLIP {:.4}",
+                        psnr_db(column.difference.psnr_db),
+                        column.difference.mean_flip
+                    )
+                },
+            }
+        })
+        .collect();
+    let mut html = comparison::grid(context, prefix, &options.reference.to_string(), &compared)?;
+    html += &format!(
+        "<p><a href=\"{strip}\">Every lobe in one image</a> (what specula render --grid writes).</p>\n"
+    );
     let rows: Vec<Vec<String>> = grid
         .columns
         .iter()
@@ -92,9 +120,10 @@ fn lobe_table(
             ]
         })
         .collect();
-    html += &table(
+    html += &table_with_files(
         &["lobe", "image", header, "max abs error", "mean FLIP"],
         &rows,
+        &[1],
     );
     Ok((html, reference))
 }
@@ -111,7 +140,7 @@ pub fn renders(context: &mut Context) -> Result<String, String> {
     // The environment-lit renders (most of the section's work) run beside the rest.
     let mut lit = context.sibling();
     let (html, environment) = rayon::join(|| default_scene(context), || environment_lit(&mut lit));
-    context.files.append(&mut lit.files);
+    context.absorb(lit);
     Ok(html? + &environment?)
 }
 
@@ -158,11 +187,7 @@ fn default_scene(context: &mut Context) -> Result<String, String> {
             let d = compare(&reference_image, &image, base.display).map_err(|e| e.to_string())?;
             html += &paragraph(&format!(
                 "CPU against GPU ({adapter}): PSNR {}, max abs error {}, mean FLIP {:.2e}.",
-                if d.psnr_db.is_finite() {
-                    format!("{} dB", psnr(d.psnr_db))
-                } else {
-                    psnr(d.psnr_db)
-                },
+                psnr_db(d.psnr_db),
                 sig(d.max_abs_error),
                 d.mean_flip
             ));
@@ -175,7 +200,14 @@ fn default_scene(context: &mut Context) -> Result<String, String> {
                 "FLIP, CPU against GPU",
             )?;
         }
-        Err(error) => html += &paragraph(&format!("CPU against GPU: not run ({error}).")),
+        Err(error) => {
+            html += &paragraph(
+                "CPU against GPU: not run (no GPU adapter here; see the notes on this machine).",
+            );
+            context.machine_note(format!(
+                "No GPU adapter: the GPU renders and timings were not run ({error})."
+            ));
+        }
     }
     Ok(html)
 }

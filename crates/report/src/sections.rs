@@ -8,7 +8,7 @@ use specula::zones::{bloom_angle, epicentre_angle};
 use specula::{Exponent, Lobe, LobeKind};
 use specula_synth::OnMiss;
 
-use super::html::{escape, paragraph, table};
+use super::html::{escape, multiples, paragraph, table};
 use super::plot::{Chart, Series, SEQUENCE};
 use super::{Context, RealScanSizes, Sizes};
 use crate::format::sig;
@@ -78,7 +78,8 @@ pub fn models(context: &mut Context) -> Result<String, String> {
 }
 
 pub fn shapes(context: &mut Context) -> Result<String, String> {
-    let mut html = paragraph("Each lobe against cos^n over the angle; the epicentre (t^n >= 1/2) and bloom (t^n >= 1/256) zones are shaded. The log-scale variant shows the tail.");
+    let html = paragraph("Each lobe against cos^n over the angle; the epicentre (t^n >= 1/2) and bloom (t^n >= 1/256) zones are shaded. The log-scale variant beside each shows the tail.");
+    let mut figures = String::new();
     for n in [2.0, 8.0, 32.0, 128.0, 512.0] {
         let exponent = Exponent::new(n);
         let (epicentre, bloom) = (
@@ -129,7 +130,7 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
                 ..Chart::default()
             };
             let name = format!("shape-n{n}{}.svg", if log_y { "-log" } else { "" });
-            html += &context.svg(
+            figures += &context.svg(
                 &name,
                 &chart,
                 &if log_y {
@@ -140,11 +141,12 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
             )?;
         }
     }
-    Ok(html)
+    Ok(html + &multiples(&figures, 440))
 }
 
 pub fn errors(context: &mut Context) -> Result<String, String> {
-    let mut html = paragraph("Signed error lobe - t^n against the angle, scaled by the bloom's edge so that every n fits one axis, for n = 8, 64 and 512.");
+    let mut html = paragraph("Signed error lobe - t^n against the angle, scaled by the bloom's edge so that every n fits one axis, for n = 8, 64 and 512: one small chart per lobe, each on its own vertical scale. An error that keeps its shape across n is the model's; one that grows with n is its approximation breaking down.");
+    let mut figures = String::new();
     for kind in context
         .lobes
         .clone()
@@ -190,12 +192,14 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
             series: curves,
             ..Chart::default()
         };
-        html += &context.svg(
+        figures += &context.svg_sized(
             &format!("error-angle-{}.svg", kind.id()),
             &chart,
-            &format!("{kind}: error against the angle, one curve per n; an error that keeps its shape across n is the model's, one that grows with n is its approximation breaking down"),
+            &format!("{kind}: one curve per n"),
+            (420, 280),
         )?;
     }
+    html += &multiples(&figures, 330);
     let sizes = context.sizes.clone();
     let grid = exponents(sizes.n_steps);
     let kinds: Vec<LobeKind> = context
@@ -390,7 +394,7 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
     let mut html = paragraph(
         "What each lobe's explicit SIMD kernel executes per vector, read off the kernel (a test \
          holds the count to what it runs); not a guess of operation weights. The GPU columns \
-         are the cost model's bound for the lobe's exported shader (more is cheaper; see \
+         are the cost model's bound for the lobe's exported shader (higher is better; see \
          Which lobe when).",
     );
     if let Some(measured) = &measured {

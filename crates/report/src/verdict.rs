@@ -38,7 +38,7 @@ fn answers(lobes: &[LobeKind], target: Target, n: f64) -> Result<Vec<Recommendat
 fn gpu_cell(answer: &Recommendation) -> String {
     answer.best_candidate().map_or("-".to_owned(), |best| {
         format!(
-            "{} ({} pow)",
+            "{} ({} pow's throughput)",
             best.lobe,
             versus_pow(best.rate, answer.pow_rate())
         )
@@ -113,8 +113,8 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
          --n N --max-error BOUND answers (the same library call, the lobes below as \
          candidates). On the GPUs, by the cost model: each lobe's exported shader, its \
          instructions counted and weighed by the vendor's published per-clock rates \
-         (crates/specula/src/gpu_cost.rs); the ratio is its modelled rate over pow's. For \
-         the CPU, run specula recommend --target cpu: its costs are measured.",
+         (crates/specula/src/gpu_cost.rs); the ratio is its modelled throughput over pow's (higher is \
+         better, as everywhere in this report). For the CPU, run specula recommend --target cpu: its costs are measured.",
     );
     let yours: Vec<String> = context
         .lobes
@@ -159,6 +159,7 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
             .map(|k| &gpu[k])
             .ok_or("every GPU row was answered")
     };
+    let answer = answer(&gpu_rows, &gpu, &hardware, &fpga)?;
     let mut rows = Vec::new();
     for (target, name) in FAMILIES {
         for n in EXPONENTS {
@@ -192,7 +193,7 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
         .filter_map(|a| a.note.as_deref())
         .take(1)
     {
-        html += &paragraph(&format!("Note: {note}."));
+        context.machine_note(format!("FPGA costs: {note}."));
     }
     for (target, name) in FAMILIES {
         let plotted_answer = &gpu_answers(target, PLOTTED)?[0];
@@ -220,5 +221,53 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
             &format!("{name}: error against cost, higher left is better; the grey line joins the Pareto front"),
         )?;
     }
-    Ok(html)
+    Ok(answer + &html)
+}
+
+/// The bound and exponent the answer box states.
+const HEADLINE: (f64, f64) = (PLOTTED, 0.02);
+
+/// The section's lead: for each target, the cheapest lobe within 2 % at n = 64 and the figure
+/// that decides it; the CPU's measured answer named, not guessed.
+fn answer(
+    gpu_rows: &[(Target, f64)],
+    gpu: &[Vec<Recommendation>],
+    hardware: &[u32],
+    fpga: &[Vec<Recommendation>],
+) -> Result<String, String> {
+    let (n, bound) = HEADLINE;
+    let column = ACCURACIES
+        .iter()
+        .position(|&a| a == bound)
+        .ok_or("the headline bound is one of the table's")?;
+    let within = format!("n = {n}, epicentre error within {} %", bound * 100.0);
+    let mut lines = Vec::new();
+    for (target, name) in FAMILIES {
+        let answer = gpu_rows
+            .iter()
+            .position(|&row| row == (target, n))
+            .map(|k| &gpu[k][column])
+            .ok_or("the headline exponent is one of the table's")?;
+        lines.push(match answer.best_candidate() {
+            Some(best) => format!(
+                "{name} GPUs ({within}): {}, at {} pow's throughput (modelled; higher is better).",
+                best.lobe,
+                versus_pow(best.rate, answer.pow_rate())
+            ),
+            None => format!("{name} GPUs ({within}): no lobe meets it."),
+        });
+    }
+    let headline_fpga = hardware
+        .iter()
+        .position(|&h| f64::from(h) == n)
+        .and_then(|k| fpga.get(k))
+        .map(|answers| &answers[column]);
+    if let Some(answer) = headline_fpga {
+        lines.push(format!("FPGA ({within}): {}.", fpga_cell(answer)));
+    }
+    lines.push(format!(
+        "CPU: measured, not modelled, on the machine that will run it: specula recommend --target cpu --n {n} --max-error {}.",
+        bound
+    ));
+    Ok(super::html::answer(&lines))
 }

@@ -19,9 +19,10 @@ use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::Volume;
 use specula_render::{Display, Image};
 
-use super::html::{paragraph, table};
+use super::comparison::{self, Compared};
+use super::html::{paragraph, table, table_with_files};
 use super::Context;
-use crate::format::{psnr, sig};
+use crate::format::{psnr, psnr_db, sig};
 
 /// The exponent of every lobe in the section (VTK's specular power in the comparison).
 pub(crate) const EXPONENT: f64 = 32.0;
@@ -85,7 +86,7 @@ pub fn volumes(context: &mut Context) -> Result<String, String> {
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         (phantom, real_scans)
     });
-    context.files.append(&mut real.files);
+    context.absorb(real);
     Ok(phantom? + &real_scans?)
 }
 
@@ -170,12 +171,12 @@ fn phantom(context: &mut Context) -> Result<String, String> {
         None => vec![None; lobes.len()],
     };
     let mut rows = Vec::new();
-    let mut figures = String::new();
     let mut reference: Option<Image> = None;
+    let mut differences = Vec::new();
     for ((&kind, image), gpu_image) in context.lobes.clone().iter().zip(marched).zip(gpu_images) {
         let name = format!("volume-{}.png", kind.id());
         let bytes = image.to_srgb8(Display::default());
-        figures += &context.png_srgb8(&name, pixels, pixels, &bytes, &kind.to_string())?;
+        context.write_png_file(&name, pixels, pixels, &bytes)?;
         let written = Image::from_srgb8(pixels, pixels, &bytes).ok_or("inconsistent image size")?;
         let reference_image = reference.get_or_insert_with(|| written.clone());
         let against_pow =
@@ -196,8 +197,23 @@ fn phantom(context: &mut Context) -> Result<String, String> {
             format!("{:.5}", against_pow.mean_flip),
             parity,
         ]);
+        differences.push((kind, name, against_pow));
     }
-    html += &table(
+    let compared: Vec<Compared> = differences
+        .iter()
+        .map(|(kind, name, d)| Compared {
+            lobe: *kind,
+            file: name.clone(),
+            difference: (*kind != LobeKind::Pow).then_some(d),
+            caption: if *kind == LobeKind::Pow {
+                "the reference".to_owned()
+            } else {
+                format!("PSNR {}, mean FLIP {:.4}", psnr_db(d.psnr_db), d.mean_flip)
+            },
+        })
+        .collect();
+    html += &comparison::grid(context, "volume", "pow", &compared)?;
+    html += &table_with_files(
         &[
             "lobe",
             "image",
@@ -206,12 +222,18 @@ fn phantom(context: &mut Context) -> Result<String, String> {
             "mean FLIP, CPU vs GPU",
         ],
         &rows,
+        &[1],
     );
-    html += &figures;
-    html += &paragraph(&match &gpu {
-        Ok(gpu) => format!("GPU: {}.", gpu.adapter_name()),
-        Err(error) => format!("GPU: not run ({error})."),
-    });
+    match &gpu {
+        Ok(gpu) => html += &paragraph(&format!("GPU: {}.", gpu.adapter_name())),
+        Err(error) => {
+            html +=
+                &paragraph("GPU: not run (no GPU adapter here; see the notes on this machine).");
+            context.machine_note(format!(
+                "No GPU adapter: the GPU renders and timings were not run ({error})."
+            ));
+        }
+    }
     let iso = default_isovalue(&volume);
     let settings = IsoSettings {
         width: pixels,

@@ -51,30 +51,59 @@ use super::volume::{volume_png, Choice, VolumeRequest, MAX_VOLUME_SIZE};
 /// The largest render side, in pixels.
 pub const MAX_RENDER_SIZE: u32 = 1024;
 
-/// A lobe's cost on one target, as the explorer shows it beside its errors.
+/// A lobe's rate on one target, as a cost model gives it: higher is better.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct TargetCost {
+pub struct TargetRate {
     /// The target's id (`cpu`, `gpu-nvidia`, ...).
     pub target: String,
-    /// The figure.
+    /// The rate (evaluations per instruction, per clock, ...): higher is better.
     pub value: f64,
     /// What it counts.
     pub unit: String,
 }
 
-/// The costs of a prepared lobe on every target the server knows. The binary supplies the
+/// A lobe's cost on one target, as the explorer shows it beside its errors: its rate and that
+/// rate over pow's at the same `n` (one direction on every target: higher is better).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TargetCost {
+    /// The model's rate.
+    #[serde(flatten)]
+    pub rate: TargetRate,
+    /// The rate over pow's on the same target at the same `n`: pow's throughput times this.
+    pub versus_pow: f64,
+}
+
+/// The rates of a prepared lobe on every target the server knows. The binary supplies the
 /// GPU models (they need the shader compiler, which this crate does not depend on); the
 /// default knows the CPU's counted SIMD instructions only.
-pub type CostModel = Arc<dyn Fn(&Lobe) -> Result<Vec<TargetCost>, String> + Send + Sync>;
+pub type CostModel = Arc<dyn Fn(&Lobe) -> Result<Vec<TargetRate>, String> + Send + Sync>;
 
-/// The CPU's cost: the instructions the lobe's SIMD kernel executes per vector of 8.
+/// The CPU's rate: evaluations per instruction of the lobe's SIMD kernel (8 per vector).
 #[must_use]
-pub fn cpu_cost(lobe: &Lobe) -> TargetCost {
-    TargetCost {
+pub fn cpu_cost(lobe: &Lobe) -> TargetRate {
+    TargetRate {
         target: "cpu".into(),
-        value: f64::from(lobe.batch_instructions().total()),
-        unit: "SIMD instructions per 8 evaluations (counted; fewer is cheaper)".into(),
+        value: 8.0 / f64::from(lobe.batch_instructions().total().max(1)),
+        unit: "evaluations per SIMD instruction (counted; higher is better)".into(),
     }
+}
+
+/// `lobe`'s costs by `model`, each with its rate over pow's at the same `n`.
+pub(crate) fn costs_versus_pow(model: &CostModel, lobe: &Lobe) -> Result<Vec<TargetCost>, String> {
+    let pow = model(&Lobe::new(specula::LobeKind::Pow, lobe.exponent()))?;
+    model(lobe)?
+        .into_iter()
+        .map(|rate| {
+            let reference = pow
+                .iter()
+                .find(|p| p.target == rate.target)
+                .ok_or_else(|| format!("the cost model has no rate for pow on {}", rate.target))?;
+            Ok(TargetCost {
+                versus_pow: rate.value / reference.value,
+                rate,
+            })
+        })
+        .collect()
 }
 
 /// What the handlers share.
@@ -262,7 +291,10 @@ pub async fn analyze_lobe(
     let (kind, n) = (params.lobe()?, params.exponent()?);
     let costs = state.costs.clone();
     let (report, costs) = compute_with(&state, kind, n, move |lobe| {
-        (analyze(kind, n, &mut Precision::F64), costs(&lobe))
+        (
+            analyze(kind, n, &mut Precision::F64),
+            costs_versus_pow(&costs, &lobe),
+        )
     })
     .await?;
     let costs = costs.map_err(ApiError::internal)?;

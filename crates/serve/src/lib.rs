@@ -26,7 +26,7 @@ mod volume;
 
 use std::net::SocketAddr;
 
-pub use api::{cpu_cost, AppState, CostModel, TargetCost, MAX_RENDER_SIZE};
+pub use api::{cpu_cost, AppState, CostModel, TargetCost, TargetRate, MAX_RENDER_SIZE};
 pub use design::{DesignModel, DesignQuery, DESIGN_TARGETS};
 pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};

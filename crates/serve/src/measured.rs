@@ -41,7 +41,7 @@ use specula_render::measured::{
     BUNDLED_MATERIALS,
 };
 
-use super::api::{compute, png, AppState, CostModel, TargetCost};
+use super::api::{compute, costs_versus_pow, png, AppState, CostModel, TargetCost};
 use super::query::{pairs, ApiError, Params, QueryPairs};
 
 /// The most materials a `--data` folder may hold.
@@ -456,7 +456,7 @@ fn summary(fit: &Fit, reference_error: f64, ggx_error: f64, costs: &CostModel) -
                 Some(geometry.id()),
                 Some(n),
                 None,
-                Some(costs(&lobe)),
+                Some(costs_versus_pow(costs, &lobe)),
             )
         }
         Specular::Ggx => ("ggx".to_owned(), None, None, Some(fit.parameter[0]), None),

@@ -100,8 +100,8 @@ fn print_table(answer: &Design, format: crate::args::Format) {
         "meets",
         "epicentre",
         "whole lobe",
-        "cost",
-        "vs pow",
+        "rate",
+        "x pow's throughput",
         "pareto",
         "why",
     ]);

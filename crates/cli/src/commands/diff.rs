@@ -22,6 +22,10 @@ pub struct Args {
     /// Write FLIP's per-pixel error, coloured with its magma map, to this PNG.
     #[arg(long)]
     heatmap: Option<PathBuf>,
+    /// The FLIP value drawn at the heatmap's bright end (0 < S <= 1; above it, drawn there
+    /// too): below 1 it shows differences FLIP's own scale leaves black, as the report's maps.
+    #[arg(long, default_value_t = 1.0)]
+    heatmap_scale: f32,
     /// Exposure applied to both images before comparison (matters for EXR input).
     #[arg(long, default_value_t = 1.0)]
     exposure: f32,
@@ -52,6 +56,12 @@ pub fn run(args: &Args) -> CommandResult {
             args.exposure
         ));
     }
+    if !(args.heatmap_scale > 0.0 && args.heatmap_scale <= 1.0) {
+        return Err(format!(
+            "--heatmap-scale must lie in (0, 1] (FLIP's range), got {}",
+            args.heatmap_scale
+        ));
+    }
     let reference = read_image(&args.reference).map_err(|e| e.to_string())?;
     let test = read_image(&args.test).map_err(|e| e.to_string())?;
     let display = Display {
@@ -64,7 +74,7 @@ pub fn run(args: &Args) -> CommandResult {
             path,
             difference.width,
             difference.height,
-            &difference.heatmap_srgb8(),
+            &difference.heatmap_srgb8_scaled(args.heatmap_scale),
         )
         .map_err(|e| e.to_string())?;
     }

@@ -12,7 +12,7 @@ use specula::gpu_cost::GpuFamily;
 use specula::{Exponent, Lobe};
 use specula_decide::design::{default_whole_error, design, Bounds, DesignRequest};
 use specula_decide::Target;
-use specula_serve::{cpu_cost, DesignModel, DesignQuery, Materials, TargetCost};
+use specula_serve::{cpu_cost, DesignModel, DesignQuery, Materials, TargetRate};
 
 use super::CommandResult;
 
@@ -109,12 +109,13 @@ fn designer() -> DesignModel {
 }
 
 /// A lobe's costs: the CPU's counted SIMD instructions and the GPU families' modelled rates.
-pub fn costs(lobe: &Lobe) -> Result<Vec<TargetCost>, String> {
+pub fn costs(lobe: &Lobe) -> Result<Vec<TargetRate>, String> {
     let gpus = GpuFamily::ALL.iter().map(|family| {
-        Ok(TargetCost {
+        Ok(TargetRate {
             target: family.id.to_owned(),
             value: specula_decide::modelled_rate(family, lobe)?,
-            unit: "evaluations per clock per multiprocessor (modelled; more is cheaper)".to_owned(),
+            unit: "evaluations per clock per multiprocessor (modelled; higher is better)"
+                .to_owned(),
         })
     });
     std::iter::once(Ok(cpu_cost(lobe))).chain(gpus).collect()

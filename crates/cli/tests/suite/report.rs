@@ -74,7 +74,8 @@ fn the_quick_report_is_complete_and_well_formed() {
         .descendants()
         .filter(|n| n.has_tag_name("section"))
         .count();
-    assert_eq!(sections, 14);
+    assert_eq!(sections, 15);
+    answer_first(&document);
     // Into other renderers: every lobe's record and its lowering give the lobe's own bits.
     let renderers = page
         .find("Into other renderers")
@@ -138,6 +139,7 @@ fn the_quick_report_is_complete_and_well_formed() {
             assert_eq!(row.len(), 5, "{row:?}");
             check_row(&out, prefix, &row[0], &row[1], &row[2], &row[4]);
         }
+        check_tiles(&document, &out, prefix);
     }
     let rows = table_rows(&document, "PSNR vs the pow image (dB)");
     assert_eq!(rows.len(), specula::LobeKind::ALL.len(), "every lobe");
@@ -145,6 +147,7 @@ fn the_quick_report_is_complete_and_well_formed() {
         assert_eq!(row.len(), 5, "{row:?}");
         check_row(&out, "volume", &row[0], &row[1], &row[2], &row[3]);
     }
+    check_tiles(&document, &out, "volume");
     real_scans(&document, &text, &out);
     materials(&document, &out);
     one_answer(&document, d);
@@ -211,7 +214,7 @@ fn one_answer(document: &roxmltree::Document, directory: &std::path::Path) {
             } else {
                 let pow = answer.iter().find(|c| c["lobe"] == "pow").expect("pow");
                 checked[0] += 1;
-                format!("{lobe} ({:.2}x pow)", rate(best) / rate(pow))
+                format!("{lobe} ({:.2}x pow's throughput)", rate(best) / rate(pow))
             };
             assert_eq!(cell, &expected, "{target} n = {} within {bound}", row[1]);
         }
@@ -220,6 +223,127 @@ fn one_answer(document: &roxmltree::Document, directory: &std::path::Path) {
         checked[0] > 0 && checked[1] > 0,
         "GPU and FPGA cells: {checked:?}"
     );
+}
+
+/// The page opens with the answer: the first section leads with a box naming a lobe for each
+/// target, before any table; what the machine lacked is in the last section alone.
+fn answer_first(document: &roxmltree::Document) {
+    let sections: Vec<roxmltree::Node> = document
+        .descendants()
+        .filter(|n| n.has_tag_name("section"))
+        .collect();
+    let text = |node: roxmltree::Node| -> String {
+        node.descendants()
+            .filter(|n| n.is_text())
+            .filter_map(|n| n.text())
+            .collect()
+    };
+    let first = sections[0];
+    let lead = first
+        .children()
+        .find(|n| n.is_element() && !n.has_tag_name("h2"))
+        .expect("the first section has a body");
+    assert_eq!(lead.attribute("class"), Some("answer"), "the verdict leads");
+    let answer = text(lead);
+    for target in ["NVIDIA GPUs", "AMD RDNA GPUs", "FPGA", "CPU"] {
+        assert!(
+            answer.contains(target),
+            "the answer names {target}: {answer}"
+        );
+    }
+    assert!(
+        answer.contains("pow's throughput (modelled; higher is better)"),
+        "{answer}"
+    );
+    let last = sections.last().expect("sections");
+    assert!(
+        text(*last).contains("Notes on this machine"),
+        "the notes close the page"
+    );
+    for section in &sections[..sections.len() - 1] {
+        let said = text(*section);
+        for machine in ["is not installed", "No GPU adapter", "pip install"] {
+            assert!(
+                !said.contains(machine),
+                "a machine note outside the notes: '{machine}' in {}",
+                &said[..said.len().min(80)]
+            );
+        }
+    }
+}
+
+/// The comparison's tiles: one per lobe, each image a link to itself, every lobe but pow's
+/// with its FLIP map below, the maps on the scale the colour bar states, each the map
+/// `specula diff --heatmap --heatmap-scale` draws from the two files the tile shows.
+fn check_tiles(document: &roxmltree::Document, out: &std::path::Path, prefix: &str) {
+    let bar = document
+        .descendants()
+        .find(|n| n.attribute("id") == Some(&format!("{prefix}-scale")))
+        .unwrap_or_else(|| panic!("{prefix}: a colour bar"));
+    let scale = bar.attribute("data-scale").expect("a scale");
+    let grid = bar
+        .next_siblings()
+        .find(|n| n.attribute("class") == Some("tiles"))
+        .expect("the tiles after the colour bar");
+    let tiles: Vec<roxmltree::Node> = grid
+        .children()
+        .filter(|n| n.has_tag_name("figure"))
+        .collect();
+    assert_eq!(
+        tiles.len(),
+        specula::LobeKind::ALL.len(),
+        "{prefix}: a tile per lobe"
+    );
+    for (tile, lobe) in tiles.iter().zip(specula::LobeKind::ALL) {
+        let links: Vec<(&str, &str)> = tile
+            .descendants()
+            .filter(|n| n.has_tag_name("a"))
+            .map(|a| {
+                let image = a
+                    .children()
+                    .find(|n| n.has_tag_name("img"))
+                    .expect("an image");
+                (
+                    a.attribute("href").unwrap(),
+                    image.attribute("src").unwrap(),
+                )
+            })
+            .collect();
+        let image = format!("{prefix}-{}.png", lobe.id());
+        if lobe == specula::LobeKind::Pow {
+            assert_eq!(links, [(image.as_str(), image.as_str())]);
+            continue;
+        }
+        let map = format!("{prefix}-flip-{}.png", lobe.id());
+        assert_eq!(
+            links,
+            [
+                (image.as_str(), image.as_str()),
+                (map.as_str(), map.as_str())
+            ]
+        );
+        let drawn = out.join(format!("{prefix}-{}-heatmap.png", lobe.id()));
+        let reference = format!("{prefix}-pow.png");
+        let heatmap = drawn.to_str().unwrap();
+        ok(
+            out,
+            &[
+                "diff",
+                &reference,
+                &image,
+                "--heatmap",
+                heatmap,
+                "--heatmap-scale",
+                scale,
+            ],
+        );
+        assert_eq!(
+            std::fs::read(&drawn).unwrap(),
+            std::fs::read(out.join(&map)).unwrap(),
+            "{map} is specula diff's map at {scale}"
+        );
+        std::fs::remove_file(drawn).unwrap();
+    }
 }
 
 /// The FLIP figure a render's caption gives (the number after `FLIP `).
@@ -254,7 +378,12 @@ fn cells(table: roxmltree::Node) -> Vec<Vec<String>> {
         .map(|row| {
             row.children()
                 .filter(|n| n.has_tag_name("td"))
-                .map(|cell| cell.text().unwrap_or("").to_owned())
+                .map(|cell| {
+                    cell.descendants()
+                        .filter(|n| n.is_text())
+                        .filter_map(|n| n.text())
+                        .collect()
+                })
                 .collect()
         })
         .collect()

@@ -268,7 +268,7 @@ pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design,
             lobe.meets = lobe.verified && costed.meets;
             if lobe.meets {
                 lobe.why = format!(
-                    "meets every bound at {:.2}x pow's rate",
+                    "meets every bound at {:.2}x pow's throughput",
                     costed.rate / pow_rate
                 );
             } else if !costed.meets {
@@ -334,7 +334,7 @@ fn verdict(design: &Design, request: &DesignRequest) -> String {
         || format!("no {others} meets it"),
         |c| {
             format!(
-                "the cheapest {others} is {} at {:.2}x pow",
+                "the cheapest {others} is {} at {:.2}x pow's throughput",
                 c.lobe,
                 c.rate / design.pow_rate
             )
@@ -349,7 +349,7 @@ fn verdict(design: &Design, request: &DesignRequest) -> String {
                 _ => format!("; {builtin}"),
             };
             format!(
-                "{}: the cheapest designed lobe {within}, at {:.2}x pow's rate{versus}",
+                "{}: the cheapest designed lobe {within}, at {:.2}x pow's throughput{versus}",
                 best.name,
                 best.rate / design.pow_rate
             )

@@ -5,7 +5,7 @@
 // measuredAddress() into the address, so the view is shared with the rest of the page.
 "use strict";
 
-// GGX is no lobe of the registry: Paul Tol's indigo, none of the lobes' Okabe-Ito colours.
+// GGX is no lobe of the registry: Paul Tol's indigo, none of the built-in lobes' colours.
 const GGX_STYLE = { colour: "#332288", dashed: false };
 // Blinn fits are drawn thinner than Phong ones, the same colour and dash.
 const LINE_WIDTH = { phong: 2.25, blinn: 1.1 };
@@ -114,13 +114,13 @@ function measuredTable() {
     const style = fitStyle(f);
     const swatch = style.dashed ? `repeating-linear-gradient(90deg, ${style.colour} 0 4px, #fff 4px 6px)` : style.colour;
     const parameter = f.n !== undefined ? `n = ${number(f.n)}` : `α = ${number(f.alpha)}`;
-    const cells = (f.costs ?? costs.map(() => null)).map((c) => `<td>${c ? number(c.value) : ""}</td>`).join("");
+    const cells = (f.costs ?? costs.map(() => null)).map((c) => `<td>${c ? c.versus_pow.toFixed(2) + "x" : ""}</td>`).join("");
     return `<tr><td><label class="inline"><input type="checkbox" value="${f.label}"${measured.fits.includes(f.label) ? " checked" : ""}> <span class="swatch" style="background:${swatch}"></span> ${f.label}</label></td><td>${parameter}</td><td>${triple(f.kd)}</td><td>${triple(f.k)}</td><td>${number(f.error)}</td><td>${number(f.relative_to_pow_best)}</td><td>${number(f.relative_to_ggx)}</td><td>${triple(f.albedo_at_normal)}</td>${f.family === "ggx" ? costs.map(() => "<td></td>").join("") : cells}</tr>`;
   });
-  const heads = costs.map((c) => `<th title="${c.unit}">cost: ${c.target}</th>`).join("");
+  const heads = costs.map((c) => `<th title="${c.unit}">x pow's throughput: ${c.target}</th>`).join("");
   const table = document.getElementById("measured-fits");
   table.innerHTML = `<table><thead><tr><th>fit (draw)</th><th>n or α</th><th>kd (r, g, b)</th><th>K (r, g, b)</th><th>error E</th><th>E / pow's best</th><th>E / GGX's</th><th>albedo at normal</th>${heads}</tr></thead><tbody>${rows.join("")}</tbody></table>`
-    + `<p class="note">Shared n, best first. f = kd/π + K lobe(t), K = ks N(n). E: ${data.error_measure}; pow's best E ${number(data.reference_error)}, GGX's ${number(data.ggx_error)}.${costs.length ? " Costs at the fitted n: " + costs.map((c) => `${c.target}: ${c.unit}`).join("; ") + "." : ""}</p>`;
+    + `<p class="note">Shared n, best first. f = kd/π + K lobe(t), K = ks N(n). E: ${data.error_measure}; pow's best E ${number(data.reference_error)}, GGX's ${number(data.ggx_error)}.${costs.length ? " Costs: throughput over pow's at the fitted n, higher is better; rates in " + costs.map((c) => `${c.target}: ${c.unit}`).join("; ") + "." : ""}</p>`;
   table.querySelectorAll("input[type=checkbox]").forEach((box) => box.addEventListener("change", () => {
     measured.fits = measured.fits.filter((label) => label !== box.value);
     // The fit checked last is the one rendered.

@@ -371,23 +371,29 @@ async fn other_host_names_are_refused() {
     assert_eq!(status("127.0.0.1:8123").await, StatusCode::OK);
 }
 
-/// The analysis carries each lobe's costs from the server's cost model: by default the CPU's
-/// counted SIMD instructions; a supplied model's figures verbatim.
+/// The analysis carries each lobe's costs from the server's cost model, each a rate (higher
+/// is better) and that rate over pow's: by default the CPU's evaluations per counted SIMD
+/// instruction; a supplied model's figures verbatim.
 #[tokio::test]
 async fn analyze_carries_the_cost_model() {
     let (status, report) = json("/api/analyze?lobe=cosquad&n=64").await;
     assert_eq!(status, StatusCode::OK);
-    let lobe = specula::Lobe::new(
-        specula::LobeKind::CosQuad { v: 4 },
-        specula::Exponent::new(64.0),
-    );
-    assert_eq!(report["costs"][0]["target"], "cpu");
-    assert_eq!(
-        report["costs"][0]["value"].as_f64(),
-        Some(f64::from(lobe.batch_instructions().total()))
-    );
+    let instructions = |kind| {
+        f64::from(
+            specula::Lobe::new(kind, specula::Exponent::new(64.0))
+                .batch_instructions()
+                .total(),
+        )
+    };
+    let cosquad = instructions(specula::LobeKind::CosQuad { v: 4 });
+    let pow = instructions(specula::LobeKind::Pow);
+    let cost = &report["costs"][0];
+    assert_eq!(cost["target"], "cpu");
+    assert_eq!(cost["value"].as_f64(), Some(8.0 / cosquad));
+    let versus_pow = cost["versus_pow"].as_f64().expect("a ratio");
+    assert!((versus_pow - pow / cosquad).abs() < 1e-12, "{cost}");
     let model: crate::CostModel = std::sync::Arc::new(|lobe: &specula::Lobe| {
-        Ok(vec![crate::TargetCost {
+        Ok(vec![crate::TargetRate {
             target: "test".into(),
             value: lobe.exponent().get() * 2.0,
             unit: "twice n".into(),

@@ -158,35 +158,28 @@ impl LobeKind {
         LobeKind::FasterPow,
     ];
 
-    /// How every plot draws the lobe (the report's and the explorer's): a colour of Okabe and
-    /// Ito's colour-blind-safe set, a family sharing one and its variants dashed, so that no
-    /// two lobes look alike even without colour vision.
+    /// How every plot draws the lobe (the report's, the explorer's, the Python package's): a
+    /// colour of its own, from Kelly's set of maximum contrast and Tol's cyan (no two lobes,
+    /// a user's included, closer than 25 in CIELAB: tested), a family's variants dashed as
+    /// well, so that the families read apart even without colour vision.
     #[must_use]
     pub fn line_style(self) -> LineStyle {
-        const BLACK: [u8; 3] = [0, 0, 0];
-        const ORANGE: [u8; 3] = [230, 159, 0];
-        const SKY_BLUE: [u8; 3] = [86, 180, 233];
-        const BLUISH_GREEN: [u8; 3] = [0, 158, 115];
-        const BLUE: [u8; 3] = [0, 114, 178];
-        const VERMILLION: [u8; 3] = [213, 94, 0];
-        const REDDISH_PURPLE: [u8; 3] = [204, 121, 167];
-        const GREY: [u8; 3] = [120, 120, 120];
         let (rgb, dashed) = match self {
-            LobeKind::Pow => (BLACK, false),
-            LobeKind::Schlick => (VERMILLION, false),
-            LobeKind::SchlickMod => (VERMILLION, true),
-            LobeKind::Cheb2Thesis => (BLUE, true),
-            LobeKind::Cheb2 => (BLUE, false),
-            LobeKind::Minimax2 => (SKY_BLUE, false),
-            LobeKind::LogExp => (BLUISH_GREEN, false),
-            LobeKind::LogExpRr => (BLUISH_GREEN, true),
-            LobeKind::CosQuad { .. } => (ORANGE, false),
-            LobeKind::Sg => (REDDISH_PURPLE, false),
-            LobeKind::SgKaris => (REDDISH_PURPLE, true),
-            LobeKind::FastPow => (GREY, false),
-            LobeKind::FasterPow => (GREY, true),
-            // Paul Tol's wine, indigo, olive and teal: none of Okabe and Ito's set, so a user's
-            // lobe never looks like a built-in one.
+            LobeKind::Pow => ([0, 0, 0], false),
+            LobeKind::Schlick => ([190, 0, 50], false),
+            LobeKind::SchlickMod => ([243, 132, 0], true),
+            LobeKind::Cheb2Thesis => ([51, 187, 238], true),
+            LobeKind::Cheb2 => ([0, 103, 165], false),
+            LobeKind::Minimax2 => ([96, 78, 151], false),
+            LobeKind::LogExp => ([0, 136, 86], false),
+            LobeKind::LogExpRr => ([141, 182, 0], true),
+            LobeKind::CosQuad { .. } => ([136, 45, 23], false),
+            LobeKind::Sg => ([230, 143, 172], false),
+            LobeKind::SgKaris => ([249, 147, 121], true),
+            LobeKind::FastPow => ([132, 132, 130], false),
+            LobeKind::FasterPow => ([194, 178, 128], true),
+            // Paul Tol's wine, indigo, olive and teal: none of the built-ins' colours, so a
+            // user's lobe never looks like a built-in one.
             LobeKind::Formula(FormulaId(id)) => {
                 const USER: [[u8; 3]; 4] =
                     [[136, 34, 85], [51, 34, 136], [153, 153, 51], [68, 170, 153]];
@@ -488,6 +481,57 @@ mod tests {
         );
         for bad in ["cosquad:v=11", "cosquad:w=3", "cosquad:v", "schlick:v=2"] {
             assert!(LobeKind::parse(bad).is_err(), "{bad} accepted");
+        }
+    }
+
+    /// A colour in CIELAB (D65), by the standard's formulas.
+    fn cielab([r, g, b]: [u8; 3]) -> [f64; 3] {
+        let linear = |c: u8| {
+            let c = f64::from(c) / 255.0;
+            if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
+        };
+        let (r, g, b) = (linear(r), linear(g), linear(b));
+        let x = (0.4124 * r + 0.3576 * g + 0.1805 * b) / 0.95047;
+        let y = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+        let z = (0.0193 * r + 0.1192 * g + 0.9505 * b) / 1.08883;
+        let f = |t: f64| {
+            if t > 216.0 / 24389.0 {
+                t.cbrt()
+            } else {
+                (24389.0 / 27.0 * t + 16.0) / 116.0
+            }
+        };
+        [
+            116.0 * f(y) - 16.0,
+            500.0 * (f(x) - f(y)),
+            200.0 * (f(y) - f(z)),
+        ]
+    }
+
+    /// Every lobe a colour of its own: no two, the built-ins and four users' lobes, closer
+    /// than 25 in CIELAB (where about 2 is the least difference a viewer sees side by side).
+    #[test]
+    fn no_two_lobes_share_a_colour() {
+        let lobes: Vec<LobeKind> = LobeKind::ALL
+            .into_iter()
+            .chain((0..4).map(|id| LobeKind::Formula(FormulaId(id))))
+            .collect();
+        for (i, a) in lobes.iter().enumerate() {
+            for b in &lobes[i + 1..] {
+                let (p, q) = (cielab(a.line_style().rgb), cielab(b.line_style().rgb));
+                let distance = p
+                    .iter()
+                    .zip(q)
+                    .map(|(x, y)| (x - y).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                let (a, b) = (a.line_style().hex(), b.line_style().hex());
+                assert!(distance >= 25.0, "{a} and {b}: {distance:.1} apart");
+            }
         }
     }
 
