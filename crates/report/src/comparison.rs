@@ -12,6 +12,7 @@ use specula_render::metrics::{magma_srgb8, Difference};
 
 use super::html::{colour_bar, tiles, Tile};
 use super::Context;
+use crate::format::psnr_db;
 
 /// One image of a comparison.
 pub(crate) struct Compared<'a> {
@@ -23,6 +24,33 @@ pub(crate) struct Compared<'a> {
     pub difference: Option<&'a Difference>,
     /// The figures under it.
     pub caption: String,
+}
+
+impl<'a> Compared<'a> {
+    /// `lobe`'s image in `file` and how it differs from the reference's, its caption the
+    /// PSNR and mean FLIP, or, for the reference itself, "the reference".
+    #[must_use]
+    pub(crate) fn new(
+        lobe: LobeKind,
+        file: &str,
+        difference: &'a Difference,
+        reference: bool,
+    ) -> Self {
+        Self {
+            lobe,
+            file: file.to_owned(),
+            difference: (!reference).then_some(difference),
+            caption: if reference {
+                "the reference".to_owned()
+            } else {
+                format!(
+                    "PSNR {}, mean FLIP {:.4}",
+                    psnr_db(difference.psnr_db),
+                    difference.mean_flip
+                )
+            },
+        }
+    }
 }
 
 /// The scale every map of a comparison shares: the largest 99th percentile of the maps' FLIP

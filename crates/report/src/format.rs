@@ -79,6 +79,52 @@ pub fn resource_cells(r: &Resources) -> [String; 8] {
     ]
 }
 
+/// The columns of [`resource_numbers`].
+pub const RESOURCE_NUMBER_COLUMNS: [&str; 13] = [
+    "multipliers",
+    "multiplier area (sum of a*b bits)",
+    "squarers",
+    "squarer bits (sum)",
+    "adders",
+    "adder bits (sum)",
+    "dividers",
+    "divider area (sum of dividend*divisor bits)",
+    "shifters",
+    "shifter bits (sum)",
+    "ROM bits",
+    "register bits",
+    "latency (cycles)",
+];
+
+/// A datapath's resources as numbers alone, for scripts (CSV): each kind of operator's count
+/// and its summed size, then ROM bits, register bits and latency ([`RESOURCE_NUMBER_COLUMNS`]).
+#[must_use]
+pub fn resource_numbers(r: &Resources) -> [String; 13] {
+    let sum = |items: &[u32]| items.iter().map(|&b| u64::from(b)).sum::<u64>().to_string();
+    let area = |pairs: &[(u32, u32)]| {
+        pairs
+            .iter()
+            .map(|&(a, b)| u64::from(a) * u64::from(b))
+            .sum::<u64>()
+            .to_string()
+    };
+    [
+        r.multipliers.len().to_string(),
+        area(&r.multipliers),
+        r.squarers.len().to_string(),
+        sum(&r.squarers),
+        r.adders.len().to_string(),
+        sum(&r.adders),
+        r.dividers.len().to_string(),
+        area(&r.dividers),
+        r.shifters.len().to_string(),
+        sum(&r.shifters),
+        r.rom_bits.to_string(),
+        r.register_bits.to_string(),
+        r.latency.to_string(),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

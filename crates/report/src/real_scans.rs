@@ -15,7 +15,8 @@ use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::{self, vtk, Units, Volume};
 use specula_render::{read_image, srgb_encode, Display, Image};
 
-use super::html::{paragraph, table};
+use super::comparison::{self, Compared};
+use super::html::{paragraph, table_with_files};
 use super::volumes::{cpu_threads, march_times, shading, EXPONENT};
 use super::{Context, RealScanSizes};
 use crate::format::psnr;
@@ -269,18 +270,12 @@ fn lobe_table(
         lobes.len(),
     ));
     let mut rows = Vec::new();
-    let mut figures = String::new();
+    let mut differences = Vec::new();
     let mut reference: Option<Image> = None;
     for (&kind, image) in lobes.iter().zip(images) {
         let name = format!("real-{}-{}.png", scan.key, kind.id());
         let bytes = image.to_srgb8(Display::default());
-        figures += &context.png_srgb8(
-            &name,
-            side,
-            side,
-            &bytes,
-            &format!("real {}, {kind}", scan.name),
-        )?;
+        context.write_png_file(&name, side, side, &bytes)?;
         // Compared as written (8-bit sRGB), so `specula diff` on the files prints the same.
         let written = Image::from_srgb8(side, side, &bytes).ok_or("inconsistent image size")?;
         let reference_image = reference.get_or_insert_with(|| written.clone());
@@ -288,12 +283,18 @@ fn lobe_table(
             compare(reference_image, &written, Display::default()).map_err(|e| e.to_string())?;
         rows.push(vec![
             kind.to_string(),
-            name,
+            name.clone(),
             psnr(against_pow.psnr_db),
             format!("{:.5}", against_pow.mean_flip),
         ]);
+        differences.push((kind, name, against_pow));
     }
-    html += &table(
+    let compared: Vec<Compared> = differences
+        .iter()
+        .map(|(kind, name, d)| Compared::new(*kind, name, d, *kind == LobeKind::Pow))
+        .collect();
+    html += &comparison::grid(context, &format!("real-{}", scan.key), "pow", &compared)?;
+    html += &table_with_files(
         &[
             "lobe",
             "image",
@@ -301,8 +302,8 @@ fn lobe_table(
             "mean FLIP vs the pow image",
         ],
         &rows,
+        &[1],
     );
-    html += &figures;
     Ok(html)
 }
 
@@ -473,7 +474,7 @@ fn against_vtk(
     if rows.is_empty() {
         return Ok(html);
     }
-    html += &table(
+    html += &table_with_files(
         &[
             "scan",
             "specula image",
@@ -483,9 +484,10 @@ fn against_vtk(
             "mean FLIP, specula vs VTK",
             "specula frames/s",
             "VTK frames/s",
-            "specula vs VTK",
+            "specula frames/s over VTK's (higher is better)",
         ],
         &rows,
+        &[1, 2],
     );
     html += &paragraph(&format!(
         "VTK {}. The differences are of linear values in [0, 1] per channel over the whole image (background included); a pixel is off when any channel differs by more than 0.1; FLIP is of the images as shown (sRGB). Frames per second are the median of {frames} frame(s) ({} threads each; VTK's own time to draw after an untimed first frame, in which it computes its gradients; specula's whole frame, its gradients and bricks computed once before), specula's taken after VTK's, both while the report's other sections run and on small images, where a frame's fixed costs weigh more: a rough guide, not a benchmark (specula bench volume --input FILE measures on a quiet machine at 512x512). Timings are printed, never asserted.",

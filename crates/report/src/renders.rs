@@ -83,21 +83,12 @@ fn lobe_table(
         .iter()
         .zip(&names)
         .map(|(column, name)| {
-            let reference = column.lobe == options.reference;
-            Compared {
-                lobe: column.lobe,
-                file: name.clone(),
-                difference: (!reference).then_some(&column.difference),
-                caption: if reference {
-                    "the reference".to_owned()
-                } else {
-                    format!(
-                        "PSNR {}, mean FLIP {:.4}",
-                        psnr_db(column.difference.psnr_db),
-                        column.difference.mean_flip
-                    )
-                },
-            }
+            Compared::new(
+                column.lobe,
+                name,
+                &column.difference,
+                column.lobe == options.reference,
+            )
         })
         .collect();
     let mut html = comparison::grid(context, prefix, &options.reference.to_string(), &compared)?;

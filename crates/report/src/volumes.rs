@@ -22,7 +22,7 @@ use specula_render::{Display, Image};
 use super::comparison::{self, Compared};
 use super::html::{paragraph, table, table_with_files};
 use super::Context;
-use crate::format::{psnr, psnr_db, sig};
+use crate::format::{psnr, sig};
 
 /// The exponent of every lobe in the section (VTK's specular power in the comparison).
 pub(crate) const EXPONENT: f64 = 32.0;
@@ -201,16 +201,7 @@ fn phantom(context: &mut Context) -> Result<String, String> {
     }
     let compared: Vec<Compared> = differences
         .iter()
-        .map(|(kind, name, d)| Compared {
-            lobe: *kind,
-            file: name.clone(),
-            difference: (*kind != LobeKind::Pow).then_some(d),
-            caption: if *kind == LobeKind::Pow {
-                "the reference".to_owned()
-            } else {
-                format!("PSNR {}, mean FLIP {:.4}", psnr_db(d.psnr_db), d.mean_flip)
-            },
-        })
+        .map(|(kind, name, d)| Compared::new(*kind, name, d, *kind == LobeKind::Pow))
         .collect();
     html += &comparison::grid(context, "volume", "pow", &compared)?;
     html += &table_with_files(

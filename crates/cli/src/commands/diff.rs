@@ -8,7 +8,7 @@ use specula_render::{read_image, write_png_srgb8, Display, ToneMap};
 
 use super::{print_json, CommandResult};
 use crate::args::{choice, Format};
-use crate::output::Table;
+use crate::output::{number, Table};
 
 /// Arguments of `specula diff`.
 #[derive(Debug, clap::Args)]
@@ -88,12 +88,31 @@ pub fn run(args: &Args) -> CommandResult {
     if args.format == Format::Json {
         return print_json(&report);
     }
+    if args.format == Format::Csv {
+        // Data alone: one row, every figure with all its digits; identical images' PSNR is
+        // `inf` (what every CSV reader parses as infinity).
+        let mut table = Table::new(&["psnr (dB)", "max abs error", "mean FLIP", "width", "height"]);
+        table.push(vec![
+            number(report.psnr_db),
+            number(report.max_abs_error),
+            number(report.mean_flip),
+            report.width.to_string(),
+            report.height.to_string(),
+        ]);
+        table.print(args.format);
+        return Ok(());
+    }
     let mut table = Table::new(&["metric", "value"]);
     table.push(vec![
         "size".into(),
         format!("{}x{}", report.width, report.height),
     ]);
-    table.push(vec!["PSNR (dB)".into(), format!("{:.2}", report.psnr_db)]);
+    let psnr = if report.psnr_db.is_finite() {
+        format!("{:.2}", report.psnr_db)
+    } else {
+        "identical".to_owned()
+    };
+    table.push(vec!["PSNR (dB)".into(), psnr]);
     table.push(vec![
         "max abs error".into(),
         format!("{:.4}", report.max_abs_error),

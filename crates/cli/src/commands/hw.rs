@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use specula_decide::sweeps;
 use specula_hw::analysis::MEETS_TOLERANCE;
 use specula_hw::{diagram, integer_exponent, verilog, HwLobe, BITS};
-use specula_report::format::resource_cells;
+use specula_report::format::{resource_cells, resource_numbers, RESOURCE_NUMBER_COLUMNS};
 
 use super::{print_json, synth, CommandResult};
 use crate::args::Format;
@@ -224,9 +224,10 @@ fn table(args: &TableArgs) -> CommandResult {
     if args.format == Format::Json {
         return print_json(&results);
     }
-    // CSV is data: the error in % as a number, with all its digits.
+    // CSV is data: the error in % as a number, with all its digits, and each kind of
+    // operator's count and summed size where the table lists widths.
     let csv = args.format == Format::Csv;
-    let mut table = Table::new(&[
+    let mut header = vec![
         "datapath",
         "bits",
         if csv {
@@ -235,15 +236,22 @@ fn table(args: &TableArgs) -> CommandResult {
             "epicentre max rel"
         },
         "bloom max abs",
-        "multipliers",
-        "squarers",
-        "adders",
-        "dividers",
-        "shifters",
-        "ROM bits",
-        "register bits",
-        "latency",
-    ]);
+    ];
+    if csv {
+        header.extend(RESOURCE_NUMBER_COLUMNS);
+    } else {
+        header.extend([
+            "multipliers",
+            "squarers",
+            "adders",
+            "dividers",
+            "shifters",
+            "ROM bits",
+            "register bits",
+            "latency",
+        ]);
+    }
+    let mut table = Table::new(&header);
     for result in &results {
         for row in &result.rows {
             let mut cells = vec![
@@ -260,7 +268,11 @@ fn table(args: &TableArgs) -> CommandResult {
                     sig(row.errors.bloom_max_abs)
                 },
             ];
-            cells.extend(resource_cells(&row.resources));
+            if csv {
+                cells.extend(resource_numbers(&row.resources));
+            } else {
+                cells.extend(resource_cells(&row.resources));
+            }
             table.push(cells);
         }
     }

@@ -318,7 +318,30 @@ fn analyze_csv_carries_the_json_figures_as_numbers() {
 /// only a model's formula is text.
 #[test]
 fn csv_tables_hold_data_alone() {
-    let commands: [&[&str]; 5] = [
+    // Two images for `diff`: the default scene with pow and with schlick.
+    let directory = tempfile::tempdir().unwrap();
+    let image = |lobe: &str| {
+        let path = directory.path().join(format!("{lobe}.png"));
+        let path = path.to_str().unwrap().to_owned();
+        let args = [
+            "render", "--width", "32", "--height", "18", "--lobe", lobe, "-o", &path,
+        ];
+        assert!(specula(&args).status.success(), "{args:?}");
+        path
+    };
+    let (pow, schlick) = (image("pow"), image("schlick"));
+    let commands: [&[&str]; 7] = [
+        &["diff", &pow, &schlick],
+        &[
+            "hw",
+            "table",
+            "--lobe",
+            "schlick,cosquad",
+            "--bits",
+            "10..11",
+            "--n",
+            "64",
+        ],
         &["analyze", "--lobe", "cosquad,sg", "--n", "8,512"],
         &[
             "recommend",

@@ -10,7 +10,7 @@ use specula_decide::c_twins::{self, CTwins};
 use specula_decide::rates::{cosquad_formula, measure, LobeRate, Measured, L1_SIZE, STREAM_SIZE};
 
 use crate::args::Format;
-use crate::output::{percent, sig, Table};
+use crate::output::{number, percent, sig, Table};
 
 /// Measures and prints.
 pub fn run(n: Exponent, format: Format) -> Result<(), String> {
@@ -56,7 +56,13 @@ pub fn run(n: Exponent, format: Format) -> Result<(), String> {
             c_twins: twins.as_ref(),
         });
     }
-    print_peaks(&measured);
+    if format == Format::Csv {
+        // Data alone on stdout: the machine's notes go to stderr, the C twins to JSON.
+        eprintln!("{}", peaks_line(&measured));
+        print_csv(&measured);
+        return Ok(());
+    }
+    println!("{}", peaks_line(&measured));
     let g = |rate: f64| format!("{:.2}", rate / 1e9);
     let ratio = |a: f64, b: f64| format!("{:.2}x", a / b);
     let mut table = Table::new(&[
@@ -164,7 +170,50 @@ fn print_twins(measured: &Measured, twins: &CTwins, format: Format) {
     table.print(format);
 }
 
-fn print_peaks(measured: &Measured) {
+/// `bench lobes --format csv`: one row a lobe, every figure a number with all its digits, the
+/// unit in its column's name (ratios as multiples, shares in %).
+fn print_csv(measured: &Measured) {
+    let mut table = Table::new(&[
+        "lobe",
+        "G evaluations/s",
+        "bound (G evaluations/s)",
+        "of bound (%)",
+        "limited by",
+        "instructions per vector",
+        "plain loop (G evaluations/s)",
+        "x the plain loop",
+        "x powf",
+        "x the fast pow",
+        "streaming 1 thread (G evaluations/s)",
+        "streaming all threads (G evaluations/s)",
+        "of copy, all threads (%)",
+        "epicentre max rel (%)",
+    ]);
+    let g = |rate: f64| number(rate / 1e9);
+    let copy_all = measured.copy_stream.map_or(f64::NAN, |c| c[1]);
+    for rate in &measured.lobes {
+        let stream = rate.stream.unwrap_or([f64::NAN; 2]);
+        table.push(vec![
+            rate.lobe.clone(),
+            g(rate.explicit),
+            g(rate.bound.evals_per_second),
+            number(100.0 * rate.of_bound()),
+            rate.bound.limit.to_string(),
+            rate.instructions.total().to_string(),
+            g(rate.plain),
+            number(rate.explicit / rate.plain),
+            number(rate.explicit / measured.powf),
+            number(rate.explicit / measured.fast_pow()),
+            g(stream[0]),
+            g(stream[1]),
+            number(100.0 * stream[1] / copy_all),
+            number(100.0 * rate.epicentre_max_rel),
+        ]);
+    }
+    table.print(Format::Csv);
+}
+
+fn peaks_line(measured: &Measured) -> String {
     let lanes = measured.level.lanes() as f64;
     let peaks = &measured.peaks;
     let mut parts: Vec<String> = Class::ALL
@@ -177,9 +226,9 @@ fn print_peaks(measured: &Measured) {
         .collect();
     parts.push(format!("dispatch {}", sig(peaks.dispatch / 1e9)));
     parts.push(format!("L1 copy {}", sig(peaks.copy / 1e9)));
-    println!(
+    format!(
         "measured peaks, G vector instructions/s on one thread ({} lanes each; compares count against dispatch): {}",
         lanes,
         parts.join(", ")
-    );
+    )
 }

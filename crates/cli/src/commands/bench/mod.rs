@@ -8,7 +8,7 @@ use specula_gpu::{throughput, Gpu, GpuRenderer};
 use specula_render::{render, Overrides, Scene, Shading};
 
 use super::CommandResult;
-use crate::output::Table;
+use crate::output::{number, Table};
 
 pub mod environment;
 pub mod lobes;
@@ -270,18 +270,34 @@ fn bench_gpu(args: &Args) -> CommandResult {
 
 fn bench_gpu_lobes(args: &Args) -> CommandResult {
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
-    println!(
+    // CSV is data alone: the notes go to stderr, every figure a number with all its digits.
+    let csv = args.format == crate::args::Format::Csv;
+    let note = |text: String| {
+        if csv {
+            eprintln!("{text}");
+        } else {
+            println!("{text}");
+        }
+    };
+    let ratio = |x: f64| {
+        if csv {
+            number(x)
+        } else {
+            format!("{x:.2}x")
+        }
+    };
+    note(format!(
         "{}\nevery lobe at n = {}, its constants baked into a compute shader; each invocation \
          sums the lobe at {} cosines; dispatches grow until one takes 20 ms, best of 5",
         gpu.adapter_name(),
         args.n,
         throughput::CHAIN
-    );
+    ));
     let families = specula::gpu_cost::GpuFamily::ALL;
     let mut headers = vec![
         "lobe".to_owned(),
         "G evals/s".to_owned(),
-        "vs pow".to_owned(),
+        "x pow's throughput".to_owned(),
         "evaluations timed".to_owned(),
         "ms".to_owned(),
         "shader ops".to_owned(),
@@ -289,7 +305,7 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
     headers.extend(
         families
             .iter()
-            .map(|f| format!("modelled vs pow, {}", f.id)),
+            .map(|f| format!("modelled x pow's throughput, {}", f.id)),
     );
     let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
     let mut table = Table::new(&headers);
@@ -307,23 +323,32 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
             .clone();
         let mut row = vec![
             kind.to_string(),
-            format!("{:.1}", rate.evals_per_second / 1e9),
-            format!("{:.2}x", rate.evals_per_second / pow_rate),
+            if csv {
+                number(rate.evals_per_second / 1e9)
+            } else {
+                format!("{:.1}", rate.evals_per_second / 1e9)
+            },
+            ratio(rate.evals_per_second / pow_rate),
             rate.evaluations.to_string(),
-            format!("{:.2}", rate.time.as_secs_f64() * 1e3),
+            if csv {
+                number(rate.time.as_secs_f64() * 1e3)
+            } else {
+                format!("{:.2}", rate.time.as_secs_f64() * 1e3)
+            },
             ops.expanded().total().to_string(),
         ];
         row.extend(
             modelled
                 .iter()
                 .zip(&pow_modelled)
-                .map(|(m, p)| format!("{:.2}x", m / p)),
+                .map(|(m, p)| ratio(m / p)),
         );
         table.push(row);
     }
-    println!(
+    note(
         "modelled: the shader's instructions (naga IR, acos expanded) at published per-clock \
          rates (crates/specula/src/gpu_cost.rs names the sources)"
+            .to_owned(),
     );
     table.print(args.format);
     Ok(())
