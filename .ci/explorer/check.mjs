@@ -80,21 +80,21 @@ try {
   if (relobed.environmentPow !== moved.environmentPow) failures.push("changing the lobes changed the environment's pow image");
   if (!/^PSNR [0-9.]+ dB against pow/.test(relobed.environmentPsnr)) failures.push(`logexp under the sky has no PSNR against pow: '${relobed.environmentPsnr}'`);
 
-  // The volume view's own lobe selector re-renders the lobe's image and leaves pow's alone;
-  // the volume selector changes both.
-  await page.locator("#volume_lobe").selectOption("schlick");
-  await drawn("volume_lobe", "schlick");
-  const volumeLobe = await snapshot();
-  if (volumeLobe.volume === relobed.volume) failures.push("choosing the volume's lobe did not change its image");
-  if (volumeLobe.volumePow !== relobed.volumePow) failures.push("choosing the volume's lobe changed the pow image");
+  // The volume follows the chosen lobe as every panel does: logexp's image, pow's unchanged;
+  // pow chosen, the two agree; the volume selector changes both.
+  if (relobed.volume === moved.volume) failures.push("changing the lobes: the volume did not re-render the chosen lobe");
+  if (relobed.volumePow !== moved.volumePow) failures.push("changing the lobes changed the volume's pow image");
+  const volumeName = () => page.evaluate(() => document.getElementById("volume-lobe-name").textContent);
+  if ((await volumeName()) !== "logexp") failures.push(`the volume shows '${await volumeName()}', not the chosen logexp`);
   const psnr = await page.evaluate(() => document.getElementById("volume-psnr").textContent);
-  if (!/^PSNR [0-9.]+ dB against pow/.test(psnr)) failures.push(`schlick's volume has no PSNR against pow: '${psnr}'`);
-  await page.locator("#volume_lobe").selectOption("pow");
-  await drawn("volume_lobe", "pow");
+  if (!/^PSNR [0-9.]+ dB against pow/.test(psnr)) failures.push(`logexp's volume has no PSNR against pow: '${psnr}'`);
+  await page.locator('#lobes input[value="pow"]').check();
+  await drawn("render", "pow");
   const same = await page.evaluate(() => document.getElementById("volume-psnr").textContent);
   if (same !== "identical to pow") failures.push(`pow against itself: '${same}'`);
-  await page.locator("#volume_lobe").selectOption("schlick");
-  await drawn("volume_lobe", "schlick");
+  await page.locator('#lobes input[value="pow"]').uncheck();
+  await drawn("lobes", "logexp,cosquad");
+  const volumeLobe = await snapshot();
   await page.locator("#volume").selectOption("marschner-lobb");
   await drawn("volume", "marschner-lobb");
   const otherVolume = await snapshot();
@@ -105,8 +105,19 @@ try {
   const other = await browser.newPage();
   await other.goto(shared);
   await other.waitForFunction(() => Number(document.body.dataset.updates) > 0, null, { timeout: 30000 });
-  const restored = await other.evaluate(() => [...document.querySelectorAll("#lobes input:checked")].map((c) => c.value).sort().join(",") + " " + document.getElementById("volume_lobe").value + " " + document.getElementById("volume").value);
-  if (restored !== "cosquad,logexp schlick marschner-lobb") failures.push(`the shared address restored ${restored}`);
+  const restored = await other.evaluate(() => [...document.querySelectorAll("#lobes input:checked")].map((c) => c.value).sort().join(",") + " " + document.getElementById("volume-lobe-name").textContent + " " + document.getElementById("volume").value);
+  if (restored !== "cosquad,logexp cosquad marschner-lobb") failures.push(`the shared address restored ${restored}`);
+
+  // The controls stay in view when the page scrolls, and the plots fill their sections.
+  await page.evaluate(() => window.scrollTo(0, document.body.scrollHeight));
+  const controlsTop = await page.evaluate(() => document.getElementById("controls").getBoundingClientRect().top);
+  if (Math.abs(controlsTop) > 1) failures.push(`scrolled down, the controls moved to ${controlsTop} px`);
+  const fill = await page.evaluate(() => {
+    const canvas = document.getElementById("cartesian");
+    const section = canvas.parentElement;
+    return canvas.getBoundingClientRect().width / (section.clientWidth - 20);
+  });
+  if (!(fill > 0.95 && fill <= 1.01)) failures.push(`the lobe plot fills ${(100 * fill).toFixed(0)} % of its section`);
 
   // Energy creation is said, and a bad address is reported rather than silently fixed.
   const warned = await browser.newPage();
@@ -187,6 +198,8 @@ try {
   const expected = ["0 5 10 15 20", "-0.10 -0.05 0.00 0.05 0.10", "0.0 0.2 0.4 0.6 0.8 1.0", "0 20 40 60 80"];
   ticks.forEach((got, k) => { if (got !== expected[k]) failures.push(`ticks: '${got}', expected '${expected[k]}'`); });
 
+  // From the top: the controls are sticky, so a full-page capture draws them where the view is.
+  await page.evaluate(() => window.scrollTo(0, 0));
   await page.screenshot({ path: screenshot, fullPage: true });
   if (messages.length) failures.push(...messages.map((m) => `console: ${m}`));
 } finally {
@@ -197,4 +210,4 @@ if (failures.length) {
   console.error("explorer check failed:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`explorer check: loaded, moved n, changed lobes (and the environment view), changed the volume's lobe and volume, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, typed a formula (drawn and rendered) and two refused ones (their errors beside the box), ran a design (its lobe drawn from the box), round ticks; no console message; screenshot ${screenshot}`);
+console.log(`explorer check: loaded, moved n, changed lobes (and the environment view), the volume followed the chosen lobe, changed the volume, the controls stayed in view, the plots filled their sections, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, typed a formula (drawn and rendered) and two refused ones (their errors beside the box), ran a design (its lobe drawn from the box), round ticks; no console message; screenshot ${screenshot}`);

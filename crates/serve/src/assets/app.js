@@ -6,7 +6,7 @@
 const DASH = [7, 4];
 // Phong geometry with the lobe's own normalisation: energy-conserving (albedo <= 1) for every
 // lobe, so the first view is physically sensible.
-const DEFAULTS = { lobes: "pow,schlick,schlick-mod", formula: "", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "", volume: "phantom", view: "anterior", volume_lobe: "cosquad" };
+const DEFAULTS = { lobes: "pow,schlick,schlick-mod", formula: "", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "", volume: "phantom", view: "anterior" };
 const $ = (id) => document.getElementById(id);
 let registry = null;
 let generation = 0;
@@ -75,7 +75,6 @@ function currentState() {
     render: names[ids.indexOf(renderLobe)] ?? "",
     volume: $("volume").value,
     view: $("view").value,
-    volume_lobe: $("volume_lobe").value === FORMULA ? FORMULA : lobeName({ value: $("volume_lobe").value }),
     // The measured-materials view's (measured.js), when a material is chosen.
     ...measuredAddress(),
   };
@@ -132,11 +131,8 @@ function buildControls(state) {
   select("model", registry.models);
   select("volume", registry.volumes);
   select("view", registry.views);
-  const volumeLobe = state.volume_lobe.split(":")[0];
-  const volumeKnown = known.has(volumeLobe) || volumeLobe === FORMULA;
-  if (!volumeKnown) notes.push(`volume_lobe '${state.volume_lobe}' is not a lobe; using ${DEFAULTS.volume_lobe}`);
-  fillSelect("volume_lobe", [...known, FORMULA], volumeKnown ? volumeLobe : DEFAULTS.volume_lobe);
-  $("volume_lobe").lastElementChild.textContent = "formula (the text box)";
+  // An address from before every panel followed the chosen lobe.
+  if (new URLSearchParams(location.search).has("volume_lobe")) notes.push("volume_lobe is no longer a choice of its own: the volume shows the chosen lobe, as every panel does");
   $("formula").value = state.formula;
   const limits = registry.formula;
   $("formula-help").textContent = `An expression of t (the cosine, 0 to 1) and n (the exponent), after any "let NAME = ...;". Operators + - * / ^; comparisons < <= > >= as the condition of select or if; # starts a comment. Functions: ${limits.functions.join(", ")}; constants pi, e. Its value must stay in [0, 1]; up to ${limits.max_bytes} bytes.`;
@@ -160,8 +156,8 @@ function showValues(state, shown) {
   $("environment-lobe").textContent = shown.render || "no lobe";
   $("environment-image").style.borderColor = colourOf(shown.render);
   $("environment-pow").style.borderColor = colourOf("pow");
-  $("volume-lobe-name").textContent = shown.volume_lobe;
-  $("volume-image").style.borderColor = colourOf(shown.volume_lobe);
+  $("volume-lobe-name").textContent = shown.render || "pow";
+  $("volume-image").style.borderColor = colourOf(shown.render || "pow");
   $("volume-pow").style.borderColor = colourOf("pow");
   $("theta_in-value").textContent = state.theta_in + "°";
   $("light_theta-value").textContent = state.light_theta + "°";
@@ -396,13 +392,12 @@ async function update() {
     const data = typed.data ? [...builtIn, { ...typed.data, lobe: FORMULA }] : builtIn;
     const reports = await Promise.all(lobes.map((lobe) => getJson("/api/analyze?" + new URLSearchParams({ lobe: apiLobe(lobe), n: state.n })).then((r) => ({ ...r, lobe }))));
     if (mine !== generation) return;
-    // A refused formula is drawn nowhere: the renders show the last box's lobe, the volume its default.
+    // A refused formula is drawn nowhere: every panel shows the last box's lobe instead.
     const shown = {
       render: state.render === FORMULA && !typed.data ? boxes[boxes.length - 1] ?? "" : state.render,
-      volume_lobe: state.volume_lobe === FORMULA && !typed.data ? DEFAULTS.volume_lobe : state.volume_lobe,
     };
     showValues(state, shown);
-    draw(data, state);
+    draw(data, { ...state, render: shown.render });
     warnAboutAlbedo(data, state);
     $("analysis").innerHTML = lobes.length ? analysisTable(reports) : "<p>Choose a lobe.</p>";
     if (shown.render) {
@@ -414,7 +409,7 @@ async function update() {
       drawDifference($("environment-image"), $("environment-pow"), $("environment-diff"), $("environment-psnr"));
     }
     const volume = (lobe) => "/api/volume?" + new URLSearchParams({ volume: state.volume, view: state.view, lobe, ...common, size: "256" });
-    await Promise.all([loadImage($("volume-image"), volume(apiLobe(shown.volume_lobe))), loadImage($("volume-pow"), volume("pow"))]);
+    await Promise.all([loadImage($("volume-image"), volume(apiLobe(shown.render || "pow"))), loadImage($("volume-pow"), volume("pow"))]);
     if (mine !== generation) return;
     drawDifference($("volume-image"), $("volume-pow"), $("volume-diff"), $("volume-psnr"));
     $("status").textContent = "";
@@ -455,7 +450,21 @@ function drawDifference(a, b, canvas, caption, against = "pow") {
   caption.textContent = mse === 0 ? `identical to ${against}` : `PSNR ${(10 * Math.log10(255 * 255 / mse)).toFixed(1)} dB against ${against} (8-bit sRGB)`;
 }
 
+// What the plots show now, for a redraw at another width.
+let lastDrawn = null;
+let resizing = 0;
+
+// A plot canvas as wide as its section, in the proportion it was drawn at (560 x 320).
+function fitWidth(canvas) {
+  const style = getComputedStyle(canvas.parentElement);
+  const inner = canvas.parentElement.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight);
+  const width = Math.max(320, Math.floor(inner));
+  if (canvas.width !== width) [canvas.width, canvas.height] = [width, Math.round(width * 320 / 560)];
+}
+
 function draw(data, state) {
+  lastDrawn = [data, state];
+  for (const id of ["cartesian", "error", "polar", "albedo"]) fitWidth($(id));
   const right = Math.max(1e-3, ...data.map((d) => d.angles_deg[d.angles_deg.length - 1]));
   const first = data[0];
   const bands = first ? [[0, first.epicentre_deg, "rgba(255,200,0,0.18)"], [first.epicentre_deg, first.bloom_deg, "rgba(0,120,255,0.08)"]] : [];
@@ -471,7 +480,9 @@ function draw(data, state) {
   drawPolar($("polar"), data, Number(state.theta_in));
   const albedoTop = Math.max(1.05, ...data.flatMap((d) => d.albedo));
   plot($("albedo"), { series: data.map((d) => ({ points: zip(d.albedo_deg, d.albedo), colour: colourOf(d.lobe), dash: dashOf(d.lobe) })), x: [0, 90], y: [0, albedoTop], xLabel: "angle of incidence (degrees)", yLabel: "albedo" });
-  if (first) drawSlice($("slice"), first);
+  // The slice is of the lobe every panel shows (the chosen one), else the first.
+  const chosen = data.find((d) => d.lobe === state.render || d.lobe === state.render.split(":")[0]) ?? first;
+  if (chosen) drawSlice($("slice"), chosen);
   // A legend under each plot: every lobe drawn, in its colour and dash.
   const entry = (colour, dashed, name) => {
     const line = dashed ? `repeating-linear-gradient(90deg, ${colour} 0 5px, transparent 5px 8px)` : colour;
@@ -510,16 +521,16 @@ async function start() {
   document.querySelectorAll("#controls input, #controls select, #volume-controls select").forEach((el) => el.addEventListener("input", schedule));
   $("lobes").addEventListener("change", schedule);
   $("design-run").addEventListener("click", runDesign);
-  // Typing in the formula makes it the lobe the renders and the volume show; a pause sends it.
+  // Typing in the formula makes it the lobe every panel shows; a pause sends it.
   $("formula").addEventListener("input", () => {
-    if (formulaText()) {
-      renderLobe = FORMULA;
-      $("volume_lobe").value = FORMULA;
-    } else if ($("volume_lobe").value === FORMULA) {
-      $("volume_lobe").value = DEFAULTS.volume_lobe;
-    }
+    if (formulaText()) renderLobe = FORMULA;
     clearTimeout(pending);
     pending = setTimeout(update, FORMULA_DEBOUNCE_MS);
+  });
+  // The plots take the width their sections have, redrawn when the window changes.
+  window.addEventListener("resize", () => {
+    clearTimeout(resizing);
+    resizing = setTimeout(() => { if (lastDrawn) draw(...lastDrawn); }, 100);
   });
   await update();
 }
