@@ -176,7 +176,7 @@ fn pareto_plot(
     };
     let chart = pareto_chart(
         format!(
-            "{name}: designed and built-in lobes, worst epicentre error over n = {}..{} against modelled cost",
+            "{name}: worst epicentre error over n = {}..{} against cost",
             RANGE.0, RANGE.1
         ),
         &points,

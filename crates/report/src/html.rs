@@ -96,7 +96,7 @@ pub fn tiles(tiles: &[Tile]) -> String {
         {
             let _ = write!(
                 html,
-                "<a href=\"{0}\"><img src=\"{0}\" alt=\"{1}{what}\" loading=\"lazy\"/></a>",
+                "<a href=\"{0}\"><img src=\"{0}\" alt=\"{1}{what}\"/></a>",
                 escape(file),
                 escape(&tile.label)
             );

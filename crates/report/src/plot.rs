@@ -40,6 +40,9 @@ pub struct Chart {
 /// Pixels to the right of the plotting area, for the legend.
 const LEGEND_WIDTH: u32 = 150;
 
+/// The room above the plot: the title (18 points) and a gap below it, in displayed pixels.
+const TITLE_ROOM: u32 = 38;
+
 /// plotters' SVG back end writes whole-pixel coordinates, which turns a steep curve into
 /// stairs; charts are drawn this many times larger and shown at their size through the
 /// `viewBox`, so points land on quarter pixels. Every size in a drawing is multiplied by it.
@@ -58,6 +61,17 @@ const fn offset(pixels: i32) -> i32 {
 /// The font size for text shown `points` high.
 fn font(points: u32) -> (&'static str, u32) {
     ("sans-serif", px(points))
+}
+
+/// A log axis's tick labels: [`tick`]'s at 1, 2 and 5 times a power of ten, none between
+/// (plotters marks every integer multiple, whose labels would run into each other).
+fn log_tick(value: &f64) -> String {
+    let mantissa = *value / 10f64.powf(value.abs().log10().floor());
+    if [1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-6) {
+        tick(value)
+    } else {
+        String::new()
+    }
 }
 
 /// Tick labels: plain decimals in `[1e-3, 1e4)`, powers of ten outside, and 0 for the
@@ -84,6 +98,28 @@ pub const SEQUENCE: [RGBColor; 6] = [
     RGBColor(230, 159, 0),
     RGBColor(86, 180, 233),
 ];
+
+/// The SVG without a text element that repeats one before it, the same text at the same place:
+/// plotters marks a log axis's decade boundary twice (the end of one decade, the start of the
+/// next), and the label drawn twice reads as overlapping text.
+fn without_repeated_text(svg: &str) -> String {
+    let mut seen = std::collections::HashSet::new();
+    let mut kept = String::with_capacity(svg.len());
+    let mut rest = svg;
+    while let Some(start) = rest.find("<text") {
+        let Some(length) = rest[start..].find("</text>") else {
+            break;
+        };
+        let element = &rest[start..start + length + "</text>".len()];
+        kept.push_str(&rest[..start]);
+        if seen.insert(element) {
+            kept.push_str(element);
+        }
+        rest = &rest[start + element.len()..];
+    }
+    kept.push_str(rest);
+    kept
+}
 
 /// An SVG drawn [`SUPERSAMPLE`] times larger, declared at its displayed size (`viewBox`
 /// keeps the drawing's coordinates).
@@ -130,7 +166,7 @@ impl Chart {
             }?;
             root.present().map_err(|e| e.to_string())?;
         }
-        shown_at(&svg, (width + LEGEND_WIDTH, height))
+        shown_at(&without_repeated_text(&svg), (width + LEGEND_WIDTH, height))
     }
 
     fn draw<X, Y>(
@@ -146,9 +182,24 @@ impl Chart {
         Y::CoordDescType: ValueFormatter<f64>,
     {
         let error = |e: DrawingAreaErrorKind<_>| e.to_string();
+        let (root_width, _) = root.dim_in_pixel();
+        let title = font(18)
+            .into_font()
+            .color(&BLACK)
+            .pos(text_anchor::Pos::new(
+                text_anchor::HPos::Center,
+                text_anchor::VPos::Top,
+            ));
+        root.draw(&Text::new(
+            self.title.clone(),
+            ((root_width - px(LEGEND_WIDTH)) as i32 / 2, offset(8)),
+            title,
+        ))
+        .map_err(error)?;
         let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, font(18))
             .margin(px(10))
+            // The title, drawn below, and a gap under it for the top tick's label.
+            .margin_top(px(TITLE_ROOM))
             .margin_right(px(10 + LEGEND_WIDTH))
             .x_label_area_size(px(40))
             .y_label_area_size(px(60))
@@ -164,8 +215,8 @@ impl Chart {
             .label_style(font(12))
             .axis_desc_style(font(13))
             .set_all_tick_mark_size(px(5))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
+            .x_label_formatter(if self.log_x { &log_tick } else { &tick })
+            .y_label_formatter(if self.log_y { &log_tick } else { &tick })
             .draw()
             .map_err(error)?;
         for &(from, to, colour, _) in &self.bands {
@@ -192,6 +243,7 @@ impl Chart {
             };
             drawn.map_err(error)?;
         }
+        let (x_range, y_range) = chart.plotting_area().get_pixel_range();
         // The markers' names, each where it overlaps no other name nor marker.
         let markers: Vec<(String, (i32, i32))> = self
             .series
@@ -208,14 +260,16 @@ impl Chart {
                     })
             })
             .collect();
-        for (name, at) in place_labels(&markers) {
+        let area = (x_range.start, y_range.start, x_range.end, y_range.end);
+        for (name, at) in place_labels(&markers, area) {
             root.draw(&Text::new(name, at, font(12))).map_err(error)?;
         }
         // The legend, drawn beside the plotting area (plotters keeps its own inside, on the
         // data): one row per band and series, a swatch and the name.
-        let (x_range, y_range) = chart.plotting_area().get_pixel_range();
         let entries = self.bands.len() + self.series.len();
-        let row = offset(18);
+        // Rows 18 pixels apart, closer where that would run past the plot's height.
+        let room = (y_range.end - y_range.start) / entries.max(1) as i32;
+        let row = offset(18).min(room.max(offset(13)));
         let height = row * entries as i32;
         let x0 = x_range.end + offset(14);
         let y0 = if self.legend_below {
@@ -268,12 +322,20 @@ impl Chart {
     }
 }
 
-/// Where each marker's name goes (its top-left corner, drawn pixels): the first of a few
-/// places around the marker where the name's box overlaps no name already placed and no
-/// marker, else the first place (12-point text about 7 pixels a character, 14 high).
-fn place_labels(markers: &[(String, (i32, i32))]) -> Vec<(String, (i32, i32))> {
+/// Where each marker's name goes (its top-left corner, drawn pixels): the first of the places
+/// around the marker, nearest first, where the name's box stays inside `area` (left, top,
+/// right, bottom) and overlaps no name already placed and no marker; where none is free, the
+/// place that overlaps least (12-point text about 7 pixels a character, 14 high).
+fn place_labels(
+    markers: &[(String, (i32, i32))],
+    area: (i32, i32, i32, i32),
+) -> Vec<(String, (i32, i32))> {
     type Box = (i32, i32, i32, i32);
-    let overlaps = |a: Box, b: Box| a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3;
+    let overlap = |a: Box, b: Box| {
+        let width = (a.2.min(b.2) - a.0.max(b.0)).max(0);
+        let height = (a.3.min(b.3) - a.1.max(b.1)).max(0);
+        i64::from(width) * i64::from(height)
+    };
     let radius = offset(6);
     let dots: Vec<Box> = markers
         .iter()
@@ -283,27 +345,43 @@ fn place_labels(markers: &[(String, (i32, i32))]) -> Vec<(String, (i32, i32))> {
     let mut labels = Vec::new();
     for (name, (x, y)) in markers {
         let (width, height) = (offset(7) * name.chars().count() as i32, offset(14));
-        let places = [
-            (offset(8), -height / 2),
-            (-offset(8) - width, -height / 2),
-            (offset(6), -offset(6) - height),
-            (offset(6), offset(6)),
-            (-width / 2, -offset(8) - 2 * height),
-            (-width / 2, offset(8) + height),
-            (offset(8), -offset(6) - 2 * height),
-            (offset(8), offset(6) + height),
-        ];
+        // Beside, then above and below, then farther out in rings.
+        let mut places = Vec::new();
+        for ring in 0..4 {
+            let (near, step) = (offset(8) + ring * height, ring * height);
+            places.extend([
+                (near, -height / 2 - step),
+                (near, -height / 2 + step),
+                (-near - width, -height / 2 - step),
+                (-near - width, -height / 2 + step),
+                (-width / 2, -near - height - step),
+                (-width / 2, near + step),
+            ]);
+        }
         let boxed = |(dx, dy): (i32, i32)| (x + dx, y + dy, x + dx + width, y + dy + height);
-        let free = places.iter().copied().find(|&place| {
+        let inside = |b: Box| b.0 >= area.0 && b.1 >= area.1 && b.2 <= area.2 && b.3 <= area.3;
+        let cost = |place: (i32, i32)| {
             let candidate = boxed(place);
-            !placed
+            let covered: i64 = placed
                 .iter()
                 .chain(&dots)
-                .any(|&other| overlaps(candidate, other))
-        });
-        let (dx, dy) = free.unwrap_or(places[0]);
-        placed.push(boxed((dx, dy)));
-        labels.push((name.clone(), (x + dx, y + dy)));
+                .map(|&other| overlap(candidate, other))
+                .sum();
+            // Outside the plot counts as much as covering a whole name.
+            covered
+                + if inside(candidate) {
+                    0
+                } else {
+                    i64::from(width) * i64::from(height)
+                }
+        };
+        let best = places
+            .iter()
+            .copied()
+            .min_by_key(|&place| cost(place))
+            .unwrap_or((offset(8), -height / 2));
+        placed.push(boxed(best));
+        labels.push((name.clone(), (x + best.0, y + best.1)));
     }
     labels
 }
@@ -550,11 +628,30 @@ impl Polar {
 mod tests {
     use super::*;
 
+    /// A text element repeated at its place is dropped; the same text elsewhere is kept.
+    #[test]
+    fn a_repeated_label_is_drawn_once() {
+        let svg = "<svg><text x=\"1\" y=\"2\">10</text><line/><text x=\"1\" y=\"2\">10</text><text x=\"1\" y=\"9\">10</text></svg>";
+        assert_eq!(
+            without_repeated_text(svg),
+            "<svg><text x=\"1\" y=\"2\">10</text><line/><text x=\"1\" y=\"9\">10</text></svg>"
+        );
+    }
+
     /// Markers at one place and close by (sg and sg-karis share a point; the quadratics
     /// nearly do): no two names' boxes overlap, nor a name a marker.
     #[test]
     fn marker_names_do_not_overlap() {
-        let names = ["sg", "sg-karis", "minimax2", "cheb2", "cheb2-thesis", "pow"];
+        // fasterpow at the right edge: its name goes to the left, inside the plot.
+        let names = [
+            "sg",
+            "sg-karis",
+            "minimax2",
+            "cheb2",
+            "cheb2-thesis",
+            "pow",
+            "fasterpow",
+        ];
         let at = [
             (400, 300),
             (400, 300),
@@ -562,13 +659,14 @@ mod tests {
             (490, 380),
             (500, 382),
             (900, 900),
+            (990, 500),
         ];
         let markers: Vec<(String, (i32, i32))> = names
             .iter()
             .zip(at)
             .map(|(name, (x, y))| ((*name).to_owned(), (x * 4, y * 4)))
             .collect();
-        let placed = place_labels(&markers);
+        let placed = place_labels(&markers, (0, 0, 4000, 4000));
         let boxed =
             |(name, (x, y)): &(String, (i32, i32))| (*x, *y, x + 28 * name.len() as i32, y + 56);
         let overlaps = |a: (i32, i32, i32, i32), b: (i32, i32, i32, i32)| {
@@ -578,6 +676,12 @@ mod tests {
             for b in &placed[k + 1..] {
                 assert!(!overlaps(boxed(a), boxed(b)), "{} and {} overlap", a.0, b.0);
             }
+            let (left, top, right, bottom) = boxed(a);
+            assert!(
+                left >= 0 && top >= 0 && right <= 4000 && bottom <= 4000,
+                "{} leaves the plot",
+                a.0
+            );
             for (_, (x, y)) in &markers {
                 let dot = (x - 24, y - 24, x + 24, y + 24);
                 assert!(!overlaps(boxed(a), dot), "{} covers a marker", a.0);

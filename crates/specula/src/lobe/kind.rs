@@ -178,12 +178,19 @@ impl LobeKind {
             LobeKind::SgKaris => ([249, 147, 121], true),
             LobeKind::FastPow => ([132, 132, 130], false),
             LobeKind::FasterPow => ([194, 178, 128], true),
-            // Paul Tol's wine, indigo, olive and teal: none of the built-ins' colours, so a
-            // user's lobe never looks like a built-in one.
+            // Six colours none of the built-ins has (Paul Tol's wine, indigo, teal and purple,
+            // a khaki and a dark teal), so a user's lobe never looks like a built-in one; the
+            // seventh user's lobe takes the first colour dashed.
             LobeKind::Formula(FormulaId(id)) => {
-                const USER: [[u8; 3]; 4] =
-                    [[136, 34, 85], [51, 34, 136], [153, 153, 51], [68, 170, 153]];
-                (USER[id as usize % 4], (id / 4) % 2 == 1)
+                const USER: [[u8; 3]; 6] = [
+                    [136, 34, 85],
+                    [51, 34, 136],
+                    [68, 170, 153],
+                    [107, 107, 0],
+                    [0, 95, 95],
+                    [170, 68, 153],
+                ];
+                (USER[id as usize % 6], (id / 6) % 2 == 1)
             }
         };
         LineStyle { rgb, dashed }
@@ -512,13 +519,13 @@ mod tests {
         ]
     }
 
-    /// Every lobe a colour of its own: no two, the built-ins and four users' lobes, closer
+    /// Every lobe a colour of its own: no two, the built-ins and six users' lobes, closer
     /// than 25 in CIELAB (where about 2 is the least difference a viewer sees side by side).
     #[test]
     fn no_two_lobes_share_a_colour() {
         let lobes: Vec<LobeKind> = LobeKind::ALL
             .into_iter()
-            .chain((0..4).map(|id| LobeKind::Formula(FormulaId(id))))
+            .chain((0..6).map(|id| LobeKind::Formula(FormulaId(id))))
             .collect();
         for (i, a) in lobes.iter().enumerate() {
             for b in &lobes[i + 1..] {
