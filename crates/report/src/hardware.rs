@@ -102,6 +102,12 @@ fn synthesized(
         claim.measured,
         claim.reading
     ));
+    // The cost direction of the rest of the report: throughput per LUT as a multiple of pow's.
+    let pow_cost = claim
+        .designs
+        .iter()
+        .find(|design| design.lobe == HwLobe::Pow)
+        .and_then(|design| design.synthesis.as_ref()?.logic_ns_per_result());
     let rows: Vec<Vec<String>> = claim
         .designs
         .iter()
@@ -125,6 +131,10 @@ fn synthesized(
                     s.logic_ns_per_result()
                         .map_or("-".to_owned(), |v| format!("{v:.0}"))
                 }),
+                cell(&|s| match (pow_cost, s.logic_ns_per_result()) {
+                    (Some(pow), Some(own)) => format!("{:.2}x", pow / own),
+                    _ => "-".to_owned(),
+                }),
                 estimate(design.lobe, design.bits),
             ]
         })
@@ -140,6 +150,7 @@ fn synthesized(
             "Fmax MHz",
             "latency",
             "LUT x ns/result",
+            "x pow's throughput per LUT (higher is better)",
             "formula estimate (cells)",
         ],
         &rows,

@@ -350,6 +350,13 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
         .then(|| specula_decide::rates::measure(n, false, &indicatif::ProgressBar::hidden()));
     let mut rows = Vec::new();
     let mut points = Vec::new();
+    let pow = Lobe::new(LobeKind::Pow, n);
+    let pow_instructions = pow.batch_instructions().total();
+    let pow_shader = specula_gpu::shader_ops::lobe_shader_ops(&pow)?;
+    let pow_rates: Vec<f64> = specula::gpu_cost::GpuFamily::ALL
+        .iter()
+        .map(|family| family.cost(&pow_shader).evals_per_clock)
+        .collect();
     for kind in context.lobes.clone() {
         let lobe = Lobe::new(kind, n);
         let error = error_figures(&lobe, &mut Precision::F64, context.sizes.samples_per_zone)
@@ -358,14 +365,22 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
         let shader = specula_gpu::shader_ops::lobe_shader_ops(&lobe)?;
         let mut row = vec![
             kind.to_string(),
-            format!("{} ({instructions})", instructions.total()),
             format!("{:.3}%", 100.0 * error),
+            format!(
+                "{:.2}x",
+                f64::from(pow_instructions) / f64::from(instructions.total().max(1))
+            ),
         ];
         row.extend(
             specula::gpu_cost::GpuFamily::ALL
                 .iter()
-                .map(|family| format!("{:.2}", family.cost(&shader).evals_per_clock)),
+                .zip(&pow_rates)
+                .map(|(family, pow_rate)| {
+                    let rate = family.cost(&shader).evals_per_clock;
+                    format!("{:.2}x ({rate:.2})", rate / pow_rate)
+                }),
         );
+        row.push(format!("{} ({instructions})", instructions.total()));
         if let Some(measured) = &measured {
             // The measured lobes are the built-in ones and K4's formula: a lobe of the
             // user's is found by its id or shown unmeasured.
@@ -386,22 +401,25 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
     }
     let mut header = vec![
         "lobe",
-        "SIMD instructions per 8 lanes (counted from the kernel)",
         "epicentre max rel error (n = 64)",
-        "NVIDIA: evals/clock/SM (modelled)",
-        "AMD RDNA: evals/clock/CU (modelled)",
+        "CPU: x pow's throughput (counted instructions)",
+        "NVIDIA: x pow's throughput (evals/clock/SM, modelled)",
+        "AMD RDNA: x pow's throughput (evals/clock/CU, modelled)",
+        "SIMD instructions per 8 lanes (counted from the kernel)",
     ];
     let mut html = paragraph(
-        "What each lobe's explicit SIMD kernel executes per vector, read off the kernel (a test \
-         holds the count to what it runs); not a guess of operation weights. The GPU columns \
-         are the cost model's bound for the lobe's exported shader (higher is better; see \
-         Which lobe when).",
+        "Cost as everywhere in this report: throughput as a multiple of pow's, higher is \
+         better. On the CPU, pow's instructions over the lobe's, as its explicit SIMD kernel \
+         executes them per vector, read off the kernel (a test holds the count to what it runs; \
+         the last column lists them); not a guess of operation weights. On the GPUs, the cost \
+         model's bound for the lobe's exported shader over pow's (its rate beside it; see Which \
+         lobe when).",
     );
     if let Some(measured) = &measured {
         header.extend([
             "G evaluations/s (one thread, L1)",
             "of its bound",
-            "vs powf",
+            "x powf's throughput",
         ]);
         html += &paragraph(&format!(
             "Measured on this machine ({}; the bound is the fastest the kernel's instructions \
