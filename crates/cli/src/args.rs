@@ -127,7 +127,7 @@ fn invalid_value(cmd: &Command, arg: Option<&Arg>, message: &str) -> clap::Error
 
 /// Output formats of the table commands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum Format {
+pub enum OutputFormat {
     /// Aligned columns for reading.
     #[default]
     Table,

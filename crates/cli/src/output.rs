@@ -98,9 +98,9 @@ impl Table {
 }
 
 impl Table {
-    /// Prints as CSV for `Format::Csv`, aligned columns otherwise.
-    pub fn print(&self, format: crate::args::Format) {
-        if format == crate::args::Format::Csv {
+    /// Prints as CSV for `OutputFormat::Csv`, aligned columns otherwise.
+    pub fn print(&self, format: crate::args::OutputFormat) {
+        if format == crate::args::OutputFormat::Csv {
             print!("{}", self.csv());
         } else {
             print!("{}", self.render());

@@ -4,14 +4,14 @@
 //!
 //! A datapath is a list of named nodes in topological order. Each node is one hardware stage
 //! (an adder, a multiplier, a squarer, a divider, a log2 unit, a ROM, a multiplexer, or a
-//! wiring-only shift) with its own output [`Format`] and [`Rounding`]; its exact result is
+//! wiring-only shift) with its own output [`FixedPoint`] and [`Rounding`]; its exact result is
 //! resized into that format (rounded, then saturated). In the pipeline every non-wiring node
 //! ends in a register, and operands from earlier stages are delayed to arrive together.
 
 use serde::Serialize;
 
 use crate::exp2::Exp2Unit;
-use crate::fixed::{exact_add, exact_mul, Format, Rounding, MAX_WIDTH};
+use crate::fixed::{exact_add, exact_mul, FixedPoint, Rounding, MAX_WIDTH};
 use crate::log2::Log2Unit;
 
 /// A node's position in its datapath.
@@ -71,7 +71,7 @@ pub struct Node {
     /// The computation.
     pub op: Op,
     /// The output format.
-    pub format: Format,
+    pub format: FixedPoint,
     /// How fraction bits are dropped into it.
     pub rounding: Rounding,
 }
@@ -113,7 +113,7 @@ impl Builder {
     /// # Panics
     /// If the format is wider than [`MAX_WIDTH`] or an operand does not exist yet: both are
     /// mistakes in a datapath's construction, not in its inputs.
-    pub fn node(&mut self, name: &str, op: Op, format: Format) -> NodeId {
+    pub fn node(&mut self, name: &str, op: Op, format: FixedPoint) -> NodeId {
         assert!(
             format.width() <= MAX_WIDTH,
             "{name}: {} is too wide",
@@ -139,7 +139,7 @@ impl Builder {
     }
 
     /// An input.
-    pub fn input(&mut self, name: &str, format: Format) -> NodeId {
+    pub fn input(&mut self, name: &str, format: FixedPoint) -> NodeId {
         self.node(name, Op::Input, format)
     }
 
@@ -252,17 +252,6 @@ impl Datapath {
     #[must_use]
     pub fn eval(&self, inputs: &[i64]) -> i64 {
         self.eval_in(inputs, &mut Vec::new())
-    }
-
-    /// Every node's value for raw `inputs`.
-    ///
-    /// # Panics
-    /// If `inputs` does not have one value per input.
-    #[must_use]
-    pub fn eval_all(&self, inputs: &[i64]) -> Vec<i64> {
-        let mut values = Vec::new();
-        self.eval_in(inputs, &mut values);
-        values
     }
 
     /// The output for raw `inputs`, with every node's value left in `values`: a caller that
@@ -452,7 +441,7 @@ impl Datapath {
 }
 
 /// `a / b` for unsigned operands, truncated, into `out` (saturated; `b = 0` gives 0).
-fn divide(a: i64, fa: Format, b: i64, fb: Format, out: Format) -> i64 {
+fn divide(a: i64, fa: FixedPoint, b: i64, fb: FixedPoint, out: FixedPoint) -> i64 {
     if b <= 0 {
         return 0;
     }

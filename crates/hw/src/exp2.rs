@@ -12,7 +12,7 @@
 
 use serde::Serialize;
 
-use crate::fixed::{Format, Rounding};
+use crate::fixed::{FixedPoint, Rounding};
 use crate::log2::split;
 
 /// The guard bits the table keeps beyond the unit's output fraction.
@@ -46,7 +46,7 @@ impl Exp2Unit {
         (0..=segments)
             .map(|i| {
                 let x = -f64::from(i) / f64::from(segments);
-                Format::unsigned(1, frac).quantize(x.exp2(), Rounding::HalfEven)
+                FixedPoint::unsigned(1, frac).quantize(x.exp2(), Rounding::HalfEven)
             })
             .collect()
     }
@@ -65,7 +65,7 @@ impl Exp2Unit {
         self,
         table: &[i64],
         raw: i64,
-        input: Format,
+        input: FixedPoint,
         out_frac: u32,
     ) -> (i128, u32) {
         debug_assert!(!input.signed);
@@ -88,7 +88,7 @@ impl Exp2Unit {
 mod tests {
     use super::*;
 
-    fn exp2_neg(unit: Exp2Unit, x: f64, input: Format, out_frac: u32) -> f64 {
+    fn exp2_neg(unit: Exp2Unit, x: f64, input: FixedPoint, out_frac: u32) -> f64 {
         let raw = input.quantize(x, Rounding::HalfEven);
         let table = unit.table(Exp2Unit::frac_bits(out_frac));
         let (value, frac) = unit.eval_with_table(&table, raw, input, out_frac);
@@ -98,7 +98,7 @@ mod tests {
     /// Integers are exact: the table's first entry is 1 and the shift is the whole answer.
     #[test]
     fn integers_are_exact() {
-        let input = Format::unsigned(6, 12);
+        let input = FixedPoint::unsigned(6, 12);
         let unit = Exp2Unit { segments_log2: 4 };
         for i in 0..=18 {
             let expected = (-f64::from(i)).exp2();
@@ -111,7 +111,7 @@ mod tests {
     /// rounding.
     #[test]
     fn error_matches_the_interpolation_bound() {
-        let input = Format::unsigned(3, 14);
+        let input = FixedPoint::unsigned(3, 14);
         let unit = Exp2Unit { segments_log2: 4 };
         let out_frac = 20;
         let mut worst = 0.0_f64;
@@ -131,7 +131,7 @@ mod tests {
     /// Past the last shift every bit is gone.
     #[test]
     fn large_arguments_give_zero() {
-        let input = Format::unsigned(6, 8);
+        let input = FixedPoint::unsigned(6, 8);
         let unit = Exp2Unit { segments_log2: 3 };
         let out_frac = 10;
         let beyond = Exp2Unit::last_shift(out_frac) as f64 + 1.0;

@@ -1,14 +1,14 @@
 //! Fixed-point formats: `Q` numbers with an explicit rounding and saturation on every resize.
 //!
-//! A value is a raw integer and a [`Format`]: `value = raw / 2^frac_bits`, with `int_bits`
+//! A value is a raw integer and a [`FixedPoint`]: `value = raw / 2^frac_bits`, with `int_bits`
 //! integer bits and a sign bit when signed (two's complement), so a format is `width()` bits
 //! wide. Every operation computes its exact result first (a sum at the finer of the two
-//! fraction widths, a product at the sum of both) and then [`Format::resize`]s it into the
+//! fraction widths, a product at the sum of both) and then [`FixedPoint::resize`]s it into the
 //! destination: drop fraction bits by [`Rounding`], then saturate to the destination's range.
 //! That is what a hardware datapath does, and it is what the Verilog emitter writes.
 //!
 //! [`Q`] is the same arithmetic with the format in the type (const generics), for code whose
-//! widths are fixed; the datapaths, whose widths are swept at run time, use [`Format`] and raw
+//! widths are fixed; the datapaths, whose widths are swept at run time, use [`FixedPoint`] and raw
 //! integers directly.
 
 use serde::Serialize;
@@ -26,7 +26,7 @@ pub enum Rounding {
 
 /// A fixed-point format: sign, integer bits and fraction bits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
-pub struct Format {
+pub struct FixedPoint {
     /// Two's complement when true.
     pub signed: bool,
     /// Integer bits (not counting the sign).
@@ -39,7 +39,7 @@ pub struct Format {
 /// `i128` with room to spare, and the Verilog's 64-bit intermediates hold every exact result.
 pub const MAX_WIDTH: u32 = 36;
 
-impl Format {
+impl FixedPoint {
     /// Unsigned `UQ int.frac`.
     #[must_use]
     pub const fn unsigned(int_bits: u32, frac_bits: u32) -> Self {
@@ -136,15 +136,15 @@ impl Format {
 
 /// `a + b` exactly, at the finer fraction width: `(raw, frac_bits)`.
 #[must_use]
-pub fn exact_add(a: i64, fa: Format, b: i64, fb: Format) -> (i128, u32) {
+pub fn exact_add(a: i64, fa: FixedPoint, b: i64, fb: FixedPoint) -> (i128, u32) {
     let frac = fa.frac_bits.max(fb.frac_bits);
-    let widen = |raw: i64, f: Format| i128::from(raw) << (frac - f.frac_bits);
+    let widen = |raw: i64, f: FixedPoint| i128::from(raw) << (frac - f.frac_bits);
     (widen(a, fa) + widen(b, fb), frac)
 }
 
 /// `a * b` exactly: `(raw, frac_bits)`.
 #[must_use]
-pub fn exact_mul(a: i64, fa: Format, b: i64, fb: Format) -> (i128, u32) {
+pub fn exact_mul(a: i64, fa: FixedPoint, b: i64, fb: FixedPoint) -> (i128, u32) {
     (i128::from(a) * i128::from(b), fa.frac_bits + fb.frac_bits)
 }
 
@@ -162,7 +162,7 @@ pub type SQ<const INT: u32, const FRAC: u32> = Q<true, INT, FRAC>;
 
 impl<const SIGNED: bool, const INT: u32, const FRAC: u32> Q<SIGNED, INT, FRAC> {
     /// The runtime description of this type's format.
-    pub const FORMAT: Format = Format {
+    pub const FORMAT: FixedPoint = FixedPoint {
         signed: SIGNED,
         int_bits: INT,
         frac_bits: FRAC,
@@ -284,8 +284,8 @@ mod tests {
     use super::*;
 
     /// The reference: the exact rational `numerator / 2^shift` rounded with integer division
-    /// and an explicit tie test, then clamped. Written independently of `Format::resize`.
-    fn reference(numerator: i128, shift: i32, to: Format, rounding: Rounding) -> i64 {
+    /// and an explicit tie test, then clamped. Written independently of `FixedPoint::resize`.
+    fn reference(numerator: i128, shift: i32, to: FixedPoint, rounding: Rounding) -> i64 {
         let value = if shift <= 0 {
             numerator * (1_i128 << -shift)
         } else {
@@ -351,10 +351,10 @@ mod tests {
     #[test]
     fn resize_matches_integer_reference_exhaustively() {
         let targets = [
-            Format::unsigned(1, 1),
-            Format::signed(0, 2),
-            Format::signed(3, 4),
-            Format::unsigned(2, 0),
+            FixedPoint::unsigned(1, 1),
+            FixedPoint::signed(0, 2),
+            FixedPoint::signed(3, 4),
+            FixedPoint::unsigned(2, 0),
         ];
         for rounding in [Rounding::Truncate, Rounding::HalfEven] {
             for a in all::<true, 2, 3>() {

@@ -16,7 +16,7 @@ use specula::{Exponent, Lobe, LobeKind};
 
 use crate::datapath::{Builder, Datapath, Op};
 use crate::exp2::Exp2Unit;
-use crate::fixed::{Format, Rounding};
+use crate::fixed::{FixedPoint, Rounding};
 use crate::log2::Log2Unit;
 
 /// The word lengths the models are built for.
@@ -170,8 +170,8 @@ impl HwLobe {
 
     /// The input format of `t` (or `g`) and of the output.
     #[must_use]
-    pub fn unit_format(bits: u32) -> Format {
-        Format::unsigned(1, bits - 1)
+    pub fn unit_format(bits: u32) -> FixedPoint {
+        FixedPoint::unsigned(1, bits - 1)
     }
 
     /// The datapath at word length `bits`.
@@ -186,9 +186,9 @@ impl HwLobe {
         let output = match self {
             HwLobe::Schlick | HwLobe::SchlickMod => {
                 let t = b.input("t", unit);
-                let n = b.input("n", Format::unsigned(10, 0));
+                let n = b.input("n", FixedPoint::unsigned(10, 0));
                 let numerator = if self == HwLobe::SchlickMod {
-                    let k = b.input("k", Format::unsigned(3, 0));
+                    let k = b.input("k", FixedPoint::unsigned(3, 0));
                     let mut powers = vec![t];
                     for i in 1..=SCHLICK_MOD_MAX_SQUARINGS {
                         let previous = powers[powers.len() - 1];
@@ -207,8 +207,8 @@ impl HwLobe {
                 };
                 let one = b.node("one", Op::Const(1 << frac), unit);
                 let u = b.node("u", Op::Sub(one, t), unit);
-                let n_u = b.node("n_u", Op::Mul(n, u), Format::unsigned(10, frac));
-                let denominator = b.node("d", Op::Add(n_u, t), Format::unsigned(10, frac));
+                let n_u = b.node("n_u", Op::Mul(n, u), FixedPoint::unsigned(10, frac));
+                let denominator = b.node("d", Op::Add(n_u, t), FixedPoint::unsigned(10, frac));
                 if self == HwLobe::SchlickMod {
                     // Above t = 1 the quotient is t^(a-1) > 1; the float model clamps t to 1.
                     let quotient = b.node("quotient", Op::Div(numerator, denominator), unit);
@@ -219,29 +219,33 @@ impl HwLobe {
             }
             HwLobe::Cheb2 => {
                 let g = b.input("g", unit);
-                let n = b.input("n", Format::unsigned(10, 0));
+                let n = b.input("n", FixedPoint::unsigned(10, 0));
                 let [c, b_coef, a] = cheb2_roms(frac);
-                let rom = |b: &mut Builder, name: &str, (table, format): (Vec<i64>, Format)| {
+                let rom = |b: &mut Builder, name: &str, (table, format): (Vec<i64>, FixedPoint)| {
                     b.node(name, Op::Rom { index: n, table }, format)
                 };
                 let (fa, fb, fc) = (a.1, b_coef.1, c.1);
                 let a = rom(&mut b, "rom_a", a);
                 let b_node = rom(&mut b, "rom_b", b_coef);
                 let c = rom(&mut b, "rom_c", c);
-                let a_g = b.node("a_g", Op::Mul(a, g), Format::signed(fa.int_bits + 1, frac));
+                let a_g = b.node(
+                    "a_g",
+                    Op::Mul(a, g),
+                    FixedPoint::signed(fa.int_bits + 1, frac),
+                );
                 let inner_int = fa.int_bits.max(fb.int_bits) + 2;
                 let inner = b.node(
                     "inner",
                     Op::Add(a_g, b_node),
-                    Format::signed(inner_int, frac),
+                    FixedPoint::signed(inner_int, frac),
                 );
                 // The result is clamped to [0, 1] and C is near 1, so these two may saturate
                 // at +-8 and +-4: any value beyond clamps to the same 0 or 1.
-                let times_g = b.node("inner_g", Op::Mul(inner, g), Format::signed(3, frac));
+                let times_g = b.node("inner_g", Op::Mul(inner, g), FixedPoint::signed(3, frac));
                 let sum = b.node(
                     "sum",
                     Op::Add(times_g, c),
-                    Format::signed(fc.int_bits.max(2), frac),
+                    FixedPoint::signed(fc.int_bits.max(2), frac),
                 );
                 let one = b.node("one", Op::Const(1 << frac), unit);
                 // min(sum, 1), and negatives saturate to 0 in the unsigned output.
@@ -254,36 +258,48 @@ impl HwLobe {
                     Log2Unit::Mitchell
                 };
                 let t = b.input("t", unit);
-                let n = b.input("n", Format::unsigned(10, 0));
-                let log_t = b.node("log2_t", Op::Log2(t, log2_unit), Format::signed(5, frac));
-                let zero = b.node("zero", Op::Const(0), Format::unsigned(1, frac));
+                let n = b.input("n", FixedPoint::unsigned(10, 0));
+                let log_t = b.node(
+                    "log2_t",
+                    Op::Log2(t, log2_unit),
+                    FixedPoint::signed(5, frac),
+                );
+                let zero = b.node("zero", Op::Const(0), FixedPoint::unsigned(1, frac));
                 let minus_log = b.node(
                     "minus_log2_t",
                     Op::Sub(zero, log_t),
-                    Format::unsigned(5, frac),
+                    FixedPoint::unsigned(5, frac),
                 );
                 // -y = -n log2 t; at 3 and above the lobe is 0, so 2 integer bits suffice.
-                let minus_y = b.node("minus_y", Op::Mul(n, minus_log), Format::unsigned(2, frac));
+                let minus_y = b.node(
+                    "minus_y",
+                    Op::Mul(n, minus_log),
+                    FixedPoint::unsigned(2, frac),
+                );
                 let one = b.node("one", Op::Const(1 << frac), unit);
                 let s = b.node(
                     "one_minus_y",
                     Op::Add(one, minus_y),
-                    Format::unsigned(3, frac),
+                    FixedPoint::unsigned(3, frac),
                 );
-                let log_s = b.node("log2_s", Op::Log2(s, log2_unit), Format::unsigned(2, frac));
+                let log_s = b.node(
+                    "log2_s",
+                    Op::Log2(s, log2_unit),
+                    FixedPoint::unsigned(2, frac),
+                );
                 let half = b.node(
                     "half_log2_s",
                     Op::Shift(log_s, -1),
-                    Format::unsigned(1, frac + 1),
+                    FixedPoint::unsigned(1, frac + 1),
                 );
                 b.node("value", Op::Sub(one, half), unit)
             }
             HwLobe::CosQuad => {
                 let t = b.input("t", unit);
-                let a = b.input("a", Format::unsigned(6, frac));
+                let a = b.input("a", FixedPoint::unsigned(6, frac));
                 let one = b.node("one", Op::Const(1 << frac), unit);
                 let u = b.node("u", Op::Sub(one, t), unit);
-                let a_u = b.node("a_u", Op::Mul(a, u), Format::unsigned(6, frac));
+                let a_u = b.node("a_u", Op::Mul(a, u), FixedPoint::unsigned(6, frac));
                 let mut value = b.node("base", Op::Sub(one, a_u), unit);
                 for i in 1..=COSQUAD_V {
                     value = b.node(&format!("power_{}", 1 << i), Op::Square(value), unit);
@@ -293,29 +309,33 @@ impl HwLobe {
             }
             HwLobe::Pow => {
                 let t = b.input("t", unit);
-                let n = b.input("n", Format::unsigned(10, 0));
+                let n = b.input("n", FixedPoint::unsigned(10, 0));
                 // Six integer bits: log2 0 saturates to -32, and 2^-32 is 0 at every width.
                 let log_t = b.node(
                     "log2_t",
                     Op::Log2(t, POW_LOG2_TABLE),
-                    Format::signed(6, frac),
+                    FixedPoint::signed(6, frac),
                 );
-                let zero = b.node("zero", Op::Const(0), Format::unsigned(1, frac));
+                let zero = b.node("zero", Op::Const(0), FixedPoint::unsigned(1, frac));
                 // Above t = 1 the logarithm is positive and this saturates to 0: t^n = 1.
                 let minus_log = b.node(
                     "minus_log2_t",
                     Op::Sub(zero, log_t),
-                    Format::unsigned(6, frac),
+                    FixedPoint::unsigned(6, frac),
                 );
-                let minus_y = b.node("minus_y", Op::Mul(n, minus_log), Format::unsigned(6, frac));
+                let minus_y = b.node(
+                    "minus_y",
+                    Op::Mul(n, minus_log),
+                    FixedPoint::unsigned(6, frac),
+                );
                 b.node("value", Op::Exp2Neg(minus_y, POW_EXP2_TABLE), unit)
             }
             HwLobe::Sg => {
                 let t = b.input("t", unit);
-                let rate = b.input("rate", Format::unsigned(SG_RATE_INT_BITS, frac));
+                let rate = b.input("rate", FixedPoint::unsigned(SG_RATE_INT_BITS, frac));
                 let one = b.node("one", Op::Const(1 << frac), unit);
                 let u = b.node("u", Op::Sub(one, t), unit);
-                let minus_y = b.node("minus_y", Op::Mul(rate, u), Format::unsigned(6, frac));
+                let minus_y = b.node("minus_y", Op::Mul(rate, u), FixedPoint::unsigned(6, frac));
                 let value = b.node("gaussian", Op::Exp2Neg(minus_y, POW_EXP2_TABLE), unit);
                 // The Gaussian is exp(-n) at t = 0.
                 zero_at_t_zero(&mut b, t, value, unit)
@@ -337,14 +357,14 @@ impl HwLobe {
             | HwLobe::LogExpMitchell
             | HwLobe::Cheb2
             | HwLobe::Pow => vec![n_raw],
-            HwLobe::Sg => vec![Format::unsigned(SG_RATE_INT_BITS, bits - 1)
+            HwLobe::Sg => vec![FixedPoint::unsigned(SG_RATE_INT_BITS, bits - 1)
                 .quantize(packed().slope, Rounding::HalfEven)],
             HwLobe::SchlickMod => {
                 let squarings = i64::from(packed().squarings).min(SCHLICK_MOD_MAX_SQUARINGS.into());
                 vec![n_raw, squarings]
             }
             HwLobe::CosQuad => {
-                vec![Format::unsigned(6, bits - 1).quantize(packed().slope, Rounding::HalfEven)]
+                vec![FixedPoint::unsigned(6, bits - 1).quantize(packed().slope, Rounding::HalfEven)]
             }
         }
     }
@@ -372,9 +392,9 @@ fn zero_at_t_zero(
     b: &mut Builder,
     t: crate::NodeId,
     value: crate::NodeId,
-    unit: Format,
+    unit: FixedPoint,
 ) -> crate::NodeId {
-    let lit = b.node("t_nonzero", Op::NonZero(t), Format::unsigned(1, 0));
+    let lit = b.node("t_nonzero", Op::NonZero(t), FixedPoint::unsigned(1, 0));
     let zero = b.node("zero", Op::Const(0), unit);
     b.node(
         "value",
@@ -397,7 +417,7 @@ pub fn integer_exponent(n: f64) -> Result<u32, HwError> {
 
 /// The `cheb2` ROMs `[C, B, A]` for `n = 0..=1000` (address 0 repeats `n = 1`), each with the
 /// signed format its largest magnitude needs and `frac` fraction bits.
-fn cheb2_roms(frac: u32) -> [(Vec<i64>, Format); 3] {
+fn cheb2_roms(frac: u32) -> [(Vec<i64>, FixedPoint); 3] {
     let coefficients: Vec<[f64; 3]> = (0..=1000)
         .map(|n: u32| {
             let lobe = Lobe::new(LobeKind::Cheb2, Exponent::new(f64::from(n.max(1))));
@@ -407,7 +427,7 @@ fn cheb2_roms(frac: u32) -> [(Vec<i64>, Format); 3] {
     core::array::from_fn(|k| {
         let largest = coefficients.iter().map(|c| c[k].abs()).fold(0.0, f64::max);
         let int_bits = (largest + 1.0).log2().ceil() as u32;
-        let format = Format::signed(int_bits, frac);
+        let format = FixedPoint::signed(int_bits, frac);
         let table = coefficients
             .iter()
             .map(|c| format.quantize(c[k], Rounding::HalfEven))

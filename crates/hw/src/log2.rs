@@ -15,7 +15,7 @@
 
 use serde::Serialize;
 
-use crate::fixed::{Format, Rounding};
+use crate::fixed::{FixedPoint, Rounding};
 
 /// How the unit approximates `log2(1 + f)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -51,7 +51,7 @@ impl Log2Unit {
 
     /// The fraction bits of the unit's exact result for an input of format `input`.
     #[must_use]
-    pub fn frac_bits(self, input: Format, out_frac: u32) -> u32 {
+    pub fn frac_bits(self, input: FixedPoint, out_frac: u32) -> u32 {
         match self {
             Log2Unit::Mitchell => input.width() - 1,
             Log2Unit::Table { .. } => Self::table_frac_bits(out_frac),
@@ -69,7 +69,7 @@ impl Log2Unit {
                 (0..=segments)
                     .map(|i| {
                         let x = 1.0 + f64::from(i) / f64::from(segments);
-                        Format::unsigned(1, frac).quantize(x.log2(), Rounding::HalfEven)
+                        FixedPoint::unsigned(1, frac).quantize(x.log2(), Rounding::HalfEven)
                     })
                     .collect()
             }
@@ -79,7 +79,7 @@ impl Log2Unit {
     /// `log2` of `raw` in format `input` (unsigned), exactly as the hardware computes it:
     /// `(raw, frac_bits)` of the result before its final resize.
     #[must_use]
-    pub fn eval(self, raw: i64, input: Format, out_frac: u32, out: Format) -> (i128, u32) {
+    pub fn eval(self, raw: i64, input: FixedPoint, out_frac: u32, out: FixedPoint) -> (i128, u32) {
         let table = self.table(Self::table_frac_bits(out_frac));
         self.eval_with_table(&table, raw, input, out_frac, out)
     }
@@ -91,9 +91,9 @@ impl Log2Unit {
         self,
         table: &[i64],
         raw: i64,
-        input: Format,
+        input: FixedPoint,
         out_frac: u32,
-        out: Format,
+        out: FixedPoint,
     ) -> (i128, u32) {
         debug_assert!(!input.signed);
         let width = input.width();
@@ -147,8 +147,8 @@ pub(crate) fn split(fraction: i64, bits: u32, k: u32) -> (usize, i64, u32) {
 mod tests {
     use super::*;
 
-    fn log2_of(unit: Log2Unit, x: f64, input: Format) -> f64 {
-        let out = Format::signed(5, 16);
+    fn log2_of(unit: Log2Unit, x: f64, input: FixedPoint) -> f64 {
+        let out = FixedPoint::signed(5, 16);
         let raw = input.quantize(x, Rounding::HalfEven);
         let (value, frac) = unit.eval(raw, input, out.frac_bits, out);
         value as f64 / (frac as f64).exp2()
@@ -157,7 +157,7 @@ mod tests {
     /// Powers of two are exact in both units: the leading-one position is the whole answer.
     #[test]
     fn powers_of_two_are_exact() {
-        let input = Format::unsigned(3, 12);
+        let input = FixedPoint::unsigned(3, 12);
         for unit in [Log2Unit::Mitchell, Log2Unit::Table { segments_log2: 4 }] {
             for e in -12..3 {
                 let x = f64::from(e).exp2();
@@ -170,7 +170,7 @@ mod tests {
     /// table brings it to the interpolation bound `(ln 2)^-1 / 8 / 16^2` plus rounding.
     #[test]
     fn errors_match_the_known_bounds() {
-        let input = Format::unsigned(2, 14);
+        let input = FixedPoint::unsigned(2, 14);
         let mut worst = [0.0_f64; 2];
         for raw in 1..=input.max_raw() {
             let x = input.to_f64(raw);
@@ -200,8 +200,8 @@ mod tests {
 
     #[test]
     fn zero_saturates_to_the_most_negative_output() {
-        let out = Format::signed(5, 10);
-        let input = Format::unsigned(1, 7);
+        let out = FixedPoint::signed(5, 10);
+        let input = FixedPoint::unsigned(1, 7);
         for unit in [Log2Unit::Mitchell, Log2Unit::Table { segments_log2: 3 }] {
             let (raw, frac) = unit.eval(0, input, 10, out);
             assert_eq!(out.resize(raw, frac, Rounding::HalfEven), out.min_raw());

@@ -8,7 +8,7 @@ use specula::{Exponent, LobeKind};
 use specula_gpu::{Gpu, GpuEvaluator, LobeEvaluator};
 
 use super::{print_json, CommandResult};
-use crate::args::{parse_exponent, BackendArg, Format};
+use crate::args::{parse_exponent, BackendArg, OutputFormat};
 use crate::output::{number, percent, sig, Table};
 
 /// Arguments of `specula analyze`.
@@ -22,7 +22,7 @@ pub struct Args {
     n: Vec<Exponent>,
     /// Output format.
     #[arg(long, value_enum, default_value_t)]
-    format: Format,
+    format: OutputFormat,
     /// Arithmetic for the error figures: the f64 reference, the f32 fast path, or f32 in a GPU
     /// compute shader.
     #[arg(long, value_enum, default_value_t)]
@@ -77,10 +77,10 @@ pub fn run(args: &Args) -> CommandResult {
             specula::quadrature::MAX_PANELS
         );
     }
-    if args.format == Format::Json {
+    if args.format == OutputFormat::Json {
         return print_json(&reports);
     }
-    if args.format == Format::Csv {
+    if args.format == OutputFormat::Csv {
         print_csv(&reports);
         return Ok(());
     }
@@ -157,5 +157,5 @@ fn print_csv(reports: &[LobeReport]) {
         row.extend(r.ops.entries().map(|(_, count)| count.to_string()));
         table.push(row);
     }
-    table.print(Format::Csv);
+    table.print(OutputFormat::Csv);
 }

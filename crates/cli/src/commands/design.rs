@@ -45,8 +45,8 @@ pub struct Args {
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Output format.
-    #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
-    format: crate::args::Format,
+    #[arg(long, value_enum, default_value_t = crate::args::OutputFormat::Table)]
+    format: crate::args::OutputFormat,
 }
 
 /// The range of exponents, its ends.
@@ -84,7 +84,7 @@ pub fn run(args: &Args) -> CommandResult {
     if let Some(path) = &args.output {
         write_lobe(&answer, &request, path)?;
     }
-    if args.format == crate::args::Format::Json {
+    if args.format == crate::args::OutputFormat::Json {
         return super::print_json(&answer);
     }
     println!("{}", answer.verdict);
@@ -93,7 +93,7 @@ pub fn run(args: &Args) -> CommandResult {
 }
 
 /// Every designed lobe, then the built-ins, with the Pareto front over both.
-fn print_table(answer: &Design, format: crate::args::Format) {
+fn print_table(answer: &Design, format: crate::args::OutputFormat) {
     let mut table = Table::new(&[
         "lobe",
         "kind",

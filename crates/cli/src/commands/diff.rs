@@ -7,7 +7,7 @@ use specula_render::metrics::compare;
 use specula_render::{read_image, write_png_srgb8, Display, ToneMap};
 
 use super::{print_json, CommandResult};
-use crate::args::{choice, Format};
+use crate::args::{choice, OutputFormat};
 use crate::output::{number, Table};
 
 /// Arguments of `specula diff`.
@@ -34,7 +34,7 @@ pub struct Args {
     tonemap: ToneMap,
     /// Output format (table or json).
     #[arg(long, value_enum, default_value_t)]
-    format: Format,
+    format: OutputFormat,
 }
 
 #[derive(Serialize)]
@@ -85,10 +85,10 @@ pub fn run(args: &Args) -> CommandResult {
         width: difference.width,
         height: difference.height,
     };
-    if args.format == Format::Json {
+    if args.format == OutputFormat::Json {
         return print_json(&report);
     }
-    if args.format == Format::Csv {
+    if args.format == OutputFormat::Csv {
         // Data alone: one row, every figure with all its digits; identical images' PSNR is
         // `inf` (what every CSV reader parses as infinity).
         let mut table = Table::new(&["psnr (dB)", "max abs error", "mean FLIP", "width", "height"]);

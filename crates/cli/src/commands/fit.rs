@@ -93,7 +93,7 @@ fn print_table(a: &Assessment) {
             if row.meets { "yes" } else { "" }.to_owned(),
         ]);
     }
-    table.print(crate::args::Format::Table);
+    table.print(crate::args::OutputFormat::Table);
     println!(
         "E: {}; albedo: the fit's at normal incidence (luminance); rate: {}; *: at an end of the range searched.\n",
         a.error_measure, a.rate_unit
@@ -105,9 +105,9 @@ fn print_table(a: &Assessment) {
 pub fn print_ranking(
     a: &Assessment,
     ranked: &[Ranked],
-    format: crate::args::Format,
+    format: crate::args::OutputFormat,
 ) -> CommandResult {
-    if format == crate::args::Format::Json {
+    if format == crate::args::OutputFormat::Json {
         return super::print_json(&ranked);
     }
     println!("{} ({}): {}", a.material, a.description, verdict_line(a));

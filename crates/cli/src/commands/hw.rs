@@ -10,7 +10,7 @@ use specula_hw::{diagram, integer_exponent, verilog, HwLobe, BITS};
 use specula_report::format::{resource_cells, resource_numbers, RESOURCE_NUMBER_COLUMNS};
 
 use super::{print_json, synth, CommandResult};
-use crate::args::Format;
+use crate::args::OutputFormat;
 use crate::output::{number, percent, sig, Table};
 
 /// Arguments of `specula hw`.
@@ -96,7 +96,7 @@ struct TableArgs {
     samples: u32,
     /// Output format.
     #[arg(long, value_enum, default_value_t)]
-    format: Format,
+    format: OutputFormat,
 }
 
 #[derive(Debug, clap::Args)]
@@ -221,12 +221,12 @@ fn table(args: &TableArgs) -> CommandResult {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let results = sweeps(&lobes, args.n, args.bits, args.samples as usize, &progress)?;
-    if args.format == Format::Json {
+    if args.format == OutputFormat::Json {
         return print_json(&results);
     }
     // CSV is data: the error in % as a number, with all its digits, and each kind of
     // operator's count and summed size where the table lists widths.
-    let csv = args.format == Format::Csv;
+    let csv = args.format == OutputFormat::Csv;
     let mut header = vec![
         "datapath",
         "bits",
@@ -277,7 +277,7 @@ fn table(args: &TableArgs) -> CommandResult {
         }
     }
     table.print(args.format);
-    if args.format == Format::Table {
+    if args.format == OutputFormat::Table {
         println!("\nn = {}; widths are in bits; \"meets\" = epicentre max rel within {MEETS_TOLERANCE}x the f64 model's.", args.n);
         for result in &results {
             let meets = result.minimum_width().map_or_else(

@@ -7,7 +7,7 @@ use specula::analysis::{self, Shape};
 use specula::{Lobe, LobeKind};
 
 use super::CommandResult;
-use crate::args::Format;
+use crate::args::OutputFormat;
 use crate::output::{sig, Table};
 
 /// Arguments of `specula lobe`.
@@ -43,7 +43,7 @@ struct CheckArgs {
     n: String,
     /// Output format: `csv` and `json` give the shape at five exponents, numbers only.
     #[arg(long, value_enum, default_value_t)]
-    format: Format,
+    format: OutputFormat,
 }
 
 /// The worked example a new lobe file starts as.
@@ -118,7 +118,7 @@ fn check(args: &CheckArgs) -> CommandResult {
         .collect();
     warn_of(&shapes);
     let rows: Vec<ShapeRow> = shapes.iter().map(ShapeRow::from).collect();
-    if args.format == Format::Json {
+    if args.format == OutputFormat::Json {
         return super::print_json(&rows);
     }
     let mut table = Table::new(&[
@@ -141,8 +141,8 @@ fn check(args: &CheckArgs) -> CommandResult {
             format!("{:.4}", row.energy_ratio),
         ]);
     }
-    if args.format == Format::Csv {
-        table.print(Format::Csv);
+    if args.format == OutputFormat::Csv {
+        table.print(OutputFormat::Csv);
         return Ok(());
     }
     println!(
@@ -152,7 +152,7 @@ fn check(args: &CheckArgs) -> CommandResult {
         lobe.warp().id()
     );
     println!("operations per evaluation: {}", lobe.ops());
-    table.print(Format::Table);
+    table.print(OutputFormat::Table);
     let mut table = Table::new(&["constant", &format!("n = {first}"), &format!("n = {last}")]);
     let at_last = Lobe::new(args.lobe, last);
     for parameter in lobe.parameters() {
@@ -168,7 +168,7 @@ fn check(args: &CheckArgs) -> CommandResult {
             value_at(&at_last),
         ]);
     }
-    table.print(Format::Table);
+    table.print(OutputFormat::Table);
     Ok(())
 }
 

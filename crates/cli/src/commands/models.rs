@@ -6,7 +6,7 @@ use specula::ops::OpCounts;
 use specula::{Exponent, Lobe};
 
 use super::{print_json, CommandResult};
-use crate::args::{parse_exponent, Format};
+use crate::args::{parse_exponent, OutputFormat};
 use crate::output::Table;
 
 /// Arguments of `specula models`.
@@ -17,7 +17,7 @@ pub struct Args {
     n: Exponent,
     /// Output format.
     #[arg(long, value_enum, default_value_t)]
-    format: Format,
+    format: OutputFormat,
 }
 
 #[derive(Serialize)]
@@ -44,12 +44,12 @@ pub fn run(args: &Args) -> CommandResult {
         })
         .collect();
     match args.format {
-        Format::Json => print_json(&rows),
-        Format::Csv => {
+        OutputFormat::Json => print_json(&rows),
+        OutputFormat::Csv => {
             print_csv(&rows);
             Ok(())
         }
-        Format::Table => {
+        OutputFormat::Table => {
             let ops_header = format!("ops at n = {}", args.n);
             let mut table = Table::new(&[
                 "id",
@@ -99,7 +99,7 @@ fn print_csv(rows: &[ModelRow]) {
         cells.push(row.ops_total.to_string());
         table.push(cells);
     }
-    table.print(Format::Csv);
+    table.print(OutputFormat::Csv);
 }
 
 /// A model's id, origin and input (`angle` or `cosine`), as both tables begin.

@@ -43,8 +43,8 @@ pub struct Args {
     #[arg(long, value_parser = crate::args::LobeListParser)]
     lobe: Vec<crate::args::LobeList>,
     /// Output format.
-    #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
-    format: crate::args::Format,
+    #[arg(long, value_enum, default_value_t = crate::args::OutputFormat::Table)]
+    format: crate::args::OutputFormat,
 }
 
 /// One exponent or a sampled range.
@@ -83,7 +83,7 @@ pub fn run(args: &Args) -> CommandResult {
     if let Some(note) = &answer.note {
         eprintln!("note: {note}");
     }
-    if args.format == crate::args::Format::Json {
+    if args.format == crate::args::OutputFormat::Json {
         return super::print_json(&answer.candidates);
     }
     let max_error = request.max_error;
@@ -111,7 +111,7 @@ pub fn run(args: &Args) -> CommandResult {
         ),
     };
     let pow_rate = answer.pow_rate();
-    if args.format == crate::args::Format::Csv {
+    if args.format == crate::args::OutputFormat::Csv {
         // Data alone on stdout: numbers, ids and booleans under a header that names the
         // units; the verdict goes to stderr.
         eprintln!("{verdict}");

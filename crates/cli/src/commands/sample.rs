@@ -26,7 +26,7 @@ const SUITE_VIEWS: [f64; 3] = [0.0, 35.0, 70.0];
 
 /// Output formats of the drawn directions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Format {
+pub enum SampleFormat {
     /// `x,y,z,pdf,value` with a header line.
     Csv,
     /// An array of objects.
@@ -58,8 +58,8 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// How the directions are printed.
-    #[arg(long, value_enum, default_value_t = Format::Csv)]
-    format: Format,
+    #[arg(long, value_enum, default_value_t = SampleFormat::Csv)]
+    format: SampleFormat,
     /// Run the chi-square suite instead: one line per case with its p-value, exit status 1
     /// if any case fails.
     #[arg(long)]
@@ -130,8 +130,8 @@ pub fn run(args: &Args) -> CommandResult {
     });
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = match args.format {
-        Format::Csv => write_csv(&mut out, drawn),
-        Format::Json => serde_json::to_writer(&mut out, &drawn.collect::<Vec<_>>())
+        SampleFormat::Csv => write_csv(&mut out, drawn),
+        SampleFormat::Json => serde_json::to_writer(&mut out, &drawn.collect::<Vec<_>>())
             .map_err(std::io::Error::other)
             .and_then(|()| std::io::Write::write_all(&mut out, b"\n")),
     };

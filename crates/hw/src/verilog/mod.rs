@@ -1,7 +1,7 @@
 //! Verilog from a datapath description: a pipelined module and a self-checking testbench.
 //!
 //! Every registered node becomes `r_<name>`, loaded each clock from its exact result passed
-//! through `specula_resize` (the rounding and saturation of [`Format::resize`], written once
+//! through `specula_resize` (the rounding and saturation of [`FixedPoint::resize`], written once
 //! as a parameterised module). Exact results are computed in 64-bit signed intermediates, a
 //! width the emitter checks each node's exact result fits; synthesis trims the bits that are
 //! constant. Operands that arrive from earlier stages are read from delay registers
@@ -16,7 +16,7 @@ use core::fmt::Write as _;
 
 use crate::datapath::{Datapath, NodeId, Op};
 use crate::exp2::Exp2Unit;
-use crate::fixed::Format;
+use crate::fixed::FixedPoint;
 use crate::lobes::HwLobe;
 use crate::log2::Log2Unit;
 
@@ -64,7 +64,7 @@ impl Emitter<'_> {
 
     /// Operand `operand` of the registered node `reader`: its 64-bit signed value (raw in
     /// the operand's own format) and that format.
-    fn operand(&self, reader: NodeId, operand: NodeId) -> (String, Format) {
+    fn operand(&self, reader: NodeId, operand: NodeId) -> (String, FixedPoint) {
         let format = self.datapath.node(operand).format;
         let source = self.datapath.wired_source(operand);
         if let Op::Const(raw) = self.datapath.node(source).op {
@@ -87,7 +87,7 @@ impl Emitter<'_> {
         let out = node.format;
         let width_of = |operand: NodeId| self.datapath.node(operand).format.width();
         let fb_of = |operand: NodeId| self.datapath.node(operand).format.frac_bits;
-        let aligned = |(expr, format): (String, Format), frac: u32| {
+        let aligned = |(expr, format): (String, FixedPoint), frac: u32| {
             let shift = frac - format.frac_bits;
             (format!("({expr} <<< {shift})"), format.width() + shift)
         };
@@ -205,7 +205,7 @@ impl Emitter<'_> {
             }
             Op::Select { index, options } => {
                 let index = self.operand_reg(id, *index);
-                let values: Vec<(String, Format)> = options
+                let values: Vec<(String, FixedPoint)> = options
                     .iter()
                     .map(|option| self.operand(id, *option))
                     .collect();
@@ -237,7 +237,7 @@ impl Emitter<'_> {
 
 /// Bits that bound the magnitude of a log2 unit's exact result: `(e + f) 2^frac` with the
 /// leading-one position `|e| <=` the input's larger part, or the saturated minimum for 0.
-fn log2_bound(unit: Log2Unit, input: Format, out: Format) -> u32 {
+fn log2_bound(unit: Log2Unit, input: FixedPoint, out: FixedPoint) -> u32 {
     let frac = unit.frac_bits(input, out.frac_bits);
     let largest_exponent = input.frac_bits.max(input.int_bits) + 1;
     let normal = frac + (u32::BITS - largest_exponent.leading_zeros());

@@ -6,17 +6,17 @@ use core::fmt::Write as _;
 use super::{literal, EXACT_BITS};
 use crate::datapath::{Datapath, NodeId};
 use crate::exp2::Exp2Unit;
-use crate::fixed::Format;
+use crate::fixed::FixedPoint;
 use crate::log2::Log2Unit;
 
-/// `specula_resize`: [`Format::resize`] in Verilog, written once and parameterised.
+/// `specula_resize`: [`FixedPoint::resize`] in Verilog, written once and parameterised.
 pub(super) const RESIZE_MODULE: &str = r#"`ifndef SPECULA_RESIZE
 `define SPECULA_RESIZE
 // Rounds x (an exact value with SHIFT more fraction bits than the result, whose low XW bits
 // hold it as a signed number) by dropping SHIFT bits, to nearest with ties to even or towards
 // minus infinity, or appends -SHIFT zero bits; then saturates to [MIN, MAX] and keeps the low
 // WIDTH bits (the result's format: every value in [MIN, MAX] fits). The Rust model's
-// Format::resize, bit for bit. XW tells synthesis how wide the arithmetic really is.
+// FixedPoint::resize, bit for bit. XW tells synthesis how wide the arithmetic really is.
 module specula_resize #(
     parameter integer XW = 63,
     parameter integer SHIFT = 0,
@@ -115,7 +115,7 @@ pub(super) fn log2_module(
     datapath: &Datapath,
     id: NodeId,
     unit: Log2Unit,
-    input: Format,
+    input: FixedPoint,
 ) -> String {
     let node = datapath.node(id);
     let out = node.format;
@@ -176,7 +176,7 @@ pub(super) fn exp2_module(
     datapath: &Datapath,
     id: NodeId,
     unit: Exp2Unit,
-    input: Format,
+    input: FixedPoint,
 ) -> String {
     let node = datapath.node(id);
     let frac = Exp2Unit::frac_bits(node.format.frac_bits);

@@ -293,7 +293,7 @@ pub fn run(args: &Args) -> CommandResult {
             }
         }
     }
-    table.print(crate::args::Format::Table);
+    table.print(crate::args::OutputFormat::Table);
     println!(
         "images: the RMS difference between specula's and Mitsuba's first frames over that between two of specula's \
          (seeds 1 and 99), about 1 where they differ by noise alone; and how far Mitsuba's mean is from specula's"

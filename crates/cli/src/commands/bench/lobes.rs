@@ -9,11 +9,11 @@ use specula::{Exponent, LobeKind};
 use specula_decide::c_twins::{self, CTwins};
 use specula_decide::rates::{cosquad_formula, measure, LobeRate, Measured, L1_SIZE, STREAM_SIZE};
 
-use crate::args::Format;
+use crate::args::OutputFormat;
 use crate::output::{number, percent, sig, Table};
 
 /// Measures and prints.
-pub fn run(n: Exponent, format: Format) -> Result<(), String> {
+pub fn run(n: Exponent, format: OutputFormat) -> Result<(), String> {
     let progress = ProgressBar::new(1).with_style(
         ProgressStyle::with_template("measuring {bar:30} {pos}/{len} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -50,13 +50,13 @@ pub fn run(n: Exponent, format: Format) -> Result<(), String> {
             }
         }
     }
-    if format == Format::Json {
+    if format == OutputFormat::Json {
         return super::super::print_json(&WithTwins {
             measured: &measured,
             c_twins: twins.as_ref(),
         });
     }
-    if format == Format::Csv {
+    if format == OutputFormat::Csv {
         // Data alone on stdout: the machine's notes go to stderr, the C twins to JSON.
         eprintln!("{}", peaks_line(&measured));
         print_csv(&measured);
@@ -140,7 +140,7 @@ struct WithTwins<'a> {
     c_twins: Option<&'a CTwins>,
 }
 
-fn print_twins(measured: &Measured, twins: &CTwins, format: Format) {
+fn print_twins(measured: &Measured, twins: &CTwins, format: OutputFormat) {
     println!(
         "C twins: the same formulas as plain C loops ({}, {}; libmvec for exp and log), one \
          thread, the same cosines in L1",
@@ -210,7 +210,7 @@ fn print_csv(measured: &Measured) {
             number(100.0 * rate.epicentre_max_rel),
         ]);
     }
-    table.print(Format::Csv);
+    table.print(OutputFormat::Csv);
 }
 
 fn peaks_line(measured: &Measured) -> String {

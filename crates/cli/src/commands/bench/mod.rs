@@ -62,8 +62,8 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = crate::args::parse_exponent)]
     n: specula::Exponent,
     /// Output format (`bench lobes`, `bench gpu-lobes`).
-    #[arg(long, value_enum, default_value_t = crate::args::Format::Table)]
-    format: crate::args::Format,
+    #[arg(long, value_enum, default_value_t = crate::args::OutputFormat::Table)]
+    format: crate::args::OutputFormat,
     /// The volume `bench volume` renders: built-in (phantom, marschner-lobb), NIfTI or DICOM.
     #[arg(long, default_value = "phantom")]
     input: String,
@@ -217,7 +217,7 @@ fn bench_frame(args: &Args) -> CommandResult {
             format!("{:.2}", cpu / gpu.best),
         ]);
     }
-    table.print(crate::args::Format::Table);
+    table.print(crate::args::OutputFormat::Table);
     Ok(())
 }
 
@@ -264,14 +264,14 @@ fn bench_gpu(args: &Args) -> CommandResult {
             format!("{:.2}x", figure / pow),
         ]);
     }
-    table.print(crate::args::Format::Table);
+    table.print(crate::args::OutputFormat::Table);
     Ok(())
 }
 
 fn bench_gpu_lobes(args: &Args) -> CommandResult {
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     // CSV is data alone: the notes go to stderr, every figure a number with all its digits.
-    let csv = args.format == crate::args::Format::Csv;
+    let csv = args.format == crate::args::OutputFormat::Csv;
     let note = |text: String| {
         if csv {
             eprintln!("{text}");
@@ -386,6 +386,6 @@ fn bench_render(args: &Args) -> CommandResult {
             format!("{:.2}x", best / flat),
         ]);
     }
-    table.print(crate::args::Format::Table);
+    table.print(crate::args::OutputFormat::Table);
     Ok(())
 }

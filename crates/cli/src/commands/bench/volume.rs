@@ -141,7 +141,7 @@ pub fn run(args: &Args) -> CommandResult {
             );
         }
     }
-    table.print(crate::args::Format::Table);
+    table.print(crate::args::OutputFormat::Table);
     if let Some(dir) = &args.images {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         write_image(&dir.join("specula.exr"), &image, Display::default())
