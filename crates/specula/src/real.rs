@@ -1,7 +1,7 @@
 //! The scalar type every lobe is written against.
 //!
 //! Each model's formula exists once, generic over [`Real`]. Instantiated with `f64` it is the
-//! reference; with `f32` it is the fast path; with [`Counted`](crate::ops::Counted) it counts
+//! reference; with `f32` it is the fast path; with `Counted` (`ops.rs`) it counts
 //! the operations of one evaluation, so the cost table is read off the implementation rather
 //! than typed by hand. Anything a formula needs (a squaring, a `log2`, a comparison) is a
 //! method here so that the counting type sees it.
@@ -25,7 +25,7 @@ pub trait Real:
     fn from_f64(x: f64) -> Self;
     /// A per-material constant the model prepared from `n`, by name (`n`, `slope`, ...): the
     /// number itself, except to a recorded expression, which keeps the name so that a target
-    /// can expose it as an input ([`crate::expression::Node::Parameter`]).
+    /// can expose it as an input (`Node::Parameter`, `expression/mod.rs`).
     #[inline(always)]
     fn parameter(_name: &'static str, value: f64) -> Self {
         Self::from_f64(value)
@@ -92,7 +92,7 @@ pub trait Real:
     fn bits_exp2(self) -> Self;
     /// `then` where `self < bound`, else `otherwise` (a comparison and a select; false for
     /// NaN). Models choose with this rather than an `if`, so that a recorded expression
-    /// ([`crate::expression`]) keeps both sides and a target evaluates the choice itself.
+    /// (`expression/mod.rs`) keeps both sides and a target evaluates the choice itself.
     #[must_use]
     fn select_less(self, bound: Self, then: Self, otherwise: Self) -> Self;
     /// [`Real::select_less`] of two sides computed on demand: a float computes only the

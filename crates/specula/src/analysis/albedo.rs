@@ -10,8 +10,6 @@
 
 use core::f64::consts::{FRAC_PI_2, PI};
 
-use glam::DVec3;
-
 use crate::quadrature::integrate_pieces;
 use crate::{zones, Brdf, Geometry, Lobe, Rgb};
 
@@ -153,10 +151,4 @@ pub fn max_directional_albedo(brdf: &Brdf) -> (f64, f64) {
     } else {
         best
     }
-}
-
-/// The unit outgoing direction at polar angle `theta_o` in the `xz` plane.
-#[must_use]
-pub fn outgoing_direction(theta_o: f64) -> DVec3 {
-    DVec3::new(theta_o.sin(), 0.0, theta_o.cos())
 }

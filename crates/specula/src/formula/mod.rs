@@ -31,6 +31,7 @@
 
 pub(crate) mod batch;
 mod compile;
+mod op;
 pub(crate) mod program;
 pub(crate) mod registry;
 mod syntax;
@@ -42,7 +43,7 @@ pub use registry::{define, instance, kinds, parse_values, Instance, Naming, MAX_
 pub use syntax::{MAX_DEPTH, MAX_LETS, MAX_NODES, MAX_SOURCE_BYTES};
 
 use crate::{Error, Exponent, Lobe, LobeKind};
-use compile::Op;
+use op::Op;
 use program::Leaves;
 
 /// The most declared parameters.

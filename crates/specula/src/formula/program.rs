@@ -5,7 +5,7 @@
 //! per-material constants). The formula's varying part, its tail and each slot's preparation
 //! are tapes cut from the compiled program ([`extract`]), so one loop runs them all.
 
-use super::compile::Op;
+use super::op::Op;
 use crate::real::Real;
 
 /// `op` applied to its operands' values (`at(i)` is operand `i`'s); leaves are the caller's.

@@ -70,10 +70,7 @@ impl Lobe {
             Model::Sg(m) => f.call(m.kernel()),
             Model::FastPow(m) => f.call(m.kernel()),
             Model::FasterPow(m) => f.call(m.kernel()),
-            Model::Formula(m) => f.call(super::formula::FormulaKernel {
-                lobe: *self,
-                stated: m.instructions(),
-            }),
+            Model::Formula(m) => f.call(m.kernel(*self)),
         }
     }
 }

@@ -125,6 +125,15 @@ impl FormulaLobe {
     pub(crate) fn instructions(&self) -> Instructions {
         self.instance.formula().plan().instructions(self.rules)
     }
+
+    /// The plain loop's kernel for `lobe`, the lobe this formula was prepared into (the
+    /// kernel evaluates through it, and so through its rules).
+    pub(crate) fn kernel(&self, lobe: super::Lobe) -> FormulaKernel {
+        FormulaKernel {
+            lobe,
+            stated: self.instructions(),
+        }
+    }
 }
 
 struct Columns<'a> {
@@ -150,8 +159,8 @@ impl Job for Columns<'_> {
 /// the plain loop the compiled batch is measured against.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct FormulaKernel {
-    pub(crate) lobe: super::Lobe,
-    pub(crate) stated: Instructions,
+    lobe: super::Lobe,
+    stated: Instructions,
 }
 
 impl Kernel for FormulaKernel {

@@ -73,7 +73,7 @@ pub enum Warp {
     /// The closed-form integral inverted by safeguarded Newton iterations.
     Newton,
     /// A tabulated inverse CDF, built when the sampler is prepared
-    /// ([`crate::sampling::CosineDistribution`]).
+    /// (`CosineDistribution`, `sampling/cosine.rs`).
     Table,
 }
 
@@ -347,7 +347,7 @@ impl Lobe {
 
     /// For a lobe sampled in closed form ([`Warp::Analytic`]): the inverse of its tail,
     /// `t(u)` with `int_t^1 lobe = u int_0^1 lobe`, and the whole `int_0^1 lobe`, written once
-    /// over [`Real`] so that a target that samples records them ([`crate::expression`]).
+    /// over [`Real`] so that a target that samples records them (`expression/mod.rs`).
     pub fn closed_form_sampling<R: Real>(&self, u: R) -> Option<(R, R)> {
         match &self.model {
             Model::Pow(m) => Some((m.tail_inverse(u), m.total())),

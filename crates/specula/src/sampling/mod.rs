@@ -34,7 +34,7 @@ use core::f64::consts::TAU;
 use glam::DVec3;
 
 use crate::lobe::Warp;
-use crate::{Brdf, Geometry, Lobe, Normalisation};
+use crate::{Geometry, Lobe, Normalisation};
 
 /// One sampled direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -115,12 +115,6 @@ impl SpecularSampler {
             cosine: CosineDistribution::new(lobe),
             geometry,
         }
-    }
-
-    /// The specular term of `brdf`.
-    #[must_use]
-    pub fn for_brdf(brdf: &Brdf) -> Self {
-        Self::new(*brdf.lobe(), brdf.geometry(), brdf.normalisation())
     }
 
     /// The lobe.

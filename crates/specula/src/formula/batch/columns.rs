@@ -7,7 +7,7 @@
 //! of a positive number, a `log2` of 0) is recomputed lane by lane with the standard library.
 
 use super::{Source, Step};
-use crate::formula::compile::Op;
+use crate::formula::op::Op;
 use crate::simd::{math, Lanes};
 
 /// A function the columns compute lane by lane.

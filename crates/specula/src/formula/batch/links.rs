@@ -5,7 +5,7 @@
 
 use super::columns::LaneFunction;
 use super::Role;
-use crate::formula::compile::Op;
+use crate::formula::op::Op;
 use crate::simd::math;
 use crate::simd::tally::{Class, Instructions};
 

@@ -18,7 +18,7 @@ mod columns;
 mod links;
 mod ranges;
 
-use super::compile::Op;
+use super::op::Op;
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::Lanes;
 use chain::{Chain, End};
