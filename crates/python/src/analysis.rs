@@ -9,7 +9,7 @@ use specula::{Exponent, LobeKind};
 
 use crate::arrays::{self, count};
 use crate::errors::{guarded, value_error};
-use crate::lobe::{exponent, lobe_kind};
+use crate::options::{exponent, lobe_kind};
 
 /// `value` as JSON text.
 pub fn json(value: &impl serde::Serialize) -> PyResult<String> {

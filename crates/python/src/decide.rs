@@ -14,7 +14,8 @@ use specula_decide::{
 };
 
 use crate::errors::{guarded, value_error};
-use crate::lobe::{lobe_kind, Lobe};
+use crate::lobe::Lobe;
+use crate::options::lobe_kind;
 
 fn lobes(texts: &[String]) -> PyResult<Vec<LobeKind>> {
     texts.iter().map(|text| lobe_kind(text)).collect()

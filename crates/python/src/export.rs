@@ -2,11 +2,11 @@
 
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
+use specula::{Geometry, Normalisation};
 use specula_gpu::export::{Format, GlslVersion, Options, ShaderCode};
 
 use crate::errors::value_error;
-use crate::lobe::Lobe;
-use crate::render::choose;
+use crate::options::choose;
 
 /// The languages and formats :meth:`Lobe.shader` writes.
 #[pyfunction]
@@ -14,10 +14,12 @@ pub fn languages() -> Vec<&'static str> {
     Format::ALL.iter().map(|format| format.id()).collect()
 }
 
-/// `lobe` in `language`: a `str`, or `bytes` for SPIR-V.
+/// `lobe`, shaded with `geometry` and `normalisation`, in `language`: a `str`, or `bytes` for
+/// SPIR-V.
 pub fn shader(
     py: Python<'_>,
-    lobe: &Lobe,
+    lobe: &specula::Lobe,
+    (geometry, normalisation): (Geometry, Normalisation),
     language: &str,
     glsl_version: &str,
     example: bool,
@@ -29,14 +31,8 @@ pub fn shader(
         glsl_version,
         "GLSL version",
     )?;
-    let (geometry, normalisation) = lobe.shading();
     let code = format
-        .write(
-            lobe.core(),
-            geometry,
-            normalisation,
-            Options { example, glsl },
-        )
+        .write(lobe, geometry, normalisation, Options { example, glsl })
         .map_err(value_error)?;
     Ok(match code {
         ShaderCode::Text(text) => text.into_pyobject(py)?.into_any().unbind(),

@@ -14,6 +14,7 @@ mod decide;
 mod errors;
 mod export;
 mod lobe;
+mod options;
 mod render;
 mod volume;
 

@@ -14,40 +14,14 @@ use specula::analysis::{
 };
 use specula::claims::ClaimOptions;
 use specula::sampling::SpecularSampler;
-use specula::{Brdf, Exponent, Geometry, LobeKind, Normalisation};
+use specula::{Brdf, Geometry, LobeKind, Normalisation};
 
 use crate::arrays::{
     self, contiguous, count, first_non_finite, float64_rows, floats, map_chunks, non_finite,
     shaped, tuple, Finite, Floats,
 };
 use crate::errors::{guarded, value_error};
-
-/// The CLI's lobe text (`cosquad`, `cosquad:v=5`, `@lobe.toml`, `=t^n`) as a lobe kind.
-pub fn lobe_kind(text: &str) -> PyResult<LobeKind> {
-    specula_render::lobe_file::parse_lobe(text, None).map_err(value_error)
-}
-
-/// Parses the CLI's lobe text and `n`, checking a user's lobe at `n` as the CLI does.
-pub fn parse(lobe: &str, n: f64) -> PyResult<specula::Lobe> {
-    let kind = lobe_kind(lobe)?;
-    let n = exponent(n)?;
-    specula::Lobe::checked(kind, n).map_err(|e| value_error(e.to_string()))
-}
-
-/// `n` as an [`Exponent`], refused with the library's message outside `[1, 1000]`.
-pub fn exponent(n: f64) -> PyResult<Exponent> {
-    Exponent::try_new(n).map_err(|e| value_error(e.to_string()))
-}
-
-/// A geometry by id.
-pub fn geometry(id: &str) -> PyResult<Geometry> {
-    Geometry::parse(id).map_err(|e| value_error(e.to_string()))
-}
-
-/// A normalisation by id.
-pub fn normalisation(id: &str) -> PyResult<Normalisation> {
-    Normalisation::parse(id).map_err(|e| value_error(e.to_string()))
-}
+use crate::options::{geometry, normalisation, parse};
 
 /// A specular lobe prepared for one exponent.
 ///
@@ -428,7 +402,16 @@ impl Lobe {
         glsl_version: &str,
         example: bool,
     ) -> PyResult<Py<PyAny>> {
-        guarded(|| crate::export::shader(py, self, language, glsl_version, example))
+        guarded(|| {
+            crate::export::shader(
+                py,
+                self.core(),
+                self.shading(),
+                language,
+                glsl_version,
+                example,
+            )
+        })
     }
 }
 

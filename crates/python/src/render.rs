@@ -14,17 +14,7 @@ use specula_render::{
 
 use crate::arrays::{self, shaped, unsigned};
 use crate::errors::{file_error, guarded, value_error};
-use crate::lobe::{exponent, geometry, lobe_kind, normalisation};
-
-/// The one of `all` whose id is `text`, or the library's message naming the valid ones.
-pub fn choose<T: Copy>(
-    all: &[T],
-    id: fn(T) -> &'static str,
-    text: &str,
-    what: &str,
-) -> PyResult<T> {
-    specula::choose(all, id, text, what, &format!("{what}s")).map_err(value_error)
-}
+use crate::options::{choose, exponent, geometry, lobe_kind, normalisation};
 
 /// `image` as an `H x W x 3` float32 array.
 pub fn image_array(py: Python<'_>, image: &Image) -> PyResult<Py<PyAny>> {

@@ -14,8 +14,8 @@ use specula_render::volume::{self, Units};
 
 use crate::arrays::unsigned;
 use crate::errors::{file_error, guarded, value_error};
-use crate::lobe::{geometry, normalisation, parse};
-use crate::render::{choose, image_array};
+use crate::options::{choose, geometry, normalisation, parse};
+use crate::render::image_array;
 
 /// A scalar volume on a regular grid, placed in world millimetres (RAS, as NIfTI).
 ///

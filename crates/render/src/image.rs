@@ -9,9 +9,10 @@ use std::path::Path;
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
-use thiserror::Error;
 
+use crate::image_error::ImageError;
 use crate::output::write_atomically;
+use crate::srgb8;
 
 /// A linear RGB image, row-major from the top-left pixel.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,34 +20,6 @@ pub struct Image {
     width: u32,
     height: u32,
     pixels: Vec<Vec3>,
-}
-
-/// Why an image could not be read or written.
-#[derive(Debug, Error)]
-#[non_exhaustive]
-pub enum ImageError {
-    /// The extension is none of `.png`, `.exr` and `.hdr`.
-    #[error("{path}: unknown image format; use a file name ending in .png (8-bit sRGB), .exr (linear f32) or .hdr (Radiance RGBE)")]
-    UnknownFormat {
-        /// The path.
-        path: String,
-    },
-    /// The file system refused.
-    #[error("{path}: {source}")]
-    Io {
-        /// The path.
-        path: String,
-        /// The cause.
-        source: std::io::Error,
-    },
-    /// The codec refused.
-    #[error("{path}: {message}")]
-    Codec {
-        /// The path.
-        path: String,
-        /// The codec's message.
-        message: String,
-    },
 }
 
 /// How radiance above 1 is brought into the displayable range before sRGB encoding.
@@ -100,26 +73,6 @@ impl Default for Display {
             exposure: 1.0,
             tonemap: ToneMap::Clamp,
         }
-    }
-}
-
-/// The sRGB transfer function (IEC 61966-2-1) of a value in `[0, 1]`.
-#[must_use]
-pub fn srgb_encode(linear: f32) -> f32 {
-    if linear <= 0.003_130_8 {
-        12.92 * linear
-    } else {
-        1.055 * linear.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// The inverse of [`srgb_encode`].
-#[must_use]
-pub fn srgb_decode(encoded: f32) -> f32 {
-    if encoded <= 0.040_45 {
-        encoded / 12.92
-    } else {
-        ((encoded + 0.055) / 1.055).powf(2.4)
     }
 }
 
@@ -188,7 +141,7 @@ impl Image {
                 let mapped = display.tonemap.apply(c * display.exposure);
                 // NaN cannot reach here (the renderer never writes one), but a NaN would
                 // encode as 0 rather than poison the file.
-                crate::srgb8::encode(mapped)
+                srgb8::encode(mapped)
             })
             .collect()
     }
@@ -196,7 +149,7 @@ impl Image {
     /// The image from 8-bit sRGB values, decoded to linear.
     #[must_use]
     pub fn from_srgb8(width: u32, height: u32, bytes: &[u8]) -> Option<Self> {
-        let decode = crate::srgb8::decode;
+        let decode = srgb8::decode;
         let pixels = bytes
             .chunks_exact(3)
             .map(|c| Vec3::new(decode(c[0]), decode(c[1]), decode(c[2])))
@@ -404,17 +357,7 @@ pub fn read_image(path: &Path) -> Result<Image, ImageError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn srgb_curve_matches_its_definition_and_inverts() {
-        // IEC 61966-2-1 reference points: 0.5 linear encodes to 0.7353569830524495.
-        assert!((srgb_encode(0.5) - 0.735_357).abs() < 1e-6);
-        assert!((srgb_encode(0.002) - 0.025_84).abs() < 1e-6);
-        for k in 0..=255 {
-            let v = k as f32 / 255.0;
-            assert!((srgb_encode(srgb_decode(v)) - v).abs() < 1e-5);
-        }
-    }
+    use crate::srgb8::srgb_encode;
 
     #[test]
     fn tone_maps_and_exposure_apply_before_encoding() {

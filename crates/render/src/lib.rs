@@ -26,6 +26,7 @@ mod description;
 mod grid;
 pub mod ibl;
 mod image;
+mod image_error;
 pub mod input;
 mod load;
 pub mod lobe_file;
@@ -51,9 +52,10 @@ pub use grid::{
     Grid, GridColumn, GridError, GridOptions, Srgb8Image,
 };
 pub use image::{
-    check_output_path, encode_png_srgb8, is_linear_output, read_image, srgb_decode, srgb_encode,
-    write_image, write_png_srgb8, Display, Image, ImageError, ToneMap, MAX_IMAGE_PIXELS,
+    check_output_path, encode_png_srgb8, is_linear_output, read_image, write_image,
+    write_png_srgb8, Display, Image, ToneMap, MAX_IMAGE_PIXELS,
 };
+pub use image_error::ImageError;
 pub use load::{load_mesh, parse_mesh, LoadError, LoadedMesh, MeshFormat, MESH_EXTENSIONS};
 pub use material::{IlluminationModel, Light, Material, Shader, Shading};
 pub use mesh::{Mesh, MeshError};
@@ -64,4 +66,5 @@ pub use pipeline::{
 };
 pub use scene::{Analytic, Object, Overrides, Scene, Settings, DEFAULT_SCENE, IBL_SCENE};
 pub use shapes::{plane, sphere, torus};
+pub use srgb8::{srgb_decode, srgb_encode};
 pub use teapot::{teapot, BezierPatch, TEAPOT_PATCHES};

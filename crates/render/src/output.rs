@@ -17,7 +17,7 @@
 use std::io::{BufWriter, Cursor, Seek, Write};
 use std::path::{Path, PathBuf};
 
-use crate::image::ImageError;
+use crate::image_error::ImageError;
 
 /// A writer an encoder may also seek in.
 pub trait SeekWrite: Write + Seek {}

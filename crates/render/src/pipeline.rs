@@ -28,6 +28,9 @@ pub const MAX_SAMPLES: u32 = 8;
 /// Larger requests are refused before anything is allocated.
 pub const MAX_PIXELS: u64 = 1 << 26;
 
+/// The most samples per pixel a Monte Carlo render (`ibl/`) may take.
+pub const MAX_SPP: u32 = 1 << 16;
+
 /// A render that cannot be done, and why.
 #[derive(Clone, Debug, Error, PartialEq)]
 #[non_exhaustive]
@@ -43,7 +46,7 @@ pub enum RenderError {
         samples: u32,
     },
     /// The samples per pixel of a Monte Carlo render are out of range.
-    #[error("cannot render with {spp} samples per pixel: spp must be in [1, {max}]", max = crate::ibl::MAX_SPP)]
+    #[error("cannot render with {spp} samples per pixel: spp must be in [1, {MAX_SPP}]")]
     Spp {
         /// The samples asked for.
         spp: u32,
@@ -132,7 +135,7 @@ pub struct SurfacePoint {
 /// The visible surface at every sample position (`width * samples` by `height * samples`,
 /// row-major), `None` where nothing is drawn: the rasterizer's coverage and visibility,
 /// with the surface handed back instead of shaded (a G-buffer, for renderers that light
-/// the surface themselves, such as the environment lighting of [`crate::ibl`]).
+/// the surface themselves, such as the environment lighting of `ibl/`).
 pub fn surfaces(scene: &Scene) -> Result<Vec<Option<SurfacePoint>>, RenderError> {
     let settings = &scene.settings;
     let shaders = prepare(scene)?;

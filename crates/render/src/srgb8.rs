@@ -1,6 +1,7 @@
-//! 8-bit sRGB by tables: exactly the bytes `(srgb_encode(x) * 255).round() as u8` gives and
-//! the values `srgb_decode(b / 255)` gives, without a `powf` per channel (an image's
-//! encoding was a tenth of the report's time).
+//! The sRGB transfer function ([`srgb_encode`], [`srgb_decode`]), and 8-bit sRGB by tables:
+//! exactly the bytes `(srgb_encode(x) * 255).round() as u8` gives and the values
+//! `srgb_decode(b / 255)` gives, without a `powf` per channel (an image's encoding was a tenth
+//! of the report's time).
 //!
 //! Encoding finds, for each byte `b`, the smallest `f32` whose byte exceeds `b` (by bisection
 //! on the formula itself, which is monotonic), and, for each of the 32,512 groups of floats
@@ -10,7 +11,25 @@
 
 use std::sync::LazyLock;
 
-use crate::image::{srgb_decode, srgb_encode};
+/// The sRGB transfer function (IEC 61966-2-1) of a value in `[0, 1]`.
+#[must_use]
+pub fn srgb_encode(linear: f32) -> f32 {
+    if linear <= 0.003_130_8 {
+        12.92 * linear
+    } else {
+        1.055 * linear.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// The inverse of [`srgb_encode`].
+#[must_use]
+pub fn srgb_decode(encoded: f32) -> f32 {
+    if encoded <= 0.040_45 {
+        encoded / 12.92
+    } else {
+        ((encoded + 0.055) / 1.055).powf(2.4)
+    }
+}
 
 /// Bits dropped from a float to find its group.
 const SHIFT: u32 = 15;
@@ -80,6 +99,17 @@ pub fn decode(b: u8) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn srgb_curve_matches_its_definition_and_inverts() {
+        // IEC 61966-2-1 reference points: 0.5 linear encodes to 0.7353569830524495.
+        assert!((srgb_encode(0.5) - 0.735_357).abs() < 1e-6);
+        assert!((srgb_encode(0.002) - 0.025_84).abs() < 1e-6);
+        for k in 0..=255 {
+            let v = k as f32 / 255.0;
+            assert!((srgb_encode(srgb_decode(v)) - v).abs() < 1e-5);
+        }
+    }
 
     /// Every byte's threshold and its neighbours, and a stride through every float in
     /// `[0, 1]` (and beyond, and NaN), encode as the formula does.

@@ -16,6 +16,7 @@ pub mod format;
 mod hardware;
 mod html;
 mod materials;
+mod medical;
 mod plot;
 mod real_scans;
 mod renderers;

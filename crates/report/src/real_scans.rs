@@ -17,9 +17,9 @@ use specula_render::{read_image, srgb_encode, Display, Image};
 
 use super::comparison::{self, Compared};
 use super::html::{paragraph, table_with_files};
-use super::volumes::{cpu_threads, march_times, shading, EXPONENT};
 use super::{Context, RealScanSizes};
 use crate::format::psnr;
+use crate::medical::{cpu_threads, march_times, shading, EXPONENT};
 use crate::vtk_peer;
 
 /// A real scan a Debian package installs.

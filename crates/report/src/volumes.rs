@@ -6,14 +6,14 @@
 use std::time::Instant;
 
 use glam::{DVec3, Vec3};
-use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+use specula::{Geometry, Lobe, LobeKind};
 use specula_gpu::{Gpu, GpuVolumeRenderer};
 use specula_render::metrics::compare;
 use specula_render::volume::isosurface::{default_isovalue, render_isosurface, IsoSettings};
 use specula_render::volume::march::PreparedVolume;
 use specula_render::volume::phantom::{self, marschner_lobb_gradient};
 use specula_render::volume::raymarch::{
-    render_dvr_lobes, render_dvr_prepared, DvrSettings, RayCamera, Shading, View,
+    render_dvr_lobes, render_dvr_prepared, DvrSettings, RayCamera, View,
 };
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::Volume;
@@ -23,19 +23,7 @@ use super::comparison::{self, Compared};
 use super::html::{paragraph, table, table_with_files};
 use super::Context;
 use crate::format::{psnr, sig};
-
-/// The exponent of every lobe in the section (VTK's specular power in the comparison).
-pub(crate) const EXPONENT: f64 = 32.0;
-
-/// The section's shading with `kind` as the specular term.
-pub(crate) fn shading(kind: LobeKind) -> Result<Shading, String> {
-    let n = Exponent::try_new(EXPONENT).map_err(|e| e.to_string())?;
-    Ok(Shading::new(
-        Lobe::new(kind, n),
-        Geometry::Blinn,
-        Normalisation::ThesisPhong,
-    ))
-}
+use crate::medical::{cpu_threads, march_times, shading, EXPONENT};
 
 /// The best of `runs` wall-clock runs, in milliseconds, and what the last one made.
 fn timed<T>(runs: usize, mut draw: impl FnMut() -> Result<T, String>) -> Result<(f64, T), String> {
@@ -47,22 +35,6 @@ fn timed<T>(runs: usize, mut draw: impl FnMut() -> Result<T, String>) -> Result<
         best = best.min(started.elapsed().as_secs_f64() * 1e3);
     }
     Ok((best, made.ok_or("no run")?))
-}
-
-/// The sentence giving pow's frame alone and every lobe's from one march, `on` the CPU's
-/// threads or the GPU.
-#[must_use]
-pub(crate) fn march_times(on: &str, alone_ms: f64, together_ms: f64, lobes: usize) -> String {
-    format!(
-        "One frame on {on}: pow alone {alone_ms:.1} ms; all {lobes} lobes' images from one march {together_ms:.1} ms, {:.1} ms a lobe beyond the first (each image bit for bit the one marched for its lobe alone).",
-        (together_ms - alone_ms) / (lobes.max(2) - 1) as f64,
-    )
-}
-
-/// [`march_times`]' `on` for the CPU.
-#[must_use]
-pub(crate) fn cpu_threads() -> String {
-    format!("{} threads", rayon::current_num_threads())
 }
 
 /// The phantom and, beside it, the real scans.

@@ -20,7 +20,9 @@
 //! - `GET /api/environment?lobe&n&geometry&normalisation&size&spp`: the environment scene lit
 //!   by the procedural sky (Monte Carlo, CPU), as a PNG;
 //! - `GET /api/materials`, `GET /api/fits?material`, `GET /api/material-render?material&fit&size&spp`:
-//!   the measured materials of the `--data` folder, by name (`measured.rs`).
+//!   the measured materials of the `--data` folder, by name (`measured.rs`);
+//! - `GET /api/design?target&low&high&max_error`: a lobe designed for a GPU family, by the
+//!   search the server was handed (`design.rs`).
 
 use std::sync::Arc;
 
@@ -28,10 +30,10 @@ use axum::extract::State;
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use axum::Json;
-use serde::Serialize;
 use serde_json::json;
 use specula::analysis::{analyze, Precision};
 use specula::formula::MAX_SOURCE_BYTES;
+use specula::measured::fit::POLAR_ANGLES_DEGREES;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use specula_render::volume::raymarch::View;
 use specula_render::{IlluminationModel, Shading};
@@ -45,66 +47,15 @@ use specula_render::volume::phantom::BuiltIn;
 use super::environment::{
     environment_png, EnvironmentRequest, MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP,
 };
-use super::measured::Materials;
+use super::measured::{
+    material, render_labels, Assessment, Materials, MAX_MATERIALS, MAX_MATERIAL_RENDER_SIZE,
+    MAX_MATERIAL_RENDER_SPP, MEASURED, NO_DATA,
+};
 use super::volume::{volume_png, Choice, VolumeRequest, MAX_VOLUME_SIZE};
+use crate::costs::{costs_versus_pow, cpu_cost, CostModel};
 
 /// The largest render side, in pixels.
 pub const MAX_RENDER_SIZE: u32 = 1024;
-
-/// A lobe's rate on one target, as a cost model gives it: higher is better.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct TargetRate {
-    /// The target's id (`cpu`, `gpu-nvidia`, ...).
-    pub target: String,
-    /// The rate (evaluations per instruction, per clock, ...): higher is better.
-    pub value: f64,
-    /// What it counts.
-    pub unit: String,
-}
-
-/// A lobe's cost on one target, as the explorer shows it beside its errors: its rate and that
-/// rate over pow's at the same `n` (one direction on every target: higher is better).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct TargetCost {
-    /// The model's rate.
-    #[serde(flatten)]
-    pub rate: TargetRate,
-    /// The rate over pow's on the same target at the same `n`: pow's throughput times this.
-    pub versus_pow: f64,
-}
-
-/// The rates of a prepared lobe on every target the server knows. The binary supplies the
-/// GPU models (they need the shader compiler, which this crate does not depend on); the
-/// default knows the CPU's counted SIMD instructions only.
-pub type CostModel = Arc<dyn Fn(&Lobe) -> Result<Vec<TargetRate>, String> + Send + Sync>;
-
-/// The CPU's rate: evaluations per instruction of the lobe's SIMD kernel (8 per vector).
-#[must_use]
-pub fn cpu_cost(lobe: &Lobe) -> TargetRate {
-    TargetRate {
-        target: "cpu".into(),
-        value: 8.0 / f64::from(lobe.batch_instructions().total().max(1)),
-        unit: "evaluations per SIMD instruction (counted; higher is better)".into(),
-    }
-}
-
-/// `lobe`'s costs by `model`, each with its rate over pow's at the same `n`.
-pub(crate) fn costs_versus_pow(model: &CostModel, lobe: &Lobe) -> Result<Vec<TargetCost>, String> {
-    let pow = model(&Lobe::new(specula::LobeKind::Pow, lobe.exponent()))?;
-    model(lobe)?
-        .into_iter()
-        .map(|rate| {
-            let reference = pow
-                .iter()
-                .find(|p| p.target == rate.target)
-                .ok_or_else(|| format!("the cost model has no rate for pow on {}", rate.target))?;
-            Ok(TargetCost {
-                versus_pow: rate.value / reference.value,
-                rate,
-            })
-        })
-        .collect()
-}
 
 /// What the handlers share.
 #[derive(Clone)]
@@ -412,4 +363,105 @@ pub(crate) fn png(encoded: Vec<u8>) -> Response {
         encoded,
     )
         .into_response()
+}
+
+/// The material's fits: the cached ones at once, or computed in a turn of the queue.
+async fn assessment(state: &AppState, index: usize) -> Result<Arc<Assessment>, Response> {
+    let result = match state.materials.fitted(index) {
+        Some(done) => done,
+        None => {
+            let (materials, costs) = (Arc::clone(&state.materials), state.costs.clone());
+            compute(state, move || materials.assess(index, &costs)).await?
+        }
+    };
+    result.map_err(|error| ApiError::internal(error).into())
+}
+
+/// `GET /api/materials`: the materials offered (each with whether its fits are ready), the
+/// polar plots' viewing elevations and the renders' limits and choices.
+pub async fn materials(State(state): State<AppState>) -> Response {
+    let materials = &state.materials;
+    let offered: Vec<_> = materials
+        .names()
+        .enumerate()
+        .map(|(index, name)| json!({ "name": name, "fitted": materials.is_fitted(index) }))
+        .collect();
+    Json(json!({
+        "hint": if offered.is_empty() { Some(NO_DATA) } else { None },
+        "materials": offered,
+        "max_materials": MAX_MATERIALS,
+        "polar_angles_deg": POLAR_ANGLES_DEGREES,
+        "render_fits": render_labels(),
+        "max_render_size": MAX_MATERIAL_RENDER_SIZE,
+        "max_render_spp": MAX_MATERIAL_RENDER_SPP,
+    }))
+    .into_response()
+}
+
+/// `GET /api/fits?material=NAME`: the shared-`n` fits and the polar data (see
+/// [`Assessment`]'s JSON: `fits`, `polar_elevations_deg`, `polar`).
+pub async fn fits(State(state): State<AppState>, query: QueryPairs) -> Result<Response, Response> {
+    let params = Params::new(pairs(query)?, &["material"])?;
+    let index = material(&params, &state.materials)?;
+    let assessment = assessment(&state, index).await?;
+    Ok((
+        [(header::CONTENT_TYPE, "application/json")],
+        assessment.body(),
+    )
+        .into_response())
+}
+
+/// `GET /api/material-render?material=NAME&fit=LABEL&size&spp`: the environment scene in the
+/// material (`fit=measured`, the default) or one of its shared fits (`pow/phong`, `ggx`), as a
+/// PNG; every render uses seed 0.
+pub async fn render_material(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<Response, Response> {
+    let params = Params::new(pairs(query)?, &["material", "fit", "size", "spp"])?;
+    let index = material(&params, &state.materials)?;
+    let labels = render_labels();
+    let shown = params.text("fit").unwrap_or(MEASURED).to_owned();
+    if !labels.contains(&shown) {
+        return Err(ApiError::bad(
+            "fit",
+            format!("unknown fit `{}`", specula::excerpt(&shown)),
+            labels.join(", "),
+        )
+        .into());
+    }
+    let size = params.number("size", 16.0..=f64::from(MAX_MATERIAL_RENDER_SIZE), 256.0)? as u32;
+    let spp = params.number("spp", 1.0..=f64::from(MAX_MATERIAL_RENDER_SPP), 8.0)? as u32;
+    let (materials, costs) = (Arc::clone(&state.materials), state.costs.clone());
+    let encoded = compute(&state, move || {
+        materials.render_png(index, &shown, &costs, size, spp)
+    })
+    .await?;
+    Ok(png(encoded.map_err(ApiError::internal)?))
+}
+
+/// `GET /api/design?target&low&high&max_error`: `specula design`'s answer, from the search the
+/// server was handed (`design.rs`).
+pub async fn design_lobe(State(state): State<AppState>, query_pairs: QueryPairs) -> Response {
+    let asked = match pairs(query_pairs)
+        .and_then(|q| Params::new(q, &["target", "low", "high", "max_error"]))
+        .and_then(|params| crate::design::query(&params))
+    {
+        Ok(asked) => asked,
+        Err(error) => return error.into_response(),
+    };
+    let Some(model) = state.designer.clone() else {
+        return ApiError::unavailable(
+            "this server designs no lobes: specula serve offers /api/design".to_owned(),
+        )
+        .into_response();
+    };
+    match compute(&state, move || model(&asked)).await {
+        Ok(Ok(answer)) => Json(answer).into_response(),
+        Ok(Err(refusal)) => {
+            ApiError::bad("max_error", refusal, "a bound the search can meet".into())
+                .into_response()
+        }
+        Err(response) => response,
+    }
 }

@@ -1,16 +1,11 @@
-//! `/api/design`: a lobe designed for a GPU family, a range of `n` and an epicentre bound
-//! (`specula design`'s answer as JSON). The search lives in `specula-decide`, above this
-//! crate, so the server is handed it ([`DesignModel`]) by the command that starts it; a
-//! server without one says so.
+//! What `/api/design` (`api.rs`) asks for: a lobe designed for a GPU family, a range of `n`
+//! and an epicentre bound (`specula design`'s answer as JSON). The search lives in
+//! `specula-decide`, above this crate, so the server is handed it ([`DesignModel`]) by the
+//! command that starts it; a server without one says so.
 
 use std::sync::Arc;
 
-use axum::extract::State;
-use axum::response::{IntoResponse, Response};
-use axum::Json;
-
-use crate::api::{compute, AppState};
-use crate::query::{pairs, ApiError, Params, QueryPairs};
+use crate::query::{ApiError, Params};
 
 /// What a design request asks for.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,7 +25,8 @@ pub type DesignModel = Arc<dyn Fn(&DesignQuery) -> Result<serde_json::Value, Str
 /// of seconds a design, so `specula design --target cpu` is for a quiet machine).
 pub const DESIGN_TARGETS: [&str; 2] = ["gpu-nvidia", "gpu-amd"];
 
-fn query(params: &Params) -> Result<DesignQuery, ApiError> {
+/// The request's design query, refused with the parameter at fault.
+pub(crate) fn query(params: &Params) -> Result<DesignQuery, ApiError> {
     let target = params.text("target").unwrap_or(DESIGN_TARGETS[0]);
     if !DESIGN_TARGETS.contains(&target) {
         return Err(ApiError::bad(
@@ -60,28 +56,4 @@ fn query(params: &Params) -> Result<DesignQuery, ApiError> {
         range: (low, high),
         max_error: percent / 100.0,
     })
-}
-
-pub async fn design(State(state): State<AppState>, query_pairs: QueryPairs) -> Response {
-    let asked = match pairs(query_pairs)
-        .and_then(|q| Params::new(q, &["target", "low", "high", "max_error"]))
-        .and_then(|params| query(&params))
-    {
-        Ok(asked) => asked,
-        Err(error) => return error.into_response(),
-    };
-    let Some(model) = state.designer.clone() else {
-        return ApiError::unavailable(
-            "this server designs no lobes: specula serve offers /api/design".to_owned(),
-        )
-        .into_response();
-    };
-    match compute(&state, move || model(&asked)).await {
-        Ok(Ok(answer)) => Json(answer).into_response(),
-        Ok(Err(refusal)) => {
-            ApiError::bad("max_error", refusal, "a bound the search can meet".into())
-                .into_response()
-        }
-        Err(response) => response,
-    }
 }

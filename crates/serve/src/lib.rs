@@ -13,6 +13,7 @@
 //! given at start-up, named by their stems (`measured.rs`).
 
 mod api;
+mod costs;
 mod design;
 mod environment;
 mod explorer;
@@ -26,7 +27,8 @@ mod volume;
 
 use std::net::SocketAddr;
 
-pub use api::{cpu_cost, AppState, CostModel, TargetCost, TargetRate, MAX_RENDER_SIZE};
+pub use api::{AppState, MAX_RENDER_SIZE};
+pub use costs::{cpu_cost, CostModel, TargetCost, TargetRate};
 pub use design::{DesignModel, DesignQuery, DESIGN_TARGETS};
 pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
@@ -88,10 +90,10 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/render", get(api::render))
         .route("/api/volume", get(api::volume))
         .route("/api/environment", get(api::environment))
-        .route("/api/materials", get(measured::list))
-        .route("/api/fits", get(measured::fits))
-        .route("/api/material-render", get(measured::render_material))
-        .route("/api/design", get(design::design))
+        .route("/api/materials", get(api::materials))
+        .route("/api/fits", get(api::fits))
+        .route("/api/material-render", get(api::render_material))
+        .route("/api/design", get(api::design_lobe))
         .fallback(api::not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
         .layer(axum::middleware::from_fn_with_state(
@@ -108,7 +110,7 @@ pub fn router_with(state: api::AppState) -> Router {
 pub fn serve(
     address: SocketAddr,
     open: bool,
-    costs: api::CostModel,
+    costs: CostModel,
     designer: design::DesignModel,
     materials: Materials,
 ) -> Result<(), String> {

@@ -22,13 +22,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use axum::body::Bytes;
-use axum::extract::State;
-use axum::http::header;
-use axum::response::{IntoResponse, Response};
-use axum::Json;
 use glam::DVec3;
 use serde::Serialize;
-use serde_json::json;
 use specula::brdf::luminance;
 use specula::measured::fit::{
     families, fit_all, plane_of_incidence, Fit, Observations, Sharing, Specular, GRID,
@@ -41,8 +36,8 @@ use specula_render::measured::{
     BUNDLED_MATERIALS,
 };
 
-use super::api::{compute, costs_versus_pow, png, AppState, CostModel, TargetCost};
-use super::query::{pairs, ApiError, Params, QueryPairs};
+use super::query::{ApiError, Params};
+use crate::costs::{costs_versus_pow, CostModel, TargetCost};
 
 /// The most materials a `--data` folder may hold.
 pub const MAX_MATERIALS: usize = 64;
@@ -485,7 +480,7 @@ fn summary(fit: &Fit, reference_error: f64, ggx_error: f64, costs: &CostModel) -
 
 /// The request's `material`: a name from the list, never a path. Refused with the valid
 /// names, or with how to start the server with some when it has none.
-fn material(params: &Params, materials: &Materials) -> Result<usize, ApiError> {
+pub(crate) fn material(params: &Params, materials: &Materials) -> Result<usize, ApiError> {
     let names: Vec<&str> = materials.names().collect();
     if names.is_empty() {
         return Err(ApiError::bad(
@@ -512,79 +507,4 @@ fn material(params: &Params, materials: &Materials) -> Result<usize, ApiError> {
 }
 
 /// What the view says when the server has no materials.
-const NO_DATA: &str = "the server offers no measured materials: start it with `specula serve` (the five bundled ones) or `specula serve --data DIR`, DIR a folder of RGL .bsdf files";
-
-/// The material's fits: the cached ones at once, or computed in a turn of the queue.
-async fn assessment(state: &AppState, index: usize) -> Result<Arc<Assessment>, Response> {
-    let result = match state.materials.fitted(index) {
-        Some(done) => done,
-        None => {
-            let (materials, costs) = (Arc::clone(&state.materials), state.costs.clone());
-            compute(state, move || materials.assess(index, &costs)).await?
-        }
-    };
-    result.map_err(|error| ApiError::internal(error).into())
-}
-
-/// `GET /api/materials`: the materials offered (each with whether its fits are ready), the
-/// polar plots' viewing elevations and the renders' limits and choices.
-pub async fn list(State(state): State<AppState>) -> Response {
-    let materials = &state.materials;
-    let offered: Vec<_> = materials
-        .names()
-        .enumerate()
-        .map(|(index, name)| json!({ "name": name, "fitted": materials.is_fitted(index) }))
-        .collect();
-    Json(json!({
-        "hint": if offered.is_empty() { Some(NO_DATA) } else { None },
-        "materials": offered,
-        "max_materials": MAX_MATERIALS,
-        "polar_angles_deg": POLAR_ANGLES_DEGREES,
-        "render_fits": render_labels(),
-        "max_render_size": MAX_MATERIAL_RENDER_SIZE,
-        "max_render_spp": MAX_MATERIAL_RENDER_SPP,
-    }))
-    .into_response()
-}
-
-/// `GET /api/fits?material=NAME`: the shared-`n` fits and the polar data (see
-/// [`Assessment`]'s JSON: `fits`, `polar_elevations_deg`, `polar`).
-pub async fn fits(State(state): State<AppState>, query: QueryPairs) -> Result<Response, Response> {
-    let params = Params::new(pairs(query)?, &["material"])?;
-    let index = material(&params, &state.materials)?;
-    let assessment = assessment(&state, index).await?;
-    Ok((
-        [(header::CONTENT_TYPE, "application/json")],
-        assessment.body(),
-    )
-        .into_response())
-}
-
-/// `GET /api/material-render?material=NAME&fit=LABEL&size&spp`: the environment scene in the
-/// material (`fit=measured`, the default) or one of its shared fits (`pow/phong`, `ggx`), as a
-/// PNG; every render uses seed 0.
-pub async fn render_material(
-    State(state): State<AppState>,
-    query: QueryPairs,
-) -> Result<Response, Response> {
-    let params = Params::new(pairs(query)?, &["material", "fit", "size", "spp"])?;
-    let index = material(&params, &state.materials)?;
-    let labels = render_labels();
-    let shown = params.text("fit").unwrap_or(MEASURED).to_owned();
-    if !labels.contains(&shown) {
-        return Err(ApiError::bad(
-            "fit",
-            format!("unknown fit `{}`", specula::excerpt(&shown)),
-            labels.join(", "),
-        )
-        .into());
-    }
-    let size = params.number("size", 16.0..=f64::from(MAX_MATERIAL_RENDER_SIZE), 256.0)? as u32;
-    let spp = params.number("spp", 1.0..=f64::from(MAX_MATERIAL_RENDER_SPP), 8.0)? as u32;
-    let (materials, costs) = (Arc::clone(&state.materials), state.costs.clone());
-    let encoded = compute(&state, move || {
-        materials.render_png(index, &shown, &costs, size, spp)
-    })
-    .await?;
-    Ok(png(encoded.map_err(ApiError::internal)?))
-}
+pub(crate) const NO_DATA: &str = "the server offers no measured materials: start it with `specula serve` (the five bundled ones) or `specula serve --data DIR`, DIR a folder of RGL .bsdf files";

@@ -18,7 +18,7 @@
 //! **Scope.** The environment is at infinity and unoccluded: a surface sees the whole map
 //! (no shadows, no interreflection), which is what an engine's image-based specular term
 //! computes, and keeps every difference between two renders the lobe's. Primary visibility
-//! is the rasterizer's ([`crate::pipeline`]), so IBL renders line up pixel for pixel with the
+//! is the rasterizer's (`pipeline.rs`), so IBL renders line up pixel for pixel with the
 //! rasterized ones; a pixel's `spp` samples cycle through its `samples x samples` positions,
 //! which antialiases edges at no extra cost. Random numbers are a function of (seed, pixel
 //! sample, dimension), so an image is identical on any number of threads.
@@ -38,15 +38,13 @@ mod packet;
 mod sky;
 mod trace;
 
+pub use crate::pipeline::MAX_SPP;
 pub use environment::{Environment, EnvironmentError, EnvironmentSample};
 pub use sky::{sun_direction, SKY_WIDTH, SUN_RADIANCE, SUN_RADIUS};
 pub use trace::{
     cosine_direction, render_ibl, render_ibl_grid, render_ibl_lobes, render_ibl_with,
     MaterialReflectance, Reflectance,
 };
-
-/// The most samples per pixel a render may take.
-pub const MAX_SPP: u32 = 1 << 16;
 
 /// How each sample of the reflected radiance is drawn.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
