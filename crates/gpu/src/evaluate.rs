@@ -201,7 +201,7 @@ impl Evaluator for GpuEvaluator<'_> {
         "gpu"
     }
 
-    fn eval_batch(&mut self, lobe: &Lobe, cosines: &[f64]) -> Vec<f64> {
+    fn evaluate(&mut self, lobe: &Lobe, cosines: &[f64]) -> Vec<f64> {
         let narrow: Vec<f32> = cosines.iter().map(|&t| t as f32).collect();
         match self.evaluator.eval(lobe, &narrow) {
             Ok(values) => values.into_iter().map(f64::from).collect(),

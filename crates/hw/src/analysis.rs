@@ -46,7 +46,7 @@ impl Evaluator for HwEvaluator {
         "fixed-point"
     }
 
-    fn eval_batch(&mut self, _lobe: &Lobe, cosines: &[f64]) -> Vec<f64> {
+    fn evaluate(&mut self, _lobe: &Lobe, cosines: &[f64]) -> Vec<f64> {
         let unit = HwLobe::unit_format(self.bits);
         // The samples are sorted, and at narrow widths runs of them quantise to the same
         // input: the datapath is a pure function of it, so a run is evaluated once.
@@ -166,7 +166,7 @@ mod tests {
                 .map(|i| 0.9 + 0.1 * f64::from(i) / 400.0)
                 .chain([0.5, 0.5, 0.95])
                 .collect();
-            let batch = evaluator.eval_batch(&Lobe::new(lobe.float_kind(), lobe_n), &cosines);
+            let batch = evaluator.evaluate(&Lobe::new(lobe.float_kind(), lobe_n), &cosines);
             let datapath = lobe.build(bits).unwrap();
             for (&t, &value) in cosines.iter().zip(&batch) {
                 let input = if lobe.takes_angle() { t.acos() } else { t };

@@ -49,7 +49,7 @@ pub trait Evaluator {
     /// The name reports give it (`f64`, `f32`, `gpu`).
     fn name(&self) -> &'static str;
     /// The lobe at each cosine, widened to `f64`; one value per input, in order.
-    fn eval_batch(&mut self, lobe: &Lobe, cosines: &[f64]) -> Vec<f64>;
+    fn evaluate(&mut self, lobe: &Lobe, cosines: &[f64]) -> Vec<f64>;
 }
 
 impl Evaluator for Precision {
@@ -61,7 +61,7 @@ impl Evaluator for Precision {
         }
     }
 
-    fn eval_batch(&mut self, lobe: &Lobe, cosines: &[f64]) -> Vec<f64> {
+    fn evaluate(&mut self, lobe: &Lobe, cosines: &[f64]) -> Vec<f64> {
         match self {
             Precision::F64 => cosines.iter().map(|&t| lobe.eval(t)).collect(),
             Precision::F32 => cosines
@@ -158,7 +158,7 @@ struct ZoneScan {
 }
 
 fn scan_zone(lobe: &Lobe, evaluator: &mut dyn Evaluator, zone: &ZoneSample) -> ZoneScan {
-    let values = evaluator.eval_batch(lobe, &zone.cosines);
+    let values = evaluator.evaluate(lobe, &zone.cosines);
     let mut scan = ZoneScan::default();
     let mut sum_square = 0.0;
     for (&reference, &value) in zone.references.iter().zip(&values) {

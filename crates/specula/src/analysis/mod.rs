@@ -3,19 +3,19 @@
 //! [`analyze`] gathers every figure of SPEC section 4 and the white-furnace maximum of
 //! section 6 for one lobe at one `n`; the submodules expose each measurement on its own.
 
+pub mod accuracy;
 pub mod albedo;
-pub mod error;
 pub mod reciprocity;
 pub mod shape;
 
 use glam::DVec3;
 use serde::Serialize;
 
-pub use albedo::{directional_albedo, max_directional_albedo, specular_albedo_per_unit};
-pub use error::{
+pub use accuracy::{
     error_figures, error_figures_on, ErrorFigures, Evaluator, Precision, ZoneSamples,
     DEFAULT_SAMPLES_PER_ZONE,
 };
+pub use albedo::{directional_albedo, max_directional_albedo, specular_albedo_per_unit};
 pub use reciprocity::max_reciprocity_error;
 pub use shape::{shape, Shape};
 

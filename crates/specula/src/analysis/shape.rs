@@ -7,8 +7,8 @@
 
 use serde::Serialize;
 
+use super::accuracy::{error_figures, Precision};
 use super::energy_ratio;
-use super::error::{error_figures, Precision};
 use crate::Lobe;
 
 /// A lobe's shape at one `n`.
@@ -73,7 +73,7 @@ pub fn shape(lobe: &Lobe) -> Shape {
     let errors = error_figures(
         lobe,
         &mut Precision::F64,
-        super::error::DEFAULT_SAMPLES_PER_ZONE,
+        super::accuracy::DEFAULT_SAMPLES_PER_ZONE,
     );
     Shape {
         n: lobe.exponent().get(),

@@ -142,7 +142,7 @@ impl CosQuad {
 
 impl Kernel for CosQuadDraw {
     #[inline(always)]
-    fn apply<V: Lanes>(self, u: V) -> V {
+    fn eval_lanes<V: Lanes>(self, u: V) -> V {
         let one = u.splat(1.0);
         let remaining = remaining_share(u, self.floor);
         let base = exp2(log2(remaining) * u.splat(self.inverse_power));
@@ -185,7 +185,7 @@ impl CosQuad {
 
 impl<const SQUARINGS: u32, const MASKED: bool> Kernel for CosQuadKernel<SQUARINGS, MASKED> {
     #[inline(always)]
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         let one = t.splat(1.0);
         let base = (t - one).mul_add(t.splat(self.slope), one);
         let mut value = if MASKED {

@@ -77,7 +77,7 @@ pub(crate) struct FasterPowKernel {
 
 impl Kernel for FasterPowKernel {
     #[inline(always)]
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         let c = |value: f64| t.splat(value as f32);
         let clamped = clamp_unit(t);
         let (m, e) = frexp(clamped);

@@ -147,7 +147,7 @@ pub(crate) struct FastPowKernel {
 
 impl Kernel for FastPowKernel {
     #[inline(always)]
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         let c = |value: f32| t.splat(value);
         let clamped = clamp_unit(t);
         let (m, e) = frexp(clamped);

@@ -164,7 +164,7 @@ pub(crate) struct FormulaKernel {
 }
 
 impl Kernel for FormulaKernel {
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         let mut lanes = [0.0_f32; 64];
         t.store(&mut lanes[..V::WIDTH]);
         for value in &mut lanes[..V::WIDTH] {

@@ -65,7 +65,7 @@ impl LogExp {
 
 impl Kernel for LogExpKernel {
     #[inline(always)]
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         let one = t.splat(1.0);
         let y = t.splat(self.n) * log2(clamp_unit(t));
         log2(one - y)

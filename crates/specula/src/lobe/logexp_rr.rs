@@ -62,7 +62,7 @@ impl LogExpRr {
 
 impl Kernel for LogExpRrKernel {
     #[inline(always)]
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         let one = t.splat(1.0);
         let y = (t.splat(self.n) * log2(clamp_unit(t))).max(t.splat(-127.0));
         let k = y.float_to_int();

@@ -85,14 +85,14 @@ impl Pow {
 
 impl Kernel for PowDraw {
     #[inline(always)]
-    fn apply<V: Lanes>(self, u: V) -> V {
+    fn eval_lanes<V: Lanes>(self, u: V) -> V {
         exp2(log2(remaining_share(u, 0.0)) * u.splat(self.inverse_power))
     }
 }
 
 impl Kernel for PowKernel {
     #[inline(always)]
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         exp2(t.splat(self.n) * log2(clamp_unit(t)))
     }
 }

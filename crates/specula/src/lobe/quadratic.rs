@@ -216,7 +216,7 @@ impl AngleQuadratic {
 
 impl Kernel for AngleQuadraticKernel {
     #[inline(always)]
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         let [c, b, a] = self.coeffs.map(|value| t.splat(value));
         let g = acos(clamp_unit(t));
         let value = a.mul_add(g, b).mul_add(g, c).min(t.splat(1.0));

@@ -123,7 +123,7 @@ impl Schlick {
 
 impl<const SQUARINGS: u32> Kernel for SchlickKernel<SQUARINGS> {
     #[inline(always)]
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         let c = clamp_unit(t);
         let mut numerator = c;
         for _ in 0..SQUARINGS {

@@ -109,7 +109,7 @@ impl Sg {
 
 impl Kernel for SgDraw {
     #[inline(always)]
-    fn apply<V: Lanes>(self, u: V) -> V {
+    fn eval_lanes<V: Lanes>(self, u: V) -> V {
         let one = u.splat(1.0);
         let remaining = remaining_share(u, self.floor);
         log2(remaining)
@@ -129,7 +129,7 @@ pub(crate) struct SgKernel {
 
 impl Kernel for SgKernel {
     #[inline(always)]
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         let clamped = clamp_unit(t);
         let argument = (clamped - t.splat(1.0)) * t.splat(self.rate);
         exp2(argument).keep(clamped.gt(t.splat(0.0)))

@@ -124,7 +124,7 @@ struct BinEstimate;
 
 impl Kernel for BinEstimate {
     #[inline(always)]
-    fn apply<V: Lanes>(self, t: V) -> V {
+    fn eval_lanes<V: Lanes>(self, t: V) -> V {
         let c = |value: f32| t.splat(value);
         // NaN and cosines out of range land in a bin; `density_near` gives them 0.
         let t = t.max(c(0.0)).min(c(1.0));

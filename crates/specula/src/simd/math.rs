@@ -161,7 +161,7 @@ mod tests {
     }
 
     impl Kernel for Function {
-        fn apply<V: Lanes>(self, x: V) -> V {
+        fn eval_lanes<V: Lanes>(self, x: V) -> V {
             match self {
                 Function::Log2 => log2(x),
                 Function::Exp2 => exp2(x),

@@ -118,7 +118,7 @@ pub trait Lanes:
 /// A kernel: one lobe (or any `f32 -> f32` formula) over a vector.
 pub trait Kernel: Copy {
     /// The formula on every lane of `t`.
-    fn apply<V: Lanes>(self, t: V) -> V;
+    fn eval_lanes<V: Lanes>(self, t: V) -> V;
 }
 
 /// Where a batch runs.
@@ -251,10 +251,10 @@ pub(crate) fn drive<V: Lanes, K: Kernel>(lanes: V, kernel: K, ts: &[f32], out: &
     {
         let (t, o) = (t.split_at(2 * V::WIDTH), o.split_at_mut(2 * V::WIDTH));
         let (t01, t23) = (t.0.split_at(V::WIDTH), t.1.split_at(V::WIDTH));
-        let v0 = kernel.apply(lanes.load(t01.0));
-        let v1 = kernel.apply(lanes.load(t01.1));
-        let v2 = kernel.apply(lanes.load(t23.0));
-        let v3 = kernel.apply(lanes.load(t23.1));
+        let v0 = kernel.eval_lanes(lanes.load(t01.0));
+        let v1 = kernel.eval_lanes(lanes.load(t01.1));
+        let v2 = kernel.eval_lanes(lanes.load(t23.0));
+        let v3 = kernel.eval_lanes(lanes.load(t23.1));
         let (o01, o23) = (o.0.split_at_mut(V::WIDTH), o.1.split_at_mut(V::WIDTH));
         v0.store(o01.0);
         v1.store(o01.1);
@@ -265,13 +265,13 @@ pub(crate) fn drive<V: Lanes, K: Kernel>(lanes: V, kernel: K, ts: &[f32], out: &
     let mut t_chunks = ts_rest.chunks_exact(V::WIDTH);
     let mut o_chunks = out_rest.chunks_exact_mut(V::WIDTH);
     for (t, o) in (&mut t_chunks).zip(&mut o_chunks) {
-        kernel.apply(lanes.load(t)).store(o);
+        kernel.eval_lanes(lanes.load(t)).store(o);
     }
     let (t, o) = (t_chunks.remainder(), o_chunks.into_remainder());
     if !t.is_empty() {
         let mut buffer = [1.0_f32; 64];
         buffer[..t.len()].copy_from_slice(t);
-        let value = kernel.apply(lanes.load(&buffer[..V::WIDTH]));
+        let value = kernel.eval_lanes(lanes.load(&buffer[..V::WIDTH]));
         value.store(&mut buffer[..V::WIDTH]);
         o.copy_from_slice(&buffer[..o.len()]);
     }
@@ -283,7 +283,7 @@ pub(crate) fn drive<V: Lanes, K: Kernel>(lanes: V, kernel: K, ts: &[f32], out: &
 #[inline(always)]
 pub(crate) fn plain_loop<K: Kernel>(kernel: K, ts: &[f32], out: &mut [f32]) {
     for (o, &t) in out.iter_mut().zip(ts) {
-        *o = kernel.apply(scalar::Scalar(t)).0;
+        *o = kernel.eval_lanes(scalar::Scalar(t)).0;
     }
 }
 

@@ -68,7 +68,7 @@ pub fn copy(level: Level, ts: &[f32], out: &mut [f32]) {
     #[derive(Clone, Copy)]
     struct Identity;
     impl Kernel for Identity {
-        fn apply<V: Lanes>(self, t: V) -> V {
+        fn eval_lanes<V: Lanes>(self, t: V) -> V {
             t
         }
     }

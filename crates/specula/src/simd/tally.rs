@@ -170,7 +170,7 @@ pub struct Tally(Scalar);
 #[must_use]
 pub fn count<K: Kernel>(kernel: K, t: f32) -> Instructions {
     COUNTS.with(|c| c.set(Instructions::NONE));
-    let _ = kernel.apply(Tally(Scalar(t)));
+    let _ = kernel.eval_lanes(Tally(Scalar(t)));
     COUNTS.with(Cell::get)
 }
 
