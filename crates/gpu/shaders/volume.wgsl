@@ -1,4 +1,4 @@
-// Direct volume rendering: a transcription of crates/render/src/volume/raymarch/, one
+// Direct volume rendering: a transcription of crates/render/src/volume/dvr/, one
 // invocation per pixel. The volume is the CPU marcher's prepared field (value and world
 // gradient per voxel, crates/render/src/volume/march/) as an rgba32float 3D texture read with
 // textureLoad and interpolated here, as the CPU does, so the two agree sample for sample (a

@@ -126,32 +126,32 @@ impl ShaderCode {
 /// (`specula_targets`). The CLI's `shader --lang` and the Python package's `Lobe.shader` both
 /// list and write through it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Format {
+pub enum ExportFormat {
     /// A shading language, through naga.
     Naga(Language),
     /// A renderer's file: OSL, MaterialX, Mitsuba 3.
-    Renderer(specula_targets::Renderer),
+    Renderer(specula_targets::RendererFormat),
 }
 
-impl Format {
+impl ExportFormat {
     /// Every format, in the order `--help` lists them.
-    pub const ALL: [Format; 8] = [
-        Format::Naga(Language::Wgsl),
-        Format::Naga(Language::Glsl),
-        Format::Naga(Language::Hlsl),
-        Format::Naga(Language::Msl),
-        Format::Naga(Language::Spirv),
-        Format::Renderer(specula_targets::Renderer::Osl),
-        Format::Renderer(specula_targets::Renderer::MaterialX),
-        Format::Renderer(specula_targets::Renderer::Mitsuba),
+    pub const ALL: [ExportFormat; 8] = [
+        ExportFormat::Naga(Language::Wgsl),
+        ExportFormat::Naga(Language::Glsl),
+        ExportFormat::Naga(Language::Hlsl),
+        ExportFormat::Naga(Language::Msl),
+        ExportFormat::Naga(Language::Spirv),
+        ExportFormat::Renderer(specula_targets::RendererFormat::Osl),
+        ExportFormat::Renderer(specula_targets::RendererFormat::MaterialX),
+        ExportFormat::Renderer(specula_targets::RendererFormat::Mitsuba),
     ];
 
     /// The name on the command line.
     #[must_use]
     pub fn id(self) -> &'static str {
         match self {
-            Format::Naga(language) => language.id(),
-            Format::Renderer(renderer) => renderer.id(),
+            ExportFormat::Naga(language) => language.id(),
+            ExportFormat::Renderer(renderer) => renderer.id(),
         }
     }
 
@@ -169,10 +169,10 @@ impl Format {
         options: Options,
     ) -> Result<ShaderCode, String> {
         match self {
-            Format::Naga(language) => {
+            ExportFormat::Naga(language) => {
                 export(lobe, geometry, normalisation, language, options).map_err(|e| e.to_string())
             }
-            Format::Renderer(renderer) => renderer
+            ExportFormat::Renderer(renderer) => renderer
                 .write(lobe, geometry, normalisation)
                 .map(ShaderCode::Text),
         }

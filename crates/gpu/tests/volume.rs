@@ -9,9 +9,9 @@ use common::Parity;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use specula_gpu::{GpuRenderer, GpuVolumeRenderer};
 use specula_render::metrics::compare;
+use specula_render::volume::dvr::{render_dvr, DvrSettings, Shading, View};
 use specula_render::volume::isosurface::{iso_scene, marching_cubes, IsoSettings};
 use specula_render::volume::phantom;
-use specula_render::volume::raymarch::{render_dvr, DvrSettings, Shading, View};
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::{render, Display};
 

@@ -3,7 +3,7 @@
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use specula::{Geometry, Normalisation};
-use specula_gpu::export::{Format, GlslVersion, Options, ShaderCode};
+use specula_gpu::export::{ExportFormat, GlslVersion, Options, ShaderCode};
 
 use crate::errors::value_error;
 use crate::options::choose;
@@ -11,7 +11,7 @@ use crate::options::choose;
 /// The languages and formats :meth:`Lobe.shader` writes.
 #[pyfunction]
 pub fn languages() -> Vec<&'static str> {
-    Format::ALL.iter().map(|format| format.id()).collect()
+    ExportFormat::ALL.iter().map(|format| format.id()).collect()
 }
 
 /// `lobe`, shaded with `geometry` and `normalisation`, in `language`: a `str`, or `bytes` for
@@ -24,7 +24,7 @@ pub fn shader(
     glsl_version: &str,
     example: bool,
 ) -> PyResult<Py<PyAny>> {
-    let format = Format::parse(language).map_err(value_error)?;
+    let format = ExportFormat::parse(language).map_err(value_error)?;
     let glsl = choose(
         &GlslVersion::ALL,
         GlslVersion::id,

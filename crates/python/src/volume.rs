@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use numpy::ndarray::{Array2, ShapeBuilder};
 use numpy::{IntoPyArray, ToPyArray};
 use pyo3::prelude::*;
+use specula_render::volume::dvr::{render_dvr, DvrSettings, Shading, View};
 use specula_render::volume::phantom::BuiltIn;
-use specula_render::volume::raymarch::{render_dvr, DvrSettings, Shading, View};
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::{self, Units};
 

@@ -159,22 +159,22 @@ impl Image {
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
-enum Format {
+enum ImageFileFormat {
     Png,
     Exr,
     Hdr,
 }
 
-fn format_of(path: &Path) -> Result<Format, ImageError> {
+fn format_of(path: &Path) -> Result<ImageFileFormat, ImageError> {
     match path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .as_deref()
     {
-        Some("png") => Ok(Format::Png),
-        Some("exr") => Ok(Format::Exr),
-        Some("hdr") => Ok(Format::Hdr),
+        Some("png") => Ok(ImageFileFormat::Png),
+        Some("exr") => Ok(ImageFileFormat::Exr),
+        Some("hdr") => Ok(ImageFileFormat::Hdr),
         _ => Err(ImageError::UnknownFormat {
             path: path.display().to_string(),
         }),
@@ -189,7 +189,7 @@ pub fn check_output_path(path: &Path) -> Result<(), ImageError> {
 /// Whether `path` names a format that keeps linear radiance above 1 (EXR, HDR; not PNG's
 /// 8-bit display values), or why it names no format this module writes.
 pub fn is_linear_output(path: &Path) -> Result<bool, ImageError> {
-    format_of(path).map(|format| format != Format::Png)
+    format_of(path).map(|format| format != ImageFileFormat::Png)
 }
 
 /// Writes 8-bit sRGB bytes (three per pixel) as a PNG, atomically.
@@ -228,8 +228,10 @@ pub fn write_image(path: &Path, image: &Image, display: Display) -> Result<(), I
         Encoding, Image as ExrImage, Layer, LayerAttributes, SpecificChannels, WritableImage,
     };
     match format_of(path)? {
-        Format::Png => write_png_srgb8(path, image.width, image.height, &image.to_srgb8(display)),
-        Format::Exr => write_atomically(path, |writer| {
+        ImageFileFormat::Png => {
+            write_png_srgb8(path, image.width, image.height, &image.to_srgb8(display))
+        }
+        ImageFileFormat::Exr => write_atomically(path, |writer| {
             let layer = Layer::new(
                 (image.width as usize, image.height as usize),
                 LayerAttributes::named("radiance"),
@@ -244,7 +246,7 @@ pub fn write_image(path: &Path, image: &Image, display: Display) -> Result<(), I
                 .to_buffered(writer)
                 .map_err(|e| e.to_string())
         }),
-        Format::Hdr => write_atomically(path, |writer| {
+        ImageFileFormat::Hdr => write_atomically(path, |writer| {
             let finite = |v: f32| if v.is_finite() { v.max(0.0) } else { 0.0 };
             let pixels: Vec<image::Rgb<f32>> = image
                 .pixels()
@@ -283,7 +285,7 @@ pub fn read_image(path: &Path) -> Result<Image, ImageError> {
         }
     };
     match format {
-        Format::Png => {
+        ImageFileFormat::Png => {
             let reader = || {
                 image::ImageReader::with_format(
                     std::io::Cursor::new(bytes.as_slice()),
@@ -303,7 +305,7 @@ pub fn read_image(path: &Path) -> Result<Image, ImageError> {
             Image::from_srgb8(rgb.width(), rgb.height(), rgb.as_raw())
                 .ok_or_else(|| codec("inconsistent image size".into()))
         }
-        Format::Hdr => {
+        ImageFileFormat::Hdr => {
             let decoder =
                 image::codecs::hdr::HdrDecoder::new(std::io::Cursor::new(bytes.as_slice()))
                     .map_err(|e| codec(e.to_string()))?;
@@ -319,7 +321,7 @@ pub fn read_image(path: &Path) -> Result<Image, ImageError> {
             Image::from_pixels(decoded.width(), decoded.height(), pixels)
                 .ok_or_else(|| codec("inconsistent image size".into()))
         }
-        Format::Exr => {
+        ImageFileFormat::Exr => {
             use exr::prelude::{ReadChannels as _, ReadLayers as _};
             let meta = exr::meta::MetaData::read_from_buffered(
                 std::io::Cursor::new(bytes.as_slice()),

@@ -34,7 +34,7 @@ mod material;
 pub mod measured;
 mod mesh;
 pub mod metrics;
-mod mitsuba;
+mod mitsuba_scene;
 mod output;
 mod phong;
 mod pipeline;
@@ -59,7 +59,7 @@ pub use image_error::ImageError;
 pub use load::{load_mesh, parse_mesh, LoadError, LoadedMesh, MeshFormat, MESH_EXTENSIONS};
 pub use material::{IlluminationModel, Light, Material, Shader, Shading};
 pub use mesh::{Mesh, MeshError};
-pub use mitsuba::write_mitsuba_scene;
+pub use mitsuba_scene::write_mitsuba_scene;
 pub use output::{write_atomically, SeekWrite};
 pub use pipeline::{
     overdraw, render, surfaces, RenderError, SurfacePoint, MAX_PIXELS, MAX_SAMPLES,

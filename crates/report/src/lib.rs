@@ -17,9 +17,9 @@ mod hardware;
 mod html;
 mod materials;
 mod medical;
+mod other_renderers;
 mod plot;
 mod real_scans;
-mod renderers;
 mod renders;
 mod sections;
 mod verdict;
@@ -292,7 +292,7 @@ const SECTIONS: [Section; 14] = [
     (RENDERS, renders::renders),
     ("Real materials", materials::materials),
     (VOLUMES, volumes::volumes),
-    ("Into other renderers", renderers::renderers),
+    ("Into other renderers", other_renderers::other_renderers),
     (sections::COST, sections::cost),
     (HARDWARE, hardware::hardware),
 ];

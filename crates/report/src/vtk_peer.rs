@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
+use specula_render::volume::dvr::{render_dvr_prepared, DvrSettings};
 use specula_render::volume::march::PreparedVolume;
-use specula_render::volume::raymarch::{render_dvr_prepared, DvrSettings};
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::{self, nifti, vtk, Volume};
 use specula_render::Image;

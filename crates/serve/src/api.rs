@@ -35,7 +35,7 @@ use specula::analysis::{analyze, Precision};
 use specula::formula::MAX_SOURCE_BYTES;
 use specula::measured::fit::POLAR_ANGLES_DEGREES;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-use specula_render::volume::raymarch::View;
+use specula_render::volume::dvr::View;
 use specula_render::{IlluminationModel, Shading};
 
 use crate::query::{bad_lobe, pairs, ApiError, Params, QueryPairs};

@@ -17,9 +17,9 @@ use std::path::Path;
 use std::sync::{Mutex, OnceLock, PoisonError};
 
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
+use specula_render::volume::dvr::{render_dvr_prepared, DvrSettings, Shading, View};
 use specula_render::volume::march::PreparedVolume;
 use specula_render::volume::phantom::BuiltIn;
-use specula_render::volume::raymarch::{render_dvr_prepared, DvrSettings, Shading, View};
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::Volume;
 use specula_render::Display;

@@ -20,7 +20,7 @@ use specula::{Geometry, Lobe, Normalisation};
 
 /// A renderer's own format, written from a lobe's description.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Renderer {
+pub enum RendererFormat {
     /// An OSL script node for Blender Cycles.
     Osl,
     /// A MaterialX document: the lobe as a node, and a BSDF.
@@ -29,17 +29,21 @@ pub enum Renderer {
     Mitsuba,
 }
 
-impl Renderer {
+impl RendererFormat {
     /// Every renderer format.
-    pub const ALL: [Renderer; 3] = [Renderer::Osl, Renderer::MaterialX, Renderer::Mitsuba];
+    pub const ALL: [RendererFormat; 3] = [
+        RendererFormat::Osl,
+        RendererFormat::MaterialX,
+        RendererFormat::Mitsuba,
+    ];
 
     /// The name on the command line.
     #[must_use]
     pub fn id(self) -> &'static str {
         match self {
-            Renderer::Osl => "osl",
-            Renderer::MaterialX => "mtlx",
-            Renderer::Mitsuba => "mitsuba",
+            RendererFormat::Osl => "osl",
+            RendererFormat::MaterialX => "mtlx",
+            RendererFormat::Mitsuba => "mitsuba",
         }
     }
 
@@ -54,13 +58,13 @@ impl Renderer {
     ) -> Result<String, String> {
         let fit = || specula::fit::microfacet(lobe, geometry);
         match self {
-            Renderer::Osl if normalisation != Normalisation::None => Err(format!(
+            RendererFormat::Osl if normalisation != Normalisation::None => Err(format!(
                 "--lang osl takes no --normalisation (given {}): its Emission is the thesis's specular term, which has none, and its BSDF is GGX, normalised by construction; leave it out, or use --lang mtlx or mitsuba",
                 normalisation.id()
             )),
-            Renderer::Osl => Ok(osl::shader(lobe, geometry, &fit())),
-            Renderer::MaterialX => Ok(materialx::document(lobe, geometry, normalisation, &fit())),
-            Renderer::Mitsuba => Ok(mitsuba::plugin(lobe, geometry, normalisation)),
+            RendererFormat::Osl => Ok(osl::shader(lobe, geometry, &fit())),
+            RendererFormat::MaterialX => Ok(materialx::document(lobe, geometry, normalisation, &fit())),
+            RendererFormat::Mitsuba => Ok(mitsuba::plugin(lobe, geometry, normalisation)),
         }
     }
 }

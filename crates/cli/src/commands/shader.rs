@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-use specula_gpu::export::{Format, GlslVersion, Language, Options, ShaderCode};
+use specula_gpu::export::{ExportFormat, GlslVersion, Language, Options, ShaderCode};
 
 use super::CommandResult;
 use crate::args::{choice, parse_exponent, LobeParser};
@@ -27,8 +27,8 @@ pub struct Args {
     /// The shading language: wgsl, glsl, hlsl, msl, spirv (a function for one's own
     /// shader), osl (a Blender Cycles script node), mtlx (a MaterialX
     /// document) or mitsuba (a Mitsuba 3 BSDF plugin in Python).
-    #[arg(long, value_parser = choice(&Format::ALL, Format::id))]
-    lang: Format,
+    #[arg(long, value_parser = choice(&ExportFormat::ALL, ExportFormat::id))]
+    lang: ExportFormat,
     /// The GLSL dialect (with --lang glsl): 450 (Vulkan, OpenGL 4.5), 300es (OpenGL ES 3,
     /// WebGL 2) or 100 (OpenGL ES 2, WebGL 1; lobes that read a float's bits are refused).
     #[arg(long, value_parser = choice(&GlslVersion::ALL, GlslVersion::id), default_value = "450")]
@@ -44,7 +44,7 @@ pub struct Args {
 
 /// Exports and writes.
 pub fn run(args: &Args) -> CommandResult {
-    if args.lang == Format::Naga(Language::Spirv) && args.output.is_none() {
+    if args.lang == ExportFormat::Naga(Language::Spirv) && args.output.is_none() {
         return Err("SPIR-V is binary; give an output file with -o (e.g. -o lobe.spv)".into());
     }
     let lobe = Lobe::checked(args.lobe, args.n).map_err(|e| e.to_string())?;

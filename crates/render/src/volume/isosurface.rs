@@ -21,7 +21,7 @@ use std::sync::OnceLock;
 
 use glam::Vec3;
 
-use super::raymarch::{surface_camera, Shading, View};
+use super::dvr::{surface_camera, Shading, View};
 use super::{Volume, VolumeError};
 use crate::image::Image;
 use crate::{IlluminationModel, Light, Material, Mesh, Object, Scene, Settings};

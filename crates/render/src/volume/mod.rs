@@ -13,7 +13,7 @@
 //! - [`march`]: what makes the CPU ray marcher fast without changing what it computes;
 //! - [`vtk`]: VTK's CPU ray caster set up as specula's, the yardstick;
 //! - [`transfer`]: transfer functions (extinction and colour by value) and their presets;
-//! - [`raymarch`]: direct volume rendering with any lobe as the specular term.
+//! - [`dvr`]: direct volume rendering with any lobe as the specular term.
 
 use std::path::Path;
 
@@ -23,12 +23,12 @@ use thiserror::Error;
 pub use samples::{Sample, Samples};
 
 pub mod dicom;
+pub mod dvr;
 pub mod invesalius;
 pub mod isosurface;
 pub mod march;
 pub mod nifti;
 pub mod phantom;
-pub mod raymarch;
 mod resample;
 mod samples;
 pub mod transfer;

@@ -19,7 +19,7 @@ use glam::Vec3;
 use serde::Serialize;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 
-use super::raymarch::{DvrPlan, DvrSettings, Light, Shading, View};
+use super::dvr::{DvrPlan, DvrSettings, Light, Shading, View};
 use super::transfer::TransferFunction;
 use super::{Volume, VolumeError};
 

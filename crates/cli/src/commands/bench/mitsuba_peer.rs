@@ -8,7 +8,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-use specula_gpu::export::{Format, Options};
+use specula_gpu::export::{ExportFormat, Options};
 use specula_render::{read_image, write_mitsuba_scene, Image, Scene};
 use specula_report::vtk_peer::{self, median};
 
@@ -37,7 +37,7 @@ pub(super) fn time_mitsuba(
     threads: usize,
 ) -> Result<MitsubaRun, String> {
     let material = &scene.objects[0].material;
-    let plugin = Format::parse("mitsuba")?
+    let plugin = ExportFormat::parse("mitsuba")?
         .write(
             &material.lobe,
             material.geometry,

@@ -71,8 +71,8 @@ pub struct Args {
     #[arg(long)]
     transfer: Option<String>,
     /// The view of `bench volume` (anterior, posterior, left, right, superior, inferior).
-    #[arg(long, value_parser = specula_render::volume::raymarch::View::parse, default_value = "anterior")]
-    view: specula_render::volume::raymarch::View,
+    #[arg(long, value_parser = specula_render::volume::dvr::View::parse, default_value = "anterior")]
+    view: specula_render::volume::dvr::View,
     /// Millimetres between samples along a ray (`bench volume`; VTK's sample distance).
     #[arg(long, default_value_t = 0.5, value_parser = parse_distance)]
     sample_distance: f32,

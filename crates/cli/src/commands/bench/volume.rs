@@ -5,8 +5,8 @@
 use std::path::Path;
 use std::time::Instant;
 
+use specula_render::volume::dvr::render_dvr_prepared;
 use specula_render::volume::march::PreparedVolume;
-use specula_render::volume::raymarch::render_dvr_prepared;
 use specula_render::volume::transfer::TransferFunction;
 use specula_render::volume::vtk;
 use specula_render::{write_image, Display};

@@ -3,8 +3,8 @@
 
 use super::tests::padded_head;
 use super::*;
+use crate::volume::dvr::{render_dvr_prepared, DvrSettings, Shading, View};
 use crate::volume::phantom::BuiltIn;
-use crate::volume::raymarch::{render_dvr_prepared, DvrSettings, Shading, View};
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 
 /// `count` points of the unit cube spread evenly by three irrational steps.

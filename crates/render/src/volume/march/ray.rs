@@ -23,7 +23,7 @@ use glam::{IVec3, Vec3};
 use specula::simd::{dispatch, exp2_nonpositive, Job, Lanes, Level, Prefetch};
 
 use super::{Classification, PreparedVolume};
-use crate::volume::raymarch::lighting::{LanesView, Lighting, RayView};
+use crate::volume::dvr::lighting::{LanesView, Lighting, RayView};
 
 /// One ray's march, in grid units: `origin + direction * t` for `t` (mm) in `[start, end]`.
 #[derive(Clone, Copy, Debug)]

@@ -1,10 +1,10 @@
 use super::ray::{march_rays, Highlight, Lit, Marched, Ray};
 use super::*;
-use crate::volume::phantom::BuiltIn;
-use crate::volume::raymarch::{
+use crate::volume::dvr::{
     inside_grid, pixel_jitter, render_dvr, DvrPlan, DvrSettings, Light, Lighting, RayView, Shading,
     View,
 };
+use crate::volume::phantom::BuiltIn;
 use specula::simd::Level;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 
@@ -501,7 +501,7 @@ fn lobes_marched_together_are_each_marched_alone() {
     ] {
         let shading = Shading::new(lobes[0], geometry, normalisation);
         let settings = DvrSettings::new(36, 28, view, Some(shading));
-        let together = crate::volume::raymarch::render_dvr_lobes(
+        let together = crate::volume::dvr::render_dvr_lobes(
             &volume,
             &prepared,
             &transfer,
@@ -531,7 +531,7 @@ fn lobes_marched_together_are_each_marched_alone() {
         );
     }
     let unshaded = DvrSettings::new(8, 8, View::Anterior, None);
-    let refused = crate::volume::raymarch::render_dvr_lobes(
+    let refused = crate::volume::dvr::render_dvr_lobes(
         &volume,
         &prepared,
         &transfer,

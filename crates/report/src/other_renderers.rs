@@ -29,7 +29,7 @@ fn bit_exact(lobe: &Lobe, expression: &Expression, cosines: &[f32]) -> (usize, u
     (same(expression), same(&lowered))
 }
 
-pub fn renderers(context: &mut Context) -> Result<String, String> {
+pub fn other_renderers(context: &mut Context) -> Result<String, String> {
     let cosines: Vec<f32> = (1..=20_000).map(|k| k as f32 / 20_000.0).collect();
     let lobe = |kind: LobeKind, n: f64| Lobe::try_new(kind, n).map_err(|e| e.to_string());
     let description = context
