@@ -29,25 +29,31 @@ enum Command {
     /// Which lobe to ship on a target at an accuracy: ranked by cost, with the Pareto front.
     #[command(
         after_help = "Examples:\n  specula recommend --target gpu-nvidia --n 64 --max-error 1%\n  \
-                            specula recommend --target cpu --n 8..512 --max-error 0.5% --zone epicentre\n  \
-                            specula recommend --target gpu-amd --n 64 --max-error 2% --zone whole --energy-conserving --format json\n  \
-                            specula recommend --material paper_white_rgb.bsdf --target gpu-nvidia --margin 5%"
+                            specula recommend --target cpu --n 8..512 --max-error 0.5% --zone \
+                            epicentre\n  \
+                            specula recommend --target gpu-amd --n 64 --max-error 2% --zone whole \
+                            --energy-conserving --format json\n  \
+                            specula recommend --material paper_white_rgb.bsdf --target gpu-nvidia \
+                            --margin 5%"
     )]
     Recommend(commands::recommend::Args),
     /// Design the cheapest lobe for a target, a range of n and an accuracy: families the
     /// formula language writes, fitted across the range, verified by the analysis, costed as
     /// recommend costs, written as a lobe file.
     #[command(
-        after_help = "Examples:\n  specula design --target gpu-nvidia --n 8..512 --max-error 0.1% -o designed.toml\n  \
+        after_help = "Examples:\n  specula design --target gpu-nvidia --n 8..512 --max-error 0.1% \
+            -o designed.toml\n  \
                             specula design --target cpu --n 8..512 --max-error 0.1%\n  \
-                            specula design --target gpu-amd --n 64 --max-error 1% --energy-tolerance 0.5% --no-transcendentals"
+                            specula design --target gpu-amd --n 64 --max-error 1% \
+                            --energy-tolerance 0.5% --no-transcendentals"
     )]
     Design(commands::design::Args),
     /// Fit every lobe (and GGX) to measured materials (RGL isotropic RGB `.bsdf` files): the
     /// parameters, the fit errors against pow's and GGX's, the energy, and the lobe to ship.
     #[command(
         after_help = "Examples:\n  specula fit --material paper_white_rgb.bsdf\n  \
-                            specula fit --material a.bsdf b.bsdf --target cpu --margin 2% --format json >> fits.jsonl\n  \
+                            specula fit --material a.bsdf b.bsdf --target cpu --margin 2% --format \
+                            json >> fits.jsonl\n  \
                             specula recommend --material paper_white_rgb.bsdf --target gpu-nvidia"
     )]
     Fit(commands::fit::Args),
@@ -74,14 +80,17 @@ enum Command {
     Claims(commands::claims::Args),
     /// Write the report: models, shapes, errors, energy, claims, renders, cost (HTML + images).
     #[command(
-        after_help = "Examples:\n  specula report\n  specula report --quick --out /tmp/report\n  specula report --bench"
+        after_help = "Examples:\n  specula report\n  specula report --quick --out /tmp/report\n  \
+            specula report --bench"
     )]
     Report(commands::report::Args),
-    /// Render a scene (TOML, or the embedded default) to PNG, EXR or HDR, lit by its lights or by an environment map.
+    /// Render a scene (TOML, or the embedded default) to PNG, EXR or HDR, lit by its lights or by
+    /// an environment map.
     #[command(after_help = "Examples:\n  specula render -o out.png\n  \
                             specula render scene.toml --lobe schlick-mod --n 256 -o out.exr\n  \
                             specula render --shading gouraud --width 640 --height 360\n  \
-                            specula render --grid lobes=pow,schlick,schlick-mod,cheb2,logexp -o grid.png\n  \
+                            specula render --grid lobes=pow,schlick,schlick-mod,cheb2,logexp -o \
+                            grid.png\n  \
                             specula render --env sky --spp 64 -o sky.png\n  \
                             specula render scene.toml --env studio.hdr --spp 256 -o lit.exr\n  \
                             specula render --dump-default-scene > my-scene.toml")]
@@ -94,43 +103,56 @@ enum Command {
     /// MaterialX or Mitsuba 3 file.
     #[command(
         after_help = "Examples:\n  specula shader --lobe schlick-mod --n 64 --lang glsl\n  \
-                            specula shader --lobe cosquad --n 100 --geometry blinn --normalisation lobe --lang hlsl -o lobe.hlsl\n  \
+                            specula shader --lobe cosquad --n 100 --geometry blinn --normalisation \
+                            lobe --lang hlsl -o lobe.hlsl\n  \
                             specula shader --lobe cheb2 --n 32 --lang spirv -o lobe.spv\n  \
-                            specula shader --lobe cosquad --n 64 --lang osl -o specula_cosquad.osl\n  \
-                            specula shader --lobe cosquad --n 64 --lang mtlx -o specula_cosquad.mtlx\n  \
-                            specula shader --lobe cosquad --n 64 --normalisation lobe --lang mitsuba -o specula_cosquad.py"
+                            specula shader --lobe cosquad --n 64 --lang osl -o \
+                            specula_cosquad.osl\n  \
+                            specula shader --lobe cosquad --n 64 --lang mtlx -o \
+                            specula_cosquad.mtlx\n  \
+                            specula shader --lobe cosquad --n 64 --normalisation lobe --lang \
+                            mitsuba -o specula_cosquad.py"
     )]
     Shader(commands::shader::Args),
     /// Measure throughput (printed figures and ratios, not pass/fail).
     #[command(
-        after_help = "Examples:\n  specula bench render\n  specula bench gpu\n  specula bench render --width 640 --height 360 --frames 3"
+        after_help = "Examples:\n  specula bench render\n  specula bench gpu\n  specula bench \
+            render --width 640 --height 360 --frames 3"
     )]
     Bench(commands::bench::Args),
     /// Hardware datapaths: error against word length and resources, Verilog, block diagrams,
     /// synthesis.
     #[command(
-        after_help = "Datapaths (--lobe): schlick, schlick-mod, cheb2, logexp, logexp-mitchell, cosquad, pow, sg\n\
+        after_help = "Datapaths (--lobe): schlick, schlick-mod, cheb2, logexp, logexp-mitchell, \
+            cosquad, pow, sg\n\
                       Word lengths (--bits): 8 to 24 bits; n: an integer in [1, 1000]\n\n\
                       Examples:\n  specula hw table --lobe cosquad,logexp --bits 8..24 --n 64\n  \
-                            specula hw verilog --lobe cosquad --bits 16 -o cosquad.v --testbench cosquad_tb.v\n  \
+                            specula hw verilog --lobe cosquad --bits 16 -o cosquad.v --testbench \
+                            cosquad_tb.v\n  \
                             specula hw diagram --lobe logexp -o logexp.svg\n  \
-                            specula hw synth --target ice40 --device hx8k --bits 12 --lobe cosquad,pow,sg"
+                            specula hw synth --target ice40 --device hx8k --bits 12 --lobe \
+                            cosquad,pow,sg"
     )]
     Hw(commands::hw::Args),
     /// Render a volume (the Shepp-Logan head, Marschner-Lobb, NIfTI, a DICOM series) by ray
     /// marching or as an isosurface, any lobe as its specular term, on the CPU or GPU.
     #[command(
-        after_help = "Examples:\n  specula volume --input phantom --mode dvr --lobe cosquad -o head.png\n  \
-                            specula volume --input head.nii.gz --mode iso --iso 0.5 --backend gpu -o skull.png\n  \
-                            specula volume --input ct-series/ --transfer ct-bone --view axial -o ct.png\n  \
-                            specula volume --input marschner-lobb --size 64 --eye 400,-300,200 -o ml.png"
+        after_help = "Examples:\n  specula volume --input phantom --mode dvr --lobe cosquad -o \
+            head.png\n  \
+                            specula volume --input head.nii.gz --mode iso --iso 0.5 --backend gpu \
+                            -o skull.png\n  \
+                            specula volume --input ct-series/ --transfer ct-bone --view axial -o \
+                            ct.png\n  \
+                            specula volume --input marschner-lobb --size 64 --eye 400,-300,200 -o \
+                            ml.png"
     )]
     Volume(commands::volume::Args),
     /// Draw directions from a lobe's importance sampler (wi and pdf per line), or run the
     /// chi-square suite over every lobe.
     #[command(
         after_help = "Examples:\n  specula sample --lobe cosquad --n 64 --theta-o 30 --count 5\n  \
-                            specula sample --lobe schlick --n 8 --form blinn --format json --count 3\n  \
+                            specula sample --lobe schlick --n 8 --form blinn --format json --count \
+                            3\n  \
                             specula sample --test\n  \
                             specula sample --test --lobe sg --n 512 --theta-o 70 --images chi2/"
     )]
@@ -140,12 +162,14 @@ enum Command {
         after_help = "Examples:\n  specula volume-convert --input phantom -o head.nii.gz\n  \
                             specula volume-convert --input phantom -o head-dicom\n  \
                             specula volume-convert --input ct-series/ -o ct.nii.gz\n  \
-                            specula volume-convert --input Cranium.inv3 --resample 512x512x432 -o clinical-ct.nii"
+                            specula volume-convert --input Cranium.inv3 --resample 512x512x432 -o \
+                            clinical-ct.nii"
     )]
     VolumeConvert(commands::volume::ConvertArgs),
     /// Write the built-in sky (`--env sky`) as an EXR or HDR map, for other renderers.
     #[command(
-        after_help = "Examples:\n  specula sky -o sky.exr\n  specula sky --width 2048 -o sky.hdr\n\n\
+        after_help = "Examples:\n  specula sky -o sky.exr\n  specula sky --width 2048 -o \
+            sky.hdr\n\n\
                       The map is equirectangular with world z up: row y covers polar angles \
                       pi y / H to pi (y + 1) / H from the zenith; column x looks along azimuth \
                       3 pi / 2 - 2 pi (x + 0.5) / W, so the middle column looks along +y."
@@ -153,7 +177,8 @@ enum Command {
     Sky(commands::sky::Args),
     /// Serve the interactive BRDF explorer (page and JSON API) on 127.0.0.1.
     #[command(
-        after_help = "Examples:\n  specula serve --open\n  specula serve --port 9000\n  specula serve --port 0   # a free port, printed"
+        after_help = "Examples:\n  specula serve --open\n  specula serve --port 9000\n  specula \
+            serve --port 0   # a free port, printed"
     )]
     Serve(commands::serve::Args),
 }

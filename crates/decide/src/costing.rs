@@ -203,7 +203,9 @@ fn synthesized_rate(synthesis: &specula_synth::Synthesis) -> (f64, Option<&'stat
 }
 
 /// Why a material's verdict refuses the FPGA.
-pub const FPGA_MATERIAL_REFUSAL: &str = "a material verdict cannot target fpga: the fixed-point datapaths take an integer n and a word length chosen for an error against t^n, which a material's fit does not give; valid targets: cpu, gpu-nvidia, gpu-amd";
+pub const FPGA_MATERIAL_REFUSAL: &str = "a material verdict cannot target fpga: the fixed-point \
+    datapaths take an integer n and a word length chosen for an error against t^n, which a \
+    material's fit does not give; valid targets: cpu, gpu-nvidia, gpu-amd";
 
 /// `lobe`'s evaluations per clock per multiprocessor on `family`, by the GPU cost model over
 /// the instructions of its exported shader (higher is cheaper).

@@ -155,7 +155,8 @@ pub fn assess(
         file: path.display().to_string(),
         description: material.description().to_owned(),
         error_measure: format!(
-            "RMS over solid-angle-weighted direction pairs (theta <= {MAX_ELEVATION_DEGREES} deg) and channels of cbrt(f cos theta_i)"
+            "RMS over solid-angle-weighted direction pairs (theta <= {MAX_ELEVATION_DEGREES} deg) \
+                and channels of cbrt(f cos theta_i)"
         ),
         pairs: observations.len(),
         measured_albedo_at_normal: measured.to_array(),
@@ -212,7 +213,8 @@ pub fn verdict_line(a: &Assessment) -> String {
     let chosen = &a.fits[a.chosen];
     let pow_rate = pow_rate(a);
     format!(
-        "{}, n = {}: the cheapest lobe on {} whose fit is within {} % of pow's (E = {:.4}, {:.3}x pow's best; {:.2}x pow's throughput)",
+        "{}, n = {}: the cheapest lobe on {} whose fit is within {} % of pow's (E = {:.4}, {:.3}x \
+            pow's best; {:.2}x pow's throughput)",
         chosen.fit.specular.label(),
         parameter_text(&chosen.fit),
         a.target,

@@ -8,7 +8,10 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum GpuError {
     /// wgpu found no adapter at all.
-    #[error("no GPU adapter found ({0}); on a machine without a GPU install Mesa's lavapipe (Debian/Ubuntu: apt-get install mesa-vulkan-drivers), or use the CPU backend")]
+    #[error(
+        "no GPU adapter found ({0}); on a machine without a GPU install Mesa's lavapipe \
+        (Debian/Ubuntu: apt-get install mesa-vulkan-drivers), or use the CPU backend"
+    )]
     NoAdapter(String),
     /// The adapter refused a device.
     #[error("the GPU adapter {adapter} refused a device: {message}")]
@@ -66,7 +69,8 @@ impl Gpu {
         })
     }
 
-    /// The adapter's name and driver, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Mesa 22.3.6)`.
+    /// The adapter's name and driver, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Mesa
+    /// 22.3.6)`.
     #[must_use]
     pub fn adapter_name(&self) -> String {
         let info = &self.info;

@@ -342,7 +342,8 @@ pub fn export(
                 text = es100::from_es300(&text).map_err(|construct| ExportError {
                     language: "GLSL ES 1.00",
                     message: format!(
-                        "{} uses {construct}, which GLSL ES 1.00 lacks; use --glsl-version 300es (WebGL 2) or 450, or a lobe without bit operations",
+                        "{} uses {construct}, which GLSL ES 1.00 lacks; use --glsl-version 300es \
+                            (WebGL 2) or 450, or a lobe without bit operations",
                         lobe.kind()
                     ),
                 })?;

@@ -193,7 +193,8 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
         let side = dims.iter().copied().max().unwrap_or(0);
         if side > limits.max_texture_dimension_3d as usize {
             return Err(GpuError::Unsupported(format!(
-                "a volume {side} voxels wide; this GPU's 3D textures hold at most {} per side (use --backend cpu)",
+                "a volume {side} voxels wide; this GPU's 3D textures hold at most {} per side (use \
+                    --backend cpu)",
                 limits.max_texture_dimension_3d
             )));
         }
@@ -203,7 +204,8 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
         let output_bytes = image_bytes * images as u64;
         if output_bytes > limits.max_storage_buffer_binding_size {
             return Err(GpuError::Unsupported(format!(
-                "{images} image(s) of {width} x {height} need {output_bytes} bytes; this GPU binds at most {} (use --backend cpu or a smaller image)",
+                "{images} image(s) of {width} x {height} need {output_bytes} bytes; this GPU binds \
+                    at most {} (use --backend cpu or a smaller image)",
                 limits.max_storage_buffer_binding_size
             )));
         }

@@ -78,7 +78,8 @@ fn every_lobe_on_the_gpu_matches_f64_within_its_bound() {
                 }
                 assert!(
                     error <= bound,
-                    "{kind} n = {n} t = {t:e}: gpu {value:e}, f64 {reference:e}, error {:.0} ULP > {:.0}",
+                    "{kind} n = {n} t = {t:e}: gpu {value:e}, f64 {reference:e}, error {:.0} ULP > \
+                        {:.0}",
                     error / ULP,
                     bound / ULP
                 );

@@ -46,8 +46,10 @@ pub fn svg(datapath: &Datapath, title: &str) -> String {
     let mut v = String::new();
     let _ = writeln!(
         v,
-        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" font-family="sans-serif" font-size="12">
-<defs><marker id="arrow" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="7" markerHeight="7" orient="auto"><path d="M0,0 L10,5 L0,10 z" fill="#555"/></marker></defs>
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}"
+ viewBox="0 0 {width} {height}" font-family="sans-serif" font-size="12">
+<defs><marker id="arrow" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="7" markerHeight="7"
+ orient="auto"><path d="M0,0 L10,5 L0,10 z" fill="#555"/></marker></defs>
 <rect width="100%" height="100%" fill="white"/>
 <text x="{MARGIN}" y="{}" font-size="15" font-weight="bold">{}</text>"##,
         MARGIN + 8.0,
@@ -98,7 +100,8 @@ pub fn svg(datapath: &Datapath, title: &str) -> String {
             };
             let _ = writeln!(
                 v,
-                r##"<line x1="{x1}" y1="{y1}" x2="{x2}" y2="{y2}" stroke="#555" marker-end="url(#arrow)"/>"##
+                r##"<line x1="{x1}" y1="{y1}" x2="{x2}" y2="{y2}" stroke="#555"
+ marker-end="url(#arrow)"/>"##
             );
         }
         if matches!(node.op, Op::Const(_)) {
@@ -120,7 +123,8 @@ pub fn svg(datapath: &Datapath, title: &str) -> String {
         let stroke = if output { "#c0392b" } else { "#333" };
         let _ = writeln!(
             v,
-            r##"<rect x="{x}" y="{y}" width="{BOX_WIDTH}" height="{BOX_HEIGHT}" rx="6" fill="{fill}" stroke="{stroke}"{dashed}/>
+            r##"<rect x="{x}" y="{y}" width="{BOX_WIDTH}" height="{BOX_HEIGHT}" rx="6" fill="{fill}"
+ stroke="{stroke}"{dashed}/>
 <text x="{}" y="{}" font-weight="bold">{} <tspan font-weight="normal" fill="#666">{}</tspan></text>
 <text x="{}" y="{}">{}</text>"##,
             x + 8.0,

@@ -77,7 +77,11 @@ impl Serialize for HwLobe {
 #[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum HwError {
     /// Not a datapath id.
-    #[error("unknown hardware datapath `{0}`; valid: {valid}{hint}", valid = HwLobe::valid_ids(), hint = specula::did_you_mean(.0, HwLobe::ALL.map(HwLobe::id)))]
+    #[error(
+        "unknown hardware datapath `{0}`; valid: {valid}{hint}",
+        valid = HwLobe::valid_ids(),
+        hint = specula::did_you_mean(.0, HwLobe::ALL.map(HwLobe::id))
+    )]
     UnknownLobe(String),
     /// A user's lobe (a lobe file or a formula): no datapath is generated from a formula.
     #[error(

@@ -67,7 +67,12 @@ pub fn analyze_json(
 /// --format json`` (without the hardware claim, which synthesizes); each option the CLI's
 /// default where ``None``.
 #[pyfunction]
-#[pyo3(signature = (exponent_steps = None, samples_per_zone = None, reciprocity_pairs = None, seed = None))]
+#[pyo3(signature = (
+    exponent_steps = None,
+    samples_per_zone = None,
+    reciprocity_pairs = None,
+    seed = None
+))]
 pub fn claims_json(
     py: Python<'_>,
     exponent_steps: Option<i64>,

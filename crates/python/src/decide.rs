@@ -54,7 +54,15 @@ pub fn recommend_json(
 /// `specula design --format json`'s answer (every designed lobe, the built-ins beside them,
 /// the verdict), with the cheapest designed lobe's file text as `toml` (or `null`).
 #[pyfunction]
-#[pyo3(signature = (target, n, max_error, max_whole_error, energy_tolerance, no_transcendentals, extra_lobes))]
+#[pyo3(signature = (
+    target,
+    n,
+    max_error,
+    max_whole_error,
+    energy_tolerance,
+    no_transcendentals,
+    extra_lobes
+))]
 #[allow(clippy::too_many_arguments)] // one per keyword of `specula.design`
 pub fn design_json(
     py: Python<'_>,

@@ -131,7 +131,8 @@ fn directions(flat: &[f64], name: &str) -> PyResult<Vec<DVec3>> {
         .map(|(row, v)| {
             DVec3::new(v[0], v[1], v[2]).try_normalize().ok_or_else(|| {
                 value_error(format!(
-                    "{name}[{row}] has zero length; directions must be non-zero (they are normalised)"
+                    "{name}[{row}] has zero length; directions must be non-zero (they are \
+                        normalised)"
                 ))
             })
         })

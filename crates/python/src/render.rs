@@ -98,7 +98,8 @@ pub fn render(
         let seed = arrays::seed(seed)?;
         if environment.is_some() && (shading.is_some() || model.is_some()) {
             return Err(value_error(
-                "shading and model do not apply under an environment (it is path traced); drop them",
+                "shading and model do not apply under an environment (it is path traced); drop \
+                    them",
             ));
         }
         let loaded =

@@ -65,7 +65,8 @@ impl Camera {
         }
         if !(in_scene_range(eye) && in_scene_range(target)) {
             return fail(&format!(
-                "eye and target must lie within {MAX_COORDINATE:e} scene units of the origin in each coordinate (squared distances must stay finite in f32)"
+                "eye and target must lie within {MAX_COORDINATE:e} scene units of the origin in \
+                    each coordinate (squared distances must stay finite in f32)"
             ));
         }
         let Some(forward) = (target - eye).try_normalize() else {

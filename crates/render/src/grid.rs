@@ -31,7 +31,11 @@ pub enum GridError {
     #[error("{0}")]
     Render(String),
     /// The grid would exceed the renderer's pixel limit.
-    #[error("a grid of {lobes} lobes at {width}x{height} is {pixels} pixels (two rows of renders and FLIP maps), above the limit of {MAX_PIXELS}; use fewer lobes or a smaller --width/--height")]
+    #[error(
+        "a grid of {lobes} lobes at {width}x{height} is {pixels} pixels (two rows of renders \
+        and FLIP maps), above the limit of {MAX_PIXELS}; use fewer lobes or a smaller \
+        --width/--height"
+    )]
     TooLarge {
         /// Lobes asked for.
         lobes: usize,

@@ -278,7 +278,8 @@ pub fn read_image(path: &Path) -> Result<Image, ImageError> {
     let check = |width: u64, height: u64| {
         if width * height > MAX_IMAGE_PIXELS {
             Err(codec(format!(
-                "declares {width}x{height} pixels, above the limit of {MAX_IMAGE_PIXELS} (4096 x 4096)"
+                "declares {width}x{height} pixels, above the limit of {MAX_IMAGE_PIXELS} (4096 x \
+                    4096)"
             )))
         } else {
             Ok(())

@@ -8,7 +8,10 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum ImageError {
     /// The extension is none of `.png`, `.exr` and `.hdr`.
-    #[error("{path}: unknown image format; use a file name ending in .png (8-bit sRGB), .exr (linear f32) or .hdr (Radiance RGBE)")]
+    #[error(
+        "{path}: unknown image format; use a file name ending in .png (8-bit sRGB), .exr \
+        (linear f32) or .hdr (Radiance RGBE)"
+    )]
     UnknownFormat {
         /// The path.
         path: String,

@@ -77,7 +77,8 @@ fn open_within(path: &Path, limit: u64) -> Result<std::fs::File, String> {
 
 fn too_large(bytes: u64, limit: u64) -> String {
     format!(
-        "is {bytes} bytes, above the input limit of {limit} bytes ({} MiB; raise it with --max-input-mib)",
+        "is {bytes} bytes, above the input limit of {limit} bytes ({} MiB; raise it with \
+            --max-input-mib)",
         limit >> 20
     )
 }

@@ -143,7 +143,8 @@ mod tests {
         let path = dir.path().join("sharp.toml");
         std::fs::write(
             &path,
-            "name = \"file-sharp\"\nformula = \"t ^ (n * k)\"\n[parameters.k]\ndefault = 1\nmin = 1\nmax = 4\n",
+            "name = \"file-sharp\"\nformula = \"t ^ (n * k)\"\n[parameters.k]\ndefault = 1\nmin = \
+                1\nmax = 4\n",
         )
         .unwrap();
         let kind = parse_lobe("@sharp.toml:k=2", Some(dir.path())).unwrap();
@@ -163,7 +164,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(
             dir.path().join("two.toml"),
-            "name = \"list-two\"\nformula = \"t ^ (n * k * m)\"\n[parameters.k]\ndefault = 1\nmin = 1\nmax = 4\n[parameters.m]\ndefault = 1\nmin = 1\nmax = 4\n",
+            "name = \"list-two\"\nformula = \"t ^ (n * k * m)\"\n[parameters.k]\ndefault = 1\nmin \
+                = 1\nmax = 4\n[parameters.m]\ndefault = 1\nmin = 1\nmax = 4\n",
         )
         .unwrap();
         let kinds = parse_lobe_list(

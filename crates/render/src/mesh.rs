@@ -8,7 +8,10 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum MeshError {
     /// A position or normal with a NaN or infinite coordinate.
-    #[error("vertex {index} has a non-finite {what} ({value}); every coordinate must be a finite number")]
+    #[error(
+        "vertex {index} has a non-finite {what} ({value}); every coordinate must be a finite \
+        number"
+    )]
     NonFinite {
         /// The vertex.
         index: usize,

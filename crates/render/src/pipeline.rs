@@ -36,7 +36,11 @@ pub const MAX_SPP: u32 = 1 << 16;
 #[non_exhaustive]
 pub enum RenderError {
     /// The image or sample count is out of range.
-    #[error("cannot render {width}x{height} pixels with {samples}x{samples} samples: width and height must be at least 1, width x height at most {MAX_PIXELS} pixels, samples in [1, {MAX_SAMPLES}], and width or height times samples at most {MAX_SIDE}")]
+    #[error(
+        "cannot render {width}x{height} pixels with {samples}x{samples} samples: width and \
+        height must be at least 1, width x height at most {MAX_PIXELS} pixels, samples in [1, \
+        {MAX_SAMPLES}], and width or height times samples at most {MAX_SIDE}"
+    )]
     Size {
         /// Width in pixels.
         width: u32,

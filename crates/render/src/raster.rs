@@ -179,7 +179,8 @@ impl Setup {
 
     /// Calls `visit(x, y, depth)` for every pixel of `rect` whose centre the triangle covers.
     /// Depth is the plane through the vertices' depths, stepped along the row; barycentric
-    /// weights are left to [`Setup::edge_weights_near`], for the samples that survive the depth test.
+    /// weights are left to [`Setup::edge_weights_near`], for the samples that survive the depth
+    /// test.
     pub fn for_each_covered(&self, rect: PixelRect, mut visit: impl FnMut(u32, u32, f32)) {
         let Some(rect) = self.bounds.intersect(rect) else {
             return;

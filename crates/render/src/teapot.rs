@@ -147,7 +147,8 @@ mod tests {
     }
 
     /// Outward faces: the body's normals point away from the axis, the lid's (not its knob's)
-    /// and the rim's upwards, the bottom's downwards; each triangle's winding agrees with its normals.
+    /// and the rim's upwards, the bottom's downwards; each triangle's winding agrees with its
+    /// normals.
     #[test]
     fn faces_and_normals_point_outwards() {
         let all = patches();

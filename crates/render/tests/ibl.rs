@@ -138,7 +138,8 @@ fn the_white_furnace_gives_each_lobes_quadrature_albedo() {
         for geometry in Geometry::ALL {
             for (n, theta_o) in [(8.0, 30.0), (64.0, 60.0)] {
                 let material = format!(
-                    "kd = 0.0\nks = 1.0\nlobe = \"{}\"\nn = {n}\ngeometry = \"{}\"\nnormalisation = \"lobe\"",
+                    "kd = 0.0\nks = 1.0\nlobe = \"{}\"\nn = {n}\ngeometry = \"{}\"\nnormalisation \
+                        = \"lobe\"",
                     kind.id(),
                     geometry.id()
                 );
@@ -399,7 +400,8 @@ fn the_packet_estimator_agrees_with_the_plain_one() {
     for lobe in ["pow", "schlick", "schlick-mod"] {
         for geometry in Geometry::ALL {
             let material = format!(
-                "kd = 0.35\nks = 0.65\ncolour = [0.7, 0.1, 0.08]\nlobe = \"{lobe}\"\nn = 64\ngeometry = \"{}\"\nnormalisation = \"lobe\"",
+                "kd = 0.35\nks = 0.65\ncolour = [0.7, 0.1, 0.08]\nlobe = \"{lobe}\"\nn = \
+                    64\ngeometry = \"{}\"\nnormalisation = \"lobe\"",
                 geometry.id()
             );
             let scene = scene(&format!(

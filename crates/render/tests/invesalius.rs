@@ -47,7 +47,8 @@ fn ready() -> bool {
     if !found {
         assert!(
             !in_ci(),
-            "{} cannot import nibabel, and CI=true requires it: .ci/run installs it into target/venv",
+            "{} cannot import nibabel, and CI=true requires it: .ci/run installs it into \
+                target/venv",
             python().display()
         );
         eprintln!("skipped: nibabel is not importable (pip install nibabel into target/venv)");

@@ -38,17 +38,24 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(3000))]
 
     #[test]
-    fn every_lobe_is_finite_in_unit_range_for_any_finite_cosine(kind in any_lobe(), n in any_exponent(), t in any_finite()) {
+    fn every_lobe_is_finite_in_unit_range_for_any_finite_cosine(
+        kind in any_lobe(),
+        n in any_exponent(),
+        t in any_finite(),
+    ) {
         let lobe = Lobe::new(kind, n);
         let value = lobe.eval(t);
-        prop_assert!(value.is_finite() && (0.0..=1.0).contains(&value), "{kind} n={n} t={t}: {value}");
+        prop_assert!(value.is_finite() && (0.0..=1.0).contains(&value), "{kind} n={n} t={t}: \
+            {value}");
         let narrow = t as f32;
         if narrow.is_finite() {
             let value = lobe.eval(narrow);
-            prop_assert!(value.is_finite() && (0.0..=1.0).contains(&value), "{kind} n={n} t={narrow}: {value}");
+            prop_assert!(value.is_finite() && (0.0..=1.0).contains(&value), "{kind} n={n} \
+                t={narrow}: {value}");
             let mut batch = [0.0f32];
             lobe.eval_batch(&[narrow], &mut batch);
-            prop_assert!(batch[0].is_finite() && (0.0..=1.0).contains(&batch[0]), "batch {kind} n={n} t={narrow}");
+            prop_assert!(batch[0].is_finite() && (0.0..=1.0).contains(&batch[0]), "batch {kind} \
+                n={n} t={narrow}");
         }
     }
 
@@ -58,7 +65,8 @@ proptest! {
         geometry in proptest::sample::select(Geometry::ALL.to_vec()),
         normalisation in proptest::sample::select(Normalisation::ALL.to_vec()),
     ) {
-        let brdf = Brdf::new(Rgb::splat(0.3), Rgb::splat(0.6), Lobe::new(kind, n), geometry, normalisation);
+        let (kd, ks) = (Rgb::splat(0.3), Rgb::splat(0.6));
+        let brdf = Brdf::new(kd, ks, Lobe::new(kind, n), geometry, normalisation);
         let f = brdf.f(wo, wi);
         prop_assert!(f.is_finite() && f.min_element() >= 0.0, "{kind} n={n} {wo} {wi}: {f}");
     }
@@ -81,7 +89,10 @@ proptest! {
             Light::Point { position: narrow(light_at), intensity: Vec3::ONE },
             Light::Directional { towards: narrow(towards), intensity: Vec3::splat(0.5) },
         ];
-        let radiance = Shader::new(&material, model).shade(narrow(position), narrow(normal), narrow(wo), &lights, Vec3::splat(0.1));
+        let shader = Shader::new(&material, model);
+        let ambient = Vec3::splat(0.1);
+        let radiance =
+            shader.shade(narrow(position), narrow(normal), narrow(wo), &lights, ambient);
         prop_assert!(radiance.is_finite() && radiance.min_element() >= 0.0, "{radiance}");
     }
 }
@@ -102,18 +113,24 @@ fn any_scene() -> impl Strategy<Value = String> {
         proptest::sample::select(Normalisation::ALL.to_vec()),
         vector(0.0..1.0),
     )
-        .prop_map(|(shape, at, scale, lobe, n, geometry, normalisation, colour)| {
-            let size = match shape {
-                "plane" => "size = 20.0\n",
-                "teapot" => "level = 2\n",
-                "torus" => "segments = 12\nsides = 8\n",
-                _ => "segments = 12\nrings = 6\n",
-            };
-            format!(
-                "[[objects]]\nshape = \"{shape}\"\n{size}scale = {scale}\ntranslate = {at}\n[objects.material]\nlobe = \"{}\"\nn = {n}\ngeometry = \"{}\"\nnormalisation = \"{}\"\ncolour = {colour}\n",
-                lobe.id(), geometry.id(), normalisation.id()
-            )
-        });
+        .prop_map(
+            |(shape, at, scale, lobe, n, geometry, normalisation, colour)| {
+                let size = match shape {
+                    "plane" => "size = 20.0\n",
+                    "teapot" => "level = 2\n",
+                    "torus" => "segments = 12\nsides = 8\n",
+                    _ => "segments = 12\nrings = 6\n",
+                };
+                format!(
+                    "[[objects]]\nshape = \"{shape}\"\n{size}scale = {scale}\ntranslate = \
+                    {at}\n[objects.material]\nlobe = \"{}\"\nn = {n}\ngeometry = \
+                    \"{}\"\nnormalisation = \"{}\"\ncolour = {colour}\n",
+                    lobe.id(),
+                    geometry.id(),
+                    normalisation.id()
+                )
+            },
+        );
     let light = prop_oneof![
         vector(-10.0..10.0).prop_map(|p| format!(
             "[[lights]]\nkind = \"point\"\nposition = {p}\nintensity = [0.7, 0.7, 0.7]\n"
@@ -124,19 +141,32 @@ fn any_scene() -> impl Strategy<Value = String> {
     ];
     (
         vector(-12.0..12.0),
-        prop_oneof![(5.0f32..150.0).prop_map(|f| format!("fov = {f}")), (0.5f32..20.0).prop_map(|h| format!("orthographic = {h}"))],
+        prop_oneof![
+            (5.0f32..150.0).prop_map(|f| format!(
+                "fov = \
+            {f}"
+            )),
+            (0.5f32..20.0).prop_map(|h| format!("orthographic = {h}"))
+        ],
         (8u32..40, 8u32..40, 1u32..=2),
         proptest::sample::select(Shading::ALL.to_vec()),
         proptest::sample::select(IlluminationModel::ALL.to_vec()),
         proptest::collection::vec(light, 1..3),
         proptest::collection::vec(object, 1..4),
     )
-        .prop_map(|(eye, projection, (width, height, samples), shading, model, lights, objects)| {
-            format!(
-                "[camera]\neye = {eye}\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, 1.0]\n{projection}\n[render]\nwidth = {width}\nheight = {height}\nsamples = {samples}\nshading = \"{}\"\nmodel = \"{}\"\n{}{}",
-                shading.id(), model.id(), lights.concat(), objects.concat()
-            )
-        })
+        .prop_map(
+            |(eye, projection, (width, height, samples), shading, model, lights, objects)| {
+                format!(
+                    "[camera]\neye = {eye}\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, \
+                    1.0]\n{projection}\n[render]\nwidth = {width}\nheight = {height}\nsamples = \
+                    {samples}\nshading = \"{}\"\nmodel = \"{}\"\n{}{}",
+                    shading.id(),
+                    model.id(),
+                    lights.concat(),
+                    objects.concat()
+                )
+            },
+        )
 }
 
 proptest! {
@@ -149,7 +179,8 @@ proptest! {
         let loaded = Scene::from_toml(&text, "random.toml", None)
             .map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
         let image = specula_render::render(&loaded.scene, &|_, _| {}).expect("valid size");
-        prop_assert!(image.pixels().iter().all(|p| p.is_finite() && p.min_element() >= 0.0), "{text}");
+        let valid = |p: &Vec3| p.is_finite() && p.min_element() >= 0.0;
+        prop_assert!(image.pixels().iter().all(valid), "{text}");
     }
 }
 

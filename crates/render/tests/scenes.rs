@@ -34,7 +34,8 @@ fn the_default_scene_has_five_spheres_from_n_4_to_1000_and_a_teapot() {
 #[test]
 fn a_minimal_scene_takes_defaults_and_lights_are_normalised() {
     let text = format!(
-        "{CAMERA}[[lights]]\nkind = \"directional\"\ntowards = [0, 0, 2]\n[[objects]]\nshape = \"sphere\"\n"
+        "{CAMERA}[[lights]]\nkind = \"directional\"\ntowards = [0, 0, 2]\n[[objects]]\nshape = \
+            \"sphere\"\n"
     );
     let scene = parse(&text).unwrap();
     assert_eq!(scene.objects.len(), 1);
@@ -51,7 +52,8 @@ fn a_minimal_scene_takes_defaults_and_lights_are_normalised() {
 #[test]
 fn transforms_place_the_object() {
     let text = format!(
-        "{CAMERA}[[objects]]\nshape = \"sphere\"\nradius = 1.0\nscale = 2.0\ntranslate = [1, 2, 3]\n"
+        "{CAMERA}[[objects]]\nshape = \"sphere\"\nradius = 1.0\nscale = 2.0\ntranslate = [1, 2, \
+            3]\n"
     );
     let scene = parse(&text).unwrap();
     let (lo, hi) = scene.objects[0].mesh.bounds().unwrap();
@@ -158,7 +160,9 @@ fn write(directory: &Path, name: &str, bytes: &[u8]) -> std::path::PathBuf {
 fn obj_stl_and_ply_files_load_the_same_tetrahedron() {
     let directory = tempfile::tempdir().unwrap();
     let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
-    let ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    let ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float \
+        y\nproperty float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n0 \
+        0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
     let corners = [
         [0.0_f32, 0.0, 0.0],
         [1.0, 0.0, 0.0],

@@ -117,7 +117,9 @@ pub(crate) fn grid(
         &stops,
         scale,
         &format!(
-            "Below each image: its FLIP error against {reference}'s, black where they agree, on one scale for every map here (0 to {scale}; FLIP's own runs to 1; specula diff --heatmap-scale draws the same). Select an image for its full size.",
+            "Below each image: its FLIP error against {reference}'s, black where they agree, on \
+                one scale for every map here (0 to {scale}; FLIP's own runs to 1; specula diff \
+                --heatmap-scale draws the same). Select an image for its full size.",
         ),
     ) + &tiles(&shown))
 }

@@ -55,7 +55,8 @@ pub fn designed(context: &mut Context) -> Result<String, String> {
          each one's global coefficients across n from {} to {} (every per-material constant \
          a closed form of n), verifies the fitted formula with the f64 analysis at {} \
          exponents of the range (epicentre error within the bound, whole-lobe error within \
-         {} of the peak or the epicentre's bound where larger, 1 at t = 1, non-decreasing, in [0, 1]) and costs it as recommend \
+         {} of the peak or the epicentre's bound where larger, 1 at t = 1, non-decreasing, in [0, \
+         1]) and costs it as recommend \
          does. Each row is specula design --target TARGET --n {}..{} --max-error BOUND.",
         RANGE.0,
         RANGE.1,
@@ -186,7 +187,9 @@ fn pareto_plot(
         &format!("designed-{}.svg", target.id()),
         &chart,
         &format!(
-            "{name}: the designed lobes (within {}) and the built-ins, error against cost; higher left is better, the grey line joins the Pareto front over both, the red line is the bound",
+            "{name}: the designed lobes (within {}) and the built-ins, error against cost; higher \
+                left is better, the grey line joins the Pareto front over both, the red line is \
+                the bound",
             percent(bound)
         ),
     )

@@ -57,8 +57,17 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
             .collect(),
         ..Chart::default()
     };
-    let mut html = paragraph("Energy ratio 1 means the lobe reflects what t^n reflects; the analytic (n+1)/(2 pi) applied to an approximation scales its energy by exactly this ratio.");
-    html += &context.svg("energy-ratio.svg", &chart, "energy ratio against n: 1 reflects what t^n reflects; above 1 a lobe with t^n's normalisation creates energy, below it darkens")?;
+    let mut html = paragraph(
+        "Energy ratio 1 means the lobe reflects what t^n reflects; the \
+        analytic (n+1)/(2 pi) applied to an approximation scales its energy by exactly this \
+        ratio.",
+    );
+    html += &context.svg(
+        "energy-ratio.svg",
+        &chart,
+        "energy ratio against n: 1 reflects what t^n \
+        reflects; above 1 a lobe with t^n's normalisation creates energy, below it darkens",
+    )?;
     let coef1 = Chart {
         title: "the thesis's coef1 = 1.063 n / (2 pi) against the exact (n + 1) / (2 pi)".into(),
         x_label: "n".into(),
@@ -89,7 +98,12 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
         ],
         ..Chart::default()
     };
-    html += &context.svg("coef1.svg", &coef1, "coef1 against the exact normalisation: it crosses 1 at a single n, so the thesis's coefficient is right only there")?;
+    html += &context.svg(
+        "coef1.svg",
+        &coef1,
+        "coef1 against the exact normalisation: it crosses 1 \
+        at a single n, so the thesis's coefficient is right only there",
+    )?;
     let table_n = [1.0, 8.0, 64.0, 512.0, 1000.0].map(Exponent::new);
     let rows: Vec<Vec<String>> = kinds
         .iter()
@@ -106,7 +120,10 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
             row
         })
         .collect();
-    html += &paragraph("Each lobe's own normalisation constant (computed numerically), and how far it is from the analytic (n+1)/(2 pi):");
+    html += &paragraph(
+        "Each lobe's own normalisation constant (computed numerically), and how far \
+        it is from the analytic (n+1)/(2 pi):",
+    );
     html += &table(
         &["lobe", "n = 1", "n = 8", "n = 64", "n = 512", "n = 1000"],
         &rows,
@@ -162,8 +179,22 @@ pub fn reciprocity(context: &mut Context) -> Result<String, String> {
             row
         })
         .collect();
-    Ok(paragraph(&format!("White furnace: the largest directional albedo of the lobe-normalised BRDF (kd = 0, ks = 1, Phong geometry) over all outgoing angles; at most 1 conserves energy. Reciprocity: the largest |f(wo, wi) - f(wi, wo)| over {pairs} random direction pairs at n = 64 (Phong and Blinn), and the same for the BRDF the classic model implies (kd + ks lobe / cos theta_i).")) + &table(
-        &["lobe", "max albedo n = 8", "n = 64", "n = 512", "reciprocity error", "classic model's implied BRDF"],
+    Ok(paragraph(&format!(
+        "White furnace: the largest directional albedo of the lobe-normalised \
+        BRDF (kd = 0, ks = 1, Phong geometry) over all outgoing angles; at most 1 conserves \
+        energy. Reciprocity: the largest |f(wo, wi) - f(wi, wo)| over {pairs} random direction \
+        pairs at n = 64 (Phong and Blinn), and the same for the BRDF the classic model implies (kd \
+        + ks lobe / cos theta_i)."
+    )) + &table(
+        &[
+            "lobe",
+            "max albedo n = 8",
+            "n = 64",
+            "n = 512",
+            "reciprocity error",
+            "classic model's \
+            implied BRDF",
+        ],
         &rows,
     ))
 }

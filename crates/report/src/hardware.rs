@@ -72,12 +72,15 @@ fn synthesized(
                 "the designs could not be synthesized here (see the notes on this machine)"
                     .to_owned()
             }
-            Ok(_) => "not every design is in the synthesis cache (a quick report does not synthesize; run the full report or `specula claims`)".to_owned(),
+            Ok(_) => "not every design is in the synthesis cache (a quick report does not \
+                synthesize; run the full report or `specula claims`)"
+                .to_owned(),
         };
         let (target, designs) = claim::designs(sweeps);
         html += &paragraph(&format!(
             "Not measured: {why}. In its place, a fallback that is not a synthesis: the formula \
-             estimate of LUT4 logic cells (crates/decide/src/fpga_estimate.rs) for each datapath at the \
+             estimate of LUT4 logic cells (crates/decide/src/fpga_estimate.rs) for each datapath \
+             at the \
              smallest width reaching {} epicentre error at n = {CLAIM_N}.",
             percent(target)
         ));
@@ -166,7 +169,8 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
          least significant bit. Every stage rounds half to even and saturates. The error \
          includes the input's quantisation, as on silicon. A datapath meets its float model \
          when its epicentre max relative error is within {MEETS_TOLERANCE}x the f64 model's. \
-         The Verilog of every datapath is co-simulated with Icarus Verilog, bit-exact, in the tests."
+         The Verilog of every datapath is co-simulated with Icarus Verilog, bit-exact, in the \
+         tests."
     ));
     let mut rows = Vec::new();
     for (n, results) in &all {
@@ -200,7 +204,11 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
         html += &context.svg(
             &format!("hardware-error-n{n}.svg"),
             &chart,
-            &format!("every datapath's epicentre error against its word length, n = {n}: where each curve flattens, extra bits stop paying; the floor is the float model's own error"),
+            &format!(
+                "every datapath's epicentre error against its word length, n = {n}: where \
+                each curve flattens, extra bits stop paying; the floor is the float model's own \
+                error"
+            ),
         )?;
         for result in results.iter() {
             let width = result.minimum_width();
@@ -234,7 +242,8 @@ pub fn hardware(context: &mut Context) -> Result<String, String> {
     );
     html += &synthesized(context, &all)?;
     html += &paragraph(&format!(
-        "The structural schemes, drawn from the same descriptions as the models and the Verilog, at W = {DIAGRAM_BITS}: one column per pipeline stage."
+        "The structural schemes, drawn from the same descriptions as the models and the Verilog, \
+            at W = {DIAGRAM_BITS}: one column per pipeline stage."
     ));
     for lobe in HwLobe::ALL {
         let datapath = lobe.build(DIAGRAM_BITS).map_err(|e| e.to_string())?;

@@ -41,7 +41,8 @@ pub fn table_with_files(header: &[&str], rows: &[Vec<String>], file_columns: &[u
 /// A large image shown at page width, linked to itself at full size.
 pub fn linked_figure(file: &str, caption: &str) -> String {
     format!(
-        "<figure class=\"wide\"><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"/></a><figcaption>{1} (select it for full size)</figcaption></figure>\n",
+        "<figure class=\"wide\"><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"/></a><figcaption>{1} \
+            (select it for full size)</figcaption></figure>\n",
         escape(file),
         escape(caption)
     )
@@ -61,7 +62,9 @@ pub fn figure(file: &str, caption: &str) -> String {
 /// each (small multiples).
 pub fn multiples(figures: &str, min_width: u32) -> String {
     format!(
-        "<div class=\"multiples\" style=\"grid-template-columns:repeat(auto-fill,minmax({min_width}px,1fr))\">\n{figures}</div>\n"
+        "<div class=\"multiples\" \
+            style=\"grid-template-columns:repeat(auto-fill,minmax({min_width}px,1fr))\">\n{figures}\
+            </div>\n"
     )
 }
 
@@ -88,7 +91,8 @@ pub fn tiles(tiles: &[Tile]) -> String {
         let [r, g, b] = tile.colour;
         let _ = write!(
             html,
-            "<figure class=\"tile\"><figcaption><span class=\"swatch\" style=\"background:rgb({r},{g},{b})\"></span>{}</figcaption>",
+            "<figure class=\"tile\"><figcaption><span class=\"swatch\" \
+                style=\"background:rgb({r},{g},{b})\"></span>{}</figcaption>",
             escape(&tile.label)
         );
         for (file, what) in std::iter::once((&tile.image, ""))
@@ -121,7 +125,9 @@ pub fn colour_bar(id: &str, stops: &[[u8; 3]], scale: f64, what: &str) -> String
         );
     }
     format!(
-        "<figure class=\"colour-bar\" id=\"{id}\" data-scale=\"{scale}\"><svg xmlns=\"http://www.w3.org/2000/svg\" width=\"320\" height=\"34\" role=\"img\" aria-label=\"{what}: 0 to {max}\">\
+        "<figure class=\"colour-bar\" id=\"{id}\" data-scale=\"{scale}\"><svg \
+            xmlns=\"http://www.w3.org/2000/svg\" width=\"320\" height=\"34\" role=\"img\" \
+            aria-label=\"{what}: 0 to {max}\">\
 <defs><linearGradient id=\"{id}-gradient\">{gradient}</linearGradient></defs>\
 <rect x=\"10\" y=\"0\" width=\"300\" height=\"14\" fill=\"url(#{id}-gradient)\" stroke=\"#888\"/>\
 <text x=\"10\" y=\"30\" font-size=\"12\" text-anchor=\"start\">0</text>\
@@ -150,32 +156,16 @@ pub fn answer(lines: &[String]) -> String {
     html
 }
 
-const STYLE: &str = "body{font-family:system-ui,sans-serif;margin:0;color:#222;line-height:1.45}\
-.layout{display:grid;grid-template-columns:14rem minmax(0,1fr);gap:2rem;max-width:1500px;margin:0 auto;padding:0 1rem}\
-nav.toc{position:sticky;top:0;align-self:start;max-height:100vh;overflow:auto;padding:1.5rem 0;font-size:0.9em}\
-nav.toc ol{padding-left:2.2em;margin:0.5em 0}nav.toc li{margin:0.2em 0}\
-@media (max-width:900px){.layout{grid-template-columns:minmax(0,1fr)}nav.toc{position:static;max-height:none}}\
-main{padding-bottom:3em}h2{border-bottom:1px solid #ddd;padding-bottom:0.2em;margin-top:2em}\
-table{border-collapse:collapse;margin:1em 0;font-size:0.9em}\
-th,td{border:1px solid #ccc;padding:0.25em 0.6em;text-align:left}\
-th{background:#f2f2f2;position:sticky;top:0}figure{display:inline-block;margin:0.5em;vertical-align:top}\
-figure.wide{display:block}img{max-width:100%;height:auto}figcaption{font-size:0.85em;color:#555}code{background:#f5f5f5}\
-.multiples{display:grid;gap:0.75rem;margin:1em 0}.multiples figure{margin:0;display:block}.multiples img{width:100%}\
-.tiles{display:grid;grid-template-columns:repeat(auto-fill,minmax(200px,1fr));gap:0.75rem;margin:1em 0}\
-.tile{margin:0;display:block;border:1px solid #ddd;border-radius:4px;padding:0.4em;background:#fafafa}\
-.tile img{display:block;width:100%;margin:0.2em 0}.tile p{margin:0.2em 0;font-size:0.8em;color:#444}\
-.tile figcaption{font-size:0.95em;color:#222;font-weight:600}\
-.swatch{display:inline-block;width:0.85em;height:0.85em;border-radius:2px;margin-right:0.4em;vertical-align:-0.05em}\
-.colour-bar{display:block}.answer{border-left:5px solid #1a7f37;background:#f3faf5;padding:0.3em 1em;margin:1em 0;font-size:1.05em}\
-.answer li{margin:0.3em 0}.notes li{margin:0.4em 0}\
-.holds{color:#1a7f37}.qualified{color:#9a6700}.fails{color:#cf222e}footer{margin-top:3em;font-size:0.85em;color:#666}";
+/// The page's style sheet, beside this file.
+const STYLE: &str = include_str!("report.css");
 
 /// Reports on the browser's console any image that failed to load or decode (a moved page, a
 /// broken SVG): what `.ci/browser-check` looks for. Written without `<` and `&`, so the page
 /// stays well-formed XML.
 const CHECK_IMAGES: &str = "window.addEventListener('load', function () { \
 Array.prototype.forEach.call(document.images, function (img) { \
-if (!img.complete || img.naturalWidth === 0) { console.error('image failed to load: ' + img.getAttribute('src')); } \
+if (!img.complete || img.naturalWidth === 0) { console.error('image failed to load: ' + \
+img.getAttribute('src')); } \
 }); });";
 
 /// The whole page: a table of contents that stays at hand beside the sections, then the
@@ -183,8 +173,10 @@ if (!img.complete || img.naturalWidth === 0) { console.error('image failed to lo
 pub fn page(title: &str, sections: &[(String, String)], footer: &str) -> String {
     let mut html = format!(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"/>\
-         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/><title>{0}</title>\
-         <style>{STYLE}</style></head><body>\n<div class=\"layout\">\n<nav class=\"toc\"><strong>{0}</strong><ol>",
+         <meta name=\"viewport\" content=\"width=device-width, \
+         initial-scale=1\"/><title>{0}</title>\
+         <style>{STYLE}</style></head><body>\n<div class=\"layout\">\n<nav \
+         class=\"toc\"><strong>{0}</strong><ol>",
         escape(title)
     );
     for (k, (heading, _)) in sections.iter().enumerate() {
@@ -207,7 +199,8 @@ pub fn page(title: &str, sections: &[(String, String)], footer: &str) -> String 
     }
     let _ = write!(
         html,
-        "<footer>{footer}</footer>\n</main>\n</div>\n<script>{CHECK_IMAGES}</script>\n</body></html>\n"
+        "<footer>{footer}</footer>\n</main>\n</div>\n<script>{CHECK_IMAGES}</script>\n</body></html\
+            >\n"
     );
     html
 }

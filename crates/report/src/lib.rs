@@ -446,7 +446,8 @@ fn machine_notes(notes: &[String]) -> String {
         .map(|note| format!("<li>{}</li>", html::escape(note)))
         .collect();
     html::paragraph(
-        "What this machine lacked, and what the report did instead. None of it changes an answer above; each says what to install to see the missing part.",
+        "What this machine lacked, and what the report did instead. None of it changes an answer \
+            above; each says what to install to see the missing part.",
     ) + &format!("<ul class=\"notes\">{items}</ul>\n")
 }
 
@@ -463,7 +464,8 @@ fn footer(options: &Options, started: Instant, timings: &str) -> String {
     let threads = std::thread::available_parallelism().map_or(1, usize::from);
     let command: Vec<String> = std::env::args().collect();
     html::escape(&format!(
-        "specula {} on {cpu}, {threads} threads, {} {}; {} mode; computed in {:.1} s ({timings}); command: {}",
+        "specula {} on {cpu}, {threads} threads, {} {}; {} mode; computed in {:.1} s ({timings}); \
+            command: {}",
         env!("CARGO_PKG_VERSION"),
         std::env::consts::OS,
         std::env::consts::ARCH,

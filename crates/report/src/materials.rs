@@ -41,7 +41,11 @@ const POLAR_HEADROOM: f64 = 1.25;
 const GGX_GREY: plotters::style::RGBColor = plotters::style::RGBColor(150, 150, 150);
 
 /// How to get the section, shown without `--materials`.
-const HOW_TO: &str = "Not computed: run specula report --materials DIR, with DIR holding measured materials as the RGL database's isotropic RGB .bsdf files (the '_rgb.bsdf' ones; for example the five specula carries in data/rgl), to see each fitted with every lobe and GGX: the verdict on which lobe to ship, the fits' errors, polar plots of the measurement against the fits and renders under the sky scored by FLIP.";
+const HOW_TO: &str = "Not computed: run specula report --materials DIR, with DIR holding measured \
+    materials as the RGL database's isotropic RGB .bsdf files (the '_rgb.bsdf' ones; for example \
+    the five specula carries in data/rgl), to see each fitted with every lobe and GGX: the verdict \
+    on which lobe to ship, the fits' errors, polar plots of the measurement against the fits and \
+    renders under the sky scored by FLIP.";
 
 /// The `.bsdf` files in `directory` sorted by name, at most [`MAX_MATERIALS`], and how many
 /// more there were.
@@ -114,12 +118,22 @@ pub fn materials(context: &mut Context) -> Result<String, String> {
     }
     let (width, spp) = context.sizes.materials;
     let height = material_scene(width).settings.height;
-    let mut html = paragraph(&format!(
-        "The measured materials in {} ({} of them, in name order{}), each fitted as specula fit --material FILE fits it: every lobe in both geometries and GGX, kd / pi + K spec per channel, with one n for the three channels (what a renderer's material has) and with one per channel. E, the fit error, is the {error_measure}. The verdict is the cheapest lobe on {} whose one-n fit is within {} % of pow's best. Each table shows every lobe's one-n fit in its better geometry, and in its last column the same model's fit with one n per channel. The renders are the environment scene under the procedural sky ({width}x{height}, {spp} samples per pixel, the same random numbers for every model), the measured material sampled by its own data.",
+    let mut html =
+        paragraph(&format!(
+        "The measured materials in {} ({} of them, in name order{}), each fitted as specula fit \
+            --material FILE fits it: every lobe in both geometries and GGX, kd / pi + K spec per \
+            channel, with one n for the three channels (what a renderer's material has) and with \
+            one per channel. E, the fit error, is the {error_measure}. The verdict is the cheapest \
+            lobe on {} whose one-n fit is within {} % of pow's best. Each table shows every lobe's \
+            one-n fit in its better geometry, and in its last column the same model's fit with one \
+            n per channel. The renders are the environment scene under the procedural sky \
+            ({width}x{height}, {spp} samples per pixel, the same random numbers for every model), \
+            the measured material sampled by its own data.",
         directory.display(),
         files.len(),
         if more > 0 {
-            format!("; {more} more .bsdf files not shown, as a report shows at most {MAX_MATERIALS}")
+            format!("; {more} more .bsdf files not shown, as a report shows at most \
+                {MAX_MATERIALS}")
         } else {
             String::new()
         },
@@ -179,7 +193,8 @@ fn material(
     let shown = shown_fits(a);
     let mut html = format!("<h3>{}</h3>\n", escape(&name));
     html += &paragraph(&format!(
-        "{} ({}): measured albedo at normal incidence {} (luminance {:.3}); compared at {} direction pairs. Verdict on {}: {}.",
+        "{} ({}): measured albedo at normal incidence {} (luminance {:.3}); compared at {} \
+            direction pairs. Verdict on {}: {}.",
         a.description,
         a.file,
         triple(a.measured_albedo_at_normal),
@@ -330,7 +345,12 @@ fn polar(
     Ok(figure(
         &file,
         &format!(
-            "{name} in the plane of incidence, viewed from {} (dotted line; the mirror direction is opposite): the radius is the cube root of the luminance of f cos theta_i, the quantity (per channel) that the fit error E compares. Measured: broad black; each lobe's one-n fit in its better geometry in the lobe's own line style; GGX (one alpha): grey dash-dot. Curves beyond {POLAR_HEADROOM} times the measurement's largest radius are clipped at the rim.",
+            "{name} in the plane of incidence, viewed from {} (dotted line; the mirror direction \
+                is opposite): the radius is the cube root of the luminance of f cos theta_i, the \
+                quantity (per channel) that the fit error E compares. Measured: broad black; each \
+                lobe's one-n fit in its better geometry in the lobe's own line style; GGX (one \
+                alpha): grey dash-dot. Curves beyond {POLAR_HEADROOM} times the measurement's \
+                largest radius are clipped at the rim.",
             angles.join(", ")
         ),
     ))
@@ -412,7 +432,8 @@ fn every_fit(
     let images = render_comparison(measured, &fits, sky, width, spp, &|_, _| {})?;
     let scene = material_scene(width);
     let mut html = paragraph(&format!(
-        "Every model beside the measurement ({width}x{}, {spp} samples per pixel), each with its mean FLIP against the measured render at that size:",
+        "Every model beside the measurement ({width}x{}, {spp} samples per pixel), each with its \
+            mean FLIP against the measured render at that size:",
         scene.settings.height
     ));
     for render in &images {

@@ -22,7 +22,9 @@ pub(crate) fn shading(kind: LobeKind) -> Result<Shading, String> {
 #[must_use]
 pub(crate) fn march_times(on: &str, alone_ms: f64, together_ms: f64, lobes: usize) -> String {
     format!(
-        "One frame on {on}: pow alone {alone_ms:.1} ms; all {lobes} lobes' images from one march {together_ms:.1} ms, {:.1} ms a lobe beyond the first (each image bit for bit the one marched for its lobe alone).",
+        "One frame on {on}: pow alone {alone_ms:.1} ms; all {lobes} lobes' images from one march \
+            {together_ms:.1} ms, {:.1} ms a lobe beyond the first (each image bit for bit the one \
+            marched for its lobe alone).",
         (together_ms - alone_ms) / (lobes.max(2) - 1) as f64,
     )
 }

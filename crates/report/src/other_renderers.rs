@@ -78,7 +78,14 @@ pub fn other_renderers(context: &mut Context) -> Result<String, String> {
         .collect();
     fit_header.extend(labels.iter().map(String::as_str));
     let mut html = paragraph(
-        "Every lobe is recorded once as an expression (its formula run on a tracing number type, the constants prepared for n folded in or kept as named parameters) and every target is written from that record: the WGSL of specula shader (and through naga GLSL, HLSL, MSL, SPIR-V), an OSL script node for Blender Cycles, a MaterialX document and a Mitsuba 3 plugin (specula shader --lang osl|mtlx|mitsuba). Targets without bit casts get the record lowered: the bit tricks rewritten in arithmetic, floor and selects. Counted now, at n = 64 over 20,000 cosines: how often the record and its lowering give the lobe's own f32 bits.",
+        "Every lobe is recorded once as an expression (its formula run on a tracing number type, \
+            the constants prepared for n folded in or kept as named parameters) and every target \
+            is written from that record: the WGSL of specula shader (and through naga GLSL, HLSL, \
+            MSL, SPIR-V), an OSL script node for Blender Cycles, a MaterialX document and a \
+            Mitsuba 3 plugin (specula shader --lang osl|mtlx|mitsuba). Targets without bit casts \
+            get the record lowered: the bit tricks rewritten in arithmetic, floor and selects. \
+            Counted now, at n = 64 over 20,000 cosines: how often the record and its lowering give \
+            the lobe's own f32 bits.",
     );
     html.push_str(&table(
         &[
@@ -91,26 +98,49 @@ pub fn other_renderers(context: &mut Context) -> Result<String, String> {
         &description,
     ));
     html.push_str(&paragraph(
-        "Where a renderer's only glossy closures are microfacet models (Cycles' OSL, MaterialX's OSL and MDL back ends), the lobe becomes GGX with the alpha closest to it read as a distribution of normals (relative L2 distance in brackets; Phong's lobe at normal incidence).",
+        "Where a renderer's only glossy closures are microfacet models (Cycles' OSL, MaterialX's \
+            OSL and MDL back ends), the lobe becomes GGX with the alpha closest to it read as a \
+            distribution of normals (relative L2 distance in brackets; Phong's lobe at normal \
+            incidence).",
     ));
     html.push_str(&table(&fit_header, &fits));
     html.push_str(&table(
-        &["target", "what the file holds", "verified in the real renderer by the test suite"],
+        &[
+            "target",
+            "what the file holds",
+            "verified in the real renderer by the test suite",
+        ],
         &[
             vec![
                 "Blender Cycles (OSL)".into(),
-                "script node: Lobe output, the exact specular term as emission, GGX closure at the fitted alpha; n an input".into(),
-                "every lobe's node compiles in Blender 5.0's OSL compiler; Cycles renders every lobe on a sphere within 1 % of specula's render of the same scene (crates/cli/tests/suite/blender.rs)".into(),
+                "script node: Lobe output, the exact specular term as emission, GGX closure at the \
+                    fitted alpha; n an input".into(),
+                "every lobe's node compiles in Blender 5.0's OSL compiler; Cycles renders every \
+                    lobe on a sphere within 1 % of specula's render of the same scene \
+                    (crates/cli/tests/suite/blender.rs)".into(),
             ],
             vec![
                 "MaterialX".into(),
-                "the lobe as a node graph of standard nodes; a BSDF exact under each light in GLSL, ESSL and MSL, GGX at the fitted roughness in OSL and MDL".into(),
-                "every lobe's document validates and MaterialX 1.39 generates GLSL, ESSL, MSL, OSL and MDL; glslangValidator accepts the GLSL and ESSL, an OSL compiler the OSL (MSL and MDL are generated, not compiled); the lobe's node graph, evaluated as MaterialX defines its nodes, is the lobe within 1e-4 (crates/cli/tests/suite/materialx.rs)".into(),
+                "the lobe as a node graph of standard nodes; a BSDF exact under each light in \
+                    GLSL, ESSL and MSL, GGX at the fitted roughness in OSL and MDL".into(),
+                "every lobe's document validates and MaterialX 1.39 generates GLSL, ESSL, MSL, OSL \
+                    and MDL; glslangValidator accepts the GLSL and ESSL, an OSL compiler the OSL \
+                    (MSL and MDL are generated, not compiled); the lobe's node graph, evaluated as \
+                    MaterialX defines its nodes, is the lobe within 1e-4 \
+                    (crates/cli/tests/suite/materialx.rs)".into(),
             ],
             vec![
                 "Mitsuba 3".into(),
-                "Python BSDF plugin in Dr.Jit: eval, pdf, sample, eval_pdf, specula's normalisations; the cosine drawn as specula draws it: the recorded closed-form inverse (pow, sg, sg-karis, cosquad), safeguarded Newton on the recorded tail (schlick, cheb2-thesis), specula's table (the rest)".into(),
-                "Mitsuba's chi-square test passes for every lobe at n = 8, 64, 512, both geometries, three angles; Mitsuba's direct integrator renders the environment scene's sphere within the noise of specula's (crates/cli/tests/suite/mitsuba.rs)".into(),
+                "Python BSDF plugin in Dr.Jit: eval, pdf, sample, eval_pdf, specula's \
+                    normalisations; the cosine drawn as specula draws it: the recorded closed-form \
+                    inverse (pow, sg, sg-karis, cosquad), safeguarded Newton on the recorded tail \
+                    (schlick, cheb2-thesis), specula's table (the rest)"
+                    .into(),
+                "Mitsuba's chi-square test passes for every lobe at n = 8, 64, 512, both \
+                    geometries, three angles; Mitsuba's direct integrator renders the environment \
+                    scene's sphere within the noise of specula's \
+                    (crates/cli/tests/suite/mitsuba.rs)"
+                    .into(),
             ],
         ],
     ));

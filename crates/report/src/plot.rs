@@ -631,7 +631,9 @@ mod tests {
     /// A text element repeated at its place is dropped; the same text elsewhere is kept.
     #[test]
     fn a_repeated_label_is_drawn_once() {
-        let svg = "<svg><text x=\"1\" y=\"2\">10</text><line/><text x=\"1\" y=\"2\">10</text><text x=\"1\" y=\"9\">10</text></svg>";
+        let svg =
+            "<svg><text x=\"1\" y=\"2\">10</text><line/><text x=\"1\" y=\"2\">10</text><text \
+            x=\"1\" y=\"9\">10</text></svg>";
         assert_eq!(
             without_repeated_text(svg),
             "<svg><text x=\"1\" y=\"2\">10</text><line/><text x=\"1\" y=\"9\">10</text></svg>"

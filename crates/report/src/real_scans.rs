@@ -46,7 +46,8 @@ const SCANS: [Scan; 2] = [
         path: "/usr/share/doc/invesalius-examples/examples/Cranium.inv3",
         package: "invesalius-examples",
         transfer: "ct-bone",
-        vtk_reads: "for the CT a 16-bit integer copy that specula writes (the scan's own type, as a VTK user reads it)",
+        vtk_reads: "for the CT a 16-bit integer copy that specula writes (the scan's own type, as \
+            a VTK user reads it)",
     },
     Scan {
         key: "mri",
@@ -114,7 +115,8 @@ pub fn real_scans(context: &mut Context) -> Result<String, String> {
         .collect();
     for scan in SCANS.iter().filter(|scan| !Path::new(scan.path).is_file()) {
         context.machine_note(format!(
-            "The real {} is not here: it is {} at {}, which the Debian package {} installs (apt-get install {}).",
+            "The real {} is not here: it is {} at {}, which the Debian package {} installs \
+                (apt-get install {}).",
             scan.name, scan.what, scan.path, scan.package, scan.package
         ));
     }
@@ -174,7 +176,13 @@ pub fn real_scans(context: &mut Context) -> Result<String, String> {
         )
     };
     html += &paragraph(&format!(
-        "Each scan as read from the file its Debian package installs, ray-marched at {side}x{side} from the front (anterior view) through its default transfer function (ct-bone for the CT, mr for the MRI), with the phantom's shading (thesis normalisation, Blinn geometry, n = {EXPONENT}, the key light) and {which} as the specular term (specula volume --input FILE --lobe L --normalisation thesis-phong). FLIP and PSNR are against the pow image; the times are frames on all threads while the report's other sections run, after the volume's gradients and bricks were computed once."
+        "Each scan as read from the file its Debian package installs, ray-marched at {side}x{side} \
+            from the front (anterior view) through its default transfer function (ct-bone for the \
+            CT, mr for the MRI), with the phantom's shading (thesis normalisation, Blinn geometry, \
+            n = {EXPONENT}, the key light) and {which} as the specular term (specula volume \
+            --input FILE --lobe L --normalisation thesis-phong). FLIP and PSNR are against the pow \
+            image; the times are frames on all threads while the report's other sections run, \
+            after the volume's gradients and bricks were computed once."
     ));
     let compared = if every_scan_against_vtk {
         &scans[..]
@@ -245,8 +253,17 @@ fn lobe_table(
         Units::Arbitrary => "arbitrary units",
     };
     let mut html = paragraph(&format!(
-        "The real {}: {} ({}, Debian {}), {nx} x {ny} x {nz} voxels of {:.3} x {:.3} x {:.3} mm, values {low} to {high} read as {units}, read in {read_ms:.0} ms; the {} transfer function.",
-        scan.name, scan.what, scan.path, scan.package, spacing.x, spacing.y, spacing.z, scan.transfer
+        "The real {}: {} ({}, Debian {}), {nx} x {ny} x {nz} voxels of {:.3} x {:.3} x {:.3} mm, \
+            values {low} to {high} read as {units}, read in {read_ms:.0} ms; the {} transfer \
+            function.",
+        scan.name,
+        scan.what,
+        scan.path,
+        scan.package,
+        spacing.x,
+        spacing.y,
+        spacing.z,
+        scan.transfer
     ));
     // pow's frame alone, then every lobe's from one march (the samples, their colours and
     // opacities are the lobe's no more than the light is; only the highlights differ).
@@ -388,14 +405,36 @@ fn against_vtk(
         .collect::<Vec<_>>()
         .join("; ");
     html += &paragraph(&format!(
-        "VTK's vtkFixedPointVolumeRayCastMapper (the CPU ray caster 3D Slicer and ParaView build on) and specula set up alike{quick}, as specula bench volume does: the same voxels and placement (VTK reads a NIfTI file: {files}), anterior view with a parallel projection, {side}x{side} pixels, one ray per pixel, trilinear interpolation, a sample every {SAMPLE_DISTANCE} mm, the same transfer function (VTK's opacity per millimetre 1 - exp(-sigma), which its sample-distance correction turns into specula's 1 - exp(-sigma d)), VTK's headlight (a white ambient colour given to it, so that both count ambient 0.25), diffuse 0.7, specular 0.5 with VTK's Blinn-Phong power {EXPONENT} as the pow lobe without normalisation, every sample fully shaded and rays stopped at VTK's 99.22 % opacity. What differs is how each computes: VTK lights each voxel's central-difference normal quantised to 65,280 directions and interpolates the 8 corners' lit values (a voxel whose difference is exactly zero is lit black but stays opaque; in integer data that is uniform tissue and saturated bone), where specula shades the gradient of the trilinear field at the sample; VTK's samples lie on a lattice anchored at the near clipping plane, the same depths for every ray, where specula jitters each ray's first segment; VTK's arithmetic is 15-bit fixed point (docs/vtk-notes.md). VTK also takes one-sided differences, not doubled, at the grid's faces, and with several threads at the last slice of each thread's share of the gradients (a seam; docs/vtk-notes.md). So the images agree in shape and colour, and the FLIP maps show where they part: on silhouettes and at the volume's faces, where the two place their samples differently, and along the slice of VTK's seam (plain on the MRI, a line across the middle)."
+        "VTK's vtkFixedPointVolumeRayCastMapper (the CPU ray caster 3D Slicer and ParaView build \
+            on) and specula set up alike{quick}, as specula bench volume does: the same voxels and \
+            placement (VTK reads a NIfTI file: {files}), anterior view with a parallel projection, \
+            {side}x{side} pixels, one ray per pixel, trilinear interpolation, a sample every \
+            {SAMPLE_DISTANCE} mm, the same transfer function (VTK's opacity per millimetre 1 - \
+            exp(-sigma), which its sample-distance correction turns into specula's 1 - exp(-sigma \
+            d)), VTK's headlight (a white ambient colour given to it, so that both count ambient \
+            0.25), diffuse 0.7, specular 0.5 with VTK's Blinn-Phong power {EXPONENT} as the pow \
+            lobe without normalisation, every sample fully shaded and rays stopped at VTK's 99.22 \
+            % opacity. What differs is how each computes: VTK lights each voxel's \
+            central-difference normal quantised to 65,280 directions and interpolates the 8 \
+            corners' lit values (a voxel whose difference is exactly zero is lit black but stays \
+            opaque; in integer data that is uniform tissue and saturated bone), where specula \
+            shades the gradient of the trilinear field at the sample; VTK's samples lie on a \
+            lattice anchored at the near clipping plane, the same depths for every ray, where \
+            specula jitters each ray's first segment; VTK's arithmetic is 15-bit fixed point \
+            (docs/vtk-notes.md). VTK also takes one-sided differences, not doubled, at the grid's \
+            faces, and with several threads at the last slice of each thread's share of the \
+            gradients (a seam; docs/vtk-notes.md). So the images agree in shape and colour, and \
+            the FLIP maps show where they part: on silhouettes and at the volume's faces, where \
+            the two place their samples differently, and along the slice of VTK's seam (plain on \
+            the MRI, a line across the middle)."
     ));
     let vtk_runs = match theirs {
         Ok(runs) => runs,
         Err(why) => {
             html += &paragraph("VTK was not run here (see the notes on this machine).");
             context.machine_note(format!(
-                "VTK was not run ({why}): the comparison needs the vtk wheel, with nibabel, in {} (pip install vtk nibabel; SPECULA_PYTHON names another Python).",
+                "VTK was not run ({why}): the comparison needs the vtk wheel, with nibabel, in {} \
+                    (pip install vtk nibabel; SPECULA_PYTHON names another Python).",
                 vtk_peer::python().display()
             ));
             return Ok(html);
@@ -490,7 +529,15 @@ fn against_vtk(
         &[1, 2],
     );
     html += &paragraph(&format!(
-        "VTK {}. The differences are of linear values in [0, 1] per channel over the whole image (background included); a pixel is off when any channel differs by more than 0.1; FLIP is of the images as shown (sRGB). Frames per second are the median of {frames} frame(s) ({} threads each; VTK's own time to draw after an untimed first frame, in which it computes its gradients; specula's whole frame, its gradients and bricks computed once before), specula's taken after VTK's, both while the report's other sections run and on small images, where a frame's fixed costs weigh more: a rough guide, not a benchmark (specula bench volume --input FILE measures on a quiet machine at 512x512). Timings are printed, never asserted.",
+        "VTK {}. The differences are of linear values in [0, 1] per channel over the whole image \
+            (background included); a pixel is off when any channel differs by more than 0.1; FLIP \
+            is of the images as shown (sRGB). Frames per second are the median of {frames} \
+            frame(s) ({} threads each; VTK's own time to draw after an untimed first frame, in \
+            which it computes its gradients; specula's whole frame, its gradients and bricks \
+            computed once before), specula's taken after VTK's, both while the report's other \
+            sections run and on small images, where a frame's fixed costs weigh more: a rough \
+            guide, not a benchmark (specula bench volume --input FILE measures on a quiet machine \
+            at 512x512). Timings are printed, never asserted.",
         version,
         rayon::current_num_threads()
     ));

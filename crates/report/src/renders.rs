@@ -93,7 +93,8 @@ fn lobe_table(
         .collect();
     let mut html = comparison::grid(context, prefix, &options.reference.to_string(), &compared)?;
     html += &format!(
-        "<p><a href=\"{strip}\">Every lobe in one image</a> (what specula render --grid writes).</p>\n"
+        "<p><a href=\"{strip}\">Every lobe in one image</a> (what specula render --grid \
+            writes).</p>\n"
     );
     let rows: Vec<Vec<String>> = grid
         .columns
@@ -140,7 +141,9 @@ fn default_scene(context: &mut Context) -> Result<String, String> {
     let base = scene(context, Overrides::default());
     let (width, height, samples) = context.sizes.render;
     let mut html = paragraph(&format!(
-        "The default scene ({width}x{height}, {samples}x{samples} samples, classic model, Phong shading) with every material's lobe replaced, and below each its FLIP error map against pow. Look for where the highlights' size and falloff differ from pow's."
+        "The default scene ({width}x{height}, {samples}x{samples} samples, classic model, Phong \
+            shading) with every material's lobe replaced, and below each its FLIP error map \
+            against pow. Look for where the highlights' size and falloff differ from pow's."
     ));
     let (table_html, reference_image) = lobe_table(
         context,
@@ -220,7 +223,12 @@ fn environment_lit(context: &mut Context) -> Result<String, String> {
         ..IblSettings::default()
     };
     let mut html = paragraph(&format!(
-        "A sphere and the teapot lit by the procedural sky alone ({width}x{height}, {spp} samples per pixel, multiple importance sampling between each lobe's own sampler and the sky, the lobe normalisation, physical model: specula render --env sky --spp {spp} --lobe L). Every lobe's render uses the same random numbers, so what differs from pow is the reflected sun's and sky's shape; the residual Monte Carlo noise sets the floor of these figures."
+        "A sphere and the teapot lit by the procedural sky alone ({width}x{height}, {spp} samples \
+            per pixel, multiple importance sampling between each lobe's own sampler and the sky, \
+            the lobe normalisation, physical model: specula render --env sky --spp {spp} --lobe \
+            L). Every lobe's render uses the same random numbers, so what differs from pow is the \
+            reflected sun's and sky's shape; the residual Monte Carlo noise sets the floor of \
+            these figures."
     ));
     let mut images = render_ibl_grid(&base, &grid_options(context), &sky, &settings, &|_, _| {})
         .map_err(|e| e.to_string())?;

@@ -73,12 +73,28 @@ pub fn models(context: &mut Context) -> Result<String, String> {
             ]
         })
         .collect();
-    Ok(paragraph("Every lobe approximates t^n, t the cosine of the angle g to the lobe's axis (R.V for Phong, N.H for Blinn). Operation counts are measured by running each formula on a counting number type at n = 100.")
-        + &table(&["id", "origin", "formula", "parameters", "operations", "total"], &rows))
+    Ok(paragraph(
+        "Every lobe approximates t^n, t the cosine of the angle g to the lobe's axis (R.V \
+        for Phong, N.H for Blinn). Operation counts are measured by running each formula on a \
+        counting number type at n = 100.",
+    ) + &table(
+        &[
+            "id",
+            "origin",
+            "formula",
+            "parameters",
+            "operations",
+            "total",
+        ],
+        &rows,
+    ))
 }
 
 pub fn shapes(context: &mut Context) -> Result<String, String> {
-    let html = paragraph("Each lobe against cos^n over the angle; the epicentre (t^n >= 1/2) and bloom (t^n >= 1/256) zones are shaded. The log-scale variant beside each shows the tail.");
+    let html = paragraph(
+        "Each lobe against cos^n over the angle; the epicentre (t^n >= 1/2) and \
+        bloom (t^n >= 1/256) zones are shaded. The log-scale variant beside each shows the tail.",
+    );
     let mut figures = String::new();
     for n in [2.0, 8.0, 32.0, 128.0, 512.0] {
         let exponent = Exponent::new(n);
@@ -134,9 +150,15 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
                 &name,
                 &chart,
                 &if log_y {
-                    format!("lobes at n = {n}, log scale: look at the tail, where a lobe that falls too slowly (schlick, sg) or stops short (the quadratics) shows")
+                    format!(
+                        "lobes at n = {n}, log scale: look at the tail, where a lobe that \
+                        falls too slowly (schlick, sg) or stops short (the quadratics) shows"
+                    )
                 } else {
-                    format!("lobes at n = {n}: look at the epicentre (shaded first), where a lobe that departs from pow changes the highlight's core")
+                    format!(
+                        "lobes at n = {n}: look at the epicentre (shaded first), where a lobe \
+                        that departs from pow changes the highlight's core"
+                    )
                 },
             )?;
         }
@@ -145,7 +167,12 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
 }
 
 pub fn errors(context: &mut Context) -> Result<String, String> {
-    let mut html = paragraph("Signed error lobe - t^n against the angle, scaled by the bloom's edge so that every n fits one axis, for n = 8, 64 and 512: one small chart per lobe, each on its own vertical scale. An error that keeps its shape across n is the model's; one that grows with n is its approximation breaking down.");
+    let mut html = paragraph(
+        "Signed error lobe - t^n against the angle, scaled by the bloom's \
+        edge so that every n fits one axis, for n = 8, 64 and 512: one small chart per lobe, each \
+        on its own vertical scale. An error that keeps its shape across n is the model's; one that \
+        grows with n is its approximation breaking down.",
+    );
     let mut figures = String::new();
     for kind in context
         .lobes
@@ -227,7 +254,12 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
                 .collect()
         })
         .collect();
-    html += &paragraph(&format!("The figures of SPEC section 4 against n (log axis, {} exponents from 1 to 1000, {} samples per zone).", grid.len(), sizes.samples_per_zone));
+    html += &paragraph(&format!(
+        "The figures of SPEC section 4 against n (log axis, {} exponents \
+        from 1 to 1000, {} samples per zone).",
+        grid.len(),
+        sizes.samples_per_zone
+    ));
     let zone_charts: [(&str, &str, Pick); 4] = [
         (
             "epicentre max relative error",
@@ -267,7 +299,10 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
             legend_below: true,
             ..Chart::default()
         };
-        let caption = format!("{title} against n for every lobe: flat lines are errors that hold at every n; rising ones grow with the exponent");
+        let caption = format!(
+            "{title} against n for every lobe: flat lines are errors that hold \
+            at every n; rising ones grow with the exponent"
+        );
         html += &context.svg(file, &chart, &caption)?;
     }
     let rows: Vec<Vec<String>> = kinds
@@ -304,7 +339,10 @@ pub fn claims(context: &mut Context) -> Result<String, String> {
     let options = context.sizes.claims.clone();
     let results = evaluate_all(&options);
     let mut html = format!(
-        "<p>Each claim of SPEC section 9, tested over {} exponents from 1 to 1000; thresholds come from the claims' own words.</p>\n<table><thead><tr><th>claim</th><th>verdict</th><th>measured</th><th>reading</th></tr></thead><tbody>",
+        "<p>Each claim of SPEC section 9, tested over {} exponents from 1 to 1000; thresholds come \
+            from the claims' own \
+            words.</p>\n<table><thead><tr><th>claim</th><th>verdict</th><th>measured</th><th>readin\
+            g</th></tr></thead><tbody>",
         options.exponents.len()
     );
     for result in &results {
@@ -446,9 +484,17 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
             legend_below: true,
             ..Chart::default()
         };
-        html += &context.svg("pareto.svg", &chart, "error against time per evaluation: lower left is better; a lobe below and left of another beats it on both")?;
+        html += &context.svg(
+            "pareto.svg",
+            &chart,
+            "error against time per evaluation: lower left \
+            is better; a lobe below and left of another beats it on both",
+        )?;
     } else {
-        html += &paragraph("Run `specula report --bench` to add measured throughput, each kernel's share of its bound and the error-against-speed plot.");
+        html += &paragraph(
+            "Run `specula report --bench` to add measured throughput, each kernel's \
+            share of its bound and the error-against-speed plot.",
+        );
     }
     Ok(table(&header, &rows) + &html)
 }

@@ -2,7 +2,8 @@
 //! FPGA, the cheapest lobe within a few epicentre accuracies at a few exponents, and for the
 //! GPUs the Pareto plot of error against modelled cost. Every cell is `specula recommend`'s
 //! answer for its target, exponent and bound ([`specula_decide::recommend_each`]: `recommend`
-//! at a row's three bounds, each lobe measured once, over the report's lobes), so the page and the command cannot disagree. The CPU's answer needs timing
+//! at a row's three bounds, each lobe measured once, over the report's lobes), so the page and the
+//! command cannot disagree. The CPU's answer needs timing
 //! on a quiet machine, so it is `specula recommend --target cpu` (and the cost section with
 //! `--bench`).
 
@@ -113,8 +114,10 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
          --n N --max-error BOUND answers (the same library call, the lobes below as \
          candidates). On the GPUs, by the cost model: each lobe's exported shader, its \
          instructions counted and weighed by the vendor's published per-clock rates \
-         (crates/specula/src/gpu_cost.rs); the ratio is its modelled throughput over pow's (higher is \
-         better, as everywhere in this report). For the CPU, run specula recommend --target cpu: its costs are measured.",
+         (crates/specula/src/gpu_cost.rs); the ratio is its modelled throughput over pow's (higher \
+         is \
+         better, as everywhere in this report). For the CPU, run specula recommend --target cpu: \
+         its costs are measured.",
     );
     let yours: Vec<String> = context
         .lobes
@@ -218,7 +221,10 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
         html += &context.svg(
             &format!("verdict-{}.svg", target.id()),
             &chart,
-            &format!("{name}: error against cost, higher left is better; the grey line joins the Pareto front"),
+            &format!(
+                "{name}: error against cost, higher left is better; the grey line joins the \
+                Pareto front"
+            ),
         )?;
     }
     Ok(answer + &html)
@@ -266,7 +272,8 @@ fn answer(
         lines.push(format!("FPGA ({within}): {}.", fpga_cell(answer)));
     }
     lines.push(format!(
-        "CPU: measured, not modelled, on the machine that will run it: specula recommend --target cpu --n {n} --max-error {}.",
+        "CPU: measured, not modelled, on the machine that will run it: specula recommend --target \
+            cpu --n {n} --max-error {}.",
         bound
     ));
     Ok(super::html::answer(&lines))

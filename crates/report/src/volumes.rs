@@ -69,7 +69,13 @@ fn phantom(context: &mut Context) -> Result<String, String> {
     let gpu = Gpu::new();
     let renderer = gpu.as_ref().ok().map(GpuVolumeRenderer::new);
     let mut html = paragraph(&format!(
-        "The 3D Shepp-Logan head ({side}³ voxels, each the mean over its cell) ray-marched at {pixels}x{pixels}, coronal view, with the mr transfer function and the thesis's normalisation, Blinn geometry, n = {EXPONENT}: every lobe is the specular term of the gradient-shaded samples (specula volume --input phantom --size {side} --lobe L --normalisation thesis-phong). FLIP and PSNR are against the pow image; times are the best of {runs} frame(s), on all CPU cores and on the GPU, after the volume's gradients and bricks were computed once (the GPU's frames upload them)."
+        "The 3D Shepp-Logan head ({side}³ voxels, each the mean over its cell) ray-marched at \
+            {pixels}x{pixels}, coronal view, with the mr transfer function and the thesis's \
+            normalisation, Blinn geometry, n = {EXPONENT}: every lobe is the specular term of the \
+            gradient-shaded samples (specula volume --input phantom --size {side} --lobe L \
+            --normalisation thesis-phong). FLIP and PSNR are against the pow image; times are the \
+            best of {runs} frame(s), on all CPU cores and on the GPU, after the volume's gradients \
+            and bricks were computed once (the GPU's frames upload them)."
     ));
     // pow's frame alone, then every lobe's image from one march (each bit for bit the one
     // marched for its lobe alone), on the volume's gradients and bricks computed once.
@@ -214,7 +220,10 @@ fn phantom(context: &mut Context) -> Result<String, String> {
         pixels,
         pixels,
         &bytes,
-        &format!("the isosurface at {iso} (marching cubes, Phong shading, pow), seen from (300, -400, 200) mm"),
+        &format!(
+            "the isosurface at {iso} (marching cubes, Phong shading, pow), seen from (300, \
+            -400, 200) mm"
+        ),
     )?;
     html += &marschner_lobb_errors(&context.lobes)?;
     Ok(html)
@@ -264,7 +273,12 @@ fn marschner_lobb_errors(lobes: &[LobeKind]) -> Result<String, String> {
         rows.push(vec![kind.to_string(), sig(gradient_error), sig(lobe_error)]);
     }
     let mut html = paragraph(&format!(
-        "Marschner-Lobb at {SIDE}³: over {} cell centres, the normals from central differences of the trilinear field are off the analytic gradient's by {mean_angle:.2}° on average and {max_angle:.1}° at worst. Below, the RMS error in each lobe's value (peak 1, n = {EXPONENT}, Blinn, the coronal view's eye and light) caused by those normals, beside the RMS of the lobe against pow at the exact normals: where the first column is the larger, the gradient estimate, not the lobe, limits the shading.",
+        "Marschner-Lobb at {SIDE}³: over {} cell centres, the normals from central differences of \
+            the trilinear field are off the analytic gradient's by {mean_angle:.2}° on average and \
+            {max_angle:.1}° at worst. Below, the RMS error in each lobe's value (peak 1, n = \
+            {EXPONENT}, Blinn, the coronal view's eye and light) caused by those normals, beside \
+            the RMS of the lobe against pow at the exact normals: where the first column is the \
+            larger, the gradient estimate, not the lobe, limits the shading.",
         angles.len()
     ));
     html += &table(

@@ -13,13 +13,15 @@
 //! - `GET /api/evaluate?lobe&n&geometry&normalisation&theta_in`: every plot's data;
 //! - `GET /api/analyze?lobe&n`: the error, energy and albedo figures (`specula analyze`'s),
 //!   and `costs`, the lobe's cost on every target the server's cost model knows;
-//! - `GET /api/render?object&lobe&n&geometry&normalisation&shading&model&light_theta&light_phi&size`:
+//! - `GET
+//! /api/render?object&lobe&n&geometry&normalisation&shading&model&light_theta&light_phi&size`:
 //!   a PNG from the CPU renderer;
 //! - `GET /api/volume?volume&view&lobe&n&geometry&normalisation&size`: a volume (a built-in
 //!   one, or a real scan while its file is installed) ray marched on the CPU, as a PNG;
 //! - `GET /api/environment?lobe&n&geometry&normalisation&size&spp`: the environment scene lit
 //!   by the procedural sky (Monte Carlo, CPU), as a PNG;
-//! - `GET /api/materials`, `GET /api/fits?material`, `GET /api/material-render?material&fit&size&spp`:
+//! - `GET /api/materials`, `GET /api/fits?material`, `GET
+//! /api/material-render?material&fit&size&spp`:
 //!   the measured materials of the `--data` folder, by name (`measured.rs`);
 //! - `GET /api/design?target&low&high&max_error`: a lobe designed for a GPU family, by the
 //!   search the server was handed (`design.rs`).
@@ -156,7 +158,8 @@ async fn compute_with<T: Send + 'static>(
 pub async fn not_found() -> ApiError {
     ApiError::not_found(
         "no such page or endpoint".into(),
-        "/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume, /api/environment, /api/materials, /api/fits, /api/material-render, /api/design"
+        "/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume, /api/environment, \
+            /api/materials, /api/fits, /api/material-render, /api/design"
             .into(),
     )
 }

@@ -179,9 +179,11 @@ pub fn scene(request: &RenderRequest) -> Result<Scene, String> {
     let (sp, cp) = request.light_phi.sin_cos();
     let towards = [st * cp, -ct, st * sp];
     let (shape, placement) = match request.object {
-        Object::Sphere => ("shape = \"sphere\"\nradius = 1.0\nsegments = 128\nrings = 64", "eye = [0.0, -4.2, 0.0]\ntarget = [0.0, 0.0, 0.0]"),
+        Object::Sphere => ("shape = \"sphere\"\nradius = 1.0\nsegments = 128\nrings = 64", "eye = \
+            [0.0, -4.2, 0.0]\ntarget = [0.0, 0.0, 0.0]"),
         Object::Teapot => (
-            "shape = \"teapot\"\nlevel = 10\nscale = 0.55\nrotate = [0.0, 0.0, -30.0]\ntranslate = [0.0, 0.0, -0.85]",
+            "shape = \"teapot\"\nlevel = 10\nscale = 0.55\nrotate = [0.0, 0.0, -30.0]\ntranslate = \
+                [0.0, 0.0, -0.85]",
             "eye = [0.0, -6.5, 1.8]\ntarget = [0.0, 0.0, 0.0]",
         ),
     };

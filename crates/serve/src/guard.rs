@@ -82,7 +82,8 @@ pub async fn check_host(State(hosts): State<Hosts>, request: Request, next: Next
         Some(host) if !hosts.allows(&host) => (
             StatusCode::MISDIRECTED_REQUEST,
             Json(json!({
-                "error": format!("this server answers to localhost, not to {}", specula::excerpt(&host)),
+                "error": format!("this server answers to localhost, not to \
+                    {}", specula::excerpt(&host)),
                 "parameter": "Host",
                 "valid": hosts.names.join(", "),
             })),
@@ -138,7 +139,8 @@ fn busy() -> Response {
         StatusCode::SERVICE_UNAVAILABLE,
         [(header::RETRY_AFTER, "1")],
         Json(json!({
-            "error": format!("the server is busy: {QUEUED_COMPUTATIONS} computations are already queued; retry shortly"),
+            "error": format!("the server is busy: {QUEUED_COMPUTATIONS} computations are already \
+                queued; retry shortly"),
         })),
     )
         .into_response()

@@ -116,7 +116,8 @@ pub fn serve(
 ) -> Result<(), String> {
     if !address.ip().is_loopback() {
         eprintln!(
-            "warning: listening on {}, reachable from other machines; the explorer has no authentication",
+            "warning: listening on {}, reachable from other machines; the explorer has no \
+                authentication",
             address.ip()
         );
     }

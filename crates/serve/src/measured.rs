@@ -157,14 +157,17 @@ impl Materials {
             };
             if found.len() == MAX_MATERIALS {
                 return Err(format!(
-                    "--data {shown} holds more than {MAX_MATERIALS} .bsdf files; the explorer offers at most {MAX_MATERIALS}: pass a folder with fewer (links to the files will do)"
+                    "--data {shown} holds more than {MAX_MATERIALS} .bsdf files; the explorer \
+                        offers at most {MAX_MATERIALS}: pass a folder with fewer (links to the \
+                        files will do)"
                 ));
             }
             found.push((name.to_owned(), path.clone()));
         }
         if found.is_empty() {
             return Err(format!(
-                "--data {shown} holds no .bsdf file (measured materials are read from the folder itself, not its subfolders)"
+                "--data {shown} holds no .bsdf file (measured materials are read from the folder \
+                    itself, not its subfolders)"
             ));
         }
         let mut entries = self.entries;
@@ -423,7 +426,10 @@ fn assess(name: &str, material: &MeasuredBrdf, costs: &CostModel) -> Result<Asse
         material: name,
         description: material.description(),
         error_measure: format!(
-            "root mean square over {} direction pairs (a {nh} x {nd} x {nphi} grid in half and difference angles, both directions within {MAX_ELEVATION_DEGREES} degrees of the normal, weighted by solid angle) of the difference of the cube roots of f cos(theta_i), the three channels averaged",
+            "root mean square over {} direction pairs (a {nh} x {nd} x {nphi} grid in half and \
+                difference angles, both directions within {MAX_ELEVATION_DEGREES} degrees of the \
+                normal, weighted by solid angle) of the difference of the cube roots of f \
+                cos(theta_i), the three channels averaged",
             observations.len()
         ),
         pairs: observations.len(),
@@ -507,4 +513,5 @@ pub(crate) fn material(params: &Params, materials: &Materials) -> Result<usize, 
 }
 
 /// What the view says when the server has no materials.
-pub(crate) const NO_DATA: &str = "the server offers no measured materials: start it with `specula serve` (the five bundled ones) or `specula serve --data DIR`, DIR a folder of RGL .bsdf files";
+pub(crate) const NO_DATA: &str = "the server offers no measured materials: start it with `specula \
+    serve` (the five bundled ones) or `specula serve --data DIR`, DIR a folder of RGL .bsdf files";

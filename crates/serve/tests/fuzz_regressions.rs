@@ -1,5 +1,6 @@
 //! Replays the API, formula and analysis fuzzers' seeds and every crash input they found
-//! (`fuzz/regressions/{api,formula,analysis}/`) through the fuzz targets' own checks, so that CI needs
+//! (`fuzz/regressions/{api,formula,analysis}/`) through the fuzz targets' own checks, so that CI
+//! needs
 //! no fuzzer.
 
 use std::path::Path;

@@ -98,7 +98,8 @@ async fn renders_from_the_front(scan: Scan, units: Units, preset: &str) {
     }
     const SIZE: u32 = 64;
     let uri = format!(
-        "/api/volume?volume={}&view=anterior&lobe=pow&n=40&geometry=blinn&normalisation=thesis-phong&size={SIZE}",
+        "/api/volume?volume={}&view=anterior&lobe=pow&n=40&geometry=blinn&normalisation=thesis-phon\
+            g&size={SIZE}",
         scan.id()
     );
     let (status, served) = get(&uri).await;

@@ -10,7 +10,8 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum Error {
     /// A specular exponent outside `[1, 1000]`, or not a finite number.
-    #[error("specular exponent n = {value} is out of range: n must be a finite number in [{min}, {max}]", min = crate::Exponent::MIN, max = crate::Exponent::MAX)]
+    #[error("specular exponent n = {value} is out of range: n must be a finite number in [{min}, \
+        {max}]", min = crate::Exponent::MIN, max = crate::Exponent::MAX)]
     ExponentOutOfRange {
         /// The rejected value.
         value: f64,

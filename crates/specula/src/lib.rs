@@ -27,7 +27,8 @@
 //! let reference: f64 = lobe.eval(0.99_f64); // reference path, same formula
 //! assert!((f64::from(value) - reference).abs() < 1e-6);
 //! assert_eq!(lobe.eval(-0.3_f64), 0.0);
-//! let brdf = Brdf::new(Rgb::splat(0.2), Rgb::splat(0.8), lobe, Geometry::Blinn, Normalisation::Lobe);
+//! let (kd, ks) = (Rgb::splat(0.2), Rgb::splat(0.8));
+//! let brdf = Brdf::new(kd, ks, lobe, Geometry::Blinn, Normalisation::Lobe);
 //! assert!(brdf.f(Rgb::Z, Rgb::Z).x > 0.0);
 //! # Ok(())
 //! # }

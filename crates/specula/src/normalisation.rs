@@ -1,14 +1,16 @@
 //! Normalisation: the factor `N(n)` that turns a peak-1 lobe into an energy-conserving BRDF
 //! term (SPEC section 5).
 //!
-//! | id             | `N(n)`                                   | makes ... integrate to 1                |
-//! |----------------|------------------------------------------|-----------------------------------------|
-//! | `none`         | `1`                                      | (peak 1, the classic model)             |
-//! | `lobe`         | `(n+1)/(2 pi)` for `t^n`; in general `1 / (2 pi int_0^1 lobe(t) dt)` | the lobe over the hemisphere around its axis |
-//! | `thesis-phong` | `1.063 n / (2 pi)`                       | the thesis's coef1, as stated           |
-//! | `lafortune`    | `(n+2)/(2 pi)`                           | `t^n cos(theta)` at normal incidence    |
-//! | `blinn`        | `(n+2)(n+4) / (8 pi (2^(-n/2) + n))`     | Blinn's `(N.H)^n (N.L)` at normal incidence |
-//! | `blinn-approx` | `(n+8)/(8 pi)`                           | the usual approximation of `blinn`      |
+//! | id             | `N(n)`                                 | makes ... integrate to 1           |
+//! |----------------|----------------------------------------|------------------------------------|
+//! | `none`         | `1`                                    | (peak 1, the classic model)        |
+//! | `lobe`         | `(n+1)/(2 pi)` for `t^n`; in general   | the lobe over the hemisphere       |
+//! |                | `1 / (2 pi int_0^1 lobe(t) dt)`        | around its axis                    |
+//! | `thesis-phong` | `1.063 n / (2 pi)`                     | the thesis's coef1, as stated      |
+//! | `lafortune`    | `(n+2)/(2 pi)`                         | `t^n cos(theta)`, normal incidence |
+//! | `blinn`        | `(n+2)(n+4) / (8 pi (2^(-n/2) + n))`   | Blinn's `(N.H)^n (N.L)`, normal    |
+//! |                |                                        | incidence                          |
+//! | `blinn-approx` | `(n+8)/(8 pi)`                         | the usual approximation of `blinn` |
 //!
 //! `lobe` applied to an approximation uses *that lobe's own* constant, computed numerically,
 //! so a white furnace holds for it; the analytic `(n+1)/(2 pi)` of `t^n` applied to an

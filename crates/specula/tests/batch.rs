@@ -39,7 +39,10 @@ proptest! {
     fn batch_matches_scalar_within_its_bound(
         kind in kinds(),
         n in 1.0_f64..=1000.0,
-        ts in proptest::collection::vec(prop_oneof![0.0_f32..=1.0, 0.99_f32..=1.0, -1.0_f32..=1.5], 1..300),
+        ts in proptest::collection::vec(
+            prop_oneof![0.0_f32..=1.0, 0.99_f32..=1.0, -1.0_f32..=1.5],
+            1..300,
+        ),
     ) {
         check(&Lobe::new(kind, Exponent::new(n)), &ts)?;
     }

@@ -348,7 +348,8 @@ fn importance_sampled_albedo_matches_quadrature() {
         );
         assert!(
             albedo_error < 3e-3 && coverage_error < 3e-3,
-            "{} at {theta} degrees: albedo {albedo} against {sampled}, coverage {density} against {covered}",
+            "{} at {theta} degrees: albedo {albedo} against {sampled}, coverage {density} against \
+                {covered}",
             file.display()
         );
     });

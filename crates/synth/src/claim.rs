@@ -174,7 +174,11 @@ fn judge(target: f64, designs: Vec<Design>) -> HardwareClaim {
     HardwareClaim {
         claim: STATEMENT,
         reading: format!(
-            "each datapath at the smallest word length whose epicentre max relative error at n = {CLAIM_N} is at most {:.3} % ({TARGET_OVER_COSQUAD} x the cosquad model's), synthesized and placed on an iCE40 HX8K (every operator in LUT4s; {tools}); cost = LUTs x clock period per result; holds if cosquad is cheaper than both pow and sg, with qualification if only than pow",
+            "each datapath at the smallest word length whose epicentre max relative error at n = \
+                {CLAIM_N} is at most {:.3} % ({TARGET_OVER_COSQUAD} x the cosquad model's), \
+                synthesized and placed on an iCE40 HX8K (every operator in LUT4s; {tools}); cost = \
+                LUTs x clock period per result; holds if cosquad is cheaper than both pow and sg, \
+                with qualification if only than pow",
             target * 100.0
         ),
         measured: format!(

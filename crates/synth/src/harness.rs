@@ -25,7 +25,9 @@ pub fn harness(datapath: &Datapath) -> String {
     let mut v = String::new();
     let _ = writeln!(
         v,
-        "module {HARNESS} (\n    input wire clk,\n    input wire din,\n    output reg dout\n);\n    reg [{}:0] chain;\n    always @(posedge clk) chain <= {{chain[{}:0], din}};\n    wire [{}:0] value;",
+        "module {HARNESS} (\n    input wire clk,\n    input wire din,\n    output reg \
+            dout\n);\n    reg [{}:0] chain;\n    always @(posedge clk) chain <= {{chain[{}:0], \
+            din}};\n    wire [{}:0] value;",
         total - 1,
         total - 2,
         output - 1
@@ -38,7 +40,8 @@ pub fn harness(datapath: &Datapath) -> String {
     }
     let _ = writeln!(
         v,
-        "    {} dut (.clk(clk), {}, .value(value));\n    always @(posedge clk) dout <= ^value;\nendmodule",
+        "    {} dut (.clk(clk), {}, .value(value));\n    always @(posedge clk) dout <= \
+            ^value;\nendmodule",
         datapath.name,
         ports.join(", ")
     );

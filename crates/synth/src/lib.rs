@@ -187,7 +187,10 @@ impl Synthesis {
 #[derive(Debug, thiserror::Error)]
 pub enum SynthError {
     /// A tool is not installed.
-    #[error("{tool} is not installed; install the Debian package `{package}` (apt-get install {package})")]
+    #[error(
+        "{tool} is not installed; install the Debian package `{package}` (apt-get install \
+        {package})"
+    )]
     ToolMissing {
         /// The program.
         tool: &'static str,
@@ -327,7 +330,8 @@ fn place_and_route(
     let (cells_available, dsps_available) = device.capacity();
     if result.cells.dsp > dsps_available || result.cells.logic > cells_available {
         result.fmax_note = Some(format!(
-            "does not fit the {}: {} of {cells_available} LUTs, {} of {dsps_available} multiplier blocks",
+            "does not fit the {}: {} of {cells_available} LUTs, {} of {dsps_available} multiplier \
+                blocks",
             device.id().to_uppercase(),
             result.cells.logic,
             result.cells.dsp
@@ -360,7 +364,8 @@ fn place_and_route(
     if let Err(SynthError::ToolFailed { log, .. }) = &placed {
         if log.contains("Failed to expand region") {
             result.fmax_note = Some(format!(
-                "does not fit the {} once packed: {} LUTs by Yosys's count, more logic cells than its {cells_available} after packing",
+                "does not fit the {} once packed: {} LUTs by Yosys's count, more logic cells than \
+                    its {cells_available} after packing",
                 device.id().to_uppercase(),
                 result.cells.logic
             ));

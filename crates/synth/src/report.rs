@@ -150,10 +150,12 @@ mod tests {
 
     #[test]
     fn generic_and_xilinx_cells_are_classified() {
-        let generic = r#"{"design": {"num_cells_by_type": {"$_AND_": 4, "$_XOR_": 2, "$_DFF_P_": 3, "$_SDFF_PP0_": 1}}}"#;
+        let generic = r#"{"design": {"num_cells_by_type":
+            {"$_AND_": 4, "$_XOR_": 2, "$_DFF_P_": 3, "$_SDFF_PP0_": 1}}}"#;
         let cells_generic = cells(generic, Target::Generic).expect("valid");
         assert_eq!((cells_generic.logic, cells_generic.flip_flops), (6, 4));
-        let xilinx = r#"{"design": {"num_cells_by_type": {"LUT2": 4, "LUT6": 1, "CARRY4": 2, "DSP48E1": 1, "FDRE": 7, "IBUF": 3, "MUXF7": 1}}}"#;
+        let xilinx = r#"{"design": {"num_cells_by_type": {"LUT2": 4, "LUT6": 1, "CARRY4": 2,
+            "DSP48E1": 1, "FDRE": 7, "IBUF": 3, "MUXF7": 1}}}"#;
         let cells_xilinx = cells(xilinx, Target::Xilinx).expect("valid");
         assert_eq!(
             (

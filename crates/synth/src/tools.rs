@@ -101,7 +101,8 @@ impl ToolVersions {
 /// Lines of a failing tool's output kept in the message.
 const LOG_LINES: usize = 4;
 
-/// Runs `tool` with `args` on `design` in `directory` (the current one if `None`); what it printed (standard output, then standard
+/// Runs `tool` with `args` on `design` in `directory` (the current one if `None`); what it printed
+/// (standard output, then standard
 /// error: nextpnr prints its version on the latter), or why it failed.
 pub(crate) fn run(
     tool: Tool,

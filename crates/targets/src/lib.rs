@@ -59,11 +59,15 @@ impl RendererFormat {
         let fit = || specula::fit::microfacet(lobe, geometry);
         match self {
             RendererFormat::Osl if normalisation != Normalisation::None => Err(format!(
-                "--lang osl takes no --normalisation (given {}): its Emission is the thesis's specular term, which has none, and its BSDF is GGX, normalised by construction; leave it out, or use --lang mtlx or mitsuba",
+                "--lang osl takes no --normalisation (given {}): its Emission is the thesis's \
+                    specular term, which has none, and its BSDF is GGX, normalised by \
+                    construction; leave it out, or use --lang mtlx or mitsuba",
                 normalisation.id()
             )),
             RendererFormat::Osl => Ok(osl::shader(lobe, geometry, &fit())),
-            RendererFormat::MaterialX => Ok(materialx::document(lobe, geometry, normalisation, &fit())),
+            RendererFormat::MaterialX => {
+                Ok(materialx::document(lobe, geometry, normalisation, &fit()))
+            }
             RendererFormat::Mitsuba => Ok(mitsuba::plugin(lobe, geometry, normalisation)),
         }
     }

@@ -100,10 +100,11 @@ pub fn document(
     let parameter_inputs = |out: &mut String| match inputs.exponent {
         Some([low, high]) => {
             let _ = writeln!(
-                    out,
-                    "    <input name=\"n\" type=\"float\" value=\"{}\" uimin=\"{low}\" uimax=\"{high}\" />",
-                    lobe.exponent()
-                );
+                out,
+                "    <input name=\"n\" type=\"float\" value=\"{}\" uimin=\"{low}\" \
+                        uimax=\"{high}\" />",
+                lobe.exponent()
+            );
         }
         None => {
             for (name, value) in &inputs.fitted {
@@ -469,15 +470,21 @@ const BSDF_HELPERS: &str = r#"
   <nodedef name="ND_specula_closure_light_vector3" node="specula_closure_light" nodegroup="pbr">
     <output name="out" type="vector3" />
   </nodedef>
-  <implementation name="IM_specula_closure_light_vector3_genglsl" nodedef="ND_specula_closure_light_vector3" target="genglsl" sourcecode="closureData.L" />
+  <implementation name="IM_specula_closure_light_vector3_genglsl"
+    nodedef="ND_specula_closure_light_vector3" target="genglsl" sourcecode="closureData.L" />
   <nodedef name="ND_specula_closure_view_vector3" node="specula_closure_view" nodegroup="pbr">
     <output name="out" type="vector3" />
   </nodedef>
-  <implementation name="IM_specula_closure_view_vector3_genglsl" nodedef="ND_specula_closure_view_vector3" target="genglsl" sourcecode="closureData.V" />
+  <implementation name="IM_specula_closure_view_vector3_genglsl"
+    nodedef="ND_specula_closure_view_vector3" target="genglsl" sourcecode="closureData.V" />
   <nodedef name="ND_specula_reflection_bsdf" node="specula_reflection_bsdf" nodegroup="pbr">
     <input name="response" type="color3" value="0.0, 0.0, 0.0" />
     <output name="out" type="BSDF" />
   </nodedef>
-  <implementation name="IM_specula_reflection_bsdf_genglsl" nodedef="ND_specula_reflection_bsdf" target="genglsl" sourcecode="BSDF(closureData.closureType == CLOSURE_TYPE_REFLECTION ? {{response}} * closureData.occlusion : vec3(0.0), vec3(1.0))" />
-  <implementation name="IM_specula_reflection_bsdf_genmsl" nodedef="ND_specula_reflection_bsdf" target="genmsl" sourcecode="BSDF{closureData.closureType == CLOSURE_TYPE_REFLECTION ? {{response}} * closureData.occlusion : float3(0.0), float3(1.0)}" />
+  <implementation name="IM_specula_reflection_bsdf_genglsl" nodedef="ND_specula_reflection_bsdf"
+    target="genglsl" sourcecode="BSDF(closureData.closureType == CLOSURE_TYPE_REFLECTION
+    ? {{response}} * closureData.occlusion : vec3(0.0), vec3(1.0))" />
+  <implementation name="IM_specula_reflection_bsdf_genmsl" nodedef="ND_specula_reflection_bsdf"
+    target="genmsl" sourcecode="BSDF{closureData.closureType == CLOSURE_TYPE_REFLECTION
+    ? {{response}} * closureData.occlusion : float3(0.0), float3(1.0)}" />
 "#;

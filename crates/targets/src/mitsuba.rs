@@ -153,7 +153,8 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
             with_u.extend(inputs.order.iter().copied());
             let _ = writeln!(
                 sampling_functions,
-                "\n# The cosine whose tail is the fraction u of the lobe's (specula's closed form).\n{}\n# int_0^1 lobe, in closed form (of the parameters alone).\n{}",
+                "\n# The cosine whose tail is the fraction u of the lobe's (specula's closed \
+                    form).\n{}\n# int_0^1 lobe, in closed form (of the parameters alone).\n{}",
                 function(&DrJit, "_tail_inverse", &with_u, inverse),
                 function(&PythonMath, "_total_math", &with_u, total),
             );
@@ -165,16 +166,23 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
                 with_x.extend(inputs.order.iter().copied());
                 let _ = writeln!(
                     sampling_functions,
-                    "\n# The lobe's closed-form tail in the variable x Newton's method solves in, its slope,\n# and the cosine x stands for (specula's).\n{}\n{}\n{}\n# The end of x's range, and int_0^1 lobe (of the parameters alone).\n{}\n{}",
+                    "\n# The lobe's closed-form tail in the variable x Newton's method solves in, \
+                        its slope,\n# and the cosine x stands for (specula's).\n{}\n{}\n{}\n# The \
+                        end of x's range, and int_0^1 lobe (of the parameters alone).\n{}\n{}",
                     function(&DrJit, "_newton_tail", &with_x, &tail),
                     function(&DrJit, "_newton_slope", &with_x, &slope),
                     function(&DrJit, "_newton_cosine", &with_x, &cosine),
                     function(&PythonMath, "_newton_upper_math", &with_x, &upper),
                     function(&PythonMath, "_total_math", &with_x, &total),
                 );
-                "its closed-form tail inverted by Newton's method safeguarded by bisection, as\nspecula's sampler does (a fixed number of steps here, enough for float32)"
+                "its closed-form tail inverted by Newton's method safeguarded by bisection, \
+                    as\nspecula's sampler does (a fixed number of steps here, enough for float32)"
             }
-            None => "from specula's table of it, the density linear in t between the lobe's values at\nthe cosines of the angles (pi/2) (k/1024)^2, k = 0 .. 1024 (Mitsuba's\nIrregularContinuousDistribution)",
+            None => {
+                "from specula's table of it, the density linear in t between the lobe's values \
+                at\nthe cosines of the angles (pi/2) (k/1024)^2, k = 0 .. 1024 \
+                (Mitsuba's\nIrregularContinuousDistribution)"
+            }
         },
     };
     let sampling_kind = if sampling.is_some() {
@@ -190,7 +198,8 @@ pub fn plugin(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> 
             crate::code::describe_range(range)
         ),
         None => format!(
-            "n: {:?} only; the coefficients {} are properties too, fitted by\n  specula for that n (export again for another n)",
+            "n: {:?} only; the coefficients {} are properties too, fitted by\n  specula for that n \
+                (export again for another n)",
             lobe.exponent().get(),
             inputs.order.join(", ")
         ),

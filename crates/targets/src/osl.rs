@@ -80,11 +80,13 @@ pub fn shader(lobe: &Lobe, geometry: Geometry, fit: &MicrofacetFit) -> String {
     let arguments = inputs.arguments("exponent").join(", ");
     let exponent_note = match inputs.exponent {
         Some(range) => format!(
-            "`n` is an input in {}\n// (where the lobe's operations stay the same), and its constants are computed from it.",
+            "`n` is an input in {}\n// (where the lobe's operations stay the same), and its \
+                constants are computed from it.",
             describe_range(range)
         ),
         None => format!(
-            "its coefficients are inputs,\n// fitted by specula for n = {} (export again for another n).",
+            "its coefficients are inputs,\n// fitted by specula for n = {} (export again for \
+                another n).",
             lobe.exponent()
         ),
     };

@@ -71,7 +71,8 @@ pub fn run(args: &Args) -> CommandResult {
     progress.finish_and_clear();
     for r in reports.iter().filter(|r| !r.energy_converged) {
         eprintln!(
-            "note: {} at n = {}: the energy's integral did not converge within {} panels (the lobe's f64 values are noisy there); its figure is the estimate",
+            "note: {} at n = {}: the energy's integral did not converge within {} panels (the \
+                lobe's f64 values are noisy there); its figure is the estimate",
             r.lobe,
             r.n,
             specula::quadrature::MAX_PANELS

@@ -125,7 +125,8 @@ pub fn run(args: &Args) -> CommandResult {
             print!("{}", summary.render());
             for [claim, verdict, measured, reading] in &blocks {
                 println!(
-                    "\n{claim}\n  verdict:  {verdict}\n  measured: {measured}\n  reading:  {reading}"
+                    "\n{claim}\n  verdict:  {verdict}\n  measured: {measured}\n  reading:  \
+                        {reading}"
                 );
             }
             Ok(())

@@ -35,7 +35,11 @@ pub struct Args {
     #[arg(long, num_args = 1.., required = true)]
     material: Vec<PathBuf>,
     /// Where the chosen lobe will run (its cost model; `cpu` is timed on this machine).
-    #[arg(long, value_parser = described(&Target::ALL, Target::id, Target::summary), default_value_t = Target::GpuNvidia)]
+    #[arg(
+        long,
+        value_parser = described(&Target::ALL, Target::id, Target::summary),
+        default_value_t = Target::GpuNvidia,
+    )]
     target: Target,
     /// The fit error allowed over pow's, as a percentage (`5%`).
     #[arg(long, allow_hyphen_values = true, default_value = "5%", value_parser = parse_margin)]
@@ -95,7 +99,8 @@ fn print_table(a: &Assessment) {
     }
     table.print(crate::args::OutputFormat::Table);
     println!(
-        "E: {}; albedo: the fit's at normal incidence (luminance); rate: {}; *: at an end of the range searched.\n",
+        "E: {}; albedo: the fit's at normal incidence (luminance); rate: {}; *: at an end of the \
+            range searched.\n",
         a.error_measure, a.rate_unit
     );
 }

@@ -86,13 +86,27 @@ struct TableArgs {
     #[arg(long, value_parser = parse_lobe, value_delimiter = ',')]
     lobe: Vec<HwLobe>,
     /// Word lengths: LOW..HIGH or one width.
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_bits_range, default_value = "8..24")]
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_parser = parse_bits_range,
+        default_value = "8..24",
+    )]
     bits: (u32, u32),
     /// The integer exponent.
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_integer_exponent, default_value = "64")]
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_parser = parse_integer_exponent,
+        default_value = "64",
+    )]
     n: u32,
     /// Angles sampled per zone.
-    #[arg(long, default_value_t = 20_000, value_parser = clap::value_parser!(u32).range(100..=1_000_000))]
+    #[arg(
+        long,
+        default_value_t = 20_000,
+        value_parser = clap::value_parser!(u32).range(100..=1_000_000),
+    )]
     samples: u32,
     /// Output format.
     #[arg(long, value_enum, default_value_t)]
@@ -278,7 +292,11 @@ fn table(args: &TableArgs) -> CommandResult {
     }
     table.print(args.format);
     if args.format == OutputFormat::Table {
-        println!("\nn = {}; widths are in bits; \"meets\" = epicentre max rel within {MEETS_TOLERANCE}x the f64 model's.", args.n);
+        println!(
+            "\nn = {}; widths are in bits; \"meets\" = epicentre max rel within \
+            {MEETS_TOLERANCE}x the f64 model's.",
+            args.n
+        );
         for result in &results {
             let meets = result.minimum_width().map_or_else(
                 || {

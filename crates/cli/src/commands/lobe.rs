@@ -214,7 +214,8 @@ fn warn_of(shapes: &[Shape]) {
             ""
         };
         eprintln!(
-            "warning: the lobe is {:.6} at t = 1 (n = {}), not 1: it {change} every highlight{remedy}",
+            "warning: the lobe is {:.6} at t = 1 (n = {}), not 1: it {change} every \
+                highlight{remedy}",
             shape.at_one,
             sig(shape.n)
         );
@@ -224,7 +225,9 @@ fn warn_of(shapes: &[Shape]) {
         .find(|shape| shape.peak > shape.at_one + Shape::REACHES_ONE)
     {
         eprintln!(
-            "warning: the lobe peaks at {:.6} where t = {:.6} ({:.2} degrees from the mirror direction, n = {}), above its value at t = 1: its highlights move off the mirror direction",
+            "warning: the lobe peaks at {:.6} where t = {:.6} ({:.2} degrees from the mirror \
+                direction, n = {}), above its value at t = 1: its highlights move off the mirror \
+                direction",
             shape.peak,
             shape.peak_cos,
             shape.peak_angle_degrees(),

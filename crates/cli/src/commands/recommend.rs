@@ -21,17 +21,32 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = parse_exponents)]
     n: Exponents,
     /// The largest error allowed, as a percentage (`1%` or `1`).
-    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::parse_percent, required_unless_present = "material")]
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_parser = crate::args::parse_percent,
+        required_unless_present = "material",
+    )]
     max_error: Option<f64>,
     /// Rank by the fit to a measured material instead (an RGL isotropic RGB `.bsdf`): the
     /// cheapest lobe whose fit error is within `--margin` of pow's (see `specula fit`).
     #[arg(long, conflicts_with_all = ["max_error", "n", "zone", "energy_conserving"])]
     material: Option<std::path::PathBuf>,
     /// With `--material`: the fit error allowed over pow's, as a percentage [default: 5%].
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_margin, requires = "material", conflicts_with = "max_error")]
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_parser = parse_margin,
+        requires = "material",
+        conflicts_with = "max_error",
+    )]
     margin: Option<f64>,
     /// Which error.
-    #[arg(long, value_parser = described(&Zone::ALL, Zone::id, Zone::summary), default_value_t = Zone::Epicentre)]
+    #[arg(
+        long,
+        value_parser = described(&Zone::ALL, Zone::id, Zone::summary),
+        default_value_t = Zone::Epicentre,
+    )]
     zone: Zone,
     /// Only lobes whose energy stays within 0.1 % of t^n's (so the n + 1 normalisation keeps
     /// the BRDF energy-conserving).

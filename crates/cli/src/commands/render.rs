@@ -24,7 +24,11 @@ pub struct Args {
     input_limit: crate::args::InputLimit,
     /// The most triangles a scene may have (procedural shapes are counted before they are
     /// built; about 100 bytes of memory each while rendering).
-    #[arg(long, default_value_t = specula_render::MAX_TRIANGLES, value_parser = clap::value_parser!(u64).range(1..=1 << 28))]
+    #[arg(
+        long,
+        default_value_t = specula_render::MAX_TRIANGLES,
+        value_parser = clap::value_parser!(u64).range(1..=1 << 28),
+    )]
     max_triangles: u64,
     /// A scene file (TOML); the embedded default scene when omitted.
     scene: Option<PathBuf>,
@@ -56,7 +60,10 @@ pub struct Args {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     height: Option<u32>,
     /// Supersampling: S x S samples per pixel.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=specula_render::MAX_SAMPLES as i64))]
+    #[arg(
+        long,
+        value_parser = clap::value_parser!(u32).range(1..=specula_render::MAX_SAMPLES as i64),
+    )]
     samples: Option<u32>,
     /// One tile per lobe with its FLIP against pow, e.g. `lobes=pow,schlick,cheb2` (PNG only).
     #[arg(long, value_parser = parse_grid, value_name = "lobes=ID,...")]
@@ -71,7 +78,12 @@ pub struct Args {
     #[arg(long, value_name = "sky|FILE", conflicts_with_all = ["shading", "model"])]
     env: Option<PathBuf>,
     /// Samples per pixel with --env.
-    #[arg(long, requires = "env", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SPP)))]
+    #[arg(
+        long,
+        requires = "env",
+        default_value_t = 64,
+        value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SPP)),
+    )]
     spp: u32,
     /// The random stream with --env: renders with different seeds are independent.
     #[arg(long, requires = "env", default_value_t = 0)]

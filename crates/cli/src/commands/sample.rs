@@ -193,7 +193,8 @@ fn suite(args: &Args) -> CommandResult {
         settings.samples
     );
     println!(
-        "lobe           n     form   theta_o  warp      newton     p-value   dof   pdf integral  verdict"
+        "lobe           n     form   theta_o  warp      newton     p-value   dof   pdf integral  \
+            verdict"
     );
     let bar = ProgressBar::new(cases.len() as u64).with_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed}")

@@ -82,7 +82,8 @@ fn designer() -> DesignModel {
         }
         if answered.lock().map_err(|e| e.to_string())?.len() >= MAX_DESIGNS {
             return Err(format!(
-                "this server has designed {MAX_DESIGNS} lobes, its limit; ask one of those again, or restart specula serve"
+                "this server has designed {MAX_DESIGNS} lobes, its limit; ask one of those again, \
+                    or restart specula serve"
             ));
         }
         let target: Target = query.target.parse().map_err(|e: String| e)?;

@@ -22,7 +22,11 @@ pub struct Args {
     geometry: Geometry,
     /// The normalisation N(n) of the specular term (`specula_specular`, MaterialX's BSDF, the
     /// Mitsuba plugin's default); OSL takes none.
-    #[arg(long, value_parser = choice(&Normalisation::ALL, Normalisation::id), default_value = "none")]
+    #[arg(
+        long,
+        value_parser = choice(&Normalisation::ALL, Normalisation::id),
+        default_value = "none",
+    )]
     normalisation: Normalisation,
     /// The shading language: wgsl, glsl, hlsl, msl, spirv (a function for one's own
     /// shader), osl (a Blender Cycles script node), mtlx (a MaterialX

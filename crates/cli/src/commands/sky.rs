@@ -16,7 +16,11 @@ pub struct Args {
     #[arg(short, long, default_value = "sky.exr")]
     output: PathBuf,
     /// Width in pixels (the height is half of it); `--env sky` uses 1024.
-    #[arg(long, default_value_t = SKY_WIDTH, value_parser = clap::value_parser!(u32).range(2..=8192))]
+    #[arg(
+        long,
+        default_value_t = SKY_WIDTH,
+        value_parser = clap::value_parser!(u32).range(2..=8192),
+    )]
     width: u32,
 }
 
@@ -33,7 +37,8 @@ pub fn run(args: &Args) -> CommandResult {
     write_image(&args.output, sky.image(), Display::default()).map_err(|e| e.to_string())?;
     let sun = sun_direction();
     eprintln!(
-        "wrote {} ({}x{} equirectangular, linear radiance, world z up; sun towards ({:.4}, {:.4}, {:.4}), {:.1} degrees across)",
+        "wrote {} ({}x{} equirectangular, linear radiance, world z up; sun towards ({:.4}, {:.4}, \
+            {:.4}), {:.1} degrees across)",
         args.output.display(),
         sky.image().width(),
         sky.image().height(),

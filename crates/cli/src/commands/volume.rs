@@ -42,7 +42,11 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     iso: Option<f32>,
     /// How --mode iso interpolates its lighting.
-    #[arg(long, value_parser = choice(&specula_render::Shading::ALL, specula_render::Shading::id), default_value = "phong")]
+    #[arg(
+        long,
+        value_parser = choice(&specula_render::Shading::ALL, specula_render::Shading::id),
+        default_value = "phong",
+    )]
     shading: specula_render::Shading,
     /// The transfer function: a preset (ct-bone, ct-soft-tissue, mr, surface) or a .toml file; by
     /// default surface for marschner-lobb, ct-bone for CT and mr otherwise.
@@ -85,7 +89,11 @@ pub struct Args {
     #[arg(long, value_parser = choice(&Geometry::ALL, Geometry::id), default_value = "blinn")]
     geometry: Geometry,
     /// The specular normalisation (the thesis's is thesis-phong).
-    #[arg(long, value_parser = choice(&Normalisation::ALL, Normalisation::id), default_value = "none")]
+    #[arg(
+        long,
+        value_parser = choice(&Normalisation::ALL, Normalisation::id),
+        default_value = "none",
+    )]
     normalisation: Normalisation,
     /// The side the camera stands on: anterior (the face), posterior, left, right, superior or
     /// inferior (also coronal = anterior, sagittal = left, axial = inferior).
@@ -117,7 +125,12 @@ pub struct Source {
     #[arg(long, default_value = "phantom")]
     input: String,
     /// Voxels along each side of a built-in volume.
-    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(*BuiltIn::SIDES.start() as i64..=*BuiltIn::SIDES.end() as i64))]
+    #[arg(
+        long,
+        default_value_t = 128,
+        value_parser = clap::value_parser!(u32)
+            .range(*BuiltIn::SIDES.start() as i64..=*BuiltIn::SIDES.end() as i64),
+    )]
     size: u32,
     #[command(flatten)]
     input_limit: InputLimit,
@@ -281,7 +294,8 @@ pub fn run(args: &Args) -> CommandResult {
                 let voxel = volume.spacing().min_element();
                 if !(step > 0.0 && step <= 4.0 * voxel) {
                     return Err(format!(
-                        "--step {step} mm: the step must be more than 0 and at most 4 voxels ({} mm here)",
+                        "--step {step} mm: the step must be more than 0 and at most 4 voxels ({} \
+                            mm here)",
                         4.0 * voxel
                     ));
                 }

@@ -121,7 +121,9 @@ fn bad_command_line_values_name_the_valid_range() {
     assert!(files(directory.path()).is_empty());
 }
 
-const CAMERA: &str = "[camera]\neye = [0.0, -5.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, 1.0]\nfov = 40.0\n[render]\nwidth = 96\nheight = 64\n[[lights]]\nkind = \"point\"\nposition = [0.0, -1.0, 0.5]\nintensity = [1.0, 1.0, 1.0]\n";
+const CAMERA: &str = "[camera]\neye = [0.0, -5.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, \
+    1.0]\nfov = 40.0\n[render]\nwidth = 96\nheight = 64\n[[lights]]\nkind = \"point\"\nposition = \
+    [0.0, -1.0, 0.5]\nintensity = [1.0, 1.0, 1.0]\n";
 
 /// Degenerate triangles are dropped with a warning; a huge triangle through the camera's
 /// plane (clipped) and a light inside the geometry render without a NaN pixel.
@@ -136,11 +138,13 @@ fn nasty_but_valid_meshes_render_without_nan() {
     .expect("write");
     std::fs::write(
         path.join("huge.obj"),
-        "v -1e7 -1e7 0\nv 1e7 -1e7 0\nv 0 1e7 0\nv -1e7 1e3 -1e6\nv 1e7 1e3 -1e6\nv 0 1e3 1e7\nf 1 2 3\nf 4 5 6\n",
+        "v -1e7 -1e7 0\nv 1e7 -1e7 0\nv 0 1e7 0\nv -1e7 1e3 -1e6\nv 1e7 1e3 -1e6\nv 0 1e3 1e7\nf 1 \
+            2 3\nf 4 5 6\n",
     )
     .expect("write");
     let scene = format!(
-        "{CAMERA}[[objects]]\nshape = \"mesh\"\npath = \"degenerate.obj\"\n[[objects]]\nshape = \"mesh\"\npath = \"huge.obj\"\n[objects.material]\nlobe = \"logexp-rr\"\nn = 1000\n"
+        "{CAMERA}[[objects]]\nshape = \"mesh\"\npath = \"degenerate.obj\"\n[[objects]]\nshape = \
+            \"mesh\"\npath = \"huge.obj\"\n[objects.material]\nlobe = \"logexp-rr\"\nn = 1000\n"
     );
     std::fs::write(path.join("nasty.toml"), scene).expect("write");
     for shading in ["flat", "gouraud", "phong"] {

@@ -213,7 +213,12 @@ fn cycles_renders_every_lobe_as_specula_does() {
         let [ours, theirs] = render_both(dir.path(), lobe, geometry, n, n);
         let measured = difference(&ours, &theirs);
         let (largest, rms, peak) = measured;
-        eprintln!("{lobe} ({geometry}): peak {peak:.4}, largest difference {:.3} %, rms {:.4} % of the peak", 100.0 * largest, 100.0 * rms);
+        eprintln!(
+            "{lobe} ({geometry}): peak {peak:.4}, largest difference {:.3} %, rms {:.4} % of \
+            the peak",
+            100.0 * largest,
+            100.0 * rms
+        );
         if !agrees(measured) {
             failures.push(format!(
                 "{lobe} ({geometry}): peak {peak}, largest {largest}, rms {rms}"

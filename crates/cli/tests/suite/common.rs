@@ -78,7 +78,8 @@ pub fn have_python_module(module: &str, package: &str) -> bool {
     if !found {
         assert!(
             std::env::var("CI").as_deref() != Ok("true"),
-            "{} cannot import {module}, and CI=true requires it: .ci/run installs {package} into target/venv",
+            "{} cannot import {module}, and CI=true requires it: .ci/run installs {package} into \
+                target/venv",
             python().display()
         );
         eprintln!("skipped: {module} is not importable (pip install {package} into target/venv)");

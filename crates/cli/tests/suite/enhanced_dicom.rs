@@ -37,7 +37,8 @@ fn run(script: &str, args: &[&str]) -> String {
 
 /// The path of one of pydicom-data's files.
 fn test_file(name: &str) -> PathBuf {
-    let script = "import sys; from pydicom.data import get_testdata_file; print(get_testdata_file(sys.argv[1]))";
+    let script = "import sys; from pydicom.data import get_testdata_file; \
+        print(get_testdata_file(sys.argv[1]))";
     PathBuf::from(run(script, &[name]).trim())
 }
 
@@ -83,7 +84,8 @@ for k in (0, frames - 1):
         for j in (0, ds.Rows - 1):
             lps = positions[order[k]] + i * column_spacing * row + j * row_spacing * column
             ras = np.append(lps * np.array([-1.0, -1.0, 1.0]), 1.0)
-            corner_error = max(corner_error, float(np.abs(image.affine @ [i, j, k, 1.0] - ras).max()))
+            off = np.abs(image.affine @ [i, j, k, 1.0] - ras).max()
+            corner_error = max(corner_error, float(off))
 print(json.dumps({
     "shape": list(got.shape),
     "expected_shape": list(expected.shape),

@@ -359,7 +359,9 @@ fn exported_glsl_compiles_unedited_for_each_version() {
                 "{kind} {version}: an example"
             );
             let shader = format!(
-                "{exported}\n{output}\nvoid main() {{\n    float s = specula_specular(vec3(0.0, 0.0, 1.0), normalize(vec3(0.2, 0.1, 1.0)), normalize(vec3(-0.2, 0.0, 1.0)));\n    {write} = vec4(s, s, s, 1.0);\n}}\n"
+                "{exported}\n{output}\nvoid main() {{\n    float s = specula_specular(vec3(0.0, \
+                    0.0, 1.0), normalize(vec3(0.2, 0.1, 1.0)), normalize(vec3(-0.2, 0.0, \
+                    1.0)));\n    {write} = vec4(s, s, s, 1.0);\n}}\n"
             );
             let file = d.join(format!("{}-{version}.frag", kind.id()));
             std::fs::write(&file, shader).unwrap();

@@ -149,7 +149,8 @@ fn worst_errors(
         }
     }
     eprintln!(
-        "{} (Mitsuba reading {}): worst relative error f_cos {:.2e} (pair {}), pdf {:.2e} (pair {})",
+        "{} (Mitsuba reading {}): worst relative error f_cos {:.2e} (pair {}), pdf {:.2e} (pair \
+            {})",
         ours.display(),
         material.file_name().unwrap().to_string_lossy(),
         worst[0].0,

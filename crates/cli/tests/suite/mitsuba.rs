@@ -350,7 +350,11 @@ fn mitsuba_renders_the_environment_scene_as_specula_does() {
             rms_difference(&first, &theirs),
         );
         let bias = mean_radiance(&theirs) / mean_radiance(&first) - 1.0;
-        eprintln!("{lobe}, the sphere: RMS difference from Mitsuba {against:.5}, between specula's seeds {noise:.5}; means differ by {:.2} %", 100.0 * bias);
+        eprintln!(
+            "{lobe}, the sphere: RMS difference from Mitsuba {against:.5}, between specula's \
+            seeds {noise:.5}; means differ by {:.2} %",
+            100.0 * bias
+        );
         assert!(
             against < 1.3 * noise && bias.abs() < 0.01,
             "{lobe}: Mitsuba {against} against noise {noise}, bias {bias}"

@@ -307,10 +307,12 @@ fn the_reference_is_what_help_prints() {
     }
     assert!(
         readme == expected_readme,
-        "the README's command table differs from --help; run UPDATE_REFERENCE=1 cargo test -p specula-cli --test suite readme::"
+        "the README's command table differs from --help; run UPDATE_REFERENCE=1 cargo test -p \
+            specula-cli --test suite readme::"
     );
     assert!(
         read("docs/reference.md") == pages,
-        "docs/reference.md differs from --help; run UPDATE_REFERENCE=1 cargo test -p specula-cli --test suite readme::"
+        "docs/reference.md differs from --help; run UPDATE_REFERENCE=1 cargo test -p specula-cli \
+            --test suite readme::"
     );
 }

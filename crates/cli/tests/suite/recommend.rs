@@ -131,7 +131,8 @@ fn csv_is_numbers_under_a_header_with_the_verdict_on_stderr() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "lobe,meets,error (%),\"rate (evals/s, 1 thread)\",x pow's throughput (higher is better),energy ratio,pareto"
+        "lobe,meets,error (%),\"rate (evals/s, 1 thread)\",x pow's throughput (higher is \
+            better),energy ratio,pareto"
     );
     let answer = json(&line.replace("csv", "json"));
     let mut rows = 0;

@@ -388,7 +388,12 @@ fn bad_formulas_get_one_line_each() {
         "name = \"typo\"\nformul = \"t ^ n\"\n",
     )
     .unwrap();
-    std::fs::write(dir.join("range.toml"), "name = \"range\"\nformula = \"t ^ (n * k)\"\n[parameters.k]\ndefault = 1\nmin = 1\nmax = 2\n").unwrap();
+    std::fs::write(
+        dir.join("range.toml"),
+        "name = \"range\"\nformula = \"t ^ (n * \
+        k)\"\n[parameters.k]\ndefault = 1\nmin = 1\nmax = 2\n",
+    )
+    .unwrap();
     std::fs::create_dir(dir.join("folder.toml")).unwrap();
     let cases: [(&[&str], &str); 12] = [
         (

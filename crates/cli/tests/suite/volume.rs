@@ -167,7 +167,8 @@ fn bad_volume_requests_are_refused_in_one_line() {
         ),
         (
             vec!["volume", "--transfer", "ct-boen"],
-            "presets: ct-bone, ct-soft-tissue, mr, surface, or a .toml file; did you mean 'ct-bone'?",
+            "presets: ct-bone, ct-soft-tissue, mr, surface, or a .toml file; did you mean \
+                'ct-bone'?",
         ),
         (
             vec!["volume", "--eye", "0,0,0"],

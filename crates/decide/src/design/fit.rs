@@ -1,7 +1,8 @@
 //! Fitting a family's coefficients across a range of `n`: Nelder-Mead (argmin) on the
 //! epicentre's largest relative error over the fitting exponents, with the whole lobe's
 //! largest absolute error and, where asked, the energy's distance from `t^n`'s kept within
-//! their bounds by a steep penalty. The figures here are on coarse grids, for speed; the verification measures the
+//! their bounds by a steep penalty. The figures here are on coarse grids, for speed; the
+//! verification measures the
 //! fitted formula with the analysis itself.
 
 use argmin::core::{CostFunction, Executor, State};
@@ -178,7 +179,8 @@ impl CostFunction for Objective<'_> {
 const RESTARTS: usize = 3;
 const ITERATIONS: u64 = 600;
 
-/// The family's coefficients fitted over the exponents of `grids` against `bounds`, and their score (at
+/// The family's coefficients fitted over the exponents of `grids` against `bounds`, and their score
+/// (at
 /// most 1 where the coarse grids meet every bound).
 #[must_use]
 pub fn fit(family: Family, grids: &[Grid], bounds: Bounds) -> (Vec<f64>, f64) {

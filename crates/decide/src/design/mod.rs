@@ -161,7 +161,10 @@ impl Design {
 }
 
 /// Why the FPGA cannot rank a designed lobe.
-pub const FPGA_DESIGN_REFUSAL: &str = "design cannot target fpga: the FPGA's costs are the synthesized fixed-point datapaths, which exist for the built-in lobes only (a designed formula has none); rank those with specula recommend --target fpga; valid targets: cpu, gpu-nvidia, gpu-amd";
+pub const FPGA_DESIGN_REFUSAL: &str = "design cannot target fpga: the FPGA's costs are the \
+    synthesized fixed-point datapaths, which exist for the built-in lobes only (a designed formula \
+    has none); rank those with specula recommend --target fpga; valid targets: cpu, gpu-nvidia, \
+    gpu-amd";
 
 fn check(request: &DesignRequest) -> Result<(), String> {
     let fraction = |what: &str, value: f64| {
@@ -360,7 +363,8 @@ fn verdict(design: &Design, request: &DesignRequest) -> String {
                 .iter()
                 .min_by(|a, b| a.epicentre_error.total_cmp(&b.epicentre_error));
             format!(
-                "no designed lobe {within}: searched {} families ({}); the closest, {}, reached {} in the epicentre and {} over the whole lobe; {builtin}",
+                "no designed lobe {within}: searched {} families ({}); the closest, {}, reached {} \
+                    in the epicentre and {} over the whole lobe; {builtin}",
                 design.designed.len(),
                 design
                     .designed
@@ -431,7 +435,8 @@ fn short(
         whole_error: figures.whole,
         energy_deviation: figures.energy,
         why: format!(
-            "its best fit reaches {} in the epicentre and {} over the whole lobe (fit grids; not verified)",
+            "its best fit reaches {} in the epicentre and {} over the whole lobe (fit grids; not \
+                verified)",
             percent(figures.epicentre),
             percent(figures.whole)
         ),

@@ -87,10 +87,12 @@ mod tests {
 
     #[test]
     fn stage_variables_become_varyings_and_the_output_gl_frag_color() {
-        let text = "#version 300 es\nsmooth in vec3 _vs2fs_location0;\nlayout(location = 0) out vec4 _fs2p_location0;\nvoid main() {\n    _fs2p_location0 = vec4(1.0);\n}\n";
+        let text = "#version 300 es\nsmooth in vec3 _vs2fs_location0;\nlayout(location = 0) out \
+            vec4 _fs2p_location0;\nvoid main() {\n    _fs2p_location0 = vec4(1.0);\n}\n";
         assert_eq!(
             from_es300(text).unwrap(),
-            "#version 100\nvarying vec3 _vs2fs_location0;\nvoid main() {\n    gl_FragColor = vec4(1.0);\n}\n"
+            "#version 100\nvarying vec3 _vs2fs_location0;\nvoid main() {\n    gl_FragColor = \
+                vec4(1.0);\n}\n"
         );
     }
 }

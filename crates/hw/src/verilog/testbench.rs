@@ -118,7 +118,13 @@ pub fn testbench_in(datapath: &Datapath, vectors: &[(Vec<i64>, i64)], form: Form
     let name = &form.module_name(datapath);
     let count = vectors.len();
     let mut v = String::new();
-    let _ = writeln!(v, "// Self-checking testbench for {name}: vectors and expected outputs from specula_hw::Datapath::eval.\n`timescale 1ns/1ps\n`default_nettype none\n/* verilator lint_off DECLFILENAME */\nmodule {name}_tb;\n    localparam integer COUNT = {count};\n    localparam integer LATENCY = {latency};");
+    let _ = writeln!(
+        v,
+        "// Self-checking testbench for {name}: vectors and expected outputs from \
+        specula_hw::Datapath::eval.\n`timescale 1ns/1ps\n`default_nettype none\n/* verilator \
+        lint_off DECLFILENAME */\nmodule {name}_tb;\n    localparam integer COUNT = {count};\n    \
+        localparam integer LATENCY = {latency};"
+    );
     // The combinational form has no clock: the same 10 ns steps pace its vectors.
     let (rise, fall) = match form {
         Form::Pipelined => {
@@ -130,7 +136,8 @@ pub fn testbench_in(datapath: &Datapath, vectors: &[(Vec<i64>, i64)], form: Form
     for (input, width) in &inputs {
         let _ = writeln!(
             v,
-            "    reg [{}:0] {input};  // x until the first vector: its assignment is an event\n    reg [{}:0] vector_{input} [0:COUNT-1];",
+            "    reg [{}:0] {input};  // x until the first vector: its assignment is an event\n    \
+                reg [{}:0] vector_{input} [0:COUNT-1];",
             width - 1,
             width - 1
         );
@@ -168,7 +175,14 @@ pub fn testbench_in(datapath: &Datapath, vectors: &[(Vec<i64>, i64)], form: Form
         .collect();
     let _ = writeln!(
         v,
-        "        errors = 0;\n        for (i = 0; i < COUNT + LATENCY - 1; i = i + 1) begin\n            if (i < COUNT) begin {} end\n            {rise}\n            #1;\n            j = i + 1 - LATENCY;\n            if (j >= 0 && value !== expected[j]) begin\n                errors = errors + 1;\n                if (errors <= 10) $display(\"MISMATCH vector %0d: got %0d, expected %0d\", j, value, expected[j]);\n            end\n            {fall}\n        end\n        if (errors != 0) $fatal(1, \"FAIL %0d of %0d vectors\", errors, COUNT);\n        $display(\"PASS %0d vectors\", COUNT);\n        $finish;\n    end\nendmodule",
+        "        errors = 0;\n        for (i = 0; i < COUNT + LATENCY - 1; i = i + 1) \
+            begin\n            if (i < COUNT) begin {} end\n            {rise}\n            \
+            #1;\n            j = i + 1 - LATENCY;\n            if (j >= 0 && value !== \
+            expected[j]) begin\n                errors = errors + 1;\n                if (errors \
+            <= 10) $display(\"MISMATCH vector %0d: got %0d, expected %0d\", j, value, \
+            expected[j]);\n            end\n            {fall}\n        end\n        if (errors != \
+            0) $fatal(1, \"FAIL %0d of %0d vectors\", errors, COUNT);\n        $display(\"PASS %0d \
+            vectors\", COUNT);\n        $finish;\n    end\nendmodule",
         assign.join(" ")
     );
     v

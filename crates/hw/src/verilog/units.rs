@@ -91,7 +91,11 @@ fn interpolation(
     };
     let _ = writeln!(
         v,
-        "    wire [{k}:0] index = {{1'b0, {source}[{top}:{rest}]}};\n    wire [{w}:0] first = entry(index);\n    wire [{w}:0] second = entry(index + 1'b1);\n    // The product's low bits are the part of a step the interpolation drops.\n    /* verilator lint_off UNUSEDSIGNAL */\n    wire [{p}:0] step = {{{{{rest}{{1'b0}}}}, {difference}}} * {{{{{width}{{1'b0}}}}, {source}[{}:0]}};\n    /* verilator lint_on UNUSEDSIGNAL */",
+        "    wire [{k}:0] index = {{1'b0, {source}[{top}:{rest}]}};\n    wire [{w}:0] first = \
+            entry(index);\n    wire [{w}:0] second = entry(index + 1'b1);\n    // The product's \
+            low bits are the part of a step the interpolation drops.\n    /* verilator lint_off \
+            UNUSEDSIGNAL */\n    wire [{p}:0] step = {{{{{rest}{{1'b0}}}}, {difference}}} * \
+            {{{{{width}{{1'b0}}}}, {source}[{}:0]}};\n    /* verilator lint_on UNUSEDSIGNAL */",
         rest - 1,
         w = width - 1,
         p = product - 1,
@@ -139,13 +143,18 @@ pub(super) fn log2_module(
     );
     let _ = writeln!(
         v,
-        "    integer i;\n    reg [6:0] p;\n    reg [{}:0] f;\n    reg signed [63:0] e;\n    // x shifted so its leading one is the top bit, which f then drops.\n    /* verilator lint_off UNUSEDSIGNAL */\n    reg [{}:0] normalised;\n    /* verilator lint_on UNUSEDSIGNAL */",
+        "    integer i;\n    reg [6:0] p;\n    reg [{}:0] f;\n    reg signed [63:0] e;\n    // x \
+            shifted so its leading one is the top bit, which f then drops.\n    /* verilator \
+            lint_off UNUSEDSIGNAL */\n    reg [{}:0] normalised;\n    /* verilator lint_on \
+            UNUSEDSIGNAL */",
         mantissa - 1,
         width - 1
     );
     let _ = writeln!(
         v,
-        "    always @* begin\n        p = 7'd0;\n        for (i = 0; i < {width}; i = i + 1)\n            if (x[i]) p = i[6:0];\n        normalised = x << ({mantissa} - p);\n        f = normalised[{}:0];\n        e = $signed({{57'd0, p}}) - {};\n    end",
+        "    always @* begin\n        p = 7'd0;\n        for (i = 0; i < {width}; i = i + \
+            1)\n            if (x[i]) p = i[6:0];\n        normalised = x << ({mantissa} - \
+            p);\n        f = normalised[{}:0];\n        e = $signed({{57'd0, p}}) - {};\n    end",
         mantissa - 1,
         input.frac_bits
     );
@@ -161,7 +170,8 @@ pub(super) fn log2_module(
     };
     let _ = writeln!(
         v,
-        "    always @*\n        if (x == 0)\n            y = {};\n        else\n            y = (e <<< {frac}) + {mantissa_value};\nendmodule\n",
+        "    always @*\n        if (x == 0)\n            y = {};\n        else\n            y = (e \
+            <<< {frac}) + {mantissa_value};\nendmodule\n",
         literal(zero)
     );
     v
@@ -216,7 +226,8 @@ pub(super) fn exp2_module(
     if last < (1 << int_bits) - 1 {
         let _ = writeln!(
             v,
-            "    // Past a shift of {last} every bit is gone.\n    assign y = (shift > {int_bits}'d{last}) ? 64'sd0 : {shifted};"
+            "    // Past a shift of {last} every bit is gone.\n    assign y = (shift > \
+                {int_bits}'d{last}) ? 64'sd0 : {shifted};"
         );
     } else {
         let _ = writeln!(v, "    assign y = {shifted};");

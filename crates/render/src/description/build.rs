@@ -50,15 +50,33 @@ pub(super) fn build_light(
         locate.finite_non_negative("intensity", &Spanned::new(light.span(), l.intensity))?;
     let fail = |message: &str| Err(locate.error(light.span(), message));
     match (l.kind, l.towards, l.position) {
-        (LightKind::Directional, Some(towards), None) => match Vec3::from(towards).try_normalize() {
-            Some(towards) => Ok(Light::Directional { towards, intensity }),
-            None => fail("lights.towards: must be a finite, non-zero direction (towards the light)"),
-        },
-        (LightKind::Point, None, Some(position)) if in_scene_range(position.into()) => {
-            Ok(Light::Point { position: position.into(), intensity })
+        (LightKind::Directional, Some(towards), None) => {
+            match Vec3::from(towards).try_normalize() {
+                Some(towards) => Ok(Light::Directional { towards, intensity }),
+                None => fail(
+                    "lights.towards: must be a finite, non-zero direction (towards the \
+                light)",
+                ),
+            }
         }
-        (LightKind::Directional, ..) => fail("lights: a directional light takes `towards` (the direction to the light) and no `position`"),
-        (LightKind::Point, ..) => Err(locate.error(light.span(), format!("lights: a point light takes a `position` (finite, each coordinate within {MAX_COORDINATE:e}) and no `towards`"))),
+        (LightKind::Point, None, Some(position)) if in_scene_range(position.into()) => {
+            Ok(Light::Point {
+                position: position.into(),
+                intensity,
+            })
+        }
+        (LightKind::Directional, ..) => fail(
+            "lights: a directional light takes `towards` (the \
+            direction to the light) and no `position`",
+        ),
+        (LightKind::Point, ..) => Err(locate.error(
+            light.span(),
+            format!(
+                "lights: a point light \
+            takes a `position` (finite, each coordinate within {MAX_COORDINATE:e}) and no \
+            `towards`"
+            ),
+        )),
     }
 }
 
@@ -89,7 +107,8 @@ impl TriangleBudget {
     fn charge(&mut self, triangles: u64) -> Result<(), String> {
         self.left = self.left.checked_sub(triangles).ok_or_else(|| {
             format!(
-                "this object's {triangles} triangles take the scene past its limit of {} triangles (raise it with --max-triangles)",
+                "this object's {triangles} triangles take the scene past its limit of {} triangles \
+                    (raise it with --max-triangles)",
                 self.limit
             )
         })?;
@@ -188,7 +207,11 @@ pub(super) fn build_object(
         }
         ShapeKind::Mesh => {
             let Some(path) = &o.path else {
-                return Err(locate.error(object.span(), "path: a mesh object needs `path`, a .obj, .stl or .ply file relative to the scene"));
+                return Err(locate.error(
+                    object.span(),
+                    "path: a mesh object needs `path`, a .obj, \
+                    .stl or .ply file relative to the scene",
+                ));
             };
             let full: PathBuf =
                 base.map_or_else(|| PathBuf::from(path.get_ref()), |b| b.join(path.get_ref()));

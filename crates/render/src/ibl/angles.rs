@@ -85,7 +85,8 @@ pub fn acos(x: f32) -> f32 {
 }
 
 /// `atan2(y, x)` in `[-pi, pi]`: the arctangent of the smaller over the larger magnitude by
-/// an odd polynomial of degree 13 fitted on `[0, 1]` (error `2.5e-7`), then the octant's symmetries.
+/// an odd polynomial of degree 13 fitted on `[0, 1]` (error `2.5e-7`), then the octant's
+/// symmetries.
 #[must_use]
 #[inline]
 pub fn atan2(y: f32, x: f32) -> f32 {

@@ -39,7 +39,10 @@ pub enum EnvironmentError {
     #[error(transparent)]
     Image(#[from] ImageError),
     /// A pixel is NaN, infinite or negative: radiance is finite and non-negative.
-    #[error("{name}: pixel ({x}, {y}) is {value}; an environment's radiance must be finite and non-negative in every channel")]
+    #[error(
+        "{name}: pixel ({x}, {y}) is {value}; an environment's radiance must be finite and \
+        non-negative in every channel"
+    )]
     BadPixel {
         /// The map's name (its path, or what built it).
         name: String,
@@ -51,7 +54,10 @@ pub enum EnvironmentError {
         value: f32,
     },
     /// The map is too small to be a panorama, or its weights overflow.
-    #[error("{name}: {width}x{height} pixels cannot be an equirectangular environment; it needs at least 2x1 pixels whose radiances sum to a finite value")]
+    #[error(
+        "{name}: {width}x{height} pixels cannot be an equirectangular environment; it needs at \
+        least 2x1 pixels whose radiances sum to a finite value"
+    )]
     Shape {
         /// The map's name.
         name: String,

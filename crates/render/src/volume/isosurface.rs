@@ -155,7 +155,8 @@ pub fn marching_cubes(volume: &Volume, iso: f32) -> Result<Mesh, VolumeError> {
                 }
                 if triangles.len() > MAX_TRIANGLES {
                     return Err(VolumeError(format!(
-                        "the isosurface at {iso} has more than {MAX_TRIANGLES} triangles; choose another value or a smaller volume"
+                        "the isosurface at {iso} has more than {MAX_TRIANGLES} triangles; choose \
+                            another value or a smaller volume"
                     )));
                 }
             }

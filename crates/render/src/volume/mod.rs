@@ -4,7 +4,8 @@
 //! A [`Volume`] holds samples on an `nx x ny x nz` grid (`i` fastest; whole numbers as `i16`,
 //! others as `f32`: [`Samples`]), and the affine
 //! map from grid indices to world millimetres in the patient's RAS frame, as NIfTI counts it
-//! (`+x` towards the patient's Right, `+y` Anterior, `+z` Superior). Sampling is trilinear; gradients are central differences of the trilinear
+//! (`+x` towards the patient's Right, `+y` Anterior, `+z` Superior). Sampling is trilinear;
+//! gradients are central differences of the trilinear
 //! field, one voxel apart, taken to world units by the inverse transpose of the map.
 //!
 //! - [`phantom`]: the built-in volumes (the 3D Shepp-Logan head, the Marschner-Lobb signal);
@@ -108,7 +109,8 @@ impl Volume {
         let voxels = dims[0] * dims[1] * dims[2];
         if voxels > MAX_VOXELS {
             return Err(VolumeError(format!(
-                "a volume of {} x {} x {} voxels ({voxels}) is over the limit of {MAX_VOXELS} voxels (1 GiB of f32)",
+                "a volume of {} x {} x {} voxels ({voxels}) is over the limit of {MAX_VOXELS} \
+                    voxels (1 GiB of f32)",
                 dims[0], dims[1], dims[2]
             )));
         }
@@ -159,7 +161,9 @@ impl Volume {
         let determinant = to_world.determinant();
         if !(to_world.is_finite() && origin.is_finite() && determinant.abs() > 1e-12) {
             return Err(VolumeError(
-                "the voxel spacing and orientation must be finite and non-degenerate (a zero spacing or parallel axes cannot place the voxels)".into(),
+                "the voxel spacing and orientation must be finite and non-degenerate (a zero \
+                    spacing or parallel axes cannot place the voxels)"
+                    .into(),
             ));
         }
         let range = samples
@@ -353,7 +357,8 @@ pub fn read(path: &Path) -> Result<Volume, VolumeError> {
         dicom::read_file(path)
     } else {
         Err(VolumeError(format!(
-            "{}: not a volume; give a .nii or .nii.gz file, an InVesalius .inv3 project, a folder holding a DICOM series, or a multi-frame DICOM file",
+            "{}: not a volume; give a .nii or .nii.gz file, an InVesalius .inv3 project, a folder \
+                holding a DICOM series, or a multi-frame DICOM file",
             path.display()
         )))
     }

@@ -143,7 +143,8 @@ fn check_header(header: &NiftiHeader, gz: bool, file_bytes: u64) -> Result<[usiz
         .product();
     if extra > 1 {
         return Err(format!(
-            "{extra} volumes in one file (a time series); specula renders one 3-D volume, so extract one first"
+            "{extra} volumes in one file (a time series); specula renders one 3-D volume, so \
+                extract one first"
         ));
     }
     let dims = [
@@ -162,7 +163,8 @@ fn check_header(header: &NiftiHeader, gz: bool, file_bytes: u64) -> Result<[usiz
         NiftiType::Int64 | NiftiType::Uint64 | NiftiType::Float64 => 8,
         other => {
             return Err(format!(
-                "voxels of type {other:?}; specula reads scalar volumes (8- to 64-bit integers, 32- or 64-bit floats)"
+                "voxels of type {other:?}; specula reads scalar volumes (8- to 64-bit integers, \
+                    32- or 64-bit floats)"
             ))
         }
     };
@@ -170,7 +172,8 @@ fn check_header(header: &NiftiHeader, gz: bool, file_bytes: u64) -> Result<[usiz
     let limit = input::max_input_bytes();
     if data_bytes > limit {
         return Err(format!(
-            "the voxels take {data_bytes} bytes, above the input limit of {limit} bytes ({} MiB; raise it with --max-input-mib)",
+            "the voxels take {data_bytes} bytes, above the input limit of {limit} bytes ({} MiB; \
+                raise it with --max-input-mib)",
             limit >> 20
         ));
     }
@@ -183,7 +186,8 @@ fn check_header(header: &NiftiHeader, gz: bool, file_bytes: u64) -> Result<[usiz
     }
     if !gz && file_bytes < offset as u64 + data_bytes {
         return Err(format!(
-            "truncated: the header declares {data_bytes} bytes of voxels from byte {offset}, the file has {file_bytes} bytes"
+            "truncated: the header declares {data_bytes} bytes of voxels from byte {offset}, the \
+                file has {file_bytes} bytes"
         ));
     }
     if !(header.scl_slope.is_finite() && header.scl_inter.is_finite()) {
@@ -217,7 +221,8 @@ fn placement(header: &NiftiHeader) -> Result<(Mat3, Vec3), String> {
     let spacing = Vec3::new(header.pixdim[1], header.pixdim[2], header.pixdim[3]);
     if !(spacing.is_finite() && spacing.min_element() > 0.0) {
         return Err(format!(
-            "no voxel spacing: pixdim is {}, {}, {} and there is no sform; every spacing must be positive",
+            "no voxel spacing: pixdim is {}, {}, {} and there is no sform; every spacing must be \
+                positive",
             spacing.x, spacing.y, spacing.z
         ));
     }

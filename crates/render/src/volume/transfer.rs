@@ -77,7 +77,8 @@ impl TransferFunction {
         for (k, p) in points.iter().enumerate() {
             if !(p.value.is_finite() && p.sigma.is_finite() && p.sigma >= 0.0) {
                 return Err(VolumeError(format!(
-                    "control point {k}: value and sigma must be finite, sigma >= 0 (got value {}, sigma {})",
+                    "control point {k}: value and sigma must be finite, sigma >= 0 (got value {}, \
+                        sigma {})",
                     p.value, p.sigma
                 )));
             }
@@ -226,7 +227,8 @@ impl TransferFunction {
     pub fn windowed(&self, window: f32, level: f32) -> Result<Self, VolumeError> {
         if !(window.is_finite() && window > 0.0 && level.is_finite()) {
             return Err(VolumeError(format!(
-                "--window {window} --level {level}: the window must be a positive width and the level a finite centre, in the volume's values"
+                "--window {window} --level {level}: the window must be a positive width and the \
+                    level a finite centre, in the volume's values"
             )));
         }
         let (first, last) = (
@@ -248,7 +250,8 @@ impl TransferFunction {
             .collect();
         Self::try_new(points, self.scale).map_err(|e| {
             VolumeError(format!(
-                "--window {window} --level {level} squeezes the transfer function's points together ({e}); widen the window"
+                "--window {window} --level {level} squeezes the transfer function's points \
+                    together ({e}); widen the window"
             ))
         })
     }

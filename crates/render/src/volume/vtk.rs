@@ -59,7 +59,8 @@ pub fn alike_settings(
     let voxel = volume.spacing().min_element();
     if !(sample_distance > 0.0 && sample_distance <= 4.0 * voxel) {
         return Err(VolumeError(format!(
-            "a sample distance of {sample_distance} mm: it must be more than 0 and at most 4 voxels ({} mm)",
+            "a sample distance of {sample_distance} mm: it must be more than 0 and at most 4 \
+                voxels ({} mm)",
             4.0 * voxel
         )));
     }

@@ -45,7 +45,8 @@ async fn a_request_is_answered_under_two_thousand_idle_connections() {
     let address = spawn_server().await;
     assert!(
         crate::max_waiting() >= 2_100,
-        "this test needs a descriptor limit of at least 4,200 (ulimit -n), which lets 2,100 connections wait; {} may wait here",
+        "this test needs a descriptor limit of at least 4,200 (ulimit -n), which lets 2,100 \
+            connections wait; {} may wait here",
         crate::max_waiting()
     );
     let idle = idle_connections(address, 2_000).await;

@@ -110,7 +110,9 @@ async fn volume_renders_the_named_volume_view_and_lobe() {
     use specula_render::volume::dvr::{render_dvr, DvrSettings, Shading, View};
     use specula_render::volume::{phantom, transfer::TransferFunction};
 
-    let uri = "/api/volume?volume=phantom&view=inferior&lobe=cosquad&n=40&geometry=phong&normalisation=lobe&size=48";
+    let uri =
+        "/api/volume?volume=phantom&view=inferior&lobe=cosquad&n=40&geometry=phong&normalisat\
+        ion=lobe&size=48";
     let served = served_png(uri, (48, 48)).await;
 
     let volume = phantom::shepp_logan(64).expect("phantom");

@@ -90,7 +90,8 @@ pub(super) fn chebyshev_epicentre(options: &ClaimOptions, errors: &Errors) -> Ou
             format!("max {:.2} %, <= 0.5 % only at n = {first}", 100.0 * max)
         } else {
             format!(
-                "max {:.2} %, <= 0.5 % at {count} of {total} n (between n = {first:.3} and {last:.3})",
+                "max {:.2} %, <= 0.5 % at {count} of {total} n (between n = {first:.3} and \
+                    {last:.3})",
                 100.0 * max
             )
         }

@@ -76,7 +76,8 @@ pub(super) fn thesis_phong_coefficient(options: &ClaimOptions) -> Outcome {
          [1, 1000]; also against Lafortune's (n+2)/(2 pi) (the cosine-weighted reading)"
             .to_owned(),
         format!(
-            "coef1 / exact ranges from {lo:.4} to {hi:.4} (exact only at n = {crossover:.2}); within 5 % \
+            "coef1 / exact ranges from {lo:.4} to {hi:.4} (exact only at n = {crossover:.2}); \
+                within 5 % \
              at {count} of {} tested n (n = {first:.3} to {last:.3}); coef1 / Lafortune ranges \
              {:.4} to {:.4}",
             options.exponents.len(),

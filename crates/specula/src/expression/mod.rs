@@ -162,7 +162,12 @@ pub struct Expression {
 pub struct Branched;
 
 thread_local! {
-    static TAPE: RefCell<Tape> = const { RefCell::new(Tape { nodes: Vec::new(), branched: false }) };
+    static TAPE: RefCell<Tape> = const {
+        RefCell::new(Tape {
+            nodes: Vec::new(),
+            branched: false,
+        })
+    };
 }
 
 struct Tape {

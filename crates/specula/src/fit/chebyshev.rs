@@ -3,7 +3,8 @@
 //! With `N` nodes on `[a, b]`:
 //!
 //! ```text
-//! c_j   = 2/N * sum_{k=1..N} f(x_k) cos(pi j (k - 1/2) / N),   x_k = cos(pi (k - 1/2) / N) (b-a)/2 + (b+a)/2
+//! x_k   = cos(pi (k - 1/2) / N) (b-a)/2 + (b+a)/2
+//! c_j   = 2/N * sum_{k=1..N} f(x_k) cos(pi j (k - 1/2) / N)
 //! ap(x) = sum_{j<N} c_j T_j(y) - c_0 / 2,                      y = (x - (b+a)/2) / ((b-a)/2)
 //! ```
 //!

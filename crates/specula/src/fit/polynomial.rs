@@ -38,7 +38,8 @@ impl Polynomial {
     /// normalised interval back to the caller's variable.
     #[must_use]
     pub fn compose_linear(&self, scale: f64, offset: f64) -> Polynomial {
-        // Horner over polynomials: q = (...(c_d * u + c_{d-1}) * u + ...) with u = scale*x + offset.
+        // Horner over polynomials: q = (...(c_d * u + c_{d-1}) * u + ...) with u = scale*x +
+        // offset.
         let mut result: Vec<f64> = Vec::with_capacity(self.coeffs.len());
         for &c in self.coeffs.iter().rev() {
             let mut next = vec![0.0; result.len() + 1];

@@ -309,7 +309,8 @@ mod tests {
                             assert!(
                                 f64::from((value - scalar).abs()) <= bound
                                     && (0.0..=1.0).contains(&value),
-                                "{kind} n = {n} {level:?} {batch_loop:?} t = {t}: {value} vs {scalar}"
+                                "{kind} n = {n} {level:?} {batch_loop:?} t = {t}: {value} vs \
+                                    {scalar}"
                             );
                         }
                     }

@@ -1,7 +1,8 @@
 //! # `fasterpow`: the IEEE bit-trick power, uncorrected (Schraudolph, fastapprox)
 //!
 //! ```text
-//! fasterpow(t) = min(1, bits_exp2(n (e + 2 m - 1.94269504) - 0.05730496)),   t = m 2^e, m in [1/2, 1)
+//! t = m 2^e, m in [1/2, 1)
+//! fasterpow(t) = min(1, bits_exp2(n (e + 2 m - 1.94269504) - 0.05730496))
 //! ```
 //!
 //! The bit pattern of `t`, read as a number, is `e + 2m + 125` (with `e`, `m` from `frexp`):

@@ -1,9 +1,10 @@
 //! # `fastpow`: the IEEE bit-trick power with a rational correction (fastapprox)
 //!
 //! ```text
-//! log2~(t)  = e + 0.77448501 + 0.501969698 m - 1.72587999 / (0.3520887068 + m),   t = m 2^e, m in [1/2, 1)
-//!           = e + (N0 + u (N1 + 0.501969698 u)) / (1.3520887068 + u),   u = m - 1
-//! exp2~(p)  = bits_exp2(p - 5.7259425 + 27.7280233 / (4.84252568 - z) - 1.49012907 z),   z = p - floor(p)
+//! t = m 2^e, m in [1/2, 1);   u = m - 1;   z = p - floor(p)
+//! log2~(t)  = e + 0.77448501 + 0.501969698 m - 1.72587999 / (0.3520887068 + m)
+//!           = e + (N0 + u (N1 + 0.501969698 u)) / (1.3520887068 + u)
+//! exp2~(p)  = bits_exp2(p - 5.7259425 + 27.7280233 / (4.84252568 - z) - 1.49012907 z)
 //! fastpow(t) = min(1, exp2~(n log2~(t)))
 //! ```
 //!
@@ -16,7 +17,8 @@
 //! one fraction expanded around `m = 1`, where its terms cancel (evaluated as written, the
 //! cancellation leaves `1e-16` of noise in `log2`, `1e-13` of the value at `n = 1000`, enough
 //! to stall adaptive integration), and the `f64` path evaluates the same formulas exactly,
-//! with `bits_exp2` as the exact piecewise-linear `2^x`. The log's residual error (about `5e-5` absolute) is multiplied by `n`, so the lobe
+//! with `bits_exp2` as the exact piecewise-linear `2^x`. The log's residual error (about `5e-5`
+//! absolute) is multiplied by `n`, so the lobe
 //! is accurate at small `n` and drifts at large `n`. At `t = 1` the corrected log is `4e-9`,
 //! not 0, and the exp's correction `-4e-6`: the value stays just below 1 in `f64`, and a `min`
 //! keeps the `f32` roundings from lifting it above.

@@ -117,7 +117,8 @@ impl MeasuredBrdf {
         let file = TensorFile::parse(bytes)?;
         if file.field("rgb").is_err() && file.field("spectra").is_ok() {
             return Err(refuse(
-                "spectral measurements are not supported: pass the material's RGB file (the '_rgb.bsdf' one)",
+                "spectral measurements are not supported: pass the material's RGB file (the \
+                    '_rgb.bsdf' one)",
             ));
         }
         let description = String::from_utf8_lossy(file.u8s("description", 1)?)
@@ -127,7 +128,8 @@ impl MeasuredBrdf {
         let (theta, _) = file.f32s("theta_i", 1)?;
         if phi.len() > 2 {
             return Err(refuse(format!(
-                "anisotropic materials are not supported: phi_i has {} values (an isotropic file has 1 or 2)",
+                "anisotropic materials are not supported: phi_i has {} values (an isotropic file \
+                    has 1 or 2)",
                 phi.len()
             )));
         }
@@ -172,12 +174,15 @@ impl MeasuredBrdf {
             .all(|shape| grid(shape));
         if !shapes_agree {
             return Err(refuse(format!(
-                "the tables' shapes disagree: phi_i {p}, theta_i {t}, vndf {vndf_shape:?}, luminance {luminance_shape:?}, rgb {rgb_shape:?} (expected [phi_i, theta_i, h, w], rgb [phi_i, theta_i, 3, h, w] on luminance's grid, tables at least 2 x 2)"
+                "the tables' shapes disagree: phi_i {p}, theta_i {t}, vndf {vndf_shape:?}, \
+                    luminance {luminance_shape:?}, rgb {rgb_shape:?} (expected [phi_i, theta_i, h, \
+                    w], rgb [phi_i, theta_i, 3, h, w] on luminance's grid, tables at least 2 x 2)"
             )));
         }
         if jacobian[0] != 0 && !(sigma.iter().all(|&v| v > 0.0) && ndf.iter().all(|&v| v >= 0.0)) {
             return Err(refuse(
-                "tables 'sigma' and 'ndf' must be positive and non-negative (the Jacobian divides by sigma)",
+                "tables 'sigma' and 'ndf' must be positive and non-negative (the Jacobian divides \
+                    by sigma)",
             ));
         }
         for (name, table, shape) in [
@@ -190,7 +195,8 @@ impl MeasuredBrdf {
                 .all(|values| values.iter().all(|&v| v >= 0.0) && values.iter().any(|&v| v > 0.0));
             if !sampleable {
                 return Err(refuse(format!(
-                    "table '{name}' has a negative value or an all-zero slice (it must be a density)"
+                    "table '{name}' has a negative value or an all-zero slice (it must be a \
+                        density)"
                 )));
             }
         }

@@ -217,13 +217,15 @@ impl<'a> TensorFile<'a> {
                 .filter(|&n| n <= MAX_ELEMENTS)
                 .ok_or_else(|| {
                     error(format!(
-                        "field '{name}' declares shape {shape:?}, over the limit of {MAX_ELEMENTS} elements"
+                        "field '{name}' declares shape {shape:?}, over the limit of {MAX_ELEMENTS} \
+                            elements"
                     ))
                 })?;
             let end = offset.checked_add(elements * dtype.size());
             if end.is_none_or(|end| end > bytes.len() as u64) {
                 return Err(error(format!(
-                    "truncated: field '{name}' ({} x {shape:?}) extends past the end of the file ({} bytes)",
+                    "truncated: field '{name}' ({} x {shape:?}) extends past the end of the file \
+                        ({} bytes)",
                     dtype.name(),
                     bytes.len()
                 )));

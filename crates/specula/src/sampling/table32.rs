@@ -1,5 +1,6 @@
 //! A lobe's cosine distribution tabulated in `f32`, for renderers that shade in `f32`: the
-//! table [`CosineDistribution`](super::CosineDistribution) draws a tabulated lobe from (the lobe at each bin edge, the
+//! table [`CosineDistribution`](super::CosineDistribution) draws a tabulated lobe from (the lobe at
+//! each bin edge, the
 //! bins' trapezoid masses), built for any lobe, with the edges' cosines stored rather than
 //! recomputed and a guide that finds a mass's bin in a step or two: a draw costs a square
 //! root and a density an `acos` and a square root, where the `f64` path spends two `cos`, a
@@ -30,7 +31,8 @@ pub struct CosineTable32 {
 }
 
 impl CosineTable32 {
-    /// `lobe`'s table: the same edges, values and masses as [`CosineDistribution`](super::CosineDistribution)'s for a
+    /// `lobe`'s table: the same edges, values and masses as
+    /// [`CosineDistribution`](super::CosineDistribution)'s for a
     /// tabulated lobe.
     #[must_use]
     pub fn of(lobe: &Lobe) -> Self {
@@ -55,7 +57,8 @@ impl CosineTable32 {
         }
     }
 
-    /// The cosine for the uniform number `u` in `[0, 1)`, as [`CosineDistribution::sample`](super::CosineDistribution::sample)
+    /// The cosine for the uniform number `u` in `[0, 1)`, as
+    /// [`CosineDistribution::sample`](super::CosineDistribution::sample)
     /// draws a tabulated lobe.
     #[must_use]
     pub fn sample(&self, u: f32) -> f32 {
@@ -70,7 +73,8 @@ impl CosineTable32 {
         draw_in_bin(k, &self.cumulative, &self.values, |k| self.edges[k], target)
     }
 
-    /// The density of the cosine at `t`, as [`CosineDistribution::density`](super::CosineDistribution::density) reads a
+    /// The density of the cosine at `t`, as
+    /// [`CosineDistribution::density`](super::CosineDistribution::density) reads a
     /// tabulated lobe's.
     #[must_use]
     pub fn density(&self, t: f32) -> f32 {

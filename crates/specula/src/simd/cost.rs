@@ -147,7 +147,8 @@ impl Peaks {
 mod tests {
     use super::*;
 
-    /// Round numbers for a hypothetical 8-lane machine at 1 GHz: 2 FMAs or multiplies, 2 adds, 1 shift per
+    /// Round numbers for a hypothetical 8-lane machine at 1 GHz: 2 FMAs or multiplies, 2 adds, 1
+    /// shift per
     /// cycle, a divide every 4 cycles, 4 instructions dispatched and 1 vector copied per cycle.
     fn peaks() -> Peaks {
         let mut per_class = [None; Class::ALL.len()];

@@ -135,7 +135,8 @@ pub(crate) const FREXP: Instructions = Instructions::of(&[
     (Class::Convert, 1),
 ]);
 
-/// [`Real::bits_exp2`](crate::Real::bits_exp2) on vector lanes: `(x + 127) 2^23` truncated is the bit pattern.
+/// [`Real::bits_exp2`](crate::Real::bits_exp2) on vector lanes: `(x + 127) 2^23` truncated is the
+/// bit pattern.
 #[inline(always)]
 pub(crate) fn bits_exp2<V: Lanes>(x: V) -> V {
     x.max(x.splat(-127.0))

@@ -211,19 +211,25 @@ pub fn run(args: &Args) -> CommandResult {
     let all = rayon::current_num_threads();
     let threads: Vec<usize> = if all > 1 { vec![1, all] } else { vec![1] };
     println!(
-        "lit by the built-in sky ({SKY_WIDTH} x {}), each view's own exponents; warm renders: the median of {} \
-         frames after one; samples/s = pixels x spp / seconds per frame; x: how many times faster specula is",
+        "lit by the built-in sky ({SKY_WIDTH} x {}), each view's own exponents; warm renders: the \
+            median of {} \
+         frames after one; samples/s = pixels x spp / seconds per frame; x: how many times faster \
+         specula is",
         SKY_WIDTH / 2,
         args.frames
     );
     println!(
-        "Mitsuba: llvm_ad_rgb, direct integrator (1 emitter + 1 BSDF sample, MIS), specula's plugin of the lobe, \
-         spheres as Mitsuba's own sphere shape and the teapot as the same OBJ triangles, the same camera and sky.exr; \
+        "Mitsuba: llvm_ad_rgb, direct integrator (1 emitter + 1 BSDF sample, MIS), specula's \
+            plugin of the lobe, \
+         spheres as Mitsuba's own sphere shape and the teapot as the same OBJ triangles, the same \
+         camera and sky.exr; \
          on 1 thread it runs two Dr.Jit workers pinned to one core (taskset; one worker deadlocks)"
     );
     println!(
-        "specula process: `specula render` from start to the image written (the sky, the raster, the render, the EXR), \
-         the median of {} runs; Mitsuba cold: from starting Python to its first image written (the import, the \
+        "specula process: `specula render` from start to the image written (the sky, the raster, \
+            the render, the EXR), \
+         the median of {} runs; Mitsuba cold: from starting Python to its first image written (the \
+         import, the \
          scene's loading, the kernels' compilation, the render)",
         args.frames
     );
@@ -295,17 +301,22 @@ pub fn run(args: &Args) -> CommandResult {
     }
     table.print(crate::args::OutputFormat::Table);
     println!(
-        "images: the RMS difference between specula's and Mitsuba's first frames over that between two of specula's \
-         (seeds 1 and 99), about 1 where they differ by noise alone; and how far Mitsuba's mean is from specula's"
+        "images: the RMS difference between specula's and Mitsuba's first frames over that between \
+            two of specula's \
+         (seeds 1 and 99), about 1 where they differ by noise alone; and how far Mitsuba's mean is \
+         from specula's"
     );
     println!(
-        "what still differs: Mitsuba traces a camera ray and a shadow ray per sample (the scenes have nothing to \
-         occlude the sky, so the shadow rays change no pixel) and interpolates the map bilinearly where specula takes \
+        "what still differs: Mitsuba traces a camera ray and a shadow ray per sample (the scenes \
+            have nothing to \
+         occlude the sky, so the shadow rays change no pixel) and interpolates the map bilinearly \
+         where specula takes \
          the nearest texel (a smooth sky: within noise)"
     );
     match (missing, version) {
         (Some(why), _) => println!(
-            "Mitsuba not measured: {why} (install the mitsuba and drjit wheels and Debian's libllvm19 for {})",
+            "Mitsuba not measured: {why} (install the mitsuba and drjit wheels and Debian's \
+                libllvm19 for {})",
             vtk_peer::python().display()
         ),
         (None, Some(version)) => println!("Mitsuba {version}"),

@@ -227,7 +227,8 @@ fn peaks_line(measured: &Measured) -> String {
     parts.push(format!("dispatch {}", sig(peaks.dispatch / 1e9)));
     parts.push(format!("L1 copy {}", sig(peaks.copy / 1e9)));
     format!(
-        "measured peaks, G vector instructions/s on one thread ({} lanes each; compares count against dispatch): {}",
+        "measured peaks, G vector instructions/s on one thread ({} lanes each; compares count \
+            against dispatch): {}",
         lanes,
         parts.join(", ")
     )

@@ -52,14 +52,22 @@ pub struct Args {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     height: Option<u32>,
     /// Samples per pixel (`bench environment`; by default 16, then 64).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(specula_render::ibl::MAX_SPP)))]
+    #[arg(
+        long,
+        value_parser = clap::value_parser!(u32).range(1..=i64::from(specula_render::ibl::MAX_SPP)),
+    )]
     spp: Option<u32>,
     /// Timed frames per method (after one untimed warm-up frame).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     frames: u32,
     /// The exponent the lobes are prepared for (`bench lobes`; VTK's specular power in
     /// `bench volume`).
-    #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = crate::args::parse_exponent)]
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        default_value = "64",
+        value_parser = crate::args::parse_exponent,
+    )]
     n: specula::Exponent,
     /// Output format (`bench lobes`, `bench gpu-lobes`).
     #[arg(long, value_enum, default_value_t = crate::args::OutputFormat::Table)]
@@ -71,7 +79,11 @@ pub struct Args {
     #[arg(long)]
     transfer: Option<String>,
     /// The view of `bench volume` (anterior, posterior, left, right, superior, inferior).
-    #[arg(long, value_parser = specula_render::volume::dvr::View::parse, default_value = "anterior")]
+    #[arg(
+        long,
+        value_parser = specula_render::volume::dvr::View::parse,
+        default_value = "anterior",
+    )]
     view: specula_render::volume::dvr::View,
     /// Millimetres between samples along a ray (`bench volume`; VTK's sample distance).
     #[arg(long, default_value_t = 0.5, value_parser = parse_distance)]

@@ -68,8 +68,10 @@ pub fn run(args: &Args) -> CommandResult {
         });
     let [nx, ny, nz] = volume.dims();
     println!(
-        "{} ({nx} x {ny} x {nz}), {} view, {width} x {height}, {} mm between samples, {threads} threads; \
-         median of {} frames after one warm-up; specula's gradients and bricks took {:.0} ms once, its first frame {:.0} ms",
+        "{} ({nx} x {ny} x {nz}), {} view, {width} x {height}, {} mm between samples, {threads} \
+            threads; \
+         median of {} frames after one warm-up; specula's gradients and bricks took {:.0} ms once, \
+         its first frame {:.0} ms",
         args.input,
         view.id(),
         args.sample_distance,
@@ -78,9 +80,12 @@ pub fn run(args: &Args) -> CommandResult {
         first_frame * 1e3
     );
     println!(
-        "first image: specula from reading the file to its first frame (in this process, started a few ms before); \
-         VTK from starting Python to its first frame (the imports, nibabel's read, VTK's copy, the mapper's gradients, \
-         the ray cast); peak: each process's peak resident memory (VTK's: Python, nibabel, VTK together)"
+        "first image: specula from reading the file to its first frame (in this process, started a \
+            few ms before); \
+         VTK from starting Python to its first frame (the imports, nibabel's read, VTK's copy, the \
+         mapper's gradients, \
+         the ray cast); peak: each process's peak resident memory (VTK's: Python, nibabel, VTK \
+         together)"
     );
     let voxels = (nx * ny * nz) as f64;
     let mut table = Table::new(&[
@@ -151,7 +156,8 @@ pub fn run(args: &Args) -> CommandResult {
                 .map_err(|e| format!("{}: {e}", dir.display()))?;
         }
         println!(
-            "wrote {} (linear) and, from VTK, vtk.png (8-bit linear values, as VTK composites them)",
+            "wrote {} (linear) and, from VTK, vtk.png (8-bit linear values, as VTK composites \
+                them)",
             dir.join("specula.exr").display()
         );
     }

@@ -60,7 +60,8 @@ fn bench_images(d: &Path, input: &Path, transfer: &str) -> Option<(Pixels, Pixel
     if let Some(line) = stdout.lines().find(|l| l.starts_with("VTK not measured")) {
         assert!(
             std::env::var("CI").as_deref() != Ok("true"),
-            "CI=true requires VTK to render (apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri): {line}"
+            "CI=true requires VTK to render (apt-get install libegl1 libegl-mesa0 \
+                libgl1-mesa-dri): {line}"
         );
         eprintln!("skipped: {line}");
         return None;
@@ -146,7 +147,9 @@ fn vtk_comparison(input: &Path, transfer: &str, bounds: (f64, f64, f64, f64)) {
     let outside = outside_box(d, input, 256);
     let (mean, far, one_black, overlap, background) = agreement(&specula, &vtk, &outside);
     eprintln!(
-        "{} ({transfer}) against VTK: mean absolute difference {mean:.4}, pixels off by more than 0.1: {far:.4}, black in one only: {one_black:.4}, covered: intersection over union {overlap:.4}; {} pixels outside the grid's box",
+        "{} ({transfer}) against VTK: mean absolute difference {mean:.4}, pixels off by more than \
+            0.1: {far:.4}, black in one only: {one_black:.4}, covered: intersection over union \
+            {overlap:.4}; {} pixels outside the grid's box",
         input.display(),
         count(&outside)
     );

@@ -57,7 +57,10 @@ fn the_ct_as_nifti_and_as_a_dicom_series_render_alike_as_ct() {
         specula_render::metrics::compare(&nifti, &series, specula_render::Display::default())
             .unwrap()
             .mean_flip;
-    eprintln!("NIfTI against series: mean absolute difference {same:.2e}, mean FLIP {flip:.2e}; ct-bone against mr: {fog:.3}");
+    eprintln!(
+        "NIfTI against series: mean absolute difference {same:.2e}, mean FLIP {flip:.2e}; \
+        ct-bone against mr: {fog:.3}"
+    );
     assert!(
         fog > 0.03,
         "ct-bone and mr look alike ({fog}): the test could not tell them apart"
@@ -134,7 +137,8 @@ fn ct_presets_show_bone_or_skin_as_the_voxels_silhouettes_predict() {
             fraction_in(&window_drawn, &skin_only),
         ];
         eprintln!(
-            "{view}: {figures:?}; skin only ({} px) covered by ct-bone, ct-soft-tissue, window: {shown:?}",
+            "{view}: {figures:?}; skin only ({} px) covered by ct-bone, ct-soft-tissue, window: \
+                {shown:?}",
             count(&skin_only)
         );
         for (what, value) in figures {
@@ -257,7 +261,8 @@ fn the_skull_defect_renders_as_background_with_ct_bone() {
     let in_skin = fraction_in(&skin, &defect);
     let soft = fraction_in(&covered(&soft_drawn, 0.01), &defect);
     eprintln!(
-        "the defect: {} pixels, {in_skin} in the skin silhouette, {} not background with ct-bone, {soft} covered with ct-soft-tissue",
+        "the defect: {} pixels, {in_skin} in the skin silhouette, {} not background with ct-bone, \
+            {soft} covered with ct-soft-tissue",
         count(&defect),
         lit.len()
     );

@@ -155,7 +155,8 @@ fn marker_views(input: &Path, kind: Kind) {
         let expected_x = half_image + (dot(world, right) - (r0 + r1) / 2.0) / half * half_image;
         let expected_y = half_image - (dot(world, up) - (u0 + u1) / 2.0) / half * half_image;
         eprintln!(
-            "{}: {view}: blob of {lit} pixels centred at ({x:.1}, {y:.1}), expected ({expected_x:.1}, {expected_y:.1})",
+            "{}: {view}: blob of {lit} pixels centred at ({x:.1}, {y:.1}), expected \
+                ({expected_x:.1}, {expected_y:.1})",
             input.display()
         );
         let checked = |axis: [f64; 3]| kind != Kind::Enhanced || axis[2] == 0.0;

@@ -48,7 +48,8 @@ pub fn read_file(path: &Path) -> Result<Volume, VolumeError> {
     if let Some(stated) = header.spacing_between_slices {
         if (stated.abs() - grid.gap).abs() > GAP_TOLERANCE * grid.gap {
             return Err(fail(format!(
-                "Spacing Between Slices says {stated} mm but the frames' positions are {:.3} mm apart along the slice normal; specula does not guess which is right",
+                "Spacing Between Slices says {stated} mm but the frames' positions are {:.3} mm \
+                    apart along the slice normal; specula does not guess which is right",
                 grid.gap
             )));
         }
@@ -59,7 +60,8 @@ pub fn read_file(path: &Path) -> Result<Volume, VolumeError> {
     let limit = input::max_input_bytes();
     if bytes > limit {
         return Err(fail(format!(
-            "{frames} frames of {} x {} pixels decode to {bytes} bytes, above the input limit of {limit} bytes ({} MiB; raise it with --max-input-mib)",
+            "{frames} frames of {} x {} pixels decode to {bytes} bytes, above the input limit of \
+                {limit} bytes ({} MiB; raise it with --max-input-mib)",
             header.rows,
             header.columns,
             limit >> 20
@@ -70,7 +72,8 @@ pub fn read_file(path: &Path) -> Result<Volume, VolumeError> {
         .map_err(|e| fail(format!("pixel data: {e}")))?;
     if decoded.data().len() as u64 != bytes || decoded.number_of_frames() as usize != frames {
         return Err(fail(format!(
-            "the pixel data decodes to {} bytes in {} frames where Rows x Columns x Number of Frames x {} bytes is {bytes}",
+            "the pixel data decodes to {} bytes in {} frames where Rows x Columns x Number of \
+                Frames x {} bytes is {bytes}",
             decoded.data().len(),
             decoded.number_of_frames(),
             header.bytes_per_sample
@@ -120,7 +123,8 @@ fn read_header(object: &InMemDicomObject) -> Result<Frames, String> {
     let frames = match integer(object, tags::NUMBER_OF_FRAMES, "Number of Frames")? {
         None | Some(1) => {
             return Err(
-                "a single-frame DICOM image (one slice); give the folder holding its series, or a multi-frame object"
+                "a single-frame DICOM image (one slice); give the folder holding its series, or a \
+                    multi-frame object"
                     .into(),
             )
         }
@@ -145,7 +149,8 @@ fn read_header(object: &InMemDicomObject) -> Result<Frames, String> {
     )? {
         if !photometric.starts_with("MONOCHROME") {
             return Err(format!(
-                "Photometric Interpretation {photometric}; specula reads MONOCHROME1 or MONOCHROME2 frames"
+                "Photometric Interpretation {photometric}; specula reads MONOCHROME1 or \
+                    MONOCHROME2 frames"
             ));
         }
     }
@@ -170,12 +175,17 @@ fn read_header(object: &InMemDicomObject) -> Result<Frames, String> {
         .unwrap_or(&[]);
     if per_frame.is_empty() {
         return Err(format!(
-            "{frames} frames without per-frame geometry: no Per-Frame Functional Groups Sequence (5200,9230) giving each frame's Plane Position Sequence (0020,9113) > Image Position (Patient); specula needs every frame's position, with Plane Orientation (0020,9116) and Pixel Measures (0028,9110) per frame or shared, to stack the frames into a volume"
+            "{frames} frames without per-frame geometry: no Per-Frame Functional Groups Sequence \
+                (5200,9230) giving each frame's Plane Position Sequence (0020,9113) > Image \
+                Position (Patient); specula needs every frame's position, with Plane Orientation \
+                (0020,9116) and Pixel Measures (0028,9110) per frame or shared, to stack the \
+                frames into a volume"
         ));
     }
     if per_frame.len() != frames {
         return Err(format!(
-            "the Per-Frame Functional Groups Sequence has {} items for {frames} frames; it needs one per frame",
+            "the Per-Frame Functional Groups Sequence has {} items for {frames} frames; it needs \
+                one per frame",
             per_frame.len()
         ));
     }
@@ -192,16 +202,28 @@ fn read_header(object: &InMemDicomObject) -> Result<Frames, String> {
         let group = |tag| item(own, tag).or_else(|| shared.and_then(|s| item(s, tag)));
         let lacking = |what: &str| {
             format!(
-                "{name} lacks per-frame geometry: no {what}; specula needs each frame's Image Position (Patient), Image Orientation (Patient) and Pixel Spacing to stack the frames into a volume"
+                "{name} lacks per-frame geometry: no {what}; specula needs each frame's Image \
+                    Position (Patient), Image Orientation (Patient) and Pixel Spacing to stack the \
+                    frames into a volume"
             )
         };
         let position = item(own, tags::PLANE_POSITION_SEQUENCE)
-            .map(|g| numbers(g, tags::IMAGE_POSITION_PATIENT, "Image Position (Patient)", 3))
+            .map(|g| {
+                numbers(
+                    g,
+                    tags::IMAGE_POSITION_PATIENT,
+                    "Image Position (Patient)",
+                    3,
+                )
+            })
             .transpose()
             .map_err(at)?
             .flatten()
             .ok_or_else(|| {
-                lacking("Plane Position Sequence (0020,9113) > Image Position (Patient) in its Per-Frame Functional Groups")
+                lacking(
+                    "Plane Position Sequence (0020,9113) > Image Position (Patient) in its \
+                    Per-Frame Functional Groups",
+                )
             })?;
         let cosines = group(tags::PLANE_ORIENTATION_SEQUENCE)
             .map(|g| {
@@ -216,7 +238,10 @@ fn read_header(object: &InMemDicomObject) -> Result<Frames, String> {
             .map_err(at)?
             .flatten()
             .ok_or_else(|| {
-                lacking("Plane Orientation Sequence (0020,9116) > Image Orientation (Patient), per frame or shared")
+                lacking(
+                    "Plane Orientation Sequence (0020,9116) > Image Orientation (Patient), per \
+                    frame or shared",
+                )
             })?;
         let measures = group(tags::PIXEL_MEASURES_SEQUENCE);
         let spacing = measures

@@ -6,7 +6,8 @@
 //! header: Image Position (Patient), Image Orientation (Patient) and Pixel Spacing, which a
 //! multi-frame object gives per frame in its Per-Frame Functional Groups (5200,9230), or
 //! (orientation and spacing) once for all frames in its Shared Functional Groups
-//! (5200,9229), the per-frame value winning; its rescale is found the same way. Slices are checked as one geometry and sorted along the slice normal (Image
+//! (5200,9229), the per-frame value winning; its rescale is found the same way. Slices are checked
+//! as one geometry and sorted along the slice normal (Image
 //! Orientation's row x column) by position; one function (`stack`) does this for both kinds.
 //! Voxels along a row step by Pixel Spacing's column spacing along the row direction, rows
 //! by its row spacing along the column direction, and slices by the measured distance
@@ -100,7 +101,8 @@ fn stack(planes: &[Plane], whole: &str) -> Result<Grid, String> {
     for plane in &planes[1..] {
         if (plane.rows, plane.columns) != (first.rows, first.columns) {
             return Err(format!(
-                "{} is {} x {} pixels (Rows x Columns) where {} is {} x {}; {whole} shares one size",
+                "{} is {} x {} pixels (Rows x Columns) where {} is {} x {}; {whole} shares one \
+                    size",
                 plane.name, plane.rows, plane.columns, first.name, first.rows, first.columns
             ));
         }
@@ -124,7 +126,8 @@ fn stack(planes: &[Plane], whole: &str) -> Result<Grid, String> {
                 point(&[row.to_array(), column.to_array()].concat())
             };
             return Err(format!(
-                "{} has Image Orientation (Patient) {} where {} has {}; {whole} shares one orientation",
+                "{} has Image Orientation (Patient) {} where {} has {}; {whole} shares one \
+                    orientation",
                 plane.name,
                 cosines(plane),
                 first.name,
@@ -147,7 +150,8 @@ fn stack(planes: &[Plane], whole: &str) -> Result<Grid, String> {
     if let Some(at) = gaps.iter().position(|&g| g < 1e-6) {
         let (a, b) = (&planes[order[at]], &planes[order[at + 1]]);
         return Err(format!(
-            "{} and {} share one position {} (Image Position (Patient)); {whole} has one slice per position",
+            "{} and {} share one position {} (Image Position (Patient)); {whole} has one slice per \
+                position",
             a.name,
             b.name,
             point(&a.position.to_array())
@@ -207,7 +211,9 @@ fn uneven(planes: &[Plane], order: &[usize], gaps: &[f64]) -> String {
                 format!("{count} slices seem")
             };
             format!(
-                "uneven slice spacing: {what} missing between {}, {:.3} mm apart where the others are {usual:.3} mm; specula stacks evenly spaced slices, so give the whole series",
+                "uneven slice spacing: {what} missing between {}, {:.3} mm apart where the others \
+                    are {usual:.3} mm; specula stacks evenly spaced slices, so give the whole \
+                    series",
                 neighbours(at),
                 gaps[at]
             )
@@ -217,7 +223,8 @@ fn uneven(planes: &[Plane], order: &[usize], gaps: &[f64]) -> String {
                 .max_by(|&a, &b| (gaps[a] - usual).abs().total_cmp(&(gaps[b] - usual).abs()))
                 .unwrap_or(0);
             format!(
-                "uneven slice spacing ({:.3} to {:.3} mm; the gap most off the usual {usual:.3} mm is between {}); specula stacks evenly spaced slices",
+                "uneven slice spacing ({:.3} to {:.3} mm; the gap most off the usual {usual:.3} mm \
+                    is between {}); specula stacks evenly spaced slices",
                 sorted[0],
                 sorted[sorted.len() - 1],
                 neighbours(widest)

@@ -108,7 +108,8 @@ fn read_header(path: &Path) -> Result<Slice, String> {
     {
         if frames != 1 {
             return Err(at(format!(
-                "a multi-frame object ({frames} frames) in a series folder, where each file is one slice; pass the file itself (--input {}) to read its frames as a volume",
+                "a multi-frame object ({frames} frames) in a series folder, where each file is one \
+                    slice; pass the file itself (--input {}) to read its frames as a volume",
                 path.display()
             )));
         }

@@ -317,8 +317,10 @@ fn multi_frame_objects_without_per_frame_geometry_are_refused_in_one_line() {
 fn unevenly_spaced_or_inconsistent_frames_are_refused_before_decoding() {
     let message = Enhanced::new(&[0.0, 1.0, 3.0, 4.0]).read().unwrap_err();
     assert!(
-        message.contains("uneven slice spacing: a slice seems missing between positions (2.5, -39.134, 12) of frame 2 and (1.5, -37.402, 12) of frame 3")
-            && message.contains("2.000 mm apart where the others are 1.000 mm"),
+        message.contains(
+            "uneven slice spacing: a slice seems missing between positions (2.5, \
+            -39.134, 12) of frame 2 and (1.5, -37.402, 12) of frame 3"
+        ) && message.contains("2.000 mm apart where the others are 1.000 mm"),
         "{message}"
     );
     let message = Enhanced::new(&[0.0, 1.0, 2.7, 4.0]).read().unwrap_err();

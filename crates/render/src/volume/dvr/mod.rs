@@ -98,7 +98,8 @@ impl DvrPlan {
         let (width, height) = (settings.width, settings.height);
         if width == 0 || height == 0 || u64::from(width) * u64::from(height) > crate::MAX_PIXELS {
             return Err(VolumeError(format!(
-                "an image of {width} x {height}: width and height must be at least 1 and the image at most {} pixels",
+                "an image of {width} x {height}: width and height must be at least 1 and the image \
+                    at most {} pixels",
                 crate::MAX_PIXELS
             )));
         }

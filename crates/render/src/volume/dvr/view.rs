@@ -130,7 +130,8 @@ impl RayCamera {
                 let distance = eye.distance(centre);
                 if !(eye.is_finite() && distance > 1.01 * radius) {
                     return Err(VolumeError(format!(
-                        "--eye must be a finite point outside the volume's bounding sphere (centre {centre}, radius {radius:.1} mm)"
+                        "--eye must be a finite point outside the volume's bounding sphere (centre \
+                            {centre}, radius {radius:.1} mm)"
                     )));
                 }
                 let forward = (centre - eye) / distance;

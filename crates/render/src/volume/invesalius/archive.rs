@@ -54,7 +54,8 @@ pub(super) fn walk(path: &Path, limit: u64, visit: &mut Visit<'_>) -> Result<(),
         if kind.is_gnu_longname() || kind.is_pax_local_extensions() {
             if size > MAX_HEADER_ENTRY_BYTES {
                 return Err(format!(
-                    "a tar header entry (long name or PAX) of {size} bytes; the most read is {MAX_HEADER_ENTRY_BYTES}"
+                    "a tar header entry (long name or PAX) of {size} bytes; the most read is \
+                        {MAX_HEADER_ENTRY_BYTES}"
                 ));
             }
             let mut bytes = Vec::with_capacity(size as usize);
@@ -105,7 +106,10 @@ pub(super) fn damaged(error: io::Error) -> String {
     } else if error.kind() == io::ErrorKind::UnexpectedEof {
         format!("the archive is truncated ({said})")
     } else {
-        format!("not a readable InVesalius project: the tar.gz archive is damaged or truncated ({said})")
+        format!(
+            "not a readable InVesalius project: the tar.gz archive is damaged or truncated \
+            ({said})"
+        )
     }
 }
 
@@ -129,7 +133,8 @@ impl<R: Read> Read for Capped<R> {
             return match self.inner.read(&mut probe)? {
                 0 => Ok(0),
                 _ => Err(io::Error::other(format!(
-                    "{CAPPED} {} bytes ({INFLATION} x the input limit; raise it with --max-input-mib)",
+                    "{CAPPED} {} bytes ({INFLATION} x the input limit; raise it with \
+                        --max-input-mib)",
                     self.cap
                 ))),
             };

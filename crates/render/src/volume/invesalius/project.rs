@@ -174,7 +174,8 @@ impl Project {
         let bytes = voxels as u64 * dtype.bytes() as u64;
         if bytes > limit {
             return Err(format!(
-                "the voxels ({x} x {y} x {z} {}) take {bytes} bytes, above the input limit of {limit} bytes ({} MiB; raise it with --max-input-mib)",
+                "the voxels ({x} x {y} x {z} {}) take {bytes} bytes, above the input limit of \
+                    {limit} bytes ({} MiB; raise it with --max-input-mib)",
                 dtype.name(),
                 limit >> 20
             ));
@@ -222,7 +223,8 @@ impl Project {
                     _ => "not a number or a name".to_owned(),
                 };
                 return Err(format!(
-                    "orientation {said}: specula reads axial projects (orientation 1 or AXIAL), whose placement it knows"
+                    "orientation {said}: specula reads axial projects (orientation 1 or AXIAL), \
+                        whose placement it knows"
                 ));
             }
         }

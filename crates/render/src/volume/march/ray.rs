@@ -7,8 +7,10 @@
 //! opacity, lighting and compositing are written in the core's vectors ([`Lanes`]), with no
 //! branch on a sample's value (whether a noisy sample faces the light is a coin toss that a
 //! branch would mispredict). The turns are software-pipelined: the next turn's segments are
-//! placed before this turn is composited, and its samples read after. A lane whose ray ends takes the next ray of the
-//! list, so the packet stays full until the list runs out. Highlights are gathered across lanes and their
+//! placed before this turn is composited, and its samples read after. A lane whose ray ends takes
+//! the next ray of the
+//! list, so the packet stays full until the list runs out. Highlights are gathered across lanes and
+//! their
 //! lobe evaluated together by the lobe's vector kernel
 //! ([`specula::Lobe::eval_batch`]).
 //!

@@ -9,7 +9,8 @@ use specula::simd::Level;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 
 /// The classic model as the module states it, written here apart from
-/// `Lighting::light_lanes`'s rearranged arithmetic: the gradient's opposite, turned to the viewer, as the normal; the
+/// `Lighting::light_lanes`'s rearranged arithmetic: the gradient's opposite, turned to the viewer,
+/// as the normal; the
 /// geometry's own cosine; lit blended with unlit by the gradient's strength.
 fn classic(lighting: &Lighting, gradient: Vec3, base: Vec3, wo: Vec3) -> Vec3 {
     let strength = gradient.length();

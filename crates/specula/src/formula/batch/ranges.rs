@@ -1,4 +1,5 @@
-//! The range analysis of a chain: which of the shared rules ([`Rules`]) its output needs, from `[0, 1]`
+//! The range analysis of a chain: which of the shared rules ([`Rules`]) its output needs, from `[0,
+//! 1]`
 //! in, by interval ends evaluated as the lanes round them.
 
 use super::chain::{Chain, EXP2_DOMAIN};
