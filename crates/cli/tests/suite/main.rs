@@ -27,5 +27,6 @@ mod render;
 mod report;
 mod sample;
 mod sky;
+mod structure;
 mod user_lobe;
 mod volume;
