@@ -16,6 +16,7 @@ use specula_decide::{versus_pow, Target};
 
 use super::html::{escape, paragraph, table};
 use super::plot::Series;
+use super::prose;
 use super::verdict::{pareto_chart, EXACT_FLOOR};
 use super::Context;
 
@@ -48,23 +49,16 @@ pub fn designed(context: &mut Context) -> Result<String, String> {
         .par_iter()
         .map(|&(target, _, bound)| design(&request(target, bound, &yours), &ProgressBar::hidden()))
         .collect::<Result<_, _>>()?;
-    let mut html = paragraph(&format!(
-        "The thesis designed its lobes by hand; specula design searches the families the \
-         formula language writes (exp2 of a polynomial of 1 - t; a linear or quadratic \
-         polynomial of 1 - t, cut where it stops falling, raised to a power of two), fits \
-         each one's global coefficients across n from {} to {} (every per-material constant \
-         a closed form of n), verifies the fitted formula with the f64 analysis at {} \
-         exponents of the range (epicentre error within the bound, whole-lobe error within \
-         {} of the peak or the epicentre's bound where larger, 1 at t = 1, non-decreasing, in [0, \
-         1]) and costs it as recommend \
-         does. Each row is specula design --target TARGET --n {}..{} --max-error BOUND.",
-        RANGE.0,
-        RANGE.1,
-        answers.first().map_or(0, |a| a.exponents_verified),
-        percent(DEFAULT_WHOLE_ERROR),
-        RANGE.0,
-        RANGE.1
-    ));
+    let verified = answers.first().map_or(0, |a| a.exponents_verified);
+    let mut html = paragraph(&prose::fill(
+        prose::DESIGNED,
+        &[
+            ("low", &RANGE.0),
+            ("high", &RANGE.1),
+            ("verified", &verified),
+            ("whole", &percent(DEFAULT_WHOLE_ERROR)),
+        ],
+    )?);
     let mut rows = Vec::new();
     let mut formulas = String::new();
     for ((_, name, bound), answer) in jobs.iter().zip(&answers) {

@@ -15,6 +15,7 @@ use specula_render::measured::{load_measured, material_name, material_scene, ren
 
 use super::html::{escape, figure, paragraph, table};
 use super::plot::{Polar, PolarCurve, PolarPanel, DASHED, DASH_DOT};
+use super::prose;
 use super::sections::colour;
 use super::Context;
 use specula_decide::material::{
@@ -118,28 +119,25 @@ pub fn materials(context: &mut Context) -> Result<String, String> {
     }
     let (width, spp) = context.sizes.materials;
     let height = material_scene(width).settings.height;
-    let mut html =
-        paragraph(&format!(
-        "The measured materials in {} ({} of them, in name order{}), each fitted as specula fit \
-            --material FILE fits it: every lobe in both geometries and GGX, kd / pi + K spec per \
-            channel, with one n for the three channels (what a renderer's material has) and with \
-            one per channel. E, the fit error, is the {error_measure}. The verdict is the cheapest \
-            lobe on {} whose one-n fit is within {} % of pow's best. Each table shows every lobe's \
-            one-n fit in its better geometry, and in its last column the same model's fit with one \
-            n per channel. The renders are the environment scene under the procedural sky \
-            ({width}x{height}, {spp} samples per pixel, the same random numbers for every model), \
-            the measured material sampled by its own data.",
-        directory.display(),
-        files.len(),
-        if more > 0 {
-            format!("; {more} more .bsdf files not shown, as a report shows at most \
-                {MAX_MATERIALS}")
-        } else {
-            String::new()
-        },
-        TARGET,
-        100.0 * MARGIN,
-    ));
+    let more = if more > 0 {
+        format!("; {more} more .bsdf files not shown, as a report shows at most {MAX_MATERIALS}")
+    } else {
+        String::new()
+    };
+    let mut html = paragraph(&prose::fill(
+        prose::MATERIALS,
+        &[
+            ("folder", &directory.display()),
+            ("count", &files.len()),
+            ("more", &more),
+            ("error_measure", &error_measure),
+            ("target", &TARGET),
+            ("margin", &(100.0 * MARGIN)),
+            ("width", &width),
+            ("height", &height),
+            ("spp", &spp),
+        ],
+    )?);
     html += &shown;
     Ok(html)
 }

@@ -11,6 +11,7 @@ use specula::fit::microfacet;
 use specula::{Geometry, Lobe, LobeKind};
 
 use super::html::{paragraph, table};
+use super::prose;
 use super::Context;
 
 const FIT_EXPONENTS: [f64; 3] = [8.0, 64.0, 512.0];
@@ -77,16 +78,10 @@ pub fn other_renderers(context: &mut Context) -> Result<String, String> {
         .flat_map(|g| FIT_EXPONENTS.map(|n| format!("{} n = {n}", g.id())))
         .collect();
     fit_header.extend(labels.iter().map(String::as_str));
-    let mut html = paragraph(
-        "Every lobe is recorded once as an expression (its formula run on a tracing number type, \
-            the constants prepared for n folded in or kept as named parameters) and every target \
-            is written from that record: the WGSL of specula shader (and through naga GLSL, HLSL, \
-            MSL, SPIR-V), an OSL script node for Blender Cycles, a MaterialX document and a \
-            Mitsuba 3 plugin (specula shader --lang osl|mtlx|mitsuba). Targets without bit casts \
-            get the record lowered: the bit tricks rewritten in arithmetic, floor and selects. \
-            Counted now, at n = 64 over 20,000 cosines: how often the record and its lowering give \
-            the lobe's own f32 bits.",
-    );
+    let mut html = paragraph(&prose::fill(
+        prose::OTHER_RENDERERS,
+        &[("n", &DESCRIPTION_EXPONENT), ("count", &cosines.len())],
+    )?);
     html.push_str(&table(
         &[
             "lobe",

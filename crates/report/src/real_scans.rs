@@ -17,6 +17,7 @@ use specula_render::{read_image, srgb_encode, Display, Image};
 
 use super::comparison::{self, Compared};
 use super::html::{paragraph, table_with_files};
+use super::prose;
 use super::{Context, RealScanSizes};
 use crate::format::psnr;
 use crate::medical::{cpu_threads, march_times, shading, EXPONENT};
@@ -404,30 +405,16 @@ fn against_vtk(
         .map(|loaded| loaded.scan.vtk_reads)
         .collect::<Vec<_>>()
         .join("; ");
-    html += &paragraph(&format!(
-        "VTK's vtkFixedPointVolumeRayCastMapper (the CPU ray caster 3D Slicer and ParaView build \
-            on) and specula set up alike{quick}, as specula bench volume does: the same voxels and \
-            placement (VTK reads a NIfTI file: {files}), anterior view with a parallel projection, \
-            {side}x{side} pixels, one ray per pixel, trilinear interpolation, a sample every \
-            {SAMPLE_DISTANCE} mm, the same transfer function (VTK's opacity per millimetre 1 - \
-            exp(-sigma), which its sample-distance correction turns into specula's 1 - exp(-sigma \
-            d)), VTK's headlight (a white ambient colour given to it, so that both count ambient \
-            0.25), diffuse 0.7, specular 0.5 with VTK's Blinn-Phong power {EXPONENT} as the pow \
-            lobe without normalisation, every sample fully shaded and rays stopped at VTK's 99.22 \
-            % opacity. What differs is how each computes: VTK lights each voxel's \
-            central-difference normal quantised to 65,280 directions and interpolates the 8 \
-            corners' lit values (a voxel whose difference is exactly zero is lit black but stays \
-            opaque; in integer data that is uniform tissue and saturated bone), where specula \
-            shades the gradient of the trilinear field at the sample; VTK's samples lie on a \
-            lattice anchored at the near clipping plane, the same depths for every ray, where \
-            specula jitters each ray's first segment; VTK's arithmetic is 15-bit fixed point \
-            (docs/vtk-notes.md). VTK also takes one-sided differences, not doubled, at the grid's \
-            faces, and with several threads at the last slice of each thread's share of the \
-            gradients (a seam; docs/vtk-notes.md). So the images agree in shape and colour, and \
-            the FLIP maps show where they part: on silhouettes and at the volume's faces, where \
-            the two place their samples differently, and along the slice of VTK's seam (plain on \
-            the MRI, a line across the middle)."
-    ));
+    html += &paragraph(&prose::fill(
+        prose::VTK_SETUP,
+        &[
+            ("quick", &quick),
+            ("files", &files),
+            ("side", &side),
+            ("sample_distance", &SAMPLE_DISTANCE),
+            ("exponent", &EXPONENT),
+        ],
+    )?);
     let vtk_runs = match theirs {
         Ok(runs) => runs,
         Err(why) => {
@@ -528,19 +515,14 @@ fn against_vtk(
         &rows,
         &[1, 2],
     );
-    html += &paragraph(&format!(
-        "VTK {}. The differences are of linear values in [0, 1] per channel over the whole image \
-            (background included); a pixel is off when any channel differs by more than 0.1; FLIP \
-            is of the images as shown (sRGB). Frames per second are the median of {frames} \
-            frame(s) ({} threads each; VTK's own time to draw after an untimed first frame, in \
-            which it computes its gradients; specula's whole frame, its gradients and bricks \
-            computed once before), specula's taken after VTK's, both while the report's other \
-            sections run and on small images, where a frame's fixed costs weigh more: a rough \
-            guide, not a benchmark (specula bench volume --input FILE measures on a quiet machine \
-            at 512x512). Timings are printed, never asserted.",
-        version,
-        rayon::current_num_threads()
-    ));
+    html += &paragraph(&prose::fill(
+        prose::VTK_FIGURES,
+        &[
+            ("version", &version),
+            ("frames", &frames),
+            ("threads", &rayon::current_num_threads()),
+        ],
+    )?);
     html += &figures;
     Ok(html)
 }

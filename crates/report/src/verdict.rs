@@ -14,6 +14,7 @@ use specula_decide::{recommend_each, versus_pow, Recommendation, Request, Target
 
 use super::html::{paragraph, table};
 use super::plot::{Chart, Series};
+use super::prose;
 use super::sections::series;
 use super::Context;
 use crate::format::sig;
@@ -180,16 +181,7 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
         &["target", "n", "within 0.5 %", "within 2 %", "within 10 %"],
         &rows,
     );
-    html += &paragraph(
-        "FPGA rows: specula recommend --target fpga's answer too. Each lobe is costed as its \
-         fixed-point datapath (of a lobe's datapaths, the one with the fewest estimated logic \
-         cells) at the smallest word length whose epicentre error is within the bound, \
-         synthesized with Yosys and placed with nextpnr on an iCE40 HX8K (the synthesis is \
-         cached, so only the first run waits for the tools), and ranked by results per \
-         microsecond per 1000 LUTs; each cell names the datapath, its word length and that \
-         rate. Where the tools are missing, the rate is the formula estimate instead, per \
-         1000 estimated logic cells, and its unit says so. '-': no lobe meets it.",
-    );
+    html += &paragraph(&prose::fill(prose::FPGA_ROWS, &[])?);
     for note in fpga
         .iter()
         .flatten()
