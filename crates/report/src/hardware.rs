@@ -8,6 +8,7 @@ use specula_hw::{diagram, HwLobe, Resources, BITS};
 
 use super::html::{linked_figure, paragraph, table};
 use super::plot::{Chart, Series};
+use super::prose;
 use super::sections::colour;
 use super::Context;
 use specula_hw::analysis::WidthSweep;
@@ -163,15 +164,10 @@ fn synthesized(
 
 pub fn hardware(context: &mut Context) -> Result<String, String> {
     let all = context.hardware_sweeps()?;
-    let mut html = paragraph(&format!(
-        "Each approximation as a bit-accurate fixed-point datapath (SPEC section 8; crates/hw). \
-         W is the word length of signals in [0, 1] (UQ1.(W-1)); wider signals keep the same \
-         least significant bit. Every stage rounds half to even and saturates. The error \
-         includes the input's quantisation, as on silicon. A datapath meets its float model \
-         when its epicentre max relative error is within {MEETS_TOLERANCE}x the f64 model's. \
-         The Verilog of every datapath is co-simulated with Icarus Verilog, bit-exact, in the \
-         tests."
-    ));
+    let mut html = paragraph(&prose::fill(
+        prose::HARDWARE,
+        &[("tolerance", &MEETS_TOLERANCE)],
+    )?);
     let mut rows = Vec::new();
     for (n, results) in &all {
         let series: Vec<Series> = results

@@ -7,6 +7,16 @@
 
 use core::fmt::Display;
 
+/// What "Which lobe when" answers, and how.
+pub(crate) const VERDICT: &str = include_str!("prose/verdict.txt");
+/// How the real scans are drawn.
+pub(crate) const REAL_SCANS: &str = include_str!("prose/real-scans.txt");
+/// How the phantom is drawn.
+pub(crate) const PHANTOM: &str = include_str!("prose/phantom.txt");
+/// What the hardware section's datapaths are.
+pub(crate) const HARDWARE: &str = include_str!("prose/hardware.txt");
+/// How the environment-lit renders are made.
+pub(crate) const ENVIRONMENT: &str = include_str!("prose/environment.txt");
 /// How VTK and specula are set up alike on the real scans.
 pub(crate) const VTK_SETUP: &str = include_str!("prose/vtk-setup.txt");
 /// How the VTK comparison's figures are obtained.
@@ -65,6 +75,11 @@ mod tests {
     #[test]
     fn every_template_has_well_formed_placeholders() {
         for template in [
+            super::VERDICT,
+            super::PHANTOM,
+            super::HARDWARE,
+            super::ENVIRONMENT,
+            super::REAL_SCANS,
             super::VTK_SETUP,
             super::VTK_FIGURES,
             super::MATERIALS,

@@ -176,15 +176,10 @@ pub fn real_scans(context: &mut Context) -> Result<String, String> {
                 .join(", ")
         )
     };
-    html += &paragraph(&format!(
-        "Each scan as read from the file its Debian package installs, ray-marched at {side}x{side} \
-            from the front (anterior view) through its default transfer function (ct-bone for the \
-            CT, mr for the MRI), with the phantom's shading (thesis normalisation, Blinn geometry, \
-            n = {EXPONENT}, the key light) and {which} as the specular term (specula volume \
-            --input FILE --lobe L --normalisation thesis-phong). FLIP and PSNR are against the pow \
-            image; the times are frames on all threads while the report's other sections run, \
-            after the volume's gradients and bricks were computed once."
-    ));
+    html += &paragraph(&prose::fill(
+        prose::REAL_SCANS,
+        &[("side", &side), ("exponent", &EXPONENT), ("which", &which)],
+    )?);
     let compared = if every_scan_against_vtk {
         &scans[..]
     } else {

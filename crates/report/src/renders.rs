@@ -14,6 +14,7 @@ use specula_render::{
 
 use super::comparison::{self, Compared};
 use super::html::{paragraph, table_with_files};
+use super::prose;
 use super::Context;
 use crate::format::{psnr, psnr_db, sig};
 
@@ -222,14 +223,10 @@ fn environment_lit(context: &mut Context) -> Result<String, String> {
         spp,
         ..IblSettings::default()
     };
-    let mut html = paragraph(&format!(
-        "A sphere and the teapot lit by the procedural sky alone ({width}x{height}, {spp} samples \
-            per pixel, multiple importance sampling between each lobe's own sampler and the sky, \
-            the lobe normalisation, physical model: specula render --env sky --spp {spp} --lobe \
-            L). Every lobe's render uses the same random numbers, so what differs from pow is the \
-            reflected sun's and sky's shape; the residual Monte Carlo noise sets the floor of \
-            these figures."
-    ));
+    let mut html = paragraph(&prose::fill(
+        prose::ENVIRONMENT,
+        &[("width", &width), ("height", &height), ("spp", &spp)],
+    )?);
     let mut images = render_ibl_grid(&base, &grid_options(context), &sky, &settings, &|_, _| {})
         .map_err(|e| e.to_string())?;
     let (table_html, _) = lobe_table(

@@ -109,17 +109,7 @@ pub(crate) fn pareto_chart(
 }
 
 pub fn verdict(context: &mut Context) -> Result<String, String> {
-    let mut html = paragraph(
-        "The cheapest lobe whose epicentre error (largest relative error where t^n >= 1/2) \
-         stays within each accuracy: each cell is what specula recommend --target TARGET \
-         --n N --max-error BOUND answers (the same library call, the lobes below as \
-         candidates). On the GPUs, by the cost model: each lobe's exported shader, its \
-         instructions counted and weighed by the vendor's published per-clock rates \
-         (crates/specula/src/gpu_cost.rs); the ratio is its modelled throughput over pow's (higher \
-         is \
-         better, as everywhere in this report). For the CPU, run specula recommend --target cpu: \
-         its costs are measured.",
-    );
+    let mut html = paragraph(&prose::fill(prose::VERDICT, &[])?);
     let yours: Vec<String> = context
         .lobes
         .iter()

@@ -21,6 +21,7 @@ use specula_render::{Display, Image};
 
 use super::comparison::{self, Compared};
 use super::html::{paragraph, table, table_with_files};
+use super::prose;
 use super::Context;
 use crate::format::{psnr, sig};
 use crate::medical::{cpu_threads, march_times, shading, EXPONENT};
@@ -68,15 +69,15 @@ fn phantom(context: &mut Context) -> Result<String, String> {
     let transfer = TransferFunction::default_for(&volume).for_volume(&volume);
     let gpu = Gpu::new();
     let renderer = gpu.as_ref().ok().map(GpuVolumeRenderer::new);
-    let mut html = paragraph(&format!(
-        "The 3D Shepp-Logan head ({side}³ voxels, each the mean over its cell) ray-marched at \
-            {pixels}x{pixels}, coronal view, with the mr transfer function and the thesis's \
-            normalisation, Blinn geometry, n = {EXPONENT}: every lobe is the specular term of the \
-            gradient-shaded samples (specula volume --input phantom --size {side} --lobe L \
-            --normalisation thesis-phong). FLIP and PSNR are against the pow image; times are the \
-            best of {runs} frame(s), on all CPU cores and on the GPU, after the volume's gradients \
-            and bricks were computed once (the GPU's frames upload them)."
-    ));
+    let mut html = paragraph(&prose::fill(
+        prose::PHANTOM,
+        &[
+            ("side", &side),
+            ("pixels", &pixels),
+            ("exponent", &EXPONENT),
+            ("runs", &runs),
+        ],
+    )?);
     // pow's frame alone, then every lobe's image from one march (each bit for bit the one
     // marched for its lobe alone), on the volume's gradients and bricks computed once.
     let prepared = PreparedVolume::new(&volume);
