@@ -24,6 +24,7 @@
 
 use super::batch::LobeKernel;
 use super::draw_batch::remaining_share;
+use super::facts::closed_form_facts;
 use crate::real::Real;
 use crate::simd::math::{exp2, log2};
 use crate::simd::tally::{Class, Instructions};
@@ -225,3 +226,6 @@ impl<const SQUARINGS: u32, const MASKED: bool> LobeKernel for CosQuadKernel<SQUA
         }
     }
 }
+
+// Sampled in closed form: the tail and its inverse exactly.
+closed_form_facts!(CosQuad);

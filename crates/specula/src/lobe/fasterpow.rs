@@ -24,6 +24,7 @@
 //!   N. N. Schraudolph, "A fast, compact approximation of the exponential function" (1999).
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::facts::ModelFacts;
 use super::fastpow::kinks;
 use crate::real::Real;
 use crate::simd::math::{bits_exp2, frexp, BITS_EXP2, FREXP};
@@ -99,5 +100,12 @@ impl LobeKernel for FasterPowKernel {
             .plus(Class::MinMax, 1)
             .plus(Class::Compare, 1)
             .plus(Class::Logic, 1)
+    }
+}
+
+/// Kinked where its bit trick crosses a binade or an integer.
+impl ModelFacts for FasterPow {
+    fn lobe_kinks(&self) -> Vec<f64> {
+        self.kinks()
     }
 }

@@ -12,6 +12,7 @@
 //! - **Sampling**: Newton on the formula's own tail where it gives one, else a table.
 
 use super::batch::LobeKernel;
+use super::facts::ModelFacts;
 use super::invert::NewtonStart;
 use super::{Inverted, NewtonForm};
 use crate::formula::batch::Rules;
@@ -177,5 +178,21 @@ impl Kernel for FormulaKernel {
 impl LobeKernel for FormulaKernel {
     fn instructions(self) -> Instructions {
         self.stated
+    }
+}
+
+/// A user's lobe states what its formula has: a tail and its Newton form where the formula
+/// integrates in closed form.
+impl ModelFacts for FormulaLobe {
+    fn lobe_tail(&self, t: f64) -> Option<f64> {
+        self.tail(t)
+    }
+
+    fn lobe_tail_inverse(&self, u: f64, start: NewtonStart) -> Option<Inverted> {
+        self.tail_inverse(u, start)
+    }
+
+    fn lobe_newton_sampling<R: Real>(&self, x: R) -> Option<NewtonForm<R>> {
+        self.newton_sampling(x)
     }
 }

@@ -18,6 +18,7 @@
 //! - **Source**: the thesis, slide "Models based on the logarithmic and exponential functions".
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::facts::ModelFacts;
 use crate::real::Real;
 use crate::simd::math::{log2, LOG2};
 use crate::simd::tally::{Class, Instructions};
@@ -85,3 +86,6 @@ impl LobeKernel for LogExpKernel {
             .plus(Class::MinMax, 1)
     }
 }
+
+/// Sampled from a table: no closed-form tail, no kinks, one structure for every `n`.
+impl ModelFacts for LogExp {}

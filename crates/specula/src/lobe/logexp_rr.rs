@@ -18,6 +18,7 @@
 //! - **Source**: specula.
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::facts::ModelFacts;
 use super::logexp::exp2_by_log2;
 use crate::real::Real;
 use crate::simd::math::{log2, LOG2};
@@ -86,3 +87,6 @@ impl LobeKernel for LogExpRrKernel {
             .plus(Class::Shift, 1)
     }
 }
+
+/// Sampled from a table: no closed-form tail, no kinks, one structure for every `n`.
+impl ModelFacts for LogExpRr {}

@@ -16,6 +16,7 @@ mod cheb2;
 mod cheb2_thesis;
 mod cosquad;
 mod draw_batch;
+mod facts;
 mod fasterpow;
 mod fastpow;
 mod formula;
@@ -33,6 +34,7 @@ mod sg_karis;
 
 pub use cheb2_thesis::thesis_coefficients;
 pub use cosquad::CosQuad;
+use facts::{each_model, ModelFacts};
 use invert::NewtonStart;
 pub use invert::{Inverted, F32_RESOLUTION, F64_RESOLUTION};
 pub use kind::{FormulaId, LineStyle, LobeInfo, LobeKind, Origin, ParamInfo};
@@ -173,10 +175,7 @@ impl Lobe {
     /// The coefficients `[C, B, A]` of a quadratic-in-angle lobe, `None` for the others.
     #[must_use]
     pub fn angle_quadratic(&self) -> Option<AngleQuadratic> {
-        match self.model {
-            Model::AngleQuadratic(q) => Some(q),
-            _ => None,
-        }
+        each_model!(&self.model, m => m.lobe_angle_quadratic())
     }
 
     /// The prepared constants as flat numbers (see [`PackedLobe`]).
@@ -214,11 +213,7 @@ impl Lobe {
     /// boundaries and integer crossings. Empty for the others.
     #[must_use]
     pub fn kinks(&self) -> Vec<f64> {
-        match &self.model {
-            Model::FastPow(m) => m.kinks(),
-            Model::FasterPow(m) => m.kinks(),
-            _ => Vec::new(),
-        }
+        each_model!(&self.model, m => m.lobe_kinks())
     }
 
     /// How the lobe's cosine is sampled.
@@ -244,15 +239,7 @@ impl Lobe {
     #[must_use]
     pub fn tail(&self, t: f64) -> Option<f64> {
         let t = t.clamp(0.0, 1.0);
-        match &self.model {
-            Model::Pow(m) => Some(m.tail(t)),
-            Model::Sg(m) => Some(m.tail(t)),
-            Model::CosQuad(m) => Some(m.tail(t)),
-            Model::Schlick(m) => Some(m.tail(t)),
-            Model::AngleQuadratic(m) if m.has_closed_form_tail() => Some(m.tail(t)),
-            Model::Formula(m) => m.tail(t),
-            _ => None,
-        }
+        each_model!(&self.model, m => m.lobe_tail(t))
     }
 
     /// The cosine `t` with `tail(t) = u tail(0)`, `u` in `[0, 1]`, and the iterations it
@@ -285,16 +272,7 @@ impl Lobe {
 
     fn tail_inverse_from(&self, u: f64, start: NewtonStart) -> Option<Inverted> {
         let u = u.clamp(0.0, 1.0);
-        let exact = |x| Some(Inverted { x, iterations: 0 });
-        match &self.model {
-            Model::Pow(m) => exact(m.tail_inverse(u)),
-            Model::Sg(m) => exact(m.tail_inverse(u)),
-            Model::CosQuad(m) => exact(m.tail_inverse(u)),
-            Model::Schlick(m) => Some(m.tail_inverse(u, start)),
-            Model::AngleQuadratic(m) if m.has_closed_form_tail() => Some(m.tail_inverse(u, start)),
-            Model::Formula(m) => m.tail_inverse(u, start),
-            _ => None,
-        }
+        each_model!(&self.model, m => m.lobe_tail_inverse(u, start))
     }
 
     /// The lobe at cosine `t` (any value; see the module docs for the rules).
@@ -332,54 +310,21 @@ impl Lobe {
     #[inline]
     #[must_use]
     pub fn eval_angle<R: Real>(&self, g: R) -> R {
-        match &self.model {
-            Model::AngleQuadratic(m) => {
-                let g = g.max(-g);
-                if g < R::from_f64(core::f64::consts::FRAC_PI_2) {
-                    m.eval_angle(g)
-                } else {
-                    R::from_f64(0.0)
-                }
-            }
-            _ => self.eval(g.cos()),
-        }
+        each_model!(&self.model, m => m.lobe_eval_angle(g)).unwrap_or_else(|| self.eval(g.cos()))
     }
 
     /// For a lobe sampled in closed form ([`Warp::Analytic`]): the inverse of its tail,
     /// `t(u)` with `int_t^1 lobe = u int_0^1 lobe`, and the whole `int_0^1 lobe`, written once
     /// over [`Real`] so that a target that samples records them (`expression/mod.rs`).
     pub fn closed_form_sampling<R: Real>(&self, u: R) -> Option<(R, R)> {
-        match &self.model {
-            Model::Pow(m) => Some((m.tail_inverse(u), m.total())),
-            Model::Sg(m) => Some((m.tail_inverse(u), m.total())),
-            Model::CosQuad(m) => Some((m.tail_inverse(u), m.total())),
-            _ => None,
-        }
+        each_model!(&self.model, m => m.lobe_closed_form_sampling(u))
     }
 
     /// For a lobe sampled by Newton on a closed-form tail ([`Warp::Newton`]), in the variable
     /// `x` its solver works in (`d = 1 - t` for `schlick`, the angle for the quadratics),
     /// written once over [`Real`] so that a target that samples records it.
     pub fn newton_sampling<R: Real>(&self, x: R) -> Option<NewtonForm<R>> {
-        let one = R::from_f64(1.0);
-        match &self.model {
-            Model::Schlick(m) => Some(NewtonForm {
-                tail: m.tail_from_peak(x),
-                slope: m.eval(one - x),
-                cosine: one - x,
-                upper: one,
-                total: m.tail_from_peak(one),
-            }),
-            Model::AngleQuadratic(m) if m.has_closed_form_tail() => Some(NewtonForm {
-                tail: m.tail_angle(x),
-                slope: m.tail_slope(x),
-                cosine: x.cos(),
-                upper: m.cutoff_parameter(),
-                total: m.tail_angle(m.cutoff_parameter()),
-            }),
-            Model::Formula(m) => m.newton_sampling(x),
-            _ => None,
-        }
+        each_model!(&self.model, m => m.lobe_newton_sampling(x))
     }
 
     /// The named parameter `name` of [`Lobe::expression`] computed from the exponent `n`, as
@@ -408,22 +353,7 @@ impl Lobe {
     /// constants cannot follow `n` at all, so their range is this `n` alone.
     #[must_use]
     pub fn structural_range(&self) -> [f64; 2] {
-        let n = self.n.get();
-        match &self.model {
-            Model::AngleQuadratic(_) => [n, n],
-            Model::SchlickMod(m) => {
-                let squarings = m.squarings();
-                let low = if squarings == 0 {
-                    Exponent::MIN
-                } else {
-                    f64::from(1u32 << (squarings + 2))
-                };
-                let next = f64::from(1u32 << (squarings + 3));
-                // Below the next power of two by an amount `f32` still resolves.
-                [low, (next * (1.0 - 2f64.powi(-20))).min(Exponent::MAX)]
-            }
-            _ => [Exponent::MIN, Exponent::MAX],
-        }
+        each_model!(&self.model, m => m.lobe_structural_range(self.n.get()))
     }
 
     /// The operations one evaluation from a cosine performs, counted by running

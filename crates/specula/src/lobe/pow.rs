@@ -16,6 +16,7 @@
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use super::draw_batch::remaining_share;
+use super::facts::closed_form_facts;
 use crate::real::Real;
 use crate::simd::math::{exp2, log2, EXP2, LOG2};
 use crate::simd::tally::{Class, Instructions};
@@ -102,3 +103,6 @@ impl LobeKernel for PowKernel {
         CLAMP.and(LOG2).and(EXP2).plus(Class::Mul, 1)
     }
 }
+
+// Sampled in closed form: the tail and its inverse exactly.
+closed_form_facts!(Pow);

@@ -13,7 +13,9 @@
 //! overshoots 1 (clamped, so no longer the quadratic) is sampled from a table instead.
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::facts::ModelFacts;
 use super::invert::{solve_increasing, Inverted, NewtonStart};
+use super::NewtonForm;
 use crate::real::Real;
 use crate::simd::math::{acos, ACOS};
 use crate::simd::tally::{Class, Instructions};
@@ -232,6 +234,46 @@ impl LobeKernel for AngleQuadraticKernel {
             .plus(Class::MinMax, 1)
             .plus(Class::Compare, 1)
             .plus(Class::Logic, 1)
+    }
+}
+
+/// Native in the angle; sampled by Newton in the angle where its tail has a closed form; its
+/// fitted constants follow no `n` but its own.
+impl ModelFacts for AngleQuadratic {
+    fn lobe_angle_quadratic(&self) -> Option<AngleQuadratic> {
+        Some(*self)
+    }
+
+    fn lobe_tail(&self, t: f64) -> Option<f64> {
+        self.has_closed_form_tail().then(|| self.tail(t))
+    }
+
+    fn lobe_tail_inverse(&self, u: f64, start: NewtonStart) -> Option<Inverted> {
+        self.has_closed_form_tail()
+            .then(|| self.tail_inverse(u, start))
+    }
+
+    fn lobe_newton_sampling<R: Real>(&self, x: R) -> Option<NewtonForm<R>> {
+        self.has_closed_form_tail().then(|| NewtonForm {
+            tail: self.tail_angle(x),
+            slope: self.tail_slope(x),
+            cosine: x.cos(),
+            upper: self.cutoff_parameter(),
+            total: self.tail_angle(self.cutoff_parameter()),
+        })
+    }
+
+    fn lobe_eval_angle<R: Real>(&self, g: R) -> Option<R> {
+        let g = g.max(-g);
+        Some(if g < R::from_f64(core::f64::consts::FRAC_PI_2) {
+            self.eval_angle(g)
+        } else {
+            R::from_f64(0.0)
+        })
+    }
+
+    fn lobe_structural_range(&self, n: f64) -> [f64; 2] {
+        [n, n]
     }
 }
 

@@ -20,7 +20,9 @@
 //! - **Source**: C. Schlick, "A customizable reflectance model for everyday rendering" (1993).
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::facts::ModelFacts;
 use super::invert::{solve_increasing, Inverted, NewtonStart};
+use super::NewtonForm;
 use crate::real::Real;
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
@@ -140,5 +142,27 @@ impl<const SQUARINGS: u32> LobeKernel for SchlickKernel<SQUARINGS> {
             .plus(Class::Add, 1)
             .plus(Class::Fma, 1)
             .plus(Class::Div, 1)
+    }
+}
+
+/// Sampled by Newton on its closed-form tail, in `d = 1 - t`.
+impl ModelFacts for Schlick {
+    fn lobe_tail(&self, t: f64) -> Option<f64> {
+        Some(self.tail(t))
+    }
+
+    fn lobe_tail_inverse(&self, u: f64, start: NewtonStart) -> Option<Inverted> {
+        Some(self.tail_inverse(u, start))
+    }
+
+    fn lobe_newton_sampling<R: Real>(&self, x: R) -> Option<NewtonForm<R>> {
+        let one = R::from_f64(1.0);
+        Some(NewtonForm {
+            tail: self.tail_from_peak(x),
+            slope: self.eval(one - x),
+            cosine: one - x,
+            upper: one,
+            total: self.tail_from_peak(one),
+        })
     }
 }

@@ -24,6 +24,7 @@
 //!   (`sampling::CosineDistribution`) is exact enough and cheaper to trust.
 //! - **Source**: the thesis, slide "Modified Schlick BRDF".
 
+use super::facts::ModelFacts;
 use super::schlick::schlick_denominator_ratio;
 use super::schlick::SchlickKernel;
 use crate::real::Real;
@@ -74,6 +75,21 @@ impl SchlickMod {
     pub(crate) fn kernel<const SQUARINGS: u32>(&self) -> SchlickKernel<SQUARINGS> {
         debug_assert_eq!(SQUARINGS, self.squarings);
         SchlickKernel { n: self.n as f32 }
+    }
+}
+
+/// Its squarings change at every power of two of `n` from 8 on.
+impl ModelFacts for SchlickMod {
+    fn lobe_structural_range(&self, _n: f64) -> [f64; 2] {
+        let squarings = self.squarings();
+        let low = if squarings == 0 {
+            Exponent::MIN
+        } else {
+            f64::from(1u32 << (squarings + 2))
+        };
+        let next = f64::from(1u32 << (squarings + 3));
+        // Below the next power of two by an amount `f32` still resolves.
+        [low, (next * (1.0 - 2f64.powi(-20))).min(Exponent::MAX)]
     }
 }
 

@@ -23,6 +23,7 @@
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use super::draw_batch::remaining_share;
+use super::facts::closed_form_facts;
 use crate::real::Real;
 use crate::simd::math::{exp2, log2, EXP2};
 use crate::simd::tally::{Class, Instructions};
@@ -146,3 +147,6 @@ impl LobeKernel for SgKernel {
             .plus(Class::Logic, 1)
     }
 }
+
+// Sampled in closed form: the tail and its inverse exactly.
+closed_form_facts!(Sg);

@@ -1,0 +1,104 @@
+//! What a model states about itself beyond its formula: the tail it integrates in closed form
+//! and how that tail is inverted, where its value has kinks, the exponents its recorded
+//! operations hold for. Each model's file implements [`ModelFacts`] for what it has; the
+//! defaults say "not this model", so a model states only its own facts and `Lobe` dispatches
+//! through [`each_model`], the one list of the models, with no catch-all arm anywhere.
+
+use super::invert::{Inverted, NewtonStart};
+use super::{AngleQuadratic, NewtonForm};
+use crate::{Exponent, Real};
+
+/// A model's facts; every method's default is the answer for a model without the fact.
+pub(crate) trait ModelFacts {
+    /// The coefficients of a quadratic-in-angle lobe.
+    fn lobe_angle_quadratic(&self) -> Option<AngleQuadratic> {
+        None
+    }
+
+    /// Cosines in `(0, 1)` where the value is not smooth beyond the zones' breakpoints.
+    fn lobe_kinks(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    /// `int_t^1 lobe(s) ds` in closed form, `t` in `[0, 1]`.
+    fn lobe_tail(&self, _t: f64) -> Option<f64> {
+        None
+    }
+
+    /// The cosine whose tail is `u` of the whole (`u` in `[0, 1]`), and the iterations it took.
+    fn lobe_tail_inverse(&self, _u: f64, _start: NewtonStart) -> Option<Inverted> {
+        None
+    }
+
+    /// For a closed-form sampler: the tail's inverse at `u` and the whole integral.
+    fn lobe_closed_form_sampling<R: Real>(&self, _u: R) -> Option<(R, R)> {
+        None
+    }
+
+    /// For a Newton sampler: the tail in the solver's variable `x`.
+    fn lobe_newton_sampling<R: Real>(&self, _x: R) -> Option<NewtonForm<R>> {
+        None
+    }
+
+    /// The value at angle `g` from the axis, for a model whose native input is the angle.
+    fn lobe_eval_angle<R: Real>(&self, _g: R) -> Option<R> {
+        None
+    }
+
+    /// The exponents whose lobes share this one's recorded operations, for the model
+    /// prepared at `n`.
+    fn lobe_structural_range(&self, _n: f64) -> [f64; 2] {
+        [Exponent::MIN, Exponent::MAX]
+    }
+}
+
+/// `$body` with `$m` bound to the prepared model, whichever it is: the one place that lists
+/// the models, so a model added to `Model` is a compile error here until it is listed.
+macro_rules! each_model {
+    ($model:expr, $m:ident => $body:expr) => {
+        match $model {
+            Model::Pow($m) => $body,
+            Model::Schlick($m) => $body,
+            Model::SchlickMod($m) => $body,
+            Model::AngleQuadratic($m) => $body,
+            Model::LogExp($m) => $body,
+            Model::LogExpRr($m) => $body,
+            Model::CosQuad($m) => $body,
+            Model::Sg($m) => $body,
+            Model::FastPow($m) => $body,
+            Model::FasterPow($m) => $body,
+            Model::Formula($m) => $body,
+        }
+    };
+}
+
+pub(crate) use each_model;
+
+/// The facts of a model sampled in closed form, from its own `tail`, `tail_inverse` and
+/// `total`: the tail, its exact inverse, and both over any `Real` for a target that samples.
+macro_rules! closed_form_facts {
+    ($model:ty) => {
+        impl super::facts::ModelFacts for $model {
+            fn lobe_tail(&self, t: f64) -> Option<f64> {
+                Some(self.tail(t))
+            }
+
+            fn lobe_tail_inverse(
+                &self,
+                u: f64,
+                _start: super::invert::NewtonStart,
+            ) -> Option<super::invert::Inverted> {
+                Some(super::invert::Inverted {
+                    x: self.tail_inverse(u),
+                    iterations: 0,
+                })
+            }
+
+            fn lobe_closed_form_sampling<R: Real>(&self, u: R) -> Option<(R, R)> {
+                Some((self.tail_inverse(u), self.total()))
+            }
+        }
+    };
+}
+
+pub(crate) use closed_form_facts;
