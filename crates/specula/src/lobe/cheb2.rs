@@ -20,9 +20,26 @@
 //!   a table when the fit overshoots 1 at the peak and is clamped.
 //! - **Source**: the thesis's method; coefficients computed by specula.
 
+use super::info::{LineStyle, LobeInfo, Origin};
 use super::quadratic::AngleQuadratic;
 use crate::fit::{cached_angle_quadratic, AngleFit};
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "cheb2",
+    summary: "quadratic in the angle, 3-node Chebyshev fit of cos^n over the epicentre",
+    formula: "max(0, C + B g + A g^2), g = acos t, fitted per n",
+    takes_angle: true,
+    params: &[],
+    origin: Origin::Thesis,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [0, 103, 165],
+    dashed: false,
+};
 
 pub(crate) fn new(n: Exponent) -> AngleQuadratic {
     AngleQuadratic::new(cached_angle_quadratic(AngleFit::Chebyshev3, n))

@@ -24,8 +24,25 @@
 //!   a table when the fit overshoots 1 at the peak and is clamped.
 //! - **Source**: the thesis, slide "Approximating the BRDF with Chebyshev polynomials".
 
+use super::info::{LineStyle, LobeInfo, Origin};
 use super::quadratic::AngleQuadratic;
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "cheb2-thesis",
+    summary: "quadratic in the angle, the thesis's slide coefficients fra(n), frb(n)",
+    formula: "max(0, 1 + frb(n) g + fra(n) g^2), g = acos t",
+    takes_angle: true,
+    params: &[],
+    origin: Origin::Thesis,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [51, 187, 238],
+    dashed: true,
+};
 
 /// The slide's coefficients `[C, B, A]` for exponent `n`.
 #[must_use]

@@ -25,11 +25,37 @@
 use super::batch::LobeKernel;
 use super::draw_batch::remaining_share;
 use super::facts::closed_form_facts;
+use super::info::{LineStyle, LobeInfo, Origin, ParamInfo};
 use crate::real::Real;
 use crate::simd::math::{exp2, log2};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "cosquad",
+    summary: "the thesis's cosine-quadratic K_v, energy-matched to t^n",
+    formula: "max(0, a (t - 1) + 1)^(2^v), a = (n + 1) / (2^v + 1)",
+    takes_angle: false,
+    params: &[V_PARAM],
+    origin: Origin::Thesis,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [136, 45, 23],
+    dashed: false,
+};
+
+/// The parameter `v` (`cosquad:v=5`).
+pub(super) const V_PARAM: ParamInfo = ParamInfo {
+    name: "v",
+    description: "number of squarings; the lobe is a polynomial of degree 2^v in the cosine",
+    default: CosQuad::DEFAULT_V as u32,
+    min: 0,
+    max: CosQuad::MAX_V as u32,
+};
 
 /// The prepared cosine-quadratic lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]

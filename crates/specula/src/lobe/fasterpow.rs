@@ -26,11 +26,28 @@
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::fastpow::kinks;
+use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
 use crate::simd::math::{bits_exp2, frexp, BITS_EXP2, FREXP};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "fasterpow",
+    summary: "the IEEE bit-trick power, uncorrected (Schraudolph; fastapprox)",
+    formula: "bits_exp2(n (bits_log2(t) + 0.0573) - 0.0573), clamped to 1",
+    takes_angle: false,
+    params: &[],
+    origin: Origin::Literature,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [194, 178, 128],
+    dashed: true,
+};
 
 /// fastapprox's offset between the bit pattern and `log2`, on both sides.
 const OFFSET: f64 = 126.942_695_04;

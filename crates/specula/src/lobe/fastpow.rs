@@ -33,11 +33,28 @@
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use super::facts::ModelFacts;
+use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
 use crate::simd::math::{bits_exp2, frexp, BITS_EXP2, FREXP};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "fastpow",
+    summary: "the IEEE bit-trick power with fastapprox's rational corrections",
+    formula: "fastpow2(n fastlog2(t)), log and exp read off the float's bits",
+    takes_angle: false,
+    params: &[],
+    origin: Origin::Literature,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [132, 132, 130],
+    dashed: false,
+};
 
 // fastapprox's `fastlog2` correction, `A + B m - D / (C + m)`, as one fraction whose numerator
 // `(A + B m)(C + m) - D` is expanded around `m = 1`, where it nearly vanishes: with `u = m - 1`

@@ -1,12 +1,14 @@
 //! The registry: every lobe specula knows, its id, description and parameters.
 //!
 //! [`LobeKind`] is the closed set of models; [`LobeInfo`] is what the CLI's `models` table, its
-//! help text, the id parser and the documentation read. Adding a model means adding a variant
-//! here and an entry in [`LobeKind::info`]; the compiler then points at every `match` that
-//! must learn it.
+//! help text, the id parser and the documentation read. Each lobe's entry and plot style live in
+//! its own file (`INFO`, `STYLE`, beside its formula and its `ModelFacts`); this file maps the
+//! variants to them, one line each, in matches without a catch-all arm, so the compiler points
+//! at every line a new variant needs.
 
 use serde::{Serialize, Serializer};
 
+use super::info::{LineStyle, LobeInfo, ParamInfo};
 use super::CosQuad;
 use crate::error::{Error, Result};
 
@@ -51,93 +53,6 @@ pub enum LobeKind {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct FormulaId(pub(crate) u32);
 
-/// A lobe parameter other than `n`.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct ParamInfo {
-    /// Its name in ids such as `cosquad:v=5`.
-    pub name: &'static str,
-    /// What it does.
-    pub description: &'static str,
-    /// The default value.
-    pub default: u32,
-    /// The smallest valid value.
-    pub min: u32,
-    /// The largest valid value.
-    pub max: u32,
-}
-
-/// Where a lobe comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Origin {
-    /// The classic lobe every approximation is measured against.
-    Reference,
-    /// Published before the thesis.
-    Literature,
-    /// Proposed in the thesis.
-    Thesis,
-    /// A variant added by specula, measured the same way.
-    Specula,
-    /// Written by the user as a formula.
-    User,
-}
-
-impl Origin {
-    /// The origin in words, as tables show it.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Origin::Reference => "reference",
-            Origin::Literature => "literature",
-            Origin::Thesis => "thesis",
-            Origin::Specula => "specula",
-            Origin::User => "user",
-        }
-    }
-}
-
-/// A registry entry.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct LobeInfo {
-    /// The id used on the command line and in scenes.
-    pub id: &'static str,
-    /// One line on what the lobe is.
-    pub summary: &'static str,
-    /// The formula, in plain text.
-    pub formula: &'static str,
-    /// Whether the lobe's native input is the angle `g` rather than the cosine `t`.
-    pub takes_angle: bool,
-    /// Parameters other than `n`.
-    pub params: &'static [ParamInfo],
-    /// Where it comes from.
-    pub origin: Origin,
-}
-
-/// How a lobe's curves are drawn: [`LobeKind::line_style`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct LineStyle {
-    /// Red, green, blue.
-    pub rgb: [u8; 3],
-    /// Dashed rather than solid.
-    pub dashed: bool,
-}
-
-impl LineStyle {
-    /// The colour as `#rrggbb`.
-    #[must_use]
-    pub fn hex(self) -> String {
-        format!("#{:02x}{:02x}{:02x}", self.rgb[0], self.rgb[1], self.rgb[2])
-    }
-}
-
-const COSQUAD_V: ParamInfo = ParamInfo {
-    name: "v",
-    description: "number of squarings; the lobe is a polynomial of degree 2^v in the cosine",
-    default: CosQuad::DEFAULT_V as u32,
-    min: 0,
-    max: CosQuad::MAX_V as u32,
-};
-
 impl LobeKind {
     /// Every lobe, with default parameters, in the order tables list them.
     pub const ALL: [LobeKind; 13] = [
@@ -164,20 +79,20 @@ impl LobeKind {
     /// well, so that the families read apart even without colour vision.
     #[must_use]
     pub fn line_style(self) -> LineStyle {
-        let (rgb, dashed) = match self {
-            LobeKind::Pow => ([0, 0, 0], false),
-            LobeKind::Schlick => ([190, 0, 50], false),
-            LobeKind::SchlickMod => ([243, 132, 0], true),
-            LobeKind::Cheb2Thesis => ([51, 187, 238], true),
-            LobeKind::Cheb2 => ([0, 103, 165], false),
-            LobeKind::Minimax2 => ([96, 78, 151], false),
-            LobeKind::LogExp => ([0, 136, 86], false),
-            LobeKind::LogExpRr => ([141, 182, 0], true),
-            LobeKind::CosQuad { .. } => ([136, 45, 23], false),
-            LobeKind::Sg => ([230, 143, 172], false),
-            LobeKind::SgKaris => ([249, 147, 121], true),
-            LobeKind::FastPow => ([132, 132, 130], false),
-            LobeKind::FasterPow => ([194, 178, 128], true),
+        match self {
+            LobeKind::Pow => super::pow::STYLE,
+            LobeKind::Schlick => super::schlick::STYLE,
+            LobeKind::SchlickMod => super::schlick_mod::STYLE,
+            LobeKind::Cheb2Thesis => super::cheb2_thesis::STYLE,
+            LobeKind::Cheb2 => super::cheb2::STYLE,
+            LobeKind::Minimax2 => super::minimax2::STYLE,
+            LobeKind::LogExp => super::logexp::STYLE,
+            LobeKind::LogExpRr => super::logexp_rr::STYLE,
+            LobeKind::CosQuad { .. } => super::cosquad::STYLE,
+            LobeKind::Sg => super::sg::STYLE,
+            LobeKind::SgKaris => super::sg_karis::STYLE,
+            LobeKind::FastPow => super::fastpow::STYLE,
+            LobeKind::FasterPow => super::fasterpow::STYLE,
             // Six colours none of the built-ins has (Paul Tol's wine, indigo, teal and purple,
             // a khaki and a dark teal), so a user's lobe never looks like a built-in one; the
             // seventh user's lobe takes the first colour dashed.
@@ -190,10 +105,12 @@ impl LobeKind {
                     [0, 95, 95],
                     [170, 68, 153],
                 ];
-                (USER[id as usize % 6], (id / 6) % 2 == 1)
+                LineStyle {
+                    rgb: USER[id as usize % 6],
+                    dashed: (id / 6) % 2 == 1,
+                }
             }
-        };
-        LineStyle { rgb, dashed }
+        }
     }
 
     /// The registry entry.
@@ -201,110 +118,19 @@ impl LobeKind {
     pub fn info(self) -> &'static LobeInfo {
         match self {
             LobeKind::Formula(id) => crate::formula::registry::get(id).info(),
-            LobeKind::Pow => &LobeInfo {
-                id: "pow",
-                summary: "the exact lobe t^n (Phong, Blinn): the reference",
-                formula: "t^n",
-                takes_angle: false,
-                params: &[],
-                origin: Origin::Reference,
-            },
-            LobeKind::Schlick => &LobeInfo {
-                id: "schlick",
-                summary: "Schlick's rational approximation",
-                formula: "t / (n (1 - t) + t)",
-                takes_angle: false,
-                params: &[],
-                origin: Origin::Literature,
-            },
-            LobeKind::SchlickMod => &LobeInfo {
-                id: "schlick-mod",
-                summary: "the thesis's modified Schlick: a power of two of t in the numerator",
-                formula: "t^a / (n (1 - t) + t), a = 2^max(0, floor(log2 n) - 2)",
-                takes_angle: false,
-                params: &[],
-                origin: Origin::Thesis,
-            },
-            LobeKind::Cheb2Thesis => &LobeInfo {
-                id: "cheb2-thesis",
-                summary: "quadratic in the angle, the thesis's slide coefficients fra(n), frb(n)",
-                formula: "max(0, 1 + frb(n) g + fra(n) g^2), g = acos t",
-                takes_angle: true,
-                params: &[],
-                origin: Origin::Thesis,
-            },
-            LobeKind::Cheb2 => &LobeInfo {
-                id: "cheb2",
-                summary: "quadratic in the angle, 3-node Chebyshev fit of cos^n over the epicentre",
-                formula: "max(0, C + B g + A g^2), g = acos t, fitted per n",
-                takes_angle: true,
-                params: &[],
-                origin: Origin::Thesis,
-            },
-            LobeKind::Minimax2 => &LobeInfo {
-                id: "minimax2",
-                summary: "quadratic in the angle, minimax relative error over the epicentre",
-                formula: "max(0, C + B g + A g^2), g = acos t, Remez per n",
-                takes_angle: true,
-                params: &[],
-                origin: Origin::Specula,
-            },
-            LobeKind::LogExp => &LobeInfo {
-                id: "logexp",
-                summary: "the thesis's log/exp lobe: 2^y replaced by a second log2",
-                formula: "max(0, 1 - log2(1 - y) / 2), y = n log2 t",
-                takes_angle: false,
-                params: &[],
-                origin: Origin::Thesis,
-            },
-            LobeKind::LogExpRr => &LobeInfo {
-                id: "logexp-rr",
-                summary: "log/exp with range reduction: exact shift for the integer part of y",
-                formula: "2^k (1 - log2(1 - (y - k)) / 2), y = n log2 t, k = ceil y",
-                takes_angle: false,
-                params: &[],
-                origin: Origin::Specula,
-            },
-            LobeKind::CosQuad { .. } => &LobeInfo {
-                id: "cosquad",
-                summary: "the thesis's cosine-quadratic K_v, energy-matched to t^n",
-                formula: "max(0, a (t - 1) + 1)^(2^v), a = (n + 1) / (2^v + 1)",
-                takes_angle: false,
-                params: &[COSQUAD_V],
-                origin: Origin::Thesis,
-            },
-            LobeKind::Sg => &LobeInfo {
-                id: "sg",
-                summary: "the spherical Gaussian engines use for cos^n: one exp2",
-                formula: "exp(n (t - 1)) = exp2(n log2(e) (t - 1))",
-                takes_angle: false,
-                params: &[],
-                origin: Origin::Literature,
-            },
-            LobeKind::SgKaris => &LobeInfo {
-                id: "sg-karis",
-                summary: "the spherical Gaussian with the fitted rate n + 0.775 (UE4)",
-                formula: "exp((n + 0.775) (t - 1))",
-                takes_angle: false,
-                params: &[],
-                origin: Origin::Literature,
-            },
-            LobeKind::FastPow => &LobeInfo {
-                id: "fastpow",
-                summary: "the IEEE bit-trick power with fastapprox's rational corrections",
-                formula: "fastpow2(n fastlog2(t)), log and exp read off the float's bits",
-                takes_angle: false,
-                params: &[],
-                origin: Origin::Literature,
-            },
-            LobeKind::FasterPow => &LobeInfo {
-                id: "fasterpow",
-                summary: "the IEEE bit-trick power, uncorrected (Schraudolph; fastapprox)",
-                formula: "bits_exp2(n (bits_log2(t) + 0.0573) - 0.0573), clamped to 1",
-                takes_angle: false,
-                params: &[],
-                origin: Origin::Literature,
-            },
+            LobeKind::Pow => &super::pow::INFO,
+            LobeKind::Schlick => &super::schlick::INFO,
+            LobeKind::SchlickMod => &super::schlick_mod::INFO,
+            LobeKind::Cheb2Thesis => &super::cheb2_thesis::INFO,
+            LobeKind::Cheb2 => &super::cheb2::INFO,
+            LobeKind::Minimax2 => &super::minimax2::INFO,
+            LobeKind::LogExp => &super::logexp::INFO,
+            LobeKind::LogExpRr => &super::logexp_rr::INFO,
+            LobeKind::CosQuad { .. } => &super::cosquad::INFO,
+            LobeKind::Sg => &super::sg::INFO,
+            LobeKind::SgKaris => &super::sg_karis::INFO,
+            LobeKind::FastPow => &super::fastpow::INFO,
+            LobeKind::FasterPow => &super::fasterpow::INFO,
         }
     }
 
@@ -382,7 +208,7 @@ impl LobeKind {
         match (kind, params) {
             (_, None) => Ok(kind),
             (LobeKind::CosQuad { .. }, Some(params)) => {
-                let v = parse_param(kind.id(), &COSQUAD_V, params)?;
+                let v = parse_param(kind.id(), &super::cosquad::V_PARAM, params)?;
                 Ok(LobeKind::CosQuad { v: v as u8 })
             }
             (_, Some(params)) => Err(Error::InvalidLobeParameter {

@@ -19,11 +19,28 @@
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use super::facts::ModelFacts;
+use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
 use crate::simd::math::{log2, LOG2};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "logexp",
+    summary: "the thesis's log/exp lobe: 2^y replaced by a second log2",
+    formula: "max(0, 1 - log2(1 - y) / 2), y = n log2 t",
+    takes_angle: false,
+    params: &[],
+    origin: Origin::Thesis,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [0, 136, 86],
+    dashed: false,
+};
 
 /// The prepared log/exp lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -19,12 +19,29 @@
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use super::facts::ModelFacts;
+use super::info::{LineStyle, LobeInfo, Origin};
 use super::logexp::exp2_by_log2;
 use crate::real::Real;
 use crate::simd::math::{log2, LOG2};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "logexp-rr",
+    summary: "log/exp with range reduction: exact shift for the integer part of y",
+    formula: "2^k (1 - log2(1 - (y - k)) / 2), y = n log2 t, k = ceil y",
+    takes_angle: false,
+    params: &[],
+    origin: Origin::Specula,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [141, 182, 0],
+    dashed: true,
+};
 
 /// The prepared range-reduced log/exp lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]

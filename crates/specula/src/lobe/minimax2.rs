@@ -17,9 +17,26 @@
 //!   a table when the fit overshoots 1 at the peak and is clamped.
 //! - **Source**: specula (a variant measured like the thesis's models, SPEC section 2).
 
+use super::info::{LineStyle, LobeInfo, Origin};
 use super::quadratic::AngleQuadratic;
 use crate::fit::{cached_angle_quadratic, AngleFit};
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "minimax2",
+    summary: "quadratic in the angle, minimax relative error over the epicentre",
+    formula: "max(0, C + B g + A g^2), g = acos t, Remez per n",
+    takes_angle: true,
+    params: &[],
+    origin: Origin::Specula,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [96, 78, 151],
+    dashed: false,
+};
 
 pub(crate) fn new(n: Exponent) -> AngleQuadratic {
     AngleQuadratic::new(cached_angle_quadratic(AngleFit::MinimaxRelative, n))

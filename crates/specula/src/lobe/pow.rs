@@ -17,11 +17,28 @@
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use super::draw_batch::remaining_share;
 use super::facts::closed_form_facts;
+use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
 use crate::simd::math::{exp2, log2, EXP2, LOG2};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "pow",
+    summary: "the exact lobe t^n (Phong, Blinn): the reference",
+    formula: "t^n",
+    takes_angle: false,
+    params: &[],
+    origin: Origin::Reference,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [0, 0, 0],
+    dashed: false,
+};
 
 /// The prepared reference lobe `t^n`.
 #[derive(Clone, Copy, Debug, PartialEq)]

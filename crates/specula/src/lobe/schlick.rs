@@ -21,12 +21,29 @@
 
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use super::facts::ModelFacts;
+use super::info::{LineStyle, LobeInfo, Origin};
 use super::invert::{solve_increasing, Inverted, NewtonStart};
 use super::NewtonForm;
 use crate::real::Real;
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "schlick",
+    summary: "Schlick's rational approximation",
+    formula: "t / (n (1 - t) + t)",
+    takes_angle: false,
+    params: &[],
+    origin: Origin::Literature,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [190, 0, 50],
+    dashed: false,
+};
 
 /// The prepared Schlick lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]

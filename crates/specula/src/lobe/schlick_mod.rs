@@ -25,10 +25,27 @@
 //! - **Source**: the thesis, slide "Modified Schlick BRDF".
 
 use super::facts::ModelFacts;
+use super::info::{LineStyle, LobeInfo, Origin};
 use super::schlick::schlick_denominator_ratio;
 use super::schlick::SchlickKernel;
 use crate::real::Real;
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "schlick-mod",
+    summary: "the thesis's modified Schlick: a power of two of t in the numerator",
+    formula: "t^a / (n (1 - t) + t), a = 2^max(0, floor(log2 n) - 2)",
+    takes_angle: false,
+    params: &[],
+    origin: Origin::Thesis,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [243, 132, 0],
+    dashed: true,
+};
 
 /// The prepared modified Schlick lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]

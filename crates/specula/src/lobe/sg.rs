@@ -24,11 +24,28 @@
 use super::batch::{clamp_unit, LobeKernel, CLAMP};
 use super::draw_batch::remaining_share;
 use super::facts::closed_form_facts;
+use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
 use crate::simd::math::{exp2, log2, EXP2};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{Kernel, Lanes};
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "sg",
+    summary: "the spherical Gaussian engines use for cos^n: one exp2",
+    formula: "exp(n (t - 1)) = exp2(n log2(e) (t - 1))",
+    takes_angle: false,
+    params: &[],
+    origin: Origin::Literature,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [230, 143, 172],
+    dashed: false,
+};
 
 /// A prepared spherical Gaussian `exp2(rate (t - 1))`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -21,8 +21,25 @@
 //!   Engine 4's shading (B. Karis, "Real Shading in Unreal Engine 4", 2013, and its mobile
 //!   path), after S. Lagarde (2012).
 
+use super::info::{LineStyle, LobeInfo, Origin};
 use super::sg::Sg;
 use crate::Exponent;
+
+/// The registry's entry for this lobe.
+pub(super) const INFO: LobeInfo = LobeInfo {
+    id: "sg-karis",
+    summary: "the spherical Gaussian with the fitted rate n + 0.775 (UE4)",
+    formula: "exp((n + 0.775) (t - 1))",
+    takes_angle: false,
+    params: &[],
+    origin: Origin::Literature,
+};
+
+/// How every plot draws this lobe (`LobeKind::line_style`).
+pub(super) const STYLE: LineStyle = LineStyle {
+    rgb: [249, 147, 121],
+    dashed: true,
+};
 
 /// The published offset added to `n`.
 pub const KARIS_OFFSET: f64 = 0.775;
