@@ -19,6 +19,7 @@ mod materials;
 mod medical;
 mod other_renderers;
 mod plot;
+mod polar;
 mod prose;
 mod real_scans;
 mod renders;

@@ -14,7 +14,7 @@ use specula_render::ibl::{Environment, SKY_WIDTH};
 use specula_render::measured::{load_measured, material_name, material_scene, render_comparison};
 
 use super::html::{escape, figure, paragraph, table};
-use super::plot::{Polar, PolarCurve, PolarPanel, DASHED, DASH_DOT};
+use super::polar::{Polar, PolarCurve, PolarPanel, DASHED, DASH_DOT};
 use super::prose;
 use super::sections::colour;
 use super::Context;
