@@ -61,9 +61,10 @@ pub(crate) fn shared_scale(maps: &[&[f32]]) -> f64 {
         .iter()
         .filter(|map| !map.is_empty())
         .map(|map| {
-            let mut sorted = map.to_vec();
-            sorted.sort_by(f32::total_cmp);
-            f64::from(sorted[(sorted.len() - 1) * 99 / 100])
+            // The 99th percentile without sorting the whole map.
+            let mut values = map.to_vec();
+            let rank = (values.len() - 1) * 99 / 100;
+            f64::from(*values.select_nth_unstable_by(rank, f32::total_cmp).1)
         })
         .fold(0.0, f64::max);
     // A power of ten at or below the percentile, as 1 / 10^k so that the steps print short.
