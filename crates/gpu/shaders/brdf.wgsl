@@ -1,6 +1,7 @@
 // Geometry, lights and the two illumination models: a transcription of crates/render's
-// `Shader::shade` (see crates/render/src/material.rs for the formulas). Needs lobes.wgsl and
-// geometry.wgsl, and a `lights` array declared by the entry points' module.
+// `Shader::shade` (see crates/render/src/material.rs for the formulas). Needs the generated
+// lobe library (wgsl::lobes) and geometry.wgsl, and a `lights` array declared by the entry
+// points' module.
 
 struct Material {
     // ka colour.

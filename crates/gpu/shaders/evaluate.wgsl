@@ -1,4 +1,4 @@
-// Evaluates one lobe over a batch of cosines. Needs lobes.wgsl.
+// Evaluates one lobe over a batch of cosines. Needs the generated lobe library (wgsl::lobes).
 
 @group(0) @binding(0) var<uniform> lobe: Lobe;
 @group(0) @binding(1) var<storage, read> cosines: array<f32>;

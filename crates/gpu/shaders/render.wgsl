@@ -1,5 +1,6 @@
 // The render pipeline: flat, Gouraud and Phong shading of crates/render, on the GPU.
-// Needs lobes.wgsl and brdf.wgsl. Flat shading draws unindexed triangles whose three vertices
+// Needs the generated lobe library (wgsl::lobes) and brdf.wgsl. Flat shading draws unindexed
+// triangles whose three vertices
 // carry the face normal and the centroid (`anchor`), so each face gets one colour, lit at its
 // centroid as on the CPU.
 

@@ -6,6 +6,7 @@
 //! buffer), submits it and waits, so timing it measures the GPU's frame, not the set-up.
 //! Where the adapter has timestamp queries, the pass itself is timed on the GPU too.
 
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use specula_render::{Image, Projection, Scene, Shading};
@@ -35,7 +36,7 @@ struct PassTimer {
 /// A scene on the GPU, ready to draw.
 pub struct GpuFrame<'r> {
     gpu: &'r Gpu,
-    pipeline: &'r wgpu::RenderPipeline,
+    pipeline: Arc<wgpu::RenderPipeline>,
     globals: wgpu::BindGroup,
     objects: Vec<ObjectBuffers>,
     colour: wgpu::Texture,
@@ -65,23 +66,30 @@ impl GpuRenderer<'_> {
         self.check_size(settings)?;
         let samples = settings.samples;
         let (width, height) = (settings.width * samples, settings.height * samples);
-        let pipeline = self.pipeline(settings.cull_back_faces);
+        let materials: Vec<MaterialBlock> = scene
+            .objects
+            .iter()
+            .map(|object| MaterialBlock::new(&object.material, settings.model))
+            .collect();
+        let mut keys: Vec<_> = materials.iter().map(MaterialBlock::lobe_key).collect();
+        keys.sort_unstable();
+        keys.dedup();
+        let pipeline = self.pipeline(&keys, settings.cull_back_faces)?;
         self.gpu.checked(|| {
             let device = &self.gpu.device;
             let row_bytes = (width * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
             let background = settings.background.as_dvec3();
             GpuFrame {
                 gpu: self.gpu,
-                pipeline,
-                globals: globals(device, pipeline, scene, width, height),
+                globals: globals(device, &pipeline, scene, width, height),
                 objects: scene
                     .objects
                     .iter()
-                    .map(|object| {
-                        let material = MaterialBlock::new(&object.material, settings.model);
+                    .zip(&materials)
+                    .map(|(object, material)| {
                         let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                             label: Some("material"),
-                            contents: bytemuck::bytes_of(&material),
+                            contents: bytemuck::bytes_of(material),
                             usage: wgpu::BufferUsages::UNIFORM,
                         });
                         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -122,6 +130,7 @@ impl GpuRenderer<'_> {
                     a: 1.0,
                 },
                 timer: pass_timer(self.gpu),
+                pipeline,
             }
         })
     }
@@ -203,7 +212,7 @@ impl GpuFrame<'_> {
                 }),
                 ..wgpu::RenderPassDescriptor::default()
             });
-            pass.set_pipeline(self.pipeline);
+            pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.globals, &[]);
             for object in &self.objects {
                 pass.set_bind_group(1, &object.material, &[]);

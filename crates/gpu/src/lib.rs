@@ -6,10 +6,10 @@
 //! shader export to WGSL, GLSL, HLSL, MSL and SPIR-V through naga.
 //!
 //! ## Design
-//! - **One transcription.** `shaders/lobes.wgsl` mirrors `crates/specula/src/lobe`: a function
-//!   per lobe named after its id, a `switch` on the kind's index where Rust has its `match`,
-//!   and the prepared constants uploaded from `Lobe::packed`, so the GPU never re-derives
-//!   anything the core computed in `f64`.
+//! - **No transcription.** The lobe library is generated from each lobe's recorded
+//!   expression (`lobe_library`): a function per shape of each lobe, a `switch` on the kind's
+//!   index where Rust has its `match`, and the named parameters uploaded as the core
+//!   prepared them in `f64`, so the GPU never re-derives anything and no lobe is typed twice.
 //! - **Same images, measured.** The renderer uploads the materials exactly as the CPU's
 //!   shader prepares them, supersamples at the same sample positions and box-filters on read
 //!   back; parity tests compare the two images by FLIP and PSNR.
@@ -20,6 +20,7 @@ mod context;
 mod evaluate;
 pub mod export;
 mod frame;
+mod lobe_library;
 mod render;
 pub mod shader_ops;
 pub mod throughput;

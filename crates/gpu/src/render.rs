@@ -4,80 +4,113 @@
 //! read back and box-filtered on the CPU, exactly as the CPU renderer filters its samples, so
 //! the two backends differ only in rasterization and arithmetic details.
 
+use std::sync::{Arc, Mutex, PoisonError};
+
 use glam::Vec3;
 use specula_render::{Image, Scene};
 
-use crate::{wgsl, Gpu, GpuError};
+use crate::wgsl::{self, ShapeKey};
+use crate::{Gpu, GpuError};
 
 pub(crate) const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Position, normal, anchor: nine floats per vertex.
 pub(crate) const VERTEX_FLOATS: usize = 9;
 
-/// Compiled render pipelines (with and without back-face culling) on one GPU.
+/// The render pipelines of one GPU: one per scene's set of lobes and culling mode, compiled
+/// when a scene first needs it ([`wgsl::render_module_for`]: a material's shader holds the
+/// lobes it draws, not every lobe).
 #[derive(Debug)]
 pub struct GpuRenderer<'gpu> {
     pub(crate) gpu: &'gpu Gpu,
-    culled: wgpu::RenderPipeline,
-    unculled: wgpu::RenderPipeline,
+    pipelines: Mutex<Vec<(PipelineKey, Arc<wgpu::RenderPipeline>)>>,
 }
 
+/// The lobes a pipeline's module holds (sorted, each once) and whether it culls back faces.
+type PipelineKey = (Vec<ShapeKey>, bool);
+
 impl<'gpu> GpuRenderer<'gpu> {
-    /// Compiles the render module on `gpu`.
-    pub fn new(gpu: &'gpu Gpu) -> Result<Self, GpuError> {
+    /// The renderer for `gpu`; each scene's pipeline is compiled when first drawn.
+    #[must_use]
+    pub fn new(gpu: &'gpu Gpu) -> Self {
+        Self {
+            gpu,
+            pipelines: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The pipeline for materials whose lobes are `keys` (sorted, each once).
+    pub(crate) fn pipeline(
+        &self,
+        keys: &[ShapeKey],
+        cull_back_faces: bool,
+    ) -> Result<Arc<wgpu::RenderPipeline>, GpuError> {
+        let compiled = || {
+            self.pipelines
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+        };
+        let known = |(key, _): &&(PipelineKey, _)| key.0 == keys && key.1 == cull_back_faces;
+        if let Some((_, pipeline)) = compiled().iter().find(known) {
+            return Ok(Arc::clone(pipeline));
+        }
+        let pipeline = Arc::new(self.compile(keys, cull_back_faces)?);
+        compiled().push(((keys.to_vec(), cull_back_faces), Arc::clone(&pipeline)));
+        Ok(pipeline)
+    }
+
+    fn compile(
+        &self,
+        keys: &[ShapeKey],
+        cull_back_faces: bool,
+    ) -> Result<wgpu::RenderPipeline, GpuError> {
+        let gpu = self.gpu;
         gpu.checked(|| {
             let module = gpu
                 .device
                 .create_shader_module(wgpu::ShaderModuleDescriptor {
                     label: Some("specula render"),
-                    source: wgpu::ShaderSource::Wgsl(wgsl::render_module().into()),
+                    source: wgpu::ShaderSource::Wgsl(wgsl::render_module_for(keys).into()),
                 });
-            let pipeline = |cull_mode| {
-                gpu.device
-                    .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                        label: Some("specula render"),
-                        layout: None,
-                        vertex: wgpu::VertexState {
-                            module: &module,
-                            entry_point: Some("vs_main"),
-                            compilation_options: wgpu::PipelineCompilationOptions::default(),
-                            buffers: &[Some(wgpu::VertexBufferLayout {
-                                array_stride: (VERTEX_FLOATS * 4) as u64,
-                                step_mode: wgpu::VertexStepMode::Vertex,
-                                attributes: &wgpu::vertex_attr_array![
-                                    0 => Float32x3, 1 => Float32x3, 2 => Float32x3
-                                ],
-                            })],
-                        },
-                        primitive: wgpu::PrimitiveState {
-                            topology: wgpu::PrimitiveTopology::TriangleList,
-                            front_face: wgpu::FrontFace::Ccw,
-                            cull_mode,
-                            ..wgpu::PrimitiveState::default()
-                        },
-                        depth_stencil: Some(wgpu::DepthStencilState {
-                            format: DEPTH_FORMAT,
-                            depth_write_enabled: Some(true),
-                            depth_compare: Some(wgpu::CompareFunction::Less),
-                            stencil: wgpu::StencilState::default(),
-                            bias: wgpu::DepthBiasState::default(),
-                        }),
-                        multisample: wgpu::MultisampleState::default(),
-                        fragment: Some(wgpu::FragmentState {
-                            module: &module,
-                            entry_point: Some("fs_main"),
-                            compilation_options: wgpu::PipelineCompilationOptions::default(),
-                            targets: &[Some(COLOUR_FORMAT.into())],
-                        }),
-                        multiview_mask: None,
-                        cache: None,
-                    })
-            };
-            Self {
-                gpu,
-                culled: pipeline(Some(wgpu::Face::Back)),
-                unculled: pipeline(None),
-            }
+            gpu.device
+                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some("specula render"),
+                    layout: None,
+                    vertex: wgpu::VertexState {
+                        module: &module,
+                        entry_point: Some("vs_main"),
+                        compilation_options: wgpu::PipelineCompilationOptions::default(),
+                        buffers: &[Some(wgpu::VertexBufferLayout {
+                            array_stride: (VERTEX_FLOATS * 4) as u64,
+                            step_mode: wgpu::VertexStepMode::Vertex,
+                            attributes: &wgpu::vertex_attr_array![
+                                0 => Float32x3, 1 => Float32x3, 2 => Float32x3
+                            ],
+                        })],
+                    },
+                    primitive: wgpu::PrimitiveState {
+                        topology: wgpu::PrimitiveTopology::TriangleList,
+                        front_face: wgpu::FrontFace::Ccw,
+                        cull_mode: cull_back_faces.then_some(wgpu::Face::Back),
+                        ..wgpu::PrimitiveState::default()
+                    },
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: DEPTH_FORMAT,
+                        depth_write_enabled: Some(true),
+                        depth_compare: Some(wgpu::CompareFunction::Less),
+                        stencil: wgpu::StencilState::default(),
+                        bias: wgpu::DepthBiasState::default(),
+                    }),
+                    multisample: wgpu::MultisampleState::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &module,
+                        entry_point: Some("fs_main"),
+                        compilation_options: wgpu::PipelineCompilationOptions::default(),
+                        targets: &[Some(COLOUR_FORMAT.into())],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
         })
     }
 
@@ -100,14 +133,6 @@ impl<'gpu> GpuRenderer<'gpu> {
     /// [`GpuFrame`](crate::GpuFrame) from [`prepare`](Self::prepare)).
     pub fn render(&self, scene: &Scene) -> Result<Image, GpuError> {
         self.prepare(scene)?.image()
-    }
-
-    pub(crate) fn pipeline(&self, cull_back_faces: bool) -> &wgpu::RenderPipeline {
-        if cull_back_faces {
-            &self.culled
-        } else {
-            &self.unculled
-        }
     }
 }
 

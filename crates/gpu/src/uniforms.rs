@@ -3,41 +3,42 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use specula::lobe::PackedLobe;
 use specula::{Geometry, Lobe};
 use specula_render::{IlluminationModel, Light, Material, Shader};
 
-/// `struct Lobe` of lobes.wgsl (32 bytes).
+use crate::lobe_library::ShapeKey;
+
+/// `struct Lobe` of the generated lobe library (32 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LobeBlock {
     kind: u32,
-    squarings: u32,
+    shape: u32,
     n: f32,
-    slope: f32,
-    quadratic: [f32; 3],
-    cutoff: f32,
+    padding: u32,
+    parameters: [f32; 4],
 }
 
 impl LobeBlock {
-    /// The prepared lobe's constants, rounded to `f32`.
+    /// The prepared lobe's function and constants, rounded to `f32`.
     #[must_use]
     pub fn new(lobe: &Lobe) -> Self {
-        let PackedLobe {
-            kind_index,
-            squarings,
-            n,
-            slope,
-            quadratic,
-            cutoff,
-        } = lobe.packed();
+        let ShapeKey { kind, shape } = ShapeKey::of(lobe);
         Self {
-            kind: kind_index,
-            squarings,
-            n: n as f32,
-            slope: slope as f32,
-            quadratic: quadratic.map(|c| c as f32),
-            cutoff: cutoff as f32,
+            kind,
+            shape,
+            n: lobe.exponent().get() as f32,
+            padding: 0,
+            parameters: crate::lobe_library::parameter_slots(lobe).map(|p| p as f32),
+        }
+    }
+
+    /// The generated function that computes the lobe.
+    #[must_use]
+    pub fn key(&self) -> ShapeKey {
+        ShapeKey {
+            kind: self.kind,
+            shape: self.shape,
         }
     }
 }
@@ -84,6 +85,12 @@ impl MaterialBlock {
             padding: 0,
             lobe: LobeBlock::new(shader.lobe()),
         }
+    }
+
+    /// The generated function that computes the material's lobe.
+    #[must_use]
+    pub fn lobe_key(&self) -> ShapeKey {
+        self.lobe.key()
     }
 }
 

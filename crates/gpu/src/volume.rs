@@ -6,7 +6,7 @@
 use std::sync::{Arc, Mutex, PoisonError};
 
 use bytemuck::{Pod, Zeroable};
-use specula::{Lobe, LobeKind};
+use specula::Lobe;
 use specula_render::volume::dvr::{DvrPlan, DvrSettings, Lighting};
 use specula_render::volume::march::{Classification, PreparedVolume};
 use specula_render::volume::transfer::TransferFunction;
@@ -15,7 +15,8 @@ use specula_render::Image;
 use wgpu::util::DeviceExt;
 
 use crate::uniforms::{geometry_id, LobeBlock};
-use crate::{wgsl, Gpu, GpuError};
+use crate::wgsl::{self, ShapeKey};
+use crate::{Gpu, GpuError};
 
 /// `struct Params` of volume.wgsl.
 #[repr(C)]
@@ -45,12 +46,12 @@ struct HighlightBlock {
     scale: [f32; 4],
 }
 
-/// The compiled ray marcher: one pipeline per list of highlights' lobe kinds, compiled when
+/// The compiled ray marcher: one pipeline per list of highlights' lobes, compiled when
 /// first asked for ([`wgsl::volume_module`]).
 #[derive(Debug)]
 pub struct GpuVolumeRenderer<'gpu> {
     gpu: &'gpu Gpu,
-    pipelines: Mutex<Vec<(Vec<LobeKind>, Arc<wgpu::ComputePipeline>)>>,
+    pipelines: Mutex<Vec<(Vec<ShapeKey>, Arc<wgpu::ComputePipeline>)>>,
 }
 
 fn with_w(v: glam::Vec3, w: f32) -> [f32; 4] {
@@ -76,24 +77,24 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
     /// # Errors
     /// When the driver refuses the shader.
     pub fn prepare(&self, lobes: &[Lobe]) -> Result<(), GpuError> {
-        let kinds: Vec<LobeKind> = lobes.iter().map(Lobe::kind).collect();
-        for some in kinds.chunks(wgsl::MAX_HIGHLIGHTS) {
+        let keys: Vec<ShapeKey> = lobes.iter().map(ShapeKey::of).collect();
+        for some in keys.chunks(wgsl::MAX_HIGHLIGHTS) {
             self.pipeline(some)?;
         }
         Ok(())
     }
 
-    /// The pipeline whose images' highlights are `kinds`' lobes, in order.
-    fn pipeline(&self, kinds: &[LobeKind]) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
+    /// The pipeline whose images' highlights are `keys`' lobes, in order.
+    fn pipeline(&self, keys: &[ShapeKey]) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
         let compiled = || {
             self.pipelines
                 .lock()
                 .unwrap_or_else(PoisonError::into_inner)
         };
-        if let Some((_, pipeline)) = compiled().iter().find(|(known, _)| known == kinds) {
+        if let Some((_, pipeline)) = compiled().iter().find(|(known, _)| known == keys) {
             return Ok(Arc::clone(pipeline));
         }
-        let source = wgsl::volume_module(kinds);
+        let source = wgsl::volume_module(keys);
         let device = &self.gpu.device;
         let pipeline = Arc::new(self.gpu.checked(|| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -111,10 +112,10 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
         })?);
         // Another thread may have compiled the same list meanwhile: the first one is kept.
         let mut compiled = compiled();
-        if let Some((_, known)) = compiled.iter().find(|(known, _)| known == kinds) {
+        if let Some((_, known)) = compiled.iter().find(|(known, _)| known == keys) {
             return Ok(Arc::clone(known));
         }
-        compiled.push((kinds.to_vec(), Arc::clone(&pipeline)));
+        compiled.push((keys.to_vec(), Arc::clone(&pipeline)));
         Ok(pipeline)
     }
 
@@ -181,12 +182,12 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
             Some(lighting) => lobes.iter().map(|lobe| highlight(lighting, lobe)).collect(),
             None => Vec::new(),
         };
-        let kinds: Vec<LobeKind> = lobes
+        let keys: Vec<ShapeKey> = lobes
             .iter()
             .take(highlights.len())
-            .map(Lobe::kind)
+            .map(ShapeKey::of)
             .collect();
-        let pipeline = self.pipeline(&kinds)?;
+        let pipeline = self.pipeline(&keys)?;
         let device = &self.gpu.device;
         let limits = device.limits();
         let dims = volume.dims();
@@ -434,12 +435,16 @@ fn params(
 
 #[cfg(test)]
 mod tests {
+    use specula::{Exponent, LobeKind};
+
     use super::*;
 
     /// `Params` and `Highlight` have the sizes WGSL's layout rules give them.
     #[test]
     fn blocks_match_the_wgsl_layout() {
-        let wgsl_size = crate::uniforms::wgsl_size_of(&wgsl::volume_module(&[LobeKind::Pow]));
+        let wgsl_size = crate::uniforms::wgsl_size_of(&wgsl::volume_module(&[ShapeKey::of(
+            &Lobe::new(LobeKind::Pow, Exponent::new(8.0)),
+        )]));
         assert_eq!(wgsl_size("Params"), size_of::<Params>());
         assert_eq!(wgsl_size("Highlight"), size_of::<HighlightBlock>());
     }

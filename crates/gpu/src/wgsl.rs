@@ -1,16 +1,14 @@
 //! The WGSL sources, embedded, and how they are put together.
 //!
-//! `lobes.wgsl` is the library (one function per lobe, `lobe_eval` dispatching on the kind's
-//! index); `geometry.wgsl` computes the lobe's cosine; `brdf.wgsl` adds the illumination
-//! models; `render.wgsl`, `evaluate.wgsl` and `volume.wgsl` (the ray marcher) are the entry
-//! points. A module is the concatenation of the files it needs
-//! (WGSL declarations may come in any order).
+//! The lobe library is generated ([`lobes`], from `lobe_library`); `geometry.wgsl` computes
+//! the lobe's cosine; `brdf.wgsl` adds the illumination models; `render.wgsl`,
+//! `evaluate.wgsl` and `volume.wgsl` (the ray marcher) are the entry points. A module is the
+//! concatenation of the parts it needs (WGSL declarations may come in any order).
 
 use specula::LobeKind;
 
-/// The lobe library's built-in lobes (`lobe_eval`'s default case calls `lobe_formula`,
-/// which [`lobes`] appends).
-pub const LOBES: &str = include_str!("../shaders/lobes.wgsl");
+pub use crate::lobe_library::{lobe_function, ShapeKey};
+
 /// The lobe's cosine from the directions (Phong or Blinn).
 pub const GEOMETRY: &str = include_str!("../shaders/geometry.wgsl");
 /// Materials, lights and the illumination models.
@@ -22,73 +20,61 @@ pub const VOLUME: &str = include_str!("../shaders/volume.wgsl");
 /// The lobe-evaluation compute shader.
 pub const EVALUATE: &str = include_str!("../shaders/evaluate.wgsl");
 
-/// The WGSL function that implements `kind`: `lobe_` and the id with `-` as `_`.
-#[must_use]
-pub fn lobe_function(kind: LobeKind) -> String {
-    format!("lobe_{}", kind.id().replace('-', "_"))
-}
-
-/// The lobe library with every user lobe defined so far ([`specula::formula::kinds`]): each
-/// formula's generated function of `n` and `t`, dispatched from `lobe_eval`'s default case
-/// by the kind's index, so that a user's lobe renders as the built-in ones do. A module
-/// built before a formula was defined does not know it (its index then gives 0).
+/// The lobe library, generated from every lobe's recorded expression: each built-in shape's
+/// function, the user's lobes defined so far (a module built before a formula was defined
+/// does not know it: its index then gives 0) and `lobe_eval`, which dispatches a material's
+/// `Lobe` block to them.
 #[must_use]
 pub fn lobes() -> String {
-    let mut cases = String::new();
-    let mut functions = String::new();
-    for kind in specula::formula::kinds() {
-        let lobe = specula::Lobe::new(kind, specula::Exponent::new(1.0));
-        let name = format!("lobe_formula_{}", kind.index());
-        if let Some(function) = specula_targets::wgsl::lobe_function_of_n(&lobe, &name) {
-            functions.push_str(&function);
-            cases.push_str(&format!(
-                "        case {}u: {{ return {name}(lobe.n, t); }}\n",
-                kind.index()
-            ));
-        }
-    }
-    let dispatch = format!(
-        "
-// The user's lobes, by kind index (specula::formula).
-fn lobe_formula(lobe: Lobe, t: f32) -> f32 {{
-    switch lobe.kind {{
-{cases}        default: {{ return 0.0; }}
-    }}
-}}
-"
-    );
-    [LOBES, &functions, &dispatch].concat()
+    crate::lobe_library::source()
 }
 
-/// The render module's source.
+/// The render module's source, for every lobe.
 #[must_use]
 pub fn render_module() -> String {
     [lobes().as_str(), GEOMETRY, BRDF, RENDER].concat()
 }
 
+/// The render module's source for materials whose lobes are `keys`' (the renderer's
+/// pipeline for a scene: `lobe_eval` switches over those lobes only).
+#[must_use]
+pub fn render_module_for(keys: &[ShapeKey]) -> String {
+    [
+        crate::lobe_library::source_for(keys).as_str(),
+        GEOMETRY,
+        BRDF,
+        RENDER,
+    ]
+    .concat()
+}
+
 /// The most images (one per lobe's highlight) one march of the ray marcher draws.
 pub const MAX_HIGHLIGHTS: usize = 16;
 
-/// The ray marcher's source for images whose highlights are `kinds`' lobes, in order:
-/// `add_highlights` calls each lobe's function directly (a driver that runs every case of a
-/// `switch` whose value it cannot prove uniform, as Mesa's lavapipe does, then evaluates one
-/// lobe per highlight, not every lobe).
+/// The ray marcher's source for images whose highlights are `keys`' lobes, in order:
+/// `add_highlights` calls each lobe's generated function directly (a driver that runs every
+/// case of a `switch` whose value it cannot prove uniform, as Mesa's lavapipe does, then
+/// evaluates one lobe per highlight, not every lobe), and the library holds those lobes only.
 ///
 /// # Panics
-/// If there are more than [`MAX_HIGHLIGHTS`] kinds.
+/// If there are more than [`MAX_HIGHLIGHTS`] lobes.
 #[must_use]
-pub fn volume_module(kinds: &[LobeKind]) -> String {
+pub fn volume_module(keys: &[ShapeKey]) -> String {
     assert!(
-        kinds.len() <= MAX_HIGHLIGHTS,
+        keys.len() <= MAX_HIGHLIGHTS,
         "{} highlights in one march, above {MAX_HIGHLIGHTS}",
-        kinds.len()
+        keys.len()
     );
     let mut sums = String::new();
-    for (i, &kind) in kinds.iter().enumerate() {
-        let call = if LobeKind::ALL.contains(&kind) {
-            format!("{}(highlights[{i}u].lobe, c)", lobe_function(kind))
-        } else {
-            format!("lobe_formula(highlights[{i}u].lobe, c)")
+    for (i, key) in keys.iter().enumerate() {
+        let lobe = format!("highlights[{i}u].lobe");
+        let call = match LobeKind::ALL.get(key.kind as usize) {
+            Some(&kind) => format!(
+                "{}_shape{}({lobe}.parameters, c)",
+                lobe_function(kind),
+                key.shape
+            ),
+            None => format!("lobe_formula({lobe}, c)"),
         };
         sums.push_str(&format!(
             "    (*sums)[{i}u] += weight * (highlights[{i}u].scale.x * {call});\n"
@@ -107,7 +93,13 @@ fn add_highlights(sums: ptr<function, array<f32, MAX_HIGHLIGHTS>>, weight: f32, 
 {sums}}}
 "
     );
-    [lobes().as_str(), GEOMETRY, VOLUME, &add_highlights].concat()
+    [
+        crate::lobe_library::source_for(keys).as_str(),
+        GEOMETRY,
+        VOLUME,
+        &add_highlights,
+    ]
+    .concat()
 }
 
 /// The compute module's source.

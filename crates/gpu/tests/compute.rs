@@ -61,12 +61,13 @@ fn every_lobe_on_the_gpu_matches_f64_within_its_bound() {
     let Some(gpu) = common::gpu() else { return };
     let evaluator = LobeEvaluator::new(&gpu).unwrap();
     let ts = cosines();
-    let kinds = LobeKind::ALL
-        .into_iter()
-        .chain([LobeKind::CosQuad { v: 6 }]);
-    for kind in kinds {
+    // Every variant (cosquad's every v) and every shape of schlick-mod's (a generated
+    // function each).
+    for kind in LobeKind::ALL.into_iter().flat_map(LobeKind::variants) {
         let mut worst = (0.0_f64, 0.0_f64);
-        for n in [1.0, 7.3, 64.0, 333.0, 1000.0] {
+        for n in [
+            1.0, 7.3, 8.0, 16.0, 33.0, 64.0, 128.0, 255.0, 333.0, 512.0, 1000.0,
+        ] {
             let lobe = Lobe::new(kind, Exponent::new(n));
             let values = evaluator.eval(&lobe, &ts).unwrap();
             let bound = bound_in_ulps(kind, n) * ULP;

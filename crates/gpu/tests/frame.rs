@@ -23,7 +23,7 @@ fn scene() -> Scene {
 #[test]
 fn a_prepared_frame_redraws_the_image_render_draws() {
     let Some(gpu) = common::gpu() else { return };
-    let renderer = GpuRenderer::new(&gpu).unwrap();
+    let renderer = GpuRenderer::new(&gpu);
     let scene = scene();
     let frame = renderer.prepare(&scene).unwrap();
     let first = frame.image().unwrap();
@@ -41,7 +41,7 @@ fn a_prepared_frame_redraws_the_image_render_draws() {
 #[test]
 fn frame_times_bracket_the_gpu_pass() {
     let Some(gpu) = common::gpu() else { return };
-    let renderer = GpuRenderer::new(&gpu).unwrap();
+    let renderer = GpuRenderer::new(&gpu);
     let frame = renderer.prepare(&scene()).unwrap();
     for read_back in [false, true] {
         let time = frame.draw(read_back).unwrap();

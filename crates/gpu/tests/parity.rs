@@ -19,7 +19,7 @@ const MIN_PSNR_DB: f64 = 70.0;
 #[test]
 fn gpu_renders_match_the_cpu_for_every_lobe_and_shading_method() {
     let Some(gpu) = common::gpu() else { return };
-    let renderer = GpuRenderer::new(&gpu).unwrap();
+    let renderer = GpuRenderer::new(&gpu);
     let mut parity = Parity::new(MAX_MEAN_FLIP, MIN_PSNR_DB);
     for kind in LobeKind::ALL {
         for shading in Shading::ALL {
@@ -45,7 +45,7 @@ fn gpu_renders_match_the_cpu_for_every_lobe_and_shading_method() {
 #[test]
 fn a_different_lobe_fails_the_same_thresholds() {
     let Some(gpu) = common::gpu() else { return };
-    let renderer = GpuRenderer::new(&gpu).unwrap();
+    let renderer = GpuRenderer::new(&gpu);
     let mut scene = Scene::default_scene();
     scene.apply(&Overrides {
         width: Some(320),

@@ -10,10 +10,11 @@ use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use specula_gpu::export::{export, export_wgsl_source, GlslVersion, Language, Options, ShaderCode};
 use specula_gpu::{wgsl, LobeEvaluator};
 
-/// Every lobe of `LobeKind::ALL` has its WGSL function, and `lobe_eval` dispatches its index
-/// to it: adding a lobe in Rust without its WGSL fails here.
+/// Every lobe of `LobeKind::ALL` has its generated WGSL function, `lobe_eval` dispatches its
+/// index to it, and no lobe function is typed by hand: none of the WGSL files defines one.
 #[test]
-fn every_rust_lobe_has_its_wgsl_function_and_switch_case() {
+fn every_rust_lobe_has_its_generated_function_and_switch_case() {
+    let library = wgsl::lobes();
     let (module, _) = wgsl::validate(&wgsl::render_module()).unwrap();
     let functions: Vec<&str> = module
         .functions
@@ -22,36 +23,89 @@ fn every_rust_lobe_has_its_wgsl_function_and_switch_case() {
         .collect();
     for kind in LobeKind::ALL {
         let name = wgsl::lobe_function(kind);
-        assert!(
-            functions.contains(&name.as_str()),
-            "{kind}: no `{name}` in lobes.wgsl"
-        );
+        assert!(functions.contains(&name.as_str()), "{kind}: no `{name}`");
         let case = format!("case {}u: {{ return {name}(lobe, c); }}", kind.index());
         assert!(
-            wgsl::LOBES.contains(&case),
+            library.contains(&case),
             "{kind}: `lobe_eval` lacks `{case}`"
         );
     }
-    let cases = wgsl::LOBES.matches("case ").count();
+    let lobe_eval = &library[library.find("fn lobe_eval").unwrap()..];
+    let cases = lobe_eval.matches("case ").count();
     assert_eq!(
         cases,
         LobeKind::ALL.len(),
         "a WGSL case without a Rust lobe"
     );
+    for (file, text) in [
+        ("geometry", wgsl::GEOMETRY),
+        ("brdf", wgsl::BRDF),
+        ("render", wgsl::RENDER),
+        ("volume", wgsl::VOLUME),
+        ("evaluate", wgsl::EVALUATE),
+    ] {
+        assert!(
+            !text.contains("fn lobe_"),
+            "{file}.wgsl defines a lobe function by hand"
+        );
+    }
 }
 
-/// The ray marcher's module validates for any list of lobes: none (unshaded), every
-/// built-in lobe, the most one march holds, and a user's lobe.
+/// A scene's render module holds its lobes' functions and no other built-in lobe's, and
+/// validates; the block of each of its lobes names a function it has.
+#[test]
+fn a_scenes_render_module_holds_its_lobes_only() {
+    let lobes = [
+        Lobe::new(LobeKind::SchlickMod, Exponent::new(100.0)),
+        Lobe::new(LobeKind::CosQuad { v: 6 }, Exponent::new(40.0)),
+    ];
+    let mut keys: Vec<wgsl::ShapeKey> = lobes.iter().map(wgsl::ShapeKey::of).collect();
+    keys.sort_unstable();
+    let source = wgsl::render_module_for(&keys);
+    wgsl::validate(&source).unwrap();
+    for (lobe, key) in lobes.iter().zip(&keys) {
+        let function = format!(
+            "fn {}_shape{}(",
+            wgsl::lobe_function(lobe.kind()),
+            key.shape
+        );
+        assert!(
+            source.contains(&function),
+            "{}: no `{function}`",
+            lobe.kind()
+        );
+    }
+    // schlick-mod at n = 100 squares four times (a = 16): the one shape from 64 to 128.
+    assert_eq!(keys[0].shape, 4);
+    let others = LobeKind::ALL
+        .into_iter()
+        .filter(|kind| !lobes.iter().any(|lobe| lobe.kind().index() == kind.index()))
+        .filter(|&kind| source.contains(&format!("fn {}(", wgsl::lobe_function(kind))));
+    assert_eq!(others.count(), 0, "other lobes in the scene's module");
+}
+
+/// The ray marcher's module validates for any list of lobes: none (unshaded), every shape
+/// of every built-in lobe (in marches of at most sixteen), and a user's lobe.
 #[test]
 fn the_ray_marcher_validates_for_any_lobes() {
-    let formula = LobeKind::parse("=t^n").unwrap();
-    for kinds in [
-        Vec::new(),
-        LobeKind::ALL.to_vec(),
-        LobeKind::ALL.iter().copied().cycle().take(16).collect(),
-        vec![LobeKind::Pow, formula],
-    ] {
-        wgsl::validate(&wgsl::volume_module(&kinds)).unwrap_or_else(|e| panic!("{kinds:?}: {e}"));
+    let formula = Lobe::new(LobeKind::parse("=t^n").unwrap(), Exponent::new(8.0));
+    let every_shape: Vec<Lobe> = LobeKind::ALL
+        .into_iter()
+        .flat_map(LobeKind::variants)
+        .flat_map(|kind| {
+            let starts = Lobe::new(kind, Exponent::new(1.0)).shape_exponents();
+            starts
+                .iter()
+                .map(move |&n| Lobe::new(kind, Exponent::new(n)))
+        })
+        .collect();
+    let marches = every_shape
+        .chunks(wgsl::MAX_HIGHLIGHTS)
+        .map(<[Lobe]>::to_vec)
+        .chain([Vec::new(), vec![every_shape[0], formula]]);
+    for lobes in marches {
+        let keys: Vec<wgsl::ShapeKey> = lobes.iter().map(wgsl::ShapeKey::of).collect();
+        wgsl::validate(&wgsl::volume_module(&keys)).unwrap_or_else(|e| panic!("{keys:?}: {e}"));
     }
 }
 

@@ -102,7 +102,7 @@ fn gpu_lobes_marched_together_are_each_marched_alone() {
 #[test]
 fn gpu_isosurfaces_match_the_cpu() {
     let Some(gpu) = common::gpu() else { return };
-    let renderer = GpuRenderer::new(&gpu).unwrap();
+    let renderer = GpuRenderer::new(&gpu);
     let volume = phantom::shepp_logan(48).unwrap();
     for kind in [LobeKind::Pow, LobeKind::parse("cosquad").unwrap()] {
         let settings = IsoSettings {

@@ -349,12 +349,18 @@ impl HwLobe {
     }
 
     /// The per-material inputs for integer exponent `n`: `n` itself and the constants the
-    /// library prepares for it (`Lobe::packed`), in the datapath's formats. What a renderer
-    /// uploads once per material.
+    /// library prepares for it (`Lobe::preparation`, `Lobe::squarings`), in the datapath's
+    /// formats. What a renderer uploads once per material.
     #[must_use]
     pub fn material_inputs(self, bits: u32, n: u32) -> Vec<i64> {
         let n_raw = i64::from(n);
-        let packed = || Lobe::new(self.float_kind(), Exponent::new(f64::from(n))).packed();
+        let lobe = || Lobe::new(self.float_kind(), Exponent::new(f64::from(n)));
+        // The named constant, as the library prepares it from n.
+        let prepared = |name: &str| {
+            lobe()
+                .preparation(name, f64::from(n))
+                .unwrap_or_else(|| unreachable!("{} prepares {name} from n", self.float_kind()))
+        };
         match self {
             HwLobe::Schlick
             | HwLobe::LogExp
@@ -362,13 +368,15 @@ impl HwLobe {
             | HwLobe::Cheb2
             | HwLobe::Pow => vec![n_raw],
             HwLobe::Sg => vec![FixedPoint::unsigned(SG_RATE_INT_BITS, bits - 1)
-                .quantize(packed().slope, Rounding::HalfEven)],
+                .quantize(prepared("rate"), Rounding::HalfEven)],
             HwLobe::SchlickMod => {
-                let squarings = i64::from(packed().squarings).min(SCHLICK_MOD_MAX_SQUARINGS.into());
+                let squarings = lobe().squarings().unwrap_or_default();
+                let squarings = i64::from(squarings).min(SCHLICK_MOD_MAX_SQUARINGS.into());
                 vec![n_raw, squarings]
             }
             HwLobe::CosQuad => {
-                vec![FixedPoint::unsigned(6, bits - 1).quantize(packed().slope, Rounding::HalfEven)]
+                vec![FixedPoint::unsigned(6, bits - 1)
+                    .quantize(prepared("slope"), Rounding::HalfEven)]
             }
         }
     }
@@ -425,7 +433,9 @@ fn cheb2_roms(frac: u32) -> [(Vec<i64>, FixedPoint); 3] {
     let coefficients: Vec<[f64; 3]> = (0..=1000)
         .map(|n: u32| {
             let lobe = Lobe::new(LobeKind::Cheb2, Exponent::new(f64::from(n.max(1))));
-            lobe.packed().quadratic
+            lobe.angle_quadratic()
+                .unwrap_or_else(|| unreachable!("cheb2 is quadratic in the angle"))
+                .coeffs()
         })
         .collect();
     core::array::from_fn(|k| {

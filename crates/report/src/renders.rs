@@ -175,7 +175,7 @@ fn default_scene(context: &mut Context) -> Result<String, String> {
     }
 
     match Gpu::new().and_then(|gpu| {
-        let image = GpuRenderer::new(&gpu)?.render(&base)?;
+        let image = GpuRenderer::new(&gpu).render(&base)?;
         Ok((gpu.adapter_name(), image))
     }) {
         Ok((adapter, image)) => {

@@ -152,21 +152,23 @@ fn parameters_follow_from_n_as_prepared() {
     }
 }
 
+/// A lobe's recorded operations with its parameters' values erased.
+fn shape(lobe: &Lobe) -> Vec<Node> {
+    lobe.expression()
+        .nodes()
+        .iter()
+        .map(|node| match node {
+            Node::Parameter { name, .. } => Node::Parameter { name, value: 0.0 },
+            other => *other,
+        })
+        .collect()
+}
+
 /// Across its structural range a lobe's record differs only in its parameters' values, so a
 /// target that takes `n` as an input and prepares the parameters computes the lobe at that
 /// `n`.
 #[test]
 fn within_the_structural_range_only_parameters_change() {
-    let shape = |lobe: &Lobe| -> Vec<Node> {
-        lobe.expression()
-            .nodes()
-            .iter()
-            .map(|node| match node {
-                Node::Parameter { name, .. } => Node::Parameter { name, value: 0.0 },
-                other => *other,
-            })
-            .collect()
-    };
     for kind in kinds() {
         for n in EXPONENTS {
             let lobe = Lobe::try_new(kind, n).unwrap();
@@ -192,6 +194,44 @@ fn within_the_structural_range_only_parameters_change() {
         shape(&schlick_mod(128.0)),
         "the range must end where the squarings change"
     );
+}
+
+/// A model's stated shapes are its records': every lobe records the operations of the lobe
+/// at its shape's least exponent (so a backend's function per shape computes it), and two
+/// neighbouring shapes differ (none is listed twice). Every variant of every registry entry,
+/// at exponents spread over the range, integers and not.
+#[test]
+fn a_lobe_records_the_operations_of_its_shape() {
+    let exponents = (0..=400).map(|i| 1.0 + 999.0 * (f64::from(i) / 400.0).powi(2));
+    for kind in LobeKind::ALL.into_iter().flat_map(LobeKind::variants) {
+        let starts = Lobe::try_new(kind, 1.0).unwrap().shape_exponents();
+        assert_eq!(
+            starts[0], 1.0,
+            "{kind}: the first shape starts at the least exponent"
+        );
+        for pair in starts.windows(2) {
+            let [a, b] = [pair[0], pair[1]].map(|n| shape(&Lobe::try_new(kind, n).unwrap()));
+            assert_ne!(
+                a, b,
+                "{kind}: shapes from {} and {} are one",
+                pair[0], pair[1]
+            );
+        }
+        for n in exponents
+            .clone()
+            .chain(starts.iter().map(|s| s.next_down().max(1.0)))
+        {
+            let lobe = Lobe::try_new(kind, n).unwrap();
+            let start = starts[lobe.shape() as usize];
+            assert!(start <= n, "{kind} n = {n}: shape from {start}");
+            let first = Lobe::try_new(kind, start).unwrap();
+            assert_eq!(
+                shape(&lobe),
+                shape(&first),
+                "{kind} n = {n} against {start}"
+            );
+        }
+    }
 }
 
 /// The recorded closed-form sampling is the sampler's: its inverse gives `Lobe::tail_inverse`'s

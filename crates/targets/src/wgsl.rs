@@ -18,8 +18,10 @@ impl Dialect for Wgsl {
     }
 }
 
-/// The bit tricks, as `Real`'s `f32` implementation computes them.
-const HELPERS: &str = "
+/// The bit-trick helpers, as `Real`'s `f32` implementation computes them: once in a module
+/// whose functions call them ([`lobe_function`] includes them; a library of several lobes
+/// includes them itself).
+pub const BIT_TRICKS: &str = "
 // t = m 2^e with m in [1/2, 1), read off the bits (specula's Real::frexp).
 fn specula_mantissa(t: f32) -> f32 {
     return bitcast<f32>((bitcast<u32>(t) & 0x007fffffu) | 0x3f000000u);
@@ -48,7 +50,7 @@ fn specula_shift(x: f32, k: f32) -> f32 {
 /// `fn {name}(n: f32, t: f32) -> f32`: the lobe for `t` in `(0, 1]` with its constants
 /// computed from `n` in the shader (a renderer's material carries `n`, not the constants),
 /// for a lobe whose every parameter follows from `n` ([`Inputs::of`]); `None` for the
-/// fitted ones.
+/// fitted ones. Without the helpers: the module includes [`BIT_TRICKS`] once.
 #[must_use]
 pub fn lobe_function_of_n(lobe: &Lobe, name: &str) -> Option<String> {
     let inputs = Inputs::of(lobe);
@@ -58,9 +60,6 @@ pub fn lobe_function_of_n(lobe: &Lobe, name: &str) -> Option<String> {
     let mut lines = inputs.preparation("n", &Wgsl);
     lines.extend(statements);
     let mut out = String::new();
-    if expression.has_bit_tricks() {
-        out.push_str(HELPERS);
-    }
     let _ = write!(
         out,
         "
@@ -83,7 +82,7 @@ pub fn lobe_function(lobe: &Lobe, name: &str) -> String {
     let (statements, result) = straight_line(&expression, "t", &Wgsl, Parameters::Baked);
     let mut out = String::new();
     if expression.has_bit_tricks() {
-        out.push_str(HELPERS);
+        out.push_str(BIT_TRICKS);
     }
     let _ = write!(
         out,
@@ -97,4 +96,53 @@ fn {name}(t: f32) -> f32 {{
         body(&statements, &result, "    ", |r| format!("return {r};")),
     );
     out
+}
+
+/// The components of a `vec4<f32>`, in order.
+const COMPONENTS: [&str; 4] = ["x", "y", "z", "w"];
+
+/// How many named parameters [`lobe_function_of_slots`] takes from its `vec4<f32>`.
+pub const SLOTS: usize = COMPONENTS.len();
+
+/// `fn {name}(parameters: vec4<f32>, t: f32) -> f32`: the lobe for `t` in `(0, 1]` with its
+/// named parameters read from `parameters` in order of first use
+/// ([`Expression::parameters`](specula::expression::Expression::parameters)), for a renderer
+/// that uploads each material's prepared constants; the other constants are baked in, so the
+/// function serves every lobe of the same recorded operations. `None` for a lobe with more
+/// than [`SLOTS`] parameters. Without the helpers: the module includes [`BIT_TRICKS`] once.
+#[must_use]
+pub fn lobe_function_of_slots(lobe: &Lobe, name: &str) -> Option<String> {
+    let expression = lobe.expression();
+    let parameters = expression.parameters();
+    if parameters.len() > SLOTS {
+        return None;
+    }
+    let mut lines: Vec<String> = parameters
+        .iter()
+        .zip(COMPONENTS)
+        .map(|((parameter, _), component)| {
+            Wgsl.local(parameter, &format!("parameters.{component}"))
+        })
+        .collect();
+    let (statements, result) = straight_line(&expression, "t", &Wgsl, Parameters::Named);
+    lines.extend(statements);
+    Some(format!(
+        "
+// {} at cosine t in (0, 1], its parameters ({}) from the material; generated from
+// specula's description of the lobe.
+fn {name}(parameters: vec4<f32>, t: f32) -> f32 {{
+{}}}
+",
+        lobe.kind(),
+        if parameters.is_empty() {
+            "none".to_owned()
+        } else {
+            parameters
+                .iter()
+                .map(|(p, _)| *p)
+                .collect::<Vec<_>>()
+                .join(", ")
+        },
+        body(&lines, &result, "    ", |r| format!("return {r};")),
+    ))
 }

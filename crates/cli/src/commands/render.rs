@@ -167,10 +167,7 @@ pub fn run(args: &Args) -> CommandResult {
         RendererArg::Cpu => None,
         RendererArg::Gpu => Some(Gpu::new().map_err(|e| e.to_string())?),
     };
-    let gpu_renderer = match &gpu {
-        Some(gpu) => Some(GpuRenderer::new(gpu).map_err(|e| e.to_string())?),
-        None => None,
-    };
+    let gpu_renderer = gpu.as_ref().map(GpuRenderer::new);
     let ibl = IblSettings {
         spp: args.spp,
         seed: args.seed,

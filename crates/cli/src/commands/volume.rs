@@ -368,7 +368,7 @@ fn iso(
     let scene = iso_scene(volume, mesh, &settings).map_err(|e| e.to_string())?;
     match gpu {
         Some(gpu) => GpuRenderer::new(gpu)
-            .and_then(|renderer| renderer.render(&scene))
+            .render(&scene)
             .map_err(|e| e.to_string()),
         None => {
             bar.set_message("rasterizing");

@@ -254,4 +254,8 @@ impl<const SQUARINGS: u32, const MASKED: bool> LobeKernel for CosQuadKernel<SQUA
 }
 
 // Sampled in closed form: the tail and its inverse exactly.
-closed_form_facts!(CosQuad);
+closed_form_facts!(CosQuad, {
+    fn lobe_squarings(&self) -> Option<u32> {
+        Some(self.squarings())
+    }
+});

@@ -50,6 +50,17 @@ pub(crate) trait ModelFacts {
     fn lobe_structural_range(&self, _n: f64) -> [f64; 2] {
         [Exponent::MIN, Exponent::MAX]
     }
+
+    /// The least exponent of each of the model's shapes (its recorded operations, parameter
+    /// values aside), ascending: a model whose operations change with `n` lists where.
+    fn lobe_shape_exponents(&self) -> &'static [f64] {
+        &[Exponent::MIN]
+    }
+
+    /// How many times the model squares: its cost and its hardware's select input.
+    fn lobe_squarings(&self) -> Option<u32> {
+        None
+    }
 }
 
 /// `$body` with `$m` bound to the prepared model, whichever it is: the one place that lists
@@ -75,10 +86,16 @@ macro_rules! each_model {
 pub(crate) use each_model;
 
 /// The facts of a model sampled in closed form, from its own `tail`, `tail_inverse` and
-/// `total`: the tail, its exact inverse, and both over any `Real` for a target that samples.
+/// `total`: the tail, its exact inverse, and both over any `Real` for a target that samples;
+/// the model's other facts follow in braces.
 macro_rules! closed_form_facts {
     ($model:ty) => {
+        closed_form_facts!($model, {});
+    };
+    ($model:ty, { $($other:item)* }) => {
         impl super::facts::ModelFacts for $model {
+            $($other)*
+
             fn lobe_tail(&self, t: f64) -> Option<f64> {
                 Some(self.tail(t))
             }

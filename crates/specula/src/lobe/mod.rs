@@ -47,26 +47,6 @@ use crate::ops::{count_ops, Counted, OpCounts};
 use crate::real::Real;
 use crate::Exponent;
 
-/// A prepared lobe as flat numbers, for backends outside Rust (WGSL uniforms, hardware
-/// registers): which formula, its integer parameter and its real constants, all computed by
-/// [`Lobe::new`] in `f64`. Fields a model does not use are 0.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PackedLobe {
-    /// The model's position in [`LobeKind::ALL`] (parameters aside): the shaders' `switch` case.
-    pub kind_index: u32,
-    /// Squarings: `log2 a` for `schlick-mod`, `v` for `cosquad`.
-    pub squarings: u32,
-    /// The exponent.
-    pub n: f64,
-    /// `cosquad`'s slope `a = (n + 1) / (2^v + 1)`; a spherical Gaussian's rate
-    /// `log2(e) (n + offset)`.
-    pub slope: f64,
-    /// A quadratic-in-angle lobe's `[C, B, A]`.
-    pub quadratic: [f64; 3],
-    /// A quadratic-in-angle lobe's cut-off angle (radians).
-    pub cutoff: f64,
-}
-
 /// How a lobe's cosine is drawn from a uniform number for importance sampling: each lobe's
 /// manual page says which, and why.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -180,34 +160,34 @@ impl Lobe {
         each_model!(&self.model, m => m.lobe_angle_quadratic())
     }
 
-    /// The prepared constants as flat numbers (see [`PackedLobe`]).
+    /// How many times the lobe squares (`schlick-mod`'s `log2 a`, `cosquad`'s `v`); `None`
+    /// for a model that does not.
     #[must_use]
-    pub fn packed(&self) -> PackedLobe {
-        let mut packed = PackedLobe {
-            kind_index: self.kind.index(),
-            n: self.n.get(),
-            ..PackedLobe::default()
-        };
-        match &self.model {
-            Model::SchlickMod(m) => packed.squarings = m.squarings(),
-            Model::CosQuad(m) => {
-                packed.squarings = m.squarings();
-                packed.slope = m.slope();
-            }
-            Model::AngleQuadratic(m) => {
-                packed.quadratic = m.coeffs();
-                packed.cutoff = m.cutoff();
-            }
-            Model::Sg(m) => packed.slope = m.rate(),
-            Model::Pow(_)
-            | Model::Schlick(_)
-            | Model::LogExp(_)
-            | Model::LogExpRr(_)
-            | Model::FastPow(_)
-            | Model::FasterPow(_)
-            | Model::Formula(_) => {}
-        }
-        packed
+    pub fn squarings(&self) -> Option<u32> {
+        each_model!(&self.model, m => m.lobe_squarings())
+    }
+
+    /// The least exponent of each of the model's shapes, ascending: lobes of one kind whose
+    /// exponents fall between two of them record the same operations, only their named
+    /// parameters' values differ ([`Lobe::expression`]). One entry for most models;
+    /// `schlick-mod` squares once more at every power of two from 8.
+    #[must_use]
+    pub fn shape_exponents(&self) -> &'static [f64] {
+        each_model!(&self.model, m => m.lobe_shape_exponents())
+    }
+
+    /// Which of [`Lobe::shape_exponents`]'s shapes this lobe's exponent selects: how a backend
+    /// that generates one function per shape finds this lobe's.
+    #[must_use]
+    pub fn shape(&self) -> u32 {
+        let starts = self.shape_exponents();
+        let n = self.n.get();
+        (starts
+            .iter()
+            .take_while(|&&start| start <= n)
+            .count()
+            .max(1)
+            - 1) as u32
     }
 
     /// Cosines in `(0, 1)` where the lobe's value is not smooth beyond what

@@ -108,7 +108,19 @@ impl ModelFacts for SchlickMod {
         // Below the next power of two by an amount `f32` still resolves.
         [low, (next * (1.0 - 2f64.powi(-20))).min(Exponent::MAX)]
     }
+
+    fn lobe_shape_exponents(&self) -> &'static [f64] {
+        &SHAPE_EXPONENTS
+    }
+
+    fn lobe_squarings(&self) -> Option<u32> {
+        Some(self.squarings)
+    }
 }
+
+/// Where the squarings change: one more at every power of two from 8 on, the last (7) from
+/// 512 to `Exponent::MAX`.
+const SHAPE_EXPONENTS: [f64; 8] = [1.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0];
 
 #[cfg(test)]
 mod tests {

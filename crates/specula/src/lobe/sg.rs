@@ -66,11 +66,6 @@ impl Sg {
         R::from_f64(core::f64::consts::LOG2_E) * (n + R::from_f64(offset))
     }
 
-    /// `log2(e)` times the Gaussian's sharpness: the constant a shader uploads.
-    pub(crate) fn rate(&self) -> f64 {
-        self.rate
-    }
-
     /// Evaluates at `t in (0, 1]`.
     #[inline(always)]
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {

@@ -191,7 +191,7 @@ impl GpuTimes {
 
 fn bench_frame(args: &Args) -> CommandResult {
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
-    let renderer = GpuRenderer::new(&gpu).map_err(|e| e.to_string())?;
+    let renderer = GpuRenderer::new(&gpu);
     println!(
         "default scene, {}x{}, 1 sample per pixel, {} frames per method; CPU: {} threads; GPU: {}\n\
          GPU frames are drawn from buffers uploaded once; 'GPU pass' is the scene pass by the \
@@ -235,7 +235,7 @@ fn bench_frame(args: &Args) -> CommandResult {
 
 fn bench_gpu(args: &Args) -> CommandResult {
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
-    let renderer = GpuRenderer::new(&gpu).map_err(|e| e.to_string())?;
+    let renderer = GpuRenderer::new(&gpu);
     println!(
         "{}\ndefault scene, {}x{}, Phong shading, 1 sample per pixel, {} frames per lobe, \
          drawn from buffers uploaded once (draw and wait; then with the image copied back); \
