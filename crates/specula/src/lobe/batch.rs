@@ -10,6 +10,7 @@
 //! and by the polynomials standing in for `log2`, `exp2` and `acos`, within
 //! [`Lobe::batch_ulp_bound`] (tested at every level and for the plain loop).
 
+use super::facts::each_model;
 use super::{Lobe, Model};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{dispatch, BatchLoop, Drive, Kernel, Lanes, Level};
@@ -44,34 +45,41 @@ macro_rules! with_squarings {
     };
 }
 
+pub(crate) use with_squarings;
+
 /// What to do with a lobe's kernel, once its type is known.
 pub(crate) trait WithKernel {
     type Output;
     fn call<K: LobeKernel>(self, kernel: K) -> Self::Output;
 }
 
+/// What a model states of its batch path, in its own file: its kernel, and how far the batch
+/// may stray from the scalar `f32` path ([`Lobe::batch_ulp_bound`]).
+pub(crate) trait ModelBatch {
+    /// Calls `f` with the model's kernel (one monomorphised path per constant it unrolls).
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output;
+
+    /// The largest difference, in ULPs of 1, between the batch and the scalar `f32` path at
+    /// exponent `n`.
+    fn batch_ulp_bound(&self, n: f64) -> f64;
+
+    /// For a model drawn in closed form: its draw kernel over `us` into `out` on `level`'s
+    /// lanes, and `true` ([`Lobe::tail_inverse_batch`]); `false`, `out` untouched, otherwise.
+    fn draw_batch(&self, _level: Level, _us: &[f32], _out: &mut [f32]) -> bool {
+        false
+    }
+
+    /// The least slope of the drawn inverse in its base, which divides the draw's rounding
+    /// ([`Lobe::tail_inverse_batch_bound`]): 1 unless the model's base is flatter.
+    fn draw_batch_slope(&self) -> f64 {
+        1.0
+    }
+}
+
 impl Lobe {
-    /// Calls `f` with this lobe's kernel (one monomorphised path per model and constant).
+    /// Calls `f` with this lobe's kernel.
     pub(crate) fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
-        match &self.model {
-            Model::Pow(m) => f.call(m.kernel()),
-            Model::Schlick(m) => f.call(m.kernel()),
-            Model::SchlickMod(m) => with_squarings!(m.squarings(), K => f.call(m.kernel::<K>())),
-            Model::AngleQuadratic(m) => f.call(m.kernel()),
-            Model::LogExp(m) => f.call(m.kernel()),
-            Model::LogExpRr(m) => f.call(m.kernel()),
-            Model::CosQuad(m) => with_squarings!(m.squarings(), K => {
-                if m.needs_mask() {
-                    f.call(m.kernel::<K, true>())
-                } else {
-                    f.call(m.kernel::<K, false>())
-                }
-            }),
-            Model::Sg(m) => f.call(m.kernel()),
-            Model::FastPow(m) => f.call(m.kernel()),
-            Model::FasterPow(m) => f.call(m.kernel()),
-            Model::Formula(m) => f.call(m.kernel(*self)),
-        }
+        each_model!(&self.model, m => m.with_kernel(f))
     }
 }
 
@@ -210,27 +218,7 @@ impl Lobe {
     /// scalar `f32` [`Lobe::eval`] at the same cosine.
     #[must_use]
     pub fn batch_ulp_bound(&self) -> f64 {
-        let n = self.n.get();
-        match self.model {
-            // One fused rounding in the denominator: a few ULP of the value.
-            Model::Schlick(_) | Model::SchlickMod(_) => 4.0,
-            // The fused base differs by half an ULP; each squaring doubles its effect.
-            Model::CosQuad(m) => 4.0 + f64::from(1u32 << m.squarings()) / 2.0,
-            // exp2(n log2 t): log2's error is multiplied by n.
-            Model::Pow(_) | Model::LogExp(_) | Model::LogExpRr(_) => 8.0 + 2.0 * n,
-            // acos within 2.5e-7 rad, times the quadratic's slope (at most ~2n^(1/2) per rad).
-            Model::AngleQuadratic(_) => 16.0 + 8.0 * n.sqrt(),
-            // One fused multiply-add against a rounded product, scaled by the value times its
-            // argument (at most 0.53), plus exp2's 2 ULP.
-            Model::Sg(_) => 8.0,
-            // The corrected log's rounding times n, plus one step of the bit-pattern grid
-            // (2^-17 relative, 64 ULP) where the two paths round it apart.
-            Model::FastPow(_) | Model::FasterPow(_) => 72.0 + 2.0 * n,
-            // The columns' fused multiply-adds and polynomials against libm, through whatever
-            // the formula does with them: a statement for formulas of the shapes the lobes
-            // have (a power of a base, an exponential of a multiple of t - 1), tested on them.
-            Model::Formula(_) => 64.0 + 4.0 * n,
-        }
+        each_model!(&self.model, m => m.batch_ulp_bound(self.n.get()))
     }
 }
 

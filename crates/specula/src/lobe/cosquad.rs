@@ -22,14 +22,14 @@
 //!   `x_0 = max(0, 1 - a)` the base at `t = 0`.
 //! - **Source**: the thesis, slide "A model based on a cosine-quadratic function".
 
-use super::batch::LobeKernel;
-use super::draw_batch::remaining_share;
+use super::batch::{with_squarings, LobeKernel, ModelBatch, WithKernel};
+use super::draw_batch::{self, remaining_share};
 use super::facts::closed_form_facts;
 use super::info::{LineStyle, LobeInfo, Origin, ParamInfo};
 use crate::real::Real;
 use crate::simd::math::{exp2, log2};
 use crate::simd::tally::{Class, Instructions};
-use crate::simd::{Kernel, Lanes};
+use crate::simd::{Kernel, Lanes, Level};
 use crate::Exponent;
 
 /// The registry's entry for this lobe.
@@ -258,4 +258,39 @@ closed_form_facts!(CosQuad, {
     fn lobe_squarings(&self) -> Option<u32> {
         Some(self.squarings())
     }
+
+    fn lobe_preparation<R: Real>(&self, name: &str, n: R) -> Option<R> {
+        match name {
+            "n" => Some(n),
+            "slope" => Some(CosQuad::slope_for(n, self.v)),
+            _ => None,
+        }
+    }
 });
+
+/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+impl ModelBatch for CosQuad {
+    fn draw_batch(&self, level: Level, us: &[f32], out: &mut [f32]) -> bool {
+        draw_batch::run(level, self.draw_kernel(), us, out);
+        true
+    }
+
+    fn draw_batch_slope(&self) -> f64 {
+        self.slope().min(1.0)
+    }
+
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        with_squarings!(self.squarings(), K => {
+            if self.needs_mask() {
+                f.call(self.kernel::<K, true>())
+            } else {
+                f.call(self.kernel::<K, false>())
+            }
+        })
+    }
+
+    fn batch_ulp_bound(&self, _n: f64) -> f64 {
+        // The fused base differs by half an ULP; each squaring doubles its effect.
+        4.0 + f64::from(1u32 << self.squarings()) / 2.0
+    }
+}

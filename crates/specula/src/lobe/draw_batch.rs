@@ -6,6 +6,8 @@
 //! calls `ln_1p`, `exp` and `expm1`, within [`Lobe::tail_inverse_batch_bound`] of the `f64`
 //! inverse (tested).
 
+use super::batch::ModelBatch;
+use super::facts::each_model;
 use super::{Lobe, Model};
 use crate::simd::{dispatch, BatchLoop, Drive, Kernel, Lanes, Level};
 
@@ -21,7 +23,7 @@ pub(crate) fn remaining_share<V: Lanes>(u: V, floor: f32) -> V {
 }
 
 /// Runs `kernel` over `us` into `out` on `level`'s lanes.
-fn run<K: Kernel>(level: Level, kernel: K, us: &[f32], out: &mut [f32]) {
+pub(crate) fn run<K: Kernel>(level: Level, kernel: K, us: &[f32], out: &mut [f32]) {
     let job = Drive {
         kernel,
         ts: us,
@@ -44,20 +46,7 @@ impl Lobe {
             out.len(),
             "tail_inverse_batch: one cosine per uniform"
         );
-        match &self.model {
-            Model::Pow(m) => run(level, m.draw_kernel(), us, out),
-            Model::Sg(m) => run(level, m.draw_kernel(), us, out),
-            Model::CosQuad(m) => run(level, m.draw_kernel(), us, out),
-            Model::Schlick(_)
-            | Model::SchlickMod(_)
-            | Model::AngleQuadratic(_)
-            | Model::LogExp(_)
-            | Model::LogExpRr(_)
-            | Model::FastPow(_)
-            | Model::FasterPow(_)
-            | Model::Formula(_) => return false,
-        }
-        true
+        each_model!(&self.model, m => m.draw_batch(level, us, out))
     }
 
     /// The largest difference between [`Lobe::tail_inverse_batch`]'s cosine and the `f64`
@@ -66,11 +55,7 @@ impl Lobe {
     /// inverse's slope in it, 1 but for `cosquad`'s `1 / a` where its slope `a` is below 1.
     #[must_use]
     pub fn tail_inverse_batch_bound(&self) -> f64 {
-        let slope = match &self.model {
-            Model::CosQuad(m) => m.slope().min(1.0),
-            _ => 1.0,
-        };
-        3.0 * f64::from(f32::EPSILON) / slope
+        3.0 * f64::from(f32::EPSILON) / each_model!(&self.model, m => m.draw_batch_slope())
     }
 }
 

@@ -57,6 +57,13 @@ pub(crate) trait ModelFacts {
         &[Exponent::MIN]
     }
 
+    /// The named parameter `name` of the model's expression computed from the exponent `n`, as
+    /// the preparation computes it; `None` where it is prepared numerically (a fit). By
+    /// default a model's one parameter is `n` itself.
+    fn lobe_preparation<R: Real>(&self, name: &str, n: R) -> Option<R> {
+        (name == "n").then_some(n)
+    }
+
     /// How many times the model squares: its cost and its hardware's select input.
     fn lobe_squarings(&self) -> Option<u32> {
         None

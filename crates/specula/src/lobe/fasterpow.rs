@@ -23,7 +23,7 @@
 //! - **Source**: P. Mineiro, fastapprox (`fasterlog2`, `fasterpow2`, `fasterpow`), 2011;
 //!   N. N. Schraudolph, "A fast, compact approximation of the exponential function" (1999).
 
-use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::fastpow::kinks;
 use super::info::{LineStyle, LobeInfo, Origin};
@@ -124,5 +124,18 @@ impl LobeKernel for FasterPowKernel {
 impl ModelFacts for FasterPow {
     fn lobe_kinks(&self) -> Vec<f64> {
         self.kinks()
+    }
+}
+
+/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+impl ModelBatch for FasterPow {
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        f.call(self.kernel())
+    }
+
+    fn batch_ulp_bound(&self, n: f64) -> f64 {
+        // The log's rounding times n, plus one step of the bit-pattern grid (2^-17 relative,
+        // 64 ULP) where the two paths round it apart.
+        72.0 + 2.0 * n
     }
 }

@@ -31,7 +31,7 @@
 //! - **Source**: P. Mineiro, fastapprox (`fastlog2`, `fastpow2`, `fastpow`), 2011;
 //!   N. N. Schraudolph, "A fast, compact approximation of the exponential function" (1999).
 
-use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
@@ -204,5 +204,18 @@ impl LobeKernel for FastPowKernel {
 impl ModelFacts for FastPow {
     fn lobe_kinks(&self) -> Vec<f64> {
         self.kinks()
+    }
+}
+
+/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+impl ModelBatch for FastPow {
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        f.call(self.kernel())
+    }
+
+    fn batch_ulp_bound(&self, n: f64) -> f64 {
+        // The corrected log's rounding times n, plus one step of the bit-pattern grid (2^-17
+        // relative, 64 ULP) where the two paths round it apart.
+        72.0 + 2.0 * n
     }
 }

@@ -11,10 +11,10 @@
 //! - **Cost**: what the formula writes; integer powers up to 64 are multiplications.
 //! - **Sampling**: Newton on the formula's own tail where it gives one, else a table.
 
-use super::batch::LobeKernel;
+use super::batch::{LobeKernel, ModelBatch, WithKernel};
 use super::facts::ModelFacts;
 use super::invert::NewtonStart;
-use super::{Inverted, NewtonForm};
+use super::{with_shared_rules, Inverted, NewtonForm};
 use crate::formula::batch::Rules;
 use crate::formula::{registry, Instance, MAX_SLOTS};
 use crate::real::Real;
@@ -53,10 +53,6 @@ impl FormulaLobe {
     pub(crate) fn eval<R: Real>(&self, t: R) -> R {
         let value: R = self.instance.formula().raw(t, &self.slots);
         value.max(R::from_f64(0.0)).min(R::from_f64(1.0))
-    }
-
-    pub(crate) fn has_tail(&self) -> bool {
-        self.instance.formula().has_tail()
     }
 
     /// `int_t^1 lobe`, from the formula's tail.
@@ -129,9 +125,9 @@ impl FormulaLobe {
 
     /// The plain loop's kernel for `lobe`, the lobe this formula was prepared into (the
     /// kernel evaluates through it, and so through its rules).
-    pub(crate) fn kernel(&self, lobe: super::Lobe) -> FormulaKernel {
+    pub(crate) fn kernel(&self) -> FormulaKernel {
         FormulaKernel {
-            lobe,
+            formula: *self,
             stated: self.instructions(),
         }
     }
@@ -156,11 +152,12 @@ impl Job for Columns<'_> {
     }
 }
 
-/// The formula one lane at a time in scalar `f32`, through [`Lobe::eval`] and so its rules:
-/// the plain loop the compiled batch is measured against.
+/// The formula one lane at a time in scalar `f32`, under the shared rules as
+/// [`Lobe::eval`](super::Lobe::eval) applies them: the plain loop the compiled batch is
+/// measured against.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct FormulaKernel {
-    lobe: super::Lobe,
+    formula: FormulaLobe,
     stated: Instructions,
 }
 
@@ -169,7 +166,7 @@ impl Kernel for FormulaKernel {
         let mut lanes = [0.0_f32; 64];
         t.store(&mut lanes[..V::WIDTH]);
         for value in &mut lanes[..V::WIDTH] {
-            *value = self.lobe.eval(*value);
+            *value = with_shared_rules(*value, |t| self.formula.eval(t));
         }
         t.load(&lanes[..V::WIDTH])
     }
@@ -194,5 +191,23 @@ impl ModelFacts for FormulaLobe {
 
     fn lobe_newton_sampling<R: Real>(&self, x: R) -> Option<NewtonForm<R>> {
         self.newton_sampling(x)
+    }
+
+    fn lobe_preparation<R: Real>(&self, name: &str, n: R) -> Option<R> {
+        self.preparation(name, n)
+    }
+}
+
+/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+impl ModelBatch for FormulaLobe {
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        f.call(self.kernel())
+    }
+
+    fn batch_ulp_bound(&self, n: f64) -> f64 {
+        // The columns' fused multiply-adds and polynomials against libm, through whatever the
+        // formula does with them: a statement for formulas of the shapes the lobes have (a
+        // power of a base, an exponential of a multiple of t - 1), tested on them.
+        64.0 + 4.0 * n
     }
 }

@@ -17,7 +17,7 @@
 //! - **Sampling**: table (`sampling::CosineDistribution`), as `logexp`.
 //! - **Source**: specula.
 
-use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use super::logexp::exp2_by_log2;
@@ -107,3 +107,15 @@ impl LobeKernel for LogExpRrKernel {
 
 /// Sampled from a table: no closed-form tail, no kinks, one structure for every `n`.
 impl ModelFacts for LogExpRr {}
+
+/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+impl ModelBatch for LogExpRr {
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        f.call(self.kernel())
+    }
+
+    fn batch_ulp_bound(&self, n: f64) -> f64 {
+        // Through log2, whose error is multiplied by n.
+        8.0 + 2.0 * n
+    }
+}

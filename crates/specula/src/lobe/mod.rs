@@ -90,6 +90,18 @@ pub struct NewtonForm<R> {
     pub total: R,
 }
 
+/// `lobe` at `t` under the rules every lobe shares: `t <= 0` or NaN gives 0, `t > 1` counts
+/// as 1 (SPEC section 1); `lobe` sees `t` in `(0, 1]` only.
+#[inline]
+pub(crate) fn with_shared_rules<R: Real>(t: R, lobe: impl FnOnce(R) -> R) -> R {
+    let zero = R::from_f64(0.0);
+    if t > zero {
+        lobe(t.min(R::from_f64(1.0)))
+    } else {
+        zero
+    }
+}
+
 /// A lobe function prepared for one exponent `n`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lobe {
@@ -198,21 +210,17 @@ impl Lobe {
         each_model!(&self.model, m => m.lobe_kinks())
     }
 
-    /// How the lobe's cosine is sampled.
+    /// How the lobe's cosine is sampled, from what its model states: in closed form where it
+    /// inverts its tail so, by Newton where it integrates in closed form only, else from a
+    /// table.
     #[must_use]
     pub fn warp(&self) -> Warp {
-        match &self.model {
-            Model::Pow(_) | Model::Sg(_) | Model::CosQuad(_) => Warp::Analytic,
-            Model::Schlick(_) => Warp::Newton,
-            Model::AngleQuadratic(m) if m.has_closed_form_tail() => Warp::Newton,
-            Model::Formula(m) if m.has_tail() => Warp::Newton,
-            Model::AngleQuadratic(_)
-            | Model::SchlickMod(_)
-            | Model::LogExp(_)
-            | Model::LogExpRr(_)
-            | Model::FastPow(_)
-            | Model::FasterPow(_)
-            | Model::Formula(_) => Warp::Table,
+        if self.closed_form_sampling(0.5f64).is_some() {
+            Warp::Analytic
+        } else if self.tail(0.5).is_some() {
+            Warp::Newton
+        } else {
+            Warp::Table
         }
     }
 
@@ -261,12 +269,7 @@ impl Lobe {
     #[inline]
     #[must_use]
     pub fn eval<R: Real>(&self, t: R) -> R {
-        let zero = R::from_f64(0.0);
-        if t > zero {
-            self.eval_unit(t.min(R::from_f64(1.0)))
-        } else {
-            zero
-        }
+        with_shared_rules(t, |unit| self.eval_unit(unit))
     }
 
     /// The model's own formula, for `t` in `(0, 1]` (what [`Lobe::expression`] records).
@@ -313,20 +316,7 @@ impl Lobe {
     /// the preparation computes it; `None` where specula prepares it numerically (a fit),
     /// so that a target cannot derive it from `n`.
     pub fn preparation<R: Real>(&self, name: &str, n: R) -> Option<R> {
-        match (&self.model, name) {
-            (Model::AngleQuadratic(_), _) => None,
-            (Model::Formula(m), _) => m.preparation(name, n),
-            (_, "n") => Some(n),
-            (Model::CosQuad(m), "slope") => Some(CosQuad::slope_for(n, m.squarings() as u8)),
-            (Model::Sg(_), "rate") => {
-                let offset = match self.kind {
-                    LobeKind::SgKaris => KARIS_OFFSET,
-                    _ => 0.0,
-                };
-                Some(sg::Sg::rate_for(n, offset))
-            }
-            _ => None,
-        }
+        each_model!(&self.model, m => m.lobe_preparation(name, n))
     }
 
     /// The exponents whose lobes share this one's recorded operations (only the named

@@ -14,14 +14,14 @@
 //!   `t = (1 - u)^(1/(n+1))`, the classic Phong warp.
 //! - **Source**: B. T. Phong (1975); J. F. Blinn (1977); the thesis's reference function.
 
-use super::batch::{clamp_unit, LobeKernel, CLAMP};
-use super::draw_batch::remaining_share;
+use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
+use super::draw_batch::{self, remaining_share};
 use super::facts::closed_form_facts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
 use crate::simd::math::{exp2, log2, EXP2, LOG2};
 use crate::simd::tally::{Class, Instructions};
-use crate::simd::{Kernel, Lanes};
+use crate::simd::{Kernel, Lanes, Level};
 use crate::Exponent;
 
 /// The registry's entry for this lobe.
@@ -123,3 +123,20 @@ impl LobeKernel for PowKernel {
 
 // Sampled in closed form: the tail and its inverse exactly.
 closed_form_facts!(Pow);
+
+/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+impl ModelBatch for Pow {
+    fn draw_batch(&self, level: Level, us: &[f32], out: &mut [f32]) -> bool {
+        draw_batch::run(level, self.draw_kernel(), us, out);
+        true
+    }
+
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        f.call(self.kernel())
+    }
+
+    fn batch_ulp_bound(&self, n: f64) -> f64 {
+        // exp2(n log2 t): log2's error is multiplied by n.
+        8.0 + 2.0 * n
+    }
+}

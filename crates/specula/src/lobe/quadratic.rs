@@ -12,7 +12,7 @@
 //! safeguarded Newton solves it from the Gaussian guess `g = sqrt(2 u L / C)`. A fit that
 //! overshoots 1 (clamped, so no longer the quadratic) is sampled from a table instead.
 
-use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::invert::{solve_increasing, Inverted, NewtonStart};
 use super::NewtonForm;
@@ -244,6 +244,11 @@ impl ModelFacts for AngleQuadratic {
         Some(*self)
     }
 
+    /// Its coefficients are fitted per `n`: none follows from `n` in closed form.
+    fn lobe_preparation<R: Real>(&self, _name: &str, _n: R) -> Option<R> {
+        None
+    }
+
     fn lobe_tail(&self, t: f64) -> Option<f64> {
         self.has_closed_form_tail().then(|| self.tail(t))
     }
@@ -274,6 +279,18 @@ impl ModelFacts for AngleQuadratic {
 
     fn lobe_structural_range(&self, n: f64) -> [f64; 2] {
         [n, n]
+    }
+}
+
+/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+impl ModelBatch for AngleQuadratic {
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        f.call(self.kernel())
+    }
+
+    fn batch_ulp_bound(&self, n: f64) -> f64 {
+        // acos within 2.5e-7 rad, times the quadratic's slope (at most ~2n^(1/2) per rad).
+        16.0 + 8.0 * n.sqrt()
     }
 }
 

@@ -19,7 +19,7 @@
 //!   near-peak guess `d = expm1(c u L) / c`.
 //! - **Source**: C. Schlick, "A customizable reflectance model for everyday rendering" (1993).
 
-use super::batch::{clamp_unit, LobeKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use super::invert::{solve_increasing, Inverted, NewtonStart};
@@ -181,5 +181,17 @@ impl ModelFacts for Schlick {
             upper: one,
             total: self.tail_from_peak(one),
         })
+    }
+}
+
+/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+impl ModelBatch for Schlick {
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        f.call(self.kernel())
+    }
+
+    fn batch_ulp_bound(&self, _n: f64) -> f64 {
+        // One fused rounding in the denominator: a few ULP of the value.
+        4.0
     }
 }

@@ -24,6 +24,7 @@
 //!   (`sampling::CosineDistribution`) is exact enough and cheaper to trust.
 //! - **Source**: the thesis, slide "Modified Schlick BRDF".
 
+use super::batch::{with_squarings, ModelBatch, WithKernel};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use super::schlick::schlick_denominator_ratio;
@@ -121,6 +122,18 @@ impl ModelFacts for SchlickMod {
 /// Where the squarings change: one more at every power of two from 8 on, the last (7) from
 /// 512 to `Exponent::MAX`.
 const SHAPE_EXPONENTS: [f64; 8] = [1.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0];
+
+/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+impl ModelBatch for SchlickMod {
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        with_squarings!(self.squarings(), K => f.call(self.kernel::<K>()))
+    }
+
+    fn batch_ulp_bound(&self, _n: f64) -> f64 {
+        // One fused rounding in the denominator, as Schlick's: a few ULP of the value.
+        4.0
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -21,14 +21,14 @@
 //!   Fresnel" (2012); the Gaussian form of the Phong lobe behind real-time engines' cheap
 //!   specular.
 
-use super::batch::{clamp_unit, LobeKernel, CLAMP};
-use super::draw_batch::remaining_share;
+use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
+use super::draw_batch::{self, remaining_share};
 use super::facts::closed_form_facts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
 use crate::simd::math::{exp2, log2, EXP2};
 use crate::simd::tally::{Class, Instructions};
-use crate::simd::{Kernel, Lanes};
+use crate::simd::{Kernel, Lanes, Level};
 use crate::Exponent;
 
 /// The registry's entry for this lobe.
@@ -51,6 +51,7 @@ pub(super) const STYLE: LineStyle = LineStyle {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sg {
     rate: f64,
+    offset: f64,
 }
 
 impl Sg {
@@ -58,6 +59,7 @@ impl Sg {
     pub(crate) fn new(n: Exponent, offset: f64) -> Self {
         Self {
             rate: Self::rate_for(n.get(), offset),
+            offset,
         }
     }
 
@@ -161,4 +163,30 @@ impl LobeKernel for SgKernel {
 }
 
 // Sampled in closed form: the tail and its inverse exactly.
-closed_form_facts!(Sg);
+closed_form_facts!(Sg, {
+    fn lobe_preparation<R: Real>(&self, name: &str, n: R) -> Option<R> {
+        match name {
+            "n" => Some(n),
+            "rate" => Some(Sg::rate_for(n, self.offset)),
+            _ => None,
+        }
+    }
+});
+
+/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+impl ModelBatch for Sg {
+    fn draw_batch(&self, level: Level, us: &[f32], out: &mut [f32]) -> bool {
+        draw_batch::run(level, self.draw_kernel(), us, out);
+        true
+    }
+
+    fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
+        f.call(self.kernel())
+    }
+
+    fn batch_ulp_bound(&self, _n: f64) -> f64 {
+        // One fused multiply-add against a rounded product, scaled by the value times its
+        // argument (at most 0.53), plus exp2's 2 ULP.
+        8.0
+    }
+}
