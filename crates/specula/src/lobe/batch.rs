@@ -10,7 +10,6 @@
 //! and by the polynomials standing in for `log2`, `exp2` and `acos`, within
 //! [`Lobe::batch_ulp_bound`] (tested at every level and for the plain loop).
 
-use super::facts::each_model;
 use super::{Lobe, Model};
 use crate::simd::tally::{Class, Instructions};
 use crate::simd::{dispatch, BatchLoop, Drive, Kernel, Lanes, Level};

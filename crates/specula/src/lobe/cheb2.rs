@@ -41,6 +41,9 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: false,
 };
 
-pub(crate) fn new(n: Exponent) -> AngleQuadratic {
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = AngleQuadratic;
+
+pub(super) fn prepare(n: Exponent) -> Prepared {
     AngleQuadratic::new(cached_angle_quadratic(AngleFit::Chebyshev3, n))
 }

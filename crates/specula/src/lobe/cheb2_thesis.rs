@@ -44,6 +44,9 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: true,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = AngleQuadratic;
+
 /// The slide's coefficients `[C, B, A]` for exponent `n`.
 #[must_use]
 pub fn thesis_coefficients(n: Exponent) -> [f64; 3] {
@@ -61,6 +64,6 @@ pub fn thesis_coefficients(n: Exponent) -> [f64; 3] {
     [1.0, b, a]
 }
 
-pub(crate) fn new(n: Exponent) -> AngleQuadratic {
+pub(super) fn prepare(n: Exponent) -> Prepared {
     AngleQuadratic::new(thesis_coefficients(n))
 }

@@ -48,6 +48,14 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: false,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = CosQuad;
+
+/// This lobe prepared for `n` and `v` squarings.
+pub(super) fn prepare(n: Exponent, v: u8) -> Prepared {
+    CosQuad::new(n, v)
+}
+
 /// The parameter `v` (`cosquad:v=5`).
 pub(super) const V_PARAM: ParamInfo = ParamInfo {
     name: "v",

@@ -7,7 +7,6 @@
 //! inverse (tested).
 
 use super::batch::ModelBatch;
-use super::facts::each_model;
 use super::{Lobe, Model};
 use crate::simd::{dispatch, BatchLoop, Drive, Kernel, Lanes, Level};
 

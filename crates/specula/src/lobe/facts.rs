@@ -2,14 +2,19 @@
 //! and how that tail is inverted, where its value has kinks, the exponents its recorded
 //! operations hold for. Each model's file implements [`ModelFacts`] for what it has; the
 //! defaults say "not this model", so a model states only its own facts and `Lobe` dispatches
-//! through [`each_model`], the one list of the models, with no catch-all arm anywhere.
+//! through `each_model!`, which the registry (`lobes!`) writes from its one list, with no
+//! catch-all arm anywhere.
 
 use super::invert::{Inverted, NewtonStart};
 use super::{AngleQuadratic, NewtonForm};
 use crate::{Exponent, Real};
 
-/// A model's facts; every method's default is the answer for a model without the fact.
+/// A model's facts; every method's default is the answer for a model without the fact, but
+/// the formula's, which every model states.
 pub(crate) trait ModelFacts {
+    /// The model's own formula at `t` in `(0, 1]` (what `Lobe::expression` records).
+    fn lobe_eval_unit<R: Real>(&self, t: R) -> R;
+
     /// The coefficients of a quadratic-in-angle lobe.
     fn lobe_angle_quadratic(&self) -> Option<AngleQuadratic> {
         None
@@ -70,28 +75,6 @@ pub(crate) trait ModelFacts {
     }
 }
 
-/// `$body` with `$m` bound to the prepared model, whichever it is: the one place that lists
-/// the models, so a model added to `Model` is a compile error here until it is listed.
-macro_rules! each_model {
-    ($model:expr, $m:ident => $body:expr) => {
-        match $model {
-            Model::Pow($m) => $body,
-            Model::Schlick($m) => $body,
-            Model::SchlickMod($m) => $body,
-            Model::AngleQuadratic($m) => $body,
-            Model::LogExp($m) => $body,
-            Model::LogExpRr($m) => $body,
-            Model::CosQuad($m) => $body,
-            Model::Sg($m) => $body,
-            Model::FastPow($m) => $body,
-            Model::FasterPow($m) => $body,
-            Model::Formula($m) => $body,
-        }
-    };
-}
-
-pub(crate) use each_model;
-
 /// The facts of a model sampled in closed form, from its own `tail`, `tail_inverse` and
 /// `total`: the tail, its exact inverse, and both over any `Real` for a target that samples;
 /// the model's other facts follow in braces.
@@ -101,6 +84,11 @@ macro_rules! closed_form_facts {
     };
     ($model:ty, { $($other:item)* }) => {
         impl super::facts::ModelFacts for $model {
+            #[inline]
+            fn lobe_eval_unit<R: Real>(&self, t: R) -> R {
+                self.eval(t)
+            }
+
             $($other)*
 
             fn lobe_tail(&self, t: f64) -> Option<f64> {

@@ -49,6 +49,14 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: true,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = FasterPow;
+
+/// This lobe prepared for `n`.
+pub(super) fn prepare(n: Exponent) -> Prepared {
+    FasterPow::new(n)
+}
+
 /// fastapprox's offset between the bit pattern and `log2`, on both sides.
 const OFFSET: f64 = 126.942_695_04;
 
@@ -122,6 +130,11 @@ impl LobeKernel for FasterPowKernel {
 
 /// Kinked where its bit trick crosses a binade or an integer.
 impl ModelFacts for FasterPow {
+    #[inline]
+    fn lobe_eval_unit<R: Real>(&self, t: R) -> R {
+        self.eval(t)
+    }
+
     fn lobe_kinks(&self) -> Vec<f64> {
         self.kinks()
     }

@@ -56,6 +56,14 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: false,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = FastPow;
+
+/// This lobe prepared for `n`.
+pub(super) fn prepare(n: Exponent) -> Prepared {
+    FastPow::new(n)
+}
+
 // fastapprox's `fastlog2` correction, `A + B m - D / (C + m)`, as one fraction whose numerator
 // `(A + B m)(C + m) - D` is expanded around `m = 1`, where it nearly vanishes: with `u = m - 1`
 // (exact) it is `N0 + u (N1 + B u)`, and the cancellation happens once, here, in `f64`.
@@ -202,6 +210,11 @@ impl LobeKernel for FastPowKernel {
 
 /// Kinked where its bit trick crosses a binade or an integer.
 impl ModelFacts for FastPow {
+    #[inline]
+    fn lobe_eval_unit<R: Real>(&self, t: R) -> R {
+        self.eval(t)
+    }
+
     fn lobe_kinks(&self) -> Vec<f64> {
         self.kinks()
     }

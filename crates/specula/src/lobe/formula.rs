@@ -181,6 +181,11 @@ impl LobeKernel for FormulaKernel {
 /// A user's lobe states what its formula has: a tail and its Newton form where the formula
 /// integrates in closed form.
 impl ModelFacts for FormulaLobe {
+    #[inline]
+    fn lobe_eval_unit<R: Real>(&self, t: R) -> R {
+        self.eval(t)
+    }
+
     fn lobe_tail(&self, t: f64) -> Option<f64> {
         self.tail(t)
     }

@@ -1,52 +1,12 @@
-//! The registry: every lobe specula knows, its id, description and parameters.
-//!
-//! [`LobeKind`] is the closed set of models; [`LobeInfo`] is what the CLI's `models` table, its
-//! help text, the id parser and the documentation read. Each lobe's entry and plot style live in
-//! its own file (`INFO`, `STYLE`, beside its formula and its `ModelFacts`); this file maps the
-//! variants to them, one line each, in matches without a catch-all arm, so the compiler points
-//! at every line a new variant needs.
+//! What the registry's `LobeKind` does beyond the list (`lobes!` in `lobe/mod.rs` makes the
+//! variants, `ALL`, entries and styles from each lobe's file): ids and their parsing, the
+//! kinds a parameter's values make, the user's lobes' colours.
 
 use serde::{Serialize, Serializer};
 
-use super::info::{LineStyle, LobeInfo, ParamInfo};
-use super::CosQuad;
+use super::info::{LineStyle, ParamInfo};
+use super::LobeKind;
 use crate::error::{Error, Result};
-
-/// Which lobe function, with its structural parameters (but not `n`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum LobeKind {
-    /// `t^n`, the reference.
-    Pow,
-    /// Schlick's rational approximation.
-    Schlick,
-    /// The thesis's modified Schlick lobe.
-    SchlickMod,
-    /// The thesis's quadratic in the angle, with the slide's coefficient formulas.
-    Cheb2Thesis,
-    /// The thesis's Chebyshev method applied per `n` over the epicentre.
-    Cheb2,
-    /// The minimax relative-error quadratic in the angle over the epicentre.
-    Minimax2,
-    /// The thesis's log/exp lobe.
-    LogExp,
-    /// The log/exp lobe with range reduction.
-    LogExpRr,
-    /// The thesis's cosine-quadratic lobe with `v` squarings (`K_v`).
-    CosQuad {
-        /// Number of squarings, `0..=10`.
-        v: u8,
-    },
-    /// The spherical Gaussian `exp(n (t - 1))`.
-    Sg,
-    /// The spherical Gaussian with the rate `n + 0.775`.
-    SgKaris,
-    /// The IEEE bit-trick power with fastapprox's rational corrections.
-    FastPow,
-    /// The IEEE bit-trick power without corrections (Schraudolph).
-    FasterPow,
-    /// A lobe of the user's, written as a formula ([`crate::formula`]).
-    Formula(FormulaId),
-}
 
 /// A user's lobe: a formula and its parameter values, defined in this process
 /// ([`crate::formula::instance`]).
@@ -54,86 +14,6 @@ pub enum LobeKind {
 pub struct FormulaId(pub(crate) u32);
 
 impl LobeKind {
-    /// Every lobe, with default parameters, in the order tables list them.
-    pub const ALL: [LobeKind; 13] = [
-        LobeKind::Pow,
-        LobeKind::Schlick,
-        LobeKind::SchlickMod,
-        LobeKind::Cheb2Thesis,
-        LobeKind::Cheb2,
-        LobeKind::Minimax2,
-        LobeKind::LogExp,
-        LobeKind::LogExpRr,
-        LobeKind::CosQuad {
-            v: CosQuad::DEFAULT_V,
-        },
-        LobeKind::Sg,
-        LobeKind::SgKaris,
-        LobeKind::FastPow,
-        LobeKind::FasterPow,
-    ];
-
-    /// How every plot draws the lobe (the report's, the explorer's, the Python package's): a
-    /// colour of its own, from Kelly's set of maximum contrast and Tol's cyan (no two lobes,
-    /// a user's included, closer than 25 in CIELAB: tested), a family's variants dashed as
-    /// well, so that the families read apart even without colour vision.
-    #[must_use]
-    pub fn line_style(self) -> LineStyle {
-        match self {
-            LobeKind::Pow => super::pow::STYLE,
-            LobeKind::Schlick => super::schlick::STYLE,
-            LobeKind::SchlickMod => super::schlick_mod::STYLE,
-            LobeKind::Cheb2Thesis => super::cheb2_thesis::STYLE,
-            LobeKind::Cheb2 => super::cheb2::STYLE,
-            LobeKind::Minimax2 => super::minimax2::STYLE,
-            LobeKind::LogExp => super::logexp::STYLE,
-            LobeKind::LogExpRr => super::logexp_rr::STYLE,
-            LobeKind::CosQuad { .. } => super::cosquad::STYLE,
-            LobeKind::Sg => super::sg::STYLE,
-            LobeKind::SgKaris => super::sg_karis::STYLE,
-            LobeKind::FastPow => super::fastpow::STYLE,
-            LobeKind::FasterPow => super::fasterpow::STYLE,
-            // Six colours none of the built-ins has (Paul Tol's wine, indigo, teal and purple,
-            // a khaki and a dark teal), so a user's lobe never looks like a built-in one; the
-            // seventh user's lobe takes the first colour dashed.
-            LobeKind::Formula(FormulaId(id)) => {
-                const USER: [[u8; 3]; 6] = [
-                    [136, 34, 85],
-                    [51, 34, 136],
-                    [68, 170, 153],
-                    [107, 107, 0],
-                    [0, 95, 95],
-                    [170, 68, 153],
-                ];
-                LineStyle {
-                    rgb: USER[id as usize % 6],
-                    dashed: (id / 6) % 2 == 1,
-                }
-            }
-        }
-    }
-
-    /// The registry entry.
-    #[must_use]
-    pub fn info(self) -> &'static LobeInfo {
-        match self {
-            LobeKind::Formula(id) => crate::formula::registry::get(id).info(),
-            LobeKind::Pow => &super::pow::INFO,
-            LobeKind::Schlick => &super::schlick::INFO,
-            LobeKind::SchlickMod => &super::schlick_mod::INFO,
-            LobeKind::Cheb2Thesis => &super::cheb2_thesis::INFO,
-            LobeKind::Cheb2 => &super::cheb2::INFO,
-            LobeKind::Minimax2 => &super::minimax2::INFO,
-            LobeKind::LogExp => &super::logexp::INFO,
-            LobeKind::LogExpRr => &super::logexp_rr::INFO,
-            LobeKind::CosQuad { .. } => &super::cosquad::INFO,
-            LobeKind::Sg => &super::sg::INFO,
-            LobeKind::SgKaris => &super::sg_karis::INFO,
-            LobeKind::FastPow => &super::fastpow::INFO,
-            LobeKind::FasterPow => &super::fasterpow::INFO,
-        }
-    }
-
     /// The id without parameters, e.g. `cosquad`.
     #[must_use]
     pub fn id(self) -> &'static str {
@@ -235,21 +115,14 @@ impl LobeKind {
                     ),
                 }
             })?;
-        match (kind, params) {
-            (_, None) => Ok(kind),
-            (LobeKind::CosQuad { .. }, Some(params)) => {
-                let v = parse_param(kind.id(), &super::cosquad::V_PARAM, params)?;
-                Ok(LobeKind::CosQuad { v: v as u8 })
-            }
-            (_, Some(params)) => Err(Error::InvalidLobeParameter {
-                lobe: kind.id(),
-                message: format!("'{params}' given, but this lobe takes no parameters besides n"),
-            }),
+        match params {
+            None => Ok(kind),
+            Some(params) => kind.with_parameter(params),
         }
     }
 }
 
-fn parse_param(lobe: &'static str, param: &ParamInfo, text: &str) -> Result<u32> {
+pub(super) fn parse_param(lobe: &'static str, param: &ParamInfo, text: &str) -> Result<u32> {
     let invalid = |message: String| Error::InvalidLobeParameter { lobe, message };
     let (name, value) = text
         .split_once('=')
@@ -276,15 +149,32 @@ fn parse_param(lobe: &'static str, param: &ParamInfo, text: &str) -> Result<u32>
 impl core::fmt::Display for LobeKind {
     /// The id, with parameters only where they differ from the defaults.
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            LobeKind::CosQuad { v } if *v != CosQuad::DEFAULT_V => write!(f, "cosquad:v={v}"),
-            LobeKind::Formula(id) => {
+        match (self, self.built_in_text()) {
+            (LobeKind::Formula(id), _) => {
                 let instance = crate::formula::registry::get(*id);
                 f.write_str(instance.info().id)
                     .and_then(|()| write_values(f, instance))
             }
-            kind => f.write_str(kind.id()),
+            (_, text) => f.write_str(&text.unwrap_or_default()),
         }
+    }
+}
+
+/// A user's lobe's line: six colours none of the built-ins has (Paul Tol's wine, indigo, teal
+/// and purple, a khaki and a dark teal), so a user's lobe never looks like a built-in one; the
+/// seventh user's lobe takes the first colour dashed.
+pub(super) fn user_line_style(FormulaId(id): FormulaId) -> LineStyle {
+    const USER: [[u8; 3]; 6] = [
+        [136, 34, 85],
+        [51, 34, 136],
+        [68, 170, 153],
+        [107, 107, 0],
+        [0, 95, 95],
+        [170, 68, 153],
+    ];
+    LineStyle {
+        rgb: USER[id as usize % 6],
+        dashed: (id / 6) % 2 == 1,
     }
 }
 

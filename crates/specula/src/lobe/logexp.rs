@@ -42,6 +42,14 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: false,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = LogExp;
+
+/// This lobe prepared for `n`.
+pub(super) fn prepare(n: Exponent) -> Prepared {
+    LogExp::new(n)
+}
+
 /// The prepared log/exp lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LogExp {
@@ -105,7 +113,12 @@ impl LobeKernel for LogExpKernel {
 }
 
 /// Sampled from a table: no closed-form tail, no kinks, one structure for every `n`.
-impl ModelFacts for LogExp {}
+impl ModelFacts for LogExp {
+    #[inline]
+    fn lobe_eval_unit<R: Real>(&self, t: R) -> R {
+        self.eval(t)
+    }
+}
 
 /// Its batch kernel and how far the batch may stray from the scalar `f32` path.
 impl ModelBatch for LogExp {

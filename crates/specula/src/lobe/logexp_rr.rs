@@ -43,6 +43,14 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: true,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = LogExpRr;
+
+/// This lobe prepared for `n`.
+pub(super) fn prepare(n: Exponent) -> Prepared {
+    LogExpRr::new(n)
+}
+
 /// The prepared range-reduced log/exp lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LogExpRr {
@@ -106,7 +114,12 @@ impl LobeKernel for LogExpRrKernel {
 }
 
 /// Sampled from a table: no closed-form tail, no kinks, one structure for every `n`.
-impl ModelFacts for LogExpRr {}
+impl ModelFacts for LogExpRr {
+    #[inline]
+    fn lobe_eval_unit<R: Real>(&self, t: R) -> R {
+        self.eval(t)
+    }
+}
 
 /// Its batch kernel and how far the batch may stray from the scalar `f32` path.
 impl ModelBatch for LogExpRr {

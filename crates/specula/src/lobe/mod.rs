@@ -11,38 +11,46 @@
 //! gives 0; `t > 1` is treated as 1 (dot products of unit vectors overshoot by an ulp); the
 //! value is never NaN, negative, or above 1.
 
+#[macro_use]
+mod registry;
+
+// The registry: a line per lobe, its file beside (`registry.rs` says what a line makes).
+lobes! { $
+    Pow => pow,
+    Schlick => schlick,
+    SchlickMod => schlick_mod,
+    Cheb2Thesis => cheb2_thesis,
+    Cheb2 => cheb2,
+    Minimax2 => minimax2,
+    LogExp => logexp,
+    LogExpRr => logexp_rr,
+    CosQuad { v: u8 = CosQuad::DEFAULT_V } => cosquad,
+    Sg => sg,
+    SgKaris => sg_karis,
+    FastPow => fastpow,
+    FasterPow => fasterpow,
+}
+
 mod batch;
-mod cheb2;
-mod cheb2_thesis;
-mod cosquad;
 mod draw_batch;
 mod facts;
-mod fasterpow;
-mod fastpow;
 mod formula;
 mod info;
 mod invert;
 mod kind;
-mod logexp;
-mod logexp_rr;
-mod minimax2;
-mod pow;
 mod quadratic;
-mod schlick;
-mod schlick_mod;
-mod sg;
-mod sg_karis;
 
 pub use cheb2_thesis::thesis_coefficients;
 pub use cosquad::CosQuad;
-use facts::{each_model, ModelFacts};
+use facts::ModelFacts;
 pub use info::{LineStyle, LobeInfo, Origin, ParamInfo};
 use invert::NewtonStart;
 pub use invert::{Inverted, F32_RESOLUTION, F64_RESOLUTION};
-pub use kind::{FormulaId, LobeKind};
+pub use kind::FormulaId;
 pub use quadratic::AngleQuadratic;
 pub use sg_karis::KARIS_OFFSET;
 
+use crate::error::{Error, Result};
 use crate::ops::{count_ops, Counted, OpCounts};
 use crate::real::Real;
 use crate::Exponent;
@@ -110,42 +118,11 @@ pub struct Lobe {
     model: Model,
 }
 
-/// The prepared state, one variant per distinct evaluation routine.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Model {
-    Pow(pow::Pow),
-    Schlick(schlick::Schlick),
-    SchlickMod(schlick_mod::SchlickMod),
-    AngleQuadratic(AngleQuadratic),
-    LogExp(logexp::LogExp),
-    LogExpRr(logexp_rr::LogExpRr),
-    CosQuad(CosQuad),
-    Sg(sg::Sg),
-    FastPow(fastpow::FastPow),
-    FasterPow(fasterpow::FasterPow),
-    Formula(formula::FormulaLobe),
-}
-
 impl Lobe {
     /// Prepares `kind` for exponent `n`.
     #[must_use]
     pub fn new(kind: LobeKind, n: Exponent) -> Self {
-        let model = match kind {
-            LobeKind::Pow => Model::Pow(pow::Pow::new(n)),
-            LobeKind::Schlick => Model::Schlick(schlick::Schlick::new(n)),
-            LobeKind::SchlickMod => Model::SchlickMod(schlick_mod::SchlickMod::new(n)),
-            LobeKind::Cheb2Thesis => Model::AngleQuadratic(cheb2_thesis::new(n)),
-            LobeKind::Cheb2 => Model::AngleQuadratic(cheb2::new(n)),
-            LobeKind::Minimax2 => Model::AngleQuadratic(minimax2::new(n)),
-            LobeKind::LogExp => Model::LogExp(logexp::LogExp::new(n)),
-            LobeKind::LogExpRr => Model::LogExpRr(logexp_rr::LogExpRr::new(n)),
-            LobeKind::CosQuad { v } => Model::CosQuad(CosQuad::new(n, v)),
-            LobeKind::Sg => Model::Sg(sg::Sg::new(n, 0.0)),
-            LobeKind::SgKaris => Model::Sg(sg_karis::new(n)),
-            LobeKind::FastPow => Model::FastPow(fastpow::FastPow::new(n)),
-            LobeKind::FasterPow => Model::FasterPow(fasterpow::FasterPow::new(n)),
-            LobeKind::Formula(id) => Model::Formula(formula::FormulaLobe::new(id, n)),
-        };
+        let model = prepare(kind, n);
         Self { kind, n, model }
     }
 
@@ -275,19 +252,7 @@ impl Lobe {
     /// The model's own formula, for `t` in `(0, 1]` (what [`Lobe::expression`] records).
     #[inline]
     pub(crate) fn eval_unit<R: Real>(&self, t: R) -> R {
-        match &self.model {
-            Model::Pow(m) => m.eval(t),
-            Model::Schlick(m) => m.eval(t),
-            Model::SchlickMod(m) => m.eval(t),
-            Model::AngleQuadratic(m) => m.eval_angle(t.acos()),
-            Model::LogExp(m) => m.eval(t),
-            Model::LogExpRr(m) => m.eval(t),
-            Model::CosQuad(m) => m.eval(t),
-            Model::Sg(m) => m.eval(t),
-            Model::FastPow(m) => m.eval(t),
-            Model::FasterPow(m) => m.eval(t),
-            Model::Formula(m) => m.eval(t),
-        }
+        each_model!(&self.model, m => m.lobe_eval_unit(t))
     }
 
     /// The lobe at angle `g` (radians) from its axis. Lobes whose native input is the angle

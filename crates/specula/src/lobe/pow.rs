@@ -40,6 +40,14 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: false,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = Pow;
+
+/// This lobe prepared for `n`.
+pub(super) fn prepare(n: Exponent) -> Prepared {
+    Pow::new(n)
+}
+
 /// The prepared reference lobe `t^n`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pow {

@@ -240,6 +240,11 @@ impl LobeKernel for AngleQuadraticKernel {
 /// Native in the angle; sampled by Newton in the angle where its tail has a closed form; its
 /// fitted constants follow no `n` but its own.
 impl ModelFacts for AngleQuadratic {
+    #[inline]
+    fn lobe_eval_unit<R: Real>(&self, t: R) -> R {
+        self.eval_angle(t.acos())
+    }
+
     fn lobe_angle_quadratic(&self) -> Option<AngleQuadratic> {
         Some(*self)
     }

@@ -45,6 +45,14 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: false,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = Schlick;
+
+/// This lobe prepared for `n`.
+pub(super) fn prepare(n: Exponent) -> Prepared {
+    Schlick::new(n)
+}
+
 /// The prepared Schlick lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Schlick {
@@ -164,6 +172,11 @@ impl<const SQUARINGS: u32> LobeKernel for SchlickKernel<SQUARINGS> {
 
 /// Sampled by Newton on its closed-form tail, in `d = 1 - t`.
 impl ModelFacts for Schlick {
+    #[inline]
+    fn lobe_eval_unit<R: Real>(&self, t: R) -> R {
+        self.eval(t)
+    }
+
     fn lobe_tail(&self, t: f64) -> Option<f64> {
         Some(self.tail(t))
     }

@@ -48,6 +48,14 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: true,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = SchlickMod;
+
+/// This lobe prepared for `n`.
+pub(super) fn prepare(n: Exponent) -> Prepared {
+    SchlickMod::new(n)
+}
+
 /// The prepared modified Schlick lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SchlickMod {
@@ -98,6 +106,11 @@ impl SchlickMod {
 
 /// Its squarings change at every power of two of `n` from 8 on.
 impl ModelFacts for SchlickMod {
+    #[inline]
+    fn lobe_eval_unit<R: Real>(&self, t: R) -> R {
+        self.eval(t)
+    }
+
     fn lobe_structural_range(&self, _n: f64) -> [f64; 2] {
         let squarings = self.squarings();
         let low = if squarings == 0 {

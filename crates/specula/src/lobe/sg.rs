@@ -47,6 +47,14 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: false,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = Sg;
+
+/// This lobe prepared for `n`.
+pub(super) fn prepare(n: Exponent) -> Prepared {
+    Sg::new(n, 0.0)
+}
+
 /// A prepared spherical Gaussian `exp2(rate (t - 1))`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sg {

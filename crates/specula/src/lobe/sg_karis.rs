@@ -41,9 +41,12 @@ pub(super) const STYLE: LineStyle = LineStyle {
     dashed: true,
 };
 
+/// What this lobe prepares (its `Model` variant holds it).
+pub(super) type Prepared = Sg;
+
 /// The published offset added to `n`.
 pub const KARIS_OFFSET: f64 = 0.775;
 
-pub(crate) fn new(n: Exponent) -> Sg {
+pub(super) fn prepare(n: Exponent) -> Prepared {
     Sg::new(n, KARIS_OFFSET)
 }
