@@ -176,9 +176,8 @@ fn library(keep: impl Fn(ShapeKey) -> bool) -> String {
         let body = if kind_shapes.len() == 1 {
             format!("    return {name}_shape0(lobe.parameters, t);\n")
         } else {
-            format!(
-                "    switch lobe.shape {{\n{shape_cases}        default: {{ return 0.0; }}\n    }}\n"
-            )
+            let default = "        default: { return 0.0; }\n";
+            format!("    switch lobe.shape {{\n{shape_cases}{default}    }}\n")
         };
         let _ = write!(
             out,

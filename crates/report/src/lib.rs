@@ -12,6 +12,8 @@
 mod comparison;
 mod designed;
 mod energy;
+#[cfg(all(test, feature = "example-lobe"))]
+mod example_lobe;
 pub mod format;
 mod hardware;
 mod html;

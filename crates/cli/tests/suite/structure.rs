@@ -1,8 +1,10 @@
 //! The sources' shape: every line of Rust within the formatter's width (`max_width` in
 //! rustfmt.toml), which rustfmt itself leaves unchecked inside string literals, comments and
-//! macros.
+//! macros; and a lobe as its file and one registry line, proven by the registry's worked
+//! example.
 
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -47,5 +49,79 @@ fn every_line_is_within_the_formatters_width() {
         over.is_empty(),
         "lines over {width} characters:\n{}",
         over.join("\n")
+    );
+}
+
+/// A lobe is its file and one line of the registry: the worked example
+/// (`crates/specula/src/lobe/example.rs`, behind the `example-lobe` feature) is named by
+/// one line of `lobes!` and by no other source of the library crates, and with the feature
+/// on, `crates/report/src/example_lobe.rs` finds it in the analysis, the batch path, the GPU's
+/// library and evaluation, every export and the report's tables. That module runs here, in a
+/// build of the report with the feature (cargo has released the target folder's lock by
+/// the time tests run; the crates the feature does not touch are this build's).
+#[test]
+fn a_lobe_is_its_file_and_one_registry_line() {
+    let registry = std::fs::read_to_string(root().join("crates/specula/src/lobe/mod.rs")).unwrap();
+    let naming: Vec<&str> = registry
+        .lines()
+        .filter(|line| line.contains("example"))
+        .collect();
+    assert_eq!(
+        naming,
+        ["    #[cfg(feature = \"example-lobe\")] Example => example,"],
+        "the registry's line for the example"
+    );
+    let mut files = Vec::new();
+    for library in [
+        "specula", "gpu", "targets", "render", "report", "decide", "hw",
+    ] {
+        rust_files(&root().join("crates").join(library).join("src"), &mut files);
+    }
+    let mentions: Vec<String> = files
+        .iter()
+        .filter(|file| {
+            !file.ends_with("lobe/example.rs")
+                && !file.ends_with("lobe/mod.rs")
+                && !file.ends_with("report/src/example_lobe.rs")
+        })
+        .filter(|file| {
+            let text = std::fs::read_to_string(file).unwrap();
+            [
+                "LobeKind::Example",
+                "example::",
+                "lobe_example",
+                "\"example\"",
+            ]
+            .iter()
+            .any(|name| text.contains(name))
+        })
+        .map(|file| file.display().to_string())
+        .collect();
+    assert!(
+        mentions.is_empty(),
+        "the example lobe named in {mentions:?}"
+    );
+    let output = Command::new(env!("CARGO"))
+        .current_dir(root())
+        .args([
+            "test",
+            "--locked",
+            "-p",
+            "specula-report",
+            "--features",
+            "example-lobe",
+        ])
+        .args(["--lib", "example_lobe"])
+        .output()
+        .expect("cargo runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(output.status.success(), "the example lobe's tests:\n{text}");
+    assert!(
+        text.contains("test result: ok. 6 passed"),
+        "the example lobe's six tests ran:\n{text}"
     );
 }

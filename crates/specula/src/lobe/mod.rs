@@ -29,6 +29,7 @@ lobes! { $
     SgKaris => sg_karis,
     FastPow => fastpow,
     FasterPow => fasterpow,
+    #[cfg(feature = "example-lobe")] Example => example,
 }
 
 mod batch;

@@ -22,7 +22,7 @@ macro_rules! lobes {
         pub enum LobeKind {
             $(
                 $(#[$attr])*
-                #[doc = concat!("The lobe of `lobe/", stringify!($module), ".rs` (its manual page).")]
+                #[doc = concat!("The lobe of `lobe/", stringify!($module), ".rs`, its manual.")]
                 $variant $({
                     #[doc = concat!("The `", stringify!($field), "` of its `INFO.params`.")]
                     $field: $field_type
