@@ -9,7 +9,7 @@ use specula::{Brdf, ClassicModel, Exponent, Geometry, Lobe, LobeKind, Normalisat
 use super::html::{paragraph, table};
 use super::plot::{Chart, Series, SEQUENCE};
 use super::sections::{exponents, series};
-use super::Context;
+use super::{prose, Context};
 use crate::format::sig;
 
 pub fn energy(context: &mut Context) -> Result<String, String> {
@@ -179,22 +179,19 @@ pub fn reciprocity(context: &mut Context) -> Result<String, String> {
             row
         })
         .collect();
-    Ok(paragraph(&format!(
-        "White furnace: the largest directional albedo of the lobe-normalised \
-        BRDF (kd = 0, ks = 1, Phong geometry) over all outgoing angles; at most 1 conserves \
-        energy. Reciprocity: the largest |f(wo, wi) - f(wi, wo)| over {pairs} random direction \
-        pairs at n = 64 (Phong and Blinn), and the same for the BRDF the classic model implies (kd \
-        + ks lobe / cos theta_i)."
-    )) + &table(
-        &[
-            "lobe",
-            "max albedo n = 8",
-            "n = 64",
-            "n = 512",
-            "reciprocity error",
-            "classic model's \
+    Ok(
+        paragraph(&prose::fill(prose::WHITE_FURNACE, &[("pairs", &pairs)])?)
+            + &table(
+                &[
+                    "lobe",
+                    "max albedo n = 8",
+                    "n = 64",
+                    "n = 512",
+                    "reciprocity error",
+                    "classic model's \
             implied BRDF",
-        ],
-        &rows,
-    ))
+                ],
+                &rows,
+            ),
+    )
 }

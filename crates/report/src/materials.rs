@@ -41,13 +41,6 @@ const POLAR_HEADROOM: f64 = 1.25;
 /// GGX's colour in the polar plots: a grey lighter than fastpow's, drawn dash-dot.
 const GGX_GREY: plotters::style::RGBColor = plotters::style::RGBColor(150, 150, 150);
 
-/// How to get the section, shown without `--materials`.
-const HOW_TO: &str = "Not computed: run specula report --materials DIR, with DIR holding measured \
-    materials as the RGL database's isotropic RGB .bsdf files (the '_rgb.bsdf' ones; for example \
-    the five specula carries in data/rgl), to see each fitted with every lobe and GGX: the verdict \
-    on which lobe to ship, the fits' errors, polar plots of the measurement against the fits and \
-    renders under the sky scored by FLIP.";
-
 /// The `.bsdf` files in `directory` sorted by name, at most [`MAX_MATERIALS`], and how many
 /// more there were.
 pub(crate) fn material_files(directory: &Path) -> Result<(Vec<PathBuf>, usize), String> {
@@ -103,7 +96,7 @@ fn file_safe(name: &str) -> String {
 /// `--materials`, how to get it.
 pub fn materials(context: &mut Context) -> Result<String, String> {
     let Some(directory) = context.materials.clone() else {
-        return Ok(paragraph(HOW_TO));
+        return Ok(paragraph(&prose::fill(prose::MATERIALS_HOW_TO, &[])?));
     };
     let (files, more) = material_files(&directory)?;
     let yours = context.yours();
@@ -342,15 +335,14 @@ fn polar(
         .collect();
     Ok(figure(
         &file,
-        &format!(
-            "{name} in the plane of incidence, viewed from {} (dotted line; the mirror direction \
-                is opposite): the radius is the cube root of the luminance of f cos theta_i, the \
-                quantity (per channel) that the fit error E compares. Measured: broad black; each \
-                lobe's one-n fit in its better geometry in the lobe's own line style; GGX (one \
-                alpha): grey dash-dot. Curves beyond {POLAR_HEADROOM} times the measurement's \
-                largest radius are clipped at the rim.",
-            angles.join(", ")
-        ),
+        &prose::fill(
+            prose::MATERIAL_POLAR,
+            &[
+                ("name", &name),
+                ("angles", &angles.join(", ")),
+                ("headroom", &POLAR_HEADROOM),
+            ],
+        )?,
     ))
 }
 

@@ -29,6 +29,16 @@ pub(crate) const DESIGNED: &str = include_str!("prose/designed.txt");
 pub(crate) const FPGA_ROWS: &str = include_str!("prose/fpga-rows.txt");
 /// How the lobes reach other renderers.
 pub(crate) const OTHER_RENDERERS: &str = include_str!("prose/other-renderers.txt");
+/// What the white furnace and reciprocity columns measure.
+pub(crate) const WHITE_FURNACE: &str = include_str!("prose/white-furnace.txt");
+/// How to add the measured materials' section.
+pub(crate) const MATERIALS_HOW_TO: &str = include_str!("prose/materials-how-to.txt");
+/// A measured material's polar plot.
+pub(crate) const MATERIAL_POLAR: &str = include_str!("prose/material-polar.txt");
+/// How cost is stated.
+pub(crate) const COST: &str = include_str!("prose/cost.txt");
+/// What the gradient's error does to each lobe.
+pub(crate) const GRADIENT_ERROR: &str = include_str!("prose/gradient-error.txt");
 
 /// `template` as one paragraph (its lines joined by spaces), each `{name}` replaced by the
 /// figure given for `name`; an error for a placeholder without a figure or a figure without

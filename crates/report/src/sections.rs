@@ -10,7 +10,7 @@ use specula_synth::OnMiss;
 
 use super::html::{escape, multiples, paragraph, table};
 use super::plot::{Chart, Series, SEQUENCE};
-use super::{Context, RealScanSizes, Sizes};
+use super::{prose, Context, RealScanSizes, Sizes};
 use crate::format::sig;
 
 /// Chooses one figure.
@@ -445,14 +445,7 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
         "AMD RDNA: x pow's throughput (evals/clock/CU, modelled)",
         "SIMD instructions per 8 lanes (counted from the kernel)",
     ];
-    let mut html = paragraph(
-        "Cost as everywhere in this report: throughput as a multiple of pow's, higher is \
-         better. On the CPU, pow's instructions over the lobe's, as its explicit SIMD kernel \
-         executes them per vector, read off the kernel (a test holds the count to what it runs; \
-         the last column lists them); not a guess of operation weights. On the GPUs, the cost \
-         model's bound for the lobe's exported shader over pow's (its rate beside it; see Which \
-         lobe when).",
-    );
+    let mut html = paragraph(&prose::fill(prose::COST, &[])?);
     if let Some(measured) = &measured {
         header.extend([
             "G evaluations/s (one thread, L1)",

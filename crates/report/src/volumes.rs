@@ -273,15 +273,16 @@ fn marschner_lobb_errors(lobes: &[LobeKind]) -> Result<String, String> {
         let lobe_error = rms(&|e, _| specular(e, &lobe) - specular(e, &pow.lobe));
         rows.push(vec![kind.to_string(), sig(gradient_error), sig(lobe_error)]);
     }
-    let mut html = paragraph(&format!(
-        "Marschner-Lobb at {SIDE}³: over {} cell centres, the normals from central differences of \
-            the trilinear field are off the analytic gradient's by {mean_angle:.2}° on average and \
-            {max_angle:.1}° at worst. Below, the RMS error in each lobe's value (peak 1, n = \
-            {EXPONENT}, Blinn, the coronal view's eye and light) caused by those normals, beside \
-            the RMS of the lobe against pow at the exact normals: where the first column is the \
-            larger, the gradient estimate, not the lobe, limits the shading.",
-        angles.len()
-    ));
+    let mut html = paragraph(&prose::fill(
+        prose::GRADIENT_ERROR,
+        &[
+            ("side", &SIDE),
+            ("cells", &angles.len()),
+            ("mean_angle", &format!("{mean_angle:.2}")),
+            ("max_angle", &format!("{max_angle:.1}")),
+            ("exponent", &EXPONENT),
+        ],
+    )?);
     html += &table(
         &[
             "lobe",
