@@ -1,18 +1,10 @@
-//! The compute shader against the core's `f64` reference, lobe by lobe, within bounds stated
-//! in ULPs of 1.0 (`2^-23`) and derived from how each formula amplifies rounding:
-//! - exact IEEE operations only (`schlick`, `schlick-mod`): 32 ULP, as the CPU `f32` path;
-//! - through `log2` (`pow` is `exp2(n log2 t)`, `logexp`, `logexp-rr`): the error of `log2 t`
-//!   is multiplied by `n`, so `32 + 2 n` ULP;
-//! - `cosquad`: the base's rounding is doubled by each of `v` squarings and its slope grows
-//!   with `n`: `(32 + n / 2) 2^(v-4)` ULP;
-//! - `sg`, `sg-karis`: one `exp2` of a product; the error is the product's rounding times
-//!   the value times its argument (at most 0.53), plus the driver's `exp2`: 64 ULP;
-//! - the bit tricks (`fastpow`, `fasterpow`): the `f32` log's rounding times `n`, plus the
-//!   result's bit-pattern grid (`2^-17` relative, 64 ULP) against the exact `f64` model:
-//!   `128 + 4 n` ULP;
-//! - through `acos` (`cheb2-thesis`, `cheb2`, `minimax2`): the driver's `acos` is an
-//!   approximation (lavapipe's is good to about `2e-4` rad near the peak), so 8192 ULP
-//!   (about `1e-3`).
+//! The compute shader against the core's `f64` reference, lobe by lobe, within the bound each
+//! model states for a GPU (`Lobe::gpu_ulp_bound`, in ULPs of 1.0, `2^-23`), derived in the
+//! model's file from how its formula amplifies rounding: 32 ULP for exact IEEE operations
+//! (`schlick`, `schlick-mod`), `32 + 2n` through `log2` (`pow`, `logexp`, `logexp-rr`),
+//! `(32 + n / 2) 2^(v-4)` for `cosquad`'s `v` squarings, 64 for one `exp2` (`sg`,
+//! `sg-karis`), `128 + 4n` for the bit tricks against their exact `f64` models, 8192 through a
+//! driver's `acos` (the quadratics in the angle).
 //!
 //! Set on llvmpipe (LLVM 15.0.6, 256 bits), Mesa 22.3.6, where the measured maxima are about
 //! half these bounds; docs/gpu.md lists them.
@@ -23,20 +15,6 @@ use specula::{Exponent, Lobe, LobeKind};
 use specula_gpu::LobeEvaluator;
 
 const ULP: f64 = 1.0 / (1u32 << 23) as f64;
-
-fn bound_in_ulps(kind: LobeKind, n: f64) -> f64 {
-    match kind {
-        LobeKind::Schlick | LobeKind::SchlickMod => 32.0,
-        LobeKind::Pow | LobeKind::LogExp | LobeKind::LogExpRr => 32.0 + 2.0 * n,
-        LobeKind::CosQuad { v } => (32.0 + n / 2.0) * 2f64.powi(i32::from(v) - 4).max(1.0),
-        LobeKind::Cheb2Thesis | LobeKind::Cheb2 | LobeKind::Minimax2 => 8192.0,
-        LobeKind::Sg | LobeKind::SgKaris => 64.0,
-        LobeKind::FastPow | LobeKind::FasterPow => 128.0 + 4.0 * n,
-        // The user lobes of the test below: a power of a base and an exponential, whose
-        // errors grow with n as the built-in ones'.
-        LobeKind::Formula(_) => 64.0 + 2.0 * n,
-    }
-}
 
 /// Cosines crowded towards the peak, where the lobes live, plus the edge cases.
 fn cosines() -> Vec<f32> {
@@ -70,7 +48,7 @@ fn every_lobe_on_the_gpu_matches_f64_within_its_bound() {
         ] {
             let lobe = Lobe::new(kind, Exponent::new(n));
             let values = evaluator.eval(&lobe, &ts).unwrap();
-            let bound = bound_in_ulps(kind, n) * ULP;
+            let bound = lobe.gpu_ulp_bound() * ULP;
             for (&t, &value) in ts.iter().zip(&values) {
                 let reference = lobe.eval(f64::from(t));
                 let error = (f64::from(value) - reference).abs();
@@ -112,7 +90,7 @@ fn user_lobes_on_the_gpu_match_f64() {
         for n in [1.0, 7.3, 64.0, 1000.0] {
             let lobe = Lobe::new(kind, Exponent::new(n));
             let values = evaluator.eval(&lobe, &ts).unwrap();
-            let bound = bound_in_ulps(kind, n) * ULP;
+            let bound = lobe.gpu_ulp_bound() * ULP;
             for (&t, &value) in ts.iter().zip(&values) {
                 let reference = lobe.eval(f64::from(t));
                 assert!(

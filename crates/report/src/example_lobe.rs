@@ -92,8 +92,8 @@ fn the_batch_path_runs_its_kernel() {
     }
 }
 
-/// The GPU's library has its generated function, and the GPU computes it within 64 ULP of
-/// the closed form (Schlick's 32, squared).
+/// The GPU's library has its generated function, and the GPU computes it within the bound
+/// the lobe states (64 ULP: Schlick's 32, squared).
 #[test]
 fn the_gpu_library_holds_and_evaluates_it() {
     assert!(specula_gpu::wgsl::lobes().contains("fn lobe_example("));

@@ -6,24 +6,6 @@ use proptest::prelude::*;
 use specula::analysis::max_directional_albedo;
 use specula::{Brdf, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
 
-/// The `f32` path's largest absolute deviation from `f64` at the same (`f32`) input.
-const F32_ABS_TOLERANCE: f64 = 4e-6;
-
-/// `cosquad` squares its base `v` times, and each squaring doubles the base's relative
-/// rounding error (the base sits near 1, where `f32` spacing is `6e-8`), so its bound scales
-/// with `2^v` beyond the default `v = 4`.
-///
-/// The bit-trick powers evaluate a `log2` near 0 as a sum of terms near 1 (about `2^-22` of
-/// rounding), multiplied by `n`, and their `f32` result lies on a grid of `2^-17` relative
-/// steps where the `f64` model is exact.
-fn f32_tolerance(kind: LobeKind, n: Exponent) -> f64 {
-    match kind {
-        LobeKind::CosQuad { v } if v > 4 => F32_ABS_TOLERANCE * f64::from(1u32 << (v - 4)),
-        LobeKind::FastPow | LobeKind::FasterPow => 2f64.powi(-16) + n.get() * 2f64.powi(-21),
-        _ => F32_ABS_TOLERANCE,
-    }
-}
-
 fn any_lobe() -> impl Strategy<Value = LobeKind> {
     prop_oneof![
         proptest::sample::select(LobeKind::ALL.to_vec()),
@@ -63,7 +45,7 @@ proptest! {
     fn f32_path_tracks_f64(kind in any_lobe(), n in any_exponent(), t in 0.0f32..=1.0) {
         let lobe = Lobe::new(kind, n);
         let (fast, reference) = (f64::from(lobe.eval(t)), lobe.eval(f64::from(t)));
-        prop_assert!((fast - reference).abs() <= f32_tolerance(kind, n),
+        prop_assert!((fast - reference).abs() <= lobe.f32_tolerance(),
             "{kind} n={n} t={t}: f32 {fast} vs f64 {reference}");
     }
 

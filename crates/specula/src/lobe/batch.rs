@@ -52,9 +52,10 @@ pub(crate) trait WithKernel {
     fn call<K: LobeKernel>(self, kernel: K) -> Self::Output;
 }
 
-/// What a model states of its batch path, in its own file: its kernel, and how far the batch
-/// may stray from the scalar `f32` path ([`Lobe::batch_ulp_bound`]).
-pub(crate) trait ModelBatch {
+/// What a model states of its `f32` paths, in its own file: its batch kernel, and how far
+/// each `f32` evaluation may stray (the batch from the scalar `f32` path, the scalar `f32` path
+/// and a GPU's from the `f64` formula).
+pub(crate) trait ModelF32 {
     /// Calls `f` with the model's kernel (one monomorphised path per constant it unrolls).
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output;
 
@@ -72,6 +73,21 @@ pub(crate) trait ModelBatch {
     /// ([`Lobe::tail_inverse_batch_bound`]): 1 unless the model's base is flatter.
     fn draw_batch_slope(&self) -> f64 {
         1.0
+    }
+
+    /// The largest absolute difference between the scalar `f32` path and the `f64` formula at
+    /// the same cosine, for exponent `n`: `4e-6` for a formula whose roundings do not grow
+    /// with `n` or through squarings.
+    fn f32_tolerance(&self, _n: f64) -> f64 {
+        4e-6
+    }
+
+    /// The largest difference, in ULPs of 1, between a GPU's `f32` evaluation of the generated
+    /// function and the `f64` formula at exponent `n`: 32 for exact IEEE operations only (the
+    /// CPU `f32` path's). Set on llvmpipe (LLVM 15.0.6, 256 bits), Mesa 22.3.6, whose
+    /// transcendental functions are coarser than IEEE's; docs/gpu.md lists the measured worst.
+    fn gpu_ulp_bound(&self, _n: f64) -> f64 {
+        32.0
     }
 }
 
@@ -218,6 +234,21 @@ impl Lobe {
     #[must_use]
     pub fn batch_ulp_bound(&self) -> f64 {
         each_model!(&self.model, m => m.batch_ulp_bound(self.n.get()))
+    }
+
+    /// The largest absolute difference between [`Lobe::eval`] in `f32` and in `f64` at the
+    /// same cosine.
+    #[must_use]
+    pub fn f32_tolerance(&self) -> f64 {
+        each_model!(&self.model, m => m.f32_tolerance(self.n.get()))
+    }
+
+    /// The largest difference, in ULPs of 1 (`2^-23`), between a GPU's evaluation of the
+    /// lobe's generated WGSL and [`Lobe::eval`] in `f64` (a driver's `log2`, `exp2` and `acos`
+    /// are approximations).
+    #[must_use]
+    pub fn gpu_ulp_bound(&self) -> f64 {
+        each_model!(&self.model, m => m.gpu_ulp_bound(self.n.get()))
     }
 }
 

@@ -6,7 +6,7 @@
 //! calls `ln_1p`, `exp` and `expm1`, within [`Lobe::tail_inverse_batch_bound`] of the `f64`
 //! inverse (tested).
 
-use super::batch::ModelBatch;
+use super::batch::ModelF32;
 use super::{Lobe, Model};
 use crate::simd::{dispatch, BatchLoop, Drive, Kernel, Lanes, Level};
 

@@ -19,7 +19,7 @@
 //! - **Sampling**: table (it states no closed-form tail, so the facts' defaults say so).
 //! - **Source**: specula's tests.
 
-use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
@@ -113,7 +113,7 @@ impl LobeKernel for ExampleKernel {
 }
 
 /// Its batch kernel and how far the batch may stray from the scalar `f32` path.
-impl ModelBatch for Example {
+impl ModelF32 for Example {
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
         f.call(ExampleKernel {
             half_n: self.half_n as f32,
@@ -123,5 +123,10 @@ impl ModelBatch for Example {
     fn batch_ulp_bound(&self, _n: f64) -> f64 {
         // Schlick's few ULP from the fused denominator, doubled by the square.
         8.0
+    }
+
+    fn gpu_ulp_bound(&self, _n: f64) -> f64 {
+        // Schlick's 32 for exact IEEE operations, doubled by the square.
+        64.0
     }
 }

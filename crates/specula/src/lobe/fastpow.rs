@@ -31,7 +31,7 @@
 //! - **Source**: P. Mineiro, fastapprox (`fastlog2`, `fastpow2`, `fastpow`), 2011;
 //!   N. N. Schraudolph, "A fast, compact approximation of the exponential function" (1999).
 
-use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
@@ -221,7 +221,7 @@ impl ModelFacts for FastPow {
 }
 
 /// Its batch kernel and how far the batch may stray from the scalar `f32` path.
-impl ModelBatch for FastPow {
+impl ModelF32 for FastPow {
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
         f.call(self.kernel())
     }
@@ -230,5 +230,17 @@ impl ModelBatch for FastPow {
         // The corrected log's rounding times n, plus one step of the bit-pattern grid (2^-17
         // relative, 64 ULP) where the two paths round it apart.
         72.0 + 2.0 * n
+    }
+
+    fn f32_tolerance(&self, n: f64) -> f64 {
+        // The log2 near 0 as a sum of terms near 1 (about 2^-22 of rounding) times n, and the
+        // result on a grid of 2^-17 relative steps where the f64 model is exact.
+        2f64.powi(-16) + n * 2f64.powi(-21)
+    }
+
+    fn gpu_ulp_bound(&self, n: f64) -> f64 {
+        // The f32 log's rounding times n, plus the result's bit-pattern grid (2^-17 relative,
+        // 64 ULP) against the exact f64 model.
+        128.0 + 4.0 * n
     }
 }

@@ -17,7 +17,7 @@
 //! - **Sampling**: table (`sampling::CosineDistribution`), as `logexp`.
 //! - **Source**: specula.
 
-use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use super::logexp::exp2_by_log2;
@@ -122,7 +122,7 @@ impl ModelFacts for LogExpRr {
 }
 
 /// Its batch kernel and how far the batch may stray from the scalar `f32` path.
-impl ModelBatch for LogExpRr {
+impl ModelF32 for LogExpRr {
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
         f.call(self.kernel())
     }
@@ -130,5 +130,10 @@ impl ModelBatch for LogExpRr {
     fn batch_ulp_bound(&self, n: f64) -> f64 {
         // Through log2, whose error is multiplied by n.
         8.0 + 2.0 * n
+    }
+
+    fn gpu_ulp_bound(&self, n: f64) -> f64 {
+        // Through log2, whose error the driver's log2 multiplies by n.
+        32.0 + 2.0 * n
     }
 }

@@ -14,7 +14,7 @@
 //!   `t = (1 - u)^(1/(n+1))`, the classic Phong warp.
 //! - **Source**: B. T. Phong (1975); J. F. Blinn (1977); the thesis's reference function.
 
-use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
 use super::draw_batch::{self, remaining_share};
 use super::facts::closed_form_facts;
 use super::info::{LineStyle, LobeInfo, Origin};
@@ -133,7 +133,7 @@ impl LobeKernel for PowKernel {
 closed_form_facts!(Pow);
 
 /// Its batch kernel and how far the batch may stray from the scalar `f32` path.
-impl ModelBatch for Pow {
+impl ModelF32 for Pow {
     fn draw_batch(&self, level: Level, us: &[f32], out: &mut [f32]) -> bool {
         draw_batch::run(level, self.draw_kernel(), us, out);
         true
@@ -146,5 +146,10 @@ impl ModelBatch for Pow {
     fn batch_ulp_bound(&self, n: f64) -> f64 {
         // exp2(n log2 t): log2's error is multiplied by n.
         8.0 + 2.0 * n
+    }
+
+    fn gpu_ulp_bound(&self, n: f64) -> f64 {
+        // exp2(n log2 t): the driver's log2 error is multiplied by n.
+        32.0 + 2.0 * n
     }
 }

@@ -4,7 +4,7 @@
 //! and its place in `LobeKind::ALL`, the prepared `Model` variant and its preparation,
 //! `each_model!` (the dispatch every stated fact goes through), the registry entry and plot
 //! style, and the parameter's parsing and printing. What a lobe is lives in its file: `INFO`,
-//! `STYLE`, `type Prepared`, `fn prepare`, and `ModelFacts`/`ModelBatch` for `Prepared`.
+//! `STYLE`, `type Prepared`, `fn prepare`, and `ModelFacts`/`ModelF32` for `Prepared`.
 //!
 //! The invocation starts with `$`, which the expansion needs to define `each_model!` (a
 //! macro written by a macro spells its own `$` that way).

@@ -19,7 +19,7 @@
 //!   near-peak guess `d = expm1(c u L) / c`.
 //! - **Source**: C. Schlick, "A customizable reflectance model for everyday rendering" (1993).
 
-use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use super::invert::{solve_increasing, Inverted, NewtonStart};
@@ -198,7 +198,7 @@ impl ModelFacts for Schlick {
 }
 
 /// Its batch kernel and how far the batch may stray from the scalar `f32` path.
-impl ModelBatch for Schlick {
+impl ModelF32 for Schlick {
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
         f.call(self.kernel())
     }

@@ -24,7 +24,7 @@
 //!   (`sampling::CosineDistribution`) is exact enough and cheaper to trust.
 //! - **Source**: the thesis, slide "Modified Schlick BRDF".
 
-use super::batch::{with_squarings, ModelBatch, WithKernel};
+use super::batch::{with_squarings, ModelF32, WithKernel};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use super::schlick::schlick_denominator_ratio;
@@ -137,7 +137,7 @@ impl ModelFacts for SchlickMod {
 const SHAPE_EXPONENTS: [f64; 8] = [1.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0];
 
 /// Its batch kernel and how far the batch may stray from the scalar `f32` path.
-impl ModelBatch for SchlickMod {
+impl ModelF32 for SchlickMod {
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
         with_squarings!(self.squarings(), K => f.call(self.kernel::<K>()))
     }

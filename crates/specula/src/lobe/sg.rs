@@ -21,7 +21,7 @@
 //!   Fresnel" (2012); the Gaussian form of the Phong lobe behind real-time engines' cheap
 //!   specular.
 
-use super::batch::{clamp_unit, LobeKernel, ModelBatch, WithKernel, CLAMP};
+use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
 use super::draw_batch::{self, remaining_share};
 use super::facts::closed_form_facts;
 use super::info::{LineStyle, LobeInfo, Origin};
@@ -182,7 +182,7 @@ closed_form_facts!(Sg, {
 });
 
 /// Its batch kernel and how far the batch may stray from the scalar `f32` path.
-impl ModelBatch for Sg {
+impl ModelF32 for Sg {
     fn draw_batch(&self, level: Level, us: &[f32], out: &mut [f32]) -> bool {
         draw_batch::run(level, self.draw_kernel(), us, out);
         true
@@ -196,5 +196,11 @@ impl ModelBatch for Sg {
         // One fused multiply-add against a rounded product, scaled by the value times its
         // argument (at most 0.53), plus exp2's 2 ULP.
         8.0
+    }
+
+    fn gpu_ulp_bound(&self, _n: f64) -> f64 {
+        // One exp2 of a product: the product's rounding times the value times its argument
+        // (at most 0.53), plus the driver's exp2.
+        64.0
     }
 }
