@@ -1,8 +1,7 @@
 // The render pipeline: flat, Gouraud and Phong shading of crates/render, on the GPU.
 // Needs the generated lobe library (wgsl::lobes) and brdf.wgsl. Flat shading draws unindexed
-// triangles whose three vertices
-// carry the face normal and the centroid (`anchor`), so each face gets one colour, lit at its
-// centroid as on the CPU.
+// triangles whose three vertices carry the face normal and the centroid (`anchor`), so each
+// face gets one colour, lit at its centroid as on the CPU.
 
 struct Frame {
     view_projection: mat4x4<f32>,

@@ -60,7 +60,9 @@ pub struct FrameTime {
 }
 
 impl GpuRenderer<'_> {
-    /// Uploads `scene`: buffers, materials, render targets and the read-back buffer.
+    /// Uploads `scene`: buffers, materials, render targets and the read-back buffer; compiles
+    /// the pipeline for the scene's lobes the first time a scene holds them (a driver's
+    /// refusal of the shader is then this call's error).
     pub fn prepare(&self, scene: &Scene) -> Result<GpuFrame<'_>, GpuError> {
         let settings = &scene.settings;
         self.check_size(settings)?;

@@ -1,11 +1,11 @@
 //! The lobe library in WGSL, generated from each lobe's recorded expression, as the exports
 //! are: no lobe is typed twice.
 //!
-//! A built-in lobe's formula changes shape with its parameters (`cosquad`'s `v`) and, for a
-//! few models, with `n` (`schlick-mod` squares once more at each power of two): each
-//! combination is one [`Shape`], and each shape one straight-line function written by
+//! A built-in lobe's formula changes with its parameters (`cosquad`'s `v`) and, for a few
+//! models, with `n` (`schlick-mod` squares once more at each power of two: its shapes,
+//! `Lobe::shape`): each combination is one straight-line function ([`Generated`]) written by
 //! `specula_targets::wgsl` with the lobe's named parameters read from the material's
-//! `parameters` (four slots; everything else baked in). `lobe_<id>` picks the shape the
+//! `parameters` (four slots; everything else baked in). `lobe_<id>` picks the function the
 //! material's block names, `lobe_eval` the kind: both `switch`es generated from the registry.
 //! The user's lobes are functions of `n` ([`specula_targets::wgsl::lobe_function_of_n`]),
 //! as they were defined when the module was built.
@@ -13,6 +13,7 @@
 use std::fmt::Write as _;
 use std::sync::OnceLock;
 
+use specula::expression::Node;
 use specula::{Exponent, Lobe, LobeKind};
 use specula_targets::wgsl::{lobe_function_of_n, lobe_function_of_slots, BIT_TRICKS, SLOTS};
 
@@ -22,8 +23,8 @@ const LOBE_STRUCT: &str = "
 struct Lobe {
     // The kind's position in specula's registry (LobeKind::index); a user's lobe's follow.
     kind: u32,
-    // Which of the kind's shapes (its parameters and its range of n): lobe_<id> switches on it.
-    shape: u32,
+    // Which of the kind's functions (its parameters and its range of n): lobe_<id> switches on it.
+    function: u32,
     // The exponent, from which a user's lobe computes its constants.
     n: f32,
     padding: u32,
@@ -32,10 +33,11 @@ struct Lobe {
 }
 ";
 
-/// One of a built-in kind's formulas: the lobes of `kind` from `exponents[0]` up to (not
-/// including) `exponents[1]` record the same operations.
+/// One of a built-in kind's generated functions: the lobes of `kind` (one variant: its
+/// parameters set) from `exponents[0]` up to (not including) `exponents[1]`, which record the
+/// same operations (one of the variant's shapes, `Lobe::shape`).
 #[derive(Clone, Debug)]
-struct Shape {
+struct Generated {
     kind: LobeKind,
     shape: u32,
     /// The lobe recorded for the function (at the shape's least exponent).
@@ -43,9 +45,9 @@ struct Shape {
     exponents: [f64; 2],
 }
 
-/// Every built-in kind's shapes, by the kind's index.
-fn shapes() -> &'static [Vec<Shape>] {
-    static SHAPES: OnceLock<Vec<Vec<Shape>>> = OnceLock::new();
+/// Every built-in kind's generated functions, by the kind's index.
+fn generated() -> &'static [Vec<Generated>] {
+    static SHAPES: OnceLock<Vec<Vec<Generated>>> = OnceLock::new();
     SHAPES.get_or_init(|| {
         LobeKind::ALL
             .into_iter()
@@ -58,7 +60,7 @@ fn shapes() -> &'static [Vec<Shape>] {
                         (0..starts.len()).map(move |shape| {
                             let low = starts[shape];
                             let high = starts.get(shape + 1).copied().unwrap_or(Exponent::MAX);
-                            Shape {
+                            Generated {
                                 kind: variant,
                                 shape: shape as u32,
                                 representative: Lobe::new(variant, Exponent::new(low)),
@@ -72,36 +74,56 @@ fn shapes() -> &'static [Vec<Shape>] {
     })
 }
 
-/// Which generated function computes a lobe: its kind's index and the position of its shape
-/// among the kind's shapes (0 for a user's lobe, which has one). What a material's block
-/// uploads, and what a module generated for some lobes only is keyed by.
+/// Which generated function computes a lobe: its kind's index and the function's position
+/// among the kind's (0 for a user's lobe, which has one). What a material's block uploads,
+/// and what a module generated for some lobes only is keyed by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct ShapeKey {
+pub struct FunctionKey {
     /// `LobeKind::index`.
     pub kind: u32,
-    /// The shape's position among the kind's.
-    pub shape: u32,
+    /// The function's position among the kind's generated functions.
+    pub function: u32,
 }
 
-impl ShapeKey {
+impl FunctionKey {
     /// `lobe`'s function.
     #[must_use]
     pub fn of(lobe: &Lobe) -> Self {
         let kind = lobe.kind().index();
-        let Some(shapes) = shapes().get(kind as usize) else {
-            return Self { kind, shape: 0 };
+        let Some(functions) = generated().get(kind as usize) else {
+            return Self { kind, function: 0 };
         };
-        let found = shapes
+        let found = functions
             .iter()
-            .position(|s| s.kind == lobe.kind() && s.shape == lobe.shape());
-        let shape = found.unwrap_or_else(|| {
-            unreachable!("{}: every variant's shapes are generated", lobe.kind())
+            .position(|g| g.kind == lobe.kind() && g.shape == lobe.shape())
+            // A parameter beyond its range (`cosquad` with `v` above 10, which the model
+            // clamps) records the operations of a generated function all the same.
+            .or_else(|| {
+                let mine = operations(lobe);
+                functions
+                    .iter()
+                    .position(|g| operations(&g.representative) == mine)
+            });
+        let function = found.unwrap_or_else(|| {
+            unreachable!(
+                "{}: every prepared model's operations are generated",
+                lobe.kind()
+            )
         });
         Self {
             kind,
-            shape: shape as u32,
+            function: function as u32,
         }
     }
+}
+
+/// `lobe`'s recorded operations, its parameters' values left out.
+fn operations(lobe: &Lobe) -> Vec<Node> {
+    let erase = |node: &Node| match *node {
+        Node::Parameter { name, .. } => Node::Parameter { name, value: 0.0 },
+        other => other,
+    };
+    lobe.expression().nodes().iter().map(erase).collect()
 }
 
 /// The values of `lobe`'s named parameters in the order its generated function reads them
@@ -122,8 +144,9 @@ pub fn lobe_function(kind: LobeKind) -> String {
     format!("lobe_{}", kind.id().replace('-', "_"))
 }
 
-/// The library: `struct Lobe`, the bit-trick helpers, every built-in shape's function, each
-/// kind's `switch` on its shape, the user's lobes defined so far and `lobe_eval`.
+/// The library: `struct Lobe`, the bit-trick helpers, every built-in lobe's generated
+/// functions, each kind's `switch` on the material's function, the user's lobes defined so far
+/// and `lobe_eval`.
 #[must_use]
 pub fn source() -> String {
     library(|_| true)
@@ -134,55 +157,59 @@ pub fn source() -> String {
 /// prove the switch's value uniform runs every case, as Mesa's lavapipe does). A lobe
 /// outside `keys` gives 0 in it.
 #[must_use]
-pub fn source_for(keys: &[ShapeKey]) -> String {
+pub fn source_for(keys: &[FunctionKey]) -> String {
     library(|key| keys.contains(&key))
 }
 
-fn library(keep: impl Fn(ShapeKey) -> bool) -> String {
+fn library(keep: impl Fn(FunctionKey) -> bool) -> String {
     let mut out = [LOBE_STRUCT, BIT_TRICKS].concat();
     let mut kind_cases = String::new();
-    for (index, kind_shapes) in shapes().iter().enumerate() {
+    for (index, kind_functions) in generated().iter().enumerate() {
         let kind = LobeKind::ALL[index];
         let name = lobe_function(kind);
-        let mut shape_cases = String::new();
-        for (position, shape) in kind_shapes.iter().enumerate() {
-            let key = ShapeKey {
+        let mut cases = String::new();
+        for (position, generated) in kind_functions.iter().enumerate() {
+            let key = FunctionKey {
                 kind: index as u32,
-                shape: position as u32,
+                function: position as u32,
             };
             if !keep(key) {
                 continue;
             }
-            let function = format!("{name}_shape{position}");
+            let function = format!("{name}_f{position}");
             let text =
-                lobe_function_of_slots(&shape.representative, &function).unwrap_or_else(|| {
-                    unreachable!("{}: more named parameters than {SLOTS} slots", shape.kind)
+                lobe_function_of_slots(&generated.representative, &function).unwrap_or_else(|| {
+                    unreachable!(
+                        "{} has more named parameters than struct Lobe's {SLOTS} slots: widen \
+                            `parameters` there and in LobeBlock",
+                        generated.kind
+                    )
                 });
-            let [low, high] = shape.exponents;
+            let [low, high] = generated.exponents;
             let closing = if high == Exponent::MAX { ']' } else { ')' };
             let _ = write!(
                 out,
-                "\n// Shape {position} of {kind}: {}, n in [{low}, {high}{closing}.{text}",
-                shape.kind
+                "\n// Function {position} of {kind}: {}, n in [{low}, {high}{closing}.{text}",
+                generated.kind
             );
             let _ = writeln!(
-                shape_cases,
+                cases,
                 "        case {position}u: {{ return {function}(lobe.parameters, t); }}"
             );
         }
-        if shape_cases.is_empty() {
+        if cases.is_empty() {
             continue;
         }
-        let body = if kind_shapes.len() == 1 {
-            format!("    return {name}_shape0(lobe.parameters, t);\n")
+        let body = if kind_functions.len() == 1 {
+            format!("    return {name}_f0(lobe.parameters, t);\n")
         } else {
             let default = "        default: { return 0.0; }\n";
-            format!("    switch lobe.shape {{\n{shape_cases}{default}    }}\n")
+            format!("    switch lobe.function {{\n{cases}{default}    }}\n")
         };
         let _ = write!(
             out,
             "
-// {kind}: the function of the material's shape.
+// {kind}: the material's function.
 fn {name}(lobe: Lobe, t: f32) -> f32 {{
 {body}}}
 "

@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use glam::Vec3;
 use specula_render::{Image, Scene};
 
-use crate::wgsl::{self, ShapeKey};
+use crate::wgsl::{self, FunctionKey};
 use crate::{Gpu, GpuError};
 
 pub(crate) const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -19,7 +19,8 @@ pub(crate) const VERTEX_FLOATS: usize = 9;
 
 /// The render pipelines of one GPU: one per scene's set of lobes and culling mode, compiled
 /// when a scene first needs it ([`wgsl::render_module_for`]: a material's shader holds the
-/// lobes it draws, not every lobe).
+/// lobes it draws, not every lobe) and kept for the renderer's life, as an engine keeps its
+/// shader permutations.
 #[derive(Debug)]
 pub struct GpuRenderer<'gpu> {
     pub(crate) gpu: &'gpu Gpu,
@@ -27,7 +28,7 @@ pub struct GpuRenderer<'gpu> {
 }
 
 /// The lobes a pipeline's module holds (sorted, each once) and whether it culls back faces.
-type PipelineKey = (Vec<ShapeKey>, bool);
+type PipelineKey = (Vec<FunctionKey>, bool);
 
 impl<'gpu> GpuRenderer<'gpu> {
     /// The renderer for `gpu`; each scene's pipeline is compiled when first drawn.
@@ -42,7 +43,7 @@ impl<'gpu> GpuRenderer<'gpu> {
     /// The pipeline for materials whose lobes are `keys` (sorted, each once).
     pub(crate) fn pipeline(
         &self,
-        keys: &[ShapeKey],
+        keys: &[FunctionKey],
         cull_back_faces: bool,
     ) -> Result<Arc<wgpu::RenderPipeline>, GpuError> {
         let compiled = || {
@@ -55,13 +56,18 @@ impl<'gpu> GpuRenderer<'gpu> {
             return Ok(Arc::clone(pipeline));
         }
         let pipeline = Arc::new(self.compile(keys, cull_back_faces)?);
-        compiled().push(((keys.to_vec(), cull_back_faces), Arc::clone(&pipeline)));
+        let mut compiled = compiled();
+        // Another thread may have compiled the same pipeline meanwhile: keep the first.
+        if let Some((_, known)) = compiled.iter().find(known) {
+            return Ok(Arc::clone(known));
+        }
+        compiled.push(((keys.to_vec(), cull_back_faces), Arc::clone(&pipeline)));
         Ok(pipeline)
     }
 
     fn compile(
         &self,
-        keys: &[ShapeKey],
+        keys: &[FunctionKey],
         cull_back_faces: bool,
     ) -> Result<wgpu::RenderPipeline, GpuError> {
         let gpu = self.gpu;

@@ -6,14 +6,14 @@ use glam::Vec3;
 use specula::{Geometry, Lobe};
 use specula_render::{IlluminationModel, Light, Material, Shader};
 
-use crate::lobe_library::ShapeKey;
+use crate::lobe_library::FunctionKey;
 
 /// `struct Lobe` of the generated lobe library (32 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LobeBlock {
     kind: u32,
-    shape: u32,
+    function: u32,
     n: f32,
     padding: u32,
     parameters: [f32; 4],
@@ -23,10 +23,10 @@ impl LobeBlock {
     /// The prepared lobe's function and constants, rounded to `f32`.
     #[must_use]
     pub fn new(lobe: &Lobe) -> Self {
-        let ShapeKey { kind, shape } = ShapeKey::of(lobe);
+        let FunctionKey { kind, function } = FunctionKey::of(lobe);
         Self {
             kind,
-            shape,
+            function,
             n: lobe.exponent().get() as f32,
             padding: 0,
             parameters: crate::lobe_library::parameter_slots(lobe).map(|p| p as f32),
@@ -35,10 +35,10 @@ impl LobeBlock {
 
     /// The generated function that computes the lobe.
     #[must_use]
-    pub fn key(&self) -> ShapeKey {
-        ShapeKey {
+    pub fn key(&self) -> FunctionKey {
+        FunctionKey {
             kind: self.kind,
-            shape: self.shape,
+            function: self.function,
         }
     }
 }
@@ -89,7 +89,7 @@ impl MaterialBlock {
 
     /// The generated function that computes the material's lobe.
     #[must_use]
-    pub fn lobe_key(&self) -> ShapeKey {
+    pub fn lobe_key(&self) -> FunctionKey {
         self.lobe.key()
     }
 }

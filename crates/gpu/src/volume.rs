@@ -15,7 +15,7 @@ use specula_render::Image;
 use wgpu::util::DeviceExt;
 
 use crate::uniforms::{geometry_id, LobeBlock};
-use crate::wgsl::{self, ShapeKey};
+use crate::wgsl::{self, FunctionKey};
 use crate::{Gpu, GpuError};
 
 /// `struct Params` of volume.wgsl.
@@ -51,7 +51,7 @@ struct HighlightBlock {
 #[derive(Debug)]
 pub struct GpuVolumeRenderer<'gpu> {
     gpu: &'gpu Gpu,
-    pipelines: Mutex<Vec<(Vec<ShapeKey>, Arc<wgpu::ComputePipeline>)>>,
+    pipelines: Mutex<Vec<(Vec<FunctionKey>, Arc<wgpu::ComputePipeline>)>>,
 }
 
 fn with_w(v: glam::Vec3, w: f32) -> [f32; 4] {
@@ -77,7 +77,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
     /// # Errors
     /// When the driver refuses the shader.
     pub fn prepare(&self, lobes: &[Lobe]) -> Result<(), GpuError> {
-        let keys: Vec<ShapeKey> = lobes.iter().map(ShapeKey::of).collect();
+        let keys: Vec<FunctionKey> = lobes.iter().map(FunctionKey::of).collect();
         for some in keys.chunks(wgsl::MAX_HIGHLIGHTS) {
             self.pipeline(some)?;
         }
@@ -85,7 +85,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
     }
 
     /// The pipeline whose images' highlights are `keys`' lobes, in order.
-    fn pipeline(&self, keys: &[ShapeKey]) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
+    fn pipeline(&self, keys: &[FunctionKey]) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
         let compiled = || {
             self.pipelines
                 .lock()
@@ -182,10 +182,10 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
             Some(lighting) => lobes.iter().map(|lobe| highlight(lighting, lobe)).collect(),
             None => Vec::new(),
         };
-        let keys: Vec<ShapeKey> = lobes
+        let keys: Vec<FunctionKey> = lobes
             .iter()
             .take(highlights.len())
-            .map(ShapeKey::of)
+            .map(FunctionKey::of)
             .collect();
         let pipeline = self.pipeline(&keys)?;
         let device = &self.gpu.device;
@@ -442,7 +442,7 @@ mod tests {
     /// `Params` and `Highlight` have the sizes WGSL's layout rules give them.
     #[test]
     fn blocks_match_the_wgsl_layout() {
-        let wgsl_size = crate::uniforms::wgsl_size_of(&wgsl::volume_module(&[ShapeKey::of(
+        let wgsl_size = crate::uniforms::wgsl_size_of(&wgsl::volume_module(&[FunctionKey::of(
             &Lobe::new(LobeKind::Pow, Exponent::new(8.0)),
         )]));
         assert_eq!(wgsl_size("Params"), size_of::<Params>());

@@ -7,7 +7,7 @@
 
 use specula::LobeKind;
 
-pub use crate::lobe_library::{lobe_function, ShapeKey};
+pub use crate::lobe_library::{lobe_function, FunctionKey};
 
 /// The lobe's cosine from the directions (Phong or Blinn).
 pub const GEOMETRY: &str = include_str!("../shaders/geometry.wgsl");
@@ -38,7 +38,7 @@ pub fn render_module() -> String {
 /// The render module's source for materials whose lobes are `keys`' (the renderer's
 /// pipeline for a scene: `lobe_eval` switches over those lobes only).
 #[must_use]
-pub fn render_module_for(keys: &[ShapeKey]) -> String {
+pub fn render_module_for(keys: &[FunctionKey]) -> String {
     [
         crate::lobe_library::source_for(keys).as_str(),
         GEOMETRY,
@@ -59,7 +59,7 @@ pub const MAX_HIGHLIGHTS: usize = 16;
 /// # Panics
 /// If there are more than [`MAX_HIGHLIGHTS`] lobes.
 #[must_use]
-pub fn volume_module(keys: &[ShapeKey]) -> String {
+pub fn volume_module(keys: &[FunctionKey]) -> String {
     assert!(
         keys.len() <= MAX_HIGHLIGHTS,
         "{} highlights in one march, above {MAX_HIGHLIGHTS}",
@@ -70,9 +70,9 @@ pub fn volume_module(keys: &[ShapeKey]) -> String {
         let lobe = format!("highlights[{i}u].lobe");
         let call = match LobeKind::ALL.get(key.kind as usize) {
             Some(&kind) => format!(
-                "{}_shape{}({lobe}.parameters, c)",
+                "{}_f{}({lobe}.parameters, c)",
                 lobe_function(kind),
-                key.shape
+                key.function
             ),
             None => format!("lobe_formula({lobe}, c)"),
         };

@@ -59,24 +59,21 @@ fn a_scenes_render_module_holds_its_lobes_only() {
         Lobe::new(LobeKind::SchlickMod, Exponent::new(100.0)),
         Lobe::new(LobeKind::CosQuad { v: 6 }, Exponent::new(40.0)),
     ];
-    let mut keys: Vec<wgsl::ShapeKey> = lobes.iter().map(wgsl::ShapeKey::of).collect();
-    keys.sort_unstable();
+    let keys: Vec<wgsl::FunctionKey> = lobes.iter().map(wgsl::FunctionKey::of).collect();
     let source = wgsl::render_module_for(&keys);
     wgsl::validate(&source).unwrap();
     for (lobe, key) in lobes.iter().zip(&keys) {
-        let function = format!(
-            "fn {}_shape{}(",
-            wgsl::lobe_function(lobe.kind()),
-            key.shape
-        );
+        let function = format!("fn {}_f{}(", wgsl::lobe_function(lobe.kind()), key.function);
         assert!(
             source.contains(&function),
             "{}: no `{function}`",
             lobe.kind()
         );
     }
-    // schlick-mod at n = 100 squares four times (a = 16): the one shape from 64 to 128.
-    assert_eq!(keys[0].shape, 4);
+    // schlick-mod's functions are its shapes: at n = 100 it squares four times (a = 16), the
+    // fifth shape, from 64 to 128; cosquad's are its variants, v = 0 to 10.
+    assert_eq!(keys[0].function, 4);
+    assert_eq!(keys[1].function, 6);
     let others = LobeKind::ALL
         .into_iter()
         .filter(|kind| !lobes.iter().any(|lobe| lobe.kind().index() == kind.index()))
@@ -84,27 +81,46 @@ fn a_scenes_render_module_holds_its_lobes_only() {
     assert_eq!(others.count(), 0, "other lobes in the scene's module");
 }
 
-/// The ray marcher's module validates for any list of lobes: none (unshaded), every shape
-/// of every built-in lobe (in marches of at most sixteen), and a user's lobe.
+/// A parameter beyond its range, which the model clamps (`cosquad` with `v` = 12 prepares
+/// `v` = 10), finds the function of the operations it records.
 #[test]
-fn the_ray_marcher_validates_for_any_lobes() {
-    let formula = Lobe::new(LobeKind::parse("=t^n").unwrap(), Exponent::new(8.0));
-    let every_shape: Vec<Lobe> = LobeKind::ALL
+fn a_clamped_parameter_finds_its_function() {
+    let n = Exponent::new(64.0);
+    let beyond = Lobe::new(LobeKind::CosQuad { v: 12 }, n);
+    let clamped = Lobe::new(LobeKind::CosQuad { v: 10 }, n);
+    assert_eq!(
+        wgsl::FunctionKey::of(&beyond),
+        wgsl::FunctionKey::of(&clamped)
+    );
+}
+
+/// A lobe for each generated function: every variant of every built-in lobe at the least
+/// exponent of each of its shapes, plus `inside`.
+fn one_lobe_per_function(inside: f64) -> Vec<Lobe> {
+    let lobes = LobeKind::ALL
         .into_iter()
         .flat_map(LobeKind::variants)
         .flat_map(|kind| {
             let starts = Lobe::new(kind, Exponent::new(1.0)).shape_exponents();
             starts
                 .iter()
-                .map(move |&n| Lobe::new(kind, Exponent::new(n)))
-        })
-        .collect();
+                .map(move |start| Lobe::new(kind, Exponent::new(start + inside)))
+        });
+    lobes.collect()
+}
+
+/// The ray marcher's module validates for any list of lobes: none (unshaded), every shape
+/// of every built-in lobe (in marches of at most sixteen), and a user's lobe.
+#[test]
+fn the_ray_marcher_validates_for_any_lobes() {
+    let formula = Lobe::new(LobeKind::parse("=t^n").unwrap(), Exponent::new(8.0));
+    let every_shape = one_lobe_per_function(0.0);
     let marches = every_shape
         .chunks(wgsl::MAX_HIGHLIGHTS)
         .map(<[Lobe]>::to_vec)
         .chain([Vec::new(), vec![every_shape[0], formula]]);
     for lobes in marches {
-        let keys: Vec<wgsl::ShapeKey> = lobes.iter().map(wgsl::ShapeKey::of).collect();
+        let keys: Vec<wgsl::FunctionKey> = lobes.iter().map(wgsl::FunctionKey::of).collect();
         wgsl::validate(&wgsl::volume_module(&keys)).unwrap_or_else(|e| panic!("{keys:?}: {e}"));
     }
 }
@@ -188,8 +204,12 @@ fn every_lobe_exports_to_every_language_and_validates() {
     }
 }
 
-/// The exported function computes what the library computes: its baked constants are the
-/// prepared lobe's. Run on the GPU through a compute entry point appended to the export.
+/// The exported function computes what the library computes, bit for bit: its baked
+/// constants are the prepared lobe's, and the library's block picks the function of the same
+/// operations and uploads the same parameters. Every variant just inside each of its shapes
+/// and at n = 77, on the GPU through a compute entry point appended to the export (not at an
+/// exponent such as 1, where a compiler may fold `pow(t, 1.0)` to `t` when the exponent is a
+/// literal, as the export's is, but not when it is a uniform, as the library's is).
 #[test]
 fn the_exported_function_evaluates_like_the_library() {
     let Some(gpu) = common::gpu() else { return };
@@ -197,12 +217,13 @@ fn the_exported_function_evaluates_like_the_library() {
     let ts: Vec<f32> = (0..=2000)
         .map(|i| 1.0 - (i as f32 / 2000.0).powi(2))
         .collect();
-    for kind in LobeKind::ALL {
-        let lobe = Lobe::new(kind, Exponent::new(77.0));
+    let at_77 = LobeKind::ALL.map(|kind| Lobe::new(kind, Exponent::new(77.0)));
+    for lobe in one_lobe_per_function(0.37).into_iter().chain(at_77) {
+        let kind = lobe.kind();
         let source = export_wgsl_source(&lobe, Geometry::Blinn, Normalisation::None);
         let exported =
             specula_gpu::evaluate_wgsl_function(&gpu, &source, "specula_lobe", &ts).unwrap();
         let library = evaluator.eval(&lobe, &ts).unwrap();
-        assert_eq!(exported, library, "{kind}");
+        assert_eq!(exported, library, "{kind} n = {}", lobe.exponent());
     }
 }

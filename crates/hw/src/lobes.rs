@@ -370,7 +370,9 @@ impl HwLobe {
             HwLobe::Sg => vec![FixedPoint::unsigned(SG_RATE_INT_BITS, bits - 1)
                 .quantize(prepared("rate"), Rounding::HalfEven)],
             HwLobe::SchlickMod => {
-                let squarings = lobe().squarings().unwrap_or_default();
+                let squarings = lobe()
+                    .squarings()
+                    .unwrap_or_else(|| unreachable!("schlick-mod squares"));
                 let squarings = i64::from(squarings).min(SCHLICK_MOD_MAX_SQUARINGS.into());
                 vec![n_raw, squarings]
             }

@@ -39,7 +39,7 @@ pub(super) const INFO: LobeInfo = LobeInfo {
 
 /// How every plot draws this lobe (`LobeKind::line_style`).
 pub(super) const STYLE: LineStyle = LineStyle {
-    rgb: [96, 96, 96],
+    rgb: [0, 0, 240],
     dashed: true,
 };
 
@@ -112,7 +112,7 @@ impl LobeKernel for ExampleKernel {
     }
 }
 
-/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+/// Its `f32` paths: the batch kernel and how far each `f32` evaluation may stray.
 impl ModelF32 for Example {
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
         f.call(ExampleKernel {

@@ -220,7 +220,7 @@ impl ModelFacts for FastPow {
     }
 }
 
-/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+/// Its `f32` paths: the batch kernel and how far each `f32` evaluation may stray.
 impl ModelF32 for FastPow {
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
         f.call(self.kernel())

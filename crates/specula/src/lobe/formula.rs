@@ -123,8 +123,7 @@ impl FormulaLobe {
         self.instance.formula().plan().instructions(self.rules)
     }
 
-    /// The plain loop's kernel for `lobe`, the lobe this formula was prepared into (the
-    /// kernel evaluates through it, and so through its rules).
+    /// The plain loop's kernel: the formula one lane at a time under the shared rules.
     pub(crate) fn kernel(&self) -> FormulaKernel {
         FormulaKernel {
             formula: *self,
@@ -203,7 +202,7 @@ impl ModelFacts for FormulaLobe {
     }
 }
 
-/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+/// Its `f32` paths: the batch kernel and how far each `f32` evaluation may stray.
 impl ModelF32 for FormulaLobe {
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
         f.call(self.kernel())

@@ -120,7 +120,7 @@ impl ModelFacts for LogExp {
     }
 }
 
-/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+/// Its `f32` paths: the batch kernel and how far each `f32` evaluation may stray.
 impl ModelF32 for LogExp {
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
         f.call(self.kernel())

@@ -132,7 +132,7 @@ impl LobeKernel for PowKernel {
 // Sampled in closed form: the tail and its inverse exactly.
 closed_form_facts!(Pow);
 
-/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+/// Its `f32` paths: the batch kernel and how far each `f32` evaluation may stray.
 impl ModelF32 for Pow {
     fn draw_batch(&self, level: Level, us: &[f32], out: &mut [f32]) -> bool {
         draw_batch::run(level, self.draw_kernel(), us, out);

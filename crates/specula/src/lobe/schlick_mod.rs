@@ -112,15 +112,12 @@ impl ModelFacts for SchlickMod {
     }
 
     fn lobe_structural_range(&self, _n: f64) -> [f64; 2] {
-        let squarings = self.squarings();
-        let low = if squarings == 0 {
-            Exponent::MIN
-        } else {
-            f64::from(1u32 << (squarings + 2))
-        };
-        let next = f64::from(1u32 << (squarings + 3));
-        // Below the next power of two by an amount `f32` still resolves.
-        [low, (next * (1.0 - 2f64.powi(-20))).min(Exponent::MAX)]
+        let shape = self.squarings() as usize;
+        // Up to the next shape's least exponent, less an amount `f32` still resolves.
+        let high = SHAPE_EXPONENTS
+            .get(shape + 1)
+            .map_or(Exponent::MAX, |next| next * (1.0 - 2f64.powi(-20)));
+        [SHAPE_EXPONENTS[shape], high]
     }
 
     fn lobe_shape_exponents(&self) -> &'static [f64] {
@@ -136,7 +133,7 @@ impl ModelFacts for SchlickMod {
 /// 512 to `Exponent::MAX`.
 const SHAPE_EXPONENTS: [f64; 8] = [1.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0];
 
-/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+/// Its `f32` paths: the batch kernel and how far each `f32` evaluation may stray.
 impl ModelF32 for SchlickMod {
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output {
         with_squarings!(self.squarings(), K => f.call(self.kernel::<K>()))

@@ -181,7 +181,7 @@ closed_form_facts!(Sg, {
     }
 });
 
-/// Its batch kernel and how far the batch may stray from the scalar `f32` path.
+/// Its `f32` paths: the batch kernel and how far each `f32` evaluation may stray.
 impl ModelF32 for Sg {
     fn draw_batch(&self, level: Level, us: &[f32], out: &mut [f32]) -> bool {
         draw_batch::run(level, self.draw_kernel(), us, out);
