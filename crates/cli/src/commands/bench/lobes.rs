@@ -4,7 +4,7 @@
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
-use specula::simd::tally::Class;
+use specula::simd::tally::{Class, Instructions};
 use specula::{Exponent, LobeKind};
 use specula_decide::c_twins::{self, CTwins};
 use specula_decide::rates::{cosquad_formula, measure, LobeRate, Measured, L1_SIZE, STREAM_SIZE};
@@ -64,41 +64,7 @@ pub fn run(n: Exponent, format: OutputFormat) -> Result<(), String> {
     }
     println!("{}", peaks_line(&measured));
     let g = |rate: f64| format!("{:.2}", rate / 1e9);
-    let ratio = |a: f64, b: f64| format!("{:.2}x", a / b);
-    let mut table = Table::new(&[
-        "lobe",
-        "G/s",
-        "bound G/s",
-        "of bound",
-        "limited by",
-        "instructions per vector",
-        "plain loop G/s",
-        "vs plain",
-        "vs powf",
-        "vs fast pow",
-        "stream 1T / all G/s",
-        "of copy (all)",
-        "epicentre max rel",
-    ]);
-    let copy_all = measured.copy_stream.map_or(f64::NAN, |c| c[1]);
-    for rate in &measured.lobes {
-        let stream = rate.stream.unwrap_or([f64::NAN; 2]);
-        table.push(vec![
-            rate.lobe.clone(),
-            g(rate.explicit),
-            g(rate.bound.evals_per_second),
-            percent(rate.of_bound()),
-            rate.bound.limit.to_string(),
-            format!("{} ({})", rate.instructions.total(), rate.instructions),
-            g(rate.plain),
-            ratio(rate.explicit, rate.plain),
-            ratio(rate.explicit, measured.powf),
-            ratio(rate.explicit, measured.fast_pow()),
-            format!("{} / {}", g(stream[0]), g(stream[1])),
-            percent(stream[1] / copy_all),
-            format!("{:.4}%", 100.0 * rate.epicentre_max_rel),
-        ]);
-    }
+    let table = lobe_table(&measured, Figure::shown, |column| column.table);
     println!(
         "lobes at n = {}: {L1_SIZE} cosines in L1 on one thread unless stated; streaming {} Mi \
          cosines; level {}; powf (libm) {} G/s; copy streaming 1T / all {} G floats/s",
@@ -173,44 +139,149 @@ fn print_twins(measured: &Measured, twins: &CTwins, format: OutputFormat) {
 /// `bench lobes --format csv`: one row a lobe, every figure a number with all its digits, the
 /// unit in its column's name (ratios as multiples, shares in %).
 fn print_csv(measured: &Measured) {
-    let mut table = Table::new(&[
-        "lobe",
-        "G evaluations/s",
-        "bound (G evaluations/s)",
-        "of bound (%)",
-        "limited by",
-        "instructions per vector",
-        "plain loop (G evaluations/s)",
-        "x the plain loop",
-        "x powf",
-        "x the fast pow",
-        "streaming 1 thread (G evaluations/s)",
-        "streaming all threads (G evaluations/s)",
-        "of copy, all threads (%)",
-        "epicentre max rel (%)",
-    ]);
-    let g = |rate: f64| number(rate / 1e9);
-    let copy_all = measured.copy_stream.map_or(f64::NAN, |c| c[1]);
-    for rate in &measured.lobes {
-        let stream = rate.stream.unwrap_or([f64::NAN; 2]);
-        table.push(vec![
-            rate.lobe.clone(),
-            g(rate.explicit),
-            g(rate.bound.evals_per_second),
-            number(100.0 * rate.of_bound()),
-            rate.bound.limit.to_string(),
-            rate.instructions.total().to_string(),
-            g(rate.plain),
-            number(rate.explicit / rate.plain),
-            number(rate.explicit / measured.powf),
-            number(rate.explicit / measured.fast_pow()),
-            g(stream[0]),
-            g(stream[1]),
-            number(100.0 * stream[1] / copy_all),
-            number(100.0 * rate.epicentre_max_rel),
-        ]);
+    lobe_table(measured, Figure::data, |column| column.csv).print(OutputFormat::Csv);
+}
+
+/// A figure of a lobe's row, in the unit it is measured in.
+enum Figure {
+    /// Evaluations per second.
+    Rate(f64),
+    /// A fraction of a whole.
+    Share(f64),
+    /// A multiple of another rate.
+    Times(f64),
+    /// The kernel's instructions per vector.
+    Instructions(Instructions),
+    /// Words.
+    Text(String),
+}
+
+impl Figure {
+    /// As the table shows it: G/s to two places, shares in %, multiples with an x, the
+    /// instructions with their classes.
+    fn shown(&self) -> String {
+        match self {
+            Figure::Rate(rate) => format!("{:.2}", rate / 1e9),
+            Figure::Share(share) => percent(*share),
+            Figure::Times(times) => format!("{times:.2}x"),
+            Figure::Instructions(count) => format!("{} ({count})", count.total()),
+            Figure::Text(text) => text.clone(),
+        }
     }
-    table.print(OutputFormat::Csv);
+
+    /// As CSV holds it: every digit, in the unit its header names (G evaluations/s, %, a
+    /// multiple, a count).
+    fn data(&self) -> String {
+        match self {
+            Figure::Rate(rate) => number(rate / 1e9),
+            Figure::Share(share) => number(100.0 * share),
+            Figure::Times(times) => number(*times),
+            Figure::Instructions(count) => count.total().to_string(),
+            Figure::Text(text) => text.clone(),
+        }
+    }
+}
+
+/// A column of the lobes' table: its header in the table and in CSV, and its figure.
+struct Column {
+    table: &'static str,
+    csv: &'static str,
+    figure: fn(&Measured, &LobeRate) -> Figure,
+}
+
+/// Each lobe's figures, written once for both outputs.
+const COLUMNS: [Column; 14] = [
+    Column {
+        table: "lobe",
+        csv: "lobe",
+        figure: |_, rate| Figure::Text(rate.lobe.clone()),
+    },
+    Column {
+        table: "G/s",
+        csv: "G evaluations/s",
+        figure: |_, rate| Figure::Rate(rate.explicit),
+    },
+    Column {
+        table: "bound G/s",
+        csv: "bound (G evaluations/s)",
+        figure: |_, rate| Figure::Rate(rate.bound.evals_per_second),
+    },
+    Column {
+        table: "of bound",
+        csv: "of bound (%)",
+        figure: |_, rate| Figure::Share(rate.of_bound()),
+    },
+    Column {
+        table: "limited by",
+        csv: "limited by",
+        figure: |_, rate| Figure::Text(rate.bound.limit.to_string()),
+    },
+    Column {
+        table: "instructions per vector",
+        csv: "instructions per vector",
+        figure: |_, rate| Figure::Instructions(rate.instructions),
+    },
+    Column {
+        table: "plain loop G/s",
+        csv: "plain loop (G evaluations/s)",
+        figure: |_, rate| Figure::Rate(rate.plain),
+    },
+    Column {
+        table: "vs plain",
+        csv: "x the plain loop",
+        figure: |_, rate| Figure::Times(rate.explicit / rate.plain),
+    },
+    Column {
+        table: "vs powf",
+        csv: "x powf",
+        figure: |measured, rate| Figure::Times(rate.explicit / measured.powf),
+    },
+    Column {
+        table: "vs fast pow",
+        csv: "x the fast pow",
+        figure: |measured, rate| Figure::Times(rate.explicit / measured.fast_pow()),
+    },
+    Column {
+        table: "stream 1T G/s",
+        csv: "streaming 1 thread (G evaluations/s)",
+        figure: |_, rate| Figure::Rate(rate.stream.map_or(f64::NAN, |s| s[0])),
+    },
+    Column {
+        table: "stream all G/s",
+        csv: "streaming all threads (G evaluations/s)",
+        figure: |_, rate| Figure::Rate(rate.stream.map_or(f64::NAN, |s| s[1])),
+    },
+    Column {
+        table: "of copy (all)",
+        csv: "of copy, all threads (%)",
+        figure: |measured, rate| {
+            let copy_all = measured.copy_stream.map_or(f64::NAN, |c| c[1]);
+            Figure::Share(rate.stream.map_or(f64::NAN, |s| s[1]) / copy_all)
+        },
+    },
+    Column {
+        table: "epicentre max rel",
+        csv: "epicentre max rel (%)",
+        figure: |_, rate| Figure::Share(rate.epicentre_max_rel),
+    },
+];
+
+/// The lobes' table: `header` names each column, `write` each figure.
+fn lobe_table(
+    measured: &Measured,
+    write: fn(&Figure) -> String,
+    header: fn(&Column) -> &'static str,
+) -> Table {
+    let mut table = Table::new(&COLUMNS.each_ref().map(header));
+    for rate in &measured.lobes {
+        table.push(
+            COLUMNS
+                .iter()
+                .map(|column| write(&(column.figure)(measured, rate)))
+                .collect(),
+        );
+    }
+    table
 }
 
 fn peaks_line(measured: &Measured) -> String {
