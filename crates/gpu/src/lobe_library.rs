@@ -13,7 +13,6 @@
 use std::fmt::Write as _;
 use std::sync::OnceLock;
 
-use specula::expression::Node;
 use specula::{Exponent, Lobe, LobeKind};
 use specula_targets::wgsl::{lobe_function_of_n, lobe_function_of_slots, BIT_TRICKS, SLOTS};
 
@@ -99,10 +98,10 @@ impl FunctionKey {
             // A parameter beyond its range (`cosquad` with `v` above 10, which the model
             // clamps) records the operations of a generated function all the same.
             .or_else(|| {
-                let mine = operations(lobe);
+                let mine = lobe.expression().operations();
                 functions
                     .iter()
-                    .position(|g| operations(&g.representative) == mine)
+                    .position(|g| g.representative.expression().operations() == mine)
             });
         let function = found.unwrap_or_else(|| {
             unreachable!(
@@ -115,15 +114,6 @@ impl FunctionKey {
             function: function as u32,
         }
     }
-}
-
-/// `lobe`'s recorded operations, its parameters' values left out.
-fn operations(lobe: &Lobe) -> Vec<Node> {
-    let erase = |node: &Node| match *node {
-        Node::Parameter { name, .. } => Node::Parameter { name, value: 0.0 },
-        other => other,
-    };
-    lobe.expression().nodes().iter().map(erase).collect()
 }
 
 /// The values of `lobe`'s named parameters in the order its generated function reads them

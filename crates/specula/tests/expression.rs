@@ -152,16 +152,9 @@ fn parameters_follow_from_n_as_prepared() {
     }
 }
 
-/// A lobe's recorded operations with its parameters' values erased.
+/// A lobe's recorded operations, its parameters' values left out.
 fn shape(lobe: &Lobe) -> Vec<Node> {
-    lobe.expression()
-        .nodes()
-        .iter()
-        .map(|node| match node {
-            Node::Parameter { name, .. } => Node::Parameter { name, value: 0.0 },
-            other => *other,
-        })
-        .collect()
+    lobe.expression().operations()
 }
 
 /// Across its structural range a lobe's record differs only in its parameters' values, so a

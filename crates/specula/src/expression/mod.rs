@@ -342,6 +342,17 @@ impl Expression {
         uses
     }
 
+    /// The nodes with the named parameters' values left out: what the lobes of one shape
+    /// share ([`Lobe::shape_exponents`]), so that two records compare by their operations.
+    #[must_use]
+    pub fn operations(&self) -> Vec<Node> {
+        let erase = |node: &Node| match *node {
+            Node::Parameter { name, .. } => Node::Parameter { name, value: 0.0 },
+            other => other,
+        };
+        self.nodes.iter().map(erase).collect()
+    }
+
     /// Whether any node is a bit trick ([`Node::is_bit_trick`]).
     #[must_use]
     pub fn has_bit_tricks(&self) -> bool {

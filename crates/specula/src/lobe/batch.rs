@@ -52,6 +52,50 @@ pub(crate) trait WithKernel {
     fn call<K: LobeKernel>(self, kernel: K) -> Self::Output;
 }
 
+/// How far a model's `f32` evaluations may stray: the batch from the scalar `f32` path (ULPs
+/// of 1, `2^-23`), the scalar `f32` path from the `f64` formula (absolute), and a GPU's
+/// evaluation of the generated WGSL from the `f64` formula (ULPs of 1; set on llvmpipe, LLVM
+/// 15.0.6, 256 bits, Mesa 22.3.6, whose `log2`, `exp2` and `acos` are coarser than IEEE's;
+/// docs/gpu.md lists the measured worst). The shared cases are named here; a model with its
+/// own states it in its file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct F32Bounds {
+    pub(crate) batch_ulps: f64,
+    pub(crate) f32_tolerance: f64,
+    pub(crate) gpu_ulps: f64,
+}
+
+impl F32Bounds {
+    /// Exact IEEE operations only: one fused rounding in the batch (a few ULP of the value),
+    /// `4e-6` for the scalar path, 32 ULP on a GPU.
+    pub(crate) const EXACT: F32Bounds = F32Bounds {
+        batch_ulps: 4.0,
+        f32_tolerance: 4e-6,
+        gpu_ulps: 32.0,
+    };
+
+    /// Through `log2 t` scaled by `n` (`exp2(n log2 t)`, the log/exp lobes): the error of
+    /// `log2` (the batch's polynomial, the driver's function) multiplied by `n`.
+    pub(crate) fn through_log2(n: f64) -> F32Bounds {
+        F32Bounds {
+            batch_ulps: 8.0 + 2.0 * n,
+            gpu_ulps: 32.0 + 2.0 * n,
+            ..F32Bounds::EXACT
+        }
+    }
+
+    /// The bit-trick powers against their exact `f64` models: the `f32` log's rounding (a sum
+    /// of terms near 1, about `2^-22`) times `n`, plus the result's grid of `2^-17` relative
+    /// steps (64 ULP) where the two paths round it apart.
+    pub(crate) fn bit_trick(n: f64) -> F32Bounds {
+        F32Bounds {
+            batch_ulps: 72.0 + 2.0 * n,
+            f32_tolerance: 2f64.powi(-16) + n * 2f64.powi(-21),
+            gpu_ulps: 128.0 + 4.0 * n,
+        }
+    }
+}
+
 /// What a model states of its `f32` paths, in its own file: its batch kernel, and how far
 /// each `f32` evaluation may stray (the batch from the scalar `f32` path, the scalar `f32` path
 /// and a GPU's from the `f64` formula).
@@ -59,9 +103,8 @@ pub(crate) trait ModelF32 {
     /// Calls `f` with the model's kernel (one monomorphised path per constant it unrolls).
     fn with_kernel<F: WithKernel>(&self, f: F) -> F::Output;
 
-    /// The largest difference, in ULPs of 1, between the batch and the scalar `f32` path at
-    /// exponent `n`.
-    fn batch_ulp_bound(&self, n: f64) -> f64;
+    /// How far its `f32` evaluations may stray at exponent `n`.
+    fn bounds(&self, n: f64) -> F32Bounds;
 
     /// For a model drawn in closed form: its draw kernel over `us` into `out` on `level`'s
     /// lanes, and `true` ([`Lobe::tail_inverse_batch`]); `false`, `out` untouched, otherwise.
@@ -73,21 +116,6 @@ pub(crate) trait ModelF32 {
     /// ([`Lobe::tail_inverse_batch_bound`]): 1 unless the model's base is flatter.
     fn draw_batch_slope(&self) -> f64 {
         1.0
-    }
-
-    /// The largest absolute difference between the scalar `f32` path and the `f64` formula at
-    /// the same cosine, for exponent `n`: `4e-6` for a formula whose roundings do not grow
-    /// with `n` or through squarings.
-    fn f32_tolerance(&self, _n: f64) -> f64 {
-        4e-6
-    }
-
-    /// The largest difference, in ULPs of 1, between a GPU's `f32` evaluation of the generated
-    /// function and the `f64` formula at exponent `n`: 32 for exact IEEE operations only (the
-    /// CPU `f32` path's). Set on llvmpipe (LLVM 15.0.6, 256 bits), Mesa 22.3.6, whose
-    /// transcendental functions are coarser than IEEE's; docs/gpu.md lists the measured worst.
-    fn gpu_ulp_bound(&self, _n: f64) -> f64 {
-        32.0
     }
 }
 
@@ -233,14 +261,14 @@ impl Lobe {
     /// scalar `f32` [`Lobe::eval`] at the same cosine.
     #[must_use]
     pub fn batch_ulp_bound(&self) -> f64 {
-        each_model!(&self.model, m => m.batch_ulp_bound(self.n.get()))
+        self.bounds().batch_ulps
     }
 
     /// The largest absolute difference between [`Lobe::eval`] in `f32` and in `f64` at the
     /// same cosine.
     #[must_use]
     pub fn f32_tolerance(&self) -> f64 {
-        each_model!(&self.model, m => m.f32_tolerance(self.n.get()))
+        self.bounds().f32_tolerance
     }
 
     /// The largest difference, in ULPs of 1 (`2^-23`), between a GPU's evaluation of the
@@ -248,7 +276,11 @@ impl Lobe {
     /// are approximations).
     #[must_use]
     pub fn gpu_ulp_bound(&self) -> f64 {
-        each_model!(&self.model, m => m.gpu_ulp_bound(self.n.get()))
+        self.bounds().gpu_ulps
+    }
+
+    fn bounds(&self) -> F32Bounds {
+        each_model!(&self.model, m => m.bounds(self.n.get()))
     }
 }
 

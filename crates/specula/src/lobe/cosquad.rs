@@ -22,7 +22,7 @@
 //!   `x_0 = max(0, 1 - a)` the base at `t = 0`.
 //! - **Source**: the thesis, slide "A model based on a cosine-quadratic function".
 
-use super::batch::{with_squarings, LobeKernel, ModelF32, WithKernel};
+use super::batch::{with_squarings, F32Bounds, LobeKernel, ModelF32, WithKernel};
 use super::draw_batch::{self, remaining_share};
 use super::facts::closed_form_facts;
 use super::info::{LineStyle, LobeInfo, Origin, ParamInfo};
@@ -297,19 +297,14 @@ impl ModelF32 for CosQuad {
         })
     }
 
-    fn batch_ulp_bound(&self, _n: f64) -> f64 {
-        // The fused base differs by half an ULP; each squaring doubles its effect.
-        4.0 + f64::from(1u32 << self.squarings()) / 2.0
-    }
-
-    fn f32_tolerance(&self, _n: f64) -> f64 {
-        // Each squaring doubles the base's relative rounding (the base sits near 1, where the
-        // f32 spacing is 6e-8): 4e-6 up to the default v = 4, doubled per squaring beyond.
-        4e-6 * f64::from(1u32 << self.squarings().saturating_sub(4))
-    }
-
-    fn gpu_ulp_bound(&self, n: f64) -> f64 {
-        // The base's rounding doubled by each squaring, its slope growing with n.
-        (32.0 + n / 2.0) * 2f64.powi(self.squarings() as i32 - 4).max(1.0)
+    fn bounds(&self, n: f64) -> F32Bounds {
+        // The base (near 1, where the f32 spacing is 6e-8) rounds by half an ULP, and each
+        // squaring doubles its effect; on a GPU its slope grows with n as well.
+        let v = self.squarings();
+        F32Bounds {
+            batch_ulps: 4.0 + f64::from(1u32 << v) / 2.0,
+            f32_tolerance: 4e-6 * f64::from(1u32 << v.saturating_sub(4)),
+            gpu_ulps: (32.0 + n / 2.0) * 2f64.powi(v as i32 - 4).max(1.0),
+        }
     }
 }

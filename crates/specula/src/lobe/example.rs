@@ -19,7 +19,7 @@
 //! - **Sampling**: table (it states no closed-form tail, so the facts' defaults say so).
 //! - **Source**: specula's tests.
 
-use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
+use super::batch::{clamp_unit, CLAMP, F32Bounds, LobeKernel, ModelF32, WithKernel};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use crate::real::Real;
@@ -120,13 +120,12 @@ impl ModelF32 for Example {
         })
     }
 
-    fn batch_ulp_bound(&self, _n: f64) -> f64 {
-        // Schlick's few ULP from the fused denominator, doubled by the square.
-        8.0
-    }
-
-    fn gpu_ulp_bound(&self, _n: f64) -> f64 {
-        // Schlick's 32 for exact IEEE operations, doubled by the square.
-        64.0
+    fn bounds(&self, _n: f64) -> F32Bounds {
+        // Schlick's exact operations, their rounding doubled by the square.
+        F32Bounds {
+            batch_ulps: 8.0,
+            gpu_ulps: 64.0,
+            ..F32Bounds::EXACT
+        }
     }
 }

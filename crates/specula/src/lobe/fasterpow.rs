@@ -23,7 +23,7 @@
 //! - **Source**: P. Mineiro, fastapprox (`fasterlog2`, `fasterpow2`, `fasterpow`), 2011;
 //!   N. N. Schraudolph, "A fast, compact approximation of the exponential function" (1999).
 
-use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
+use super::batch::{clamp_unit, CLAMP, F32Bounds, LobeKernel, ModelF32, WithKernel};
 use super::facts::ModelFacts;
 use super::fastpow::kinks;
 use super::info::{LineStyle, LobeInfo, Origin};
@@ -146,21 +146,7 @@ impl ModelF32 for FasterPow {
         f.call(self.kernel())
     }
 
-    fn batch_ulp_bound(&self, n: f64) -> f64 {
-        // The log's rounding times n, plus one step of the bit-pattern grid (2^-17 relative,
-        // 64 ULP) where the two paths round it apart.
-        72.0 + 2.0 * n
-    }
-
-    fn f32_tolerance(&self, n: f64) -> f64 {
-        // The log2 near 0 as a sum of terms near 1 (about 2^-22 of rounding) times n, and the
-        // result on a grid of 2^-17 relative steps where the f64 model is exact.
-        2f64.powi(-16) + n * 2f64.powi(-21)
-    }
-
-    fn gpu_ulp_bound(&self, n: f64) -> f64 {
-        // The f32 log's rounding times n, plus the result's bit-pattern grid (2^-17 relative,
-        // 64 ULP) against the exact f64 model.
-        128.0 + 4.0 * n
+    fn bounds(&self, n: f64) -> F32Bounds {
+        F32Bounds::bit_trick(n)
     }
 }

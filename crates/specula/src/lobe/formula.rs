@@ -11,7 +11,7 @@
 //! - **Cost**: what the formula writes; integer powers up to 64 are multiplications.
 //! - **Sampling**: Newton on the formula's own tail where it gives one, else a table.
 
-use super::batch::{LobeKernel, ModelF32, WithKernel};
+use super::batch::{F32Bounds, LobeKernel, ModelF32, WithKernel};
 use super::facts::ModelFacts;
 use super::invert::NewtonStart;
 use super::{with_shared_rules, Inverted, NewtonForm};
@@ -208,17 +208,15 @@ impl ModelF32 for FormulaLobe {
         f.call(self.kernel())
     }
 
-    fn batch_ulp_bound(&self, n: f64) -> f64 {
-        // The columns' fused multiply-adds and polynomials against libm, through whatever the
-        // formula does with them: a statement for formulas of the shapes the lobes have (a
-        // power of a base, an exponential of a multiple of t - 1), tested on them.
-        64.0 + 4.0 * n
-    }
-
-    fn gpu_ulp_bound(&self, n: f64) -> f64 {
-        // A statement for formulas of the shapes the lobes have (a power of a base, an
-        // exponential of a multiple of t - 1), whose errors grow with n as theirs do; tested
-        // on them.
-        64.0 + 2.0 * n
+    fn bounds(&self, n: f64) -> F32Bounds {
+        // The columns' fused multiply-adds and polynomials against libm, and a driver's
+        // functions, through whatever the formula does with them: a statement for formulas
+        // of the shapes the lobes have (a power of a base, an exponential of a multiple of
+        // t - 1), whose errors grow with n as theirs do; tested on them.
+        F32Bounds {
+            batch_ulps: 64.0 + 4.0 * n,
+            gpu_ulps: 64.0 + 2.0 * n,
+            ..F32Bounds::EXACT
+        }
     }
 }

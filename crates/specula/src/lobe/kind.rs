@@ -20,36 +20,6 @@ impl LobeKind {
         self.info().id
     }
 
-    /// Every kind this one's registry entry names: one per combination of its parameters'
-    /// values (`cosquad:v=0` to `cosquad:v=10`), or itself for a lobe without parameters.
-    /// A user's lobe is itself: its parameters are reals.
-    #[must_use]
-    pub fn variants(self) -> Vec<LobeKind> {
-        if matches!(self, LobeKind::Formula(_)) {
-            return vec![self];
-        }
-        let mut settings = vec![String::new()];
-        for param in self.info().params {
-            settings = settings
-                .iter()
-                .flat_map(|set| {
-                    (param.min..=param.max).map(move |value| {
-                        let separator = if set.is_empty() { "" } else { "," };
-                        format!("{set}{separator}{}={value}", param.name)
-                    })
-                })
-                .collect();
-        }
-        settings
-            .into_iter()
-            .map(|set| match set.as_str() {
-                "" => self,
-                _ => Self::parse(&format!("{}:{set}", self.id()))
-                    .unwrap_or_else(|e| unreachable!("a value within the registry's range: {e}")),
-            })
-            .collect()
-    }
-
     /// Every registered id, comma separated (for error messages and help).
     #[must_use]
     pub fn valid_ids() -> String {
@@ -210,6 +180,15 @@ impl Serialize for LobeKind {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A registry entry's variants are one per value of its parameter's range, stated in its
+    /// `ParamInfo` (cosquad: `v` from 0 to 10), or the kind alone.
+    #[test]
+    fn variants_span_the_parameters_range() {
+        let cosquad: Vec<LobeKind> = (0..=10).map(|v| LobeKind::CosQuad { v }).collect();
+        assert_eq!(LobeKind::CosQuad { v: 2 }.variants(), cosquad);
+        assert_eq!(LobeKind::Pow.variants(), [LobeKind::Pow]);
+    }
 
     #[test]
     fn every_id_round_trips_and_is_unique() {

@@ -17,7 +17,7 @@
 //! - **Sampling**: table (`sampling::CosineDistribution`), as `logexp`.
 //! - **Source**: specula.
 
-use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
+use super::batch::{clamp_unit, CLAMP, F32Bounds, LobeKernel, ModelF32, WithKernel};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use super::logexp::exp2_by_log2;
@@ -127,13 +127,7 @@ impl ModelF32 for LogExpRr {
         f.call(self.kernel())
     }
 
-    fn batch_ulp_bound(&self, n: f64) -> f64 {
-        // Through log2, whose error is multiplied by n.
-        8.0 + 2.0 * n
-    }
-
-    fn gpu_ulp_bound(&self, n: f64) -> f64 {
-        // Through log2, whose error the driver's log2 multiplies by n.
-        32.0 + 2.0 * n
+    fn bounds(&self, n: f64) -> F32Bounds {
+        F32Bounds::through_log2(n)
     }
 }

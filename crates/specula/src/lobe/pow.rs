@@ -14,7 +14,7 @@
 //!   `t = (1 - u)^(1/(n+1))`, the classic Phong warp.
 //! - **Source**: B. T. Phong (1975); J. F. Blinn (1977); the thesis's reference function.
 
-use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
+use super::batch::{clamp_unit, CLAMP, F32Bounds, LobeKernel, ModelF32, WithKernel};
 use super::draw_batch::{self, remaining_share};
 use super::facts::closed_form_facts;
 use super::info::{LineStyle, LobeInfo, Origin};
@@ -143,13 +143,8 @@ impl ModelF32 for Pow {
         f.call(self.kernel())
     }
 
-    fn batch_ulp_bound(&self, n: f64) -> f64 {
-        // exp2(n log2 t): log2's error is multiplied by n.
-        8.0 + 2.0 * n
-    }
-
-    fn gpu_ulp_bound(&self, n: f64) -> f64 {
-        // exp2(n log2 t): the driver's log2 error is multiplied by n.
-        32.0 + 2.0 * n
+    fn bounds(&self, n: f64) -> F32Bounds {
+        // exp2(n log2 t).
+        F32Bounds::through_log2(n)
     }
 }

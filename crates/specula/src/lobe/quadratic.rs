@@ -12,7 +12,7 @@
 //! safeguarded Newton solves it from the Gaussian guess `g = sqrt(2 u L / C)`. A fit that
 //! overshoots 1 (clamped, so no longer the quadratic) is sampled from a table instead.
 
-use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
+use super::batch::{clamp_unit, F32Bounds, LobeKernel, ModelF32, WithKernel, CLAMP};
 use super::facts::ModelFacts;
 use super::invert::{solve_increasing, Inverted, NewtonStart};
 use super::NewtonForm;
@@ -293,15 +293,15 @@ impl ModelF32 for AngleQuadratic {
         f.call(self.kernel())
     }
 
-    fn batch_ulp_bound(&self, n: f64) -> f64 {
-        // acos within 2.5e-7 rad, times the quadratic's slope (at most ~2n^(1/2) per rad).
-        16.0 + 8.0 * n.sqrt()
-    }
-
-    fn gpu_ulp_bound(&self, _n: f64) -> f64 {
-        // The driver's acos is an approximation (lavapipe's is good to about 2e-4 rad near
-        // the peak): about 1e-3.
-        8192.0
+    fn bounds(&self, n: f64) -> F32Bounds {
+        F32Bounds {
+            // acos within 2.5e-7 rad, times the quadratic's slope (at most ~2n^(1/2) per rad).
+            batch_ulps: 16.0 + 8.0 * n.sqrt(),
+            // The driver's acos is an approximation (lavapipe's is good to about 2e-4 rad
+            // near the peak): about 1e-3.
+            gpu_ulps: 8192.0,
+            ..F32Bounds::EXACT
+        }
     }
 }
 

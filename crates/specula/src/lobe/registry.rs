@@ -60,6 +60,19 @@ macro_rules! lobes {
                 }
             }
 
+            /// Every kind this one's registry entry names: one per value of its parameter
+            /// (`cosquad:v=0` to `cosquad:v=10`), or itself for a lobe without one. A user's
+            /// lobe is itself: its parameters are reals.
+            #[must_use]
+            pub fn variants(self) -> Vec<LobeKind> {
+                match self {
+                    $( $(#[$attr])* LobeKind::$variant { .. } => {
+                        lobes!(@variants $variant, $module $(, $field, $field_type)?)
+                    } )*
+                    LobeKind::Formula(_) => vec![self],
+                }
+            }
+
             /// This built-in kind with its parameter set from `name=value` (`v=5`).
             fn with_parameter(self, text: &str) -> Result<Self> {
                 match self {
@@ -117,15 +130,34 @@ macro_rules! lobes {
         })
     };
     (@with_parameter $variant:ident, $module:ident, $text:ident, $field:ident, $field_type:ty) => {{
-        let info = &$module::INFO;
-        let param = info.params.iter().find(|p| p.name == stringify!($field));
-        let param = param.unwrap_or_else(|| unreachable!("{} lists its parameter", info.id));
-        let value = kind::parse_param(info.id, param, $text)?;
+        let param = lobes!(@param $module, $field);
+        let value = kind::parse_param($module::INFO.id, param, $text)?;
         Ok(LobeKind::$variant {
-            $field: <$field_type>::try_from(value)
-                .unwrap_or_else(|_| unreachable!("{} fits its type", param.name)),
+            $field: lobes!(@value param, value, $field_type),
         })
     }};
+    (@variants $variant:ident, $module:ident) => {
+        vec![LobeKind::$variant]
+    };
+    (@variants $variant:ident, $module:ident, $field:ident, $field_type:ty) => {{
+        let param = lobes!(@param $module, $field);
+        (param.min..=param.max)
+            .map(|value| LobeKind::$variant {
+                $field: lobes!(@value param, value, $field_type),
+            })
+            .collect()
+    }};
+    // The `ParamInfo` the lobe's entry lists for its variant's field.
+    (@param $module:ident, $field:ident) => {{
+        let info = &$module::INFO;
+        let param = info.params.iter().find(|p| p.name == stringify!($field));
+        param.unwrap_or_else(|| unreachable!("{} lists its parameter", info.id))
+    }};
+    // A value within the parameter's range, as its field's type.
+    (@value $param:ident, $value:ident, $field_type:ty) => {
+        <$field_type>::try_from($value)
+            .unwrap_or_else(|_| unreachable!("{}'s range fits its type", $param.name))
+    };
     (@text $module:ident) => {
         $module::INFO.id.to_owned()
     };

@@ -19,7 +19,7 @@
 //!   near-peak guess `d = expm1(c u L) / c`.
 //! - **Source**: C. Schlick, "A customizable reflectance model for everyday rendering" (1993).
 
-use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
+use super::batch::{clamp_unit, CLAMP, F32Bounds, LobeKernel, ModelF32, WithKernel};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use super::invert::{solve_increasing, Inverted, NewtonStart};
@@ -203,8 +203,8 @@ impl ModelF32 for Schlick {
         f.call(self.kernel())
     }
 
-    fn batch_ulp_bound(&self, _n: f64) -> f64 {
-        // One fused rounding in the denominator: a few ULP of the value.
-        4.0
+    fn bounds(&self, _n: f64) -> F32Bounds {
+        // One fused rounding in the denominator.
+        F32Bounds::EXACT
     }
 }

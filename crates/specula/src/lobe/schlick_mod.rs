@@ -24,7 +24,7 @@
 //!   (`sampling::CosineDistribution`) is exact enough and cheaper to trust.
 //! - **Source**: the thesis, slide "Modified Schlick BRDF".
 
-use super::batch::{with_squarings, ModelF32, WithKernel};
+use super::batch::{with_squarings, F32Bounds, ModelF32, WithKernel};
 use super::facts::ModelFacts;
 use super::info::{LineStyle, LobeInfo, Origin};
 use super::schlick::schlick_denominator_ratio;
@@ -139,9 +139,9 @@ impl ModelF32 for SchlickMod {
         with_squarings!(self.squarings(), K => f.call(self.kernel::<K>()))
     }
 
-    fn batch_ulp_bound(&self, _n: f64) -> f64 {
-        // One fused rounding in the denominator, as Schlick's: a few ULP of the value.
-        4.0
+    fn bounds(&self, _n: f64) -> F32Bounds {
+        // One fused rounding in the denominator, as Schlick's.
+        F32Bounds::EXACT
     }
 }
 

@@ -21,7 +21,7 @@
 //!   Fresnel" (2012); the Gaussian form of the Phong lobe behind real-time engines' cheap
 //!   specular.
 
-use super::batch::{clamp_unit, LobeKernel, ModelF32, WithKernel, CLAMP};
+use super::batch::{clamp_unit, CLAMP, F32Bounds, LobeKernel, ModelF32, WithKernel};
 use super::draw_batch::{self, remaining_share};
 use super::facts::closed_form_facts;
 use super::info::{LineStyle, LobeInfo, Origin};
@@ -192,15 +192,13 @@ impl ModelF32 for Sg {
         f.call(self.kernel())
     }
 
-    fn batch_ulp_bound(&self, _n: f64) -> f64 {
-        // One fused multiply-add against a rounded product, scaled by the value times its
-        // argument (at most 0.53), plus exp2's 2 ULP.
-        8.0
-    }
-
-    fn gpu_ulp_bound(&self, _n: f64) -> f64 {
-        // One exp2 of a product: the product's rounding times the value times its argument
-        // (at most 0.53), plus the driver's exp2.
-        64.0
+    fn bounds(&self, _n: f64) -> F32Bounds {
+        F32Bounds {
+            // One fused multiply-add against a rounded product, scaled by the value times its
+            // argument (at most 0.53), plus exp2's 2 ULP; on a GPU, the driver's exp2.
+            batch_ulps: 8.0,
+            gpu_ulps: 64.0,
+            ..F32Bounds::EXACT
+        }
     }
 }
