@@ -16,16 +16,21 @@
 //! - **Classification without a search.** A table over the volume's range finds the piece
 //!   of the transfer function a value falls in, whose line then gives extinction and colour
 //!   exactly as the function does.
+//! - **Transparent cells not read.** In a brick that is not empty, a cell whose corners all
+//!   lie where the transfer function has no extinction is marked ([`cells`]); a sample there
+//!   is known to have none without reading a voxel.
 
 use std::borrow::Cow;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use glam::{IVec3, Vec3, Vec4};
 use rayon::prelude::*;
+use specula::simd::{dispatch, Job, Lanes, Level};
 
 use super::transfer::TransferFunction;
 use super::{Sample, Samples, Volume};
 
+mod cells;
 #[cfg(test)]
 mod prepared_tests;
 pub(super) mod ray;
@@ -157,6 +162,15 @@ impl PreparedVolume {
         self.voxels.quantisation_error()
     }
 
+    /// How far a sample's interpolated value may stray from the range of its cell's corners
+    /// (as [`Self::voxels`] gives them): the rounding of three nested interpolations, a few
+    /// units in the last place of the largest value, and, for values stored as integers
+    /// scaled, half a step.
+    fn value_margin(&self) -> f32 {
+        let largest = self.range.0.abs().max(self.range.1.abs());
+        largest * f32::EPSILON * 8.0 + f32::MIN_POSITIVE + self.quantisation_error().0
+    }
+
     /// Bricks along each axis ([`BRICK`]^3 cells each, the last ones possibly partial).
     #[must_use]
     pub fn bricks(&self) -> [usize; 3] {
@@ -171,17 +185,12 @@ impl PreparedVolume {
         (IVec3::new(x, y, z), Vec3::new(fx, fy, fz))
     }
 
-    /// [`Self::cell`] along one axis whose last cell is `last_cell`. Adding 1.5 * 2^23 to
-    /// p - 1/2 rounds it to an integer held in the low mantissa bits (the sum lies in
-    /// [2^23, 2^24), where the spacing is 1): floor of p, or p - 1 where p is an odd whole
-    /// number (a tie rounded to even), whose cell then holds p at its far corner (f = 1). Two
-    /// instructions a lane, where `as i32` (saturating) takes several; p lies in [0, 4096)
-    /// (`MAX_SIDE`). The last layer of voxels belongs to the last cell.
+    /// [`Self::cell`] along one axis whose last cell is `last_cell`: [`whole_below`] of p,
+    /// whose cell then holds p at its far corner (f = 1) where p is an odd whole number. The
+    /// last layer of voxels belongs to the last cell.
     #[inline(always)]
     fn cell_along(p: f32, last_cell: i32) -> (i32, f32) {
-        const ROUND: f32 = 12_582_912.0;
-        let rounded = (p - 0.5) + ROUND;
-        let cell = (rounded.to_bits() as i32 - ROUND.to_bits() as i32).min(last_cell);
+        let cell = whole_below(p).min(last_cell);
         (cell, p - cell as f32)
     }
 
@@ -190,8 +199,16 @@ impl PreparedVolume {
     #[inline(always)]
     #[must_use]
     pub fn sample(&self, p: Vec3) -> Vec4 {
-        let (cell, f) = self.cell(p.clamp(Vec3::ZERO, self.last_index));
-        self.sample_at(self.voxel(cell.to_array()) as usize, f)
+        struct Sample<'a>(&'a PreparedVolume, Vec3);
+        impl Job for Sample<'_> {
+            type Output = Vec4;
+            fn run<V: Lanes>(self, lanes: V) -> Vec4 {
+                let Sample(volume, p) = self;
+                let (cell, f) = volume.cell(p.clamp(Vec3::ZERO, volume.last_index));
+                volume.sample_at(lanes, volume.voxel(cell.to_array()) as usize, f)
+            }
+        }
+        dispatch(Level::Baseline, Sample(self, p))
     }
 
     /// The first voxel of `cell` (its corner of smallest indices). Plain `i32` arithmetic (a
@@ -204,9 +221,9 @@ impl PreparedVolume {
 
     /// The trilinear value and gradient at `f` in the cell whose first voxel is `at`.
     #[inline(always)]
-    fn sample_at(&self, at: usize, f: Vec3) -> Vec4 {
+    fn sample_at<V: Lanes>(&self, lanes: V, at: usize, f: Vec3) -> Vec4 {
         let (nx, nxy) = (self.dims[0], self.dims[0] * self.dims[1]);
-        self.voxels.trilinear(at, f, nx, nxy)
+        self.voxels.trilinear(lanes, at, f, nx, nxy)
     }
 
     /// Whether the voxels are too many for the caches (held in the compact layout), so that
@@ -241,6 +258,17 @@ impl PreparedVolume {
         let c = (high - origin) * inverse_direction;
         a.max(c).min_element()
     }
+}
+
+/// `x` (in `[0, 2^22)`) rounded down to a whole number, or to one less where `x` is an odd
+/// whole number. Adding 1.5 * 2^23 to x - 1/2 rounds it to an integer held in the low
+/// mantissa bits (the sum lies in [2^23, 2^24), where the spacing is 1), a tie to even: two
+/// instructions a lane, where `as i32` (saturating, NaN to 0) takes several.
+#[inline(always)]
+fn whole_below(x: f32) -> i32 {
+    const ROUND: f32 = 12_582_912.0;
+    let rounded = (x - 0.5) + ROUND;
+    rounded.to_bits() as i32 - ROUND.to_bits() as i32
 }
 
 /// The smallest and largest of `samples` (a grid of `dims`) over each of `bricks` bricks'
@@ -290,6 +318,9 @@ pub struct Classification {
     /// bricks to the nearest such brick (at most [`MOST_CLEARANCE`]): every brick less than
     /// that far from it is empty too.
     clearance: Vec<u8>,
+    /// Per brick, a bit per cell ([`cells::cell_bit`]) set where no value in the cell has
+    /// extinction (only in bricks whose clearance is 0).
+    transparent: Vec<u64>,
 }
 
 impl Classification {
@@ -345,6 +376,7 @@ impl Classification {
             })
             .collect();
         let clearance = chessboard_distance(&occupied, volume.bricks);
+        let transparent = cells::transparent_cells(volume, points, &occupied);
         Self {
             bounds,
             pieces,
@@ -352,6 +384,7 @@ impl Classification {
             lowest,
             per_entry,
             clearance,
+            transparent,
         }
     }
 

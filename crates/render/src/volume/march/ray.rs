@@ -24,7 +24,8 @@
 use glam::{IVec3, Vec3};
 use specula::simd::{dispatch, exp2_nonpositive, Job, Lanes, Level, Prefetch};
 
-use super::{Classification, PreparedVolume};
+use super::cells::cell_bit;
+use super::{whole_below, Classification, PreparedVolume};
 use crate::volume::dvr::lighting::{LanesView, Lighting, RayView};
 
 /// One ray's march, in grid units: `origin + direction * t` for `t` (mm) in `[start, end]`.
@@ -119,6 +120,7 @@ pub(crate) fn march_rays(
                 lit,
                 rays,
                 step,
+                inverse_step: 1.0 / step,
                 opacity_cutoff,
                 prefetch: Prefetch::new(),
                 lookahead,
@@ -143,6 +145,8 @@ struct Packet<'a, const FETCH: bool> {
     lit: Option<Lit<'a>>,
     rays: &'a [Ray],
     step: f32,
+    /// `1 / step`.
+    inverse_step: f32,
     opacity_cutoff: f32,
     prefetch: Prefetch,
     /// How far ahead of each sample (mm along the ray) the voxels are fetched when `FETCH`.
@@ -187,9 +191,13 @@ struct Turn {
     /// Where the cell [`LOOKAHEAD`] steps further on starts, when the volume is prefetched.
     ahead: Lane<i32>,
     brick: Lane<i32>,
+    /// The cell's bit in its brick's mask of transparent cells.
+    bit: Lane<u32>,
     /// The midpoint's place in its cell.
     fraction: [Lane<f32>; 3],
     length: Lane<f32>,
+    /// The field's value at the midpoint.
+    value: Lane<f32>,
     /// The extinction at the midpoint (0 where a lane took no sample).
     sigma: Lane<f32>,
     /// The transfer function's colour there.
@@ -227,8 +235,10 @@ impl Turn {
         voxel: [0; LANES],
         ahead: [0; LANES],
         brick: [0; LANES],
+        bit: [0; LANES],
         fraction: [[0.0; LANES]; 3],
         length: [0.0; LANES],
+        value: [0.0; LANES],
         sigma: [0.0; LANES],
         base: [[0.0; LANES]; 3],
         gradient: [[0.0; LANES]; 3],
@@ -309,7 +319,7 @@ impl<const FETCH: bool> Job for Packet<'_, FETCH> {
         // whose ray ends has its read-ahead sample replaced by its next ray's first.
         let (mut current, mut ahead) = (Turn::EMPTY, Turn::EMPTY);
         self.segments(&mut marching, &mut current);
-        self.samples(&mut marching, &mut current);
+        self.samples(lanes, &mut marching, &mut current);
         while marching.live.contains(&true) {
             self.segments(&mut marching, &mut ahead);
             // A turn in which no lane took a sample with extinction composites nothing
@@ -317,7 +327,7 @@ impl<const FETCH: bool> Job for Packet<'_, FETCH> {
             if current.sigma.iter().any(|&sigma| sigma > 0.0) {
                 self.composite(lanes, &mut marching, &current, &mut highlights);
             }
-            self.samples(&mut marching, &mut ahead);
+            self.samples(lanes, &mut marching, &mut ahead);
             let mut ended = [false; LANES];
             for k in 0..LANES {
                 let going = current.t_end[k] < marching.end[k]
@@ -343,7 +353,7 @@ impl<const FETCH: bool> Job for Packet<'_, FETCH> {
                     if marching.live[k] {
                         self.segment(&mut marching, &mut ahead, k);
                     }
-                    self.sample(&mut marching, &mut ahead, k);
+                    self.sample(lanes, &mut marching, &mut ahead, k);
                 }
             }
             core::mem::swap(&mut current, &mut ahead);
@@ -412,9 +422,20 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
     /// another (a lane skipping brick after brick on its own would be one long chain of
     /// dependent instructions while the rest wait).
     #[inline(always)]
-    fn samples(&self, marching: &mut Marching, turn: &mut Turn) {
+    fn samples<V: Lanes>(&self, lanes: V, marching: &mut Marching, turn: &mut Turn) {
+        let mut reading = [false; LANES];
         for k in 0..LANES {
-            self.sample(marching, turn, k);
+            reading[k] = self.place(marching, turn, k);
+        }
+        for k in 0..LANES {
+            if reading[k] {
+                self.interpolate(lanes, turn, k);
+            }
+        }
+        for k in 0..LANES {
+            if reading[k] {
+                self.classify(turn, k);
+            }
         }
     }
 
@@ -450,6 +471,7 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
         let cell = [turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]];
         turn.voxel[k] = volume.voxel(cell);
         turn.brick[k] = volume.brick(cell);
+        turn.bit[k] = cell_bit(cell);
         if FETCH {
             turn.ahead[k] = volume.voxel(ahead);
         }
@@ -459,37 +481,61 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
 
     /// Lane `k`'s sample at its segment (see [`Self::samples`]); an idle lane's is cleared.
     #[inline(always)]
-    fn sample(&self, marching: &mut Marching, turn: &mut Turn, k: usize) {
+    fn sample<V: Lanes>(&self, lanes: V, marching: &mut Marching, turn: &mut Turn, k: usize) {
+        if self.place(marching, turn, k) {
+            self.interpolate(lanes, turn, k);
+            self.classify(turn, k);
+        }
+    }
+
+    /// Skips lane `k` past the empty bricks its segment lies in, or says whether it reads a
+    /// sample there (not in a transparent cell, whose sample has no extinction); an idle
+    /// lane's is cleared.
+    #[inline(always)]
+    fn place(&self, marching: &mut Marching, turn: &mut Turn, k: usize) -> bool {
         turn.sigma[k] = 0.0;
+        let mut reading = false;
         if marching.live[k] {
-            let clearance = self.classification.clearance[turn.brick[k] as usize];
+            let brick = turn.brick[k] as usize;
+            let clearance = self.classification.clearance[brick];
             if clearance > 0 {
                 let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
                 self.skip(marching, k, cell, clearance);
-            } else {
+            } else if self.classification.transparent[brick] >> turn.bit[k] & 1 == 0 {
                 if FETCH {
                     self.volume.prefetch(turn.ahead[k] as usize, self.prefetch);
                 }
-                self.read(turn, k);
+                reading = true;
             }
         }
         turn.t_end[k] = marching.t[k];
+        reading
     }
 
-    /// Lane `k`'s value and gradient at its midpoint, and the transfer function there.
+    /// Lane `k`'s value and gradient at its midpoint.
     #[inline(always)]
-    fn read(&self, turn: &mut Turn, k: usize) {
+    fn interpolate<V: Lanes>(&self, lanes: V, turn: &mut Turn, k: usize) {
         let fraction = Vec3::new(
             turn.fraction[0][k],
             turn.fraction[1][k],
             turn.fraction[2][k],
         );
-        let sample = self.volume.sample_at(turn.voxel[k] as usize, fraction);
-        let classified = self.classification.at(sample.x);
+        let sample = self
+            .volume
+            .sample_at(lanes, turn.voxel[k] as usize, fraction);
+        turn.value[k] = sample.x;
+        for c in 0..3 {
+            turn.gradient[c][k] = sample[c + 1];
+        }
+    }
+
+    /// The transfer function at lane `k`'s value.
+    #[inline(always)]
+    fn classify(&self, turn: &mut Turn, k: usize) {
+        let classified = self.classification.at(turn.value[k]);
         turn.sigma[k] = classified.x;
         for c in 0..3 {
             turn.base[c][k] = classified[c + 1];
-            turn.gradient[c][k] = sample[c + 1];
         }
     }
 
@@ -510,11 +556,14 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
             origin,
             marching.inverse_direction[k],
         );
-        let beyond = (exit - marching.t[k]) / self.step - 0.5 - 1e-3;
+        // At most 2^22 - 1 segments at once (whole_below's range): a shorter skip is still
+        // exact, and no ray is that many segments long.
+        let beyond = ((exit - marching.t[k]) * self.inverse_step - 0.5 - 1e-3).min(4_194_303.0);
         if beyond > 0.0 {
-            // ceil without a library call (beyond > 0).
-            let skipped = beyond as i32;
-            marching.j[k] += skipped as u32 + u32::from((skipped as f32) < beyond);
+            // The ceiling: `whole` falls short by one where beyond is not whole, or where it
+            // is an odd whole number (whole_below's rounding); the comparison makes it up.
+            let whole = whole_below(beyond);
+            marching.j[k] += whole as u32 + u32::from((whole as f32) < beyond);
             marching.t[k] = marching.lattice[k] + marching.j[k] as f32 * self.step;
         }
     }

@@ -162,8 +162,9 @@ fn the_prepared_march_is_the_reference_march() {
 
 #[test]
 fn empty_bricks_are_skipped_without_changing_a_pixel() {
-    // A ball in a large empty grid: most bricks are empty, and the image with bricks is
-    // the image without them (every brick marked occupied) bit for bit.
+    // A ball in a large empty grid: most bricks are empty, and the image with bricks and
+    // transparent cells is the image without them (every brick occupied, no cell marked) bit
+    // for bit.
     let n = 64;
     let samples = (0..n * n * n)
         .map(|v| {
@@ -192,8 +193,13 @@ fn empty_bricks_are_skipped_without_changing_a_pixel() {
         skipping.clearance.iter().any(|&c| c > 4),
         "some empty space reaches beyond 4 bricks"
     );
+    assert!(
+        skipping.transparent.iter().any(|&mask| mask != 0),
+        "some cells of occupied bricks are transparent"
+    );
     let mut everything = skipping.clone();
     everything.clearance.iter_mut().for_each(|c| *c = 0);
+    everything.transparent.fill(0);
     let direction = Vec3::new(0.3, 0.8, 0.52).normalize();
     let mut rays = Vec::new();
     for (k, first) in [0.1_f32, 0.5, 1.0].into_iter().enumerate() {

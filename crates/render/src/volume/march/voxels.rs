@@ -23,7 +23,7 @@ use std::sync::Arc;
 use glam::{Mat3, Vec3, Vec4};
 use rayon::prelude::*;
 
-use specula::simd::Prefetch;
+use specula::simd::{Lanes, Prefetch};
 
 use crate::volume::{Sample, Samples, Volume};
 
@@ -134,16 +134,29 @@ impl Voxels {
     /// The trilinear value and gradient at `f` in the cell whose first voxel is `at`, on a
     /// grid `nx` voxels wide with `nxy` to a slice. The cell's corners are four pairs of
     /// neighbours along `i`, each pair eight numbers in a row: they are interpolated pairwise
-    /// along `y`, then `z` (eight lanes at a time), and the pair's two ends along `x` last.
+    /// along `y`, then `z` (in `lanes`, eight numbers to a 256-bit vector), and the pair's two
+    /// ends along `x` last.
     #[inline(always)]
-    pub(super) fn trilinear(&self, at: usize, f: Vec3, nx: usize, nxy: usize) -> Vec4 {
+    pub(super) fn trilinear<V: Lanes>(
+        &self,
+        lanes: V,
+        at: usize,
+        f: Vec3,
+        nx: usize,
+        nxy: usize,
+    ) -> Vec4 {
         match self {
-            Voxels::Exact(voxels) => trilinear(at, f, nx, nxy, |voxel| {
-                *voxels[voxel..]
-                    .as_flattened()
-                    .first_chunk()
-                    .expect("a cell's corners lie inside the grid")
-            }),
+            Voxels::Exact(voxels) => {
+                let ends = trilinear_lanes(lanes, at, nx, nxy, f, |voxel| {
+                    *voxels[voxel..]
+                        .as_flattened()
+                        .first_chunk()
+                        .expect("a cell's corners lie inside the grid")
+                });
+                let low = Vec4::from_slice(&ends[..4]);
+                let high = Vec4::from_slice(&ends[4..]);
+                low + (high - low) * f.x
+            }
             Voxels::Compact {
                 values,
                 gradients,
@@ -151,7 +164,7 @@ impl Voxels {
             } => {
                 // Lanes `[x0, y0, z0, x1, y1, z1, v0, v1]`: one 16-byte read of the pair's
                 // gradients (and two integers past them), its last two lanes the values.
-                let lanes = trilinear_lanes(at, nx, nxy, f, |voxel| {
+                let lanes = trilinear_lanes(lanes, at, nx, nxy, f, |voxel| {
                     let mut pair = *gradients[voxel..]
                         .as_flattened()
                         .first_chunk::<8>()
@@ -166,6 +179,20 @@ impl Voxels {
                 let low = Vec4::new(lanes[6], lanes[0], lanes[1], lanes[2]);
                 let high = Vec4::new(lanes[7], lanes[3], lanes[4], lanes[5]);
                 quantised.decode(low + (high - low) * f.x)
+            }
+        }
+    }
+
+    /// Voxel `voxel`'s value, as the interpolation reads it.
+    pub(super) fn value(&self, voxel: usize) -> f32 {
+        match self {
+            Voxels::Exact(voxels) => voxels[voxel][0],
+            Voxels::Compact {
+                values, quantised, ..
+            } => {
+                quantised
+                    .decode(Vec4::new(f32::from(values[voxel]), 0.0, 0.0, 0.0))
+                    .x
             }
         }
     }
@@ -276,39 +303,26 @@ fn fill_gradients<T: Sample, O: Send>(
         });
 }
 
-/// [`Voxels::trilinear`] over pairs read by `pair`, laid out `[v0, x0, y0, z0, v1, x1, y1,
-/// z1]`.
+/// The cell's four pairs read by `pair`, interpolated along `y` and `z` in `lanes`: what is
+/// left is the pair's two ends along `x`.
 #[inline(always)]
-fn trilinear(at: usize, f: Vec3, nx: usize, nxy: usize, pair: impl Fn(usize) -> [f32; 8]) -> Vec4 {
-    let ends = trilinear_lanes(at, nx, nxy, f, pair);
-    let low = Vec4::from_slice(&ends[..4]);
-    let high = Vec4::from_slice(&ends[4..]);
-    low + (high - low) * f.x
-}
-
-/// The cell's four pairs read by `pair`, interpolated along `y` and `z`, lane by lane: what
-/// is left is the pair's two ends along `x`.
-#[inline(always)]
-fn trilinear_lanes(
+fn trilinear_lanes<V: Lanes>(
+    lanes: V,
     at: usize,
     nx: usize,
     nxy: usize,
     f: Vec3,
     pair: impl Fn(usize) -> [f32; 8],
 ) -> [f32; 8] {
-    let near = lerp8(pair(at), pair(at + nx), f.y);
-    let far = lerp8(pair(at + nxy), pair(at + nxy + nx), f.y);
-    lerp8(near, far, f.z)
-}
-
-/// `a + (b - a) t`, lane by lane.
-#[inline(always)]
-fn lerp8(a: [f32; 8], b: [f32; 8], t: f32) -> [f32; 8] {
-    let mut out = a;
-    for lane in 0..8 {
-        out[lane] = a[lane] + (b[lane] - a[lane]) * t;
+    let corners = [pair(at), pair(at + nx), pair(at + nxy), pair(at + nxy + nx)];
+    let (fy, fz) = (lanes.splat(f.y), lanes.splat(f.z));
+    let lerp = |a: V, b: V, t: V| a + (b - a) * t;
+    let mut ends = [0.0; 8];
+    for at in (0..8).step_by(V::WIDTH) {
+        let [a, b, c, d] = corners.map(|corner| lanes.load(&corner[at..at + V::WIDTH]));
+        lerp(lerp(a, b, fy), lerp(c, d, fy), fz).store(&mut ends[at..at + V::WIDTH]);
     }
-    out
+    ends
 }
 
 /// How the compact layout holds a voxel's value and gradient: `stored * scale + offset`
