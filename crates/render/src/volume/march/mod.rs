@@ -247,16 +247,21 @@ impl PreparedVolume {
         (cell[0] >> BRICK_SHIFT) + bx * ((cell[1] >> BRICK_SHIFT) + by * (cell[2] >> BRICK_SHIFT))
     }
 
-    /// Where a ray (grid index `origin + direction * t`) leaves the cube of bricks within
-    /// `reach - 1` bricks of the one holding `cell` (that brick alone for a reach of 1).
+    /// Where a ray (grid index `origin + direction * t`, one axis of it) leaves, along that
+    /// axis, the cube of bricks within `reach - 1` bricks of the one holding `cell` (that
+    /// brick alone for a reach of 1): the ray leaves the cube at the least of the three.
     #[inline(always)]
-    fn clear_exit(cell: IVec3, reach: i32, origin: Vec3, inverse_direction: Vec3) -> f32 {
+    fn clear_exit_along(cell: i32, reach: i32, origin: f32, inverse_direction: f32) -> f32 {
         let brick = cell >> BRICK_SHIFT;
-        let low = ((brick - (reach - 1)) << BRICK_SHIFT).as_vec3();
-        let high = ((brick + reach) << BRICK_SHIFT).as_vec3();
+        let low = ((brick - (reach - 1)) << BRICK_SHIFT) as f32;
+        let high = ((brick + reach) << BRICK_SHIFT) as f32;
         let a = (low - origin) * inverse_direction;
         let c = (high - origin) * inverse_direction;
-        a.max(c).min_element()
+        if a > c {
+            a
+        } else {
+            c
+        }
     }
 }
 

@@ -21,7 +21,7 @@
 // is the shape the compiler vectorises.
 #![allow(clippy::needless_range_loop)]
 
-use glam::{IVec3, Vec3};
+use glam::Vec3;
 use specula::simd::{dispatch, exp2_nonpositive, Job, Lanes, Level, Prefetch};
 
 use super::cells::cell_bit;
@@ -165,7 +165,7 @@ struct Marching {
     origin: [Lane<f32>; 3],
     direction: [Lane<f32>; 3],
     /// Per axis, `1 / direction` (huge along a grid plane), for leaving empty bricks.
-    inverse_direction: Lane<Vec3>,
+    inverse_direction: [Lane<f32>; 3],
     end: Lane<f32>,
     /// Where the first segment ends.
     first_end: Lane<f32>,
@@ -215,7 +215,7 @@ impl Marching {
         live: [false; LANES],
         origin: [[0.0; LANES]; 3],
         direction: [[0.0; LANES]; 3],
-        inverse_direction: [Vec3::ZERO; LANES],
+        inverse_direction: [[0.0; LANES]; 3],
         end: [0.0; LANES],
         first_end: [0.0; LANES],
         lattice: [0.0; LANES],
@@ -383,11 +383,14 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
         }
         // A direction along a grid plane never leaves a brick across it: a huge inverse keeps
         // that axis's exit out of the minimum (and away from 0 * infinity).
-        marching.inverse_direction[k] = Vec3::select(
+        let inverse = Vec3::select(
             ray.direction.abs().cmplt(Vec3::splat(1e-12)),
             Vec3::splat(1e30),
             ray.direction.recip(),
         );
+        for axis in 0..3 {
+            marching.inverse_direction[axis][k] = inverse[axis];
+        }
         marching.end[k] = ray.end;
         marching.first_end[k] = ray.start + ray.first;
         marching.lattice[k] = ray.start + ray.first - self.step;
@@ -423,9 +426,16 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
     /// dependent instructions while the rest wait).
     #[inline(always)]
     fn samples<V: Lanes>(&self, lanes: V, marching: &mut Marching, turn: &mut Turn) {
+        let mut bricks = [(0, false); LANES];
+        for k in 0..LANES {
+            bricks[k] = self.brick_state(turn, k);
+        }
         let mut reading = [false; LANES];
         for k in 0..LANES {
-            reading[k] = self.place(marching, turn, k);
+            reading[k] = self.advance(marching, turn, k, bricks[k]);
+        }
+        for k in 0..LANES {
+            self.fetch_ahead(turn, k, reading[k]);
         }
         for k in 0..LANES {
             if reading[k] {
@@ -489,27 +499,56 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
     }
 
     /// Skips lane `k` past the empty bricks its segment lies in, or says whether it reads a
-    /// sample there (not in a transparent cell, whose sample has no extinction); an idle
-    /// lane's is cleared.
+    /// sample there (see [`Self::advance`]).
     #[inline(always)]
     fn place(&self, marching: &mut Marching, turn: &mut Turn, k: usize) -> bool {
-        turn.sigma[k] = 0.0;
-        let mut reading = false;
-        if marching.live[k] {
-            let brick = turn.brick[k] as usize;
-            let clearance = self.classification.clearance[brick];
-            if clearance > 0 {
-                let cell = IVec3::new(turn.cell[0][k], turn.cell[1][k], turn.cell[2][k]);
-                self.skip(marching, k, cell, clearance);
-            } else if self.classification.transparent[brick] >> turn.bit[k] & 1 == 0 {
-                if FETCH {
-                    self.volume.prefetch(turn.ahead[k] as usize, self.prefetch);
-                }
-                reading = true;
-            }
-        }
-        turn.t_end[k] = marching.t[k];
+        let brick = self.brick_state(turn, k);
+        let reading = self.advance(marching, turn, k, brick);
+        self.fetch_ahead(turn, k, reading);
         reading
+    }
+
+    /// The clearance of lane `k`'s brick, and whether its cell is transparent.
+    #[inline(always)]
+    fn brick_state(&self, turn: &Turn, k: usize) -> (u8, bool) {
+        let brick = turn.brick[k] as usize;
+        let transparent = self.classification.transparent[brick] >> turn.bit[k] & 1 != 0;
+        (self.classification.clearance[brick], transparent)
+    }
+
+    /// Skips lane `k` past the empty bricks its segment lies in, given its brick's
+    /// `(clearance, transparent)`, or says whether it reads a sample there (not in a
+    /// transparent cell, whose sample has no extinction); an idle lane's is cleared. Without
+    /// a branch: every lane computes a skip, kept where it has one, so that the lanes are
+    /// computed side by side and an unpredictable clearance costs no misprediction.
+    #[inline(always)]
+    fn advance(
+        &self,
+        marching: &mut Marching,
+        turn: &mut Turn,
+        k: usize,
+        (clearance, transparent): (u8, bool),
+    ) -> bool {
+        let live = marching.live[k];
+        let skipping = live & (clearance > 0);
+        let steps = self.skip(marching, turn, k, clearance) * u32::from(skipping);
+        let j = marching.j[k] + steps;
+        let skipped = marching.lattice[k] + j as f32 * self.step;
+        marching.j[k] = j;
+        marching.t[k] = if steps > 0 { skipped } else { marching.t[k] };
+        turn.sigma[k] = 0.0;
+        turn.t_end[k] = marching.t[k];
+        live & (clearance == 0) & !transparent
+    }
+
+    /// When the volume is fetched ahead, asks for the voxels lane `k` reads [`LOOKAHEAD`]
+    /// steps on, if it reads now (a loop apart from [`Self::advance`]'s, which a call would
+    /// keep from being vectorised).
+    #[inline(always)]
+    fn fetch_ahead(&self, turn: &Turn, k: usize, reading: bool) {
+        if FETCH && reading {
+            self.volume.prefetch(turn.ahead[k] as usize, self.prefetch);
+        }
     }
 
     /// Lane `k`'s value and gradient at its midpoint.
@@ -539,33 +578,32 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
         }
     }
 
-    /// Lane `k`'s midpoint lies in the empty brick `cell` is in, whose empty surroundings
-    /// reach `clearance` bricks: every sample whose midpoint lies before the ray leaves the
-    /// empty cube of bricks centred there has no extinction, so the lane skips those segments
-    /// (a margin keeps the one that rounding could place across its exit).
+    /// The segments lane `k` skips when its midpoint lies in an empty brick whose empty
+    /// surroundings reach `clearance` bricks (1 taken for 0): every sample whose midpoint lies
+    /// before the ray leaves the empty cube of bricks centred there has no extinction (a
+    /// margin keeps the one that rounding could place across its exit).
     #[inline(always)]
-    fn skip(&self, marching: &mut Marching, k: usize, cell: IVec3, clearance: u8) {
-        let origin = Vec3::new(
-            marching.origin[0][k],
-            marching.origin[1][k],
-            marching.origin[2][k],
-        );
-        let exit = PreparedVolume::clear_exit(
-            cell,
-            i32::from(clearance),
-            origin,
-            marching.inverse_direction[k],
-        );
+    fn skip(&self, marching: &Marching, turn: &Turn, k: usize, clearance: u8) -> u32 {
+        let reach = i32::from(clearance.max(1));
+        let mut exit = f32::INFINITY;
+        for axis in 0..3 {
+            let leaves = PreparedVolume::clear_exit_along(
+                turn.cell[axis][k],
+                reach,
+                marching.origin[axis][k],
+                marching.inverse_direction[axis][k],
+            );
+            exit = if leaves < exit { leaves } else { exit };
+        }
         // At most 2^22 - 1 segments at once (whole_below's range): a shorter skip is still
         // exact, and no ray is that many segments long.
-        let beyond = ((exit - marching.t[k]) * self.inverse_step - 0.5 - 1e-3).min(4_194_303.0);
-        if beyond > 0.0 {
-            // The ceiling: `whole` falls short by one where beyond is not whole, or where it
-            // is an odd whole number (whole_below's rounding); the comparison makes it up.
-            let whole = whole_below(beyond);
-            marching.j[k] += whole as u32 + u32::from((whole as f32) < beyond);
-            marching.t[k] = marching.lattice[k] + marching.j[k] as f32 * self.step;
-        }
+        let beyond = ((exit - marching.t[k]) * self.inverse_step - 0.5 - 1e-3)
+            .min(4_194_303.0)
+            .max(0.0);
+        // The ceiling: `whole` falls short by one where beyond is not whole, or where it is
+        // an odd whole number (whole_below's rounding); the comparison makes it up.
+        let whole = whole_below(beyond);
+        whole as u32 + u32::from((whole as f32) < beyond)
     }
 
     /// Composites each lane's sample front to back, lit, and gathers its highlight: a
