@@ -431,8 +431,16 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
             bricks[k] = self.brick_state(turn, k);
         }
         let mut reading = [false; LANES];
-        for k in 0..LANES {
-            reading[k] = self.advance(marching, turn, k, bricks[k]);
+        // A turn in which no lane is in an empty brick (most, inside dense tissue) computes no
+        // skip.
+        if (0..LANES).any(|k| marching.live[k] & (bricks[k].0 > 0)) {
+            for k in 0..LANES {
+                reading[k] = self.advance(marching, turn, k, bricks[k]);
+            }
+        } else {
+            for k in 0..LANES {
+                reading[k] = self.stay(marching, turn, k, bricks[k]);
+            }
         }
         for k in 0..LANES {
             self.fetch_ahead(turn, k, reading[k]);
@@ -529,16 +537,27 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
         k: usize,
         (clearance, transparent): (u8, bool),
     ) -> bool {
-        let live = marching.live[k];
-        let skipping = live & (clearance > 0);
+        let skipping = marching.live[k] & (clearance > 0);
         let steps = self.skip(marching, turn, k, clearance) * u32::from(skipping);
         let j = marching.j[k] + steps;
         let skipped = marching.lattice[k] + j as f32 * self.step;
         marching.j[k] = j;
         marching.t[k] = if steps > 0 { skipped } else { marching.t[k] };
+        self.stay(marching, turn, k, (clearance, transparent))
+    }
+
+    /// [`Self::advance`] for a lane that does not skip.
+    #[inline(always)]
+    fn stay(
+        &self,
+        marching: &Marching,
+        turn: &mut Turn,
+        k: usize,
+        (clearance, transparent): (u8, bool),
+    ) -> bool {
         turn.sigma[k] = 0.0;
         turn.t_end[k] = marching.t[k];
-        live & (clearance == 0) & !transparent
+        marching.live[k] & (clearance == 0) & !transparent
     }
 
     /// When the volume is fetched ahead, asks for the voxels lane `k` reads [`LOOKAHEAD`]
