@@ -217,11 +217,15 @@ fn render_images(
     // Pixel `p` of image `i` at `pixels[p * images + i]`.
     let mut pixels = vec![settings.background; width as usize * height as usize * images];
     // Bands of TILE rows, drawn tile by tile: a tile's rays cross the same few columns of
-    // voxels, which then stay in cache from one ray to the next.
+    // voxels, which then stay in cache from one ray to the next. The bands are handed out in
+    // order, so that the threads draw neighbouring bands at once and share the slices the
+    // shared cache holds (split in halves, as an indexed parallel iterator is, they drew far
+    // apart: a clinical-size CT's frames 84-87 -> 78-80 ms on 2 threads).
     let band = TILE * width as usize * images;
     pixels
-        .par_chunks_mut(band)
+        .chunks_mut(band)
         .enumerate()
+        .par_bridge()
         .for_each(|(index, band)| {
             let rows = band.len() / (width as usize * images);
             let mut rays = Vec::with_capacity(TILE * TILE);
