@@ -616,9 +616,8 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
         }
         // At most 2^22 - 1 segments at once (whole_below's range): a shorter skip is still
         // exact, and no ray is that many segments long.
-        let beyond = ((exit - marching.t[k]) * self.inverse_step - 0.5 - 1e-3)
-            .min(4_194_303.0)
-            .max(0.0);
+        let beyond =
+            ((exit - marching.t[k]) * self.inverse_step - 0.5 - 1e-3).clamp(0.0, 4_194_303.0);
         // The ceiling: `whole` falls short by one where beyond is not whole, or where it is
         // an odd whole number (whole_below's rounding); the comparison makes it up.
         let whole = whole_below(beyond);
