@@ -66,7 +66,7 @@ struct Piece {
 @group(0) @binding(7) var<storage, read> highlights: array<Highlight>;
 
 // Where the ray grid_origin + grid_direction t leaves the cube of bricks within reach - 1
-// bricks of the one holding cell (PreparedVolume::clear_exit).
+// bricks of the one holding cell (PreparedVolume::clear_exit_along, per axis).
 fn clear_exit(cell: vec3<i32>, reach: i32, origin: vec3<f32>, inverse_direction: vec3<f32>) -> f32 {
     let brick = cell >> vec3<u32>(2u);
     let low = vec3<f32>((brick - vec3<i32>(reach - 1)) * 4);

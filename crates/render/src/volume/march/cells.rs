@@ -109,3 +109,52 @@ fn transparent_intervals(points: &[ControlPoint], margin: f32) -> Vec<(f32, f32)
         .filter(|(low, high)| low <= high)
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    fn point(value: f32, sigma: f32) -> ControlPoint {
+        ControlPoint {
+            value,
+            sigma,
+            colour: Vec3::ONE,
+        }
+    }
+
+    /// The intervals, worked out by hand: the open ends below the first point and above the
+    /// last, touching pieces merged into one, each narrowed by the margin, and one narrower
+    /// than twice the margin left out.
+    #[test]
+    fn transparent_intervals_are_the_pieces_without_extinction_narrowed() {
+        let points = [
+            point(0.0, 0.0),
+            point(1.0, 0.0),
+            point(2.0, 0.0),
+            point(3.0, 4.0),
+            point(4.0, 0.0),
+            point(4.1, 0.0),
+            point(5.0, 2.0),
+            point(6.0, 0.0),
+        ];
+        assert_eq!(
+            transparent_intervals(&points, 0.25),
+            vec![(f32::NEG_INFINITY, 1.75), (6.25, f32::INFINITY),],
+            "[4, 4.1] is narrower than twice the margin"
+        );
+        assert_eq!(
+            transparent_intervals(&points, 0.0),
+            vec![(f32::NEG_INFINITY, 2.0), (4.0, 4.1), (6.0, f32::INFINITY),]
+        );
+        // Extinction at both ends: no open interval.
+        let closed = [
+            point(0.0, 1.0),
+            point(1.0, 0.0),
+            point(2.0, 0.0),
+            point(3.0, 1.0),
+        ];
+        assert_eq!(transparent_intervals(&closed, 0.1), vec![(1.1, 1.9)]);
+        assert!(transparent_intervals(&[point(0.0, 1.0)], 0.0).is_empty());
+    }
+}

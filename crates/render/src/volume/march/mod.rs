@@ -163,12 +163,13 @@ impl PreparedVolume {
     }
 
     /// How far a sample's interpolated value may stray from the range of its cell's corners
-    /// (as [`Self::voxels`] gives them): the rounding of three nested interpolations, a few
-    /// units in the last place of the largest value, and, for values stored as integers
-    /// scaled, half a step.
+    /// (as [`Self::voxels`] gives them): the rounding of three nested `a + (b - a) t`, each
+    /// within about 2.5 units in the last place of the largest value (the difference, the
+    /// product and the sum rounded once each, unfused), so 7.5 in all, taken twice over; and,
+    /// for values stored as integers scaled, half a step.
     fn value_margin(&self) -> f32 {
         let largest = self.range.0.abs().max(self.range.1.abs());
-        largest * f32::EPSILON * 8.0 + f32::MIN_POSITIVE + self.quantisation_error().0
+        largest * f32::EPSILON * 16.0 + f32::MIN_POSITIVE + self.quantisation_error().0
     }
 
     /// Bricks along each axis ([`BRICK`]^3 cells each, the last ones possibly partial).

@@ -2,17 +2,17 @@
 //! lane advanced by one segment per turn of the loop.
 //!
 //! A turn has three phases. Where each lane's segment lies and which voxel cell its midpoint
-//! falls in is lane-wise arithmetic on arrays (which the compiler vectorises); reading the
-//! voxels and the transfer function is a loop over the lanes, since each lane reads elsewhere;
-//! opacity, lighting and compositing are written in the core's vectors ([`Lanes`]), with no
-//! branch on a sample's value (whether a noisy sample faces the light is a coin toss that a
-//! branch would mispredict). The turns are software-pipelined: the next turn's segments are
-//! placed before this turn is composited, and its samples read after. A lane whose ray ends takes
-//! the next ray of the
-//! list, so the packet stays full until the list runs out. Highlights are gathered across lanes and
-//! their
-//! lobe evaluated together by the lobe's vector kernel
-//! ([`specula::Lobe::eval_batch`]).
+//! falls in is lane-wise arithmetic on arrays (which the compiler vectorises). Then each lane is
+//! placed: its brick's clearance and cell mask read lane by lane, the skips of lanes in empty
+//! bricks computed side by side without a branch, and the lanes left reading (not skipping, not
+//! in a transparent cell) interpolate the voxels and the transfer function in loops of their
+//! own, since each lane reads elsewhere. Opacity, lighting and compositing are written in the
+//! core's vectors ([`Lanes`]), with no branch on a sample's value (whether a noisy sample faces
+//! the light is a coin toss that a branch would mispredict). The turns are software-pipelined:
+//! the next turn's segments are placed before this turn is composited, and its samples read
+//! after. A lane whose ray ends takes the next ray of the list, so the packet stays full until
+//! the list runs out. Highlights are gathered across lanes and their lobe evaluated together by
+//! the lobe's vector kernel ([`specula::Lobe::eval_batch`]).
 //!
 //! Every ray gets exactly the samples of a march on its own, front to back; only the order in
 //! which its highlights are summed differs.
@@ -46,7 +46,8 @@ pub(crate) const LANES: usize = 8;
 /// Steps ahead of each sample that a volume larger than the caches is fetched into them: the
 /// march otherwise waits on memory at every sample (a clinical-size CT: frames 15 % faster
 /// with it; on the real CT, whose voxels the caches hold, the extra work made frames 4 %
-/// slower, so it is left out there).
+/// slower with a cell's first rows asked for, 10 % with the whole cell, so it is left out
+/// there).
 const LOOKAHEAD: usize = 3;
 
 /// Highlights gathered before their lobe is evaluated together.
@@ -420,10 +421,11 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
         }
     }
 
-    /// Every lane's sample at its segment, read, or a skip where the brick is empty. A loop
-    /// of its own: it reads elsewhere in each lane, and its lanes skip in step with one
-    /// another (a lane skipping brick after brick on its own would be one long chain of
-    /// dependent instructions while the rest wait).
+    /// Every lane's sample at its segment: a skip where its brick is empty, nothing where its
+    /// cell is transparent, else the voxels and the transfer function read. Its lanes skip in
+    /// step with one another (a lane skipping brick after brick on its own would be one long
+    /// chain of dependent instructions while the rest wait), side by side, and not at all in a
+    /// turn with no lane in an empty brick.
     #[inline(always)]
     fn samples<V: Lanes>(&self, lanes: V, marching: &mut Marching, turn: &mut Turn) {
         let mut bricks = [(0, false); LANES];

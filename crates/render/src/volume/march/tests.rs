@@ -160,17 +160,25 @@ fn the_prepared_march_is_the_reference_march() {
     }
 }
 
+/// A ball in a large empty grid: most bricks are empty, and the image with bricks and
+/// transparent cells is the image without them (every brick occupied, no cell marked) bit for
+/// bit; in both layouts, the compact one on values that are not whole numbers (stored scaled,
+/// and its voxels fetched ahead).
 #[test]
 fn empty_bricks_are_skipped_without_changing_a_pixel() {
-    // A ball in a large empty grid: most bricks are empty, and the image with bricks and
-    // transparent cells is the image without them (every brick occupied, no cell marked) bit
-    // for bit.
+    skipping_changes_no_pixel(Layout::Exact, 1.0);
+    skipping_changes_no_pixel(Layout::Compact, 0.6);
+}
+
+/// [`empty_bricks_are_skipped_without_changing_a_pixel`] with the voxels in `layout` and the
+/// ball's value `inside`.
+fn skipping_changes_no_pixel(layout: Layout, inside: f32) {
     let n = 64;
     let samples = (0..n * n * n)
         .map(|v| {
             let p = Vec3::new((v % n) as f32, (v / n % n) as f32, (v / (n * n)) as f32);
             if p.distance(Vec3::new(40.0, 30.0, 25.0)) < 9.0 {
-                1.0
+                inside
             } else {
                 0.0
             }
@@ -178,7 +186,7 @@ fn empty_bricks_are_skipped_without_changing_a_pixel() {
         .collect();
     let volume =
         Volume::centred([n; 3], Vec3::ONE, samples, crate::volume::Units::Arbitrary).unwrap();
-    let prepared = PreparedVolume::new(&volume);
+    let prepared = PreparedVolume::with_layout(&volume, layout);
     let transfer = TransferFunction::preset("surface")
         .unwrap()
         .for_volume(&volume);
