@@ -221,8 +221,9 @@ fn png_into(
         .map_err(|e| e.to_string())
 }
 
-/// Writes `image` to `path`: `.png` as 8-bit sRGB through `display`, `.exr` as linear `f32`,
-/// `.hdr` as linear Radiance RGBE (negative and non-finite values are written as 0).
+/// Writes `image` to `path`: `.png` as 8-bit sRGB through `display`, `.exr` as linear `f32`
+/// (run-length coded), `.hdr` as linear Radiance RGBE (negative and non-finite values are
+/// written as 0).
 pub fn write_image(path: &Path, image: &Image, display: Display) -> Result<(), ImageError> {
     use exr::prelude::{
         Encoding, Image as ExrImage, Layer, LayerAttributes, SpecificChannels, WritableImage,
@@ -235,7 +236,11 @@ pub fn write_image(path: &Path, image: &Image, display: Display) -> Result<(), I
             let layer = Layer::new(
                 (image.width as usize, image.height as usize),
                 LayerAttributes::named("radiance"),
-                Encoding::SMALL_LOSSLESS,
+                // Run-length coded in 64 x 64 tiles: a render's noise leaves ZIP little to find
+                // (a 512 x 512 close-up: 3.05 MB in ZIP, 3.15 in RLE, 3.15 raw), a volume's
+                // background RLE finds as well (0.88 against 0.91 MB), and ZIP's deflate took
+                // 35 ms of a 0.21 s `specula render` on 2 threads.
+                Encoding::FAST_LOSSLESS,
                 SpecificChannels::rgb(|position: exr::math::Vec2<usize>| {
                     let p = image.get(position.x() as u32, position.y() as u32);
                     (p.x, p.y, p.z)
