@@ -21,12 +21,17 @@
 // is the shape the compiler vectorises.
 #![allow(clippy::needless_range_loop)]
 
+mod composite;
+mod sample;
+
+use composite::Highlights;
+
 use glam::Vec3;
-use specula::simd::{dispatch, exp2_nonpositive, Job, Lanes, Level, Prefetch};
+use specula::simd::{dispatch, Job, Lanes, Level, Prefetch};
 
 use super::cells::cell_bit;
-use super::{whole_below, Classification, PreparedVolume};
-use crate::volume::dvr::lighting::{LanesView, Lighting, RayView};
+use super::{Classification, PreparedVolume};
+use crate::volume::dvr::lighting::{Lighting, RayView};
 
 /// One ray's march, in grid units: `origin + direction * t` for `t` (mm) in `[start, end]`.
 #[derive(Clone, Copy, Debug)]
@@ -247,59 +252,6 @@ impl Turn {
     };
 }
 
-/// Highlights waiting for their lobes: cosine, the light the sample carried, its fade, and
-/// the ray they belong to.
-struct Highlights {
-    ts: [f32; HIGHLIGHTS],
-    carried: [f32; HIGHLIGHTS],
-    fades: [f32; HIGHLIGHTS],
-    rays: [usize; HIGHLIGHTS],
-    gathered: usize,
-}
-
-impl Highlights {
-    const EMPTY: Self = Self {
-        ts: [0.0; HIGHLIGHTS],
-        carried: [0.0; HIGHLIGHTS],
-        fades: [0.0; HIGHLIGHTS],
-        rays: [0; HIGHLIGHTS],
-        gathered: 0,
-    };
-
-    /// Evaluates each image's lobe at the gathered highlights and adds each, white, to its
-    /// ray's colour in that image.
-    #[inline(always)]
-    fn flush(&mut self, highlights: &[Highlight], out: &mut [Marched]) {
-        let n = self.gathered;
-        let images = highlights.len();
-        let mut lobes = [0.0_f32; HIGHLIGHTS];
-        for (image, highlight) in highlights.iter().enumerate() {
-            highlight.lobe.eval_batch(&self.ts[..n], &mut lobes[..n]);
-            for i in 0..n {
-                let weight = self.carried[i] * (self.fades[i] * highlight.scale);
-                out[self.rays[i] * images + image].0 += Vec3::splat(weight * lobes[i]);
-            }
-        }
-        self.gathered = 0;
-    }
-}
-
-/// The `W` lanes of `array` from `at`.
-#[inline(always)]
-fn load<V: Lanes>(lanes: V, array: &Lane<f32>, at: usize) -> V {
-    lanes.load(&array[at..at + V::WIDTH])
-}
-
-/// [`load`] for three arrays.
-#[inline(always)]
-fn load3<V: Lanes>(lanes: V, arrays: &[Lane<f32>; 3], at: usize) -> [V; 3] {
-    [
-        load(lanes, &arrays[0], at),
-        load(lanes, &arrays[1], at),
-        load(lanes, &arrays[2], at),
-    ]
-}
-
 impl<const FETCH: bool> Job for Packet<'_, FETCH> {
     type Output = ();
 
@@ -421,44 +373,6 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
         }
     }
 
-    /// Every lane's sample at its segment: a skip where its brick is empty, nothing where its
-    /// cell is transparent, else the voxels and the transfer function read. Its lanes skip in
-    /// step with one another (a lane skipping brick after brick on its own would be one long
-    /// chain of dependent instructions while the rest wait), side by side, and not at all in a
-    /// turn with no lane in an empty brick.
-    #[inline(always)]
-    fn samples<V: Lanes>(&self, lanes: V, marching: &mut Marching, turn: &mut Turn) {
-        let mut bricks = [(0, false); LANES];
-        for k in 0..LANES {
-            bricks[k] = self.brick_state(turn, k);
-        }
-        let mut reading = [false; LANES];
-        // A turn in which no lane is in an empty brick (most, inside dense tissue) computes no
-        // skip.
-        if (0..LANES).any(|k| marching.live[k] & (bricks[k].0 > 0)) {
-            for k in 0..LANES {
-                reading[k] = self.advance(marching, turn, k, bricks[k]);
-            }
-        } else {
-            for k in 0..LANES {
-                reading[k] = self.stay(marching, turn, k, bricks[k]);
-            }
-        }
-        for k in 0..LANES {
-            self.fetch_ahead(turn, k, reading[k]);
-        }
-        for k in 0..LANES {
-            if reading[k] {
-                self.interpolate(lanes, turn, k);
-            }
-        }
-        for k in 0..LANES {
-            if reading[k] {
-                self.classify(turn, k);
-            }
-        }
-    }
-
     /// Lane `k`'s next segment (see [`Self::segments`]).
     #[inline(always)]
     fn segment(&self, marching: &mut Marching, turn: &mut Turn, k: usize) {
@@ -497,199 +411,5 @@ impl<const FETCH: bool> Packet<'_, FETCH> {
         }
         marching.t[k] = next;
         marching.j[k] = j + 1;
-    }
-
-    /// Lane `k`'s sample at its segment (see [`Self::samples`]); an idle lane's is cleared.
-    #[inline(always)]
-    fn sample<V: Lanes>(&self, lanes: V, marching: &mut Marching, turn: &mut Turn, k: usize) {
-        if self.place(marching, turn, k) {
-            self.interpolate(lanes, turn, k);
-            self.classify(turn, k);
-        }
-    }
-
-    /// Skips lane `k` past the empty bricks its segment lies in, or says whether it reads a
-    /// sample there (see [`Self::advance`]).
-    #[inline(always)]
-    fn place(&self, marching: &mut Marching, turn: &mut Turn, k: usize) -> bool {
-        let brick = self.brick_state(turn, k);
-        let reading = self.advance(marching, turn, k, brick);
-        self.fetch_ahead(turn, k, reading);
-        reading
-    }
-
-    /// The clearance of lane `k`'s brick, and whether its cell is transparent.
-    #[inline(always)]
-    fn brick_state(&self, turn: &Turn, k: usize) -> (u8, bool) {
-        let brick = turn.brick[k] as usize;
-        let transparent = self.classification.transparent[brick] >> turn.bit[k] & 1 != 0;
-        (self.classification.clearance[brick], transparent)
-    }
-
-    /// Skips lane `k` past the empty bricks its segment lies in, given its brick's
-    /// `(clearance, transparent)`, or says whether it reads a sample there (not in a
-    /// transparent cell, whose sample has no extinction); an idle lane's is cleared. Without
-    /// a branch: every lane computes a skip, kept where it has one, so that the lanes are
-    /// computed side by side and an unpredictable clearance costs no misprediction.
-    #[inline(always)]
-    fn advance(
-        &self,
-        marching: &mut Marching,
-        turn: &mut Turn,
-        k: usize,
-        (clearance, transparent): (u8, bool),
-    ) -> bool {
-        let skipping = marching.live[k] & (clearance > 0);
-        let steps = self.skip(marching, turn, k, clearance) * u32::from(skipping);
-        let j = marching.j[k] + steps;
-        let skipped = marching.lattice[k] + j as f32 * self.step;
-        marching.j[k] = j;
-        marching.t[k] = if steps > 0 { skipped } else { marching.t[k] };
-        self.stay(marching, turn, k, (clearance, transparent))
-    }
-
-    /// [`Self::advance`] for a lane that does not skip.
-    #[inline(always)]
-    fn stay(
-        &self,
-        marching: &Marching,
-        turn: &mut Turn,
-        k: usize,
-        (clearance, transparent): (u8, bool),
-    ) -> bool {
-        turn.sigma[k] = 0.0;
-        turn.t_end[k] = marching.t[k];
-        marching.live[k] & (clearance == 0) & !transparent
-    }
-
-    /// When the volume is fetched ahead, asks for the voxels lane `k` reads [`LOOKAHEAD`]
-    /// steps on, if it reads now (a loop apart from [`Self::advance`]'s, which a call would
-    /// keep from being vectorised).
-    #[inline(always)]
-    fn fetch_ahead(&self, turn: &Turn, k: usize, reading: bool) {
-        if FETCH && reading {
-            self.volume.prefetch(turn.ahead[k] as usize, self.prefetch);
-        }
-    }
-
-    /// Lane `k`'s value and gradient at its midpoint.
-    #[inline(always)]
-    fn interpolate<V: Lanes>(&self, lanes: V, turn: &mut Turn, k: usize) {
-        let fraction = Vec3::new(
-            turn.fraction[0][k],
-            turn.fraction[1][k],
-            turn.fraction[2][k],
-        );
-        let sample = self
-            .volume
-            .sample_at(lanes, turn.voxel[k] as usize, fraction);
-        turn.value[k] = sample.x;
-        for c in 0..3 {
-            turn.gradient[c][k] = sample[c + 1];
-        }
-    }
-
-    /// The transfer function at lane `k`'s value.
-    #[inline(always)]
-    fn classify(&self, turn: &mut Turn, k: usize) {
-        let classified = self.classification.at(turn.value[k]);
-        turn.sigma[k] = classified.x;
-        for c in 0..3 {
-            turn.base[c][k] = classified[c + 1];
-        }
-    }
-
-    /// The segments lane `k` skips when its midpoint lies in an empty brick whose empty
-    /// surroundings reach `clearance` bricks (1 taken for 0): every sample whose midpoint lies
-    /// before the ray leaves the empty cube of bricks centred there has no extinction (a
-    /// margin keeps the one that rounding could place across its exit).
-    #[inline(always)]
-    fn skip(&self, marching: &Marching, turn: &Turn, k: usize, clearance: u8) -> u32 {
-        let reach = i32::from(clearance.max(1));
-        let mut exit = f32::INFINITY;
-        for axis in 0..3 {
-            let leaves = PreparedVolume::clear_exit_along(
-                turn.cell[axis][k],
-                reach,
-                marching.origin[axis][k],
-                marching.inverse_direction[axis][k],
-            );
-            exit = if leaves < exit { leaves } else { exit };
-        }
-        // At most 2^22 - 1 segments at once (whole_below's range): a shorter skip is still
-        // exact, and no ray is that many segments long.
-        let beyond =
-            ((exit - marching.t[k]) * self.inverse_step - 0.5 - 1e-3).clamp(0.0, 4_194_303.0);
-        // The ceiling: `whole` falls short by one where beyond is not whole, or where it is
-        // an odd whole number (whole_below's rounding); the comparison makes it up.
-        let whole = whole_below(beyond);
-        whole as u32 + u32::from((whole as f32) < beyond)
-    }
-
-    /// Composites each lane's sample front to back, lit, and gathers its highlight: a
-    /// segment of `length` at extinction `sigma` is opaque by `1 - exp(-sigma length)`.
-    #[inline(always)]
-    fn composite<V: Lanes>(
-        &mut self,
-        lanes: V,
-        marching: &mut Marching,
-        turn: &Turn,
-        highlights: &mut Highlights,
-    ) {
-        let (zero, one) = (lanes.splat(0.0), lanes.splat(1.0));
-        let mut ts = [0.0_f32; LANES];
-        let mut carried_light = [0.0_f32; LANES];
-        let mut fades = [0.0_f32; LANES];
-        for at in (0..LANES).step_by(V::WIDTH) {
-            let sigma = load(lanes, &turn.sigma, at).max(zero);
-            let length = load(lanes, &turn.length, at);
-            let alpha =
-                one - exp2_nonpositive(sigma * length * lanes.splat(-core::f32::consts::LOG2_E));
-            let transmittance = load(lanes, &marching.transmittance, at);
-            let carried = transmittance * alpha;
-            (transmittance * (one - alpha)).store(&mut marching.transmittance[at..at + V::WIDTH]);
-            let base = load3(lanes, &turn.base, at);
-            let colour = load3(lanes, &marching.colour, at);
-            let lit_scale = match self.lit {
-                None => one,
-                Some(lit) => {
-                    let view = LanesView {
-                        wo: load3(lanes, &marching.wo, at),
-                        half: load3(lanes, &marching.half, at),
-                        wi_dot_wo: load(lanes, &marching.wi_dot_wo, at),
-                    };
-                    let gradient = load3(lanes, &turn.gradient, at);
-                    let light = lit.lighting.light_lanes(gradient, &view);
-                    light.t.store(&mut ts[at..at + V::WIDTH]);
-                    // Every lobe is 0 at a cosine of 0 or less; a lane that took no sample
-                    // carried nothing (its weight is 0 and it is not gathered).
-                    carried
-                        .keep(light.t.gt(zero))
-                        .store(&mut carried_light[at..at + V::WIDTH]);
-                    light.fade.store(&mut fades[at..at + V::WIDTH]);
-                    light.colour_scale
-                }
-            };
-            // Written out rather than `array::map`: a closure a library function calls is
-            // compiled without the level's instruction set. A lane that carried nothing adds
-            // nothing, whatever its colour.
-            let carrying = carried.gt(zero);
-            for c in 0..3 {
-                (colour[c] + (carried * (base[c] * lit_scale)).keep(carrying))
-                    .store(&mut marching.colour[c][at..at + V::WIDTH]);
-            }
-        }
-        let Some(lit) = self.lit else { return };
-        for k in 0..LANES {
-            let at = highlights.gathered;
-            highlights.ts[at] = ts[k];
-            highlights.carried[at] = carried_light[k];
-            highlights.fades[at] = fades[k];
-            highlights.rays[at] = marching.ray[k];
-            highlights.gathered += usize::from(carried_light[k] * fades[k] > 0.0);
-        }
-        if highlights.gathered > HIGHLIGHTS - LANES {
-            highlights.flush(lit.highlights, self.out);
-        }
     }
 }
