@@ -151,26 +151,29 @@ pub fn surfaces(scene: &Scene) -> Result<Vec<Option<SurfacePoint>>, RenderError>
     );
     let bins = bin(&primitives, tiles_x, tiles_y, TILE * s);
     let (width, height) = (settings.width * s, settings.height * s);
-    let tiles: Vec<Vec<(usize, SurfacePoint)>> = bins
-        .par_iter()
+    let mut points = vec![None; (width * height) as usize];
+    // Each band of tile rows is written in place by one thread, its tiles in turn.
+    points
+        .par_chunks_mut((width * TILE * s) as usize)
         .enumerate()
-        .map_init(
+        .for_each_init(
             || (Vec::new(), Vec::new()),
-            |(depth, visible), (tile, bin)| {
-                let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);
-                let rect = PixelRect {
-                    x0: tx * TILE * s,
-                    y0: ty * TILE * s,
-                    x1: ((tx + 1) * TILE * s).min(width) - 1,
-                    y1: ((ty + 1) * TILE * s).min(height) - 1,
-                };
-                resolve_visibility(&primitives, bin, rect, depth, visible);
-                let sample_width = rect.x1 - rect.x0 + 1;
-                visible
-                    .iter()
-                    .enumerate()
-                    .filter(|&(_, &slot)| slot != u32::MAX)
-                    .map(|(k, &slot)| {
+            |(depth, visible), (ty, band)| {
+                let ty = ty as u32;
+                for tx in 0..tiles_x {
+                    let bin = &bins[(ty * tiles_x + tx) as usize];
+                    let rect = PixelRect {
+                        x0: tx * TILE * s,
+                        y0: ty * TILE * s,
+                        x1: ((tx + 1) * TILE * s).min(width) - 1,
+                        y1: ((ty + 1) * TILE * s).min(height) - 1,
+                    };
+                    resolve_visibility(&primitives, bin, rect, depth, visible);
+                    let sample_width = rect.x1 - rect.x0 + 1;
+                    for (k, &slot) in visible.iter().enumerate() {
+                        if slot == u32::MAX {
+                            continue;
+                        }
                         let primitive = &primitives[bin[slot as usize] as usize];
                         let (x, y) = (
                             rect.x0 + k as u32 % sample_width,
@@ -192,21 +195,15 @@ pub fn surfaces(scene: &Scene) -> Result<Vec<Option<SurfacePoint>>, RenderError>
                                 .unwrap_or_else(interpolated),
                             None => interpolated(),
                         };
-                        let point = SurfacePoint {
+                        band[((y - rect.y0) * width + x) as usize] = Some(SurfacePoint {
                             position,
                             normal,
                             object: primitive.shader,
-                        };
-                        ((y * width + x) as usize, point)
-                    })
-                    .collect()
+                        });
+                    }
+                }
             },
-        )
-        .collect();
-    let mut points = vec![None; (width * height) as usize];
-    for (index, point) in tiles.into_iter().flatten() {
-        points[index] = Some(point);
-    }
+        );
     Ok(points)
 }
 

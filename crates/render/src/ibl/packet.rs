@@ -122,9 +122,10 @@ impl PacketSurface {
         }
     }
 
-    /// The cosines drawn from the lobe for the uniforms `us`, into `drawn`, where `takes(k)`
-    /// (0 elsewhere): a closed-form inverse on `level`'s lanes for every lane (cheaper than
-    /// choosing), Newton or the table lane by lane for the lanes that take one.
+    /// The cosines drawn from the lobe for the uniforms `us`, into `drawn`, where `takes(k)`:
+    /// a closed-form inverse on `level`'s lanes for every lane (cheaper than choosing; the
+    /// lanes that take none discard theirs), Newton or the table lane by lane for the lanes
+    /// that take one (0 elsewhere).
     fn draw_cosines(
         &self,
         level: Level,
@@ -132,19 +133,21 @@ impl PacketSurface {
         takes: impl Fn(usize) -> bool,
         drawn: &mut [f32],
     ) {
-        if let CosineSampler::ClosedForm = self.sampler {
-            self.lobe.tail_inverse_batch(level, us, drawn);
-        }
-        for (k, (drawn, &u)) in drawn.iter_mut().zip(us).enumerate() {
-            *drawn = match &self.sampler {
-                _ if !takes(k) => 0.0,
-                CosineSampler::ClosedForm => *drawn,
-                CosineSampler::Newton(start) => self
-                    .lobe
+        let each_taken = |drawn: &mut [f32], draw: &dyn Fn(f32) -> f32| {
+            for (k, (drawn, &u)) in drawn.iter_mut().zip(us).enumerate() {
+                *drawn = if takes(k) { draw(u) } else { 0.0 };
+            }
+        };
+        match &self.sampler {
+            CosineSampler::ClosedForm => {
+                self.lobe.tail_inverse_batch(level, us, drawn);
+            }
+            CosineSampler::Newton(start) => each_taken(drawn, &|u| {
+                self.lobe
                     .tail_inverse_f32(f64::from(u), f64::from(start.sample(u)))
-                    .map_or(1.0, |inverted| inverted.x as f32),
-                CosineSampler::Table(table) => table.sample(u),
-            };
+                    .map_or(1.0, |inverted| inverted.x as f32)
+            }),
+            CosineSampler::Table(table) => each_taken(drawn, &|u| table.sample(u)),
         }
     }
 }
@@ -167,11 +170,12 @@ impl Frame32 {
     }
 }
 
-/// The scalar half of a packet's shared draws: the stream's draw indices, and the random
-/// bits of each environment draw's texel.
+/// The scalar half of a packet's shared draws: the stream's draw indices, the random bits
+/// of each environment draw's texel, and the row they drew.
 struct SharedScalars {
     draw: [u64; LANES],
     texel_bits: [u64; LANES],
+    row: [u32; LANES],
 }
 
 /// The columns a packet's passes write and read: made once per thread and reused for every
@@ -191,6 +195,7 @@ impl Scratch {
             scalars: SharedScalars {
                 draw: [0; LANES],
                 texel_bits: [0; LANES],
+                row: [0; LANES],
             },
             numbers: Draws::ZERO,
             shared: SharedColumns {
@@ -261,7 +266,7 @@ pub(super) fn shade(
             count = k + 1;
             scalars.draw[k] = draw;
             scalars.texel_bits[k] = random_bits(seed, draw, 0);
-            environment.prefetch_draw(scalars.texel_bits[k], prefetch);
+            scalars.row[k] = environment.prefetch_draw(scalars.texel_bits[k], prefetch);
         }
         // The lanes the jobs run: the draws rounded up to the level's width, so that a pixel
         // of 16 samples pays for 16 lanes, not 64.
@@ -271,7 +276,7 @@ pub(super) fn shade(
         // and, with a choice no lobe takes, no cosine-weighted one (u1 = 1).
         for k in 0..used {
             let (row, column) = if k < count {
-                environment.draw_cell(scalars.texel_bits[k])
+                environment.draw_cell(scalars.row[k], scalars.texel_bits[k])
             } else {
                 (0, 0)
             };
@@ -318,15 +323,19 @@ pub(super) fn shade(
                 shared,
             },
         );
+        // Only the lanes that make the cosine-weighted draw read its texel (its sine is 0
+        // elsewhere): a lobe that takes most BRDF draws leaves most lanes without one.
         for k in 0..used {
-            environment.prefetch_record(
-                numbers.diffuse_row[k] as u32,
-                numbers.diffuse_column[k] as u32,
-                prefetch,
-            );
+            if numbers.diffuse_sine[k] > 0.0 {
+                environment.prefetch_record(
+                    numbers.diffuse_row[k] as u32,
+                    numbers.diffuse_column[k] as u32,
+                    prefetch,
+                );
+            }
         }
-        // The texels' radiances and densities: every lane reads one, and a lane without a
-        // draw (its sine 0) gets density 0.
+        // The texels' radiances and densities: every lane reads its environment draw's, and a
+        // lane without a draw (its sine 0) gets density 0.
         let pdf_of = |density: f32, sine: f32| {
             if sine > 0.0 {
                 density / (2.0 * PI * PI * sine)
@@ -339,11 +348,16 @@ pub(super) fn shade(
                 environment.record(numbers.light_row[k] as u32, numbers.light_column[k] as u32);
             shared.light_pdf[k] = pdf_of(density, numbers.light_sine[k]);
             shared.light_radiance.set(k, Vec3::new(r, g, b));
-            let [r, g, b, density] = environment.record(
-                numbers.diffuse_row[k] as u32,
-                numbers.diffuse_column[k] as u32,
-            );
-            shared.diffuse_light_pdf[k] = pdf_of(density, numbers.diffuse_sine[k]);
+            let ([r, g, b, density], sine) = if numbers.diffuse_sine[k] > 0.0 {
+                let record = environment.record(
+                    numbers.diffuse_row[k] as u32,
+                    numbers.diffuse_column[k] as u32,
+                );
+                (record, numbers.diffuse_sine[k])
+            } else {
+                ([0.0; 4], 0.0)
+            };
+            shared.diffuse_light_pdf[k] = pdf_of(density, sine);
             shared.diffuse_radiance.set(k, Vec3::new(r, g, b));
         }
         let packet = Packet {

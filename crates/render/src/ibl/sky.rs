@@ -69,18 +69,31 @@ impl Environment {
         let phis: Vec<(f64, f64)> = (0..width * SUB)
             .map(|x| super::environment::phi_of_square(at(x, width * SUB)))
             .collect();
+        let texel = |x: u32, y: u32| {
+            let mut sum = Vec3::ZERO;
+            for &(sine, cosine) in &thetas[(y * SUB) as usize..((y + 1) * SUB) as usize] {
+                for &(sin_phi, cos_phi) in &phis[(x * SUB) as usize..((x + 1) * SUB) as usize] {
+                    let wi = glam::DVec3::new(sine * cos_phi, sine * sin_phi, cosine);
+                    sum += radiance(wi.as_vec3(), sun);
+                }
+            }
+            sum / (SUB * SUB) as f32
+        };
+        // The rows whose every point lies below the horizon are all ground, one value made
+        // once: half the map, and half the time it took.
+        let ground_from = (0..height)
+            .find(|&y| thetas[(y * SUB) as usize].1 as f32 <= 0.0)
+            .unwrap_or(height);
+        let ground = texel(0, ground_from.min(height - 1));
         let pixels: Vec<Vec3> = (0..width * height)
             .into_par_iter()
             .map(|index| {
                 let (x, y) = (index % width, index / width);
-                let mut sum = Vec3::ZERO;
-                for &(sine, cosine) in &thetas[(y * SUB) as usize..((y + 1) * SUB) as usize] {
-                    for &(sin_phi, cos_phi) in &phis[(x * SUB) as usize..((x + 1) * SUB) as usize] {
-                        let wi = glam::DVec3::new(sine * cos_phi, sine * sin_phi, cosine);
-                        sum += radiance(wi.as_vec3(), sun);
-                    }
+                if y >= ground_from {
+                    ground
+                } else {
+                    texel(x, y)
                 }
-                sum / (SUB * SUB) as f32
             })
             .collect();
         let image = Image::from_pixels(width, height, pixels).expect("width x height pixels");

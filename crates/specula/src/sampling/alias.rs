@@ -13,6 +13,8 @@
 //! cache, and then a slot of the drawn group, which stays in cache when the draws favour a
 //! few groups (the sun's rows of a sky).
 
+use rayon::prelude::*;
+
 /// One cell of an [`AliasTable`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Entry {
@@ -20,6 +22,51 @@ struct Entry {
     threshold: f32,
     /// The cell drawn instead.
     alias: u32,
+}
+
+impl Entry {
+    /// A slot that keeps its cell (its alias is set by [`fill`]).
+    const KEPT: Self = Self {
+        threshold: 1.0,
+        alias: 0,
+    };
+}
+
+/// Fills `entries` with the alias table of `weights` by Vose's algorithm, the cells numbered
+/// from `first`; `None` when there are no weights or one is negative or not finite, or
+/// their sum is not. All-zero weights draw every cell alike (as
+/// [`super::Distribution1D`] does).
+fn fill(weights: &[f64], first: u32, entries: &mut [Entry]) -> Option<()> {
+    let total = super::weights_total(weights)?;
+    let n = weights.len() as f64;
+    let mut scaled: Vec<f64> = if total > 0.0 {
+        weights.iter().map(|w| w * n / total).collect()
+    } else {
+        vec![1.0; weights.len()]
+    };
+    for (i, entry) in (first..).zip(entries.iter_mut()) {
+        *entry = Entry {
+            threshold: 1.0,
+            alias: i,
+        };
+    }
+    let (mut small, mut large): (Vec<u32>, Vec<u32>) =
+        (0..weights.len() as u32).partition(|&i| scaled[i as usize] < 1.0);
+    while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
+        small.pop();
+        entries[s as usize] = Entry {
+            threshold: scaled[s as usize] as f32,
+            alias: first + l,
+        };
+        // The large cell gives what the small one lacks, and may become small itself.
+        scaled[l as usize] -= 1.0 - scaled[s as usize];
+        if scaled[l as usize] < 1.0 {
+            large.pop();
+            small.push(l);
+        }
+    }
+    // What remains on either list is 1 up to rounding: kept whole (threshold 1).
+    Some(())
 }
 
 /// A table drawing cells in proportion to their weights in constant time.
@@ -34,44 +81,11 @@ impl AliasTable {
     /// [`super::Distribution1D`] does).
     #[must_use]
     pub fn new(weights: &[f64]) -> Option<Self> {
-        if weights.is_empty()
-            || u32::try_from(weights.len()).is_err()
-            || weights.iter().any(|w| !w.is_finite() || *w < 0.0)
-        {
+        if u32::try_from(weights.len()).is_err() {
             return None;
         }
-        let total: f64 = weights.iter().sum();
-        if !total.is_finite() {
-            return None;
-        }
-        let n = weights.len() as f64;
-        let mut scaled: Vec<f64> = if total > 0.0 {
-            weights.iter().map(|w| w * n / total).collect()
-        } else {
-            vec![1.0; weights.len()]
-        };
-        let mut entries: Vec<Entry> = (0..weights.len() as u32)
-            .map(|i| Entry {
-                threshold: 1.0,
-                alias: i,
-            })
-            .collect();
-        let (mut small, mut large): (Vec<u32>, Vec<u32>) =
-            (0..weights.len() as u32).partition(|&i| scaled[i as usize] < 1.0);
-        while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
-            small.pop();
-            entries[s as usize] = Entry {
-                threshold: scaled[s as usize] as f32,
-                alias: l,
-            };
-            // The large cell gives what the small one lacks, and may become small itself.
-            scaled[l as usize] -= 1.0 - scaled[s as usize];
-            if scaled[l as usize] < 1.0 {
-                large.pop();
-                small.push(l);
-            }
-        }
-        // What remains on either list is 1 up to rounding: kept whole (threshold 1).
+        let mut entries = vec![Entry::KEPT; weights.len()];
+        fill(weights, 0, &mut entries)?;
         Some(Self { entries })
     }
 
@@ -118,26 +132,27 @@ impl GroupedAliasTable {
     /// every cell alike.
     #[must_use]
     pub fn new(weights: &[f64], group: usize) -> Option<Self> {
-        if group == 0 || !weights.len().is_multiple_of(group) {
+        if group == 0
+            || !weights.len().is_multiple_of(group)
+            || u32::try_from(weights.len()).is_err()
+        {
             return None;
         }
-        // Checked as a whole first: a sum that overflows is refused, not its parts'.
-        AliasTable::new(weights)?;
-        let sums: Vec<f64> = weights.chunks(group).map(|g| g.iter().sum()).collect();
-        let groups = AliasTable::new(&sums)?;
-        let mut cells = Vec::with_capacity(weights.len());
-        for (index, weights) in weights.chunks(group).enumerate() {
-            let first = (index * group) as u32;
-            cells.extend(
-                AliasTable::new(weights)?
-                    .entries
-                    .into_iter()
-                    .map(|e| Entry {
-                        alias: first + e.alias,
-                        ..e
-                    }),
-            );
+        let sums: Vec<f64> = weights.par_chunks(group).map(|g| g.iter().sum()).collect();
+        // Checked as a whole: a sum that overflows is refused, not its parts'.
+        if !sums.iter().sum::<f64>().is_finite() {
+            return None;
         }
+        let groups = AliasTable::new(&sums)?;
+        // The groups' tables are independent: built side by side.
+        let mut cells = vec![Entry::KEPT; weights.len()];
+        cells
+            .par_chunks_mut(group)
+            .zip(weights.par_chunks(group))
+            .enumerate()
+            .try_for_each(|(index, (cells, weights))| {
+                fill(weights, (index * group) as u32, cells)
+            })?;
         Some(Self {
             groups,
             cells,
@@ -159,19 +174,36 @@ impl GroupedAliasTable {
     #[must_use]
     #[inline]
     pub fn sample_in_group(&self, bits: u64) -> (usize, usize) {
-        let group = self.groups.sample((bits >> 32) as u32);
-        let first = group * self.group;
-        let cells = &self.cells[first..first + self.group];
-        (group, draw(cells, first, bits as u32) - first)
+        let group = self.group_of(bits);
+        (group, self.place_in(group, bits))
     }
 
-    /// Asks for the cache line [`GroupedAliasTable::sample`] will read in the drawn group for
+    /// The group [`GroupedAliasTable::sample`] draws for these bits (their high 32).
+    #[must_use]
+    #[inline]
+    pub fn group_of(&self, bits: u64) -> usize {
+        self.groups.sample((bits >> 32) as u32)
+    }
+
+    /// The place in `group` (the one [`GroupedAliasTable::group_of`] drew for these bits)
+    /// that [`GroupedAliasTable::sample`] draws: a caller that asked for the slot's line
+    /// ([`GroupedAliasTable::prefetch`]) keeps the group rather than draw it twice.
+    #[must_use]
+    #[inline]
+    pub fn place_in(&self, group: usize, bits: u64) -> usize {
+        let first = group * self.group;
+        let cells = &self.cells[first..first + self.group];
+        draw(cells, first, bits as u32) - first
+    }
+
+    /// Asks for the cache line [`GroupedAliasTable::place_in`] will read in `group` for
     /// these bits (the groups' table is small enough to stay in cache).
     #[inline]
-    pub fn prefetch(&self, bits: u64, prefetch: crate::simd::Prefetch) {
-        let first = self.groups.sample((bits >> 32) as u32) * self.group;
+    pub fn prefetch(&self, group: usize, bits: u64, prefetch: crate::simd::Prefetch) {
         let slot = ((u64::from(bits as u32) * self.group as u64) >> 32) as usize;
-        prefetch.line(&self.cells[first + slot]);
+        if let Some(entry) = self.cells.get(group * self.group + slot) {
+            prefetch.line(entry);
+        }
     }
 }
 

@@ -37,13 +37,7 @@ impl Distribution1D {
     /// land somewhere; a zero map is then sampled as a constant one).
     #[must_use]
     pub fn new(weights: &[f64]) -> Option<Self> {
-        if weights.is_empty() || weights.iter().any(|w| !w.is_finite() || *w < 0.0) {
-            return None;
-        }
-        let total: f64 = weights.iter().sum();
-        if !total.is_finite() {
-            return None;
-        }
+        let total = super::weights_total(weights)?;
         let n = weights.len() as f64;
         let (weights, total) = if total > 0.0 {
             (weights.to_vec(), total)

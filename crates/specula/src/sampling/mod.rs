@@ -80,6 +80,16 @@ pub fn random_bits(seed: u64, index: u64, dimension: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// The sum of `weights`, or `None` when there are none, one is negative or not finite, or
+/// the sum is not: what a table drawing in proportion to them refuses.
+fn weights_total(weights: &[f64]) -> Option<f64> {
+    if weights.is_empty() || weights.iter().any(|w| !w.is_finite() || *w < 0.0) {
+        return None;
+    }
+    let total: f64 = weights.iter().sum();
+    total.is_finite().then_some(total)
+}
+
 /// A uniform `f32` in `[0, 1)` from the top 24 of 32 random bits.
 #[must_use]
 #[inline]
