@@ -245,18 +245,11 @@ impl Environment {
         (row, self.alias.place_in(row as usize, bits) as u32)
     }
 
-    /// The radiance and density on the unit square of the texel at `row` and `column`.
+    /// The texel at `row` and `column`.
     #[must_use]
     #[inline]
-    pub(super) fn record(&self, row: u32, column: u32) -> [f32; 4] {
-        self.texels[row as usize * self.image.width() as usize + column as usize]
-    }
-
-    /// Asks for what [`Environment::record`] will read.
-    #[inline]
-    pub(super) fn prefetch_record(&self, row: u32, column: u32, prefetch: Prefetch) {
-        let texel = row as usize * self.image.width() as usize + column as usize;
-        self.prefetch_texel(texel, prefetch);
+    pub(super) fn texel(&self, row: u32, column: u32) -> usize {
+        row as usize * self.image.width() as usize + column as usize
     }
 
     /// [`Environment::draw_in`]'s direction on SIMD lanes: the point `within` (two columns
@@ -346,8 +339,9 @@ impl Environment {
         )
     }
 
-    /// [`Environment::texel_of`] on SIMD lanes: each lane's column and row (whole numbers,
-    /// as floats) and `sin theta`, for unit directions `wi`.
+    /// [`Environment::texel_of`] on SIMD lanes: each lane's column and row (as `i32` bit
+    /// patterns, for [`Environment::texel_at`]: converted back to integers lane by lane, a
+    /// float costs a saturating conversion each) and `sin theta`, for unit directions `wi`.
     #[inline(always)]
     pub(super) fn texel_lanes<V: Lanes>(&self, wi: V3<V>) -> (V, V, V) {
         let (zero, one) = (wi.z.splat(0.0), wi.z.splat(1.0));
@@ -360,10 +354,28 @@ impl Environment {
         let column = (x * z.splat(width)).min(z.splat(width - 1.0)).max(zero);
         let row = (y * z.splat(height)).min(z.splat(height - 1.0)).max(zero);
         (
-            column.float_to_int().int_to_float(),
-            row.float_to_int().int_to_float(),
+            column.float_to_int(),
+            row.float_to_int(),
             z.neg_mul_add(z, one).max(zero).sqrt(),
         )
+    }
+
+    /// The texel at the column and row [`Environment::texel_lanes`] stored (`i32` bit
+    /// patterns of numbers it clamped to the map).
+    #[must_use]
+    #[inline]
+    pub(super) fn texel_at(&self, column: f32, row: f32) -> usize {
+        row.to_bits() as usize * self.image.width() as usize + column.to_bits() as usize
+    }
+
+    /// The radiance of `texel` and the density per solid angle of a draw there, where
+    /// `jacobian` is [`jacobian_lanes`]'s for its `sin theta`: [`Environment::look_up_texel`]
+    /// with a multiplication for the division.
+    #[must_use]
+    #[inline]
+    pub(super) fn look_up_jacobian(&self, texel: usize, jacobian: f32) -> (Vec3, f32) {
+        let [r, g, b, density] = self.texels[texel];
+        (Vec3::new(r, g, b), density * jacobian)
     }
 
     /// The radiance of `texel` and the density per solid angle [`Environment::draw`] draws a
@@ -388,6 +400,14 @@ impl Environment {
         let (texel, sine) = self.texel_of(wi);
         self.look_up_texel(texel, sine)
     }
+}
+
+/// The unit square's density to one per solid angle, `1 / (2 pi^2 sin theta)`, on lanes of
+/// `sin theta`, and 0 where that is not positive (no draw: a density of 0).
+#[inline(always)]
+pub(super) fn jacobian_lanes<V: Lanes>(sine: V) -> V {
+    let scale = sine.splat(2.0 * core::f32::consts::PI * core::f32::consts::PI);
+    (sine.splat(1.0) / (sine * scale)).keep(sine.gt(sine.splat(0.0)))
 }
 
 /// Each pixel's weight for sampling: its luminance times `sin theta` at its row's middle,
@@ -476,6 +496,7 @@ mod tests {
                         z: lanes.load(&column(|v| v.z)),
                     };
                     let (c, r, s) = self.0.texel_lanes(wi);
+                    let (c, r) = (c.int_to_float(), r.int_to_float());
                     let mut out = [vec![0.0; w], vec![0.0; w], vec![0.0; w]];
                     c.store(&mut out[0]);
                     r.store(&mut out[1]);

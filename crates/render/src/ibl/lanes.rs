@@ -21,6 +21,7 @@ use glam::Vec3;
 use specula::simd::{Job, Lanes};
 use specula::Geometry;
 
+use super::environment::jacobian_lanes;
 use super::lane_geometry::{cosine, Column, Columns3, LANES, V3};
 use super::{Environment, Strategy};
 
@@ -80,10 +81,11 @@ pub(super) struct VariantColumns {
     pub(super) brdf_half_cosine: Column,
     /// [`Source`] as a lane value.
     pub(super) source: Column,
-    /// The texel of a lobe-drawn direction: its column and row, and `sin theta` there.
+    /// The texel of a lobe-drawn direction: its column and row (`i32` bit patterns, for
+    /// [`Environment::texel_at`]), and the Jacobian there ([`jacobian_lanes`]).
     pub(super) texel_column: Column,
     pub(super) texel_row: Column,
-    pub(super) texel_sine: Column,
+    pub(super) texel_jacobian: Column,
     pub(super) brdf_radiance: Columns3,
     pub(super) brdf_light_pdf: Column,
 }
@@ -103,7 +105,7 @@ impl VariantColumns {
         source: [0.0; LANES],
         texel_column: [0.0; LANES],
         texel_row: [0.0; LANES],
-        texel_sine: [0.0; LANES],
+        texel_jacobian: [0.0; LANES],
         brdf_radiance: Columns3::ZERO,
         brdf_light_pdf: [0.0; LANES],
     };
@@ -206,7 +208,7 @@ impl Job for Directions<'_> {
             let (column, row, sine) = environment.texel_lanes(world);
             column.store(&mut variant.texel_column[k..k + w]);
             row.store(&mut variant.texel_row[k..k + w]);
-            sine.store(&mut variant.texel_sine[k..k + w]);
+            jacobian_lanes(sine).store(&mut variant.texel_jacobian[k..k + w]);
         }
     }
 }

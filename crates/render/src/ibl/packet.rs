@@ -29,12 +29,12 @@
 //! images agree with the `f64` path's within Monte Carlo noise (tested), not bit for bit:
 //! the draws map the numbers to directions differently.
 
-use core::f32::consts::{FRAC_1_PI, PI};
+use core::f32::consts::FRAC_1_PI;
 
 use glam::Vec3;
 use specula::brdf::luminance;
 use specula::lobe::Warp;
-use specula::sampling::{random_bits, unit_f32, CosineTable32};
+use specula::sampling::{random_bits, CosineTable32};
 use specula::simd::{dispatch, Level, Prefetch};
 use specula::{Geometry, Lobe};
 
@@ -176,6 +176,8 @@ struct SharedScalars {
     draw: [u64; LANES],
     texel_bits: [u64; LANES],
     row: [u32; LANES],
+    /// The texel each environment draw drew.
+    light_texel: [usize; LANES],
 }
 
 /// The columns a packet's passes write and read: made once per thread and reused for every
@@ -196,6 +198,7 @@ impl Scratch {
                 draw: [0; LANES],
                 texel_bits: [0; LANES],
                 row: [0; LANES],
+                light_texel: [0; LANES],
             },
             numbers: Draws::ZERO,
             shared: SharedColumns {
@@ -271,40 +274,29 @@ pub(super) fn shade(
         // The lanes the jobs run: the draws rounded up to the level's width, so that a pixel
         // of 16 samples pays for 16 lanes, not 64.
         let used = count.next_multiple_of(level.lanes());
-        // The drawn texels (and the hints for their records), the points within them, and
-        // the BRDF's numbers. The lanes past the draws draw nothing: no environment draw
-        // and, with a choice no lobe takes, no cosine-weighted one (u1 = 1).
+        // The drawn texels (and the hints for their records), and the bits of the points
+        // within them and of the BRDF's numbers (made uniform numbers on lanes). The lanes
+        // past the draws draw nothing (`SharedDraws` masks them); they read texel 0.
         for k in 0..used {
             let (row, column) = if k < count {
                 environment.draw_cell(scalars.row[k], scalars.texel_bits[k])
             } else {
                 (0, 0)
             };
-            environment.prefetch_record(row, column, prefetch);
+            scalars.light_texel[k] = environment.texel(row, column);
+            environment.prefetch_texel(scalars.light_texel[k], prefetch);
             (numbers.light_row[k], numbers.light_column[k]) = (row as f32, column as f32);
-            let (within, bits, more) = if k < count {
-                let draw = scalars.draw[k];
-                (
-                    random_bits(seed, draw, 1),
-                    random_bits(seed, draw, 2),
-                    random_bits(seed, draw, 3),
-                )
+            let [within, choice, more] = if k < count {
+                [1, 2, 3].map(|dimension| random_bits(seed, scalars.draw[k], dimension))
             } else {
-                (0, u64::MAX, 0)
+                [0; 3]
             };
-            numbers.within_x[k] = unit_f32(within as u32);
-            numbers.within_y[k] = unit_f32((within >> 32) as u32);
-            shared.choice[k] = if k < count {
-                unit_f32(bits as u32)
-            } else {
-                2.0
-            };
-            numbers.u1[k] = if k < count && brdf {
-                unit_f32((bits >> 32) as u32)
-            } else {
-                1.0
-            };
-            numbers.azimuth[k] = unit_f32(more as u32);
+            let bits = |bits: u64| f32::from_bits(bits as u32);
+            numbers.within_x[k] = bits(within);
+            numbers.within_y[k] = bits(within >> 32);
+            numbers.choice[k] = bits(choice);
+            numbers.u1[k] = bits(choice >> 32);
+            numbers.azimuth[k] = bits(more);
         }
         // The environment's directions and the cosine-weighted ones on lanes.
         dispatch(
@@ -316,49 +308,38 @@ pub(super) fn shade(
                     point.frame.normal,
                 ],
                 light,
+                brdf,
                 fewest_lobe_draws,
+                count,
                 used,
                 environment,
                 draws: numbers,
                 shared,
             },
         );
-        // Only the lanes that make the cosine-weighted draw read its texel (its sine is 0
+        // Only the lanes that make the cosine-weighted draw read its texel (its Jacobian is 0
         // elsewhere): a lobe that takes most BRDF draws leaves most lanes without one.
+        let diffuse_texel =
+            |k: usize| environment.texel_at(numbers.diffuse_column[k], numbers.diffuse_row[k]);
         for k in 0..used {
-            if numbers.diffuse_sine[k] > 0.0 {
-                environment.prefetch_record(
-                    numbers.diffuse_row[k] as u32,
-                    numbers.diffuse_column[k] as u32,
-                    prefetch,
-                );
+            if numbers.diffuse_jacobian[k] > 0.0 {
+                environment.prefetch_texel(diffuse_texel(k), prefetch);
             }
         }
         // The texels' radiances and densities: every lane reads its environment draw's, and a
-        // lane without a draw (its sine 0) gets density 0.
-        let pdf_of = |density: f32, sine: f32| {
-            if sine > 0.0 {
-                density / (2.0 * PI * PI * sine)
-            } else {
-                0.0
-            }
-        };
+        // lane without a draw (its Jacobian 0) gets density 0.
         for k in 0..used {
-            let [r, g, b, density] =
-                environment.record(numbers.light_row[k] as u32, numbers.light_column[k] as u32);
-            shared.light_pdf[k] = pdf_of(density, numbers.light_sine[k]);
-            shared.light_radiance.set(k, Vec3::new(r, g, b));
-            let ([r, g, b, density], sine) = if numbers.diffuse_sine[k] > 0.0 {
-                let record = environment.record(
-                    numbers.diffuse_row[k] as u32,
-                    numbers.diffuse_column[k] as u32,
-                );
-                (record, numbers.diffuse_sine[k])
+            let (radiance, pdf) =
+                environment.look_up_jacobian(scalars.light_texel[k], numbers.light_jacobian[k]);
+            shared.light_pdf[k] = pdf;
+            shared.light_radiance.set(k, radiance);
+            let (radiance, pdf) = if numbers.diffuse_jacobian[k] > 0.0 {
+                environment.look_up_jacobian(diffuse_texel(k), numbers.diffuse_jacobian[k])
             } else {
-                ([0.0; 4], 0.0)
+                (Vec3::ZERO, 0.0)
             };
-            shared.diffuse_light_pdf[k] = pdf_of(density, sine);
-            shared.diffuse_radiance.set(k, Vec3::new(r, g, b));
+            shared.diffuse_light_pdf[k] = pdf;
+            shared.diffuse_radiance.set(k, radiance);
         }
         let packet = Packet {
             point,
@@ -446,9 +427,8 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
             variant: &mut *variant,
         },
     );
-    let width = environment.image().width() as usize;
     let lobe_texel = |variant: &VariantColumns, k: usize| {
-        variant.texel_row[k] as usize * width + variant.texel_column[k] as usize
+        environment.texel_at(variant.texel_column[k], variant.texel_row[k])
     };
     for k in 0..count {
         if Source::of(variant.source[k]) == Source::Lobe {
@@ -458,7 +438,7 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
     for k in 0..count {
         let (radiance, light_pdf) = match Source::of(variant.source[k]) {
             Source::Lobe => {
-                environment.look_up_texel(lobe_texel(variant, k), variant.texel_sine[k])
+                environment.look_up_jacobian(lobe_texel(variant, k), variant.texel_jacobian[k])
             }
             Source::Diffuse => (shared.diffuse_radiance.get(k), shared.diffuse_light_pdf[k]),
             Source::None => (Vec3::ZERO, 0.0),
