@@ -150,6 +150,18 @@ impl<V: Lanes> V3<V> {
             z: self.z.select(mask, other.z),
         }
     }
+
+    /// Each component's lanes summed in order (a packet's estimates, without a column
+    /// of [`LANES`] to fill and read back).
+    #[inline(always)]
+    pub(super) fn sum_lanes(self) -> Vec3 {
+        let sum = |v: V| {
+            let mut lanes = [0.0; 16];
+            v.store(&mut lanes[..V::WIDTH]);
+            lanes[..V::WIDTH].iter().sum::<f32>()
+        };
+        Vec3::new(sum(self.x), sum(self.y), sum(self.z))
+    }
 }
 
 /// `sum coefficients[i] x^i` by Horner's rule, fused.

@@ -330,8 +330,6 @@ impl Job for Combine<'_> {
             let taken = lanes.load(&variant.source[k..k + w]).gt(zero);
             sum = sum.add(contribution.select(pdf.keep(taken).gt(zero), nothing));
         }
-        let mut columns = Columns3::ZERO;
-        sum.store(&mut columns, 0);
-        (0..w).fold(Vec3::ZERO, |total, k| total + columns.get(k))
+        sum.sum_lanes()
     }
 }

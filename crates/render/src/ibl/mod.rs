@@ -29,6 +29,7 @@
 //! same estimator over packets of samples in `f32` (`packet.rs`: the map drawn by its alias
 //! table, tabulated lobes from `f32` tables, several lobes' images from one pass).
 
+mod ahead;
 mod angles;
 mod draws;
 mod environment;

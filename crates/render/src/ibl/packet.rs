@@ -38,6 +38,7 @@ use specula::sampling::{random_bits, CosineTable32};
 use specula::simd::{dispatch, Level, Prefetch};
 use specula::{Geometry, Lobe};
 
+use super::ahead::LightCells;
 use super::draws::{Draws, SharedDraws};
 use super::lane_geometry::{Columns3, LANES};
 use super::lanes::{Brdf, Combine, Directions, Setting, SharedColumns, Source, VariantColumns};
@@ -170,13 +171,8 @@ impl Frame32 {
     }
 }
 
-/// The scalar half of a packet's shared draws: the stream's draw indices, the random bits
-/// of each environment draw's texel, and the row they drew.
+/// The scalar half of a packet's shared draws: the texel each environment draw drew.
 struct SharedScalars {
-    draw: [u64; LANES],
-    texel_bits: [u64; LANES],
-    row: [u32; LANES],
-    /// The texel each environment draw drew.
     light_texel: [usize; LANES],
 }
 
@@ -195,9 +191,6 @@ impl Scratch {
     pub(super) fn new() -> Box<Self> {
         Box::new(Self {
             scalars: SharedScalars {
-                draw: [0; LANES],
-                texel_bits: [0; LANES],
-                row: [0; LANES],
                 light_texel: [0; LANES],
             },
             numbers: Draws::ZERO,
@@ -227,10 +220,11 @@ pub(super) struct Point<'a> {
 }
 
 /// Adds to `sums[v]` the sum of the estimates of `draws` (each a draw index of the stream
-/// `seed`) at `point` with its surface `v`. The random numbers do not depend on the surface,
-/// so every variant's environment draws, and the cosine-weighted BRDF draws of every
-/// variant that makes one, are computed once; each variant's sums are the ones it would
-/// have alone, bit for bit.
+/// `seed`) at `point` with its surface `v`, their environment draws' texels taken from
+/// `cells` (where they were pushed in the same order). The random numbers do not depend on
+/// the surface, so every variant's environment draws, and the cosine-weighted BRDF draws of
+/// every variant that makes one, are computed once; each variant's sums are the ones it
+/// would have alone, bit for bit.
 ///
 /// `level` is where the per-variant arithmetic runs ([`Level::detect`]'s, but for tests).
 pub(super) fn shade(
@@ -238,15 +232,15 @@ pub(super) fn shade(
     environment: &Environment,
     (strategy, level): (Strategy, Level),
     seed: u64,
-    draws: impl Iterator<Item = u64>,
-    (scratch, sums): (&mut Scratch, &mut [glam::DVec3]),
+    draws: impl ExactSizeIterator<Item = u64>,
+    (cells, scratch, sums): (&mut LightCells, &mut Scratch, &mut [glam::DVec3]),
 ) {
     let fewest_lobe_draws = point
         .surfaces
         .iter()
         .map(|s| s.share)
         .fold(f32::INFINITY, f32::min);
-    let mut draws = draws.peekable();
+    let mut draws = draws;
     let prefetch = Prefetch::new();
     let Scratch {
         scalars,
@@ -258,39 +252,29 @@ pub(super) fn shade(
         strategy != Strategy::Brdf,
         strategy != Strategy::Environment,
     );
-    while draws.peek().is_some() {
+    while draws.len() > 0 {
         // In passes over the packet rather than lane by lane: each pass's reads of the map
         // (megabytes, mostly out of cache) are asked for a pass before they are made, and
         // are independent of one another, so they overlap.
-        let mut count = 0;
-        // The environment's draws: random numbers, and the hints for the alias entries they
-        // read.
-        for (k, draw) in draws.by_ref().take(LANES).enumerate() {
-            count = k + 1;
-            scalars.draw[k] = draw;
-            scalars.texel_bits[k] = random_bits(seed, draw, 0);
-            scalars.row[k] = environment.prefetch_draw(scalars.texel_bits[k], prefetch);
-        }
+        let count = draws.len().min(LANES);
+        let (rows, columns) = cells.take(count);
         // The lanes the jobs run: the draws rounded up to the level's width, so that a pixel
         // of 16 samples pays for 16 lanes, not 64.
         let used = count.next_multiple_of(level.lanes());
-        // The drawn texels (and the hints for their records), and the bits of the points
-        // within them and of the BRDF's numbers (made uniform numbers on lanes). The lanes
-        // past the draws draw nothing (`SharedDraws` masks them); they read texel 0.
+        // The drawn texels, and the bits of the points within them and of the BRDF's numbers
+        // (made uniform numbers on lanes). The lanes past the draws draw nothing
+        // (`SharedDraws` masks them); they read texel 0.
         for k in 0..used {
-            let (row, column) = if k < count {
-                environment.draw_cell(scalars.row[k], scalars.texel_bits[k])
-            } else {
-                (0, 0)
+            let (row, column, [within, choice, more]) = match draws.next() {
+                Some(draw) => (
+                    rows[k],
+                    columns[k],
+                    [1, 2, 3].map(|dimension| random_bits(seed, draw, dimension)),
+                ),
+                None => (0, 0, [0; 3]),
             };
             scalars.light_texel[k] = environment.texel(row, column);
-            environment.prefetch_texel(scalars.light_texel[k], prefetch);
             (numbers.light_row[k], numbers.light_column[k]) = (row as f32, column as f32);
-            let [within, choice, more] = if k < count {
-                [1, 2, 3].map(|dimension| random_bits(seed, scalars.draw[k], dimension))
-            } else {
-                [0; 3]
-            };
             let bits = |bits: u64| f32::from_bits(bits as u32);
             numbers.within_x[k] = bits(within);
             numbers.within_y[k] = bits(within >> 32);
@@ -522,13 +506,17 @@ mod tests {
         for strategy in [Strategy::Mis, Strategy::Brdf, Strategy::Environment] {
             let sums_at = |level| {
                 let mut sums = vec![DVec3::ZERO; surfaces.len()];
+                let mut cells = LightCells::default();
+                let draws = || (0..1000_u32).map(u64::from);
+                cells.push(&environment, 7, draws());
+                cells.resolve(&environment);
                 shade(
                     &point,
                     &environment,
                     (strategy, level),
                     7,
-                    0..1000,
-                    (&mut Scratch::new(), &mut sums),
+                    draws(),
+                    (&mut cells, &mut Scratch::new(), &mut sums),
                 );
                 sums
             };

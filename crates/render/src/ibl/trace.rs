@@ -7,6 +7,7 @@ use glam::{DVec3, Vec3, Vec4};
 use rayon::prelude::*;
 use specula::sampling::{power_heuristic, uniform, SpecularSampler};
 
+use super::ahead::LightCells;
 use super::packet::{shade, Frame32, PacketSurface, Point, Scratch};
 use super::{Environment, IblSettings, Strategy, MAX_SPP};
 use crate::pipeline::{surfaces, SurfacePoint};
@@ -390,47 +391,76 @@ fn render(
     );
     let images = shading.images();
     let positions = (s * s).min(settings.spp);
+    // Sample `i` of a pixel takes position `i % positions`; its draw index follows the
+    // pixel's first.
+    let draws_of = |x: u32, y: u32, position: u32| {
+        let first = u64::from(y * width + x) * u64::from(settings.spp);
+        (position..settings.spp)
+            .step_by(positions as usize)
+            .map(move |i| first + u64::from(i))
+    };
     let done = AtomicUsize::new(0);
     // Row by row, each row holding the images' rows one after another.
     let row_length = width as usize * images;
     let mut rows = vec![Vec3::ZERO; row_length * height as usize];
     let level = specula::simd::Level::detect();
+    // A row is shaded a run of pixels at a time, the run's environment draws made first.
+    let run = (RUN_DRAWS / settings.spp).max(1);
     rows.par_chunks_mut(row_length)
         .enumerate()
         .for_each(|(y, row)| {
             let y = y as u32;
-            let mut sums = vec![DVec3::ZERO; images];
+            let mut sums = vec![DVec3::ZERO; images * run as usize];
             let mut scratch = Scratch::new();
-            for x in 0..width {
-                let first = u64::from(y * width + x) * u64::from(settings.spp);
+            let mut cells = LightCells::default();
+            let mut visits = Vec::new();
+            for start in (0..width).step_by(run as usize) {
+                let end = (start + run).min(width);
                 sums.fill(DVec3::ZERO);
-                // Sample `i` of the pixel takes position `i % positions`.
-                for position in 0..positions {
-                    let (sx, sy) = (x * s + position % s, y * s + position / s);
-                    let samples = (position..settings.spp).step_by(positions as usize);
-                    let draws = samples.clone().map(|i| first + u64::from(i));
-                    let Some(point) = points[(sy * width * s + sx) as usize] else {
-                        let direction = rays.direction(sx, sy);
-                        let background =
-                            environment.radiance(direction).as_dvec3() * samples.len() as f64;
-                        sums.iter_mut().for_each(|sum| *sum += background);
-                        continue;
-                    };
-                    let Some((frame, wo)) = view(scene, point) else {
-                        continue;
-                    };
+                cells.clear();
+                visits.clear();
+                for x in start..end {
+                    let sums = &mut sums[(x - start) as usize * images..][..images];
+                    for position in 0..positions {
+                        let (sx, sy) = (x * s + position % s, y * s + position / s);
+                        let Some(point) = points[(sy * width * s + sx) as usize] else {
+                            let direction = rays.direction(sx, sy);
+                            let samples = draws_of(x, y, position).len() as f64;
+                            let background = environment.radiance(direction).as_dvec3() * samples;
+                            sums.iter_mut().for_each(|sum| *sum += background);
+                            continue;
+                        };
+                        let Some((frame, wo)) = view(scene, point) else {
+                            continue;
+                        };
+                        if let Shading::Packets { .. } = shading {
+                            cells.push(environment, settings.seed, draws_of(x, y, position));
+                        }
+                        visits.push(Visit {
+                            x,
+                            position,
+                            object: point.object as usize,
+                            frame,
+                            wo,
+                        });
+                    }
+                }
+                cells.resolve(environment);
+                for visit in &visits {
+                    let sums = &mut sums[(visit.x - start) as usize * images..][..images];
+                    let draws = draws_of(visit.x, y, visit.position);
                     match shading {
                         Shading::Packets { surfaces, .. } => shade(
                             &Point {
-                                surfaces: &surfaces[point.object as usize],
-                                frame: frame.as_f32(),
-                                wo: wo.as_vec3(),
+                                surfaces: &surfaces[visit.object],
+                                frame: visit.frame.as_f32(),
+                                wo: visit.wo.as_vec3(),
                             },
                             environment,
                             (settings.strategy, level),
                             settings.seed,
                             draws,
-                            (&mut scratch, &mut sums),
+                            (&mut cells, &mut scratch, sums),
                         ),
                         Shading::Reflectances(surfaces) => {
                             sums[0] += draws
@@ -439,10 +469,10 @@ fn render(
                                         uniform(settings.seed, draw, d as u64)
                                     });
                                     estimate(
-                                        surfaces[point.object as usize],
+                                        surfaces[visit.object],
                                         environment,
-                                        &frame,
-                                        wo,
+                                        &visit.frame,
+                                        visit.wo,
                                         settings.strategy,
                                         u,
                                     )
@@ -451,9 +481,12 @@ fn render(
                         }
                     }
                 }
-                for (image, sum) in sums.iter().enumerate() {
-                    row[image * width as usize + x as usize] =
-                        (*sum / f64::from(settings.spp)).as_vec3();
+                for x in start..end {
+                    let sums = &sums[(x - start) as usize * images..][..images];
+                    for (image, sum) in sums.iter().enumerate() {
+                        row[image * width as usize + x as usize] =
+                            (*sum / f64::from(settings.spp)).as_vec3();
+                    }
                 }
             }
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, height as usize);
@@ -466,6 +499,20 @@ fn render(
         }
     }
     Ok(out)
+}
+
+/// The environment draws a run of pixels makes ahead of shading it (`ahead.rs`): enough
+/// to keep the reads of the alias table in flight together, few enough that the records
+/// they ask for stay in cache until read.
+const RUN_DRAWS: u32 = 1024;
+
+/// A pixel's sample position that sees a surface, as the run's first pass found it.
+struct Visit {
+    x: u32,
+    position: u32,
+    object: usize,
+    frame: Frame,
+    wo: DVec3,
 }
 
 /// A visible surface point's frame and `wo` in it, or `None` where the surface faces away
