@@ -27,7 +27,8 @@
 //! [`Environment::sample`] and [`specula::sampling::SpecularSampler`], for any
 //! [`Reflectance`]: measured and fitted materials), and, for the scene's own materials, the
 //! same estimator over packets of samples in `f32` (`packet.rs`: the map drawn by its alias
-//! table, tabulated lobes from `f32` tables, several lobes' images from one pass).
+//! table a run of pixels ahead (`ahead.rs`), tabulated lobes from `f32` tables, several
+//! lobes' images from one pass).
 
 mod ahead;
 mod angles;
