@@ -152,7 +152,7 @@ pub fn surfaces(scene: &Scene) -> Result<Vec<Option<SurfacePoint>>, RenderError>
     let bins = bin(&primitives, tiles_x, tiles_y, TILE * s);
     let (width, height) = (settings.width * s, settings.height * s);
     let mut points = vec![None; (width * height) as usize];
-    // Each band of tile rows is written in place by one thread, its tiles in turn.
+    // Each band (a row of tiles) is written in place by one thread, its tiles in turn.
     points
         .par_chunks_mut((width * TILE * s) as usize)
         .enumerate()

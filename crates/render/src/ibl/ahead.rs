@@ -55,7 +55,10 @@ impl LightCells {
     pub(super) fn resolve(&mut self, environment: &Environment) {
         let prefetch = Prefetch::new();
         for k in self.columns.len()..self.bits.len() {
-            let (row, column) = environment.draw_cell(self.rows[k], self.bits[k]);
+            let (row, column) = (
+                self.rows[k],
+                environment.draw_column(self.rows[k], self.bits[k]),
+            );
             self.columns.push(column);
             environment.prefetch_texel(environment.texel(row, column), prefetch);
         }

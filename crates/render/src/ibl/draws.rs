@@ -1,9 +1,9 @@
 //! The draws every variant of a packet shares, on SIMD lanes: each environment draw's
 //! direction (the point drawn within its texel, turned to a direction in the surface's
 //! frame) and each cosine-weighted BRDF draw's direction with the texel it falls in, and
-//! the azimuth every BRDF draw turns by. What stays scalar around it (`packet.rs`): the
-//! random numbers and the alias table's draws before it, the texels' records after (reads at
-//! random places of the map). Scalar, these were the packet's most costly part: three
+//! the azimuth every BRDF draw turns by. What stays scalar around it: the alias table's draws
+//! (`ahead.rs`) and the random bits before it (`packet.rs`), the texels' records after (reads
+//! at random places of the map). Scalar, these were the packet's most costly part: three
 //! sines and cosines, an arccosine and an arctangent per sample.
 
 use glam::Vec3;
@@ -48,7 +48,7 @@ pub(super) struct Draws {
     pub(super) within_y: Column,
     /// The bits of the BRDF draw's choice of term, of its uniform number for the cosine (made
     /// that number here), and of its azimuth. A lane past the packet's draws, or without a
-    /// BRDF draw, gets the cosine 1 (whose cosine, 0, is not above the surface).
+    /// BRDF draw, gets the uniform number 1 (whose cosine, 0, is not above the surface).
     pub(super) choice: Column,
     pub(super) u1: Column,
     pub(super) azimuth: Column,
@@ -57,8 +57,8 @@ pub(super) struct Draws {
     /// surface), so that its density is 0.
     pub(super) light_jacobian: Column,
     /// The cosine-weighted direction's texel (`i32` bit patterns, for
-    /// [`Environment::texel_at`]) and the Jacobian there (0 where the lane makes no such
-    /// draw).
+    /// [`Environment::texel_of_bits`]) and the Jacobian there (0 where the lane makes no such
+    /// draw, or it lands on a pole).
     pub(super) diffuse_column: Column,
     pub(super) diffuse_row: Column,
     pub(super) diffuse_jacobian: Column,

@@ -152,13 +152,17 @@ impl Environment {
     /// renderer draws by alias and never needs it (on 2 threads it took 6 ms of the 27 a
     /// 1024 x 512 map took to prepare).
     /// Its weights are those [`Environment::from_image`] checked and the alias table took,
-    /// which it takes too, so it is never `None`.
+    /// which it takes too, so it is never `None` (were it, the `f64` path would draw
+    /// nothing: black, not a panic).
     fn distribution(&self) -> Option<&Distribution2D> {
-        self.distribution
+        let distribution = self
+            .distribution
             .get_or_init(|| {
                 Distribution2D::new(&weights_of(&self.image), self.image.width() as usize)
             })
-            .as_ref()
+            .as_ref();
+        debug_assert!(distribution.is_some(), "the alias table took these weights");
+        distribution
     }
 
     /// Reads an environment from a `.hdr` (Radiance), `.exr` or `.png` (sRGB decoded) file:
@@ -237,12 +241,12 @@ impl Environment {
         self.alias.sample(bits)
     }
 
-    /// [`Environment::draw_texel`]'s texel as its row and column, given the row
+    /// The column of [`Environment::draw_texel`]'s texel, given the row
     /// [`Environment::prefetch_draw`] drew for these bits.
     #[must_use]
     #[inline]
-    pub(super) fn draw_cell(&self, row: u32, bits: u64) -> (u32, u32) {
-        (row, self.alias.place_in(row as usize, bits) as u32)
+    pub(super) fn draw_column(&self, row: u32, bits: u64) -> u32 {
+        self.alias.place_in(row as usize, bits) as u32
     }
 
     /// The texel at `row` and `column`.
@@ -284,8 +288,8 @@ impl Environment {
         row as u32
     }
 
-    /// Asks for what [`Environment::draw_in`] and [`Environment::look_up_texel`] will read
-    /// of `texel`.
+    /// Asks for what a look-up of `texel` will read ([`Environment::look_up_jacobian`],
+    /// [`Environment::look_up_texel`], [`Environment::draw_in`]).
     #[inline]
     pub(super) fn prefetch_texel(&self, texel: usize, prefetch: Prefetch) {
         if let Some(record) = self.texels.get(texel) {
@@ -340,7 +344,7 @@ impl Environment {
     }
 
     /// [`Environment::texel_of`] on SIMD lanes: each lane's column and row (as `i32` bit
-    /// patterns, for [`Environment::texel_at`]: converted back to integers lane by lane, a
+    /// patterns, for [`Environment::texel_of_bits`]: converted back to integers lane by lane, a
     /// float costs a saturating conversion each) and `sin theta`, for unit directions `wi`.
     #[inline(always)]
     pub(super) fn texel_lanes<V: Lanes>(&self, wi: V3<V>) -> (V, V, V) {
@@ -360,12 +364,12 @@ impl Environment {
         )
     }
 
-    /// The texel at the column and row [`Environment::texel_lanes`] stored (`i32` bit
+    /// The texel at the row and column [`Environment::texel_lanes`] stored (`i32` bit
     /// patterns of numbers it clamped to the map).
     #[must_use]
     #[inline]
-    pub(super) fn texel_at(&self, column: f32, row: f32) -> usize {
-        row.to_bits() as usize * self.image.width() as usize + column.to_bits() as usize
+    pub(super) fn texel_of_bits(&self, row: f32, column: f32) -> usize {
+        self.texel(row.to_bits(), column.to_bits())
     }
 
     /// The radiance of `texel` and the density per solid angle of a draw there, where

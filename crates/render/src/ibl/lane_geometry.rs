@@ -19,6 +19,9 @@ pub(super) const LANES: usize = 64;
 
 pub(super) type Column = [f32; LANES];
 
+/// Lanes in the widest vector a level has (AVX2's 8; room for AVX-512's 16).
+const WIDEST: usize = 16;
+
 // Every level's vectors tile a packet (1 or 8 lanes).
 const _: () = assert!(LANES.is_multiple_of(8));
 
@@ -156,7 +159,7 @@ impl<V: Lanes> V3<V> {
     #[inline(always)]
     pub(super) fn sum_lanes(self) -> Vec3 {
         let sum = |v: V| {
-            let mut lanes = [0.0; 16];
+            let mut lanes = [0.0; WIDEST];
             v.store(&mut lanes[..V::WIDTH]);
             lanes[..V::WIDTH].iter().sum::<f32>()
         };

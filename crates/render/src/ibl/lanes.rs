@@ -82,7 +82,7 @@ pub(super) struct VariantColumns {
     /// [`Source`] as a lane value.
     pub(super) source: Column,
     /// The texel of a lobe-drawn direction: its column and row (`i32` bit patterns, for
-    /// [`Environment::texel_at`]), and the Jacobian there ([`jacobian_lanes`]).
+    /// [`Environment::texel_of_bits`]), and the Jacobian there ([`jacobian_lanes`]).
     pub(super) texel_column: Column,
     pub(super) texel_row: Column,
     pub(super) texel_jacobian: Column,

@@ -9,11 +9,12 @@
 //!   call of its SIMD kernel ([`specula::Lobe::eval_batch`]), and that one value gives both
 //!   the BRDF and (over the lobe's integral) the sampler's density, where the `f64` path
 //!   evaluates it twice;
-//! - the environment is drawn by **alias** in constant time ([`Environment::draw`]) and looked
-//!   up once per BRDF direction for both its radiance and its density
-//!   ([`Environment::look_up`]), in passes over the packet: first every lane's texel, then
-//!   every texel's radiance and density (one 16-byte record), so that the reads of a map of
-//!   megabytes overlap rather than wait one after another;
+//! - the environment is drawn by **alias** in constant time, a run of pixels ahead
+//!   (`ahead.rs`: the texels this packet takes), and looked up once per BRDF direction for
+//!   both its radiance and its density, in passes over the packet: first every lane's texel,
+//!   then every texel's radiance and density (one 16-byte record, the density scaled by the
+//!   Jacobian made on lanes), so that the reads of a map of megabytes overlap rather than
+//!   wait one after another;
 //! - the frame's tangents and the Phong axis's basis are built once per surface point, and
 //!   closed-form lobes draw their cosines on SIMD lanes ([`specula::Lobe::tail_inverse_batch`]),
 //!   tabulated lobes from their table in `f32` with a guide
@@ -134,22 +135,29 @@ impl PacketSurface {
         takes: impl Fn(usize) -> bool,
         drawn: &mut [f32],
     ) {
-        let each_taken = |drawn: &mut [f32], draw: &dyn Fn(f32) -> f32| {
-            for (k, (drawn, &u)) in drawn.iter_mut().zip(us).enumerate() {
-                *drawn = if takes(k) { draw(u) } else { 0.0 };
-            }
-        };
         match &self.sampler {
             CosineSampler::ClosedForm => {
                 self.lobe.tail_inverse_batch(level, us, drawn);
             }
-            CosineSampler::Newton(start) => each_taken(drawn, &|u| {
+            CosineSampler::Newton(start) => each_taken(us, takes, drawn, |u| {
                 self.lobe
                     .tail_inverse_f32(f64::from(u), f64::from(start.sample(u)))
                     .map_or(1.0, |inverted| inverted.x as f32)
             }),
-            CosineSampler::Table(table) => each_taken(drawn, &|u| table.sample(u)),
+            CosineSampler::Table(table) => each_taken(us, takes, drawn, |u| table.sample(u)),
         }
+    }
+}
+
+/// `draw(u)` into `drawn` for each uniform `u` of `us` whose lane `takes`, 0 elsewhere.
+fn each_taken(
+    us: &[f32],
+    takes: impl Fn(usize) -> bool,
+    drawn: &mut [f32],
+    draw: impl Fn(f32) -> f32,
+) {
+    for (k, (drawn, &u)) in drawn.iter_mut().zip(us).enumerate() {
+        *drawn = if takes(k) { draw(u) } else { 0.0 };
     }
 }
 
@@ -171,17 +179,13 @@ impl Frame32 {
     }
 }
 
-/// The scalar half of a packet's shared draws: the texel each environment draw drew.
-struct SharedScalars {
-    light_texel: [usize; LANES],
-}
-
 /// The columns a packet's passes write and read: made once per thread and reused for every
 /// pixel (filling some 20 kB with zeros per pixel cost more than a sample). Every pass
 /// writes the lanes it runs before any reads them, so what a pixel leaves behind is never
 /// read by the next.
 pub(super) struct Scratch {
-    scalars: SharedScalars,
+    /// The texel each environment draw drew.
+    light_texel: [usize; LANES],
     numbers: Draws,
     shared: SharedColumns,
     variant: VariantColumns,
@@ -190,9 +194,7 @@ pub(super) struct Scratch {
 impl Scratch {
     pub(super) fn new() -> Box<Self> {
         Box::new(Self {
-            scalars: SharedScalars {
-                light_texel: [0; LANES],
-            },
+            light_texel: [0; LANES],
             numbers: Draws::ZERO,
             shared: SharedColumns {
                 light_wi: Columns3::ZERO,
@@ -232,7 +234,7 @@ pub(super) fn shade(
     environment: &Environment,
     (strategy, level): (Strategy, Level),
     seed: u64,
-    draws: impl ExactSizeIterator<Item = u64>,
+    mut draws: impl ExactSizeIterator<Item = u64>,
     (cells, scratch, sums): (&mut LightCells, &mut Scratch, &mut [glam::DVec3]),
 ) {
     let fewest_lobe_draws = point
@@ -240,10 +242,9 @@ pub(super) fn shade(
         .iter()
         .map(|s| s.share)
         .fold(f32::INFINITY, f32::min);
-    let mut draws = draws;
     let prefetch = Prefetch::new();
     let Scratch {
-        scalars,
+        light_texel,
         numbers,
         shared,
         variant,
@@ -254,8 +255,9 @@ pub(super) fn shade(
     );
     while draws.len() > 0 {
         // In passes over the packet rather than lane by lane: each pass's reads of the map
-        // (megabytes, mostly out of cache) are asked for a pass before they are made, and
-        // are independent of one another, so they overlap.
+        // (megabytes, mostly out of cache) are asked for a pass before they are made (the
+        // environment draws', a run of pixels before), and are independent of one another,
+        // so they overlap.
         let count = draws.len().min(LANES);
         let (rows, columns) = cells.take(count);
         // The lanes the jobs run: the draws rounded up to the level's width, so that a pixel
@@ -268,12 +270,19 @@ pub(super) fn shade(
             let (row, column, [within, choice, more]) = match draws.next() {
                 Some(draw) => (
                     rows[k],
-                    columns[k],
+                    {
+                        debug_assert_eq!(
+                            environment.texel(rows[k], columns[k]),
+                            environment.draw_texel(random_bits(seed, draw, 0)),
+                            "draw {draw} took the texel pushed for another"
+                        );
+                        columns[k]
+                    },
                     [1, 2, 3].map(|dimension| random_bits(seed, draw, dimension)),
                 ),
                 None => (0, 0, [0; 3]),
             };
-            scalars.light_texel[k] = environment.texel(row, column);
+            light_texel[k] = environment.texel(row, column);
             (numbers.light_row[k], numbers.light_column[k]) = (row as f32, column as f32);
             let bits = |bits: u64| f32::from_bits(bits as u32);
             numbers.within_x[k] = bits(within);
@@ -301,23 +310,23 @@ pub(super) fn shade(
                 shared,
             },
         );
-        // Only the lanes that make the cosine-weighted draw read its texel (its Jacobian is 0
-        // elsewhere): a lobe that takes most BRDF draws leaves most lanes without one.
+        // Only the lanes that make the cosine-weighted draw read its texel (its direction is
+        // 0 elsewhere): a lobe that takes most BRDF draws leaves most lanes without one.
         let diffuse_texel =
-            |k: usize| environment.texel_at(numbers.diffuse_column[k], numbers.diffuse_row[k]);
+            |k: usize| environment.texel_of_bits(numbers.diffuse_row[k], numbers.diffuse_column[k]);
+        let makes_diffuse = |k: usize| shared.diffuse_wi.z[k] > 0.0;
         for k in 0..used {
-            if numbers.diffuse_jacobian[k] > 0.0 {
+            if makes_diffuse(k) {
                 environment.prefetch_texel(diffuse_texel(k), prefetch);
             }
         }
         // The texels' radiances and densities: every lane reads its environment draw's, and a
         // lane without a draw (its Jacobian 0) gets density 0.
-        for k in 0..used {
-            let (radiance, pdf) =
-                environment.look_up_jacobian(scalars.light_texel[k], numbers.light_jacobian[k]);
+        for (k, &texel) in light_texel[..used].iter().enumerate() {
+            let (radiance, pdf) = environment.look_up_jacobian(texel, numbers.light_jacobian[k]);
             shared.light_pdf[k] = pdf;
             shared.light_radiance.set(k, radiance);
-            let (radiance, pdf) = if numbers.diffuse_jacobian[k] > 0.0 {
+            let (radiance, pdf) = if makes_diffuse(k) {
                 environment.look_up_jacobian(diffuse_texel(k), numbers.diffuse_jacobian[k])
             } else {
                 (Vec3::ZERO, 0.0)
@@ -412,7 +421,7 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
         },
     );
     let lobe_texel = |variant: &VariantColumns, k: usize| {
-        environment.texel_at(variant.texel_column[k], variant.texel_row[k])
+        environment.texel_of_bits(variant.texel_row[k], variant.texel_column[k])
     };
     for k in 0..count {
         if Source::of(variant.source[k]) == Source::Lobe {

@@ -37,6 +37,7 @@ impl Entry {
 /// their sum is not. All-zero weights draw every cell alike (as
 /// [`super::Distribution1D`] does).
 fn fill(weights: &[f64], first: u32, entries: &mut [Entry]) -> Option<()> {
+    debug_assert_eq!(weights.len(), entries.len(), "an entry a weight");
     let total = super::weights_total(weights)?;
     let n = weights.len() as f64;
     let mut scaled: Vec<f64> = if total > 0.0 {
@@ -277,6 +278,16 @@ mod tests {
         assert!((seen - share).abs() < 5.0 * sigma, "{seen} against {share}");
         assert!(GroupedAliasTable::new(&weights, 5).is_none());
         assert!(GroupedAliasTable::new(&weights, 0).is_none());
+        // What the one table refuses, the grouped one refuses: a NaN, a negative weight in a
+        // group whose sum is positive, a sum that overflows only across groups, no weights.
+        for bad in [
+            vec![1.0, f64::NAN, 1.0, 1.0],
+            vec![1.0, 3.0, -1.0, 1.0],
+            vec![f64::MAX, 0.0, f64::MAX, 0.0],
+            vec![],
+        ] {
+            assert!(GroupedAliasTable::new(&bad, 2).is_none(), "{bad:?}");
+        }
     }
 
     #[test]
