@@ -46,12 +46,14 @@ pub(super) struct Draws {
     pub(super) light_row: Column,
     pub(super) within_x: Column,
     pub(super) within_y: Column,
-    /// The bits of the BRDF draw's choice of term, of its uniform number for the cosine (made
-    /// that number here), and of its azimuth. A lane past the packet's draws, or without a
-    /// BRDF draw, gets the uniform number 1 (whose cosine, 0, is not above the surface).
+    /// The bits of the BRDF draw's choice of term, of its uniform number for the cosine, and
+    /// of its azimuth.
     pub(super) choice: Column,
-    pub(super) u1: Column,
+    pub(super) u1_bits: Column,
     pub(super) azimuth: Column,
+    /// The cosine's uniform number, made from `u1_bits`. A lane past the packet's draws, or
+    /// without a BRDF draw, gets 1 (whose cosine, 0, is not above the surface).
+    pub(super) u1: Column,
     /// `1 / (2 pi^2 sin theta)` of the environment's direction ([`jacobian_lanes`]): 0 where
     /// the lane has no environment draw (or its direction is on a pole or below the
     /// surface), so that its density is 0.
@@ -71,8 +73,9 @@ impl Draws {
         within_x: [0.0; LANES],
         within_y: [0.0; LANES],
         choice: [0.0; LANES],
-        u1: [0.0; LANES],
+        u1_bits: [0.0; LANES],
         azimuth: [0.0; LANES],
+        u1: [0.0; LANES],
         light_jacobian: [0.0; LANES],
         diffuse_column: [0.0; LANES],
         diffuse_row: [0.0; LANES],
@@ -116,7 +119,7 @@ impl Job for SharedDraws<'_> {
             let choice = unit(&draws.choice).select(drawn, lanes.splat(2.0));
             choice.store(&mut shared.choice[k..k + w]);
             let u1 = if self.brdf {
-                unit(&draws.u1).select(drawn, one)
+                unit(&draws.u1_bits).select(drawn, one)
             } else {
                 one
             };

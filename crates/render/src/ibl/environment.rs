@@ -100,20 +100,20 @@ impl Environment {
     pub fn from_image(image: Image, name: &str) -> Result<Self, EnvironmentError> {
         let (width, height) = (image.width(), image.height());
         let bad = |v: &f32| !v.is_finite() || *v < 0.0;
-        if let Some(index) = image
-            .pixels()
-            .par_iter()
-            .position_first(|pixel| pixel.to_array().iter().any(bad))
+        if let Some((index, value)) =
+            image
+                .pixels()
+                .par_iter()
+                .enumerate()
+                .find_map_first(|(index, pixel)| {
+                    pixel.to_array().into_iter().find(bad).map(|v| (index, v))
+                })
         {
             return Err(EnvironmentError::BadPixel {
                 name: name.to_owned(),
                 x: index as u32 % width,
                 y: index as u32 / width,
-                value: image.pixels()[index]
-                    .to_array()
-                    .into_iter()
-                    .find(bad)
-                    .unwrap_or(0.0),
+                value,
             });
         }
         let weights = weights_of(&image);
@@ -280,7 +280,7 @@ impl Environment {
     }
 
     /// The row [`Environment::draw_texel`] draws for these bits, having asked for what it
-    /// will read in the row ([`Environment::draw_cell`] draws the texel there).
+    /// will read in the row ([`Environment::draw_column`] draws the texel there).
     #[inline]
     pub(super) fn prefetch_draw(&self, bits: u64, prefetch: Prefetch) -> u32 {
         let row = self.alias.group_of(bits);
@@ -313,9 +313,8 @@ impl Environment {
         // phi = 3 pi / 2 - 2 pi x, in turns.
         let (sin_phi, cos_phi) = angles::sin_cos_turns(0.75 - x);
         let wi = Vec3::new(sine * cos_phi, sine * sin_phi, cosine);
-        let [r, g, b, density] = self.texels[texel];
-        let pdf = density / (2.0 * core::f32::consts::PI * core::f32::consts::PI * sine);
-        Some((wi, pdf, Vec3::new(r, g, b)))
+        let (radiance, pdf) = self.look_up_jacobian(texel, jacobian(sine));
+        Some((wi, pdf, radiance))
     }
 
     /// [`Environment::draw_texel`] then [`Environment::draw_in`].
@@ -373,8 +372,7 @@ impl Environment {
     }
 
     /// The radiance of `texel` and the density per solid angle of a draw there, where
-    /// `jacobian` is [`jacobian_lanes`]'s for its `sin theta`: [`Environment::look_up_texel`]
-    /// with a multiplication for the division.
+    /// `jacobian` is [`jacobian`]'s (or [`jacobian_lanes`]'s) for its `sin theta`.
     #[must_use]
     #[inline]
     pub(super) fn look_up_jacobian(&self, texel: usize, jacobian: f32) -> (Vec3, f32) {
@@ -387,13 +385,7 @@ impl Environment {
     #[must_use]
     #[inline]
     pub fn look_up_texel(&self, texel: usize, sine: f32) -> (Vec3, f32) {
-        let [r, g, b, density] = self.texels[texel];
-        let pdf = if sine > 0.0 {
-            density / (2.0 * core::f32::consts::PI * core::f32::consts::PI * sine)
-        } else {
-            0.0
-        };
-        (Vec3::new(r, g, b), pdf)
+        self.look_up_jacobian(texel, jacobian(sine))
     }
 
     /// The radiance from the unit direction `wi` and its density under
@@ -406,8 +398,20 @@ impl Environment {
     }
 }
 
-/// The unit square's density to one per solid angle, `1 / (2 pi^2 sin theta)`, on lanes of
-/// `sin theta`, and 0 where that is not positive (no draw: a density of 0).
+/// The unit square's density to one per solid angle, `1 / (2 pi^2 sin theta)`, and 0 where
+/// `sin theta` is not positive (no draw: a density of 0). The `f32` paths' one Jacobian, made
+/// once so that a look-up multiplies.
+#[must_use]
+#[inline]
+pub(super) fn jacobian(sine: f32) -> f32 {
+    if sine > 0.0 {
+        1.0 / (sine * (2.0 * core::f32::consts::PI * core::f32::consts::PI))
+    } else {
+        0.0
+    }
+}
+
+/// [`jacobian`] on lanes of `sin theta` (the same operations).
 #[inline(always)]
 pub(super) fn jacobian_lanes<V: Lanes>(sine: V) -> V {
     let scale = sine.splat(2.0 * core::f32::consts::PI * core::f32::consts::PI);

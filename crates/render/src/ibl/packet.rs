@@ -268,18 +268,15 @@ pub(super) fn shade(
         // (`SharedDraws` masks them); they read texel 0.
         for k in 0..used {
             let (row, column, [within, choice, more]) = match draws.next() {
-                Some(draw) => (
-                    rows[k],
-                    {
-                        debug_assert_eq!(
-                            environment.texel(rows[k], columns[k]),
-                            environment.draw_texel(random_bits(seed, draw, 0)),
-                            "draw {draw} took the texel pushed for another"
-                        );
-                        columns[k]
-                    },
-                    [1, 2, 3].map(|dimension| random_bits(seed, draw, dimension)),
-                ),
+                Some(draw) => {
+                    debug_assert_eq!(
+                        environment.texel(rows[k], columns[k]),
+                        environment.draw_texel(random_bits(seed, draw, 0)),
+                        "draw {draw} took the texel pushed for another"
+                    );
+                    let bits = [1, 2, 3].map(|dimension| random_bits(seed, draw, dimension));
+                    (rows[k], columns[k], bits)
+                }
                 None => (0, 0, [0; 3]),
             };
             light_texel[k] = environment.texel(row, column);
@@ -288,7 +285,7 @@ pub(super) fn shade(
             numbers.within_x[k] = bits(within);
             numbers.within_y[k] = bits(within >> 32);
             numbers.choice[k] = bits(choice);
-            numbers.u1[k] = bits(choice >> 32);
+            numbers.u1_bits[k] = bits(choice >> 32);
             numbers.azimuth[k] = bits(more);
         }
         // The environment's directions and the cosine-weighted ones on lanes.

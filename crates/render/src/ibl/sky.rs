@@ -114,13 +114,14 @@ impl Environment {
         // The directions are separable: a sub-row fixes theta, a sub-column phi, so each
         // sine and cosine is computed once per sub-row or sub-column, not per point.
         let at = |index: usize, count: usize| (index as f64 + 0.5) / count as f64;
+        // A pixel's points' sines and cosines, point `p` taking the angle `place(p)` from
+        // `first`.
         let points = |angles: &[(f64, f64)], first: usize, place: fn(usize) -> usize| {
-            [0, 1].map(|part| {
-                core::array::from_fn(|p| {
-                    let (sine, cosine) = angles[first + place(p)];
-                    (if part == 0 { sine } else { cosine }) as f32
-                })
-            })
+            let angle = |p: usize| angles[first + place(p)];
+            [
+                core::array::from_fn(|p| angle(p).0 as f32),
+                core::array::from_fn(|p| angle(p).1 as f32),
+            ]
         };
         let thetas: Vec<(f64, f64)> = (0..height * SUB)
             .map(|y| super::environment::theta_of_square(at(y, height * SUB)))
