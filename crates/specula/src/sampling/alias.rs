@@ -106,15 +106,15 @@ impl AliasTable {
 }
 
 /// The cell `entries` (the slots from `first` on) draw for 32 uniform bits: the slot or its
-/// alias chosen by a mask, not a branch (random, and mispredicted as often as not).
+/// alias chosen by a conditional move, not a branch (random, and mispredicted as often as
+/// not; a mask of the two is turned back into a branch by the compiler).
 #[inline]
 fn draw(entries: &[Entry], first: usize, bits: u32) -> usize {
     let wide = u64::from(bits) * entries.len() as u64;
     let slot = (wide >> 32) as usize;
     let keep = super::unit_f32(wide as u32);
     let entry = entries[slot];
-    let kept = usize::from(keep < entry.threshold).wrapping_neg();
-    ((first + slot) & kept) | (entry.alias as usize & !kept)
+    core::hint::select_unpredictable(keep < entry.threshold, first + slot, entry.alias as usize)
 }
 
 /// An [`AliasTable`] over groups of `group` consecutive cells, then one per group (see the
