@@ -99,16 +99,7 @@ impl Environment {
     /// The environment of a linear-radiance lat-long `image`, or why it cannot be one.
     pub fn from_image(image: Image, name: &str) -> Result<Self, EnvironmentError> {
         let (width, height) = (image.width(), image.height());
-        let bad = |v: &f32| !v.is_finite() || *v < 0.0;
-        if let Some((index, value)) =
-            image
-                .pixels()
-                .par_iter()
-                .enumerate()
-                .find_map_first(|(index, pixel)| {
-                    pixel.to_array().into_iter().find(bad).map(|v| (index, v))
-                })
-        {
+        if let Some((index, value)) = first_bad_channel(&image) {
             return Err(EnvironmentError::BadPixel {
                 name: name.to_owned(),
                 x: index as u32 % width,
@@ -116,7 +107,6 @@ impl Environment {
                 value,
             });
         }
-        let weights = weights_of(&image);
         let shape = || EnvironmentError::Shape {
             name: name.to_owned(),
             width,
@@ -125,21 +115,33 @@ impl Environment {
         if width < 2 {
             return Err(shape());
         }
-        let alias = GroupedAliasTable::new(&weights, width as usize).ok_or_else(shape)?;
-        let total: f64 = weights.iter().sum();
-        let cells = weights.len() as f64;
-        let texels = weights
-            .par_iter()
-            .zip(image.pixels())
-            .map(|(w, radiance)| {
-                let density = if total > 0.0 {
-                    (w * cells / total) as f32
-                } else {
-                    1.0
-                };
-                [radiance.x, radiance.y, radiance.z, density]
-            })
-            .collect();
+        // The weights are made a row at a time, for the row's alias table and again for its
+        // texels' densities: never the whole map's at once (4 MB at 1024 x 512).
+        let (row_length, sines) = (width as usize, row_sines(height));
+        let alias = GroupedAliasTable::from_groups(height as usize, row_length, |row, weights| {
+            row_weights(
+                &image.pixels()[row * row_length..][..row_length],
+                sines[row],
+                weights,
+            );
+        })
+        .ok_or_else(shape)?;
+        let (total, cells) = (alias.total(), image.pixels().len() as f64);
+        let mut texels = vec![[0.0; 4]; image.pixels().len()];
+        texels
+            .par_chunks_mut(row_length)
+            .zip(image.pixels().par_chunks(row_length))
+            .zip(sines.par_iter())
+            .for_each(|((texels, pixels), &sine)| {
+                for (texel, radiance) in texels.iter_mut().zip(pixels) {
+                    let density = if total > 0.0 {
+                        (weight(*radiance, sine) * cells / total) as f32
+                    } else {
+                        1.0
+                    };
+                    *texel = [radiance.x, radiance.y, radiance.z, density];
+                }
+            });
         Ok(Self {
             image,
             distribution: OnceLock::new(),
@@ -421,19 +423,56 @@ pub(super) fn jacobian_lanes<V: Lanes>(sine: V) -> V {
 /// Each pixel's weight for sampling: its luminance times `sin theta` at its row's middle,
 /// row by row on every thread.
 fn weights_of(image: &Image) -> Vec<f64> {
-    let (width, height) = (image.width().max(1) as usize, image.height());
+    let (width, sines) = (image.width().max(1) as usize, row_sines(image.height()));
     let mut weights = vec![0.0; image.pixels().len()];
     weights
         .par_chunks_mut(width)
         .zip(image.pixels().par_chunks(width))
-        .enumerate()
-        .for_each(|(row, (weights, pixels))| {
-            let sine = (PI * (row as f64 + 0.5) / f64::from(height)).sin();
-            for (weight, pixel) in weights.iter_mut().zip(pixels) {
-                *weight = f64::from(pixel.dot(LUMINANCE)) * sine;
-            }
-        });
+        .zip(sines.par_iter())
+        .for_each(|((weights, pixels), &sine)| row_weights(pixels, sine, weights));
     weights
+}
+
+/// `sin theta` at the middle of each of `height` rows: the solid angle a row's texels span,
+/// up to a constant.
+fn row_sines(height: u32) -> Vec<f64> {
+    (0..height)
+        .map(|row| (PI * (f64::from(row) + 0.5) / f64::from(height)).sin())
+        .collect()
+}
+
+/// The sampling weight of a texel of `radiance` in a row of `sine`: its luminance times the
+/// solid angle.
+#[inline]
+fn weight(radiance: Vec3, sine: f64) -> f64 {
+    f64::from(radiance.dot(LUMINANCE)) * sine
+}
+
+/// The weights of a row of `pixels` whose `sin theta` is `sine`, into `weights`.
+fn row_weights(pixels: &[Vec3], sine: f64, weights: &mut [f64]) {
+    for (weight_of, &pixel) in weights.iter_mut().zip(pixels) {
+        *weight_of = weight(pixel, sine);
+    }
+}
+
+/// The first channel of `image` (its pixel's index and its value) that is NaN, infinite or
+/// negative. Each row is tested without a branch per channel (a map of megabytes is almost
+/// always clean), and only a row that fails is searched.
+fn first_bad_channel(image: &Image) -> Option<(usize, f32)> {
+    let bad = |v: f32| !(0.0..f32::INFINITY).contains(&v);
+    let width = image.width().max(1) as usize;
+    let row = image.pixels().par_chunks(width).position_first(|pixels| {
+        pixels
+            .iter()
+            .fold(false, |any, p| any | bad(p.x) | bad(p.y) | bad(p.z))
+    })?;
+    image.pixels()[row * width..]
+        .iter()
+        .enumerate()
+        .find_map(|(index, pixel)| {
+            let value = pixel.to_array().into_iter().find(|&v| bad(v))?;
+            Some((row * width + index, value))
+        })
 }
 
 /// The point of the unit square a unit direction maps to.
@@ -571,6 +610,14 @@ mod tests {
         );
         let error = Environment::from_image(Image::new(4, 2, -Vec3::ONE), "m").unwrap_err();
         assert!(error.to_string().contains("non-negative"), "{error}");
+        // The first bad channel in reading order is named, whatever row each thread tests.
+        let mut image = Image::new(8, 64, Vec3::ONE);
+        image.set(5, 60, Vec3::new(f32::NAN, 0.0, 0.0));
+        image.set(2, 40, Vec3::new(1.0, f32::INFINITY, -1.0));
+        let error = Environment::from_image(image, "m").unwrap_err().to_string();
+        assert!(error.contains("(2, 40) is inf"), "{error}");
+        // Negative zero is not negative radiance.
+        assert!(Environment::from_image(Image::new(4, 2, Vec3::splat(-0.0)), "m").is_ok());
         let error = Environment::from_image(Image::new(1, 1, Vec3::ONE), "m").unwrap_err();
         assert!(error.to_string().contains("at least 2x1"), "{error}");
     }

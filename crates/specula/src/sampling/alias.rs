@@ -125,6 +125,7 @@ pub struct GroupedAliasTable {
     /// Each group's table in turn, its aliases the cells' own indices.
     cells: Vec<Entry>,
     group: usize,
+    total: f64,
 }
 
 impl GroupedAliasTable {
@@ -133,32 +134,60 @@ impl GroupedAliasTable {
     /// every cell alike.
     #[must_use]
     pub fn new(weights: &[f64], group: usize) -> Option<Self> {
-        if group == 0
-            || !weights.len().is_multiple_of(group)
-            || u32::try_from(weights.len()).is_err()
-        {
+        if group == 0 || !weights.len().is_multiple_of(group) {
             return None;
         }
-        let sums: Vec<f64> = weights.par_chunks(group).map(|g| g.iter().sum()).collect();
-        // Checked as a whole: a sum that overflows is refused, not its parts'.
-        if !sums.iter().sum::<f64>().is_finite() {
+        Self::from_groups(weights.len() / group, group, |index, out| {
+            out.copy_from_slice(&weights[index * group..][..group]);
+        })
+    }
+
+    /// The table of `groups` groups of `group` cells, group `index`'s weights written into
+    /// its slice by `weights_of(index, slice)`: the weights are made a group at a time on
+    /// each thread, never all at once (a map's would be megabytes, made and thrown away).
+    /// `None` where there are no cells, more than `u32::MAX`, or [`AliasTable::new`]
+    /// refuses a group's weights or their sums.
+    #[must_use]
+    pub fn from_groups(
+        groups: usize,
+        group: usize,
+        weights_of: impl Fn(usize, &mut [f64]) + Sync,
+    ) -> Option<Self> {
+        let count = groups.checked_mul(group)?;
+        if count == 0 || u32::try_from(count).is_err() {
             return None;
         }
-        let groups = AliasTable::new(&sums)?;
-        // The groups' tables are independent: built side by side.
-        let mut cells = vec![Entry::KEPT; weights.len()];
-        cells
+        // The groups' tables are independent: built side by side, each from its weights.
+        let mut cells = vec![Entry::KEPT; count];
+        let sums = cells
             .par_chunks_mut(group)
-            .zip(weights.par_chunks(group))
             .enumerate()
-            .try_for_each(|(index, (cells, weights))| {
-                fill(weights, (index * group) as u32, cells)
-            })?;
+            .map_init(
+                || vec![0.0; group],
+                |weights, (index, cells)| {
+                    weights_of(index, weights);
+                    fill(weights, (index * group) as u32, cells)?;
+                    Some(weights.iter().sum::<f64>())
+                },
+            )
+            .collect::<Option<Vec<f64>>>()?;
+        // Checked as a whole: a sum that overflows is refused, not its parts'.
+        let total = sums.iter().sum::<f64>();
+        if !total.is_finite() {
+            return None;
+        }
         Some(Self {
-            groups,
+            groups: AliasTable::new(&sums)?,
             cells,
             group,
+            total,
         })
+    }
+
+    /// The sum of the weights: the groups' sums, added in order.
+    #[must_use]
+    pub fn total(&self) -> f64 {
+        self.total
     }
 
     /// The cell for 64 uniform bits: the high 32 draw the group, the low 32 the cell in it
@@ -249,6 +278,7 @@ mod tests {
         let total: f64 = weights.iter().sum();
         let group = 12;
         let table = GroupedAliasTable::new(&weights, group).unwrap();
+        assert!((table.total() - total).abs() <= 1e-12 * total);
         let groups = probabilities(&table.groups);
         let mut p = vec![0.0; weights.len()];
         for (g, chunk) in table.cells.chunks(group).enumerate() {
