@@ -1,10 +1,12 @@
 //! The draws every variant of a packet shares, on SIMD lanes: each environment draw's
 //! direction (the point drawn within its texel, turned to a direction in the surface's
-//! frame) and each cosine-weighted BRDF draw's direction with the texel it falls in, and
-//! the azimuth every BRDF draw turns by. What stays scalar around it: the alias table's draws
-//! (`ahead.rs`) and the random bits before it (`packet.rs`), the texels' records after (reads
-//! at random places of the map). Scalar, these were the packet's most costly part: three
-//! sines and cosines, an arccosine and an arctangent per sample.
+//! frame), each cosine-weighted BRDF draw's direction, and the azimuth every BRDF draw turns
+//! by. The texel a BRDF draw falls in is found with the variant's own directions
+//! (`lanes.rs`), the cosine-weighted ones among them: finding it here too read the same
+//! texel twice. What stays scalar around it: the alias table's draws (`ahead.rs`) and the
+//! random bits before it (`packet.rs`), the texels' records after (reads at random places of
+//! the map). Scalar, these were the packet's most costly part: sines, cosines, an arccosine
+//! and an arctangent per sample.
 
 use glam::Vec3;
 use specula::simd::{Job, Lanes};
@@ -58,12 +60,6 @@ pub(super) struct Draws {
     /// the lane has no environment draw (or its direction is on a pole or below the
     /// surface), so that its density is 0.
     pub(super) light_jacobian: Column,
-    /// The cosine-weighted direction's texel (`i32` bit patterns, for
-    /// [`Environment::texel_of_bits`]) and the Jacobian there (0 where the lane makes no such
-    /// draw, or it lands on a pole).
-    pub(super) diffuse_column: Column,
-    pub(super) diffuse_row: Column,
-    pub(super) diffuse_jacobian: Column,
 }
 
 impl Draws {
@@ -77,9 +73,6 @@ impl Draws {
         azimuth: [0.0; LANES],
         u1: [0.0; LANES],
         light_jacobian: [0.0; LANES],
-        diffuse_column: [0.0; LANES],
-        diffuse_row: [0.0; LANES],
-        diffuse_jacobian: [0.0; LANES],
     };
 }
 
@@ -159,16 +152,6 @@ impl Job for SharedDraws<'_> {
             }
             .select(above, V3::splat(lanes, Vec3::ZERO));
             diffuse.store(&mut shared.diffuse_wi, k);
-            let world = tangent.scale_add(
-                diffuse.x,
-                bitangent.scale_add(diffuse.y, normal.scale(diffuse.z)),
-            );
-            let (texel_column, texel_row, texel_sine) = environment.texel_lanes(world);
-            texel_column.store(&mut draws.diffuse_column[k..k + w]);
-            texel_row.store(&mut draws.diffuse_row[k..k + w]);
-            jacobian_lanes(texel_sine)
-                .keep(above)
-                .store(&mut draws.diffuse_jacobian[k..k + w]);
         }
     }
 }

@@ -43,11 +43,6 @@ impl Columns3 {
     pub(super) fn set(&mut self, k: usize, v: Vec3) {
         (self.x[k], self.y[k], self.z[k]) = (v.x, v.y, v.z);
     }
-
-    #[must_use]
-    pub(super) fn get(&self, k: usize) -> Vec3 {
-        Vec3::new(self.x[k], self.y[k], self.z[k])
-    }
 }
 
 /// A vector of 3-vectors.

@@ -60,8 +60,6 @@ pub(super) struct SharedColumns {
     pub(super) cos_phi: Column,
     /// Zero where the cosine-weighted draw is not taken or not above the surface.
     pub(super) diffuse_wi: Columns3,
-    pub(super) diffuse_radiance: Columns3,
-    pub(super) diffuse_light_pdf: Column,
 }
 
 /// One variant's per-lane results.

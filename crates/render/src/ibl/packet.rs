@@ -204,8 +204,6 @@ impl Scratch {
                 sin_phi: [0.0; LANES],
                 cos_phi: [0.0; LANES],
                 diffuse_wi: Columns3::ZERO,
-                diffuse_radiance: Columns3::ZERO,
-                diffuse_light_pdf: [0.0; LANES],
             },
             variant: VariantColumns::ZERO,
         })
@@ -307,29 +305,12 @@ pub(super) fn shade(
                 shared,
             },
         );
-        // Only the lanes that make the cosine-weighted draw read its texel (its direction is
-        // 0 elsewhere): a lobe that takes most BRDF draws leaves most lanes without one.
-        let diffuse_texel =
-            |k: usize| environment.texel_of_bits(numbers.diffuse_row[k], numbers.diffuse_column[k]);
-        let makes_diffuse = |k: usize| shared.diffuse_wi.z[k] > 0.0;
-        for k in 0..used {
-            if makes_diffuse(k) {
-                environment.prefetch_texel(diffuse_texel(k), prefetch);
-            }
-        }
-        // The texels' radiances and densities: every lane reads its environment draw's, and a
-        // lane without a draw (its Jacobian 0) gets density 0.
+        // The environment draws' radiances and densities: a lane without a draw (its
+        // Jacobian 0) gets density 0.
         for (k, &texel) in light_texel[..used].iter().enumerate() {
             let (radiance, pdf) = environment.look_up_jacobian(texel, numbers.light_jacobian[k]);
             shared.light_pdf[k] = pdf;
             shared.light_radiance.set(k, radiance);
-            let (radiance, pdf) = if makes_diffuse(k) {
-                environment.look_up_jacobian(diffuse_texel(k), numbers.diffuse_jacobian[k])
-            } else {
-                (Vec3::ZERO, 0.0)
-            };
-            shared.diffuse_light_pdf[k] = pdf;
-            shared.diffuse_radiance.set(k, radiance);
         }
         let packet = Packet {
             point,
@@ -420,18 +401,18 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
     let lobe_texel = |variant: &VariantColumns, k: usize| {
         environment.texel_of_bits(variant.texel_row[k], variant.texel_column[k])
     };
+    let draws_one =
+        |variant: &VariantColumns, k: usize| Source::of(variant.source[k]) != Source::None;
     for k in 0..count {
-        if Source::of(variant.source[k]) == Source::Lobe {
+        if draws_one(variant, k) {
             environment.prefetch_texel(lobe_texel(variant, k), prefetch);
         }
     }
     for k in 0..count {
-        let (radiance, light_pdf) = match Source::of(variant.source[k]) {
-            Source::Lobe => {
-                environment.look_up_jacobian(lobe_texel(variant, k), variant.texel_jacobian[k])
-            }
-            Source::Diffuse => (shared.diffuse_radiance.get(k), shared.diffuse_light_pdf[k]),
-            Source::None => (Vec3::ZERO, 0.0),
+        let (radiance, light_pdf) = if draws_one(variant, k) {
+            environment.look_up_jacobian(lobe_texel(variant, k), variant.texel_jacobian[k])
+        } else {
+            (Vec3::ZERO, 0.0)
         };
         variant.brdf_radiance.set(k, radiance);
         variant.brdf_light_pdf[k] = light_pdf;
