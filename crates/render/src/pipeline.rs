@@ -170,6 +170,9 @@ pub fn surfaces(scene: &Scene) -> Result<Vec<Option<SurfacePoint>>, RenderError>
                     };
                     resolve_visibility(&primitives, bin, rect, depth, visible);
                     let sample_width = rect.x1 - rect.x0 + 1;
+                    // A triangle's edge planes about the tile, made again only where the
+                    // visible triangle changes (neighbouring samples mostly share one).
+                    let mut planes = None;
                     for (k, &slot) in visible.iter().enumerate() {
                         if slot == u32::MAX {
                             continue;
@@ -179,7 +182,14 @@ pub fn surfaces(scene: &Scene) -> Result<Vec<Option<SurfacePoint>>, RenderError>
                             rect.x0 + k as u32 % sample_width,
                             rect.y0 + k as u32 / sample_width,
                         );
-                        let edges = primitive.setup.edge_weights_near(rect.x0, rect.y0);
+                        let edges = match planes {
+                            Some((made_for, edges)) if made_for == slot => edges,
+                            _ => {
+                                let edges = primitive.setup.edge_weights_near(rect.x0, rect.y0);
+                                planes = Some((slot, edges));
+                                edges
+                            }
+                        };
                         let weights = perspective_weights(primitive, edges.at(x, y));
                         let position = blend(primitive, weights, |v| v.position);
                         let interpolated = || {
