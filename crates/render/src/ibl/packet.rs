@@ -408,15 +408,6 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
             environment.prefetch_texel(lobe_texel(variant, k), prefetch);
         }
     }
-    for k in 0..count {
-        let (radiance, light_pdf) = if draws_one(variant, k) {
-            environment.look_up_jacobian(lobe_texel(variant, k), variant.texel_jacobian[k])
-        } else {
-            (Vec3::ZERO, 0.0)
-        };
-        variant.brdf_radiance.set(k, radiance);
-        variant.brdf_light_pdf[k] = light_pdf;
-    }
     surface.lobe.eval_batch(
         &variant.light_cosine[..count],
         &mut variant.light_value[..count],
@@ -434,6 +425,17 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
             &variant.brdf_cosine[..count],
             &mut variant.brdf_density[..count],
         );
+    }
+    // The texels' reads last: the lobe's values above do not need them, and give the reads
+    // asked for the time to arrive.
+    for k in 0..count {
+        let (radiance, light_pdf) = if draws_one(variant, k) {
+            environment.look_up_jacobian(lobe_texel(variant, k), variant.texel_jacobian[k])
+        } else {
+            (Vec3::ZERO, 0.0)
+        };
+        variant.brdf_radiance.set(k, radiance);
+        variant.brdf_light_pdf[k] = light_pdf;
     }
     dispatch(
         level,
