@@ -158,7 +158,10 @@ impl GroupedAliasTable {
             return None;
         }
         // The groups' tables are independent: built side by side, each from its weights.
-        let mut cells = vec![Entry::KEPT; count];
+        // Set on every thread, not by this one alone: the first touch of each page of
+        // megabytes is the kernel's work too.
+        let mut cells = Vec::with_capacity(count);
+        cells.par_extend(rayon::iter::repeat_n(Entry::KEPT, count));
         let sums = cells
             .par_chunks_mut(group)
             .enumerate()
