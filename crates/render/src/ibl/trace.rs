@@ -411,14 +411,19 @@ fn render(
     let level = specula::simd::Level::detect();
     // A row is shaded a run of pixels at a time, the run's environment draws made first.
     let run = (RUN_DRAWS / settings.spp).max(1);
-    rows.par_chunks_mut(row_length)
-        .enumerate()
-        .for_each(|(y, row)| {
+    // Each thread's columns and lists, made once and reused row after row.
+    let made = || {
+        (
+            vec![DVec3::ZERO; images * run as usize],
+            Scratch::new(),
+            LightCells::default(),
+            Vec::new(),
+        )
+    };
+    rows.par_chunks_mut(row_length).enumerate().for_each_init(
+        made,
+        |(sums, scratch, cells, visits), (y, row)| {
             let y = y as u32;
-            let mut sums = vec![DVec3::ZERO; images * run as usize];
-            let mut scratch = Scratch::new();
-            let mut cells = LightCells::default();
-            let mut visits = Vec::new();
             for start in (0..width).step_by(run as usize) {
                 let end = (start + run).min(width);
                 sums.fill(DVec3::ZERO);
@@ -451,7 +456,7 @@ fn render(
                     }
                 }
                 cells.resolve(environment);
-                for visit in &visits {
+                for visit in visits.iter() {
                     let sums = &mut sums[(visit.x - start) as usize * images..][..images];
                     let draws = draws_of(visit.x, y, visit.position);
                     match shading {
@@ -465,7 +470,7 @@ fn render(
                             (settings.strategy, level),
                             settings.seed,
                             draws,
-                            (&mut cells, &mut scratch, sums),
+                            (&mut *cells, &mut *scratch, sums),
                         ),
                         Shading::Reflectances(surfaces) => {
                             sums[0] += draws
@@ -495,7 +500,12 @@ fn render(
                 }
             }
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, height as usize);
-        });
+        },
+    );
+    if images == 1 {
+        let image = Image::from_pixels(width, height, rows).expect("a row a line of the image");
+        return Ok(vec![image]);
+    }
     let mut out = vec![Image::new(width, height, Vec3::ZERO); images];
     for (row, y) in rows.chunks_exact(row_length).zip(0..) {
         for (image, pixels) in out.iter_mut().zip(row.chunks_exact(width as usize)) {
