@@ -10,7 +10,7 @@
 //! - [`Combine`]: the BRDF and its density for both draws, the power heuristic, and the
 //!   packet's sum.
 //!
-//! Lanes past the packet's draws hold no draw (`light_pdf = 0`, source [`Source::None`]), so
+//! Lanes past the packet's draws hold no draw (`light_pdf = 0`, `brdf_taken = 0`), so
 //! every job runs over the packet's draws rounded up to the level's width (`used`: a packet of
 //! 16 draws costs 16 lanes, not [`LANES`]) and masks with selects, never with a multiply by 0
 //! (a masked lane may hold an infinity or a NaN).
@@ -24,30 +24,6 @@ use specula::Geometry;
 use super::environment::jacobian_lanes;
 use super::lane_geometry::{cosine, Column, Columns3, LANES, V3};
 use super::{Environment, Strategy};
-
-/// Where a lane's BRDF direction came from, as a lane value.
-#[derive(Clone, Copy, PartialEq)]
-pub(super) enum Source {
-    /// No direction above the surface.
-    None = 0,
-    /// Drawn from the lobe.
-    Lobe = 1,
-    /// The shared cosine-weighted draw.
-    Diffuse = 2,
-}
-
-impl Source {
-    #[must_use]
-    pub(super) fn of(lane: f32) -> Self {
-        if lane == 1.0 {
-            Source::Lobe
-        } else if lane == 2.0 {
-            Source::Diffuse
-        } else {
-            Source::None
-        }
-    }
-}
 
 /// What the environment's draws and the shared BRDF numbers of a packet hold.
 pub(super) struct SharedColumns {
@@ -77,9 +53,10 @@ pub(super) struct VariantColumns {
     pub(super) brdf_wi: Columns3,
     pub(super) brdf_cosine: Column,
     pub(super) brdf_half_cosine: Column,
-    /// [`Source`] as a lane value.
-    pub(super) source: Column,
-    /// The texel of a lobe-drawn direction: its column and row (`i32` bit patterns, for
+    /// 1 where the lane's BRDF draw (the lobe's or the cosine-weighted one) gives a direction
+    /// above the surface, 0 elsewhere.
+    pub(super) brdf_taken: Column,
+    /// The texel of each lane's BRDF direction: its column and row (`i32` bit patterns, for
     /// [`Environment::texel_of_bits`]), and the Jacobian there ([`jacobian_lanes`]).
     pub(super) texel_column: Column,
     pub(super) texel_row: Column,
@@ -100,7 +77,7 @@ impl VariantColumns {
         brdf_wi: Columns3::ZERO,
         brdf_cosine: [0.0; LANES],
         brdf_half_cosine: [0.0; LANES],
-        source: [0.0; LANES],
+        brdf_taken: [0.0; LANES],
         texel_column: [0.0; LANES],
         texel_row: [0.0; LANES],
         texel_jacobian: [0.0; LANES],
@@ -158,7 +135,7 @@ impl Job for Directions<'_> {
             t.keep(has_light).store(&mut variant.light_cosine[k..k + w]);
             half_cosine.store(&mut variant.light_half_cosine[k..k + w]);
             if strategy == Strategy::Environment {
-                zero.store(&mut variant.source[k..k + w]);
+                zero.store(&mut variant.brdf_taken[k..k + w]);
                 zero.store(&mut variant.brdf_cosine[k..k + w]);
                 continue;
             }
@@ -190,15 +167,11 @@ impl Job for Directions<'_> {
             let half = lobe_half.select(from_lobe, diffuse_half);
             // Above the surface with a defined half vector (false for NaN in either).
             let above = half.keep(wi.z.gt(zero)).gt(zero);
-            let source = lanes
-                .splat(Source::Lobe as u8 as f32)
-                .select(from_lobe, lanes.splat(Source::Diffuse as u8 as f32))
-                .keep(above);
-            source.store(&mut variant.source[k..k + w]);
+            one.keep(above).store(&mut variant.brdf_taken[k..k + w]);
             wi.store(&mut variant.brdf_wi, k);
             t.keep(above).store(&mut variant.brdf_cosine[k..k + w]);
             half.store(&mut variant.brdf_half_cosine[k..k + w]);
-            // The texel a lobe-drawn direction falls in.
+            // The texel the BRDF direction falls in.
             let world = V3::splat(lanes, frame[0]).scale_add(
                 wi.x,
                 V3::splat(lanes, frame[1]).scale_add(wi.y, V3::splat(lanes, frame[2]).scale(wi.z)),
@@ -325,7 +298,7 @@ impl Job for Combine<'_> {
             let contribution = f
                 .mul(V3::load(lanes, &variant.brdf_radiance, k))
                 .scale(scale);
-            let taken = lanes.load(&variant.source[k..k + w]).gt(zero);
+            let taken = lanes.load(&variant.brdf_taken[k..k + w]).gt(zero);
             sum = sum.add(contribution.select(pdf.keep(taken).gt(zero), nothing));
         }
         sum.sum_lanes()

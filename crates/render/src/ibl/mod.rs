@@ -39,6 +39,7 @@ mod lanes;
 mod packet;
 mod sky;
 mod trace;
+mod weights;
 
 pub use crate::pipeline::MAX_SPP;
 pub use environment::{Environment, EnvironmentError, EnvironmentSample};

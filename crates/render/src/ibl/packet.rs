@@ -42,7 +42,7 @@ use specula::{Geometry, Lobe};
 use super::ahead::LightCells;
 use super::draws::{Draws, SharedDraws};
 use super::lane_geometry::{Columns3, LANES};
-use super::lanes::{Brdf, Combine, Directions, Setting, SharedColumns, Source, VariantColumns};
+use super::lanes::{Brdf, Combine, Directions, Setting, SharedColumns, VariantColumns};
 use super::{Environment, Strategy};
 use crate::Material;
 
@@ -347,8 +347,9 @@ struct Packet<'a> {
 }
 
 /// One variant's estimates over a packet of `count` draws, summed: its lobe's cosine draws,
-/// then its directions and their texels on lanes, the texels' reads, the lobe's values (its
-/// SIMD kernel), a table's densities, and the combination on lanes.
+/// then its directions and their texels on lanes, the lobe's values (its SIMD kernel) and a
+/// table's densities while the texels are asked for, the texels' reads, and the combination
+/// on lanes.
 fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantColumns) -> Vec3 {
     let Packet {
         point,
@@ -398,14 +399,13 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
             variant: &mut *variant,
         },
     );
-    let lobe_texel = |variant: &VariantColumns, k: usize| {
+    let brdf_texel = |variant: &VariantColumns, k: usize| {
         environment.texel_of_bits(variant.texel_row[k], variant.texel_column[k])
     };
-    let draws_one =
-        |variant: &VariantColumns, k: usize| Source::of(variant.source[k]) != Source::None;
+    let has_brdf_direction = |variant: &VariantColumns, k: usize| variant.brdf_taken[k] > 0.0;
     for k in 0..count {
-        if draws_one(variant, k) {
-            environment.prefetch_texel(lobe_texel(variant, k), prefetch);
+        if has_brdf_direction(variant, k) {
+            environment.prefetch_texel(brdf_texel(variant, k), prefetch);
         }
     }
     surface.lobe.eval_batch(
@@ -429,8 +429,8 @@ fn shade_variant(packet: Packet, surface: &PacketSurface, variant: &mut VariantC
     // The texels' reads last: the lobe's values above do not need them, and give the reads
     // asked for the time to arrive.
     for k in 0..count {
-        let (radiance, light_pdf) = if draws_one(variant, k) {
-            environment.look_up_jacobian(lobe_texel(variant, k), variant.texel_jacobian[k])
+        let (radiance, light_pdf) = if has_brdf_direction(variant, k) {
+            environment.look_up_jacobian(brdf_texel(variant, k), variant.texel_jacobian[k])
         } else {
             (Vec3::ZERO, 0.0)
         };
