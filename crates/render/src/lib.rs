@@ -20,6 +20,7 @@
 //! - Conventions: right-handed world, `z` up, counter-clockwise front faces, depth in
 //!   `[0, 1]` (wgpu's), `wo` towards the viewer and `wi` towards the light.
 
+mod buffers;
 mod camera;
 mod clip;
 mod description;

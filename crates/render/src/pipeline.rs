@@ -151,10 +151,7 @@ pub fn surfaces(scene: &Scene) -> Result<Vec<Option<SurfacePoint>>, RenderError>
     );
     let bins = bin(&primitives, tiles_x, tiles_y, TILE * s);
     let (width, height) = (settings.width * s, settings.height * s);
-    // Set to `None` on every thread, not by this one alone: the first touch of each page of
-    // megabytes is the kernel's work too.
-    let mut points = Vec::with_capacity((width * height) as usize);
-    points.par_extend(rayon::iter::repeat_n(None, (width * height) as usize));
+    let mut points = crate::buffers::filled(None, (width * height) as usize);
     // Each band (a row of tiles) is written in place by one thread, its tiles in turn.
     points
         .par_chunks_mut((width * TILE * s) as usize)

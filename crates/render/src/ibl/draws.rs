@@ -36,7 +36,7 @@ fn unit_lanes<V: Lanes>(bits: V) -> V {
         * bits.splat(1.0 / (1u32 << 24) as f32)
 }
 
-/// A packet's shared random numbers, by lane, and the texels its draws fall in.
+/// A packet's shared random numbers by lane, and the texels its environment draws drew.
 ///
 /// The random numbers come in as 32 random bits each (as the bit patterns of `f32`s), and
 /// [`SharedDraws`] makes them uniform numbers on lanes ([`specula::sampling::unit_f32`]'s,

@@ -150,7 +150,7 @@ impl Environment {
         let ground_from = (0..height)
             .find(|&y| thetas[y * SUB].1 as f32 <= 0.0)
             .unwrap_or(height);
-        let mut pixels = vec![GROUND; width * height];
+        let mut pixels = crate::buffers::filled(GROUND, width * height);
         pixels[..ground_from * width]
             .par_chunks_mut(width)
             .enumerate()

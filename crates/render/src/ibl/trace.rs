@@ -402,12 +402,7 @@ fn render(
     let done = AtomicUsize::new(0);
     // Row by row, each row holding the images' rows one after another.
     let row_length = width as usize * images;
-    // Zeroed on every thread (see `pipeline::surfaces`).
-    let mut rows = Vec::with_capacity(row_length * height as usize);
-    rows.par_extend(rayon::iter::repeat_n(
-        Vec3::ZERO,
-        row_length * height as usize,
-    ));
+    let mut rows = crate::buffers::filled(Vec3::ZERO, row_length * height as usize);
     let level = specula::simd::Level::detect();
     // A row is shaded a run of pixels at a time, the run's environment draws made first.
     let run = (RUN_DRAWS / settings.spp).max(1);

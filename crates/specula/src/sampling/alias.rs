@@ -25,18 +25,20 @@ struct Entry {
 }
 
 impl Entry {
-    /// A slot that keeps its cell (its alias is set by [`fill`]).
+    /// A slot that keeps its cell whatever the draw: a threshold of 1 is above every number
+    /// a draw compares with it (at most `1 - 2^-24`), so its alias is never read.
     const KEPT: Self = Self {
         threshold: 1.0,
         alias: 0,
     };
 }
 
-/// Fills `entries` with the alias table of `weights` by Vose's algorithm, the cells numbered
-/// from `first`; `None` when there are no weights or one is negative or not finite, or
-/// their sum is not. All-zero weights draw every cell alike (as
+/// Writes the alias table of `weights` by Vose's algorithm into `entries`, each
+/// [`Entry::KEPT`] on entry (only the slots that give way are written), the cells numbered
+/// from `first`; the weights' sum, or `None` when there are no weights or one is negative or
+/// not finite, or their sum is not. All-zero weights draw every cell alike (as
 /// [`super::Distribution1D`] does).
-fn fill(weights: &[f64], first: u32, entries: &mut [Entry]) -> Option<()> {
+fn fill(weights: &[f64], first: u32, entries: &mut [Entry]) -> Option<f64> {
     debug_assert_eq!(weights.len(), entries.len(), "an entry a weight");
     let total = super::weights_total(weights)?;
     let n = weights.len() as f64;
@@ -45,12 +47,6 @@ fn fill(weights: &[f64], first: u32, entries: &mut [Entry]) -> Option<()> {
     } else {
         vec![1.0; weights.len()]
     };
-    for (i, entry) in (first..).zip(entries.iter_mut()) {
-        *entry = Entry {
-            threshold: 1.0,
-            alias: i,
-        };
-    }
     let (mut small, mut large): (Vec<u32>, Vec<u32>) =
         (0..weights.len() as u32).partition(|&i| scaled[i as usize] < 1.0);
     while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
@@ -66,8 +62,8 @@ fn fill(weights: &[f64], first: u32, entries: &mut [Entry]) -> Option<()> {
             small.push(l);
         }
     }
-    // What remains on either list is 1 up to rounding: kept whole (threshold 1).
-    Some(())
+    // What remains on either list is 1 up to rounding: kept whole, as it came.
+    Some(total)
 }
 
 /// A table drawing cells in proportion to their weights in constant time.
@@ -169,8 +165,7 @@ impl GroupedAliasTable {
                 || vec![0.0; group],
                 |weights, (index, cells)| {
                     weights_of(index, weights);
-                    fill(weights, (index * group) as u32, cells)?;
-                    Some(weights.iter().sum::<f64>())
+                    fill(weights, (index * group) as u32, cells)
                 },
             )
             .collect::<Option<Vec<f64>>>()?;
