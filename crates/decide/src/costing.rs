@@ -7,12 +7,11 @@
 //! (`material.rs`) takes [`lobe_rate`], which refuses the FPGA.
 
 use indicatif::ProgressBar;
-use specula::analysis::{error_figures, Precision};
 use specula::gpu_cost::GpuFamily;
 use specula::{Exponent, Lobe, LobeKind};
 use specula_hw::analysis::WidthSweep;
 
-use crate::hardware::{cheapest_datapath, hardware_sweeps, SWEEP_SAMPLES};
+use crate::hardware::{cheapest_datapath, hardware_sweeps};
 use crate::{Target, Zone};
 
 /// How a target's costs are obtained.
@@ -29,11 +28,11 @@ pub(crate) enum Costing {
     Synthesized(Vec<(Exponent, std::sync::Arc<Vec<WidthSweep>>)>),
 }
 
-/// A kernel's rate timed beside the others' ([`crate::rates::kernel_rates`]).
+/// A kernel's rates timed beside the others', one a pass ([`crate::rates::kernel_rates`]).
 pub(crate) struct TimedRate {
     kind: LobeKind,
     n: Exponent,
-    rate: f64,
+    passes: Vec<f64>,
 }
 
 /// Where the FPGA's costs are synthesized: every operator in LUTs, one area figure.
@@ -47,6 +46,9 @@ pub(crate) struct Point {
     pub(crate) error: f64,
     pub(crate) rate: f64,
     pub(crate) datapath: Option<String>,
+    /// Measured on the CPU: the median and the fastest of the timing's passes (the rate is
+    /// the fastest: noise only ever slows a kernel down).
+    pub(crate) spread: Option<[f64; 2]>,
 }
 
 /// The integer exponent the datapaths take for `n`.
@@ -112,7 +114,7 @@ impl Costing {
                 exponents
                     .iter()
                     .zip(rates)
-                    .map(move |(&n, rate)| TimedRate { kind, n, rate })
+                    .map(move |(&n, passes)| TimedRate { kind, n, passes })
             })
             .collect();
         progress.reset();
@@ -134,20 +136,28 @@ impl Costing {
         zone: Zone,
         max_error: f64,
     ) -> Result<Option<Point>, String> {
-        let float_error = || zone.error(&error_figures(lobe, &mut Precision::F64, SWEEP_SAMPLES));
+        let float_error = || zone.error(&crate::figures::f64_figures(lobe));
         Ok(match self {
-            Costing::Measured(timed) => Some(Point {
-                error: float_error(),
-                rate: timed
+            Costing::Measured(timed) => {
+                let passes = timed
                     .iter()
                     .find(|r| r.kind == lobe.kind() && r.n == lobe.exponent())
-                    .map_or_else(|| crate::rates::kernel_rate(lobe), |r| r.rate),
-                datapath: None,
-            }),
+                    .map(|r| r.passes.clone());
+                let spread = passes
+                    .as_deref()
+                    .map(|passes| [median(passes), passes.iter().copied().fold(0.0, f64::max)]);
+                Some(Point {
+                    error: float_error(),
+                    rate: spread.map_or_else(|| crate::rates::kernel_rate(lobe), |[_, best]| best),
+                    datapath: None,
+                    spread,
+                })
+            }
             Costing::Modelled(family) => Some(Point {
                 error: float_error(),
                 rate: modelled_rate(family, lobe)?,
                 datapath: None,
+                spread: None,
             }),
             Costing::Estimated(hardware) | Costing::Synthesized(hardware) => {
                 let Some(chosen) = hardware
@@ -186,9 +196,22 @@ impl Costing {
                     error: chosen.error,
                     rate,
                     datapath: Some(datapath),
+                    spread: None,
                 })
             }
         })
+    }
+}
+
+/// The median of `values` (the mean of the middle two for an even count; NaN for none).
+#[must_use]
+pub(crate) fn median(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    match sorted.len() {
+        0 => f64::NAN,
+        len if len % 2 == 1 => sorted[len / 2],
+        len => 0.5 * (sorted[len / 2 - 1] + sorted[len / 2]),
     }
 }
 

@@ -12,9 +12,11 @@ pub mod c_twins;
 mod choice;
 mod costing;
 pub mod design;
+mod figures;
 pub mod fpga_estimate;
 pub mod hardware;
 pub mod material;
+pub mod percent;
 pub mod rates;
 mod recommend;
 

@@ -115,34 +115,36 @@ pub(crate) fn kernel_rate(lobe: &Lobe) -> f64 {
 }
 
 /// Passes of [`kernel_rates`] over every lobe.
-pub(crate) const PASSES: usize = 5;
+pub const PASSES: usize = 7;
 /// Seconds one lobe at one exponent is timed in one pass of [`kernel_rates`].
-const PASS_SECONDS: f64 = 0.02;
+const PASS_SECONDS: f64 = 0.015;
 
-/// The kernel rates of `lobes[i]` at each of its exponents, L1-resident, one thread, timed so
-/// that lobes compare like with like on a machine whose speed drifts (this project's shared
-/// virtual machine slows by up to 40 % for a second or more at a time): in [`PASSES`] passes
-/// over every lobe, each pass timing each lobe at all its exponents, on one pinned CPU, and
-/// each rate the best of its passes. A slow spell then costs a lobe one pass at the
-/// exponents it covered, not its rate, and every lobe is timed in every part of the run.
-/// `progress` ticks once a pass per lobe.
+/// The kernel rates of `lobes[i]` at each of its exponents in each pass (`[lobe][exponent]
+/// [pass]`), L1-resident, one thread, timed so that lobes compare like with like on a machine
+/// whose speed drifts (this project's shared virtual machine slows by up to 40 % for a second
+/// or more at a time): in [`PASSES`] passes over every lobe, each pass timing each lobe at all
+/// its exponents, on one pinned CPU. A slow spell then costs a lobe one pass at the exponents
+/// it covered, every lobe is timed in every part of the run, and the passes' spread says how
+/// far one rate can be told from another. `progress` ticks once a pass per lobe.
 #[must_use]
-pub(crate) fn kernel_rates(lobes: &[Vec<Lobe>], progress: &ProgressBar) -> Vec<Vec<f64>> {
+pub(crate) fn kernel_rates(lobes: &[Vec<Lobe>], progress: &ProgressBar) -> Vec<Vec<Vec<f64>>> {
     let level = Level::detect();
     let _pinned = Pinned::to_current_cpu();
-    let mut best: Vec<Vec<f64>> = lobes.iter().map(|at| vec![0.0; at.len()]).collect();
+    let mut passes: Vec<Vec<Vec<f64>>> = lobes
+        .iter()
+        .map(|at| vec![Vec::with_capacity(PASSES); at.len()])
+        .collect();
     for _ in 0..PASSES {
-        for (at, best) in lobes.iter().zip(&mut best) {
-            for (lobe, best) in at.iter().zip(best.iter_mut()) {
-                let rate = timed_rate(PASS_SECONDS, &|t: &[f32], o: &mut [f32]| {
+        for (at, timed) in lobes.iter().zip(&mut passes) {
+            for (lobe, timed) in at.iter().zip(timed.iter_mut()) {
+                timed.push(timed_rate(PASS_SECONDS, &|t: &[f32], o: &mut [f32]| {
                     lobe.eval_batch_with(level, BatchLoop::Explicit, t, o);
-                });
-                *best = best.max(rate);
+                }));
             }
             progress.inc(1);
         }
     }
-    best
+    passes
 }
 
 /// The calling thread held on the CPU it runs on until dropped, then allowed its former CPUs
@@ -322,8 +324,8 @@ mod tests {
         assert_eq!(sched_getaffinity(Pid::from_raw(0)).unwrap(), before);
     }
 
-    /// Every lobe gets a rate at each of its exponents, in the order given, and the progress
-    /// counts a tick per lobe per pass.
+    /// Every lobe gets a rate at each of its exponents in every pass, in the order given, and
+    /// the progress counts a tick per lobe per pass.
     #[test]
     fn every_lobe_is_timed_at_each_exponent() {
         let lobes: Vec<Vec<Lobe>> = [LobeKind::Pow, LobeKind::Schlick]
@@ -341,7 +343,13 @@ mod tests {
         assert_eq!(rates.len(), 2);
         for lobe in &rates {
             assert_eq!(lobe.len(), 3);
-            assert!(lobe.iter().all(|&r| r.is_finite() && r > 0.0), "{lobe:?}");
+            for passes in lobe {
+                assert_eq!(passes.len(), PASSES);
+                assert!(
+                    passes.iter().all(|&r| r.is_finite() && r > 0.0),
+                    "{passes:?}"
+                );
+            }
         }
     }
 }

@@ -67,6 +67,12 @@ pub struct Candidate {
     /// The cost figure in [`Candidate::unit`], the smallest over the exponents. Higher is
     /// cheaper.
     pub rate: f64,
+    /// Where the rate was measured (the CPU), its spread: the median and the fastest of the
+    /// timing's passes at the exponent that sets the rate, the slowest (the rate is the
+    /// fastest pass's: noise only ever slows a kernel). Two candidates whose spreads overlap
+    /// cannot be told apart by this run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spread: Option<[f64; 2]>,
     /// Its unit.
     pub unit: &'static str,
     /// The worst energy ratio against `t^n` over the exponents.
@@ -87,8 +93,13 @@ pub struct Recommendation {
     /// What a face should tell its user about how the costs were obtained (the FPGA's tools
     /// missing, so its costs are the formula estimate), if anything.
     pub note: Option<String>,
-    /// Every candidate: those that meet the request first, then by rate, highest first.
+    /// Every candidate: those that meet the request first, the answer first among them, then
+    /// by rate, highest first.
     pub candidates: Vec<Candidate>,
+    /// Where rates are measured: the lobes that meet the request and whose spreads overlap
+    /// the fastest one's, a tie the run cannot break; the answer is the most accurate of
+    /// them. Empty where the fastest stands alone, and off the CPU.
+    pub tied: Vec<String>,
 }
 
 impl Recommendation {
@@ -257,6 +268,8 @@ struct Tally {
     cheapest: Option<f64>,
     /// The datapath named at the first exponent, or the one that cannot be built.
     datapath: Option<String>,
+    /// Measured: the median and fastest passes' rates at the slowest exponent so far.
+    spread: Option<[f64; 2]>,
     /// Some exponent has no datapath.
     unavailable: bool,
     energy: f64,
@@ -269,6 +282,10 @@ impl Tally {
             return;
         };
         self.error = self.error.max(point.error);
+        // The spread is the slowest exponent's, the one that sets the rate.
+        if self.cheapest.is_none_or(|c| point.rate < c) {
+            self.spread = point.spread;
+        }
         self.cheapest = Some(self.cheapest.map_or(point.rate, |c| c.min(point.rate)));
         // The first exponent's datapath names the lobe's, unless one cannot be built: that
         // one says why the lobe does not meet the request.
@@ -280,6 +297,7 @@ impl Tally {
     }
 
     fn candidate(self, unit: &'static str, max_error: f64, energy_conserving: bool) -> Candidate {
+        let spread = self.spread;
         let (error, rate, datapath) = if self.unavailable {
             (f64::INFINITY, 0.0, None)
         } else {
@@ -297,6 +315,7 @@ impl Tally {
             datapath,
             error,
             rate,
+            spread: spread.filter(|_| !self.unavailable),
             unit,
             energy_ratio: self.energy,
             meets,
@@ -325,17 +344,77 @@ fn rank(
         candidate.pareto = on_front;
     }
     candidates.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
+    let tied = break_tie(&mut candidates);
     let mut recommendation = Recommendation {
         unit,
         note,
         candidates,
+        tied,
     };
     let pow_rate = recommendation.pow_rate();
     let best = recommendation.best_candidate().map(|c| c.lobe.clone());
     for candidate in &mut recommendation.candidates {
         candidate.why = why(candidate, best.as_deref(), pow_rate, target, max_error);
+        if recommendation.tied.contains(&candidate.lobe) {
+            candidate.why += if Some(&candidate.lobe) == best.as_ref() {
+                "; tied with the fastest (rates overlap), the most accurate of the tie"
+            } else {
+                "; tied with the answer (rates overlap), less accurate"
+            };
+        }
     }
     recommendation
+}
+
+/// Whether two measured candidates cannot be told apart: their spreads overlap. Unmeasured
+/// rates (modelled, synthesized) are exact, and tie only where equal.
+#[must_use]
+pub(crate) fn overlap(a: &Candidate, b: &Candidate) -> bool {
+    rates_overlap((a.rate, a.spread), (b.rate, b.spread))
+}
+
+/// [`overlap`] of two (rate, spread) pairs.
+#[must_use]
+pub(crate) fn rates_overlap(a: (f64, Option<[f64; 2]>), b: (f64, Option<[f64; 2]>)) -> bool {
+    match (a.1, b.1) {
+        (Some([a_low, a_high]), Some([b_low, b_high])) => a_low <= b_high && b_low <= a_high,
+        _ => a.0 == b.0,
+    }
+}
+
+/// Among `sorted` (those that meet first, fastest first), the measured lobes that meet and
+/// whose spreads overlap the fastest's, a tie this run cannot break: the most accurate of
+/// them (the faster where equally accurate) is moved to the front, the answer. Returns the
+/// tie's lobes, the answer first; empty where the fastest stands alone or nothing is measured.
+fn break_tie(sorted: &mut [Candidate]) -> Vec<String> {
+    let Some(fastest) = sorted.first().filter(|c| c.meets && c.spread.is_some()) else {
+        return Vec::new();
+    };
+    let tie: Vec<usize> = (0..sorted.len())
+        .filter(|&k| sorted[k].meets && overlap(&sorted[k], fastest))
+        .collect();
+    if tie.len() < 2 {
+        return Vec::new();
+    }
+    let answer = tie
+        .iter()
+        .copied()
+        .min_by(|&a, &b| {
+            sorted[a]
+                .error
+                .total_cmp(&sorted[b].error)
+                .then(sorted[b].rate.total_cmp(&sorted[a].rate))
+        })
+        .unwrap_or(0);
+    sorted[..=answer].rotate_right(1);
+    // The rotation moved every earlier tied lobe one place down.
+    let mut names = vec![sorted[0].lobe.clone()];
+    names.extend(
+        tie.iter()
+            .filter(|&&k| k != answer)
+            .map(|&k| sorted[if k < answer { k + 1 } else { k }].lobe.clone()),
+    );
+    names
 }
 
 /// `rate` as a multiple of pow's (`1.52x`), or `-` where pow has no cost on the target (no
@@ -407,6 +486,7 @@ mod tests {
                 error: 0.03,
                 rate,
                 datapath: Some(datapath.to_owned()),
+                spread: None,
             }));
             tally.candidate("unit", 0.05, false)
         };

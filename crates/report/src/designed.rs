@@ -10,7 +10,8 @@ use indicatif::ProgressBar;
 use rayon::prelude::*;
 use specula::{Exponent, LobeKind};
 use specula_decide::design::{
-    default_whole_error, design, percent, Bounds, Design, DesignRequest, DEFAULT_WHOLE_ERROR,
+    default_whole_error, design, percent, removed, Bounds, Design, DesignRequest,
+    DEFAULT_WHOLE_ERROR,
 };
 use specula_decide::{versus_pow, Target};
 
@@ -59,9 +60,19 @@ pub fn designed(context: &mut Context) -> Result<String, String> {
             ("whole", &percent(DEFAULT_WHOLE_ERROR)),
         ],
     )?);
+    // Bounds whose answer is one design (the fit does not scale with the epicentre's bound,
+    // so a family that meets several is one lobe) share a row, a verdict and a formula.
     let mut rows = Vec::new();
+    let mut verdicts = String::new();
     let mut formulas = String::new();
-    for ((_, name, bound), answer) in jobs.iter().zip(&answers) {
+    for group in groups(&jobs, &answers) {
+        let (_, name, first_bound) = jobs[group[0]];
+        let answer = &answers[group[0]];
+        let named = group
+            .iter()
+            .map(|&k| percent(jobs[k].2))
+            .collect::<Vec<_>>()
+            .join(", ");
         let builtin = answer.best_compared().map_or("-".to_owned(), |c| {
             format!(
                 "{} ({} pow's throughput)",
@@ -69,35 +80,38 @@ pub fn designed(context: &mut Context) -> Result<String, String> {
                 versus_pow(c.rate, answer.pow_rate)
             )
         });
-        let row = match answer.best() {
+        let mut row = vec![name.to_owned(), named.clone()];
+        match answer.best() {
             Some(best) => {
                 formulas += &format!(
                     "<p>{name}, within {}: <code>{}</code></p>\n<pre>{}</pre>\n",
-                    escape(&percent(*bound)),
+                    escape(&named),
                     escape(&best.name),
                     escape(&best.formula)
                 );
-                vec![
-                    (*name).to_owned(),
-                    percent(*bound),
+                row.extend([
                     best.name.clone(),
                     percent(best.epicentre_error),
                     percent(best.whole_error),
                     versus_pow(best.rate, answer.pow_rate),
-                    builtin,
-                ]
+                ]);
             }
-            None => vec![
-                (*name).to_owned(),
-                percent(*bound),
-                "-".to_owned(),
-                "-".to_owned(),
-                "-".to_owned(),
-                "-".to_owned(),
-                builtin,
-            ],
-        };
+            None => row.extend(["-", "-", "-", "-"].map(str::to_owned)),
+        }
+        row.push(builtin);
         rows.push(row);
+        verdicts += &paragraph(&format!(
+            "{name}, within {}: {}",
+            percent(first_bound),
+            answer.verdict
+        ));
+        // A looser bound of the group says only what its whole-lobe bound removed.
+        for &k in &group[1..] {
+            let (target, _, bound) = jobs[k];
+            if let Some(removed) = removed(&answers[k], &request(target, bound, &yours)) {
+                verdicts += &paragraph(&format!("{name}, within {}: {removed}", percent(bound)));
+            }
+        }
     }
     html += &table(
         &[
@@ -111,13 +125,7 @@ pub fn designed(context: &mut Context) -> Result<String, String> {
         ],
         &rows,
     );
-    for ((_, name, bound), answer) in jobs.iter().zip(&answers) {
-        html += &paragraph(&format!(
-            "{name}, within {}: {}",
-            percent(*bound),
-            answer.verdict
-        ));
-    }
+    html += &verdicts;
     html += &formulas;
     for (k, (target, name)) in FAMILIES.iter().enumerate() {
         // The tightest bound's answer for this family.
@@ -125,6 +133,22 @@ pub fn designed(context: &mut Context) -> Result<String, String> {
         html += &pareto_plot(context, *target, name, bounds[0], answer)?;
     }
     Ok(html)
+}
+
+/// The jobs in runs of one target whose answers name the same design (or none), each run the
+/// jobs' indices, tightest bound first.
+fn groups(jobs: &[(Target, &str, f64)], answers: &[Design]) -> Vec<Vec<usize>> {
+    let design = |k: usize| answers[k].best().map(|best| best.formula.clone());
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for k in 0..jobs.len() {
+        match groups.last_mut() {
+            Some(group) if jobs[group[0]].0 == jobs[k].0 && design(group[0]) == design(k) => {
+                group.push(k);
+            }
+            _ => groups.push(vec![k]),
+        }
+    }
+    groups
 }
 
 /// Error against modelled cost, the designed lobes and the built-ins, with their joint

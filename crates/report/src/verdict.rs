@@ -18,6 +18,7 @@ use super::prose;
 use super::sections::series;
 use super::Context;
 use crate::format::sig;
+use specula_decide::percent::percent;
 
 const FAMILIES: [(Target, &str); 2] = [(Target::GpuNvidia, "NVIDIA"), (Target::GpuAmd, "AMD RDNA")];
 const EXPONENTS: [f64; 3] = [8.0, 64.0, 512.0];
@@ -212,51 +213,67 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
     Ok(answer + &html)
 }
 
-/// The bound and exponent the answer box states.
-const HEADLINE: (f64, f64) = (PLOTTED, 0.02);
+/// The bound the answer box states.
+const HEADLINE_BOUND: f64 = 0.02;
 
-/// The section's lead: for each target, the cheapest lobe within 2 % at n = 64 and the figure
-/// that decides it; the CPU's measured answer named, not guessed.
+/// The section's lead: for each target and each exponent of the table, the cheapest lobe
+/// within 2 % and the figure that decides it; the CPU's measured answer named, not guessed,
+/// as the command that gives it over the table's exponents.
 fn answer(
     gpu_rows: &[(Target, f64)],
     gpu: &[Vec<Recommendation>],
     hardware: &[u32],
     fpga: &[Vec<Recommendation>],
 ) -> Result<String, String> {
-    let (n, bound) = HEADLINE;
+    let bound = HEADLINE_BOUND;
     let column = ACCURACIES
         .iter()
         .position(|&a| a == bound)
         .ok_or("the headline bound is one of the table's")?;
-    let within = format!("n = {n}, epicentre error within {} %", bound * 100.0);
+    let within = format!("epicentre error within {}", percent(bound));
     let mut lines = Vec::new();
     for (target, name) in FAMILIES {
-        let answer = gpu_rows
+        let cells = EXPONENTS
             .iter()
-            .position(|&row| row == (target, n))
-            .map(|k| &gpu[k][column])
-            .ok_or("the headline exponent is one of the table's")?;
-        lines.push(match answer.best_candidate() {
-            Some(best) => format!(
-                "{name} GPUs ({within}): {}, at {} pow's throughput (modelled; higher is better).",
-                best.lobe,
-                versus_pow(best.rate, answer.pow_rate())
-            ),
-            None => format!("{name} GPUs ({within}): no lobe meets it."),
-        });
+            .map(|&n| {
+                let answer = gpu_rows
+                    .iter()
+                    .position(|&row| row == (target, n))
+                    .map(|k| &gpu[k][column])
+                    .ok_or("every exponent of the table has its row")?;
+                Ok(match answer.best_candidate() {
+                    Some(best) => format!(
+                        "n = {n}: {} ({} pow's throughput)",
+                        best.lobe,
+                        versus_pow(best.rate, answer.pow_rate())
+                    ),
+                    None => format!("n = {n}: no lobe meets it"),
+                })
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        lines.push(format!(
+            "{name} GPUs ({within}, modelled; higher is better): {}.",
+            cells.join("; ")
+        ));
     }
-    let headline_fpga = hardware
+    let fpga_cells: Vec<String> = hardware
         .iter()
-        .position(|&h| f64::from(h) == n)
-        .and_then(|k| fpga.get(k))
-        .map(|answers| &answers[column]);
-    if let Some(answer) = headline_fpga {
-        lines.push(format!("FPGA ({within}): {}.", fpga_cell(answer)));
+        .zip(fpga)
+        .map(|(n, answers)| format!("n = {n}: {}", fpga_cell(&answers[column])))
+        .collect();
+    if !fpga_cells.is_empty() {
+        lines.push(format!("FPGA ({within}): {}.", fpga_cells.join("; ")));
     }
+    let (low, high) = (EXPONENTS[0], EXPONENTS[EXPONENTS.len() - 1]);
     lines.push(format!(
         "CPU: measured, not modelled, on the machine that will run it: specula recommend --target \
-            cpu --n {n} --max-error {}.",
-        bound
+            cpu --n {low}..{high} --max-error {}",
+        flag_percent(bound)
     ));
     Ok(super::html::answer(&lines))
+}
+
+/// A bound as the command line takes it (`2%`).
+fn flag_percent(fraction: f64) -> String {
+    format!("{}%", fraction * 100.0)
 }

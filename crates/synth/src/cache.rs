@@ -1,4 +1,4 @@
-//! Synthesis results on disk, keyed by everything that determines them.
+//! Results on disk (syntheses, designed lobes), keyed by everything that determines them.
 //!
 //! A key hashes the Verilog, the flow and the tool versions (FNV-1a, 64 bits), so a result is
 //! reused exactly when the tools would be given the same work; the entry also stores its key,
@@ -8,11 +8,10 @@
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use crate::Synthesis;
-
-/// Bumped when [`Synthesis`] changes shape, so old entries are not misread.
+/// Bumped when [`crate::Synthesis`] changes shape, so old entries are not misread.
 const FORMAT: &str = "specula-synth 1";
 
 /// The key for `parts` (each separated, so `["ab", "c"]` and `["a", "bc"]` differ).
@@ -35,9 +34,9 @@ pub struct Cache {
 }
 
 #[derive(Serialize, Deserialize)]
-struct Entry {
+struct Entry<T> {
     key: String,
-    result: Synthesis,
+    result: T,
 }
 
 impl Cache {
@@ -53,12 +52,19 @@ impl Cache {
     /// `$HOME/.cache/specula/synth`; none when no variable is set.
     #[must_use]
     pub fn default_location() -> Option<Self> {
+        Self::default_for("synth")
+    }
+
+    /// The cache of `what` (`synth`, `design`) beside the synthesis's, where
+    /// [`Cache::default_location`] would be.
+    #[must_use]
+    pub fn default_for(what: &str) -> Option<Self> {
         let var = |name: &str| std::env::var_os(name).filter(|value| !value.is_empty());
         let base = var("SPECULA_CACHE_DIR")
             .map(PathBuf::from)
             .or_else(|| var("XDG_CACHE_HOME").map(|d| Path::new(&d).join("specula")))
             .or_else(|| var("HOME").map(|d| Path::new(&d).join(".cache/specula")))?;
-        Some(Self::new(base.join("synth")))
+        Some(Self::new(base.join(what)))
     }
 
     /// The directory.
@@ -71,11 +77,11 @@ impl Cache {
         self.directory.join(format!("{key}.json"))
     }
 
-    /// The result stored under `key`, if there is a readable one.
+    /// The result stored under `key`, if there is a readable one of its type.
     #[must_use]
-    pub fn load(&self, key: &str) -> Option<Synthesis> {
+    pub fn load<T: DeserializeOwned>(&self, key: &str) -> Option<T> {
         let text = std::fs::read_to_string(self.path(key)).ok()?;
-        let entry: Entry = serde_json::from_str(&text).ok()?;
+        let entry: Entry<T> = serde_json::from_str(&text).ok()?;
         (entry.key == key).then_some(entry.result)
     }
 
@@ -97,11 +103,11 @@ impl Cache {
     }
 
     /// Stores `result` under `key`, atomically.
-    pub fn store(&self, key: &str, result: &Synthesis) -> std::io::Result<()> {
+    pub fn store<T: Serialize>(&self, key: &str, result: &T) -> std::io::Result<()> {
         std::fs::create_dir_all(&self.directory)?;
         let entry = Entry {
             key: key.to_owned(),
-            result: result.clone(),
+            result,
         };
         let text = serde_json::to_string_pretty(&entry).map_err(std::io::Error::other)?;
         let mut file = specula_temporaries::file_in(&self.directory, ".tmp", Some(0o666))?;

@@ -6,8 +6,9 @@ use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use specula_decide::design::{default_whole_error, design, Bounds, Design, DesignRequest};
-use specula_decide::{versus_pow, Target};
+use specula_decide::Target;
 
+use super::recommend::spread_versus_pow;
 use super::CommandResult;
 use crate::args::described;
 use crate::output::Table;
@@ -128,7 +129,7 @@ fn print_table(answer: &Design, format: crate::args::OutputFormat) {
             error(d.whole_error),
             cost(d.rate),
             if d.rate > 0.0 {
-                versus_pow(d.rate, answer.pow_rate)
+                spread_versus_pow(d.rate, d.spread, answer.pow_rate)
             } else {
                 "-".to_owned()
             },
@@ -149,7 +150,7 @@ fn print_table(answer: &Design, format: crate::args::OutputFormat) {
             error(c.error),
             "".to_owned(),
             cost(c.rate),
-            versus_pow(c.rate, answer.pow_rate),
+            spread_versus_pow(c.rate, c.spread, answer.pow_rate),
             if c.pareto { "front" } else { "" }.to_owned(),
             c.why.clone(),
         ]);

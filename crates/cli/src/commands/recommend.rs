@@ -115,6 +115,12 @@ pub fn run(args: &Args) -> CommandResult {
     // Off the FPGA, pow is exact, keeps t^n's energy and so always meets the request; the
     // FPGA has no datapath for it, so there nothing may meet it.
     let verdict = match answer.best_candidate().map(|c| &c.lobe) {
+        Some(lobe) if answer.tied.len() > 1 => format!(
+            "{lobe}: the most accurate of the lobes tied for the cheapest within {} % ({zone} \
+             error) at {span} on {target} (their measured rates overlap: {})",
+            100.0 * max_error,
+            answer.tied.join(", ")
+        ),
         Some(lobe) => format!(
             "{lobe}: the cheapest lobe within {} % ({zone} error) at {span} on {target}",
             100.0 * max_error
@@ -131,11 +137,15 @@ pub fn run(args: &Args) -> CommandResult {
         // units; the verdict goes to stderr.
         eprintln!("{verdict}");
         let rate = format!("rate ({})", answer.unit);
+        let slowest = format!("median pass ({})", answer.unit);
+        let fastest = format!("fastest pass ({})", answer.unit);
         let mut table = Table::new(&[
             "lobe",
             "meets",
             "error (%)",
             &rate,
+            &slowest,
+            &fastest,
             "x pow's throughput (higher is better)",
             "energy ratio",
             "pareto",
@@ -150,6 +160,8 @@ pub fn run(args: &Args) -> CommandResult {
                     String::new()
                 },
                 number(c.rate),
+                c.spread.map_or(String::new(), |[low, _]| number(low)),
+                c.spread.map_or(String::new(), |[_, high]| number(high)),
                 number(c.rate / pow_rate),
                 number(c.energy_ratio),
                 c.pareto.to_string(),
@@ -179,14 +191,36 @@ pub fn run(args: &Args) -> CommandResult {
                 "-".to_owned()
             },
             format!("{:.3e} {}", c.rate, c.unit),
-            versus_pow(c.rate, pow_rate),
+            spread_versus_pow(c.rate, c.spread, pow_rate),
             format!("{:.4}", c.energy_ratio),
             if c.pareto { "front" } else { "" }.to_owned(),
             c.why.clone(),
         ]);
     }
     table.print(args.format);
+    if answer.candidates.iter().any(|c| c.spread.is_some()) {
+        eprintln!(
+            "measured rates: the fastest of {} passes over every lobe (noise only slows a \
+             kernel), the median pass to the fastest in brackets, at the slowest exponent; \
+             lobes whose brackets overlap are a tie, which goes to the more accurate",
+            specula_decide::rates::PASSES
+        );
+    }
     Ok(())
+}
+
+/// The rate over pow's, and where it was measured the median and fastest passes' over pow's
+/// rate (`2.48x (2.40-2.48)`).
+pub(super) fn spread_versus_pow(rate: f64, spread: Option<[f64; 2]>, pow_rate: f64) -> String {
+    match spread {
+        Some([low, high]) if pow_rate > 0.0 && pow_rate.is_finite() => format!(
+            "{} ({:.2}-{:.2})",
+            versus_pow(rate, pow_rate),
+            low / pow_rate,
+            high / pow_rate
+        ),
+        _ => versus_pow(rate, pow_rate),
+    }
 }
 
 #[cfg(test)]

@@ -12,21 +12,27 @@
 //! on the GPU models, the compiled batch kernel measured on the CPU), so a designed lobe and a
 //! built-in are ranked by one measure.
 
+mod cache;
 pub mod families;
 mod fit;
+mod verdict;
+
+pub use verdict::removed;
 
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use serde::Serialize;
-use specula::analysis::{energy_ratio, error_figures, Precision};
+use specula::analysis::energy_ratio;
 use specula::formula::{define, instance, Definition, Naming};
 use specula::{Exponent, Lobe, LobeKind};
 
 pub use families::Family;
 pub use fit::Bounds;
+pub use specula_synth::cache::Cache;
 
-use crate::hardware::SWEEP_SAMPLES;
-use crate::recommend::{pareto_front, recommend, Candidate, Request};
+pub use crate::percent::percent;
+use crate::percent::{exceeds, flag_percent_above};
+use crate::recommend::{pareto_front, rates_overlap, recommend, Candidate, Request};
 use crate::{log_spaced, sample_exponents, Target, Zone};
 
 /// The whole lobe's largest absolute error allowed by default, at least: 1 % of the peak,
@@ -92,8 +98,20 @@ pub struct DesignedLobe {
     pub energy_deviation: f64,
     /// Whether it passed every check at every exponent.
     pub verified: bool,
+    /// It passed every check but the whole lobe's bound: what a looser
+    /// `--max-whole-error` would admit (costed, never meeting).
+    pub short_of_whole_only: bool,
     /// Its cost on the target in [`Design::unit`] (0 where not costed).
     pub rate: f64,
+    /// Where the rate was measured (the CPU): the median and fastest passes' rates
+    /// ([`Candidate::spread`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spread: Option<[f64; 2]>,
+    /// Where rates are measured: the designed lobes whose rates overlap the fastest design's
+    /// (a tie this run cannot break), the most accurate of them first, as [`Design::best`].
+    /// Empty unless such a tie holds more than one.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub tied: Vec<String>,
     /// Meets every bound and was costed.
     pub meets: bool,
     /// No lobe, designed or built in, is at least as accurate and as cheap, better in one.
@@ -139,6 +157,12 @@ pub struct Design {
     pub compared: Vec<Candidate>,
     /// `pow`'s rate, what "vs pow" compares with.
     pub pow_rate: f64,
+    /// The designed lobes that met every bound but the whole lobe's, cheapest first: what the
+    /// whole-lobe bound removed.
+    pub removed_by_whole: Vec<String>,
+    /// The whole-lobe bound that admits the cheapest of [`Design::removed_by_whole`], as the
+    /// command line takes it (`1.1%`), where one is removed.
+    pub admit_whole: Option<String>,
     /// One line: what the search found against the built-ins.
     pub verdict: String,
     /// What the face should tell its user about the costs, if anything.
@@ -211,9 +235,38 @@ pub fn verification_exponents(low: Exponent, high: Exponent) -> Vec<Exponent> {
 
 /// Searches every family for the cheapest lobe on the target within the bounds over the
 /// range; `progress` counts the families fitted, then the lobes costed (pass
-/// [`ProgressBar::hidden`] for none).
+/// [`ProgressBar::hidden`] for none). The search is read from the design cache
+/// ([`Cache::default_for`]`("design")`) where this build made it before.
 pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design, String> {
     check(request)?;
+    let searched = search(request, Cache::default_for("design").as_ref(), progress);
+    rank(request, searched, progress)
+}
+
+/// Every family fitted and verified for `request`'s range and bounds (the target plays no
+/// part): read from `cache` where this build searched alike before, else searched and stored.
+/// `progress` counts the families. Two processes searching alike at once both search (no
+/// lock: a search runs inside rayon's pool, where a thread waiting on a lock its own
+/// process holds would wait for ever); the entry is written atomically either way.
+#[must_use]
+pub(crate) fn search(
+    request: &DesignRequest,
+    cache: Option<&Cache>,
+    progress: &ProgressBar,
+) -> Vec<DesignedLobe> {
+    let key = cache::key(request);
+    if let Some(found) = cache.and_then(|c| cache::load(c, &key, request)) {
+        return found;
+    }
+    let searched = search_now(request, progress);
+    if let Some(cache) = cache {
+        // A cache that cannot be written costs the next run the search, nothing else.
+        let _ = cache::store(cache, &key, &searched);
+    }
+    searched
+}
+
+fn search_now(request: &DesignRequest, progress: &ProgressBar) -> Vec<DesignedLobe> {
     let (low, high) = request.range;
     let families: Vec<Family> = Family::all()
         .into_iter()
@@ -229,8 +282,8 @@ pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design,
     .collect();
     let verify = verification_exponents(low, high);
     progress.set_length(families.len() as u64);
-    progress.set_message("fitting and verifying");
-    let mut designed: Vec<DesignedLobe> = families
+    progress.set_message("fitting and verifying the families");
+    let searched = families
         .par_iter()
         .map(|&family| {
             let (beta, score) = fit::fit(family, &grids, request.bounds);
@@ -243,15 +296,27 @@ pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design,
             lobe
         })
         .collect();
+    progress.reset();
+    searched
+}
+
+/// Ranks the searched lobes with the built-ins (and the request's other lobes) on the
+/// request's target, as `recommend` does: the costed answer.
+fn rank(
+    request: &DesignRequest,
+    mut designed: Vec<DesignedLobe>,
+    progress: &ProgressBar,
+) -> Result<Design, String> {
+    let (low, high) = request.range;
+    // The lobes short of the whole lobe's bound alone are costed too: what that bound removed.
     let kinds: Vec<LobeKind> = designed
         .iter()
-        .filter(|d| d.verified)
+        .filter(|d| d.verified || d.short_of_whole_only)
         .filter_map(DesignedLobe::kind)
         .collect();
     let mut lobes = crate::candidates(&request.also);
     let compared_ids: Vec<String> = lobes.iter().map(LobeKind::to_string).collect();
     lobes.extend(&kinds);
-    progress.reset();
     let ranking = recommend(
         &Request {
             target: request.target,
@@ -268,6 +333,7 @@ pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design,
         let costed = ranking.candidates.iter().find(|c| c.lobe == lobe.name);
         if let Some(costed) = costed {
             lobe.rate = costed.rate;
+            lobe.spread = costed.spread;
             lobe.meets = lobe.verified && costed.meets;
             if lobe.meets {
                 lobe.why = format!(
@@ -287,17 +353,54 @@ pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design,
         .collect();
     mark_front(&mut designed, &compared);
     designed.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
+    break_tie(&mut designed);
+    let removed: Vec<&DesignedLobe> = designed
+        .iter()
+        .filter(|d| d.short_of_whole_only && d.rate > 0.0)
+        .collect();
+    let admit_whole = removed.first().map(|d| flag_percent_above(d.whole_error));
+    let removed_by_whole = removed.iter().map(|d| d.name.clone()).collect();
     let mut answer = Design {
         unit: ranking.unit,
-        exponents_verified: verify.len(),
+        exponents_verified: verification_exponents(low, high).len(),
         designed,
         compared,
         pow_rate,
+        removed_by_whole,
+        admit_whole,
         verdict: String::new(),
         note: ranking.note,
     };
-    answer.verdict = verdict(&answer, request);
+    answer.verdict = verdict::verdict(&answer, request);
     Ok(answer)
+}
+
+/// Where the fastest designs' measured rates overlap, the most accurate of them first (as
+/// `recommend` breaks its ties), the tie recorded in that lobe's [`DesignedLobe::tied`].
+fn break_tie(sorted: &mut [DesignedLobe]) {
+    let Some(fastest) = sorted.first().filter(|d| d.meets && d.spread.is_some()) else {
+        return;
+    };
+    let fastest = (fastest.rate, fastest.spread);
+    let tie = sorted
+        .iter()
+        .take_while(|d| d.meets && rates_overlap((d.rate, d.spread), fastest))
+        .count();
+    // Sorted fastest first, the overlapping ones lead; any faster one overlaps as well.
+    if tie < 2 {
+        return;
+    }
+    let answer = (0..tie)
+        .min_by(|&a, &b| {
+            sorted[a]
+                .epicentre_error
+                .total_cmp(&sorted[b].epicentre_error)
+                .then(sorted[b].rate.total_cmp(&sorted[a].rate))
+        })
+        .unwrap_or(0);
+    sorted[..=answer].rotate_right(1);
+    let names = sorted[..tie].iter().map(|d| d.name.clone()).collect();
+    sorted[0].tied = names;
 }
 
 /// Marks the designed lobes no lobe (designed or built in) dominates in error and rate.
@@ -313,87 +416,6 @@ fn mark_front(designed: &mut [DesignedLobe], compared: &[Candidate]) {
     for lobe in designed.iter_mut().filter(|d| d.rate > 0.0) {
         lobe.pareto = on_front.next().unwrap_or(false);
     }
-}
-
-/// The answer in one line.
-fn verdict(design: &Design, request: &DesignRequest) -> String {
-    let (low, high) = request.range;
-    let within = format!(
-        "within {} in the epicentre (whole lobe {}{}) at n from {low} to {high} on {}",
-        percent(request.bounds.epicentre),
-        percent(request.bounds.whole),
-        request
-            .bounds
-            .energy
-            .map_or(String::new(), |e| format!(", energy {}", percent(e))),
-        request.target.id()
-    );
-    let others = if request.also.is_empty() {
-        "built-in"
-    } else {
-        "built-in or given lobe"
-    };
-    let builtin = design.best_compared().map_or_else(
-        || format!("no {others} meets it"),
-        |c| {
-            format!(
-                "the cheapest {others} is {} at {:.2}x pow's throughput",
-                c.lobe,
-                c.rate / design.pow_rate
-            )
-        },
-    );
-    match design.best() {
-        Some(best) => {
-            let versus = match design.best_compared() {
-                Some(c) if c.rate > best.rate => {
-                    format!("; {builtin}, cheaper than every design: ship the built-in")
-                }
-                _ => format!("; {builtin}"),
-            };
-            format!(
-                "{}: the cheapest designed lobe {within}, at {:.2}x pow's throughput{versus}",
-                best.name,
-                best.rate / design.pow_rate
-            )
-        }
-        None => {
-            let closest = design
-                .designed
-                .iter()
-                .min_by(|a, b| a.epicentre_error.total_cmp(&b.epicentre_error));
-            format!(
-                "no designed lobe {within}: searched {} families ({}); the closest, {}, reached {} \
-                    in the epicentre and {} over the whole lobe; {builtin}",
-                design.designed.len(),
-                design
-                    .designed
-                    .iter()
-                    .map(|d| d.family.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                closest.map_or("none", |d| d.family.as_str()),
-                closest.map_or("-".to_owned(), |d| percent(d.epicentre_error)),
-                closest.map_or("-".to_owned(), |d| percent(d.whole_error)),
-            )
-        }
-    }
-}
-
-/// A fraction as a percentage with four significant digits (`0.1 %`, `0.03115 %`).
-#[must_use]
-pub fn percent(fraction: f64) -> String {
-    if !fraction.is_finite() || fraction == 0.0 {
-        return format!("{} %", fraction * 100.0);
-    }
-    let digits = (3 - (fraction * 100.0).abs().log10().floor() as i32).max(0) as usize;
-    let text = format!("{:.digits$}", fraction * 100.0);
-    let text = if text.contains('.') {
-        text.trim_end_matches('0').trim_end_matches('.')
-    } else {
-        &text
-    };
-    format!("{text} %")
 }
 
 /// The family with `beta` written out, not yet measured (its figures infinite).
@@ -413,7 +435,10 @@ fn unmeasured(family: Family, beta: &[f64], request: &DesignRequest) -> Designed
         whole_error: f64::INFINITY,
         energy_deviation: f64::INFINITY,
         verified: false,
+        short_of_whole_only: false,
         rate: 0.0,
+        spread: None,
+        tied: Vec::new(),
         meets: false,
         pareto: false,
         why: String::new(),
@@ -444,6 +469,15 @@ fn short(
     }
 }
 
+/// Registers `lobe`'s formula (numbered where a lobe of the user's took its name), naming
+/// `lobe` as registered; `Err` says why the text was refused.
+fn register(lobe: &mut DesignedLobe) -> Result<(), String> {
+    let formula = define(lobe.definition(), Naming::Unique).map_err(|e| e.to_string())?;
+    lobe.name = formula.name().to_owned();
+    lobe.kind = Some(instance(formula, &[]).map_err(|e| e.to_string())?);
+    Ok(())
+}
+
 /// The family with `beta` written as a formula, registered, and verified at `exponents`.
 fn verified(
     family: Family,
@@ -452,76 +486,85 @@ fn verified(
     exponents: &[Exponent],
 ) -> DesignedLobe {
     let mut lobe = unmeasured(family, beta, request);
-    let kind = define(lobe.definition(), Naming::Unique)
-        .map_err(|e| e.to_string())
-        .and_then(|formula| {
-            lobe.name = formula.name().to_owned();
-            instance(formula, &[]).map_err(|e| e.to_string())
-        });
-    let kind = match kind {
-        Ok(kind) => kind,
-        Err(error) => {
-            lobe.why = format!("its formula was refused: {error}");
-            return lobe;
-        }
+    if let Err(error) = register(&mut lobe) {
+        lobe.why = format!("its formula was refused: {error}");
+        return lobe;
+    }
+    let Some(kind) = lobe.kind else {
+        return lobe;
     };
-    lobe.kind = Some(kind);
     match check_lobe(kind, exponents, request.bounds, &mut lobe) {
-        Ok(()) => {
+        Checked::Holds => {
             lobe.verified = true;
             lobe.why = format!("verified at {} exponents", exponents.len());
         }
-        Err(why) => lobe.why = why,
+        Checked::WholeOnly(why) => {
+            lobe.short_of_whole_only = true;
+            lobe.why = why;
+        }
+        Checked::Broken(why) => lobe.why = why,
     }
     lobe
 }
 
-/// Measures `kind` at every exponent into `lobe`'s figures; `Err` names the first rule or
-/// bound broken, and where.
+/// What the verification found.
+enum Checked {
+    /// Every rule and bound held at every exponent.
+    Holds,
+    /// Every rule and bound but the whole lobe's: why.
+    WholeOnly(String),
+    /// A rule or the epicentre's or energy's bound broken: the first, and where.
+    Broken(String),
+}
+
+/// Measures `kind` at every exponent into `lobe`'s figures, and says which rules and bounds
+/// held.
 fn check_lobe(
     kind: LobeKind,
     exponents: &[Exponent],
     bounds: Bounds,
     lobe: &mut DesignedLobe,
-) -> Result<(), String> {
+) -> Checked {
     let (mut epicentre, mut whole, mut energy) = (0.0_f64, 0.0_f64, 0.0_f64);
-    let mut broken: Option<String> = None;
+    let (mut first_epicentre, mut first_whole, mut first_energy) = (None, None, None);
     for &n in exponents {
-        let checked = Lobe::checked(kind, n).map_err(|e| e.to_string())?;
+        let checked = match Lobe::checked(kind, n) {
+            Ok(checked) => checked,
+            Err(error) => return Checked::Broken(error.to_string()),
+        };
         let peak = checked.eval(1.0_f64);
         if (peak - 1.0).abs() > 1e-12 {
-            return Err(format!("at n = {n} its peak is {peak}, not 1"));
+            return Checked::Broken(format!("at n = {n} its peak is {peak}, not 1"));
         }
         if let Some(t) = decreasing_at(&checked) {
-            return Err(format!("at n = {n} it falls as t rises, at t = {t}"));
+            return Checked::Broken(format!("at n = {n} it falls as t rises, at t = {t}"));
         }
-        let figures = error_figures(&checked, &mut Precision::F64, SWEEP_SAMPLES);
+        let figures = crate::figures::f64_figures(&checked);
         let here = figures
             .epicentre_max_abs
             .max(figures.bloom_max_abs)
             .max(figures.tail_max_abs);
         epicentre = epicentre.max(figures.epicentre_max_rel);
         whole = whole.max(here);
-        if bounds.energy.is_some() {
-            energy = energy.max((energy_ratio(&checked) - 1.0).abs());
+        if figures.epicentre_max_rel > bounds.epicentre && first_epicentre.is_none() {
+            first_epicentre = Some(format!(
+                "epicentre error {} at n = {n}",
+                exceeds(figures.epicentre_max_rel, bounds.epicentre)
+            ));
         }
-        if broken.is_none() {
-            if figures.epicentre_max_rel > bounds.epicentre {
-                broken = Some(format!(
-                    "epicentre error {} exceeds {} at n = {n}",
-                    percent(figures.epicentre_max_rel),
-                    percent(bounds.epicentre)
-                ));
-            } else if here > bounds.whole {
-                broken = Some(format!(
-                    "whole-lobe error {} exceeds {} at n = {n}",
-                    percent(here),
-                    percent(bounds.whole)
-                ));
-            } else if bounds.energy.is_some_and(|e| energy > e) {
-                broken = Some(format!(
+        if here > bounds.whole && first_whole.is_none() {
+            first_whole = Some(format!(
+                "whole-lobe error {} at n = {n}",
+                exceeds(here, bounds.whole)
+            ));
+        }
+        if let Some(tolerance) = bounds.energy {
+            let off = (energy_ratio(&checked) - 1.0).abs();
+            energy = energy.max(off);
+            if off > tolerance && first_energy.is_none() {
+                first_energy = Some(format!(
                     "energy ratio off by {} at n = {n}",
-                    percent(energy)
+                    exceeds(off, tolerance)
                 ));
             }
         }
@@ -529,7 +572,11 @@ fn check_lobe(
     lobe.epicentre_error = epicentre;
     lobe.whole_error = whole;
     lobe.energy_deviation = energy;
-    broken.map_or(Ok(()), Err)
+    match (first_epicentre.or(first_energy), first_whole) {
+        (Some(broken), _) => Checked::Broken(broken),
+        (None, Some(whole)) => Checked::WholeOnly(whole),
+        (None, None) => Checked::Holds,
+    }
 }
 
 /// A cosine at which `lobe` falls as `t` rises (by more than rounding), if any: checked on
@@ -548,3 +595,6 @@ fn decreasing_at(lobe: &Lobe) -> Option<f64> {
         .find(|(pair, _)| pair[1] < pair[0] - 1e-14)
         .map(|(_, &t)| t)
 }
+
+#[cfg(test)]
+mod tests;
