@@ -53,8 +53,7 @@ impl Figures {
     /// epicentre. The margin is room for what the coarse grids miss: a fit that sat on the
     /// bound there was over it on the verification's dense sweep.
     fn penalty(self, bounds: Bounds) -> f64 {
-        let over =
-            |figure: f64, bound: f64| PENALTY * (figure / (MARGIN * bound) - 1.0).max(0.0);
+        let over = |figure: f64, bound: f64| PENALTY * (figure / (MARGIN * bound) - 1.0).max(0.0);
         over(self.whole, bounds.whole) + bounds.energy.map_or(0.0, |e| over(self.energy, e))
     }
 }
