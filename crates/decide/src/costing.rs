@@ -90,7 +90,12 @@ impl Costing {
 
     /// On the CPU, times every one of `lobes` at every one of `exponents` together
     /// ([`crate::rates::kernel_rates`]), so that their rates compare like with like; elsewhere
-    /// nothing. `progress` is set to count the passes.
+    /// nothing. A lobe's exponents whose kernels execute the same instructions (every `n` of
+    /// most lobes: `n` enters as a constant; `cosquad` and `schlick-mod` change shape at
+    /// powers of two) are timed once, at the first of them: the same kernel over the same
+    /// cosines, so a range costs a few timings a lobe, not one an exponent, and its slowest
+    /// exponent is not the unluckiest of a dozen timings of one kernel. `progress` is set to
+    /// count the passes.
     pub(crate) fn time_kernels(
         &mut self,
         lobes: &[LobeKind],
@@ -102,19 +107,52 @@ impl Costing {
         };
         progress.set_length((lobes.len() * crate::rates::PASSES) as u64);
         progress.set_message("timing the kernels");
+        // Per lobe, each exponent's representative: the first exponent whose kernel executes
+        // the same instructions.
+        let representatives: Vec<Vec<usize>> = lobes
+            .iter()
+            .map(|&kind| {
+                let instructions: Vec<_> = exponents
+                    .iter()
+                    .map(|&n| Lobe::new(kind, n).batch_instructions())
+                    .collect();
+                instructions
+                    .iter()
+                    .map(|i| instructions.iter().position(|j| j == i).unwrap_or(0))
+                    .collect()
+            })
+            .collect();
         let prepared: Vec<Vec<Lobe>> = lobes
             .iter()
-            .map(|&kind| exponents.iter().map(|&n| Lobe::new(kind, n)).collect())
+            .zip(&representatives)
+            .map(|(&kind, firsts)| {
+                let mut distinct: Vec<usize> = firsts.clone();
+                distinct.dedup();
+                distinct.sort_unstable();
+                distinct.dedup();
+                distinct
+                    .into_iter()
+                    .map(|k| Lobe::new(kind, exponents[k]))
+                    .collect()
+            })
             .collect();
         let rates = crate::rates::kernel_rates(&prepared, progress);
         *timed = lobes
             .iter()
-            .zip(rates)
-            .flat_map(|(&kind, rates)| {
-                exponents
-                    .iter()
-                    .zip(rates)
-                    .map(move |(&n, passes)| TimedRate { kind, n, passes })
+            .zip(&representatives)
+            .zip(prepared.iter().zip(rates))
+            .flat_map(|((&kind, firsts), (timed_at, rates))| {
+                exponents.iter().zip(firsts).map(move |(&n, &first)| {
+                    let at = timed_at
+                        .iter()
+                        .position(|lobe| lobe.exponent() == exponents[first])
+                        .unwrap_or(0);
+                    TimedRate {
+                        kind,
+                        n,
+                        passes: rates[at].clone(),
+                    }
+                })
             })
             .collect();
         progress.reset();

@@ -115,7 +115,7 @@ pub(crate) fn kernel_rate(lobe: &Lobe) -> f64 {
 }
 
 /// Passes of [`kernel_rates`] over every lobe.
-pub const PASSES: usize = 7;
+pub const PASSES: usize = 9;
 /// Seconds one lobe at one exponent is timed in one pass of [`kernel_rates`].
 const PASS_SECONDS: f64 = 0.015;
 

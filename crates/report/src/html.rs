@@ -38,22 +38,25 @@ pub fn table_with_files(header: &[&str], rows: &[Vec<String>], file_columns: &[u
     html
 }
 
-/// A large image shown at page width, linked to itself at full size.
+/// A large image (a diagram wider than the page) shown at its own size, so that its text stays
+/// as large as it was drawn, in a frame that scrolls sideways; linked to itself.
 pub fn linked_figure(file: &str, caption: &str) -> String {
     format!(
-        "<figure class=\"wide\"><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"/></a><figcaption>{1} \
-            (select it for full size)</figcaption></figure>\n",
+        "<figure class=\"wide\"><div class=\"scrolls\"><a href=\"{0}\"><img src=\"{0}\" \
+            alt=\"{1}\"/></a></div><figcaption>{1} (select it to open it alone)</figcaption>\
+            </figure>\n",
         escape(file),
         escape(caption)
     )
 }
 
-/// An image (a file beside the page) with a caption.
+/// An image (a file beside the page) with a caption, a link to the file itself: every plot and
+/// render on the page opens alone at full size in one click.
 pub fn figure(file: &str, caption: &str) -> String {
     format!(
-        "<figure><img src=\"{}\" alt=\"{}\"/><figcaption>{}</figcaption></figure>\n",
+        "<figure><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"/></a><figcaption>{1}</figcaption>\
+            </figure>\n",
         escape(file),
-        escape(caption),
         escape(caption)
     )
 }

@@ -205,9 +205,11 @@ impl Context {
         Ok(())
     }
 
-    /// Writes a chart and returns its figure.
+    /// Writes a chart and returns its figure: a scatter chart (dots with their names) taller,
+    /// as its names need room near their dots where the dots crowd.
     fn svg(&mut self, name: &str, chart: &plot::Chart, caption: &str) -> Result<String, String> {
-        self.svg_sized(name, chart, caption, (580, 360))
+        let scatter = chart.series.iter().any(|series| series.markers);
+        self.svg_sized(name, chart, caption, (580, if scatter { 500 } else { 360 }))
     }
 
     /// Writes a chart drawn at `size` pixels (a small multiple's) and returns its figure.

@@ -1,5 +1,5 @@
-//! The report's real materials (`--materials DIR`): each measured material (an RGL isotropic
-//! RGB `.bsdf` file) assessed as `specula fit --material` assesses it (every lobe and GGX
+//! The report's real materials (those of `--materials DIR`, else the five specula carries):
+//! each measured material (an RGL isotropic RGB `.bsdf` file) assessed as `specula fit --material` assesses it (every lobe and GGX
 //! fitted, the verdict on a target), its shared-`n` fits in a table, polar plots of the
 //! measurement against the fits in the plane of incidence, and renders under the sky of the
 //! measured material beside pow's fit, the verdict's lobe and GGX, each scored by FLIP
@@ -7,11 +7,14 @@
 
 use std::path::{Path, PathBuf};
 
+use rayon::prelude::*;
 use specula::measured::fit::{plane_of_incidence, Fit, Sharing, Specular, POLAR_ANGLES_DEGREES};
 use specula::measured::MeasuredBrdf;
 use specula::LobeKind;
 use specula_render::ibl::{Environment, SKY_WIDTH};
-use specula_render::measured::{load_measured, material_name, material_scene, render_comparison};
+use specula_render::measured::{
+    load_measured, material_name, material_scene, render_comparison, BUNDLED_MATERIALS,
+};
 
 use super::html::{escape, figure, paragraph, table};
 use super::polar::{Polar, PolarCurve, PolarPanel, DASHED, DASH_DOT};
@@ -26,6 +29,9 @@ use specula_decide::Target;
 
 /// The most materials one report shows (the first, by file name).
 pub const MAX_MATERIALS: usize = 16;
+
+/// The bundled materials' render width and samples per pixel (`--quick`'s for a folder).
+const BUNDLED_RENDERS: (u32, u32) = (160, 16);
 
 /// The verdict's target (`specula fit`'s default) and margin over pow's fit error.
 const TARGET: Target = Target::GpuNvidia;
@@ -92,22 +98,42 @@ fn file_safe(name: &str) -> String {
         .collect()
 }
 
-/// The section: each material in turn (its fits already run in parallel), or, without
-/// `--materials`, how to get it.
+/// The section: each material in turn (assessed in parallel, each assessment's fits in
+/// parallel too), those of `--materials`, else the five specula carries (`data/rgl`, built
+/// into the binary), so that a report without a folder still answers for real materials.
 pub fn materials(context: &mut Context) -> Result<String, String> {
-    let Some(directory) = context.materials.clone() else {
-        return Ok(paragraph(&prose::fill(prose::MATERIALS_HOW_TO, &[])?));
+    let (materials, folder, more) = match context.materials.clone() {
+        Some(directory) => {
+            let (files, more) = material_files(&directory)?;
+            let read = files
+                .into_iter()
+                .map(|file| Ok((load_measured(&file)?, file)))
+                .collect::<Result<Vec<_>, String>>()?;
+            (read, directory.display().to_string(), more)
+        }
+        None => {
+            // Asked for by no one, so kept cheap: the quick report's render sizes in either
+            // mode (the fits, the same in both, are most of the time).
+            context.sizes.materials = BUNDLED_RENDERS;
+            (
+                bundled()?,
+                "data/rgl (the five specula carries, built into it; --materials DIR fits others)"
+                    .to_owned(),
+                0,
+            )
+        }
     };
-    let (files, more) = material_files(&directory)?;
     let yours = context.yours();
     let kinds = lobes_to_fit(&yours, TARGET)?;
     let sky = Environment::sky(SKY_WIDTH);
+    let assessed = materials
+        .par_iter()
+        .map(|(measured, path)| assess(measured, path, &kinds, TARGET, MARGIN))
+        .collect::<Result<Vec<_>, String>>()?;
     let mut shown = String::new();
     let mut error_measure = String::new();
-    for (index, path) in files.iter().enumerate() {
-        let measured = load_measured(path)?;
-        let assessment = assess(&measured, path, &kinds, TARGET, MARGIN)?;
-        shown += &material(context, index, path, &measured, &assessment, &sky)?;
+    for (index, ((measured, path), assessment)) in materials.iter().zip(&assessed).enumerate() {
+        shown += &material(context, index, path, measured, assessment, &sky)?;
         error_measure.clone_from(&assessment.error_measure);
     }
     let (width, spp) = context.sizes.materials;
@@ -120,8 +146,8 @@ pub fn materials(context: &mut Context) -> Result<String, String> {
     let mut html = paragraph(&prose::fill(
         prose::MATERIALS,
         &[
-            ("folder", &directory.display()),
-            ("count", &files.len()),
+            ("folder", &folder),
+            ("count", &materials.len()),
             ("more", &more),
             ("error_measure", &error_measure),
             ("target", &TARGET),
@@ -133,6 +159,19 @@ pub fn materials(context: &mut Context) -> Result<String, String> {
     )?);
     html += &shown;
     Ok(html)
+}
+
+/// The materials specula carries, read from the binary, each named by its file in `data/rgl`.
+fn bundled() -> Result<Vec<(MeasuredBrdf, PathBuf)>, String> {
+    BUNDLED_MATERIALS
+        .iter()
+        .map(|&(name, bytes)| {
+            let file = Path::new("data/rgl").join(format!("{name}.bsdf"));
+            let measured =
+                MeasuredBrdf::from_bytes(bytes).map_err(|e| format!("{}: {e}", file.display()))?;
+            Ok((measured, file))
+        })
+        .collect()
 }
 
 /// The shape parameter's name: `n` for a lobe, `alpha` for GGX.

@@ -4,6 +4,8 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 use plotters::style::text_anchor;
 
+mod labels;
+
 /// One curve.
 #[derive(Clone)]
 pub struct Series {
@@ -40,8 +42,14 @@ pub struct Chart {
 /// Pixels to the right of the plotting area, for the legend.
 pub(crate) const LEGEND_WIDTH: u32 = 150;
 
-/// The room above the plot: the title (18 points) and a gap below it, in displayed pixels.
+/// The room above the plot: the title and a gap below it, in displayed pixels.
 const TITLE_ROOM: u32 = 38;
+
+/// The title's size and every other text's (ticks, legend, the markers' names), in pixels at
+/// the chart's own size: the page shows charts at their own size, and the smallest text a
+/// reader is asked to read there is 10 pixels (`.ci/explorer/report.mjs` measures it).
+const TITLE_SIZE: u32 = 15;
+pub(crate) const TEXT_SIZE: u32 = labels::NAME_SIZE;
 
 /// plotters' SVG back end writes whole-pixel coordinates, which turns a steep curve into
 /// stairs; charts are drawn this many times larger and shown at their size through the
@@ -58,9 +66,11 @@ pub(crate) const fn offset(pixels: i32) -> i32 {
     pixels * SUPERSAMPLE as i32
 }
 
-/// The font size for text shown `points` high.
-pub(crate) fn font(points: u32) -> (&'static str, u32) {
-    ("sans-serif", px(points))
+/// The font for text shown `pixels` high at the chart's own size: plotters' SVG back end
+/// writes a font's size divided by 1.24, which this undoes (rounded up, so that text asked
+/// for at 10 pixels is never drawn under 10).
+pub(crate) fn font(pixels: u32) -> (&'static str, u32) {
+    ("sans-serif", (px(pixels) * 124).div_ceil(100))
 }
 
 /// A log axis's tick labels: [`tick`]'s at 1, 2 and 5 times a power of ten, none between
@@ -139,6 +149,7 @@ impl Chart {
     /// The chart as an SVG document: a `width x height` plot and, to its right, the legend.
     pub fn to_svg(&self, width: u32, height: u32) -> Result<String, String> {
         let mut svg = String::new();
+        let markers;
         let (drawn_width, drawn_height) = (px(width + LEGEND_WIDTH), px(height));
         {
             let root =
@@ -158,7 +169,7 @@ impl Chart {
                 }
             }
             let (x, y) = (self.x.0..self.x.1, low..self.y.1);
-            match (self.log_x, self.log_y) {
+            markers = match (self.log_x, self.log_y) {
                 (false, false) => self.draw(&root, x, y),
                 (true, false) => self.draw(&root, x.log_scale(), y),
                 (false, true) => self.draw(&root, x, y.log_scale()),
@@ -166,7 +177,12 @@ impl Chart {
             }?;
             root.present().map_err(|e| e.to_string())?;
         }
-        shown_at(&without_repeated_text(&svg), (width + LEGEND_WIDTH, height))
+        let drawn = without_repeated_text(&svg);
+        let end = drawn
+            .rfind("</svg>")
+            .ok_or("plotters wrote an SVG without its end")?;
+        let drawn = format!("{}{markers}{}", &drawn[..end], &drawn[end..]);
+        shown_at(&drawn, (width + LEGEND_WIDTH, height))
     }
 
     fn draw<X, Y>(
@@ -174,7 +190,7 @@ impl Chart {
         root: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
         x: X,
         y: Y,
-    ) -> Result<(), String>
+    ) -> Result<String, String>
     where
         X: AsRangedCoord<Value = f64>,
         Y: AsRangedCoord<Value = f64>,
@@ -183,7 +199,7 @@ impl Chart {
     {
         let error = |e: DrawingAreaErrorKind<_>| e.to_string();
         let (root_width, _) = root.dim_in_pixel();
-        let title = font(18)
+        let title = font(TITLE_SIZE)
             .into_font()
             .color(&BLACK)
             .pos(text_anchor::Pos::new(
@@ -212,8 +228,8 @@ impl Chart {
             .light_line_style(RGBColor(235, 235, 235).stroke_width(px(1)))
             .bold_line_style(BLACK.mix(0.2).stroke_width(px(1)))
             .axis_style(BLACK.stroke_width(px(1)))
-            .label_style(font(12))
-            .axis_desc_style(font(13))
+            .label_style(font(TEXT_SIZE))
+            .axis_desc_style(font(TEXT_SIZE + 1))
             .set_all_tick_mark_size(px(5))
             .x_label_formatter(if self.log_x { &log_tick } else { &tick })
             .y_label_formatter(if self.log_y { &log_tick } else { &tick })
@@ -227,16 +243,15 @@ impl Chart {
                 )])
                 .map_err(error)?;
         }
-        for series in &self.series {
+        // Markers are drawn after plotters' drawing, with their names (`labels`).
+        for series in self.series.iter().filter(|series| !series.markers) {
             let style = series.colour.stroke_width(px(series.width));
             let clipped = series
                 .points
                 .iter()
                 .filter(|(x, y)| x.is_finite() && y.is_finite())
                 .map(|&(x, y)| (x.clamp(self.x.0, self.x.1), y.clamp(self.y.0, self.y.1)));
-            let drawn = if series.markers {
-                chart.draw_series(clipped.map(|p| Circle::new(p, px(5), series.colour.filled())))
-            } else if series.dashed {
+            let drawn = if series.dashed {
                 chart.draw_series(DashedLineSeries::new(clipped, px(7), px(4), style))
             } else {
                 chart.draw_series(LineSeries::new(clipped, style))
@@ -244,26 +259,29 @@ impl Chart {
             drawn.map_err(error)?;
         }
         let (x_range, y_range) = chart.plotting_area().get_pixel_range();
-        // The markers' names, each where it overlaps no other name nor marker.
-        let markers: Vec<(String, (i32, i32))> = self
+        let coordinates = &chart;
+        let dots: Vec<labels::Dot> = self
             .series
             .iter()
             .filter(|series| series.markers)
             .flat_map(|series| {
+                let RGBColor(r, g, b) = series.colour;
                 series
                     .points
                     .iter()
                     .filter(|(x, y)| x.is_finite() && y.is_finite())
-                    .map(|&(x, y)| {
+                    .map(move |&(x, y)| {
                         let at = (x.clamp(self.x.0, self.x.1), y.clamp(self.y.0, self.y.1));
-                        (series.name.clone(), chart.backend_coord(&at))
+                        labels::Dot {
+                            name: series.name.clone(),
+                            colour: format!("#{r:02X}{g:02X}{b:02X}"),
+                            at: coordinates.backend_coord(&at),
+                        }
                     })
             })
             .collect();
         let area = (x_range.start, y_range.start, x_range.end, y_range.end);
-        for (name, at) in place_labels(&markers, area) {
-            root.draw(&Text::new(name, at, font(12))).map_err(error)?;
-        }
+        let markers = labels::svg(&dots, &labels::place(&dots, area));
         // The legend, drawn beside the plotting area (plotters keeps its own inside, on the
         // data): one row per band and series, a swatch and the name.
         let entries = self.bands.len() + self.series.len();
@@ -277,7 +295,7 @@ impl Chart {
         } else {
             y_range.start + offset(4)
         };
-        let text = font(12).into_font().color(&BLACK);
+        let text = font(TEXT_SIZE).into_font().color(&BLACK);
         let (swatch, half, gap) = (offset(16), offset(5), offset(22));
         for (k, &(_, _, colour, label)) in self.bands.iter().enumerate() {
             let y = y0 + row * k as i32 + row / 2;
@@ -318,72 +336,8 @@ impl Chart {
             ))
             .map_err(error)?;
         }
-        Ok(())
+        Ok(markers)
     }
-}
-
-/// Where each marker's name goes (its top-left corner, drawn pixels): the first of the places
-/// around the marker, nearest first, where the name's box stays inside `area` (left, top,
-/// right, bottom) and overlaps no name already placed and no marker; where none is free, the
-/// place that overlaps least (12-point text about 7 pixels a character, 14 high).
-fn place_labels(
-    markers: &[(String, (i32, i32))],
-    area: (i32, i32, i32, i32),
-) -> Vec<(String, (i32, i32))> {
-    type Box = (i32, i32, i32, i32);
-    let overlap = |a: Box, b: Box| {
-        let width = (a.2.min(b.2) - a.0.max(b.0)).max(0);
-        let height = (a.3.min(b.3) - a.1.max(b.1)).max(0);
-        i64::from(width) * i64::from(height)
-    };
-    let radius = offset(6);
-    let dots: Vec<Box> = markers
-        .iter()
-        .map(|(_, (x, y))| (x - radius, y - radius, x + radius, y + radius))
-        .collect();
-    let mut placed: Vec<Box> = Vec::new();
-    let mut labels = Vec::new();
-    for (name, (x, y)) in markers {
-        let (width, height) = (offset(7) * name.chars().count() as i32, offset(14));
-        // Beside, then above and below, then farther out in rings.
-        let mut places = Vec::new();
-        for ring in 0..4 {
-            let (near, step) = (offset(8) + ring * height, ring * height);
-            places.extend([
-                (near, -height / 2 - step),
-                (near, -height / 2 + step),
-                (-near - width, -height / 2 - step),
-                (-near - width, -height / 2 + step),
-                (-width / 2, -near - height - step),
-                (-width / 2, near + step),
-            ]);
-        }
-        let boxed = |(dx, dy): (i32, i32)| (x + dx, y + dy, x + dx + width, y + dy + height);
-        let inside = |b: Box| b.0 >= area.0 && b.1 >= area.1 && b.2 <= area.2 && b.3 <= area.3;
-        let cost = |place: (i32, i32)| {
-            let candidate = boxed(place);
-            let covered: i64 = placed
-                .iter()
-                .chain(&dots)
-                .map(|&other| overlap(candidate, other))
-                .sum();
-            // Outside the plot counts as much as covering a whole name.
-            covered
-                + if inside(candidate) {
-                    0
-                } else {
-                    i64::from(width) * i64::from(height)
-                }
-        };
-        let best = places
-            .iter()
-            .copied()
-            .min_by_key(|&place| cost(place))
-            .unwrap_or((offset(8), -height / 2));
-        placed.push(boxed(best));
-        labels.push((name.clone(), (x + best.0, y + best.1)));
-    }
-    labels
 }
 
 #[cfg(test)]
@@ -400,57 +354,6 @@ mod tests {
             without_repeated_text(svg),
             "<svg><text x=\"1\" y=\"2\">10</text><line/><text x=\"1\" y=\"9\">10</text></svg>"
         );
-    }
-
-    /// Markers at one place and close by (sg and sg-karis share a point; the quadratics
-    /// nearly do): no two names' boxes overlap, nor a name a marker.
-    #[test]
-    fn marker_names_do_not_overlap() {
-        // fasterpow at the right edge: its name goes to the left, inside the plot.
-        let names = [
-            "sg",
-            "sg-karis",
-            "minimax2",
-            "cheb2",
-            "cheb2-thesis",
-            "pow",
-            "fasterpow",
-        ];
-        let at = [
-            (400, 300),
-            (400, 300),
-            (480, 380),
-            (490, 380),
-            (500, 382),
-            (900, 900),
-            (990, 500),
-        ];
-        let markers: Vec<(String, (i32, i32))> = names
-            .iter()
-            .zip(at)
-            .map(|(name, (x, y))| ((*name).to_owned(), (x * 4, y * 4)))
-            .collect();
-        let placed = place_labels(&markers, (0, 0, 4000, 4000));
-        let boxed =
-            |(name, (x, y)): &(String, (i32, i32))| (*x, *y, x + 28 * name.len() as i32, y + 56);
-        let overlaps = |a: (i32, i32, i32, i32), b: (i32, i32, i32, i32)| {
-            a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3
-        };
-        for (k, a) in placed.iter().enumerate() {
-            for b in &placed[k + 1..] {
-                assert!(!overlaps(boxed(a), boxed(b)), "{} and {} overlap", a.0, b.0);
-            }
-            let (left, top, right, bottom) = boxed(a);
-            assert!(
-                left >= 0 && top >= 0 && right <= 4000 && bottom <= 4000,
-                "{} leaves the plot",
-                a.0
-            );
-            for (_, (x, y)) in &markers {
-                let dot = (x - 24, y - 24, x + 24, y + 24);
-                assert!(!overlaps(boxed(a), dot), "{} covers a marker", a.0);
-            }
-        }
     }
 
     /// A diagonal drawn at 580 x 360 must resolve finer than whole pixels: with whole-pixel

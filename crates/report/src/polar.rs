@@ -45,7 +45,7 @@ pub struct Polar {
 }
 
 /// A polar panel's displayed width and height.
-const PANEL: (u32, u32) = (330, 205);
+const PANEL: (u32, u32) = (300, 205);
 
 /// The smallest of 1, 2, 2.5 and 5 times a power of ten that is at least `value`.
 fn nice_step(value: f64) -> f64 {

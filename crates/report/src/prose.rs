@@ -31,8 +31,6 @@ pub(crate) const FPGA_ROWS: &str = include_str!("prose/fpga-rows.txt");
 pub(crate) const OTHER_RENDERERS: &str = include_str!("prose/other-renderers.txt");
 /// What the white furnace and reciprocity columns measure.
 pub(crate) const WHITE_FURNACE: &str = include_str!("prose/white-furnace.txt");
-/// How to add the measured materials' section.
-pub(crate) const MATERIALS_HOW_TO: &str = include_str!("prose/materials-how-to.txt");
 /// A measured material's polar plot.
 pub(crate) const MATERIAL_POLAR: &str = include_str!("prose/material-polar.txt");
 /// How cost is stated.

@@ -9,7 +9,7 @@ use specula_render::ibl::{render_ibl_grid, Environment, IblSettings, SKY_WIDTH};
 use specula_render::metrics::compare;
 use specula_render::{
     made_renders, render, render_grid_columns, write_png_srgb8, GridOptions, Image, Overrides,
-    Scene, Shading,
+    Scene, Shading, Srgb8Image,
 };
 
 use super::comparison::{self, Compared};
@@ -59,12 +59,8 @@ fn lobe_table(
     .map_err(|e| e.to_string())?;
     // The whole grid, one image to download; the page shows the lobes as tiles.
     let strip = format!("{prefix}s-lobes.png");
-    context.write_png_file(
-        &strip,
-        grid.image.width,
-        grid.image.height,
-        &grid.image.bytes,
-    )?;
+    let wrapped = wrap_columns(&grid.image, base.settings.width, GRID_PER_ROW);
+    context.write_png_file(&strip, wrapped.width, wrapped.height, &wrapped.bytes)?;
     // Each lobe's file written on its own thread.
     let (width, height) = (base.settings.width, base.settings.height);
     let directory = &context.directory;
@@ -95,7 +91,7 @@ fn lobe_table(
     let mut html = comparison::grid(context, prefix, &options.reference.to_string(), &compared)?;
     html += &format!(
         "<p><a href=\"{strip}\">Every lobe in one image</a> (what specula render --grid \
-            writes).</p>\n"
+            writes, its columns {GRID_PER_ROW} to a row).</p>\n"
     );
     let rows: Vec<Vec<String>> = grid
         .columns
@@ -119,6 +115,38 @@ fn lobe_table(
         &[1],
     );
     Ok((html, reference))
+}
+
+/// The columns to a row of the one image of every lobe: `specula render --grid` writes its
+/// thirteen columns side by side (6240 pixels wide at the full report's size), which no screen
+/// shows whole; four to a row keeps each lobe's render above its FLIP map.
+const GRID_PER_ROW: u32 = 4;
+
+/// `grid`'s columns (each `column_width` wide, the full height) laid out `per_row` to a row,
+/// in order, the rows below one another; the last row's gap left black.
+fn wrap_columns(grid: &Srgb8Image, column_width: u32, per_row: u32) -> Srgb8Image {
+    let columns = grid.width / column_width;
+    let across = columns.min(per_row);
+    let rows = columns.div_ceil(per_row);
+    let (width, height) = (across * column_width, rows * grid.height);
+    let mut bytes = vec![0; 3 * (width * height) as usize];
+    let line = 3 * column_width as usize;
+    for column in 0..columns {
+        let (x0, y0) = (
+            (column % per_row) * column_width,
+            (column / per_row) * grid.height,
+        );
+        for y in 0..grid.height {
+            let from = 3 * (y * grid.width + column * column_width) as usize;
+            let to = 3 * ((y0 + y) * width + x0) as usize;
+            bytes[to..to + line].copy_from_slice(&grid.bytes[from..from + line]);
+        }
+    }
+    Srgb8Image {
+        width,
+        height,
+        bytes,
+    }
 }
 
 /// Every lobe against pow.
@@ -238,4 +266,35 @@ fn environment_lit(context: &mut Context) -> Result<String, String> {
     )?;
     html += &table_html;
     Ok(html)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Five 2-pixel columns, each filled with its own index, wrapped two to a row: column k
+    /// lands at row k / 2, place k % 2, whole; the sixth place stays black.
+    #[test]
+    fn wrapping_keeps_each_column_whole_in_order() {
+        let (columns, column_width, height) = (5u32, 2u32, 3u32);
+        let width = columns * column_width;
+        let bytes = (0..width * height)
+            .flat_map(|p| [(p % width / column_width + 1) as u8; 3])
+            .collect();
+        let grid = Srgb8Image {
+            width,
+            height,
+            bytes,
+        };
+        let wrapped = wrap_columns(&grid, column_width, 2);
+        assert_eq!((wrapped.width, wrapped.height), (4, 9));
+        for y in 0..wrapped.height {
+            for x in 0..wrapped.width {
+                let place = (y / height) * 2 + x / column_width;
+                let expected = if place < columns { place as u8 + 1 } else { 0 };
+                let at = 3 * (y * wrapped.width + x) as usize;
+                assert_eq!(wrapped.bytes[at], expected, "at ({x}, {y})");
+            }
+        }
+    }
 }

@@ -9,9 +9,13 @@ use specula::{Exponent, Lobe, LobeKind};
 use specula_synth::OnMiss;
 
 use super::html::{escape, multiples, paragraph, table};
-use super::plot::{Chart, Series, SEQUENCE};
+use super::plot::{Chart, Series, LEGEND_WIDTH, SEQUENCE};
 use super::{prose, Context, RealScanSizes, Sizes};
 use crate::format::sig;
+
+/// The plotting area of a small multiple, displayed pixels: with its legend, two to a row at
+/// their own size in the page's column at 1400 pixels (1112 wide).
+const SMALL: (u32, u32) = (390, 300);
 
 /// Chooses one figure.
 type Pick = fn(&ErrorFigures) -> f64;
@@ -146,7 +150,7 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
                 ..Chart::default()
             };
             let name = format!("shape-n{n}{}.svg", if log_y { "-log" } else { "" });
-            figures += &context.svg(
+            figures += &context.svg_sized(
                 &name,
                 &chart,
                 &if log_y {
@@ -160,10 +164,11 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
                         that departs from pow changes the highlight's core"
                     )
                 },
+                SMALL,
             )?;
         }
     }
-    Ok(html + &multiples(&figures, 440))
+    Ok(html + &multiples(&figures, SMALL.0 + LEGEND_WIDTH))
 }
 
 pub fn errors(context: &mut Context) -> Result<String, String> {
@@ -223,10 +228,10 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
             &format!("error-angle-{}.svg", kind.id()),
             &chart,
             &format!("{kind}: one curve per n"),
-            (420, 280),
+            (SMALL.0, 280),
         )?;
     }
-    html += &multiples(&figures, 330);
+    html += &multiples(&figures, SMALL.0 + LEGEND_WIDTH);
     let sizes = context.sizes.clone();
     let grid = exponents(sizes.n_steps);
     let kinds: Vec<LobeKind> = context
@@ -440,7 +445,7 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
     let mut header = vec![
         "lobe",
         "epicentre max rel error (n = 64)",
-        "CPU: x pow's throughput (counted instructions)",
+        "CPU, counted: x pow's throughput (SIMD instructions)",
         "NVIDIA: x pow's throughput (evals/clock/SM, modelled)",
         "AMD RDNA: x pow's throughput (evals/clock/CU, modelled)",
         "SIMD instructions per 8 lanes (counted from the kernel)",
@@ -448,12 +453,12 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
     let mut html = paragraph(&prose::fill(prose::COST, &[])?);
     if let Some(measured) = &measured {
         header.extend([
-            "G evaluations/s (one thread, L1)",
-            "of its bound",
-            "x powf's throughput",
+            "CPU, measured: G evaluations/s (one thread, L1)",
+            "CPU, measured: of its bound",
+            "CPU, measured: x powf's throughput",
         ]);
         html += &paragraph(&format!(
-            "Measured on this machine ({}; the bound is the fastest the kernel's instructions \
+            "CPU, measured: timed on this machine, as specula recommend --target cpu times it ({}; the bound is the fastest the kernel's instructions \
              could run at the machine's measured per-instruction peaks, see `specula bench \
              lobes`); powf (libm) runs at {:.2} G/s.",
             measured.level.name(),

@@ -66,22 +66,25 @@ fn fpga_cell(answer: &Recommendation) -> String {
 
 /// Error against modelled cost: a marker per lobe in its colour, the grey line through the
 /// points flagged as the Pareto front, then `extra` series; log axes from the exact floor.
+/// Errors come as fractions and are drawn in %, the tables' unit (`extra`'s too); the axis
+/// ends a step past the largest error shown.
 pub(crate) fn pareto_chart(
     title: String,
     points: &[(LobeKind, (f64, f64), bool)],
     extra: Vec<Series>,
 ) -> Chart {
+    let percent = |(error, rate): (f64, f64)| (100.0 * error, rate);
     let mut front: Vec<(f64, f64)> = points
         .iter()
         .filter(|(_, _, on)| *on)
-        .map(|&(_, p, _)| p)
+        .map(|&(_, p, _)| percent(p))
         .collect();
     front.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut series_list: Vec<Series> = points
         .iter()
         .map(|&(kind, point, _)| Series {
             markers: true,
-            ..series(kind, vec![point])
+            ..series(kind, vec![percent(point)])
         })
         .collect();
     series_list.push(Series {
@@ -92,14 +95,21 @@ pub(crate) fn pareto_chart(
         markers: false,
         dashed: false,
     });
-    series_list.extend(extra);
+    series_list.extend(extra.into_iter().map(|line| Series {
+        points: line.points.into_iter().map(percent).collect(),
+        ..line
+    }));
     let most = points.iter().map(|p| p.1 .1).fold(0.0, f64::max);
+    let widest = points.iter().map(|p| p.1 .0).fold(EXACT_FLOOR, f64::max);
     Chart {
         title,
-        x_label: format!("epicentre max relative error (pow, exact, at {EXACT_FLOOR:e})"),
+        x_label: format!(
+            "epicentre max relative error, % (pow, exact, at {:e} %)",
+            100.0 * EXACT_FLOOR
+        ),
         y_label: "modelled evaluations per clock per multiprocessor".into(),
-        // Room on the right, past any error, for the legend.
-        x: (EXACT_FLOOR / 2.0, 1e3),
+        // The legend stands beside the plot, so the axis ends just past the largest error.
+        x: (50.0 * EXACT_FLOOR, 200.0 * widest),
         y: (0.1, most * 2.0),
         log_x: true,
         log_y: true,

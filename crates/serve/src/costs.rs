@@ -33,13 +33,15 @@ pub struct TargetCost {
 /// default knows the CPU's counted SIMD instructions only.
 pub type CostModel = Arc<dyn Fn(&Lobe) -> Result<Vec<TargetRate>, String> + Send + Sync>;
 
-/// The CPU's rate: evaluations per instruction of the lobe's SIMD kernel (8 per vector).
+/// The CPU's counted rate: evaluations per instruction of the lobe's SIMD kernel (8 per
+/// vector), counted, not timed ("CPU, counted", as the report's cost section names it; the
+/// timed rates are "CPU, measured", `specula recommend --target cpu`'s).
 #[must_use]
 pub fn cpu_cost(lobe: &Lobe) -> TargetRate {
     TargetRate {
         target: "cpu".into(),
         value: 8.0 / f64::from(lobe.batch_instructions().total().max(1)),
-        unit: "evaluations per SIMD instruction (counted; higher is better)".into(),
+        unit: "CPU, counted: evaluations per SIMD instruction (not timed; higher is better)".into(),
     }
 }
 

@@ -354,7 +354,7 @@ function analysisTable(reports) {
   const costHeads = costs.map((c) => `<th title="${c.unit}">x pow's throughput: ${c.target}</th>`).join("");
   const rows = reports.map((r) => `<tr><td>${r.lobe}</td><td>${pct(r.epicentre_max_rel)}</td><td>${r.bloom_max_abs.toPrecision(3)}</td><td>${r.rms.toPrecision(3)}</td><td>${r.energy_ratio.toPrecision(4)}</td><td>${r.max_albedo.toPrecision(4)}</td>${r.costs.map((c) => `<td title="${Number(c.value.toPrecision(3))} ${c.unit}">${c.versus_pow.toFixed(2)}x</td>`).join("")}</tr>`);
   const units = costs.map((c) => `${c.target}: ${c.unit}`).join("; ");
-  return `<table><thead><tr><th>lobe</th><th>epicentre max rel</th><th>bloom max abs</th><th>rms</th><th>energy ratio</th><th>max albedo (lobe-normalised)</th>${costHeads}</tr></thead><tbody>${rows.join("")}</tbody></table>${units ? `<p class="note">Costs: each lobe's throughput over pow's at this n on the target, higher is better (each cell's own rate on hover); measured as ${units}.</p>` : ""}`;
+  return `<table><thead><tr><th>lobe</th><th>epicentre max rel</th><th>bloom max abs</th><th>rms</th><th>energy ratio</th><th>max albedo (lobe-normalised)</th>${costHeads}</tr></thead><tbody>${rows.join("")}</tbody></table>${units ? `<p class="note">Costs: each lobe's throughput over pow's at this n on the target, higher is better (each cell's own rate on hover); rates in ${units}.</p>` : ""}`;
 }
 
 // An image already showing `url` is left alone: the volume renders take the server a while,
