@@ -1,8 +1,9 @@
-//! Fingerprints the sources a designed lobe depends on, so that `specula design`'s cache
-//! (`src/design/cache.rs`) reuses a search exactly when this build would search alike: the
-//! search, fit and verification here, the formula language, lobes and analysis in `specula`,
-//! and the locked versions of every crate (argmin's Nelder-Mead among them). A change to any of
-//! them makes a new key; nothing else does.
+//! Fingerprints the sources a designed lobe and a material's fits depend on, so that their
+//! caches (`src/design/cache.rs`, `src/fit_cache.rs`) reuse a result exactly when this build
+//! would compute it alike: the search, fit and verification here, the formula language,
+//! lobes, analysis and measured fits in `specula`, and the locked versions of every crate
+//! (argmin's Nelder-Mead among them).
+//! A change to any of them makes a new key; nothing else does.
 
 use std::path::{Path, PathBuf};
 
@@ -32,7 +33,7 @@ fn main() {
         feed(relative.to_string_lossy().as_bytes());
         feed(&std::fs::read(file).unwrap_or_default());
     }
-    println!("cargo:rustc-env=SPECULA_DESIGN_SOURCES={hash:016x}");
+    println!("cargo:rustc-env=SPECULA_SOURCES={hash:016x}");
 }
 
 /// Every `.rs`, `.toml` and `.lock` file at or below `path` (none where it is missing: a

@@ -13,6 +13,7 @@ mod choice;
 mod costing;
 pub mod design;
 mod figures;
+mod fit_cache;
 pub mod fpga_estimate;
 pub mod hardware;
 pub mod material;

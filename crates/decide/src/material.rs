@@ -108,7 +108,7 @@ pub fn assess(
         ));
     }
     let observations = Observations::of(|wo, wi| material.f_cos(wo, wi));
-    let fits = fit_all(&observations, kinds);
+    let fits = crate::fit_cache::fits(&observations, kinds, || fit_all(&observations, kinds));
     let mut rates = Vec::with_capacity(fits.len());
     for fit in &fits {
         rates.push(match (fit.specular, fit.sharing) {

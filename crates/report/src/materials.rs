@@ -1,9 +1,9 @@
 //! The report's real materials (those of `--materials DIR`, else the five specula carries):
-//! each measured material (an RGL isotropic RGB `.bsdf` file) assessed as `specula fit --material` assesses it (every lobe and GGX
-//! fitted, the verdict on a target), its shared-`n` fits in a table, polar plots of the
-//! measurement against the fits in the plane of incidence, and renders under the sky of the
-//! measured material beside pow's fit, the verdict's lobe and GGX, each scored by FLIP
-//! against the measured render.
+//! each measured material (an RGL isotropic RGB `.bsdf` file) assessed as `specula fit
+//! --material` assesses it (every lobe and GGX fitted, the verdict on a target), its
+//! shared-`n` fits in a table, polar plots of the measurement against the fits in the plane
+//! of incidence, and renders under the sky of the measured material beside pow's fit, the
+//! verdict's lobe and GGX, each scored by FLIP against the measured render.
 
 use std::path::{Path, PathBuf};
 
@@ -31,7 +31,7 @@ use specula_decide::Target;
 pub const MAX_MATERIALS: usize = 16;
 
 /// The bundled materials' render width and samples per pixel (`--quick`'s for a folder).
-const BUNDLED_RENDERS: (u32, u32) = (160, 16);
+const BUNDLED_RENDERS: (u32, u32) = (128, 8);
 
 /// The verdict's target (`specula fit`'s default) and margin over pow's fit error.
 const TARGET: Target = Target::GpuNvidia;

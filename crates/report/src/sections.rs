@@ -458,9 +458,10 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
             "CPU, measured: x powf's throughput",
         ]);
         html += &paragraph(&format!(
-            "CPU, measured: timed on this machine, as specula recommend --target cpu times it ({}; the bound is the fastest the kernel's instructions \
-             could run at the machine's measured per-instruction peaks, see `specula bench \
-             lobes`); powf (libm) runs at {:.2} G/s.",
+            "CPU, measured: timed on this machine, as specula recommend --target cpu times it \
+             ({}; the bound is the fastest the kernel's instructions could run at the machine's \
+             measured per-instruction peaks, see `specula bench lobes`); powf (libm) runs at \
+             {:.2} G/s.",
             measured.level.name(),
             measured.powf / 1e9
         ));

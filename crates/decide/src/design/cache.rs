@@ -34,7 +34,7 @@ pub(super) fn key(request: &DesignRequest) -> String {
     let (low, high) = request.range;
     specula_synth::cache::key(&[
         FORMAT,
-        env!("SPECULA_DESIGN_SOURCES"),
+        env!("SPECULA_SOURCES"),
         &bits(low.get()),
         &bits(high.get()),
         &bits(request.bounds.epicentre),

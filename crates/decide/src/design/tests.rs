@@ -21,8 +21,11 @@ fn request(target: Target, low: f64, high: f64, epicentre: f64, whole: f64) -> D
     }
 }
 
+/// A searched lobe's formula, coefficients' and figures' bits, checks and reason.
+type Found = (String, Vec<u64>, [u64; 3], bool, bool, String);
+
 /// What a search found, without the registry's kind (compared field by field).
-fn figures(lobes: &[DesignedLobe]) -> Vec<(String, Vec<u64>, [u64; 3], bool, bool, String)> {
+fn figures(lobes: &[DesignedLobe]) -> Vec<Found> {
     lobes
         .iter()
         .map(|d| {

@@ -228,8 +228,24 @@ fn answer_first(document: &roxmltree::Document) {
             "the answer names {target}: {answer}"
         );
     }
+    assert!(answer.contains("modelled; higher is better"), "{answer}");
+    // The box covers every exponent the table below it shows, for each GPU family.
+    for family in ["NVIDIA GPUs", "AMD RDNA GPUs"] {
+        let line = answer.split(family).nth(1).unwrap_or_default();
+        let line = line.split("GPUs").next().unwrap_or_default();
+        for n in ["n = 8:", "n = 64:", "n = 512:"] {
+            assert!(line.contains(n), "{family} lacks {n}: {answer}");
+        }
+    }
+    // The CPU's command as it must be typed: the bound with its % sign, the table's range.
+    let command = answer
+        .split("specula recommend")
+        .nth(1)
+        .expect("the CPU's command");
     assert!(
-        answer.contains("pow's throughput (modelled; higher is better)"),
+        command
+            .trim_start()
+            .starts_with("--target cpu --n 8..512 --max-error 2%"),
         "{answer}"
     );
     let last = sections.last().expect("sections");

@@ -1,0 +1,168 @@
+//! A measured material's fits on disk, beside the design searches: fitting every lobe to a
+//! material takes seconds of CPU each (the report fits five), and the fits depend only on the
+//! observations (the material's values at the comparison pairs), the lobes and the code, so
+//! a later run reads them back. Keyed by every observed value's bits, the lobes' ids and
+//! `build.rs`'s fingerprint of the sources the fits run. Fits of a user's formula lobe are never
+//! stored: its id names it in this process only. Numbers are stored as their `f64` bits, so
+//! a loaded fit is the fitted one bit for bit.
+
+use serde::{Deserialize, Serialize};
+use specula::measured::fit::{Fit, Observations, Sharing, Specular};
+use specula::{Geometry, LobeKind};
+use specula_synth::cache::{key, Cache};
+
+/// Bumped when [`Stored`] changes shape.
+const FORMAT: &str = "specula material fits 1";
+
+/// One fit as stored.
+#[derive(Serialize, Deserialize)]
+struct Stored {
+    /// The lobe's id, or `None` for GGX.
+    lobe: Option<String>,
+    blinn: bool,
+    per_channel: bool,
+    parameter: [u64; 3],
+    kd: [u64; 3],
+    k: [u64; 3],
+    error: u64,
+    channel_error: [u64; 3],
+}
+
+/// The fits of `kinds` to `observations`: read from the cache where this build fitted them
+/// before, else made by `fit` and stored.
+pub(crate) fn fits(
+    observations: &Observations,
+    kinds: &[LobeKind],
+    fit: impl FnOnce() -> Vec<Fit>,
+) -> Vec<Fit> {
+    let cache = Cache::default_for("fits")
+        .filter(|_| kinds.iter().all(|kind| LobeKind::ALL.contains(kind)));
+    let Some(cache) = cache else {
+        return fit();
+    };
+    let key = key_of(observations, kinds);
+    if let Some(found) = load(&cache, &key) {
+        return found;
+    }
+    let made = fit();
+    // A cache that cannot be written costs the next run the fits, nothing else.
+    let _ = cache.store(&key, &made.iter().map(stored).collect::<Vec<_>>());
+    made
+}
+
+fn key_of(observations: &Observations, kinds: &[LobeKind]) -> String {
+    // FNV-1a over every observed value's bits, as the cache's own keys hash their parts.
+    let mut digest: u64 = 0xcbf2_9ce4_8422_2325;
+    for value in &observations.value {
+        for channel in value.to_array() {
+            for byte in channel.to_bits().to_le_bytes() {
+                digest ^= u64::from(byte);
+                digest = digest.wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        }
+    }
+    let lobes: Vec<String> = kinds.iter().map(LobeKind::to_string).collect();
+    key(&[
+        FORMAT,
+        env!("SPECULA_SOURCES"),
+        &format!("{digest:016x} {}", observations.value.len()),
+        &lobes.join(","),
+    ])
+}
+
+fn load(cache: &Cache, key: &str) -> Option<Vec<Fit>> {
+    let stored: Vec<Stored> = cache.load(key)?;
+    let bits = |values: [u64; 3]| values.map(f64::from_bits);
+    stored
+        .into_iter()
+        .map(|entry| {
+            let geometry = if entry.blinn {
+                Geometry::Blinn
+            } else {
+                Geometry::Phong
+            };
+            let specular = match &entry.lobe {
+                Some(id) => Specular::Lobe {
+                    kind: LobeKind::parse(id).ok()?,
+                    geometry,
+                },
+                None => Specular::Ggx,
+            };
+            Some(Fit {
+                specular,
+                sharing: if entry.per_channel {
+                    Sharing::PerChannel
+                } else {
+                    Sharing::Shared
+                },
+                parameter: bits(entry.parameter),
+                kd: bits(entry.kd),
+                k: bits(entry.k),
+                error: f64::from_bits(entry.error),
+                channel_error: bits(entry.channel_error),
+            })
+        })
+        .collect()
+}
+
+fn stored(fit: &Fit) -> Stored {
+    let bits = |values: [f64; 3]| values.map(f64::to_bits);
+    let (lobe, blinn) = match fit.specular {
+        Specular::Lobe { kind, geometry } => (Some(kind.to_string()), geometry == Geometry::Blinn),
+        Specular::Ggx => (None, false),
+    };
+    Stored {
+        lobe,
+        blinn,
+        per_channel: fit.sharing == Sharing::PerChannel,
+        parameter: bits(fit.parameter),
+        kd: bits(fit.kd),
+        k: bits(fit.k),
+        error: fit.error.to_bits(),
+        channel_error: bits(fit.channel_error),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A stored fit reads back as the same fit, bit for bit, GGX and both geometries alike.
+    #[test]
+    fn a_stored_fit_reads_back_bit_for_bit() {
+        let directory = tempfile::tempdir().unwrap();
+        let cache = Cache::new(directory.path());
+        let fit = |specular, sharing, x: f64| Fit {
+            specular,
+            sharing,
+            parameter: [x, x * 2.0, x / 3.0],
+            kd: [0.1, 0.2, 0.3],
+            k: [x.sqrt(), 1.0 / 7.0, f64::MIN_POSITIVE],
+            error: x.ln(),
+            channel_error: [1e-300, 0.5, 2.0 / 3.0],
+        };
+        let fits = vec![
+            fit(
+                Specular::Lobe {
+                    kind: LobeKind::SgKaris,
+                    geometry: Geometry::Blinn,
+                },
+                Sharing::Shared,
+                37.25,
+            ),
+            fit(
+                Specular::Lobe {
+                    kind: LobeKind::Pow,
+                    geometry: Geometry::Phong,
+                },
+                Sharing::PerChannel,
+                0.1,
+            ),
+            fit(Specular::Ggx, Sharing::Shared, 0.3),
+        ];
+        cache
+            .store("k", &fits.iter().map(stored).collect::<Vec<_>>())
+            .unwrap();
+        assert_eq!(load(&cache, "k"), Some(fits));
+    }
+}
