@@ -123,10 +123,9 @@ fn overlap(a: Box, b: Box) -> i64 {
 /// already placed and its own dot is nearer to it than any other dot (by [`NEARER_BY`]); where
 /// no place is free it takes the one that breaks the fewest of those. The most crowded dots
 /// choose first, while the room around them is still free. A name that found no place nearer
-/// its own dot than another's, on a dot with a neighbour within three radii (a dot wedged
-/// between close neighbours has no room a name fits in), or no place free at all, on a dot
-/// with a neighbour within six, is joined with that neighbour's, and every name placed again:
-/// the joined name stands nearest one of its dots and lists them left to right.
+/// its own dot than another's is joined with the name of the dot it stands nearest, and one
+/// that found no place free at all with a neighbour within six radii; then every name is
+/// placed again: the joined name stands nearest one of its dots and lists them left to right.
 pub(super) fn place(dots: &[Dot], area: Box) -> Vec<Placed> {
     let radius = f64::from(offset(DOT_RADIUS as i32));
     // Groups of dots that hide one another, by index.
@@ -259,25 +258,22 @@ fn place_groups(
             }
         }
         if let Some(((broken, ..), area, anchor, closer)) = best {
-            // How far, in radii, a neighbour is joined: where no place is nearer this dot than
-            // another, the neighbour it is wedged against (three radii); where every place broke
-            // a rule (crowded), a neighbour farther out (six), so that one name serves both.
-            let reach = match (closer, broken) {
-                (Some(_), _) => 3.0,
-                (None, 0) => 0.0,
-                (None, _) => 6.0,
-            };
-            // The group's nearest neighbour within that reach, to be joined with it.
-            let neighbour = dots
-                .iter()
-                .enumerate()
-                .filter(|(k, _)| !group.contains(k))
-                .map(|(k, d)| {
-                    let gap = group.iter().map(|&j| apart(dots[j].at, d.at));
-                    (k, gap.fold(f64::INFINITY, f64::min))
-                })
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .filter(|&(_, gap)| gap < reach * f64::from(radius));
+            // Where no place is nearer this dot than another, the name is joined with the dot
+            // its best place stands nearest (a reader would pair them), however far; where
+            // every place broke another rule (crowded), with a neighbour within six radii, so
+            // that one name serves both.
+            let reach = if broken == 0 { 0.0 } else { 6.0 };
+            let neighbour = closer.map(|k| (k, 0.0)).or_else(|| {
+                dots.iter()
+                    .enumerate()
+                    .filter(|(k, _)| !group.contains(k))
+                    .map(|(k, d)| {
+                        let gap = group.iter().map(|&j| apart(dots[j].at, d.at));
+                        (k, gap.fold(f64::INFINITY, f64::min))
+                    })
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .filter(|&(_, gap)| gap < reach * f64::from(radius))
+            });
             if let (None, Some((other, _))) = (nearer, neighbour) {
                 nearer = Some((index, other));
             }
