@@ -126,12 +126,10 @@ impl Costing {
             .iter()
             .zip(&representatives)
             .map(|(&kind, firsts)| {
-                let mut distinct: Vec<usize> = firsts.clone();
-                distinct.dedup();
-                distinct.sort_unstable();
-                distinct.dedup();
-                distinct
-                    .into_iter()
+                // Each representative is the first of its kind, so they are the exponents that
+                // are their own.
+                (0..exponents.len())
+                    .filter(|&k| firsts[k] == k)
                     .map(|k| Lobe::new(kind, exponents[k]))
                     .collect()
             })

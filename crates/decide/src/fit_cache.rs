@@ -9,7 +9,7 @@
 use serde::{Deserialize, Serialize};
 use specula::measured::fit::{Fit, Observations, Sharing, Specular};
 use specula::{Geometry, LobeKind};
-use specula_synth::cache::{key, Cache};
+use specula_synth::cache::{key_of_bytes, Cache};
 
 /// Bumped when [`Stored`] changes shape.
 const FORMAT: &str = "specula material fits 1";
@@ -51,22 +51,18 @@ pub(crate) fn fits(
 }
 
 fn key_of(observations: &Observations, kinds: &[LobeKind]) -> String {
-    // FNV-1a over every observed value's bits, as the cache's own keys hash their parts.
-    let mut digest: u64 = 0xcbf2_9ce4_8422_2325;
-    for value in &observations.value {
-        for channel in value.to_array() {
-            for byte in channel.to_bits().to_le_bytes() {
-                digest ^= u64::from(byte);
-                digest = digest.wrapping_mul(0x0000_0100_0000_01b3);
-            }
-        }
-    }
+    let values: Vec<u8> = observations
+        .value
+        .iter()
+        .flat_map(|value| value.to_array())
+        .flat_map(|channel| channel.to_bits().to_le_bytes())
+        .collect();
     let lobes: Vec<String> = kinds.iter().map(LobeKind::to_string).collect();
-    key(&[
-        FORMAT,
-        env!("SPECULA_SOURCES"),
-        &format!("{digest:016x} {}", observations.value.len()),
-        &lobes.join(","),
+    key_of_bytes(&[
+        FORMAT.as_bytes(),
+        env!("SPECULA_SOURCES").as_bytes(),
+        &values,
+        lobes.join(",").as_bytes(),
     ])
 }
 

@@ -344,7 +344,13 @@ fn rank(
         candidate.pareto = on_front;
     }
     candidates.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
-    let tied = break_tie(&mut candidates);
+    let tie = break_tie(&mut candidates, |c| Standing {
+        meets: c.meets,
+        rate: c.rate,
+        spread: c.spread,
+        error: c.error,
+    });
+    let tied = candidates[..tie].iter().map(|c| c.lobe.clone()).collect();
     let mut recommendation = Recommendation {
         unit,
         note,
@@ -366,14 +372,8 @@ fn rank(
     recommendation
 }
 
-/// Whether two measured candidates cannot be told apart: their spreads overlap. Unmeasured
-/// rates (modelled, synthesized) are exact, and tie only where equal.
-#[must_use]
-pub(crate) fn overlap(a: &Candidate, b: &Candidate) -> bool {
-    rates_overlap((a.rate, a.spread), (b.rate, b.spread))
-}
-
-/// [`overlap`] of two (rate, spread) pairs.
+/// Whether two (rate, spread) pairs cannot be told apart: their measured spreads overlap.
+/// Unmeasured rates (modelled, synthesized) are exact, and tie only where equal.
 #[must_use]
 pub(crate) fn rates_overlap(a: (f64, Option<[f64; 2]>), b: (f64, Option<[f64; 2]>)) -> bool {
     match (a.1, b.1) {
@@ -382,39 +382,46 @@ pub(crate) fn rates_overlap(a: (f64, Option<[f64; 2]>), b: (f64, Option<[f64; 2]
     }
 }
 
+/// What [`break_tie`] reads of a ranked lobe: whether it meets the request, its rate and
+/// spread, its error.
+pub(crate) struct Standing {
+    pub(crate) meets: bool,
+    pub(crate) rate: f64,
+    pub(crate) spread: Option<[f64; 2]>,
+    pub(crate) error: f64,
+}
+
 /// Among `sorted` (those that meet first, fastest first), the measured lobes that meet and
 /// whose spreads overlap the fastest's, a tie this run cannot break: the most accurate of
-/// them (the faster where equally accurate) is moved to the front, the answer. Returns the
-/// tie's lobes, the answer first; empty where the fastest stands alone or nothing is measured.
-fn break_tie(sorted: &mut [Candidate]) -> Vec<String> {
-    let Some(fastest) = sorted.first().filter(|c| c.meets && c.spread.is_some()) else {
-        return Vec::new();
+/// them (the faster where equally accurate) is moved to the front, the answer. Returns how
+/// many lead `sorted` in the tie, the answer first (the overlapping ones are a prefix: a
+/// faster lobe's fastest pass is at least a slower one's); 0 where the fastest stands alone
+/// or nothing is measured. `recommend` and `design` rank alike through it.
+pub(crate) fn break_tie<T>(sorted: &mut [T], standing: impl Fn(&T) -> Standing) -> usize {
+    let Some(fastest) = sorted
+        .first()
+        .map(&standing)
+        .filter(|s| s.meets && s.spread.is_some())
+    else {
+        return 0;
     };
-    let tie: Vec<usize> = (0..sorted.len())
-        .filter(|&k| sorted[k].meets && overlap(&sorted[k], fastest))
-        .collect();
-    if tie.len() < 2 {
-        return Vec::new();
-    }
-    let answer = tie
+    let fastest = (fastest.rate, fastest.spread);
+    let tie = sorted
         .iter()
-        .copied()
+        .map(&standing)
+        .take_while(|s| s.meets && rates_overlap((s.rate, s.spread), fastest))
+        .count();
+    if tie < 2 {
+        return 0;
+    }
+    let answer = (0..tie)
         .min_by(|&a, &b| {
-            sorted[a]
-                .error
-                .total_cmp(&sorted[b].error)
-                .then(sorted[b].rate.total_cmp(&sorted[a].rate))
+            let (a, b) = (standing(&sorted[a]), standing(&sorted[b]));
+            a.error.total_cmp(&b.error).then(b.rate.total_cmp(&a.rate))
         })
         .unwrap_or(0);
     sorted[..=answer].rotate_right(1);
-    // The rotation moved every earlier tied lobe one place down.
-    let mut names = vec![sorted[0].lobe.clone()];
-    names.extend(
-        tie.iter()
-            .filter(|&&k| k != answer)
-            .map(|&k| sorted[if k < answer { k + 1 } else { k }].lobe.clone()),
-    );
-    names
+    tie
 }
 
 /// `rate` as a multiple of pow's (`1.52x`), or `-` where pow has no cost on the target (no

@@ -17,9 +17,16 @@ const FORMAT: &str = "specula-synth 1";
 /// The key for `parts` (each separated, so `["ab", "c"]` and `["a", "bc"]` differ).
 #[must_use]
 pub fn key(parts: &[&str]) -> String {
+    let bytes: Vec<&[u8]> = parts.iter().map(|part| part.as_bytes()).collect();
+    key_of_bytes(&bytes)
+}
+
+/// [`key`] for parts that are bytes (a measurement's numbers), hashed as they are.
+#[must_use]
+pub fn key_of_bytes(parts: &[&[u8]]) -> String {
     let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
-    for part in core::iter::once(&FORMAT).chain(parts) {
-        for byte in part.bytes().chain([0xff]) {
+    for part in core::iter::once(&FORMAT.as_bytes()).chain(parts) {
+        for &byte in part.iter().chain(&[0xff]) {
             hash ^= u64::from(byte);
             hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
         }

@@ -32,7 +32,7 @@ pub use specula_synth::cache::Cache;
 
 pub use crate::percent::percent;
 use crate::percent::{exceeds, flag_percent_above};
-use crate::recommend::{pareto_front, rates_overlap, recommend, Candidate, Request};
+use crate::recommend::{pareto_front, recommend, Candidate, Request, Standing};
 use crate::{log_spaced, sample_exponents, Target, Zone};
 
 /// The whole lobe's largest absolute error allowed by default, at least: 1 % of the peak,
@@ -378,29 +378,16 @@ fn rank(
 /// Where the fastest designs' measured rates overlap, the most accurate of them first (as
 /// `recommend` breaks its ties), the tie recorded in that lobe's [`DesignedLobe::tied`].
 fn break_tie(sorted: &mut [DesignedLobe]) {
-    let Some(fastest) = sorted.first().filter(|d| d.meets && d.spread.is_some()) else {
-        return;
-    };
-    let fastest = (fastest.rate, fastest.spread);
-    let tie = sorted
-        .iter()
-        .take_while(|d| d.meets && rates_overlap((d.rate, d.spread), fastest))
-        .count();
-    // Sorted fastest first, the overlapping ones lead; any faster one overlaps as well.
-    if tie < 2 {
-        return;
-    }
-    let answer = (0..tie)
-        .min_by(|&a, &b| {
-            sorted[a]
-                .epicentre_error
-                .total_cmp(&sorted[b].epicentre_error)
-                .then(sorted[b].rate.total_cmp(&sorted[a].rate))
-        })
-        .unwrap_or(0);
-    sorted[..=answer].rotate_right(1);
+    let tie = crate::recommend::break_tie(sorted, |d| Standing {
+        meets: d.meets,
+        rate: d.rate,
+        spread: d.spread,
+        error: d.epicentre_error,
+    });
     let names = sorted[..tie].iter().map(|d| d.name.clone()).collect();
-    sorted[0].tied = names;
+    if let Some(answer) = sorted.first_mut() {
+        answer.tied = names;
+    }
 }
 
 /// Marks the designed lobes no lobe (designed or built in) dominates in error and rate.
