@@ -1,8 +1,9 @@
-//! Fingerprints the sources a designed lobe and a material's fits depend on, so that their
-//! caches (`src/design/cache.rs`, `src/fit_cache.rs`) reuse a result exactly when this build
-//! would compute it alike: the search, fit and verification here, the formula language,
-//! lobes, analysis and measured fits in `specula`, and the locked versions of every crate
-//! (argmin's Nelder-Mead among them).
+//! Fingerprints the sources a designed lobe, a material's fits, the claims and the datapaths'
+//! sweeps depend on, so that their caches (`src/design/cache.rs`, `src/fit_cache.rs`,
+//! `src/analyses.rs`) reuse a result exactly when this build would compute it alike: the
+//! search, fit and verification here, the formula language, lobes, analysis, claims and
+//! measured fits in `specula`, the datapaths in `specula-hw`, and the locked versions of every
+//! crate (argmin's Nelder-Mead among them).
 //! A change to any of them makes a new key; nothing else does.
 
 use std::path::{Path, PathBuf};
@@ -12,6 +13,7 @@ fn main() {
     let roots = [
         manifest.join("src"),
         manifest.join("../specula/src"),
+        manifest.join("../hw/src"),
         manifest.join("../../Cargo.lock"),
     ];
     let mut files = Vec::new();

@@ -7,33 +7,55 @@
 //! formula is registered for good), so a figure never goes stale.
 
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex, OnceLock, PoisonError};
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock, PoisonError};
 
 use specula::analysis::{error_figures_on, ErrorFigures, Precision, ZoneSamples};
 use specula::{Exponent, Lobe, LobeKind};
 
 use crate::hardware::SWEEP_SAMPLES;
 
+type Figures = HashMap<(LobeKind, u64), ErrorFigures>;
+
+/// Every figure measured in this process, by lobe and exponent's bits.
+fn memo() -> MutexGuard<'static, Figures> {
+    static FIGURES: OnceLock<Mutex<Figures>> = OnceLock::new();
+    FIGURES
+        .get_or_init(Mutex::default)
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+}
+
 /// The figures of `lobe` in `f64`, as `error_figures(lobe, F64, SWEEP_SAMPLES)` gives them.
 #[must_use]
 pub(crate) fn f64_figures(lobe: &Lobe) -> ErrorFigures {
-    static FIGURES: OnceLock<Mutex<HashMap<(LobeKind, u64), ErrorFigures>>> = OnceLock::new();
     let key = (lobe.kind(), lobe.exponent().get().to_bits());
-    let figures = FIGURES.get_or_init(Mutex::default);
-    if let Some(&known) = figures
-        .lock()
-        .unwrap_or_else(PoisonError::into_inner)
-        .get(&key)
-    {
+    if let Some(&known) = memo().get(&key) {
         return known;
     }
     // Measured outside the lock: two threads may both measure one lobe, never wait on it.
     let measured = error_figures_on(lobe, &mut Precision::F64, &samples(lobe.exponent()));
-    figures
-        .lock()
-        .unwrap_or_else(PoisonError::into_inner)
-        .insert(key, measured);
+    memo().insert(key, measured);
     measured
+}
+
+/// The figures of `kind` measured so far, by exponent's bits, in increasing order: what a
+/// designed lobe's verification measured, which the design cache keeps beside the lobe.
+#[must_use]
+pub(crate) fn measured(kind: LobeKind) -> Vec<(u64, ErrorFigures)> {
+    let mut found: Vec<(u64, ErrorFigures)> = memo()
+        .iter()
+        .filter(|((measured, _), _)| *measured == kind)
+        .map(|(&(_, n), &figures)| (n, figures))
+        .collect();
+    found.sort_by_key(|&(n, _)| n);
+    found
+}
+
+/// Takes `figures` as `kind`'s at the exponent of bits `n`, as measured by an earlier process
+/// of this build (the design cache's): a lobe kind names one lobe for the whole process, so
+/// they are what measuring it again would give.
+pub(crate) fn remember(kind: LobeKind, n: u64, figures: ErrorFigures) {
+    memo().insert((kind, n), figures);
 }
 
 /// The reference samples at `n`, made once per exponent.

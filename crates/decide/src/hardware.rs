@@ -12,6 +12,9 @@ use specula::LobeKind;
 use specula_hw::analysis::{sweep, WidthSweep};
 use specula_hw::{HwLobe, BITS};
 
+use specula_synth::cache::Cache;
+
+use crate::analyses;
 use crate::fpga_estimate::logic_cells;
 use crate::Zone;
 
@@ -41,7 +44,8 @@ pub fn sweeps(
 
 /// Every datapath's sweep over every word length ([`BITS`]) at the integer exponent `n`, with
 /// [`SWEEP_SAMPLES`] angles per zone: what `recommend --target fpga` chooses from. Computed
-/// once per `n` in a process (a pure function of it) and shared after.
+/// once per `n` in a process (a pure function of it) and shared after, and read back from
+/// disk by a later process of the same build ([`analyses`]).
 pub fn hardware_sweeps(n: u32) -> Result<Arc<Vec<WidthSweep>>, String> {
     static MEMO: Mutex<BTreeMap<u32, Arc<Vec<WidthSweep>>>> = Mutex::new(BTreeMap::new());
     let memo = || MEMO.lock().unwrap_or_else(PoisonError::into_inner);
@@ -50,12 +54,23 @@ pub fn hardware_sweeps(n: u32) -> Result<Arc<Vec<WidthSweep>>, String> {
     }
     // Computed without the lock held: the sweep runs on rayon, whose threads may meanwhile
     // take other work that asks for sweeps. Two callers racing compute twice; the first kept.
-    let computed = Arc::new(sweeps(
+    let widths = (*BITS.start(), *BITS.end());
+    let cache = Cache::default_for("sweeps");
+    let computed = Arc::new(analyses::sweeps(
+        cache.as_ref(),
         &HwLobe::ALL,
         n,
-        (*BITS.start(), *BITS.end()),
+        widths,
         SWEEP_SAMPLES,
-        &ProgressBar::hidden(),
+        || {
+            sweeps(
+                &HwLobe::ALL,
+                n,
+                widths,
+                SWEEP_SAMPLES,
+                &ProgressBar::hidden(),
+            )
+        },
     )?);
     Ok(Arc::clone(memo().entry(n).or_insert(computed)))
 }

@@ -8,6 +8,7 @@
 //! progress goes to a [`indicatif::ProgressBar`] the caller passes (hidden for none); what a
 //! face should tell its user comes back as data ([`Recommendation::note`]).
 
+pub mod analyses;
 pub mod c_twins;
 mod choice;
 mod costing;
@@ -18,6 +19,7 @@ pub mod fpga_estimate;
 pub mod hardware;
 pub mod material;
 pub mod percent;
+mod pinned;
 pub mod rates;
 mod recommend;
 

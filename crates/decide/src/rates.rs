@@ -17,6 +17,8 @@ use specula::simd::tally::Instructions;
 use specula::simd::{peak, BatchLoop, Level};
 use specula::{Exponent, Lobe, LobeKind};
 
+use crate::pinned::Pinned;
+
 /// Elements of the L1-resident buffers (8 KiB in, 8 KiB out).
 pub const L1_SIZE: usize = 2048;
 /// Elements of the streaming buffers (128 MiB in, 128 MiB out).
@@ -123,13 +125,13 @@ const PASS_SECONDS: f64 = 0.015;
 /// [pass]`), L1-resident, one thread, timed so that lobes compare like with like on a machine
 /// whose speed drifts (this project's shared virtual machine slows by up to 40 % for a second
 /// or more at a time): in [`PASSES`] passes over every lobe, each pass timing each lobe at all
-/// its exponents, on one pinned CPU. A slow spell then costs a lobe one pass at the exponents
-/// it covered, every lobe is timed in every part of the run, and the passes' spread says how
-/// far one rate can be told from another. `progress` ticks once a pass per lobe.
+/// its exponents, on the CPU that was idlest when it began ([`Pinned`]). A slow spell then
+/// costs a lobe one pass at the exponents it covered, every lobe is timed in every part of the
+/// run, and the passes' spread says how far one rate can be told from another. `progress` ticks once a pass per lobe.
 #[must_use]
 pub(crate) fn kernel_rates(lobes: &[Vec<Lobe>], progress: &ProgressBar) -> Vec<Vec<Vec<f64>>> {
     let level = Level::detect();
-    let _pinned = Pinned::to_current_cpu();
+    let _pinned = Pinned::to_idlest_cpu();
     let mut passes: Vec<Vec<Vec<f64>>> = lobes
         .iter()
         .map(|at| vec![Vec::with_capacity(PASSES); at.len()])
@@ -145,45 +147,6 @@ pub(crate) fn kernel_rates(lobes: &[Vec<Lobe>], progress: &ProgressBar) -> Vec<V
         }
     }
     passes
-}
-
-/// The calling thread held on the CPU it runs on until dropped, then allowed its former CPUs
-/// again (Linux; elsewhere nothing): a thread that moves between cores mid-measurement
-/// measures two of them.
-struct Pinned {
-    #[cfg(target_os = "linux")]
-    former: Option<nix::sched::CpuSet>,
-}
-
-impl Pinned {
-    fn to_current_cpu() -> Self {
-        #[cfg(target_os = "linux")]
-        {
-            use nix::sched::{sched_getaffinity, sched_getcpu, sched_setaffinity, CpuSet};
-            use nix::unistd::Pid;
-            let former = sched_getaffinity(Pid::from_raw(0)).ok();
-            let pinned = sched_getcpu().ok().and_then(|cpu| {
-                let mut one = CpuSet::new();
-                one.set(cpu).ok()?;
-                sched_setaffinity(Pid::from_raw(0), &one).ok()
-            });
-            Self {
-                former: former.filter(|_| pinned.is_some()),
-            }
-        }
-        #[cfg(not(target_os = "linux"))]
-        Self {}
-    }
-}
-
-impl Drop for Pinned {
-    fn drop(&mut self) {
-        #[cfg(target_os = "linux")]
-        if let Some(former) = &self.former {
-            // Nothing to do if it fails: the thread stays where it is, still correct.
-            let _ = nix::sched::sched_setaffinity(nix::unistd::Pid::from_raw(0), former);
-        }
-    }
 }
 
 /// Evaluations per second of `work` over an L1-sized buffer, on one thread (best of 3).
@@ -304,25 +267,6 @@ pub fn measure(n: Exponent, stream: bool, progress: &ProgressBar) -> Measured {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Timing pins the thread to one CPU and gives it back its CPUs afterwards.
-    #[cfg(target_os = "linux")]
-    #[test]
-    fn pinning_restores_the_affinity() {
-        use nix::sched::{sched_getaffinity, CpuSet};
-        use nix::unistd::Pid;
-        let count = |set: &CpuSet| {
-            (0..CpuSet::count())
-                .filter(|&cpu| set.is_set(cpu).unwrap_or(false))
-                .count()
-        };
-        let before = sched_getaffinity(Pid::from_raw(0)).unwrap();
-        {
-            let _pinned = Pinned::to_current_cpu();
-            assert_eq!(count(&sched_getaffinity(Pid::from_raw(0)).unwrap()), 1);
-        }
-        assert_eq!(sched_getaffinity(Pid::from_raw(0)).unwrap(), before);
-    }
 
     /// Every lobe gets a rate at each of its exponents in every pass, in the order given, and
     /// the progress counts a tick per lobe per pass.

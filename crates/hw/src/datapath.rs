@@ -8,7 +8,7 @@
 //! resized into that format (rounded, then saturated). In the pipeline every non-wiring node
 //! ends in a register, and operands from earlier stages are delayed to arrive together.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::exp2::Exp2Unit;
 use crate::fixed::{exact_add, exact_mul, FixedPoint, Rounding, MAX_WIDTH};
@@ -184,7 +184,7 @@ pub fn operands(op: &Op) -> Vec<NodeId> {
 }
 
 /// What a datapath costs, counted from its nodes.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Resources {
     /// Multipliers as `(a bits, b bits)`, the log2 units' interpolation multipliers included.
     pub multipliers: Vec<(u32, u32)>,

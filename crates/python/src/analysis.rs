@@ -3,7 +3,7 @@
 
 use pyo3::prelude::*;
 use specula::analysis::{analyze_all, Precision, DEFAULT_EXPONENTS};
-use specula::claims::{claim_exponents, evaluate_all, ClaimOptions};
+use specula::claims::{claim_exponents, ClaimOptions};
 use specula::zones::{bloom_angle, bloom_cos, epicentre_angle, epicentre_cos};
 use specula::{Exponent, LobeKind};
 
@@ -95,6 +95,6 @@ pub fn claims_json(
             })?,
             seed: seed.map_or(Ok(defaults.seed), arrays::seed)?,
         };
-        json(&py.detach(|| evaluate_all(&options)))
+        json(&py.detach(|| specula_decide::analyses::claims(&options)))
     })
 }

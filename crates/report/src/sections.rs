@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 use specula::analysis::{error_figures, error_figures_on, ErrorFigures, Precision, ZoneSamples};
-use specula::claims::{evaluate_all, ClaimOptions, Verdict};
+use specula::claims::{ClaimOptions, Verdict};
 use specula::zones::{bloom_angle, epicentre_angle};
 use specula::{Exponent, Lobe, LobeKind};
 use specula_synth::OnMiss;
@@ -342,7 +342,7 @@ pub fn errors(context: &mut Context) -> Result<String, String> {
 
 pub fn claims(context: &mut Context) -> Result<String, String> {
     let options = context.sizes.claims.clone();
-    let results = evaluate_all(&options);
+    let results = specula_decide::analyses::claims(&options);
     let mut html = format!(
         "<p>Each claim of SPEC section 9, tested over {} exponents from 1 to 1000; thresholds come \
             from the claims' own \
@@ -532,7 +532,7 @@ pub fn sizes(quick: bool) -> Sizes {
             reciprocity_pairs: 20_000,
             claims: ClaimOptions::default(),
             render: (480, 270, 2),
-            environment: (480, 270, 128),
+            environment: (480, 270, 64),
             materials: (480, 64),
             volume: (64, 192, 2),
             real_scans: RealScanSizes {

@@ -1,7 +1,7 @@
 //! `specula claims`: the thesis's claims with measured figures and verdicts.
 
 use indicatif::{ProgressBar, ProgressStyle};
-use specula::claims::{evaluate_all, ClaimId, ClaimOptions, ClaimResult};
+use specula::claims::{ClaimId, ClaimOptions, ClaimResult};
 
 use specula_hw::{HwLobe, BITS};
 use specula_synth::cache::Cache;
@@ -63,7 +63,7 @@ pub fn run(args: &Args) -> CommandResult {
     );
     progress.set_message(ClaimId::ALL.len().to_string());
     progress.enable_steady_tick(std::time::Duration::from_millis(100));
-    let results: Vec<ClaimResult> = evaluate_all(&options);
+    let results: Vec<ClaimResult> = specula_decide::analyses::claims(&options);
     progress.set_message("the hardware claim: synthesizing, 8");
     let hardware = hardware_claim(
         options.samples_per_zone.min(20_001),

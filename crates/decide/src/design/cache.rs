@@ -5,15 +5,19 @@
 //! on a GPU it is the cost model's, which takes milliseconds.
 //!
 //! Numbers are stored as their `f64` bits, so a loaded lobe is the searched one bit for bit
-//! (figures of lobes never verified are infinite, which JSON cannot write).
+//! (figures of lobes never verified are infinite, which JSON cannot write). Beside each lobe
+//! are the figures its verification measured at every exponent, which ranking it reads again:
+//! a loaded lobe is not measured twice.
 
 use serde::{Deserialize, Serialize};
 use specula_synth::cache::Cache;
 
 use super::{register, unmeasured, DesignRequest, DesignedLobe, Family};
+use crate::analyses::{figure_bits, figures_of};
+use crate::figures;
 
 /// Bumped when [`Stored`] changes shape.
-const FORMAT: &str = "specula design search 1";
+const FORMAT: &str = "specula design search 2";
 
 /// One family as searched.
 #[derive(Serialize, Deserialize)]
@@ -26,6 +30,8 @@ pub(super) struct Stored {
     verified: bool,
     short_of_whole_only: bool,
     why: String,
+    /// The verification's figures, by exponent's bits: what ranking the lobe reads again.
+    figures: Vec<(u64, [u64; 5])>,
 }
 
 /// The key of `request`'s search.
@@ -75,6 +81,10 @@ pub(super) fn load(cache: &Cache, key: &str, request: &DesignRequest) -> Option<
                 // Registered when searched, so registering again can only fail where the
                 // registry is full: then the entry is of no use, and the search runs again.
                 register(&mut lobe).ok()?;
+                let kind = lobe.kind?;
+                for (n, bits) in entry.figures {
+                    figures::remember(kind, n, figures_of(bits));
+                }
             }
             Some(lobe)
         })
@@ -94,6 +104,12 @@ pub(super) fn store(cache: &Cache, key: &str, searched: &[DesignedLobe]) -> std:
             verified: lobe.verified,
             short_of_whole_only: lobe.short_of_whole_only,
             why: lobe.why.clone(),
+            figures: lobe.kind.map_or_else(Vec::new, |kind| {
+                figures::measured(kind)
+                    .into_iter()
+                    .map(|(n, measured)| (n, figure_bits(&measured)))
+                    .collect()
+            }),
         })
         .collect();
     cache.store(key, &stored)

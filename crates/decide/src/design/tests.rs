@@ -3,7 +3,10 @@
 //! removed is reported with a flag that admits it.
 
 use indicatif::ProgressBar;
-use specula::Exponent;
+use specula::analysis::{error_figures, Precision};
+use specula::{Exponent, Lobe};
+
+use crate::hardware::SWEEP_SAMPLES;
 
 use super::*;
 
@@ -54,6 +57,30 @@ fn a_stored_search_comes_back_bit_for_bit_and_other_bounds_miss_it() {
     // Loaded lobes are registered again: the same formula, so the same lobe.
     for (a, b) in again.iter().zip(&fresh) {
         assert_eq!(a.kind(), b.kind(), "{}", a.name);
+    }
+    // The figures kept beside a lobe, which a later process takes for its own, are the
+    // analysis's at those exponents.
+    let kept = cache::load(&cache, &cache::key(&asked), &asked).expect("the stored search");
+    for lobe in kept.iter().filter(|lobe| lobe.verified) {
+        let kind = lobe.kind().expect("a verified lobe is registered");
+        let measured = crate::figures::measured(kind);
+        assert!(
+            measured.len() >= 2,
+            "{}: {} exponents",
+            lobe.name,
+            measured.len()
+        );
+        for &(n, figures) in measured.iter().step_by(measured.len() / 2) {
+            let at = Lobe::new(kind, Exponent::new(f64::from_bits(n)));
+            let direct = error_figures(&at, &mut Precision::F64, SWEEP_SAMPLES);
+            assert_eq!(
+                figures,
+                direct,
+                "{} at n = {}",
+                lobe.name,
+                at.exponent().get()
+            );
+        }
     }
     let other = request(Target::GpuAmd, 16.0, 128.0, 0.005, 0.02);
     assert_ne!(cache::key(&other), cache::key(&asked));
