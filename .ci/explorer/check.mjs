@@ -3,21 +3,15 @@
 // volume, and requires that the plots and the renders change and that the console stays
 // silent. Saves a screenshot.
 // Usage: node check.mjs SPECULA_BINARY SCREENSHOT.png
-import { spawn } from "node:child_process";
 import { chromium } from "playwright-core";
+import { startServer } from "./serve.mjs";
 
 const [binary, screenshot] = process.argv.slice(2);
-const server = spawn(binary, ["serve", "--port", "0"], { stdio: ["ignore", "pipe", "inherit"] });
-const url = await new Promise((resolve, reject) => {
-  server.stdout.on("data", (chunk) => {
-    const match = /on (http:\/\/\S+)/.exec(String(chunk));
-    if (match) resolve(match[1]);
-  });
-  server.on("exit", (code) => reject(new Error(`specula serve exited with ${code}`)));
-  setTimeout(() => reject(new Error("specula serve printed no address")), 20000);
-});
+const { server, url } = await startServer(binary);
 
-const browser = await chromium.launch({ executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium", args: ["--no-sandbox", "--disable-gpu"] });
+// Without WebGL2: the page as a browser without it shows it, the server's sphere (live.mjs
+// checks the live views).
+const browser = await chromium.launch({ executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium", args: ["--no-sandbox", "--disable-gpu", "--disable-webgl2"] });
 const failures = [];
 try {
   const page = await browser.newPage({ viewport: { width: 1500, height: 1200 } });
@@ -115,7 +109,8 @@ try {
   const fill = await page.evaluate(() => {
     const canvas = document.getElementById("cartesian");
     const section = canvas.parentElement;
-    return canvas.getBoundingClientRect().width / (section.clientWidth - 20);
+    const style = getComputedStyle(section);
+    return canvas.getBoundingClientRect().width / (section.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight));
   });
   if (!(fill > 0.95 && fill <= 1.01)) failures.push(`the lobe plot fills ${(100 * fill).toFixed(0)} % of its section`);
 

@@ -143,7 +143,7 @@ pub(crate) async fn compute<T: Send + 'static>(
 
 /// [`compute`] for a request's lobe: `work` is given the lobe once [`checked`] accepts it, in
 /// the same turn.
-async fn compute_with<T: Send + 'static>(
+pub(crate) async fn compute_with<T: Send + 'static>(
     state: &AppState,
     kind: LobeKind,
     n: Exponent,
@@ -159,7 +159,8 @@ pub async fn not_found() -> ApiError {
     ApiError::not_found(
         "no such page or endpoint".into(),
         "/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume, /api/environment, \
-            /api/materials, /api/fits, /api/material-render, /api/design"
+            /api/materials, /api/fits, /api/material-render, /api/design, /api/shader, \
+            /api/live-sphere"
             .into(),
     )
 }
@@ -208,6 +209,8 @@ pub async fn models() -> impl IntoResponse {
         "max_volume_size": MAX_VOLUME_SIZE,
         "max_environment_size": MAX_ENVIRONMENT_SIZE,
         "max_environment_spp": MAX_ENVIRONMENT_SPP,
+        // The sphere the page draws itself (live.js) and /api/live-sphere draws here.
+        "live": crate::live::LIVE_SCENE,
         // The text box's language and limit (a formula is sent as `lobe==FORMULA`).
         "formula": {
             "max_bytes": MAX_SOURCE_BYTES,
@@ -277,6 +280,7 @@ pub async fn render(
         ],
     )?;
     let (kind, n) = (params.lobe()?, params.exponent()?);
+    let (light_theta, light_phi) = params.light()?;
     let request = RenderRequest {
         object: params.choice("object", &Object::ALL, Object::id, Object::Sphere)?,
         kind,
@@ -284,16 +288,9 @@ pub async fn render(
         geometry: params.geometry()?,
         normalisation: params.normalisation(Normalisation::None)?,
         shading: params.choice("shading", &Shading::ALL, Shading::id, Shading::Phong)?,
-        model: params.choice(
-            "model",
-            &IlluminationModel::ALL,
-            IlluminationModel::id,
-            IlluminationModel::Classic,
-        )?,
-        light_theta: params.number("light_theta", 0.0..=89.0, 30.0)?.to_radians(),
-        light_phi: params
-            .number("light_phi", -180.0..=180.0, 45.0)?
-            .to_radians(),
+        model: params.model()?,
+        light_theta,
+        light_phi,
         size: params.number("size", 16.0..=f64::from(MAX_RENDER_SIZE), 512.0)? as u32,
     };
     let encoded = compute_with(&state, kind, n, move |_| render_png(&request)).await?;

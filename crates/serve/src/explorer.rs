@@ -12,6 +12,8 @@ use specula::analysis::albedo::specular_albedo_per_unit;
 use specula::{zones, Brdf, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
 use specula_render::{IlluminationModel, Scene, Shading};
 
+use crate::live::{light_towards, tonemap_for, LIVE_SCENE};
+
 /// Samples along each curve.
 const CURVE_POINTS: usize = 361;
 /// Incident angles of the albedo curve.
@@ -175,12 +177,17 @@ pub struct RenderRequest {
 /// same parser and validation as a user's file.
 pub fn scene(request: &RenderRequest) -> Result<Scene, String> {
     // The camera looks along -y; the light's polar angle is measured from the camera's axis.
-    let (st, ct) = request.light_theta.sin_cos();
-    let (sp, cp) = request.light_phi.sin_cos();
-    let towards = [st * cp, -ct, st * sp];
+    let towards = light_towards(request.light_theta, request.light_phi);
+    let live = LIVE_SCENE;
+    let sphere_eye = format!(
+        "eye = [0.0, {:?}, 0.0]\ntarget = [0.0, 0.0, 0.0]",
+        -live.eye_distance
+    );
     let (shape, placement) = match request.object {
-        Object::Sphere => ("shape = \"sphere\"\nradius = 1.0\nsegments = 128\nrings = 64", "eye = \
-            [0.0, -4.2, 0.0]\ntarget = [0.0, 0.0, 0.0]"),
+        Object::Sphere => (
+            "shape = \"sphere\"\nradius = 1.0\nsegments = 128\nrings = 64",
+            sphere_eye.as_str(),
+        ),
         Object::Teapot => (
             "shape = \"teapot\"\nlevel = 10\nscale = 0.55\nrotate = [0.0, 0.0, -30.0]\ntranslate = \
                 [0.0, 0.0, -0.85]",
@@ -188,18 +195,18 @@ pub fn scene(request: &RenderRequest) -> Result<Scene, String> {
         ),
     };
     let text = format!(
-        r#"ambient = [0.04, 0.04, 0.045]
+        r#"ambient = {ambient:?}
 [camera]
 {placement}
 up = [0.0, 0.0, 1.0]
-fov = 32.0
+fov = {fov:?}
 [render]
 width = {size}
 height = {size}
 samples = 1
 shading = "{shading}"
 model = "{model}"
-background = [0.12, 0.12, 0.13]
+background = {background:?}
 tonemap = "{tonemap}"
 [[lights]]
 kind = "directional"
@@ -208,21 +215,24 @@ intensity = [1.0, 1.0, 1.0]
 [[objects]]
 {shape}
 [objects.material]
-colour = [0.7, 0.25, 0.2]
-kd = 0.5
-ks = 0.5
+colour = {colour:?}
+ka = {ka:?}
+kd = {kd:?}
+ks = {ks:?}
 lobe = "{lobe}"
 n = {n}
 geometry = "{geometry}"
 normalisation = "{normalisation}"
 "#,
         size = request.size,
-        // A normalised lobe's peak is far above 1: compress it rather than clip it.
-        tonemap = if request.normalisation == Normalisation::None {
-            "clamp"
-        } else {
-            "reinhard"
-        },
+        ambient = live.ambient,
+        fov = live.fov_y_deg,
+        background = live.background,
+        colour = live.colour,
+        ka = live.ka,
+        kd = live.kd,
+        ks = live.ks,
+        tonemap = tonemap_for(request.normalisation).id(),
         shading = request.shading.id(),
         model = request.model.id(),
         x = towards[0],

@@ -19,6 +19,7 @@ mod environment;
 mod explorer;
 mod guard;
 mod listen;
+mod live;
 mod measured;
 mod query;
 #[cfg(test)]
@@ -33,6 +34,7 @@ pub use design::{DesignModel, DesignQuery, DESIGN_TARGETS};
 pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
 pub use listen::{max_waiting, CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT};
+pub use live::{glsl_functions, sphere_radiance, LiveScene, LIVE_SCENE, MAX_LIVE_SIZE};
 pub use measured::{
     Materials, MAX_MATERIALS, MAX_MATERIAL_RENDER_SIZE, MAX_MATERIAL_RENDER_SPP, POLAR_POINTS,
 };
@@ -81,6 +83,27 @@ pub fn router_with(state: api::AppState) -> Router {
             ),
         )
         .route(
+            "/live.js",
+            asset(
+                "text/javascript; charset=utf-8",
+                include_str!("assets/live.js"),
+            ),
+        )
+        .route(
+            "/lobe3d.js",
+            asset(
+                "text/javascript; charset=utf-8",
+                include_str!("assets/lobe3d.js"),
+            ),
+        )
+        .route(
+            "/linked.js",
+            asset(
+                "text/javascript; charset=utf-8",
+                include_str!("assets/linked.js"),
+            ),
+        )
+        .route(
             "/style.css",
             asset("text/css; charset=utf-8", include_str!("assets/style.css")),
         )
@@ -94,6 +117,8 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/fits", get(api::fits))
         .route("/api/material-render", get(api::render_material))
         .route("/api/design", get(api::design_lobe))
+        .route("/api/shader", get(live::shader))
+        .route("/api/live-sphere", get(live::live_sphere))
         .fallback(api::not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
         .layer(axum::middleware::from_fn_with_state(

@@ -11,6 +11,7 @@ use axum::Json;
 use serde::Serialize;
 use specula::formula::MAX_SOURCE_BYTES;
 use specula::{Exponent, Geometry, LobeKind, Normalisation};
+use specula_render::IlluminationModel;
 
 /// A request the server cannot serve, and why.
 #[derive(Debug, Serialize)]
@@ -183,6 +184,24 @@ impl Params {
             specula::Error::InvalidLobeParameter { .. } => bad_lobe(error.to_string()),
             _ => bad_lobe(format!("unknown lobe `{}`", specula::excerpt(text))),
         })
+    }
+
+    /// The illumination model (`classic` unless named).
+    pub(crate) fn model(&self) -> Result<IlluminationModel, ApiError> {
+        self.choice(
+            "model",
+            &IlluminationModel::ALL,
+            IlluminationModel::id,
+            IlluminationModel::Classic,
+        )
+    }
+
+    /// The light's polar angle from the camera's axis (`light_theta`, 0 to 89 degrees, 30 by
+    /// default) and its azimuth (`light_phi`, -180 to 180, 45), in radians.
+    pub(crate) fn light(&self) -> Result<(f64, f64), ApiError> {
+        let theta = self.number("light_theta", 0.0..=89.0, 30.0)?;
+        let phi = self.number("light_phi", -180.0..=180.0, 45.0)?;
+        Ok((theta.to_radians(), phi.to_radians()))
     }
 
     pub(crate) fn exponent(&self) -> Result<Exponent, ApiError> {

@@ -60,6 +60,7 @@ function currentState() {
   const names = formula ? [...lobes, FORMULA] : lobes;
   if (formula) ids.push(FORMULA);
   if (!ids.includes(renderLobe)) renderLobe = ids.length ? ids[ids.length - 1] : "";
+  fillRenderChoice(ids, renderLobe);
   return {
     lobes: lobes.join(","),
     formula,
@@ -151,6 +152,14 @@ function buildControls(state) {
 }
 
 // `shown` has the lobes the renders draw: the state's, unless the formula is refused.
+// The lobes drawn, offered to the images' choice; `chosen` selected.
+function fillRenderChoice(ids, chosen) {
+  const select = $("render-choice");
+  const same = [...select.options].map((o) => o.value).join(",") === ids.join(",");
+  if (!same) select.replaceChildren(...ids.map((id) => new Option(id, id)));
+  select.value = chosen;
+}
+
 function showValues(state, shown) {
   $("render-lobe").textContent = shown.render || "no lobe";
   $("environment-lobe").textContent = shown.render || "no lobe";
@@ -172,8 +181,8 @@ function colourOf(id) { return lobeOf(id).colour; }
 function dashOf(id) { return lobeOf(id).dashed ? DASH : []; }
 
 // The API's JSON; a refusal throws an Error whose `refusal` is the API's one-line `error`.
-async function getJson(url) {
-  const response = await fetch(url);
+async function getJson(url, signal = undefined) {
+  const response = await fetch(url, { signal });
   const text = await response.text();
   let body = null;
   try { body = JSON.parse(text); } catch { /* not JSON: an HTTP-level refusal (414) */ }
@@ -368,41 +377,66 @@ function loadImage(img, url) {
   });
 }
 
+// A control's refusal beside it (empty: none), and the control marked.
+function showControlError(id, message) {
+  $(id + "-error").textContent = message;
+  $(id === "n" ? "n-box" : id).setAttribute("aria-invalid", message ? "true" : "false");
+}
+
+// Requests of the update a newer one superseded are cancelled.
+let inFlight = null;
+
 async function update() {
   const state = currentState();
   showValues(state, state);
+  const n = Number(state.n);
+  const [low, high] = registry.n;
+  if (state.n.trim() === "" || !(n >= low && n <= high)) {
+    showControlError("n", `n = '${state.n}' is outside [${low}, ${high}]: type a number from ${low} to ${high}; the views still show the last valid n`);
+    markStale(true);
+    return;
+  }
+  showControlError("n", "");
   const query = "?" + new URLSearchParams(state).toString();
   history.replaceState(null, "", query);
   const mine = ++generation;
+  inFlight?.abort();
+  inFlight = new AbortController();
+  const signal = inFlight.signal;
+  const json = (url) => getJson(url, signal);
   const boxes = state.lobes ? state.lobes.split(",") : [];
   const common = { n: state.n, geometry: state.geometry, normalisation: state.normalisation };
   const evaluate = (name) => "/api/evaluate?" + new URLSearchParams({ lobe: apiLobe(name), ...common, theta_in: state.theta_in });
+  liveLobes(state, state.render, state.formula ? [...boxes, FORMULA] : boxes);
   try {
     // The formula's own request settles apart: its refusal is shown beside the text box, and
     // the other lobes are drawn all the same.
     const tooLong = state.formula ? formulaTooLong(evaluate(FORMULA)) : "";
     const formula = !state.formula ? Promise.resolve({})
       : tooLong ? Promise.resolve({ refusal: tooLong })
-      : getJson(evaluate(FORMULA)).then((data) => ({ data }), (error) => ({ refusal: error.refusal ?? error.message }));
-    const [builtIn, typed] = await Promise.all([Promise.all(boxes.map((lobe) => getJson(evaluate(lobe)))), formula]);
+      : json(evaluate(FORMULA)).then((data) => ({ data }), (error) => ({ refusal: error.refusal ?? error.message }));
+    const [builtIn, typed] = await Promise.all([Promise.all(boxes.map((lobe) => json(evaluate(lobe)))), formula]);
     if (mine !== generation) return;
     showFormulaError(typed.refusal ?? "");
     const lobes = typed.data ? [...boxes, FORMULA] : boxes;
     // The page names the formula's lobe `formula`, whatever the server numbered it.
     const data = typed.data ? [...builtIn, { ...typed.data, lobe: FORMULA }] : builtIn;
-    const reports = await Promise.all(lobes.map((lobe) => getJson("/api/analyze?" + new URLSearchParams({ lobe: apiLobe(lobe), n: state.n })).then((r) => ({ ...r, lobe }))));
+    const reports = await Promise.all(lobes.map((lobe) => json("/api/analyze?" + new URLSearchParams({ lobe: apiLobe(lobe), n: state.n })).then((r) => ({ ...r, lobe }))));
     if (mine !== generation) return;
     // A refused formula is drawn nowhere: every panel shows the last box's lobe instead.
     const shown = {
       render: state.render === FORMULA && !typed.data ? boxes[boxes.length - 1] ?? "" : state.render,
     };
     showValues(state, shown);
+    liveLobes(state, shown.render, lobes);
     draw(data, { ...state, render: shown.render });
     warnAboutAlbedo(data, state);
     $("analysis").innerHTML = lobes.length ? analysisTable(reports) : "<p>Choose a lobe.</p>";
     if (shown.render) {
       const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: apiLobe(shown.render), ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
-      await Promise.all([loadImage($("sphere"), render("sphere")), loadImage($("teapot"), render("teapot"))]);
+      // The sphere is drawn live (linked.js); the server's is for a browser without WebGL2.
+      const sphere = live.spheres ? Promise.resolve() : loadImage($("sphere"), render("sphere"));
+      await Promise.all([sphere, loadImage($("teapot"), render("teapot"))]);
       const environment = (lobe) => "/api/environment?" + new URLSearchParams({ lobe, ...common, size: "384", spp: "16" });
       await Promise.all([loadImage($("environment-image"), environment(apiLobe(shown.render))), loadImage($("environment-pow"), environment("pow"))]);
       if (mine !== generation) return;
@@ -413,11 +447,12 @@ async function update() {
     if (mine !== generation) return;
     drawDifference($("volume-image"), $("volume-pow"), $("volume-diff"), $("volume-psnr"));
     $("status").textContent = "";
+    markStale(false);
     // What is on the page now: the count of finished updates and the state they drew.
     document.body.dataset.drawn = query;
     document.body.dataset.updates = String(Number(document.body.dataset.updates) + 1);
   } catch (error) {
-    $("status").textContent = error.message;
+    if (mine === generation) $("status").textContent = error.message;
   }
 }
 
@@ -506,11 +541,18 @@ function warnAboutAlbedo(data, state) {
 }
 
 let pending = null;
-function schedule() { clearTimeout(pending); pending = setTimeout(update, 60); }
+function schedule() {
+  clearTimeout(pending);
+  markStale(true);
+  liveRedraw();
+  // While a drag moves, only the live views follow; the server's when it ends.
+  if (!live.dragging) pending = setTimeout(update, 60);
+}
 
 async function start() {
   registry = await getJson("/api/models");
   buildControls(readState());
+  liveStart();
   // Not awaited: the measured view fills itself in while the rest of the page draws.
   measuredStart().catch((error) => measuredStatus(error.message));
   $("n").addEventListener("input", () => { $("n-box").value = String(nFromSlider(Number($("n").value))); });
@@ -520,6 +562,7 @@ async function start() {
   });
   document.querySelectorAll("#controls input, #controls select, #volume-controls select").forEach((el) => el.addEventListener("input", schedule));
   $("lobes").addEventListener("change", schedule);
+  $("render-choice").addEventListener("change", () => { renderLobe = $("render-choice").value; schedule(); });
   $("design-run").addEventListener("click", runDesign);
   // Typing in the formula makes it the lobe every panel shows; a pause sends it.
   $("formula").addEventListener("input", () => {
@@ -530,7 +573,7 @@ async function start() {
   // The plots take the width their sections have, redrawn when the window changes.
   window.addEventListener("resize", () => {
     clearTimeout(resizing);
-    resizing = setTimeout(() => { if (lastDrawn) draw(...lastDrawn); }, 100);
+    resizing = setTimeout(() => { if (lastDrawn) draw(...lastDrawn); liveRedraw(); }, 100);
   });
   await update();
 }

@@ -9,6 +9,7 @@ use super::router;
 
 mod connections;
 mod formula;
+mod live;
 mod measured;
 
 async fn get(uri: &str) -> (StatusCode, Vec<u8>) {

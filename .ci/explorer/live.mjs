@@ -1,0 +1,192 @@
+// Drives the explorer's live views (WebGL2, on SwiftShader in headless Chromium): the sphere
+// WebGL draws from each lobe's exported GLSL agrees with /api/live-sphere (the renderer's
+// shading, computed by the server) pixel by pixel; the 3D lobe's vertex program gives the
+// BRDF values /api/evaluate gives; a drag over the sphere changes the light and the image and
+// sends no request while it moves; every view of the first screen lies inside 1400 x 900; a
+// bad n is marked at its control and the views marked stale. Prints frame times (never
+// asserted). Saves a screenshot of the first screen.
+// Usage: node live.mjs SPECULA_BINARY SCREENSHOT.png
+import { chromium } from "playwright-core";
+import { startServer } from "./serve.mjs";
+
+const [binary, screenshot] = process.argv.slice(2);
+// The largest difference, in 8-bit sRGB levels, a WebGL pixel may have from the server's, and
+// the share of pixels that may differ by more than one level (rounding at a level's edge).
+// Measured on SwiftShader: see docs/explorer.md.
+const MAX_LEVELS = 1;
+const MAX_SHARE_BEYOND_ONE = 0;
+// The 3D lobe's f32 values against the API's f64, relative to the lobe's peak.
+const MAX_RELATIVE = 2e-3;
+
+const { server, url } = await startServer(binary);
+
+// SwiftShader is Chromium's software GPU: these flags give headless Chromium a WebGL2 context.
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
+  args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist"],
+});
+const failures = [];
+try {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+  const messages = [];
+  page.on("console", (message) => messages.push(`${message.type()}: ${message.text()}`));
+  page.on("pageerror", (error) => messages.push(`pageerror: ${error.message}`));
+  // The page has drawn the address it holds, and (when given) that address has `key` at `value`.
+  const drawn = (key = null, value = null) => page.waitForFunction(([k, v]) => {
+    const shown = document.body.dataset.drawn ?? "";
+    return shown === location.search && (k === null || new URLSearchParams(shown).get(k) === v);
+  }, [key, value], { timeout: 90000 });
+  await page.goto(url + "?lobes=schlick,cosquad&render=cosquad&n=32");
+  await drawn();
+  if ((await page.evaluate(() => document.body.dataset.live)) !== "webgl2") {
+    const note = await page.evaluate(() => document.getElementById("live-note").textContent);
+    throw new Error(`no WebGL2 context in Chromium: ${note}`);
+  }
+
+  // Every lobe, and a formula, against the server's sphere: same lobe, n, geometry,
+  // normalisation and light.
+  const lobes = await page.evaluate(() => registry.lobes.map((l) => l.id));
+  lobes.push("=let a = (n + 1) / 17; max(0, a * (t - 1) + 1) ^ 16");
+  const settings = [["phong", "none", 30, 45, 32], ["blinn", "lobe", 50, -60, 200], ["phong", "lobe", 15, 120, 8]];
+  let worstLevels = 0;
+  let worstShare = 0;
+  for (const [k, lobe] of lobes.entries()) {
+    const [geometry, normalisation, theta, phi, n] = settings[k % settings.length];
+    const result = await page.evaluate(async ({ lobe, geometry, normalisation, theta, phi, n }) => {
+      const [mine, pow] = await Promise.all([lobeShader(lobe, n, geometry, normalisation), lobeShader("pow", n, geometry, normalisation)]);
+      live.spheres.setLobes(mine.glsl, pow.glsl, mine.tonemap, false);
+      live.spheres.light = lightTowards(theta, phi);
+      live.spheres.draw();
+      const { size, pixels } = live.spheres.read(0);
+      const query = new URLSearchParams({ lobe, n, geometry, normalisation, model: "classic", light_theta: theta, light_phi: phi, size });
+      const image = new Image();
+      image.src = "/api/live-sphere?" + query;
+      await image.decode();
+      const canvas = Object.assign(document.createElement("canvas"), { width: size, height: size });
+      const g = canvas.getContext("2d");
+      g.drawImage(image, 0, 0);
+      const reference = g.getImageData(0, 0, size, size).data;
+      let worst = 0;
+      let beyondOne = 0;
+      for (let i = 0; i < reference.length; i += 4) {
+        const d = Math.max(...[0, 1, 2].map((c) => Math.abs(reference[i + c] - pixels[i + c])));
+        worst = Math.max(worst, d);
+        if (d > 1) beyondOne++;
+      }
+      return { size, worst, share: beyondOne / (size * size) };
+    }, { lobe, geometry, normalisation, theta, phi, n });
+    worstLevels = Math.max(worstLevels, result.worst);
+    worstShare = Math.max(worstShare, result.share);
+    console.log(`sphere ${lobe} (${geometry}, ${normalisation}, n = ${n}, light ${theta}/${phi}): ${result.size}^2 px, largest difference ${result.worst} levels, ${(100 * result.share).toFixed(3)} % beyond 1`);
+    if (result.worst > MAX_LEVELS || result.share > MAX_SHARE_BEYOND_ONE) failures.push(`the WebGL sphere of ${lobe} differs from the server's: ${result.worst} levels, ${(100 * result.share).toFixed(3)} % of pixels beyond 1`);
+  }
+  console.log(`spheres: largest difference ${worstLevels} levels, at most ${(100 * worstShare).toFixed(3)} % of pixels beyond 1 level`);
+
+  // The 3D lobe's vertex program against the API's polar values in the plane of incidence.
+  for (const [lobe, thetaIn] of [["cosquad", 30], ["schlick", 60]]) {
+    const result = await page.evaluate(async ({ lobe, thetaIn }) => {
+      const query = new URLSearchParams({ lobe, n: "32", geometry: "phong", normalisation: "lobe", theta_in: thetaIn });
+      const api = await getJson("/api/evaluate?" + query);
+      const directions = api.polar_deg.map((deg) => [Math.sin((deg * Math.PI) / 180), 0, Math.cos((deg * Math.PI) / 180)]);
+      const t = (thetaIn * Math.PI) / 180;
+      const wi = [Math.sin(t), 0, Math.cos(t)];
+      const { values, positions } = live.lobe.evaluate(lobe, directions, wi);
+      const peak = Math.max(...api.polar);
+      let worst = 0;
+      let radius = 0;
+      // The radius is f / f(mirror); the mirror direction is the API's largest value here.
+      const mirror = live.lobe.evaluate(lobe, [[-wi[0], 0, wi[2]]], wi).values[0];
+      api.polar.forEach((f, k) => {
+        worst = Math.max(worst, Math.abs(values[k] - f) / peak);
+        const r = Math.hypot(positions[3 * k], positions[3 * k + 1], positions[3 * k + 2]);
+        radius = Math.max(radius, Math.abs(r - f / mirror));
+      });
+      return { worst, radius, count: api.polar.length };
+    }, { lobe, thetaIn });
+    console.log(`3D lobe ${lobe} at ${thetaIn} degrees: ${result.count} directions, largest difference from the API ${result.worst.toExponential(2)} of the peak; radius off f / f(mirror) by at most ${result.radius.toExponential(2)}`);
+    if (!(result.worst < MAX_RELATIVE) || !(result.radius < MAX_RELATIVE)) failures.push(`the 3D lobe of ${lobe} is not the API's BRDF: ${result.worst}, radius ${result.radius}`);
+  }
+
+  // Every view of the first screen inside 1400 x 900.
+  await page.goto(url + "?lobes=pow,schlick,schlick-mod&render=schlick&n=64");
+  await drawn();
+  const outside = await page.evaluate(() => ["controls", "n-box", "cartesian", "error", "polar", "lobe3d", "live-spheres", "live-ticks", "render-choice"].map((id) => {
+    const box = document.getElementById(id).getBoundingClientRect();
+    return { id, box: [box.left, box.top, box.right, box.bottom].map(Math.round) };
+  }).filter(({ box: [, top, right, bottom] }) => top < 0 || right > 1400 || bottom > 900 || bottom <= top));
+  for (const { id, box } of outside) failures.push(`${id} is not inside the first 1400 x 900 screen: ${box}`);
+  await page.screenshot({ path: screenshot });
+
+  // A drag over the sphere: the light and the image change, and nothing is requested until
+  // the button is released.
+  const requests = [];
+  page.on("request", (request) => requests.push(request.url()));
+  const box = await page.locator("#live-spheres").boundingBox();
+  const before = await page.evaluate(() => ({ light: [$("light_theta").value, $("light_phi").value], pixels: Array.from(live.spheres.read(0).pixels.filter((_, i) => i % 97 === 0)) }));
+  const pane = box.height;
+  await page.mouse.move(box.x + pane * 0.5, box.y + pane * 0.5);
+  await page.mouse.down();
+  const frames = [];
+  for (let k = 1; k <= 17; k++) {
+    await page.mouse.move(box.x + pane * (0.5 - 0.02 * k), box.y + pane * (0.5 - 0.015 * k));
+    frames.push(await page.evaluate(() => new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(() => resolve($("light_theta").value))))));
+  }
+  const during = await page.evaluate(() => ({ light: [$("light_theta").value, $("light_phi").value], pixels: Array.from(live.spheres.read(0).pixels.filter((_, i) => i % 97 === 0)) }));
+  const sentWhileMoving = requests.length;
+  await page.mouse.up();
+  await drawn("light_theta", during.light[0]);
+  if (sentWhileMoving) failures.push(`dragging the light sent ${sentWhileMoving} requests: ${requests.slice(0, 3).join(", ")}`);
+  if (during.light.join() === before.light.join()) failures.push(`dragging did not move the light: ${during.light}`);
+  if (during.pixels.join() === before.pixels.join()) failures.push("dragging did not change the sphere's image");
+  if (new Set(frames).size < 5) failures.push(`the light took only ${new Set(frames).size} values over a 17-step drag: ${frames}`);
+  console.log(`drag: light ${before.light} -> ${during.light} in ${new Set(frames).size} steps, ${sentWhileMoving} requests while moving`);
+  if (!requests.some((r) => r.includes("/api/render?object=teapot"))) failures.push("the server's views were not updated when the drag ended");
+
+  // A bad n: marked at the control, the views stale, then mended.
+  await page.fill("#n-box", "0");
+  await page.waitForFunction(() => document.getElementById("n-error").textContent !== "");
+  const bad = await page.evaluate(() => ({ message: $("n-error").textContent, invalid: $("n-box").getAttribute("aria-invalid"), stale: document.querySelectorAll("[data-server].stale").length, box: $("n-error").getBoundingClientRect().bottom }));
+  if (bad.invalid !== "true" || bad.stale === 0 || bad.box > 900) failures.push(`a bad n is not marked where it is: ${JSON.stringify(bad)}`);
+  console.log(`bad n: "${bad.message}", ${bad.stale} views marked stale`);
+  await page.fill("#n-box", "100");
+  await drawn("n", "100");
+  const mended = await page.evaluate(() => ({ message: $("n-error").textContent, stale: document.querySelectorAll("[data-server].stale").length }));
+  if (mended.message || mended.stale) failures.push(`a mended n leaves marks: ${JSON.stringify(mended)}`);
+
+  // Frame times, printed and never asserted: 120 light positions drawn at display rate, and
+  // each draw timed to its completion (gl.finish).
+  const timing = await page.evaluate(() => new Promise((resolve) => {
+    const [start, draws] = [performance.now(), []];
+    let count = 0;
+    const step = () => {
+      $("light_theta").value = String(10 + (count % 60));
+      const t0 = performance.now();
+      live.spheres.light = lightTowards(Number($("light_theta").value), 45);
+      live.spheres.draw();
+      live.lobe.draw([Math.sin(count / 60), 0, Math.cos(count / 60)]);
+      live.spheres.gl.finish();
+      live.lobe.gl.finish();
+      draws.push(performance.now() - t0);
+      if (++count < 120) requestAnimationFrame(step);
+      else resolve({ seconds: (performance.now() - start) / 1000, draw: draws.reduce((a, b) => a + b, 0) / draws.length, size: live.spheres.canvas.height });
+    };
+    requestAnimationFrame(step);
+  }));
+  const fps = 120 / timing.seconds;
+  console.log(`frames: ${fps.toFixed(1)} per second over 120 frames (spheres ${timing.size} px a pane, 3 panes and the 3D lobe); a draw takes ${timing.draw.toFixed(1)} ms, ${(100 * timing.draw * fps / 1000).toFixed(0)} % of a frame`);
+
+  // Chromium notes each synchronous read of a WebGL canvas (this check's readPixels) as a
+  // driver warning; anything else on the console fails.
+  const noisy = messages.filter((m) => !m.includes("GPU stall due to ReadPixels"));
+  if (noisy.length) failures.push("console: " + noisy.join(" | "));
+} catch (error) {
+  failures.push(error.message);
+} finally {
+  await browser.close();
+  server.kill();
+}
+if (failures.length) {
+  console.error("explorer live check failed:\n  " + failures.join("\n  "));
+  process.exit(1);
+}
+console.log("explorer live check: ok");

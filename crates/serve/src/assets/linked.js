@@ -1,0 +1,141 @@
+// specula explorer, the linked live views and the pointer: the lit spheres (live.js) and the
+// 3D lobe (lobe3d.js) follow the controls at once, drawn by WebGL2 from the exported GLSL;
+// dragging the light over the spheres, the incidence over the polar plot or the 3D lobe, and
+// the wheel over a plot change the controls, and the server's views follow when a drag ends
+// (app.js's schedule). Without WebGL2 the server's sphere image is shown instead.
+"use strict";
+
+const live = { spheres: null, lobe: null, frame: 0, key: "", lobes: [], drawnLobes: null, dragging: false };
+// The polar plot's outgoing angles while a drag redraws it from the GPU (-90 to 90 degrees).
+const LIVE_POLAR_DEG = Array.from({ length: 181 }, (_, k) => k - 90);
+
+function liveStart() {
+  try {
+    live.spheres = new LiveSpheres($("live-spheres"), $("live-ticks"), registry.live);
+    live.lobe = new LiveLobe($("lobe3d"));
+  } catch (error) {
+    // No WebGL2 (or a driver that cannot compile the shaders): the server's image, as before.
+    live.spheres = live.lobe = null;
+    $("live-views").hidden = true;
+    $("lobe3d-view").hidden = true;
+    $("sphere").hidden = false;
+    $("live-note").textContent = `Drawn by the server: this browser has no WebGL2 (${error.message}).`;
+    return;
+  }
+  document.body.dataset.live = "webgl2";
+  $("sphere").hidden = true;
+  pointerDrag($("live-spheres"), (event) => {
+    const at = live.spheres.lightAt(event.clientX, event.clientY);
+    if (!at) return;
+    $("light_theta").value = String(Math.round(at.theta));
+    $("light_phi").value = String(Math.round(at.phi / 5) * 5);
+    liveRedraw();
+  });
+  pointerDrag($("polar"), (event) => {
+    const box = $("polar").getBoundingClientRect();
+    const [x, y] = [event.clientX - box.left, event.clientY - box.top];
+    // The plot's centre sits at the bottom middle (app.js's drawPolar).
+    const angle = (Math.atan2(x - box.width / 2, box.height - 20 - y) * 180) / Math.PI;
+    setIncidence(Math.abs(angle));
+  });
+  let last = null;
+  pointerDrag($("lobe3d"), (event) => {
+    if (last && event.shiftKey) setIncidence(Number($("theta_in").value) + 0.3 * (event.clientX - last.x));
+    else if (last) {
+      live.lobe.yaw += 0.01 * (event.clientX - last.x);
+      live.lobe.pitch = Math.max(-0.2, Math.min(1.5, live.lobe.pitch + 0.01 * (event.clientY - last.y)));
+    }
+    last = { x: event.clientX, y: event.clientY };
+    liveRedraw();
+  }, () => { last = null; });
+  for (const id of ["cartesian", "error", "polar", "lobe3d", "live-spheres"]) $(id).addEventListener("wheel", wheelExponent, { passive: false });
+}
+
+function setIncidence(degrees) {
+  $("theta_in").value = String(Math.round(Math.max(0, Math.min(89, degrees))));
+  liveRedraw();
+}
+
+// The wheel steps n along its logarithmic slider (five steps a notch), as if the slider moved.
+function wheelExponent(event) {
+  event.preventDefault();
+  const slider = $("n");
+  slider.value = String(Number(slider.value) + (event.deltaY < 0 ? 5 : -5));
+  slider.dispatchEvent(new Event("input", { bubbles: true }));
+}
+
+// `move` on every pointer move while a button is held over `element` (captured, so the drag
+// may leave it); when the drag ends, `end` and the server's views are brought up to date.
+function pointerDrag(element, move, end = () => {}) {
+  element.addEventListener("pointerdown", (event) => {
+    element.setPointerCapture(event.pointerId);
+    live.dragging = true;
+    move(event);
+  });
+  element.addEventListener("pointermove", (event) => { if (live.dragging && element.hasPointerCapture(event.pointerId)) move(event); });
+  const finish = (event) => {
+    if (!element.hasPointerCapture(event.pointerId)) return;
+    element.releasePointerCapture(event.pointerId);
+    live.dragging = false;
+    end();
+    markStale(true);
+    schedule();
+  };
+  element.addEventListener("pointerup", finish);
+  element.addEventListener("pointercancel", finish);
+}
+
+// Compiles the shown lobe and pow (the spheres), and every drawn lobe (the 3D lobe and the
+// polar plot while dragging), once their GLSL has arrived; a newer call wins.
+async function liveLobes(state, shown, lobes) {
+  if (!live.spheres) return;
+  const common = [state.n, state.geometry, state.normalisation];
+  const key = JSON.stringify([shown, lobes, common, state.model, state.formula]);
+  if (key === live.key) return liveRedraw();
+  live.key = key;
+  const names = [...new Set([shown || "pow", ...lobes, "pow"])];
+  const texts = await Promise.all(names.map((name) => lobeShader(apiLobe(name), ...common).catch(() => null)));
+  if (live.key !== key) return;
+  const byName = new Map(names.map((name, k) => [name, texts[k]]).filter(([, text]) => text));
+  const chosen = byName.get(shown || "pow") ?? byName.get("pow");
+  if (!chosen) return;
+  live.spheres.setLobes(chosen.glsl, byName.get("pow").glsl, chosen.tonemap, state.model === "physical");
+  const first = byName.has(shown) ? shown : "pow";
+  live.lobes = [first, ...[...byName.keys()].filter((name) => name !== first)];
+  live.lobe.setLobes(live.lobes.map((name) => ({ name, glsl: byName.get(name).glsl, colour: colourOf(name) })));
+  live.drawnLobes = lobes.filter((name) => byName.has(name));
+  $("lobe3d-name").textContent = first;
+  liveRedraw();
+}
+
+// One redraw at the next display frame, however many changes came before it.
+function liveRedraw() {
+  for (const id of ["theta_in", "light_theta", "light_phi"]) $(id + "-value").textContent = $(id).value + "°";
+  if (!live.spheres || live.frame) return;
+  live.frame = requestAnimationFrame(() => {
+    live.frame = 0;
+    const thetaIn = Number($("theta_in").value);
+    const wi = [Math.sin((thetaIn * Math.PI) / 180), 0, Math.cos((thetaIn * Math.PI) / 180)];
+    live.spheres.light = lightTowards(Number($("light_theta").value), Number($("light_phi").value));
+    live.spheres.draw();
+    live.lobe.draw(wi);
+    if (live.dragging && live.drawnLobes) drawPolar($("polar"), livePolar(wi), thetaIn);
+  });
+}
+
+// The polar plot's curves evaluated on the GPU for the light at `wi` (the plane of incidence).
+function livePolar(wi) {
+  const directions = LIVE_POLAR_DEG.map((deg) => [Math.sin((deg * Math.PI) / 180), 0, Math.cos((deg * Math.PI) / 180)]);
+  return live.drawnLobes.map((name) => ({ lobe: name, polar_deg: LIVE_POLAR_DEG, polar: [...live.lobe.evaluate(name, directions, wi).values] }));
+}
+
+// The server's views no longer match the controls (true) or are drawn again (false).
+function markStale(stale) {
+  document.querySelectorAll("[data-server]").forEach((view) => view.classList.toggle("stale", stale));
+}
+
+// Frame times for the benchmark (.ci/explorer/frames.mjs): the draws' mean in milliseconds.
+function liveFrameTimes() {
+  const mean = (list) => list.reduce((a, b) => a + b, 0) / Math.max(1, list.length);
+  return live.spheres ? { spheres: mean(live.spheres.frames), lobe: mean(live.lobe.frames) } : null;
+}

@@ -1,0 +1,232 @@
+//! The views the browser draws itself (`assets/live.js`, WebGL2): each lobe's GLSL ES 3.00
+//! function from the shader export (`specula shader --lang glsl --glsl-version 300es`), and
+//! the one lit sphere both sides draw, described here once.
+//!
+//! - `GET /api/shader?lobe&n&geometry&normalisation`: `{glsl, tonemap}`, the lobe's exported
+//!   functions (`specula_specular(normal, wo, wi)` and what it calls; `n` is baked in as the
+//!   export's prepared constants) and the tone map the renders use with that normalisation;
+//! - `GET /api/live-sphere?lobe&n&geometry&normalisation&model&light_theta&light_phi&size`:
+//!   the sphere the page draws live, computed here per pixel with the renderer's shading
+//!   ([`Shader::shade`]) and display encoding, as a PNG: what the browser check compares the
+//!   WebGL image against, pixel by pixel.
+//!
+//! The sphere is analytic (a ray per pixel centre hits the unit sphere), not the renderer's
+//! tessellated one, so that both sides draw exactly the same surface.
+
+use axum::extract::State;
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+use glam::Vec3;
+use serde::Serialize;
+use serde_json::json;
+use specula::{Geometry, Lobe, Normalisation};
+use specula_gpu::export::{export, GlslVersion, Language, Options, ShaderCode};
+use specula_render::{Display, IlluminationModel, Image, Light, Material, Shader, ToneMap};
+
+use crate::api::{compute_with, png, AppState};
+use crate::query::{pairs, ApiError, Params, QueryPairs};
+
+/// The largest live-sphere reference, in pixels a side.
+pub const MAX_LIVE_SIZE: u32 = 512;
+
+/// The lit sphere of the explorer: the camera, the material and the lighting the CPU renders
+/// (`explorer::scene`) and the live views (`live.js`, from `/api/models`' `live`) share.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct LiveScene {
+    /// The camera sits at `(0, -eye_distance, 0)`, looks at the origin with `z` up.
+    pub eye_distance: f32,
+    /// The vertical field of view, degrees.
+    pub fov_y_deg: f32,
+    /// The diffuse and ambient colour, linear RGB (the specular colour is white).
+    pub colour: [f32; 3],
+    /// The ambient coefficient.
+    pub ka: f32,
+    /// The diffuse coefficient.
+    pub kd: f32,
+    /// The specular coefficient (times `N(n)` and the lobe).
+    pub ks: f32,
+    /// The ambient light, linear RGB.
+    pub ambient: [f32; 3],
+    /// The radiance where the ray misses the sphere.
+    pub background: [f32; 3],
+}
+
+/// The one sphere setup.
+pub const LIVE_SCENE: LiveScene = LiveScene {
+    eye_distance: 4.2,
+    fov_y_deg: 32.0,
+    colour: [0.7, 0.25, 0.2],
+    ka: 0.1,
+    kd: 0.5,
+    ks: 0.5,
+    ambient: [0.04, 0.04, 0.045],
+    background: [0.12, 0.12, 0.13],
+};
+
+/// The tone map of a render with `normalisation`: a normalised lobe's peak is far above 1, so
+/// it is compressed rather than clipped.
+#[must_use]
+pub fn tonemap_for(normalisation: Normalisation) -> ToneMap {
+    if normalisation == Normalisation::None {
+        ToneMap::Clamp
+    } else {
+        ToneMap::Reinhard
+    }
+}
+
+/// The direction towards a light at polar angle `theta` from the camera's axis (`-y`, the
+/// camera looks along `+y`) and azimuth `phi`, radians.
+#[must_use]
+pub fn light_towards(theta: f64, phi: f64) -> [f64; 3] {
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = phi.sin_cos();
+    [st * cp, -ct, st * sp]
+}
+
+/// The lobe's GLSL ES 3.00 functions, without the `#version` line (the page's shaders put
+/// their own first) and without the example entry point.
+pub fn glsl_functions(
+    lobe: &Lobe,
+    geometry: Geometry,
+    normalisation: Normalisation,
+) -> Result<String, String> {
+    let options = Options {
+        example: false,
+        glsl: GlslVersion::Es300,
+    };
+    match export(lobe, geometry, normalisation, Language::Glsl, options) {
+        Ok(ShaderCode::Text(text)) => Ok(text
+            .split_once('\n')
+            .map_or(text.as_str(), |(_, body)| body)
+            .to_owned()),
+        Ok(ShaderCode::SpirV(_)) => Err("the GLSL export wrote SPIR-V".to_owned()),
+        Err(error) => Err(error.to_string()),
+    }
+}
+
+/// What one live-sphere reference is drawn with.
+#[derive(Clone, Copy, Debug)]
+pub struct SphereRequest {
+    pub geometry: Geometry,
+    pub normalisation: Normalisation,
+    pub model: IlluminationModel,
+    /// Towards the light, unit.
+    pub light: Vec3,
+    pub size: u32,
+}
+
+/// The sphere's linear radiance per pixel, row-major from the top left: a ray through each
+/// pixel centre, the first hit on the unit sphere shaded by the renderer's [`Shader`].
+#[must_use]
+pub fn sphere_radiance(lobe: Lobe, request: &SphereRequest) -> Vec<Vec3> {
+    let scene = LIVE_SCENE;
+    let material = Material {
+        ka: scene.ka,
+        kd: scene.kd,
+        ks: scene.ks,
+        colour: Vec3::from(scene.colour),
+        specular_colour: Vec3::ONE,
+        lobe,
+        geometry: request.geometry,
+        normalisation: request.normalisation,
+    };
+    let shader = Shader::new(&material, request.model);
+    let lights = [Light::Directional {
+        towards: request.light,
+        intensity: Vec3::ONE,
+    }];
+    let eye = Vec3::new(0.0, -scene.eye_distance, 0.0);
+    let half = (scene.fov_y_deg.to_radians() / 2.0).tan();
+    let size = request.size as f32;
+    let mut pixels = Vec::with_capacity((request.size * request.size) as usize);
+    for row in 0..request.size {
+        for column in 0..request.size {
+            let x = (2.0 * (column as f32 + 0.5) / size - 1.0) * half;
+            let z = (1.0 - 2.0 * (row as f32 + 0.5) / size) * half;
+            let direction = Vec3::new(x, 1.0, z).normalize();
+            pixels.push(match unit_sphere_hit(eye, direction) {
+                Some(point) => {
+                    shader.shade(point, point, -direction, &lights, Vec3::from(scene.ambient))
+                }
+                None => Vec3::from(scene.background),
+            });
+        }
+    }
+    pixels
+}
+
+/// Where the ray from `origin` along unit `direction` first meets the unit sphere.
+fn unit_sphere_hit(origin: Vec3, direction: Vec3) -> Option<Vec3> {
+    let b = origin.dot(direction);
+    let discriminant = b * b - (origin.length_squared() - 1.0);
+    (discriminant >= 0.0).then(|| origin + (-b - discriminant.sqrt()) * direction)
+}
+
+/// The reference sphere as an 8-bit sRGB PNG, tone mapped as the renders are.
+pub fn sphere_png(lobe: Lobe, request: &SphereRequest) -> Result<Vec<u8>, String> {
+    let pixels = sphere_radiance(lobe, request);
+    let image = Image::from_pixels(request.size, request.size, pixels)
+        .ok_or_else(|| "the sphere's pixels do not fill the image".to_owned())?;
+    let display = Display {
+        exposure: 1.0,
+        tonemap: tonemap_for(request.normalisation),
+    };
+    specula_render::encode_png_srgb8(request.size, request.size, &image.to_srgb8(display))
+        .map_err(|e| e.to_string())
+}
+
+/// `GET /api/shader`: the lobe's GLSL ES 3.00 functions and the tone map.
+pub async fn shader(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<Response, Response> {
+    let params = Params::new(pairs(query)?, &["lobe", "n", "geometry", "normalisation"])?;
+    let (kind, n) = (params.lobe()?, params.exponent()?);
+    let (geometry, normalisation) = (
+        params.geometry()?,
+        params.normalisation(Normalisation::None)?,
+    );
+    let glsl = compute_with(&state, kind, n, move |lobe| {
+        glsl_functions(&lobe, geometry, normalisation)
+    })
+    .await?
+    .map_err(ApiError::internal)?;
+    Ok(Json(json!({
+        "lobe": kind.to_string(),
+        "n": n.get(),
+        "glsl": glsl,
+        "tonemap": tonemap_for(normalisation).id(),
+    }))
+    .into_response())
+}
+
+/// What `/api/live-sphere` reads.
+const SPHERE_PARAMETERS: [&str; 8] = [
+    "lobe",
+    "n",
+    "geometry",
+    "normalisation",
+    "model",
+    "light_theta",
+    "light_phi",
+    "size",
+];
+
+/// `GET /api/live-sphere`: the sphere the page draws live, drawn here.
+pub async fn live_sphere(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<Response, Response> {
+    let params = Params::new(pairs(query)?, &SPHERE_PARAMETERS)?;
+    let (kind, n) = (params.lobe()?, params.exponent()?);
+    let (theta, phi) = params.light()?;
+    let request = SphereRequest {
+        geometry: params.geometry()?,
+        normalisation: params.normalisation(Normalisation::None)?,
+        model: params.model()?,
+        light: Vec3::from(light_towards(theta, phi).map(|c| c as f32)),
+        size: params.number("size", 16.0..=f64::from(MAX_LIVE_SIZE), 256.0)? as u32,
+    };
+    let encoded = compute_with(&state, kind, n, move |lobe| sphere_png(lobe, &request)).await?;
+    Ok(png(encoded.map_err(ApiError::internal)?))
+}
