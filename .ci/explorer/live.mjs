@@ -142,6 +142,32 @@ try {
   console.log(`drag: light ${before.light} -> ${during.light} in ${new Set(frames).size} steps, ${sentWhileMoving} requests while moving`);
   if (!requests.some((r) => r.includes("/api/render?object=teapot"))) failures.push("the server's views were not updated when the drag ended");
 
+  // A drag over the polar plot moves the incidence; the polar plot (from the GPU while it
+  // moves) and the 3D lobe follow, with no request until the button is released.
+  requests.length = 0;
+  const polar = await page.locator("#polar").boundingBox();
+  const polarBefore = await page.evaluate(() => ({ theta: $("theta_in").value, plot: $("polar").toDataURL() }));
+  await page.mouse.move(polar.x + polar.width / 2 + 40, polar.y + polar.height - 120);
+  await page.mouse.down();
+  for (let k = 1; k <= 8; k++) await page.mouse.move(polar.x + polar.width / 2 + 40 + 15 * k, polar.y + polar.height - 120 + 8 * k);
+  await page.evaluate(() => new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve))));
+  const polarDuring = await page.evaluate(() => ({ theta: $("theta_in").value, plot: $("polar").toDataURL() }));
+  const polarRequests = requests.length;
+  await page.mouse.up();
+  if (polarRequests) failures.push(`dragging the incidence sent ${polarRequests} requests`);
+  if (polarDuring.theta === polarBefore.theta || polarDuring.plot === polarBefore.plot) failures.push(`dragging over the polar plot did not move the incidence and its plot: ${polarBefore.theta} -> ${polarDuring.theta}`);
+  console.log(`polar drag: incidence ${polarBefore.theta} -> ${polarDuring.theta} degrees, ${polarRequests} requests while moving`);
+  await drawn("theta_in", polarDuring.theta);
+
+  // The wheel over the lobe plot steps n along its slider.
+  const nBefore = await page.evaluate(() => $("n-box").value);
+  const cartesian = await page.locator("#cartesian").boundingBox();
+  await page.mouse.move(cartesian.x + cartesian.width / 2, cartesian.y + cartesian.height / 2);
+  await page.mouse.wheel(0, -100);
+  const nAfter = await page.evaluate(() => $("n-box").value);
+  if (!(Number(nAfter) > Number(nBefore))) failures.push(`the wheel over the lobe plot did not raise n: ${nBefore} -> ${nAfter}`);
+  await drawn("n", nAfter);
+
   // A bad n: marked at the control, the views stale, then mended.
   await page.fill("#n-box", "0");
   await page.waitForFunction(() => document.getElementById("n-error").textContent !== "");
@@ -152,6 +178,20 @@ try {
   await drawn("n", "100");
   const mended = await page.evaluate(() => ({ message: $("n-error").textContent, stale: document.querySelectorAll("[data-server].stale").length }));
   if (mended.message || mended.stale) failures.push(`a mended n leaves marks: ${JSON.stringify(mended)}`);
+
+  // A wide screen keeps the first screen's views in it, and a narrow window scrolls down,
+  // never across.
+  for (const [width, height, first] of [[1920, 1080, true], [700, 900, false]]) {
+    await page.setViewportSize({ width, height });
+    await page.evaluate(() => new Promise((resolve) => setTimeout(resolve, 300)));
+    const fit = await page.evaluate(([width, height, first]) => {
+      const ids = ["cartesian", "error", "polar", "lobe3d", "live-spheres", "live-ticks"];
+      const out = first ? ids.filter((id) => document.getElementById(id).getBoundingClientRect().bottom > height) : [];
+      return { out, across: document.documentElement.scrollWidth - width };
+    }, [width, height, first]);
+    if (fit.out.length || fit.across > 0) failures.push(`at ${width} x ${height}: ${fit.out.join(", ")} below the first screen, ${fit.across} px of sideways scrolling`);
+  }
+  await page.setViewportSize({ width: 1400, height: 900 });
 
   // Frame times, printed and never asserted: 120 light positions drawn at display rate, and
   // each draw timed to its completion (gl.finish).
