@@ -7,7 +7,7 @@
 // asserted). Saves a screenshot of the first screen.
 // Usage: node live.mjs SPECULA_BINARY SCREENSHOT.png
 import { chromium } from "playwright-core";
-import { startServer } from "./serve.mjs";
+import { counts, startServer } from "./serve.mjs";
 
 const [binary, screenshot] = process.argv.slice(2);
 // The largest difference, in 8-bit sRGB levels, a WebGL pixel may have from the server's, and
@@ -183,13 +183,17 @@ try {
   // never across.
   for (const [width, height, first] of [[1920, 1080, true], [700, 900, false]]) {
     await page.setViewportSize({ width, height });
-    await page.evaluate(() => new Promise((resolve) => setTimeout(resolve, 300)));
+    // The page redraws 100 ms after the window's last change; the spheres then fit their box.
+    await page.waitForFunction(() => live.spheres.canvas.width === 3 * live.spheres.paneSize() + BAR_WIDTH + 8);
     const fit = await page.evaluate(([width, height, first]) => {
       const ids = ["cartesian", "error", "polar", "lobe3d", "live-spheres", "live-ticks"];
       const out = first ? ids.filter((id) => document.getElementById(id).getBoundingClientRect().bottom > height) : [];
-      return { out, across: document.documentElement.scrollWidth - width };
+      // What sticks out, outside any box that scrolls its own content.
+      const scrolls = (e) => e.closest("#analysis, #measured-fits");
+      const wide = [...document.querySelectorAll("body *")].filter((e) => e.getBoundingClientRect().right > width + 1 && !scrolls(e)).slice(0, 4).map((e) => e.id || e.tagName);
+      return { out, across: document.documentElement.scrollWidth - width, wide };
     }, [width, height, first]);
-    if (fit.out.length || fit.across > 0) failures.push(`at ${width} x ${height}: ${fit.out.join(", ")} below the first screen, ${fit.across} px of sideways scrolling`);
+    if (fit.out.length || fit.across > 0) failures.push(`at ${width} x ${height}: ${fit.out.join(", ")} below the first screen, ${fit.across} px of sideways scrolling (${fit.wide.join(", ")})`);
   }
   await page.setViewportSize({ width: 1400, height: 900 });
 
@@ -215,9 +219,7 @@ try {
   const fps = 120 / timing.seconds;
   console.log(`frames: ${fps.toFixed(1)} per second over 120 frames (spheres ${timing.size} px a pane, 3 panes and the 3D lobe); a draw takes ${timing.draw.toFixed(1)} ms, ${(100 * timing.draw * fps / 1000).toFixed(0)} % of a frame`);
 
-  // Chromium notes each synchronous read of a WebGL canvas (this check's readPixels) as a
-  // driver warning; anything else on the console fails.
-  const noisy = messages.filter((m) => !m.includes("GPU stall due to ReadPixels"));
+  const noisy = messages.filter(counts);
   if (noisy.length) failures.push("console: " + noisy.join(" | "));
 } catch (error) {
   failures.push(error.message);

@@ -7,6 +7,7 @@
 // named like no bundled material)
 import { spawn } from "node:child_process";
 import { chromium } from "playwright-core";
+import { counts } from "./serve.mjs";
 
 const [binary, data, screenshot] = process.argv.slice(2);
 const start = (args) => new Promise((resolve, reject) => {
@@ -82,7 +83,7 @@ try {
   if (await bundled.evaluate(() => document.getElementById("measured-controls").hidden)) failures.push("controls hidden without --data");
   await page.locator("#measured-scale").check();
   await page.locator("#measured-view").screenshot({ path: screenshot });
-  if (messages.length) failures.push(...messages.map((m) => `console: ${m}`));
+  failures.push(...messages.filter(counts).map((m) => `console: ${m}`));
 } finally {
   await browser.close();
   server.kill("SIGINT");

@@ -13,3 +13,10 @@ export async function startServer(binary, args = []) {
   });
   return { server, url };
 }
+
+// Whether a console message counts: Chromium notes each synchronous read of a WebGL canvas
+// (a check's readPixels, a 2D canvas drawing a WebGL one, a screenshot) as a driver
+// "performance" warning, which says nothing about the page.
+export function counts(message) {
+  return !message.includes("GPU stall due to ReadPixels");
+}

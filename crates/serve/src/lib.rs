@@ -49,6 +49,19 @@ use axum::Router;
 /// The largest request body accepted.
 const MAX_BODY_BYTES: usize = 16 * 1024;
 
+/// The page's scripts, in the order it loads them: the 2D plots, the differences, the measured
+/// materials, the WebGL2 views (spheres, 3D lobe, slice), the pointer and the page itself.
+const SCRIPTS: [(&str, &str); 8] = [
+    ("/plots.js", include_str!("assets/plots.js")),
+    ("/difference.js", include_str!("assets/difference.js")),
+    ("/measured.js", include_str!("assets/measured.js")),
+    ("/live.js", include_str!("assets/live.js")),
+    ("/lobe3d.js", include_str!("assets/lobe3d.js")),
+    ("/slice.js", include_str!("assets/slice.js")),
+    ("/linked.js", include_str!("assets/linked.js")),
+    ("/app.js", include_str!("assets/app.js")),
+];
+
 /// The explorer's routes with the default cost model (the CPU's counted instructions).
 pub fn router() -> Router {
     router_with(api::AppState::default())
@@ -60,7 +73,7 @@ pub fn router_with(state: api::AppState) -> Router {
     let asset = |content_type: &'static str, body: &'static str| {
         get(move || async move { ([(header::CONTENT_TYPE, content_type)], body).into_response() })
     };
-    Router::new()
+    let page = Router::new()
         .route(
             "/",
             asset(
@@ -69,44 +82,14 @@ pub fn router_with(state: api::AppState) -> Router {
             ),
         )
         .route(
-            "/app.js",
-            asset(
-                "text/javascript; charset=utf-8",
-                include_str!("assets/app.js"),
-            ),
-        )
-        .route(
-            "/measured.js",
-            asset(
-                "text/javascript; charset=utf-8",
-                include_str!("assets/measured.js"),
-            ),
-        )
-        .route(
-            "/live.js",
-            asset(
-                "text/javascript; charset=utf-8",
-                include_str!("assets/live.js"),
-            ),
-        )
-        .route(
-            "/lobe3d.js",
-            asset(
-                "text/javascript; charset=utf-8",
-                include_str!("assets/lobe3d.js"),
-            ),
-        )
-        .route(
-            "/linked.js",
-            asset(
-                "text/javascript; charset=utf-8",
-                include_str!("assets/linked.js"),
-            ),
-        )
-        .route(
             "/style.css",
             asset("text/css; charset=utf-8", include_str!("assets/style.css")),
-        )
+        );
+    SCRIPTS
+        .iter()
+        .fold(page, |page, &(path, script)| {
+            page.route(path, asset("text/javascript; charset=utf-8", script))
+        })
         .route("/api/models", get(api::models))
         .route("/api/evaluate", get(api::evaluate))
         .route("/api/analyze", get(api::analyze_lobe))

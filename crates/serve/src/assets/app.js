@@ -208,155 +208,6 @@ function showFormulaError(message) {
   $("formula").setAttribute("aria-invalid", message ? "true" : "false");
 }
 
-// A line plot: axes with ticks, optional shaded bands, one polyline per series.
-// Ticks at multiples of 1, 2 or 5 times a power of ten, the step giving the count nearest
-// `count` across [lo, hi], each labelled with the digits its step needs (0.05, not
-// 0.0516).
-function niceTicks(lo, hi, count = 5) {
-  const power = Math.pow(10, Math.floor(Math.log10((hi - lo) / count)));
-  const misses = (step) => Math.abs((hi - lo) / step - count);
-  const step = [1, 2, 5, 10].map((f) => f * power).reduce((best, s) => (misses(s) < misses(best) ? s : best));
-  const digits = Math.max(0, -Math.floor(Math.log10(step) + 1e-9));
-  const ticks = [];
-  for (let k = Math.ceil(lo / step - 1e-9); k * step <= hi + 1e-9 * step; k++) {
-    const v = k * step;
-    ticks.push([v, (Math.abs(v) < step / 2 ? 0 : v).toFixed(digits)]);
-  }
-  return ticks;
-}
-
-// The whole powers of ten in [10^lo, 10^hi], as exponents.
-function decades(lo, hi) {
-  const exponents = [];
-  for (let k = Math.ceil(lo - 1e-9); k <= hi + 1e-9; k++) exponents.push(k);
-  return exponents;
-}
-
-function plot(canvas, { series, x, y, logY = false, bands = [], xLabel = "", yLabel = "" }) {
-  const g = canvas.getContext("2d");
-  const [w, h] = [canvas.width, canvas.height];
-  const m = { l: 66, r: 12, t: 10, b: 36 };
-  g.clearRect(0, 0, w, h);
-  const ty = (v) => (logY ? Math.log10(Math.max(v, y[0])) : v);
-  const [y0, y1] = logY ? [Math.log10(y[0]), Math.log10(y[1])] : y;
-  const px = (v) => m.l + ((v - x[0]) / (x[1] - x[0])) * (w - m.l - m.r);
-  const py = (v) => h - m.b - ((ty(v) - y0) / (y1 - y0)) * (h - m.t - m.b);
-  for (const [from, to, colour] of bands) {
-    g.fillStyle = colour;
-    g.fillRect(px(from), m.t, px(Math.min(to, x[1])) - px(from), h - m.t - m.b);
-  }
-  g.strokeStyle = "#999"; g.fillStyle = "#444"; g.font = "11px sans-serif"; g.lineWidth = 1;
-  g.strokeRect(m.l, m.t, w - m.l - m.r, h - m.t - m.b);
-  g.textAlign = "center";
-  for (const [v, label] of niceTicks(x[0], x[1])) {
-    g.beginPath(); g.moveTo(px(v), h - m.b); g.lineTo(px(v), h - m.b + 4); g.stroke();
-    g.fillText(label, px(v), h - m.b + 15);
-  }
-  g.textAlign = "right";
-  const yTicks = logY
-    ? decades(y0, y1).map((k) => [Math.pow(10, k), `1e${k}`])
-    : niceTicks(y0, y1);
-  for (const [v, label] of yTicks) {
-    g.beginPath(); g.moveTo(m.l - 4, py(v)); g.lineTo(m.l, py(v)); g.stroke();
-    g.fillText(label, m.l - 6, py(v) + 4);
-  }
-  g.textAlign = "left";
-  g.fillText(xLabel, w / 2 - 40, h - 6);
-  g.save(); g.translate(12, h / 2 + 30); g.rotate(-Math.PI / 2); g.fillText(yLabel, 0, 0); g.restore();
-  g.save(); g.beginPath(); g.rect(m.l, m.t, w - m.l - m.r, h - m.t - m.b); g.clip();
-  for (const s of series) {
-    g.strokeStyle = s.colour; g.lineWidth = s.width ?? 2; g.setLineDash(s.dash ?? []);
-    g.beginPath();
-    s.points.forEach(([a, b], i) => (i ? g.lineTo(px(a), py(b)) : g.moveTo(px(a), py(b))));
-    g.stroke();
-  }
-  g.restore();
-}
-
-function zip(xs, ys) { return xs.map((v, i) => [v, ys[i]]); }
-
-function drawPolar(canvas, data, thetaIn) {
-  const g = canvas.getContext("2d");
-  const [w, h] = [canvas.width, canvas.height];
-  const [cx, cy, radius] = [w / 2, h - 20, Math.min(w / 2, h) - 30];
-  g.clearRect(0, 0, w, h);
-  g.strokeStyle = "#ccc"; g.lineWidth = 1;
-  for (const r of [0.25, 0.5, 0.75, 1]) { g.beginPath(); g.arc(cx, cy, r * radius, Math.PI, 2 * Math.PI); g.stroke(); }
-  g.beginPath(); g.moveTo(cx - radius, cy); g.lineTo(cx + radius, cy); g.stroke();
-  const peak = Math.max(1e-12, ...data.flatMap((d) => d.polar));
-  const at = (theta, r) => [cx + r * radius * Math.sin(theta), cy - r * radius * Math.cos(theta)];
-  g.strokeStyle = "#e0a000"; g.setLineDash([4, 3]);
-  g.beginPath(); g.moveTo(cx, cy); g.lineTo(...at((thetaIn * Math.PI) / 180, 1)); g.stroke(); g.setLineDash([]);
-  for (const d of data) {
-    g.strokeStyle = colourOf(d.lobe); g.lineWidth = 2; g.setLineDash(dashOf(d.lobe)); g.beginPath();
-    d.polar_deg.forEach((deg, i) => { const p = at((deg * Math.PI) / 180, d.polar[i] / peak); i ? g.lineTo(...p) : g.moveTo(...p); });
-    g.stroke();
-  }
-  g.setLineDash([]);
-  g.fillStyle = "#444"; g.font = "11px sans-serif";
-  g.fillText("light (dashed) at " + thetaIn + "°; radius: f / " + peak.toPrecision(3), 8, 14);
-}
-
-// The slice's colour map, from 0 (the bottom of the range) to 1 (its top).
-function sliceColour(s) {
-  return [255 * Math.min(1, 1.6 * s), 255 * Math.max(0, 2 * s - 1) * 0.9, 255 * (0.3 + 0.7 * Math.max(0, s - 0.5))];
-}
-
-// The slice with its axes: theta_h across on the API's square-root scale (column i at
-// 90 (i / (size - 1))^2 degrees), theta_d down, and a colour bar in decades of f.
-function drawSlice(canvas, d) {
-  const g = canvas.getContext("2d");
-  const size = d.slice_size;
-  const [left, top, right, bottom] = [38, 22, 62, 36];
-  const [w, h] = [canvas.width - left - right, canvas.height - top - bottom];
-  const logs = d.slice.map((v) => (v > 0 ? Math.log10(v) : -Infinity));
-  const high = Math.max(...logs.filter(Number.isFinite));
-  const low = high - 6;
-  const image = g.createImageData(size, size);
-  logs.forEach((v, k) => {
-    const s = Number.isFinite(v) ? Math.min(1, Math.max(0, (v - low) / (high - low))) : 0;
-    image.data.set([...sliceColour(s), 255], 4 * k);
-  });
-  const scratch = Object.assign(document.createElement("canvas"), { width: size, height: size });
-  scratch.getContext("2d").putImageData(image, 0, 0);
-  g.clearRect(0, 0, canvas.width, canvas.height);
-  g.imageSmoothingEnabled = false;
-  g.drawImage(scratch, left, top, w, h);
-  g.fillStyle = "#333"; g.strokeStyle = "#333"; g.font = "11px sans-serif"; g.lineWidth = 1;
-  g.fillText(`${d.lobe}: specular term f, log scale, phi_d = 90°`, left, 14);
-  // Ticks sit at the centre of the column or row that holds the angle.
-  const column = (deg) => left + ((size - 1) * Math.sqrt(deg / 90) + 0.5) * (w / size);
-  const row = (deg) => top + ((size - 1) * (deg / 90) + 0.5) * (h / size);
-  g.textAlign = "center";
-  for (const deg of [0, 1, 5, 10, 20, 45, 90]) {
-    const x = column(deg);
-    g.beginPath(); g.moveTo(x, top + h); g.lineTo(x, top + h + 4); g.stroke();
-    g.fillText(String(deg), x, top + h + 15);
-  }
-  g.fillText("θh (degrees, square-root scale)", left + w / 2, top + h + 30);
-  g.textAlign = "right";
-  for (const deg of [0, 15, 30, 45, 60, 75, 90]) {
-    const y = row(deg);
-    g.beginPath(); g.moveTo(left - 4, y); g.lineTo(left, y); g.stroke();
-    g.fillText(String(deg), left - 6, y + 4);
-  }
-  g.save(); g.translate(10, top + h / 2); g.rotate(-Math.PI / 2); g.textAlign = "center";
-  g.fillText("θd (degrees)", 0, 0); g.restore();
-  // The colour bar: its top is the slice's largest value, six decades down is black.
-  const [barX, barW] = [left + w + 10, 12];
-  for (let y = 0; y < h; y++) {
-    g.fillStyle = `rgb(${sliceColour(1 - y / (h - 1)).join(",")})`;
-    g.fillRect(barX, top + y, barW, 1);
-  }
-  g.fillStyle = "#333"; g.textAlign = "left";
-  for (const k of decades(low, high)) {
-    const y = top + (h - 1) * (1 - (k - low) / (high - low));
-    g.beginPath(); g.moveTo(barX + barW, y); g.lineTo(barX + barW + 3, y); g.stroke();
-    g.fillText(`1e${k}`, barX + barW + 5, y + 4);
-  }
-  g.textAlign = "left";
-}
-
 function analysisTable(reports) {
   const pct = (v) => (100 * v).toPrecision(3) + " %";
   const costs = reports.length ? reports[0].costs : [];
@@ -456,35 +307,6 @@ async function update() {
   }
 }
 
-const DIFFERENCE_GAIN = 8;
-
-// |a - b| per 8-bit sRGB channel, amplified, and the PSNR of a against b (named `against`)
-// over the frame.
-function drawDifference(a, b, canvas, caption, against = "pow") {
-  const pixelsOf = (img) => {
-    const c = Object.assign(document.createElement("canvas"), { width: img.naturalWidth, height: img.naturalHeight });
-    const g = c.getContext("2d");
-    g.drawImage(img, 0, 0);
-    return g.getImageData(0, 0, c.width, c.height);
-  };
-  const [pa, pb] = [pixelsOf(a), pixelsOf(b)];
-  [canvas.width, canvas.height] = [pa.width, pa.height];
-  const g = canvas.getContext("2d");
-  const out = g.createImageData(pa.width, pa.height);
-  let squares = 0;
-  for (let k = 0; k < pa.data.length; k += 4) {
-    for (let c = 0; c < 3; c++) {
-      const d = pa.data[k + c] - pb.data[k + c];
-      squares += d * d;
-      out.data[k + c] = Math.min(255, DIFFERENCE_GAIN * Math.abs(d));
-    }
-    out.data[k + 3] = 255;
-  }
-  g.putImageData(out, 0, 0);
-  const mse = squares / (3 * pa.width * pa.height);
-  caption.textContent = mse === 0 ? `identical to ${against}` : `PSNR ${(10 * Math.log10(255 * 255 / mse)).toFixed(1)} dB against ${against} (8-bit sRGB)`;
-}
-
 // What the plots show now, for a redraw at another width.
 let lastDrawn = null;
 let resizing = 0;
@@ -517,7 +339,7 @@ function draw(data, state) {
   plot($("albedo"), { series: data.map((d) => ({ points: zip(d.albedo_deg, d.albedo), colour: colourOf(d.lobe), dash: dashOf(d.lobe) })), x: [0, 90], y: [0, albedoTop], xLabel: "angle of incidence (degrees)", yLabel: "albedo" });
   // The slice is of the lobe every panel shows (the chosen one), else the first.
   const chosen = data.find((d) => d.lobe === state.render || d.lobe === state.render.split(":")[0]) ?? first;
-  if (chosen) drawSlice($("slice"), chosen);
+  if (chosen) drawSlice($("slice"), chosen, Boolean(live.slice));
   // A legend under each plot: every lobe drawn, in its colour and dash.
   const entry = (colour, dashed, name) => {
     const line = dashed ? `repeating-linear-gradient(90deg, ${colour} 0 5px, transparent 5px 8px)` : colour;

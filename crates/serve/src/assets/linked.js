@@ -5,7 +5,7 @@
 // (app.js's schedule). Without WebGL2 the server's sphere image is shown instead.
 "use strict";
 
-const live = { spheres: null, lobe: null, frame: 0, key: "", lobes: [], drawnLobes: null, dragging: false };
+const live = { spheres: null, lobe: null, slice: null, frame: 0, key: "", lobes: [], drawnLobes: null, dragging: false };
 // The polar plot's outgoing angles while a drag redraws it from the GPU (-90 to 90 degrees).
 const LIVE_POLAR_DEG = Array.from({ length: 181 }, (_, k) => k - 90);
 
@@ -13,9 +13,10 @@ function liveStart() {
   try {
     live.spheres = new LiveSpheres($("live-spheres"), $("live-ticks"), registry.live);
     live.lobe = new LiveLobe($("lobe3d"));
+    live.slice = new LiveSlice($("slice-live"), $("slice"));
   } catch (error) {
     // No WebGL2 (or a driver that cannot compile the shaders): the server's image, as before.
-    live.spheres = live.lobe = null;
+    live.spheres = live.lobe = live.slice = null;
     $("live-views").hidden = true;
     $("lobe3d-view").hidden = true;
     $("sphere").hidden = false;
@@ -24,6 +25,7 @@ function liveStart() {
   }
   document.body.dataset.live = "webgl2";
   $("sphere").hidden = true;
+  $("slice-live").hidden = false;
   pointerDrag($("live-spheres"), (event) => {
     const at = live.spheres.lightAt(event.clientX, event.clientY);
     if (!at) return;
@@ -105,6 +107,8 @@ async function liveLobes(state, shown, lobes) {
   live.lobe.setLobes(live.lobes.map((name) => ({ name, glsl: byName.get(name).glsl, colour: colourOf(name) })));
   live.drawnLobes = lobes.filter((name) => byName.has(name));
   $("lobe3d-name").textContent = first;
+  live.slice.setLobe(chosen.glsl);
+  live.slice.draw();
   liveRedraw();
 }
 

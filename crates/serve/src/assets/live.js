@@ -100,6 +100,20 @@ void main() {
 }`;
 }
 
+// A polynomial fit of viridis (perceptually uniform, readable in grey), for t in [0, 1].
+const VIRIDIS = `
+vec3 viridis(float t) {
+  const vec3 c0 = vec3(0.2777273272, 0.0054073445, 0.3340998053);
+  const vec3 c1 = vec3(0.1050930431, 1.4046134113, 1.3845901617);
+  const vec3 c2 = vec3(-0.3308618287, 0.2148475595, 0.0950952426);
+  const vec3 c3 = vec3(-4.6342304774, -5.7991007409, -19.3324409281);
+  const vec3 c4 = vec3(6.2282699363, 14.1799333668, 56.6905526007);
+  const vec3 c5 = vec3(4.7763849259, -13.7451453777, -65.3530326334);
+  const vec3 c6 = vec3(-5.4354558559, 4.6458526122, 26.3124352495);
+  return clamp(c0 + t * (c1 + t * (c2 + t * (c3 + t * (c4 + t * (c5 + t * c6))))), 0.0, 1.0);
+}
+`;
+
 // The difference of two sphere images in 8-bit sRGB code values (the largest channel's), on a
 // logarithmic scale: s = log2(1 + d) / 8, so 1, 3, 15 and 255 levels sit at 1/8, 2/8, 4/8 and
 // 1; shown in an approximation of viridis (perceptually uniform). A strip of the same map with
@@ -113,17 +127,7 @@ uniform vec2 u_extent;
 uniform float u_bar;
 out vec4 colour;
 
-vec3 viridis(float t) {
-  const vec3 c0 = vec3(0.2777273272, 0.0054073445, 0.3340998053);
-  const vec3 c1 = vec3(0.1050930431, 1.4046134113, 1.3845901617);
-  const vec3 c2 = vec3(-0.3308618287, 0.2148475595, 0.0950952426);
-  const vec3 c3 = vec3(-4.6342304774, -5.7991007409, -19.3324409281);
-  const vec3 c4 = vec3(6.2282699363, 14.1799333668, 56.6905526007);
-  const vec3 c5 = vec3(4.7763849259, -13.7451453777, -65.3530326334);
-  const vec3 c6 = vec3(-5.4354558559, 4.6458526122, 26.3124352495);
-  return c0 + t * (c1 + t * (c2 + t * (c3 + t * (c4 + t * (c5 + t * c6)))));
-}
-
+${VIRIDIS}
 void main() {
   vec2 p = gl_FragCoord.xy - u_origin;
   float s;
@@ -306,14 +310,19 @@ function lightTowards(theta, phi) {
   return [Math.sin(t) * Math.cos(p), -Math.cos(t), Math.sin(t) * Math.sin(p)];
 }
 
-// Draws the colour bar's labels beside the WebGL strip.
-function drawDifferenceTicks(canvas, size) {
-  const g = canvas.getContext("2d");
-  [canvas.width, canvas.height] = [TICKS_WIDTH, size];
-  g.clearRect(0, 0, canvas.width, canvas.height);
+// The colour bar's labels, at `x` in `g`, for a bar `height` pixels tall.
+function differenceTicks(g, x, height) {
   g.font = "11px sans-serif"; g.fillStyle = "#333";
   for (const d of DIFFERENCE_TICKS) {
-    const y = (size - 1) * (1 - Math.log2(1 + d) / 8);
-    g.fillText(String(d), 2, Math.min(size - 2, Math.max(10, y + 4)));
+    const y = (height - 1) * (1 - Math.log2(1 + d) / 8);
+    g.fillText(String(d), x, Math.min(height - 2, Math.max(10, y + 4)));
   }
+}
+
+// The labels of the live spheres' bar, on their own canvas beside the WebGL one.
+function drawDifferenceTicks(canvas, size) {
+  [canvas.width, canvas.height] = [TICKS_WIDTH, size];
+  const g = canvas.getContext("2d");
+  g.clearRect(0, 0, canvas.width, canvas.height);
+  differenceTicks(g, 2, size);
 }
