@@ -197,6 +197,17 @@ try {
   }
   await page.setViewportSize({ width: 1400, height: 900 });
 
+  // A lobe parameter out of its range: marked at its control, then mended.
+  await page.locator('#lobes input[value="cosquad"]').check();
+  await page.fill("#param-cosquad-v", "99");
+  await page.waitForFunction(() => document.getElementById("lobes-error").textContent !== "");
+  const parameter = await page.evaluate(() => ({ message: $("lobes-error").textContent, invalid: $("param-cosquad-v").getAttribute("aria-invalid") }));
+  if (parameter.invalid !== "true" || !parameter.message.includes("[")) failures.push(`a bad cosquad v is not marked at its control: ${JSON.stringify(parameter)}`);
+  console.log(`bad parameter: "${parameter.message}"`);
+  await page.fill("#param-cosquad-v", "4");
+  await drawn("lobes", "pow,schlick,schlick-mod,cosquad");
+  if (await page.evaluate(() => $("lobes-error").textContent)) failures.push("a mended cosquad v leaves its message");
+
   // Frame times, printed and never asserted: 120 light positions drawn at display rate, and
   // each draw timed to its completion (gl.finish).
   const timing = await page.evaluate(() => new Promise((resolve) => {

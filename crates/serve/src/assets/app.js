@@ -248,6 +248,18 @@ async function update() {
     return;
   }
   showControlError("n", "");
+  // A drawn lobe's parameter (its box ticked) outside its range.
+  const badParameter = [...document.querySelectorAll("#lobes .param")].find((input) => {
+    const v = Number(input.value);
+    if (!input.closest("label").querySelector("input[type=checkbox]").checked) return false;
+    return input.value.trim() === "" || !Number.isInteger(v) || v < Number(input.min) || v > Number(input.max);
+  });
+  document.querySelectorAll("#lobes .param").forEach((input) => input.setAttribute("aria-invalid", String(input === badParameter)));
+  $("lobes-error").textContent = badParameter ? `${badParameter.getAttribute("aria-label")} = '${badParameter.value}' must be a whole number in [${badParameter.min}, ${badParameter.max}]` : "";
+  if (badParameter) {
+    markStale(true);
+    return;
+  }
   const query = "?" + new URLSearchParams(state).toString();
   history.replaceState(null, "", query);
   const mine = ++generation;
@@ -283,20 +295,25 @@ async function update() {
     draw(data, { ...state, render: shown.render });
     warnAboutAlbedo(data, state);
     $("analysis").innerHTML = lobes.length ? analysisTable(reports) : "<p>Choose a lobe.</p>";
+    markFresh("plots", "analysis");
     if (shown.render) {
       const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: apiLobe(shown.render), ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
       // The sphere is drawn live (linked.js); the server's is for a browser without WebGL2.
       const sphere = live.spheres ? Promise.resolve() : loadImage($("sphere"), render("sphere"));
       await Promise.all([sphere, loadImage($("teapot"), render("teapot"))]);
+      if (mine !== generation) return;
+      markFresh("teapot");
       const environment = (lobe) => "/api/environment?" + new URLSearchParams({ lobe, ...common, size: "384", spp: "16" });
       await Promise.all([loadImage($("environment-image"), environment(apiLobe(shown.render))), loadImage($("environment-pow"), environment("pow"))]);
       if (mine !== generation) return;
       drawDifference($("environment-image"), $("environment-pow"), $("environment-diff"), $("environment-psnr"));
+      markFresh("environment");
     }
     const volume = (lobe) => "/api/volume?" + new URLSearchParams({ volume: state.volume, view: state.view, lobe, ...common, size: "256" });
     await Promise.all([loadImage($("volume-image"), volume(apiLobe(shown.render || "pow"))), loadImage($("volume-pow"), volume("pow"))]);
     if (mine !== generation) return;
     drawDifference($("volume-image"), $("volume-pow"), $("volume-diff"), $("volume-psnr"));
+    markFresh("volume");
     $("status").textContent = "";
     markStale(false);
     // What is on the page now: the count of finished updates and the state they drew.

@@ -133,9 +133,15 @@ function livePolar(wi) {
   return live.drawnLobes.map((name) => ({ lobe: name, polar_deg: LIVE_POLAR_DEG, polar: [...live.lobe.evaluate(name, directions, wi).values] }));
 }
 
-// The server's views no longer match the controls (true) or are drawn again (false).
+// The server's views no longer match the controls (true) or all are drawn again (false).
 function markStale(stale) {
   document.querySelectorAll("[data-server]").forEach((view) => view.classList.toggle("stale", stale));
+}
+
+// The views of `kinds` (their data-server) match the controls again: the marks left are the
+// progress of the update.
+function markFresh(...kinds) {
+  for (const kind of kinds) document.querySelectorAll(`[data-server="${kind}"]`).forEach((view) => view.classList.remove("stale"));
 }
 
 // Frame times for the benchmark (.ci/explorer/frames.mjs): the draws' mean in milliseconds.
