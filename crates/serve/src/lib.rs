@@ -50,14 +50,15 @@ use axum::Router;
 const MAX_BODY_BYTES: usize = 16 * 1024;
 
 /// The page's scripts, in the order it loads them: the 2D plots, the differences, the measured
-/// materials, the WebGL2 views (spheres, 3D lobe, slice), the pointer and the page itself.
-const SCRIPTS: [(&str, &str); 8] = [
+/// materials, the WebGL2 views (spheres, 3D lobe, slice, teapot), the pointer and the page itself.
+const SCRIPTS: [(&str, &str); 9] = [
     ("/plots.js", include_str!("assets/plots.js")),
     ("/difference.js", include_str!("assets/difference.js")),
     ("/measured.js", include_str!("assets/measured.js")),
     ("/live.js", include_str!("assets/live.js")),
     ("/lobe3d.js", include_str!("assets/lobe3d.js")),
     ("/slice.js", include_str!("assets/slice.js")),
+    ("/teapot.js", include_str!("assets/teapot.js")),
     ("/linked.js", include_str!("assets/linked.js")),
     ("/app.js", include_str!("assets/app.js")),
 ];
@@ -102,6 +103,7 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/design", get(api::design_lobe))
         .route("/api/shader", get(live::shader))
         .route("/api/live-sphere", get(live::live_sphere))
+        .route("/api/teapot", get(live::teapot))
         .fallback(api::not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
         .layer(axum::middleware::from_fn_with_state(

@@ -10,6 +10,10 @@
 //!   ([`Shader::shade`]) and display encoding, as a PNG: what the browser check compares the
 //!   WebGL image against, pixel by pixel.
 //!
+//! - `GET /api/teapot`: the explorer's teapot as `specula render` tessellates and places it
+//!   (world-space positions, normals and triangles) with the renderer's camera matrix and eye,
+//!   so the page rasterizes exactly the triangles the CPU renderer does.
+//!
 //! The sphere is analytic (a ray per pixel centre hits the unit sphere), not the renderer's
 //! tessellated one, so that both sides draw exactly the same surface.
 
@@ -23,7 +27,8 @@ use specula::{Geometry, Lobe, Normalisation};
 use specula_gpu::export::{export, GlslVersion, Language, Options, ShaderCode};
 use specula_render::{Display, IlluminationModel, Image, Light, Material, Shader, ToneMap};
 
-use crate::api::{compute_with, png, AppState};
+use crate::api::{compute, compute_with, png, AppState};
+use crate::explorer::{scene, Object, RenderRequest};
 use crate::query::{pairs, ApiError, Params, QueryPairs};
 
 /// The largest live-sphere reference, in pixels a side.
@@ -229,4 +234,54 @@ pub async fn live_sphere(
     };
     let encoded = compute_with(&state, kind, n, move |lobe| sphere_png(lobe, &request)).await?;
     Ok(png(encoded.map_err(ApiError::internal)?))
+}
+
+/// `GET /api/teapot`: the teapot's mesh in world space and the camera that sees it, from the
+/// scene `/api/render?object=teapot` renders (its lobe, light and size do not change them).
+pub async fn teapot(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<Response, Response> {
+    Params::new(pairs(query)?, &[])?;
+    let body = compute(&state, teapot_body)
+        .await?
+        .map_err(ApiError::internal)?;
+    Ok(Json(body).into_response())
+}
+
+fn teapot_body() -> Result<serde_json::Value, String> {
+    let scene = scene(&RenderRequest {
+        object: Object::Teapot,
+        kind: specula::LobeKind::Pow,
+        n: specula::Exponent::new(64.0),
+        geometry: Geometry::Phong,
+        normalisation: Normalisation::None,
+        shading: specula_render::Shading::Phong,
+        model: IlluminationModel::Classic,
+        light_theta: 0.0,
+        light_phi: 0.0,
+        size: 64,
+    })?;
+    let mesh = &scene
+        .objects
+        .first()
+        .ok_or("the teapot scene has no object")?
+        .mesh;
+    let flat = |vectors: &[Vec3]| {
+        vectors
+            .iter()
+            .flat_map(|v| v.to_array())
+            .collect::<Vec<_>>()
+    };
+    Ok(json!({
+        "positions": flat(mesh.positions()),
+        "normals": flat(mesh.normals()),
+        "triangles": mesh.triangles().iter().flatten().collect::<Vec<_>>(),
+        // Column-major, world to clip space (D3D's depth in [0, 1], which WebGL's clip space
+        // contains), for a square image.
+        "view_projection": scene.camera.view_projection(1.0).to_cols_array(),
+        "eye": scene.camera.eye().to_array(),
+        // Whether the renderer drops the faces clockwise on screen.
+        "cull_back_faces": scene.settings.cull_back_faces,
+    }))
 }

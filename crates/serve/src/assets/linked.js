@@ -5,7 +5,7 @@
 // (app.js's schedule). Without WebGL2 the server's sphere image is shown instead.
 "use strict";
 
-const live = { spheres: null, lobe: null, slice: null, frame: 0, key: "", lobes: [], drawnLobes: null, dragging: false };
+const live = { spheres: null, lobe: null, slice: null, teapot: null, chosen: null, frame: 0, key: "", lobes: [], drawnLobes: null, dragging: false };
 // The polar plot's outgoing angles while a drag redraws it from the GPU (-90 to 90 degrees).
 const LIVE_POLAR_DEG = Array.from({ length: 181 }, (_, k) => k - 90);
 
@@ -24,6 +24,12 @@ function liveStart() {
     return;
   }
   document.body.dataset.live = "webgl2";
+  // The teapot's mesh comes once; until then (and for gouraud shading) the server's image.
+  getJson("/api/teapot").then((mesh) => {
+    live.teapot = new LiveTeapot($("live-teapot"), registry.live, mesh);
+    if (live.chosen) live.teapot.setLobe(...live.chosen);
+    liveRedraw();
+  }, (error) => { $("teapot-by").textContent = `CPU renderer (${error.message})`; });
   $("sphere").hidden = true;
   $("slice-live").hidden = false;
   pointerDrag($("live-spheres"), (event) => {
@@ -102,6 +108,8 @@ async function liveLobes(state, shown, lobes) {
   const chosen = byName.get(shown || "pow") ?? byName.get("pow");
   if (!chosen) return;
   live.spheres.setLobes(chosen.glsl, byName.get("pow").glsl, chosen.tonemap, state.model === "physical");
+  live.chosen = [chosen.glsl, chosen.tonemap, state.model === "physical"];
+  live.teapot?.setLobe(...live.chosen);
   const first = byName.has(shown) ? shown : "pow";
   live.lobes = [first, ...[...byName.keys()].filter((name) => name !== first)];
   live.lobe.setLobes(live.lobes.map((name) => ({ name, glsl: byName.get(name).glsl, colour: colourOf(name) })));
@@ -123,6 +131,15 @@ function liveRedraw() {
     live.spheres.light = lightTowards(Number($("light_theta").value), Number($("light_phi").value));
     live.spheres.draw();
     live.lobe.draw(wi);
+    // The live teapot shades per pixel; gouraud shading is the server's.
+    const teapotLive = Boolean(live.teapot) && $("shading").value === "phong";
+    $("live-teapot").hidden = !teapotLive;
+    $("teapot").hidden = teapotLive;
+    $("teapot-by").textContent = teapotLive ? "drawn by WebGL2, the triangles specula render rasterizes" : "CPU renderer";
+    if (teapotLive) {
+      live.teapot.light = live.spheres.light;
+      live.teapot.draw();
+    }
     if (live.dragging && live.drawnLobes) drawPolar($("polar"), livePolar(wi), thetaIn);
   });
 }

@@ -51,32 +51,51 @@ void main() {
   gl_Position = vec4(2.0 * corner - 1.0, 0.0, 1.0);
 }`;
 
-// The sphere /api/live-sphere draws (crates/serve/src/live.rs, `sphere_radiance`): a ray
-// through each pixel centre from the camera at (0, -eye, 0) looking along +y with z up, the
-// first hit on the unit sphere shaded as the renderer's Shader::shade does (ambient, then the
-// directional light's diffuse and N(n) lobe(t) terms when it and the viewer are above the
-// surface), tone mapped and sRGB-encoded as its PNGs are.
-function sphereFragment(lobe) {
-  return `#version 300 es
-precision highp float;
-${lobe}
-uniform vec2 u_origin;
-uniform float u_size;
+// The renderer's shading (Shader::shade) of one point for the directional light: ambient,
+// then the light's diffuse and N(n) lobe(t) terms when it and the viewer are above the
+// surface; tone mapped and sRGB-encoded as the renders' PNGs are. Spliced after a lobe's
+// exported functions.
+const SHADING = `
 uniform vec3 u_light;
-uniform float u_eye;
-uniform float u_tan_half;
 uniform vec3 u_colour;
 uniform vec3 u_ambient;
-uniform vec3 u_background;
 uniform vec3 u_k;
 uniform float u_physical;
 uniform float u_reinhard;
-out vec4 colour;
+
+vec3 shade(vec3 normal, vec3 wo) {
+  vec3 radiance = u_k.x * u_colour * u_ambient;
+  float cosIn = dot(normal, u_light);
+  if (dot(normal, wo) > 0.0 && cosIn > 0.0) {
+    vec3 diffuse = u_k.y * u_colour * (u_physical > 0.5 ? 0.3183098862 : 1.0);
+    float specular = u_k.z * specula_specular(normal, wo, u_light);
+    radiance += u_physical > 0.5 ? (diffuse + specular) * cosIn : diffuse * cosIn + specular;
+  }
+  return radiance;
+}
 
 float encode(float x) {
   x = u_reinhard > 0.5 ? max(x, 0.0) / (1.0 + max(x, 0.0)) : clamp(x, 0.0, 1.0);
   return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
 }
+
+vec4 display(vec3 radiance) { return vec4(encode(radiance.r), encode(radiance.g), encode(radiance.b), 1.0); }
+`;
+
+// The sphere /api/live-sphere draws (crates/serve/src/live.rs, `sphere_radiance`): a ray
+// through each pixel centre from the camera at (0, -eye, 0) looking along +y with z up, the
+// first hit on the unit sphere shaded.
+function sphereFragment(lobe) {
+  return `#version 300 es
+precision highp float;
+${lobe}
+${SHADING}
+uniform vec2 u_origin;
+uniform float u_size;
+uniform float u_eye;
+uniform float u_tan_half;
+uniform vec3 u_background;
+out vec4 colour;
 
 void main() {
   vec2 p = gl_FragCoord.xy - u_origin;
@@ -84,19 +103,7 @@ void main() {
   vec3 o = vec3(0.0, -u_eye, 0.0);
   float b = dot(o, d);
   float discriminant = b * b - (dot(o, o) - 1.0);
-  vec3 radiance = u_background;
-  if (discriminant >= 0.0) {
-    vec3 normal = normalize(o + (-b - sqrt(discriminant)) * d);
-    vec3 wo = -d;
-    radiance = u_k.x * u_colour * u_ambient;
-    float cosIn = dot(normal, u_light);
-    if (dot(normal, wo) > 0.0 && cosIn > 0.0) {
-      vec3 diffuse = u_k.y * u_colour * (u_physical > 0.5 ? 0.3183098862 : 1.0);
-      float specular = u_k.z * specula_specular(normal, wo, u_light);
-      radiance += u_physical > 0.5 ? (diffuse + specular) * cosIn : diffuse * cosIn + specular;
-    }
-  }
-  colour = vec4(encode(radiance.r), encode(radiance.g), encode(radiance.b), 1.0);
+  colour = display(discriminant >= 0.0 ? shade(normalize(o + (-b - sqrt(discriminant)) * d), -d) : u_background);
 }`;
 }
 
@@ -265,15 +272,9 @@ class LiveSpheres {
   // A pane's pixels, rows from the top, RGBA (pane 0: the chosen lobe, 1: pow, 2: difference),
   // drawn again first: the canvas keeps a frame only until it is shown.
   read(pane) {
-    const gl = this.gl;
     this.draw();
-    const size = this.canvas.height;
-    const pixels = new Uint8Array(4 * size * size);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    gl.readPixels(pane * size, 0, size, size, gl.RGBA, gl.UNSIGNED_BYTE, pixels);
-    const rows = new Uint8Array(pixels.length);
-    for (let y = 0; y < size; y++) rows.set(pixels.subarray(4 * size * (size - 1 - y), 4 * size * (size - y)), 4 * size * y);
-    return { size, pixels: rows };
+    this.gl.bindFramebuffer(this.gl.FRAMEBUFFER, null);
+    return readSquare(this.gl, pane * this.canvas.height, this.canvas.height);
   }
 
   // The light towards the sphere's normal under the pointer, as (theta, phi) in degrees, or
@@ -296,6 +297,16 @@ class LiveSpheres {
     const phi = (Math.atan2(normal[2], normal[0]) * 180) / Math.PI;
     return { theta, phi };
   }
+}
+
+// The square of `size` pixels at `x` of the drawn frame, RGBA, rows from the top (WebGL's
+// are from the bottom).
+function readSquare(gl, x, size) {
+  const pixels = new Uint8Array(4 * size * size);
+  gl.readPixels(x, 0, size, size, gl.RGBA, gl.UNSIGNED_BYTE, pixels);
+  const rows = new Uint8Array(pixels.length);
+  for (let y = 0; y < size; y++) rows.set(pixels.subarray(4 * size * (size - 1 - y), 4 * size * (size - y)), 4 * size * y);
+  return { size, pixels: rows };
 }
 
 function normalise(v) {

@@ -156,3 +156,48 @@ async fn the_live_sphere_route_serves_the_asked_size_and_refuses_bad_values() {
         (StatusCode::BAD_REQUEST, Some("size"))
     );
 }
+
+/// The teapot's mesh: as many normals as positions, unit normals, every triangle's corners
+/// among them, every vertex in front of the camera and nearly all inside its square image.
+#[tokio::test]
+async fn the_teapot_route_serves_a_mesh_the_camera_sees() {
+    let (status, body) = json("/api/teapot").await;
+    assert_eq!(status, StatusCode::OK);
+    let numbers = |key: &str| -> Vec<f32> {
+        let values = body[key].as_array().expect("an array");
+        values
+            .iter()
+            .map(|v| v.as_f64().expect("a number") as f32)
+            .collect()
+    };
+    let (positions, normals) = (numbers("positions"), numbers("normals"));
+    assert_eq!(positions.len(), normals.len());
+    let vertices = positions.len() / 3;
+    assert!(vertices > 1000, "{vertices} vertices");
+    for normal in normals.chunks(3) {
+        assert!(
+            (Vec3::from_slice(normal).length() - 1.0).abs() < 1e-3,
+            "{normal:?}"
+        );
+    }
+    let triangles = numbers("triangles");
+    assert!(triangles.len() % 3 == 0 && triangles.iter().all(|&k| (k as usize) < vertices));
+    let matrix = glam::Mat4::from_cols_slice(&numbers("view_projection"));
+    // In front of the camera, and inside its image but for the spout's tip, which the
+    // explorer's framing cuts.
+    let clips: Vec<glam::Vec4> = positions
+        .chunks(3)
+        .map(|p| matrix * Vec3::from_slice(p).extend(1.0))
+        .collect();
+    assert!(clips.iter().all(|c| c.w > 0.0));
+    let inside = clips
+        .iter()
+        .filter(|c| c.x.abs() < c.w && c.y.abs() < c.w)
+        .count();
+    assert!(
+        inside as f64 > 0.99 * vertices as f64,
+        "{inside} of {vertices} inside"
+    );
+    let (status, _) = json("/api/teapot?size=3").await;
+    assert_eq!(status, StatusCode::BAD_REQUEST);
+}
