@@ -5,7 +5,7 @@
 // (app.js's schedule). Without WebGL2 the server's sphere image is shown instead.
 "use strict";
 
-const live = { spheres: null, lobe: null, slice: null, teapot: null, chosen: null, frame: 0, key: "", lobes: [], drawnLobes: null, dragging: false };
+const live = { spheres: null, lobe: null, slice: null, slicePow: null, teapot: null, chosen: null, frame: 0, key: "", lobes: [], drawnLobes: null, dragging: false };
 // The polar plot's outgoing angles while a drag redraws it from the GPU (-90 to 90 degrees).
 const LIVE_POLAR_DEG = Array.from({ length: 181 }, (_, k) => k - 90);
 
@@ -14,9 +14,10 @@ function liveStart() {
     live.spheres = new LiveSpheres($("live-spheres"), $("live-ticks"), registry.live);
     live.lobe = new LiveLobe($("lobe3d"));
     live.slice = new LiveSlice($("slice-live"), $("slice"));
+    live.slicePow = new LiveSlice($("slice-pow-live"), $("slice-pow"));
   } catch (error) {
     // No WebGL2 (or a driver that cannot compile the shaders): the server's image, as before.
-    live.spheres = live.lobe = live.slice = null;
+    live.spheres = live.lobe = live.slice = live.slicePow = null;
     $("live-views").hidden = true;
     $("lobe3d-view").hidden = true;
     $("sphere").hidden = false;
@@ -32,6 +33,7 @@ function liveStart() {
   }, (error) => { $("teapot-by").textContent = `CPU renderer (${error.message})`; });
   $("sphere").hidden = true;
   $("slice-live").hidden = false;
+  $("slice-pow-wrap").hidden = false;
   pointerDrag($("live-spheres"), (event) => {
     const at = live.spheres.lightAt(event.clientX, event.clientY);
     if (!at) return;
@@ -117,6 +119,11 @@ async function liveLobes(state, shown, lobes) {
   $("lobe3d-name").textContent = first;
   live.slice.setLobe(chosen.glsl);
   live.slice.draw();
+  // pow's slice beside it, its axes labelled from its peak f(n, n) as the GPU evaluates it.
+  live.slicePow.setLobe(byName.get("pow").glsl);
+  const peak = live.lobe.evaluate("pow", [[0, 0, 1]], [0, 0, 1]).values[0];
+  drawSlice($("slice-pow"), { lobe: "pow", slice: [peak], slice_size: 1 }, true);
+  live.slicePow.draw();
   liveRedraw();
 }
 
