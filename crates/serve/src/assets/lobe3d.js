@@ -162,7 +162,8 @@ class LiveLobe {
     if (this.frames.length > 120) this.frames.shift();
   }
 
-  // The surface's rim and normal (grey), the incident direction (amber) and the mirror one.
+  // The surface's rim and normal (grey) and the direction to the light (dark grey, as the
+  // polar plot draws it).
   drawAxes(wi, view) {
     const gl = this.gl;
     const rim = [];
@@ -173,7 +174,7 @@ class LiveLobe {
     const segments = [
       [rim, [0.6, 0.6, 0.6]],
       [[0, 0, 0, 0, 0, 1.2], [0.6, 0.6, 0.6]],
-      [[0, 0, 0, ...wi.map((c) => 1.3 * c)], [0.88, 0.63, 0]],
+      [[0, 0, 0, ...wi.map((c) => 1.3 * c)], [0.2, 0.2, 0.2]],
     ];
     gl.useProgram(this.lines);
     gl.uniformMatrix3fv(gl.getUniformLocation(this.lines, "u_rotation"), false, view.u_rotation);

@@ -79,8 +79,12 @@ function drawPolar(canvas, data, thetaIn) {
   g.beginPath(); g.moveTo(cx - radius, cy); g.lineTo(cx + radius, cy); g.stroke();
   const peak = Math.max(1e-12, ...data.flatMap((d) => d.polar));
   const at = (theta, r) => [cx + r * radius * Math.sin(theta), cy - r * radius * Math.cos(theta)];
-  g.strokeStyle = "#e0a000"; g.setLineDash([4, 3]);
-  g.beginPath(); g.moveTo(cx, cy); g.lineTo(...at((thetaIn * Math.PI) / 180, 1)); g.stroke(); g.setLineDash([]);
+  // The light: a thin grey line ending in a disc, a style no lobe has (an amber dash was
+  // schlick-mod's orange dash to the eye).
+  const light = at((thetaIn * Math.PI) / 180, 1);
+  g.strokeStyle = "#666"; g.fillStyle = "#666"; g.setLineDash([]);
+  g.beginPath(); g.moveTo(cx, cy); g.lineTo(...light); g.stroke();
+  g.beginPath(); g.arc(...light, 4, 0, 2 * Math.PI); g.fill();
   for (const d of data) {
     g.strokeStyle = colourOf(d.lobe); g.lineWidth = 2; g.setLineDash(dashOf(d.lobe)); g.beginPath();
     d.polar_deg.forEach((deg, i) => { const p = at((deg * Math.PI) / 180, d.polar[i] / peak); i ? g.lineTo(...p) : g.moveTo(...p); });
@@ -88,7 +92,7 @@ function drawPolar(canvas, data, thetaIn) {
   }
   g.setLineDash([]);
   g.fillStyle = "#444"; g.font = "11px sans-serif";
-  g.fillText("light (dashed) at " + thetaIn + "°; radius: f / " + peak.toPrecision(3), 8, 14);
+  g.fillText("light (grey, with a disc) at " + thetaIn + "°; radius: f / " + peak.toPrecision(3), 8, 14);
 }
 
 // The slice's colour map, from 0 (the bottom of the range) to 1 (its top).
