@@ -14,9 +14,9 @@ use specula_volume::transfer::TransferFunction;
 use specula_volume::Volume;
 use wgpu::util::DeviceExt;
 
+use crate::context::{Gpu, GpuError};
 use crate::uniforms::{geometry_id, LobeBlock};
 use crate::wgsl::{self, FunctionKey};
-use crate::{Gpu, GpuError};
 
 /// `struct Params` of volume.wgsl.
 #[repr(C)]
