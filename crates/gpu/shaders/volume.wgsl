@@ -1,6 +1,6 @@
-// Direct volume rendering: a transcription of crates/render/src/volume/dvr/, one
+// Direct volume rendering: a transcription of crates/volume/src/dvr/, one
 // invocation per pixel. The volume is the CPU marcher's prepared field (value and world
-// gradient per voxel, crates/render/src/volume/march/) as an rgba32float 3D texture read with
+// gradient per voxel, crates/volume/src/march/) as an rgba32float 3D texture read with
 // textureLoad and interpolated here, as the CPU does, so the two agree sample for sample (a
 // hardware sampler would filter in 8-bit fixed-point weights); a sample reads 8 texels where
 // central differences of the trilinear field would read 56.
@@ -209,7 +209,7 @@ fn march(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     // Segment j > 0 ends at lattice + (j + 1) step, from j, so that a skip lands on the
-    // lattice (crates/render/src/volume/march/ray.rs).
+    // lattice (crates/volume/src/march/ray/).
     let step = params.right.w;
     let first_end = near + step * pixel_jitter(id.x, id.y);
     let lattice = first_end - step;

@@ -5,8 +5,9 @@ use specula::analysis::Evaluator;
 use specula::Lobe;
 use wgpu::util::DeviceExt;
 
+use crate::context::{Gpu, GpuError};
 use crate::uniforms::LobeBlock;
-use crate::{wgsl, Gpu, GpuError};
+use crate::wgsl;
 
 const WORKGROUP: u32 = 64;
 /// Workgroups per dispatch row (WebGPU's per-dimension limit).

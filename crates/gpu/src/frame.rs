@@ -12,9 +12,10 @@ use std::time::{Duration, Instant};
 use specula_render::{Image, Projection, Scene, Shading};
 use wgpu::util::DeviceExt;
 
+use crate::context::{Gpu, GpuError};
+use crate::render::GpuRenderer;
 use crate::render::{downsample, COLOUR_FORMAT, DEPTH_FORMAT, VERTEX_FLOATS};
 use crate::uniforms::{FrameBlock, LightBlock, MaterialBlock};
-use crate::{Gpu, GpuError, GpuRenderer};
 
 /// One object's geometry as the shaders take it.
 struct ObjectBuffers {

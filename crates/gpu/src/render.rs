@@ -9,8 +9,8 @@ use std::sync::{Arc, Mutex, PoisonError};
 use glam::Vec3;
 use specula_render::{Image, Scene};
 
+use crate::context::{Gpu, GpuError};
 use crate::wgsl::{self, FunctionKey};
-use crate::{Gpu, GpuError};
 
 pub(crate) const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -136,7 +136,7 @@ impl<'gpu> GpuRenderer<'gpu> {
     }
 
     /// Renders `scene` and reads the image back (a renderer drawing it again would keep the
-    /// [`GpuFrame`](crate::GpuFrame) from [`prepare`](Self::prepare)).
+    /// `GpuFrame` from [`prepare`](Self::prepare)).
     pub fn render(&self, scene: &Scene) -> Result<Image, GpuError> {
         self.prepare(scene)?.image()
     }

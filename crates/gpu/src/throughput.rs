@@ -10,8 +10,8 @@ use std::time::{Duration, Instant};
 use specula::{Geometry, Lobe, Normalisation};
 use wgpu::util::DeviceExt;
 
+use crate::context::{Gpu, GpuError};
 use crate::export::export_wgsl_source;
-use crate::{Gpu, GpuError};
 
 /// Lobe evaluations per invocation.
 pub const CHAIN: u32 = 256;

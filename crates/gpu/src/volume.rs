@@ -7,16 +7,16 @@ use std::sync::{Arc, Mutex, PoisonError};
 
 use bytemuck::{Pod, Zeroable};
 use specula::Lobe;
-use specula_render::volume::dvr::{DvrPlan, DvrSettings, Lighting};
-use specula_render::volume::march::{Classification, PreparedVolume};
-use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::Volume;
 use specula_render::Image;
+use specula_volume::dvr::{DvrPlan, DvrSettings, Lighting};
+use specula_volume::march::{Classification, PreparedVolume};
+use specula_volume::transfer::TransferFunction;
+use specula_volume::Volume;
 use wgpu::util::DeviceExt;
 
+use crate::context::{Gpu, GpuError};
 use crate::uniforms::{geometry_id, LobeBlock};
 use crate::wgsl::{self, FunctionKey};
-use crate::{Gpu, GpuError};
 
 /// `struct Params` of volume.wgsl.
 #[repr(C)]
@@ -119,7 +119,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
         Ok(pipeline)
     }
 
-    /// Renders as [`specula_render::volume::dvr::render_dvr`] does.
+    /// Renders as [`specula_volume::dvr::render_dvr`] does.
     pub fn render(
         &self,
         volume: &Volume,
@@ -139,7 +139,7 @@ impl<'gpu> GpuVolumeRenderer<'gpu> {
 
     /// [`GpuVolumeRenderer::render`] once for each of `lobes`, the settings' shading with its
     /// lobe replaced by each in turn, as
-    /// [`specula_render::volume::dvr::render_dvr_lobes`] does: up to 16 images a march,
+    /// [`specula_volume::dvr::render_dvr_lobes`] does: up to 16 images a march,
     /// the samples' colours and opacities computed once for them all, and each image the one
     /// its lobe alone draws (one march's arithmetic, tested).
     ///

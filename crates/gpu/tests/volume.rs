@@ -9,11 +9,11 @@ use common::Parity;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use specula_gpu::{GpuRenderer, GpuVolumeRenderer};
 use specula_render::metrics::compare;
-use specula_render::volume::dvr::{render_dvr, DvrSettings, Shading, View};
-use specula_render::volume::isosurface::{iso_scene, marching_cubes, IsoSettings};
-use specula_render::volume::phantom;
-use specula_render::volume::transfer::TransferFunction;
 use specula_render::{render, Display};
+use specula_volume::dvr::{render_dvr, DvrSettings, Shading, View};
+use specula_volume::isosurface::{iso_scene, marching_cubes, IsoSettings};
+use specula_volume::phantom;
+use specula_volume::transfer::TransferFunction;
 
 const MAX_MEAN_FLIP: f64 = 1e-3;
 const MIN_PSNR_DB: f64 = 65.0;

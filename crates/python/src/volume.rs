@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 use numpy::ndarray::{Array2, ShapeBuilder};
 use numpy::{IntoPyArray, ToPyArray};
 use pyo3::prelude::*;
-use specula_render::volume::dvr::{render_dvr, DvrSettings, Shading, View};
-use specula_render::volume::phantom::BuiltIn;
-use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::{self, Units};
+use specula_volume::dvr::{render_dvr, DvrSettings, Shading, View};
+use specula_volume::phantom::BuiltIn;
+use specula_volume::transfer::TransferFunction;
+use specula_volume::{self as volume, Units};
 
 use crate::arrays::unsigned;
 use crate::errors::{file_error, guarded, value_error};

@@ -7,9 +7,11 @@ use rayon::prelude::*;
 use specula::LobeKind;
 use thiserror::Error;
 
+use crate::image::Image;
 use crate::metrics::{compare_srgb8, Difference};
 use crate::pipeline::MAX_PIXELS;
-use crate::{render, Overrides, RenderError, Scene};
+use crate::pipeline::{render, RenderError};
+use crate::scene::{Overrides, Scene};
 
 /// What a grid shows.
 #[derive(Clone, Debug, PartialEq)]
@@ -137,8 +139,8 @@ pub fn check_grid(scene: &Scene, options: &GridOptions) -> Result<(), GridError>
 /// [`render_grid_with`]'s renderer over renders made beforehand, by index as
 /// [`grid_renders`] lists them: hands each out once.
 pub fn made_renders(
-    renders: &mut [Option<crate::Image>],
-) -> impl FnMut(&Scene, usize) -> Result<crate::Image, String> + '_ {
+    renders: &mut [Option<Image>],
+) -> impl FnMut(&Scene, usize) -> Result<Image, String> + '_ {
     |_, index| {
         renders
             .get_mut(index)
@@ -167,7 +169,7 @@ pub fn grid_renders(options: &GridOptions) -> Vec<Option<LobeKind>> {
 pub fn render_grid_with(
     scene: &Scene,
     options: &GridOptions,
-    render: &mut dyn FnMut(&Scene, usize) -> Result<crate::Image, String>,
+    render: &mut dyn FnMut(&Scene, usize) -> Result<Image, String>,
 ) -> Result<Srgb8Image, GridError> {
     render_grid_columns(scene, options, render).map(|grid| grid.image)
 }
@@ -198,7 +200,7 @@ pub struct Grid {
 pub fn render_grid_columns(
     scene: &Scene,
     options: &GridOptions,
-    render: &mut dyn FnMut(&Scene, usize) -> Result<crate::Image, String>,
+    render: &mut dyn FnMut(&Scene, usize) -> Result<Image, String>,
 ) -> Result<Grid, GridError> {
     check_grid(scene, options)?;
     let mut with_lobe = |kind: LobeKind, index: usize| {

@@ -3,8 +3,8 @@
 //! Built on the core (`specula`): scenes (TOML, with an embedded default), meshes (built-in
 //! shapes, Newell's teapot, OBJ/STL/PLY files), a tiled parallel rasterizer, flat, Gouraud and
 //! Phong shading with any lobe, geometry and normalisation, images (PNG, OpenEXR) and image
-//! metrics (PSNR, FLIP), image-based lighting (environment maps, Monte Carlo with multiple
-//! importance sampling), and volumes (the built-in phantoms, direct volume rendering).
+//! metrics (PSNR, FLIP), and image-based lighting (environment maps, Monte Carlo with multiple
+//! importance sampling). Volumes are `specula-volume`'s, which draws with these.
 //!
 //! ## Design
 //! - **Exact coverage.** Vertices are snapped to 1/256 pixel and edge functions evaluated in
@@ -44,7 +44,6 @@ mod scene;
 mod shapes;
 mod srgb8;
 mod teapot;
-pub mod volume;
 
 pub use camera::{Camera, InvalidCamera, Projection, MAX_COORDINATE};
 pub use description::{set_max_triangles, LoadedScene, SceneError, MAX_OBJECTS, MAX_TRIANGLES};

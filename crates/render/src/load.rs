@@ -12,7 +12,7 @@ use std::path::Path;
 use glam::Vec3;
 use thiserror::Error;
 
-use crate::{Mesh, MeshError};
+use crate::mesh::{Mesh, MeshError};
 
 /// A mesh file that could not be used, and why.
 #[derive(Debug, Error)]

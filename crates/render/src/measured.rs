@@ -20,8 +20,9 @@ use specula::{Exponent, Lobe, Normalisation};
 use crate::ibl::{
     cosine_direction, render_ibl_with, Environment, IblSettings, Reflectance, Strategy,
 };
+use crate::image::Image;
 use crate::metrics::compare;
-use crate::{Image, Overrides, Scene};
+use crate::scene::{Overrides, Scene};
 
 /// The largest material file read: 64 MiB (the RGL RGB files are 0.7 to 10 MiB).
 pub const MAX_MATERIAL_BYTES: u64 = 64 << 20;

@@ -10,7 +10,7 @@
 
 use thiserror::Error;
 
-use crate::{Display, Image};
+use crate::image::{Display, Image};
 
 /// The RMS over pixels of the difference of two linear images of one size (the length of
 /// each pixel's RGB difference): two renders' disagreement, to hold against the same figure

@@ -7,7 +7,9 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::{Analytic, Projection, Scene};
+use crate::camera::Projection;
+use crate::mesh::Mesh;
+use crate::scene::{Analytic, Scene};
 
 /// Writes `scene` into `directory` as `<name>.json` and `<name>-object<i>.obj` (for the
 /// objects without an exact shape), lit by the
@@ -80,7 +82,7 @@ pub fn write_mitsuba_scene(
 }
 
 /// `mesh` as an OBJ file: positions, normals, and triangles indexing both.
-fn write_obj(mesh: &crate::Mesh, path: &Path) -> Result<(), String> {
+fn write_obj(mesh: &Mesh, path: &Path) -> Result<(), String> {
     let mut obj = String::new();
     for (p, n) in mesh.positions().iter().zip(mesh.normals()) {
         let _ = writeln!(obj, "v {} {} {}\nvn {} {} {}", p.x, p.y, p.z, n.x, n.y, n.z);

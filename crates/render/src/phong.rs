@@ -13,8 +13,8 @@
 
 use glam::Vec3;
 
+use crate::camera::{Camera, Projection};
 use crate::material::{IlluminationModel, Light, Shader};
-use crate::{Camera, Projection};
 use specula::Geometry;
 
 /// Three component slices of a structure-of-arrays vector field.
@@ -431,7 +431,7 @@ mod tests {
     use specula::{Exponent, Lobe, LobeKind, Normalisation};
 
     use super::*;
-    use crate::Material;
+    use crate::material::Material;
 
     /// Every branch of the vectorised path (both light kinds, geometries and models, lights
     /// below the horizon, hidden normals, a vanishing normal, a sample at a point light)

@@ -13,10 +13,11 @@ use rayon::prelude::*;
 use thiserror::Error;
 
 use crate::clip::{clip_triangle, ClipVertex, Varyings, MAX_SIDE};
+use crate::image::Image;
 use crate::material::{Shader, Shading};
 use crate::phong;
 use crate::raster::{Culling, EdgeWeights, PixelRect, ScreenVertex, Setup};
-use crate::{Analytic, Image, Scene, Settings};
+use crate::scene::{Analytic, Scene, Settings};
 
 /// Output pixels per tile side.
 const TILE: u32 = 32;

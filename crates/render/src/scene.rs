@@ -5,8 +5,10 @@
 use glam::Vec3;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 
+use crate::camera::Camera;
+use crate::image::Display;
 use crate::material::{IlluminationModel, Light, Material, Shading};
-use crate::{Camera, Display, Mesh};
+use crate::mesh::Mesh;
 
 /// The embedded default scene: a row of spheres with `n` = 4 ... 1000 and a teapot.
 pub const DEFAULT_SCENE: &str = include_str!("../data/default-scene.toml");
@@ -54,7 +56,7 @@ pub struct Object {
     /// The geometry, already transformed to world space.
     pub mesh: Mesh,
     /// The exact shape the mesh tessellates, where it has one: what a ray tracer given the
-    /// scene ([`crate::write_mitsuba_scene`]) draws instead of the triangles.
+    /// scene (`write_mitsuba_scene`) draws instead of the triangles.
     pub analytic: Option<Analytic>,
     /// The material.
     pub material: Material,

@@ -4,7 +4,7 @@ use core::f32::consts::{PI, TAU};
 
 use glam::Vec3;
 
-use crate::Mesh;
+use crate::mesh::Mesh;
 
 /// A grid of `(rows + 1) x (columns + 1)` vertices from `point(row, column) -> (position,
 /// normal)`, triangulated counter-clockwise when `d/drow x d/dcolumn` points outwards.

@@ -8,7 +8,7 @@
 
 use glam::Vec3;
 
-use crate::Mesh;
+use crate::mesh::Mesh;
 
 const TEAPOT_BPT: &str = include_str!("../data/teapot.bpt");
 

@@ -2,7 +2,7 @@
 //! in `real_scans.rs`): the lobes' exponent and shading, and how a frame's times are told.
 
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-use specula_render::volume::dvr::Shading;
+use specula_volume::dvr::Shading;
 
 /// The exponent of every lobe in the section (VTK's specular power in the comparison).
 pub(crate) const EXPONENT: f64 = 32.0;

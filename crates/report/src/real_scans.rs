@@ -9,11 +9,11 @@ use std::time::Instant;
 use glam::Vec3;
 use specula::{Exponent, LobeKind};
 use specula_render::metrics::compare;
-use specula_render::volume::dvr::{render_dvr_lobes, render_dvr_prepared, DvrSettings, View};
-use specula_render::volume::march::PreparedVolume;
-use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::{self, vtk, Units, Volume};
 use specula_render::{read_image, srgb_encode, Display, Image};
+use specula_volume::dvr::{render_dvr_lobes, render_dvr_prepared, DvrSettings, View};
+use specula_volume::march::PreparedVolume;
+use specula_volume::transfer::TransferFunction;
+use specula_volume::{self as volume, vtk, Units, Volume};
 
 use super::comparison::{self, Compared};
 use super::html::{paragraph, table_with_files};

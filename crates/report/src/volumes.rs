@@ -9,15 +9,13 @@ use glam::{DVec3, Vec3};
 use specula::{Geometry, Lobe, LobeKind};
 use specula_gpu::{Gpu, GpuVolumeRenderer};
 use specula_render::metrics::compare;
-use specula_render::volume::dvr::{
-    render_dvr_lobes, render_dvr_prepared, DvrSettings, RayCamera, View,
-};
-use specula_render::volume::isosurface::{default_isovalue, render_isosurface, IsoSettings};
-use specula_render::volume::march::PreparedVolume;
-use specula_render::volume::phantom::{self, marschner_lobb_gradient};
-use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::Volume;
 use specula_render::{Display, Image};
+use specula_volume::dvr::{render_dvr_lobes, render_dvr_prepared, DvrSettings, RayCamera, View};
+use specula_volume::isosurface::{default_isovalue, render_isosurface, IsoSettings};
+use specula_volume::march::PreparedVolume;
+use specula_volume::phantom::{self, marschner_lobb_gradient};
+use specula_volume::transfer::TransferFunction;
+use specula_volume::Volume;
 
 use super::comparison::{self, Compared};
 use super::html::{paragraph, table, table_with_files};

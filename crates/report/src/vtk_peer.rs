@@ -1,17 +1,17 @@
 //! VTK's CPU ray caster (`vtkFixedPointVolumeRayCastMapper`) as a peer: the embedded
 //! `vtk_volume.py` run by the Python that has the `vtk` and `nibabel` wheels, on jobs made by
-//! [`specula_render::volume::vtk::job`]. Used by `specula bench volume` and the report's
+//! [`specula_volume::vtk::job`]. Used by `specula bench volume` and the report's
 //! medical section.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-use specula_render::volume::dvr::{render_dvr_prepared, DvrSettings};
-use specula_render::volume::march::PreparedVolume;
-use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::{self, nifti, vtk, Volume};
 use specula_render::Image;
+use specula_volume::dvr::{render_dvr_prepared, DvrSettings};
+use specula_volume::march::PreparedVolume;
+use specula_volume::transfer::TransferFunction;
+use specula_volume::{self as volume, nifti, vtk, Volume};
 
 /// The VTK side of a comparison: `vtk_volume.py`, run by the Python that has VTK. The script
 /// lives beside this module (`crates/cli/tests/volumes/vtk_facts.py` runs it directly) and is

@@ -37,14 +37,14 @@ use specula::analysis::{analyze, Precision};
 use specula::formula::MAX_SOURCE_BYTES;
 use specula::measured::fit::POLAR_ANGLES_DEGREES;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-use specula_render::volume::dvr::View;
 use specula_render::{IlluminationModel, Shading};
+use specula_volume::dvr::View;
 
 use crate::query::{bad_lobe, pairs, ApiError, Params, QueryPairs};
 
 use super::explorer::{curves, render_png, Object, RenderRequest};
 use super::guard::{Hosts, Limiter};
-use specula_render::volume::phantom::BuiltIn;
+use specula_volume::phantom::BuiltIn;
 
 use super::environment::{
     environment_png, EnvironmentRequest, MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP,

@@ -17,12 +17,12 @@ use std::path::Path;
 use std::sync::{Mutex, OnceLock, PoisonError};
 
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-use specula_render::volume::dvr::{render_dvr_prepared, DvrSettings, Shading, View};
-use specula_render::volume::march::PreparedVolume;
-use specula_render::volume::phantom::BuiltIn;
-use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::Volume;
 use specula_render::Display;
+use specula_volume::dvr::{render_dvr_prepared, DvrSettings, Shading, View};
+use specula_volume::march::PreparedVolume;
+use specula_volume::phantom::BuiltIn;
+use specula_volume::transfer::TransferFunction;
+use specula_volume::Volume;
 
 /// The largest volume render side, in pixels.
 pub const MAX_VOLUME_SIZE: u32 = 512;
@@ -140,7 +140,7 @@ fn load(choice: Choice) -> Result<Loaded, String> {
             built_in.transfer(),
         ),
         Choice::Scan(scan) => {
-            let volume = specula_render::volume::read(scan.path()).map_err(|e| e.to_string())?;
+            let volume = specula_volume::read(scan.path()).map_err(|e| e.to_string())?;
             // `ct-bone` for Hounsfield units (the CT), `mr` otherwise.
             let transfer = TransferFunction::default_for(&volume);
             (volume, transfer)

@@ -14,10 +14,10 @@ use axum::body::{to_bytes, Body};
 use axum::http::{Request, StatusCode};
 use serde_json::Value;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-use specula_render::volume::dvr::{render_dvr, DvrSettings, Shading, View};
-use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::{self, Units};
 use specula_serve::{router, Scan};
+use specula_volume::dvr::{render_dvr, DvrSettings, Shading, View};
+use specula_volume::transfer::TransferFunction;
+use specula_volume::{self as volume, Units};
 use tower::ServiceExt as _;
 
 async fn get(uri: &str) -> (StatusCode, Vec<u8>) {

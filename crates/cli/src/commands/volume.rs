@@ -9,14 +9,12 @@ use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use specula_gpu::{Gpu, GpuRenderer, GpuVolumeRenderer};
-use specula_render::volume::dvr::{render_dvr, DvrSettings, Light, Shading, View};
-use specula_render::volume::isosurface::{
-    default_isovalue, iso_scene, marching_cubes, IsoSettings,
-};
-use specula_render::volume::phantom::BuiltIn;
-use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::{self, Volume};
 use specula_render::{check_output_path, render, write_image, Display, Image};
+use specula_volume::dvr::{render_dvr, DvrSettings, Light, Shading, View};
+use specula_volume::isosurface::{default_isovalue, iso_scene, marching_cubes, IsoSettings};
+use specula_volume::phantom::BuiltIn;
+use specula_volume::transfer::TransferFunction;
+use specula_volume::{self as volume, Volume};
 
 use super::CommandResult;
 use crate::args::{choice, parse_exponent, InputLimit, LobeParser, RendererArg};

@@ -75,7 +75,7 @@ fn a_lobe_is_its_file_and_one_registry_line() {
     );
     let mut files = Vec::new();
     for library in [
-        "specula", "gpu", "targets", "render", "report", "decide", "hw",
+        "specula", "gpu", "targets", "render", "volume", "report", "decide", "hw",
     ] {
         rust_files(&root().join("crates").join(library).join("src"), &mut files);
     }

@@ -205,8 +205,8 @@ fn volume_convert_resamples_onto_the_grid_asked_for() {
         d,
         &[&base[..], &["--resample", "24x20x18", "-o", "large.nii"]].concat(),
     );
-    let small = specula_render::volume::read(&d.join("small.nii")).unwrap();
-    let large = specula_render::volume::read(&d.join("large.nii")).unwrap();
+    let small = specula_volume::read(&d.join("small.nii")).unwrap();
+    let large = specula_volume::read(&d.join("large.nii")).unwrap();
     assert_eq!(large.dims(), [24, 20, 18]);
     for (a, b) in large.corners().iter().zip(small.corners()) {
         assert!((*a - b).length() < 1e-3, "{a} {b}");

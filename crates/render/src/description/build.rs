@@ -13,11 +13,15 @@ use super::format::{
     ShapeKind,
 };
 use super::{Locator, SceneError};
+use crate::camera::Camera;
 use crate::camera::{in_scene_range, Projection, MAX_COORDINATE};
 use crate::load::load_mesh;
 use crate::material::{Light, Material};
+use crate::mesh::Mesh;
+use crate::scene::Analytic;
 use crate::scene::Object;
-use crate::{plane, sphere, teapot, torus, Analytic, Camera, Mesh, TEAPOT_PATCHES};
+use crate::shapes::{plane, sphere, torus};
+use crate::teapot::{teapot, TEAPOT_PATCHES};
 
 pub(super) fn build_camera(
     locate: &Locator,

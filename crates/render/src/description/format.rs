@@ -1,14 +1,14 @@
 //! The scene file's shape as serde reads it: every key, its type and its default. Values are
 //! kept `Spanned` where a later check must point at them; `build.rs` turns this into a
-//! [`Scene`](crate::Scene).
+//! [`Scene`](crate::scene::Scene).
 
 use glam::Vec3;
 use serde::Deserialize;
 use toml::Spanned;
 
+use crate::image::{Display, ToneMap};
 use crate::material::{IlluminationModel, Shading};
 use crate::scene::Settings;
-use crate::{Display, ToneMap};
 
 /// Three numbers, exactly. serde's arrays stop after their length, so a `[f32; 3]` would take
 /// `[0, 0, 5, 7]` as `[0, 0, 5]`; this refuses the extra element.

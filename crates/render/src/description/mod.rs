@@ -21,8 +21,8 @@ use toml::Spanned;
 
 use self::build::{build_camera, build_light, build_object, prepare_lobes, TriangleBudget};
 use self::format::{SceneDescription, Triple};
-use crate::scene::Settings;
-use crate::{Display, Scene};
+use crate::image::Display;
+use crate::scene::{Scene, Settings, DEFAULT_SCENE, IBL_SCENE};
 
 /// A scene file that cannot be used: where, and why.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -130,10 +130,8 @@ impl Scene {
     ) -> Result<LoadedScene, SceneError> {
         match path {
             Some(path) => Scene::from_file(path),
-            None if lit_by_environment => {
-                Scene::from_toml(crate::IBL_SCENE, "<environment scene>", None)
-            }
-            None => Scene::from_toml(crate::DEFAULT_SCENE, "<default scene>", None),
+            None if lit_by_environment => Scene::from_toml(IBL_SCENE, "<environment scene>", None),
+            None => Scene::from_toml(DEFAULT_SCENE, "<default scene>", None),
         }
     }
 

@@ -28,7 +28,8 @@ use thiserror::Error;
 use super::angles;
 use super::lane_geometry::{acos, atan2, sin_cos_turns, V3};
 use super::weights::{first_bad_channel, row_sines, row_weights, weight, weights_of};
-use crate::{read_image, Image, ImageError};
+use crate::image::{read_image, Image};
+use crate::image_error::ImageError;
 
 /// An environment that cannot be used, and why.
 #[derive(Debug, Error)]

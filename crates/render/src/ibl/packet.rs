@@ -44,7 +44,7 @@ use super::draws::{Draws, SharedDraws};
 use super::lane_geometry::{Columns3, LANES};
 use super::lanes::{Brdf, Combine, Directions, Setting, SharedColumns, VariantColumns};
 use super::{Environment, Strategy};
-use crate::Material;
+use crate::material::Material;
 
 /// A scene material prepared for the packet estimator: `f = diffuse + specular lobe(t)`.
 pub(super) struct PacketSurface {

@@ -20,7 +20,7 @@ use specula::simd::{dispatch, Job, Lanes, Level};
 
 use super::lane_geometry::V3;
 use super::Environment;
-use crate::Image;
+use crate::image::Image;
 
 /// The default sky's width in pixels (height half of it).
 pub const SKY_WIDTH: u32 = 1024;

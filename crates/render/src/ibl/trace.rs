@@ -10,11 +10,12 @@ use specula::sampling::{power_heuristic, uniform, SpecularSampler};
 use super::ahead::LightCells;
 use super::packet::{shade, Frame32, PacketSurface, Point, Scratch};
 use super::{Environment, IblSettings, Strategy, MAX_SPP};
+use crate::grid::{check_grid, grid_renders, GridError, GridOptions};
+use crate::image::Image;
+use crate::material::Material;
+use crate::pipeline::RenderError;
 use crate::pipeline::{surfaces, SurfacePoint};
-use crate::{
-    check_grid, grid_renders, GridError, GridOptions, Image, Material, Overrides, RenderError,
-    Scene,
-};
+use crate::scene::{Overrides, Scene};
 use specula::brdf::luminance;
 use specula::LobeKind;
 
@@ -292,9 +293,9 @@ pub fn render_ibl_lobes(
     )
 }
 
-/// The renders a grid of `options`'s lobes asks for ([`crate::grid_renders`]), by index,
-/// from one pass of [`render_ibl_lobes`], for [`crate::made_renders`] to hand to
-/// `render_grid_with`; a grid it refuses ([`crate::check_grid`]) is refused first.
+/// The renders a grid of `options`'s lobes asks for ([`grid_renders`]), by index,
+/// from one pass of [`render_ibl_lobes`], for [`crate::grid::made_renders`] to hand to
+/// `render_grid_with`; a grid it refuses ([`check_grid`]) is refused first.
 pub fn render_ibl_grid(
     scene: &Scene,
     options: &GridOptions,

@@ -8,7 +8,7 @@ use core::f64::consts::PI;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::Image;
+use crate::image::Image;
 
 /// Rec. 709 luminance weights: how bright a linear RGB radiance looks.
 pub(super) const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);

@@ -108,8 +108,8 @@ async fn served_png(uri: &str, size: (u32, u32)) -> Vec<u8> {
 #[tokio::test]
 async fn volume_renders_the_named_volume_view_and_lobe() {
     use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-    use specula_render::volume::dvr::{render_dvr, DvrSettings, Shading, View};
-    use specula_render::volume::{phantom, transfer::TransferFunction};
+    use specula_volume::dvr::{render_dvr, DvrSettings, Shading, View};
+    use specula_volume::{phantom, transfer::TransferFunction};
 
     let uri =
         "/api/volume?volume=phantom&view=inferior&lobe=cosquad&n=40&geometry=phong&normalisat\

@@ -81,10 +81,10 @@ pub struct Args {
     /// The view of `bench volume` (anterior, posterior, left, right, superior, inferior).
     #[arg(
         long,
-        value_parser = specula_render::volume::dvr::View::parse,
+        value_parser = specula_volume::dvr::View::parse,
         default_value = "anterior",
     )]
-    view: specula_render::volume::dvr::View,
+    view: specula_volume::dvr::View,
     /// Millimetres between samples along a ray (`bench volume`; VTK's sample distance).
     #[arg(long, default_value_t = 0.5, value_parser = parse_distance)]
     sample_distance: f32,

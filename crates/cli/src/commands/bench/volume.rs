@@ -1,16 +1,16 @@
 //! `specula bench volume`: the CPU ray marcher's frames per second on one volume, beside
-//! VTK's CPU ray caster set up alike ([`specula_render::volume::vtk`]) when Python has the
+//! VTK's CPU ray caster set up alike ([`specula_volume::vtk`]) when Python has the
 //! `vtk` and `nibabel` packages.
 
 use std::path::Path;
 use std::time::Instant;
 
-use specula_render::volume::dvr::render_dvr_prepared;
-use specula_render::volume::march::PreparedVolume;
-use specula_render::volume::transfer::TransferFunction;
-use specula_render::volume::vtk;
 use specula_render::{write_image, Display};
 use specula_report::vtk_peer;
+use specula_volume::dvr::render_dvr_prepared;
+use specula_volume::march::PreparedVolume;
+use specula_volume::transfer::TransferFunction;
+use specula_volume::vtk;
 
 use super::Args;
 use crate::commands::volume::{load, Source};
