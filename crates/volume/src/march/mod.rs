@@ -28,8 +28,8 @@ use rayon::prelude::*;
 use specula::simd::{dispatch, Job, Lanes, Level};
 
 use crate::samples::{Sample, Samples};
-use crate::transfer::TransferFunction;
-use crate::volume::Volume;
+use crate::transfer::{ControlPoint, TransferFunction};
+use crate::volume::{Volume, MAX_SIDE, MAX_VOXELS};
 
 mod cells;
 #[cfg(test)]
@@ -56,8 +56,7 @@ const MOST_CLEARANCE: u8 = 16;
 
 // Lanes compute voxel and brick indices in `i32`, and `PreparedVolume::cell_along`'s rounding
 // holds for indices below 2^22: the grid's limits keep both true.
-const _: () =
-    assert!(crate::volume::MAX_VOXELS <= i32::MAX as usize && crate::volume::MAX_SIDE <= 1 << 22);
+const _: () = assert!(MAX_VOXELS <= i32::MAX as usize && MAX_SIDE <= 1 << 22);
 
 /// Entries of the table that finds a value's piece of the transfer function.
 pub const CLASSIFICATION_ENTRIES: usize = 4096;
@@ -337,9 +336,7 @@ impl Classification {
     pub fn new(volume: &PreparedVolume, transfer: &TransferFunction) -> Self {
         let points = transfer.points();
         let bounds: Vec<f32> = points.iter().map(|p| p.value).collect();
-        let entry = |p: &crate::transfer::ControlPoint| {
-            Vec4::new(p.sigma, p.colour.x, p.colour.y, p.colour.z)
-        };
+        let entry = |p: &ControlPoint| Vec4::new(p.sigma, p.colour.x, p.colour.y, p.colour.z);
         let mut pieces = vec![(points[0].value, entry(&points[0]), Vec4::ZERO)];
         for pair in points.windows(2) {
             let (a, b) = (&pair[0], &pair[1]);
