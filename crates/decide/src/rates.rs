@@ -127,7 +127,8 @@ const PASS_SECONDS: f64 = 0.015;
 /// or more at a time): in [`PASSES`] passes over every lobe, each pass timing each lobe at all
 /// its exponents, on the CPU that was idlest when it began ([`Pinned`]). A slow spell then
 /// costs a lobe one pass at the exponents it covered, every lobe is timed in every part of the
-/// run, and the passes' spread says how far one rate can be told from another. `progress` ticks once a pass per lobe.
+/// run, and the passes' spread says how far one rate can be told from another. `progress`
+/// ticks once a pass per lobe.
 #[must_use]
 pub(crate) fn kernel_rates(lobes: &[Vec<Lobe>], progress: &ProgressBar) -> Vec<Vec<Vec<f64>>> {
     let level = Level::detect();
