@@ -210,7 +210,7 @@ pub async fn models() -> impl IntoResponse {
         "max_environment_size": MAX_ENVIRONMENT_SIZE,
         "max_environment_spp": MAX_ENVIRONMENT_SPP,
         // The sphere the page draws itself (live.js) and /api/live-sphere draws here.
-        "live": crate::live::LIVE_SCENE,
+        "live": crate::scene_setup::LIVE_SCENE,
         // The text box's language and limit (a formula is sent as `lobe==FORMULA`).
         "formula": {
             "max_bytes": MAX_SOURCE_BYTES,

@@ -12,7 +12,7 @@ use specula::analysis::albedo::specular_albedo_per_unit;
 use specula::{zones, Brdf, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
 use specula_render::{IlluminationModel, Scene, Shading};
 
-use crate::live::{light_towards, tonemap_for, LIVE_SCENE};
+use crate::scene_setup::{light_towards, tonemap_for, LIVE_SCENE};
 
 /// Samples along each curve.
 const CURVE_POINTS: usize = 361;

@@ -8,7 +8,8 @@ use specula_render::IlluminationModel;
 
 use super::{json, png_size, served_png};
 use crate::explorer::{scene, Object, RenderRequest};
-use crate::live::{light_towards, sphere_radiance, SphereRequest, LIVE_SCENE};
+use crate::live::{sphere_radiance, SphereRequest};
+use crate::scene_setup::{light_towards, LIVE_SCENE};
 
 /// Every built-in lobe and a formula lobe export for WebGL 2: GLSL ES 3.00 functions with
 /// `specula_specular`, no `#version` line (the page's shader puts its own first), no entry
