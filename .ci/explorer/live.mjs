@@ -37,6 +37,11 @@ try {
   const messages = [];
   page.on("console", (message) => messages.push(`${message.type()}: ${message.text()}`));
   page.on("pageerror", (error) => messages.push(`pageerror: ${error.message}`));
+  const shaderRequests = [];
+  page.on("request", (request) => {
+    const address = new URL(request.url());
+    if (address.pathname === "/api/shader") shaderRequests.push(address.searchParams);
+  });
   // The page has drawn the address it holds, and (when given) that address has `key` at `value`.
   const drawn = (key = null, value = null) => page.waitForFunction(([k, v]) => {
     const shown = document.body.dataset.drawn ?? "";
@@ -73,6 +78,7 @@ try {
     const [geometry, normalisation, theta, phi, n] = settings[k % settings.length];
     const result = await page.evaluate(async ({ lobe, geometry, normalisation, theta, phi, n }) => {
       const [mine, pow] = await Promise.all([lobeShader(lobe, n, geometry, normalisation), lobeShader("pow", n, geometry, normalisation)]);
+      liveUniforms.u_n = n;
       live.spheres.setLobes(mine.glsl, pow.glsl, mine.tonemap, false);
       live.spheres.light = lightTowards(theta, phi);
       live.spheres.draw();
@@ -94,6 +100,12 @@ try {
     if (result.worst > MAX_LEVELS || result.share > MAX_SHARE_BEYOND_ONE) failures.push(`the WebGL sphere of ${lobe} differs from the server's: ${result.worst} levels, ${(100 * result.share).toFixed(3)} % of pixels beyond 1`);
   }
   console.log(`spheres: largest difference ${worstLevels} levels, at most ${(100 * worstShare).toFixed(3)} % of pixels beyond 1 level`);
+  // pow's constants are closed forms of n: its text, fetched once per geometry and
+  // normalisation, served every n the loop asked (n as the uniform u_n).
+  const powFamilies = new Set(lobes.map((_, k) => settings[k % settings.length].slice(0, 2).join("|")));
+  const powFetches = shaderRequests.filter((query) => query.get("lobe") === "pow").length;
+  console.log(`pow's shader fetched ${powFetches} times for ${lobes.length} spheres at ${new Set(settings.map((s) => s[4])).size} values of n`);
+  if (powFetches !== powFamilies.size) failures.push(`pow's shader was fetched ${powFetches} times, not once per geometry and normalisation (${powFamilies.size}): n is not a uniform`);
 
   // The WebGL teapot against `specula render`'s (the CPU renderer's /api/render) of the same
   // lobe and light, on the pixels whose neighbours are all teapot in both and none more than
@@ -103,6 +115,7 @@ try {
   for (const [lobe, geometry, normalisation, n, theta, phi] of [["pow", "phong", "none", 32, 30, 45], ["schlick", "blinn", "lobe", 200, 50, -60], ["=exp2(n * (t - 1) * 1.4427)", "phong", "lobe", 64, 20, 100]]) {
     const result = await page.evaluate(async ({ lobe, geometry, normalisation, n, theta, phi, edge }) => {
       const mine = await lobeShader(lobe, n, geometry, normalisation);
+      liveUniforms.u_n = n;
       live.teapot.setLobe(mine.glsl, mine.tonemap, false);
       live.teapot.light = lightTowards(theta, phi);
       const { size, pixels } = live.teapot.read();
@@ -137,6 +150,8 @@ try {
   for (const [lobe, thetaIn] of [["cosquad", 30], ["schlick", 60]]) {
     const result = await page.evaluate(async ({ lobe, thetaIn }) => {
       const query = new URLSearchParams({ lobe, n: "32", geometry: "phong", normalisation: "lobe", theta_in: thetaIn });
+      // The page's programs are its own state's (n = 32), whatever n the checks above set.
+      liveUniforms.u_n = 32;
       const api = await getJson("/api/evaluate?" + query);
       const directions = api.polar_deg.map((deg) => [Math.sin((deg * Math.PI) / 180), 0, Math.cos((deg * Math.PI) / 180)]);
       const t = (thetaIn * Math.PI) / 180;

@@ -21,7 +21,10 @@ use thiserror::Error;
 
 use crate::wgsl;
 
+mod engines;
 mod es100;
+
+pub use engines::Engine;
 
 /// A shading language naga writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -100,6 +103,10 @@ pub struct Options {
     pub example: bool,
     /// The GLSL dialect (for [`Language::Glsl`]).
     pub glsl: GlslVersion,
+    /// Take `n` as the functions' first argument (`specula_specular(n, normal, wo, wi)`), the
+    /// lobe's constants and normalisation computed from it in the shader, so a renderer can
+    /// make `n` a uniform ([`export_wgsl_source_of_n`]); otherwise `n` is baked in.
+    pub n_input: bool,
 }
 
 /// What an export produces: source text, or SPIR-V words.
@@ -131,11 +138,13 @@ pub enum ExportFormat {
     Naga(Language),
     /// A renderer's file: OSL, MaterialX, Mitsuba 3.
     Renderer(specula_targets::RendererFormat),
+    /// A real-time engine's module patching its Phong material: three.js, Babylon.js.
+    Engine(Engine),
 }
 
 impl ExportFormat {
     /// Every format, in the order `--help` lists them.
-    pub const ALL: [ExportFormat; 8] = [
+    pub const ALL: [ExportFormat; 10] = [
         ExportFormat::Naga(Language::Wgsl),
         ExportFormat::Naga(Language::Glsl),
         ExportFormat::Naga(Language::Hlsl),
@@ -144,6 +153,8 @@ impl ExportFormat {
         ExportFormat::Renderer(specula_targets::RendererFormat::Osl),
         ExportFormat::Renderer(specula_targets::RendererFormat::MaterialX),
         ExportFormat::Renderer(specula_targets::RendererFormat::Mitsuba),
+        ExportFormat::Engine(Engine::ThreeJs),
+        ExportFormat::Engine(Engine::Babylon),
     ];
 
     /// The name on the command line.
@@ -152,6 +163,7 @@ impl ExportFormat {
         match self {
             ExportFormat::Naga(language) => language.id(),
             ExportFormat::Renderer(renderer) => renderer.id(),
+            ExportFormat::Engine(engine) => engine.id(),
         }
     }
 
@@ -172,6 +184,16 @@ impl ExportFormat {
             ExportFormat::Naga(language) => {
                 export(lobe, geometry, normalisation, language, options).map_err(|e| e.to_string())
             }
+            ExportFormat::Renderer(_) | ExportFormat::Engine(_) if options.n_input => Err(format!(
+                "--n-input is for naga's languages ({}); {} takes n as an input already \
+                        where the lobe's constants follow it",
+                Language::ALL.map(Language::id).join(", "),
+                self.id()
+            )),
+            ExportFormat::Engine(engine) => engine
+                .write(lobe, geometry, normalisation)
+                .map(ShaderCode::Text)
+                .map_err(|e| e.to_string()),
             ExportFormat::Renderer(renderer) => renderer
                 .write(lobe, geometry, normalisation)
                 .map(ShaderCode::Text),
@@ -194,15 +216,13 @@ fn float(value: f32) -> String {
     format!("{value:?}")
 }
 
-/// The WGSL module an export starts from.
+/// The WGSL module an export starts from, `n` baked in as the lobe's prepared constants.
 #[must_use]
 pub fn export_wgsl_source(lobe: &Lobe, geometry: Geometry, normalisation: Normalisation) -> String {
     let scale = normalisation.constant_for(lobe) as f32;
     let kind = lobe.kind();
-    let mut source = String::new();
-    let _ = writeln!(
-        source,
-        "// specula: {kind}, n = {}, geometry {}, normalisation {} (N = {})",
+    let mut source = format!(
+        "// specula: {kind}, n = {}, geometry {}, normalisation {} (N = {})\n",
         lobe.exponent(),
         geometry.id(),
         normalisation.id(),
@@ -216,8 +236,8 @@ pub fn export_wgsl_source(lobe: &Lobe, geometry: Geometry, normalisation: Normal
     let _ = write!(
         source,
         "
-const SPECULA_NORMALISATION: f32 = {};
-const SPECULA_GEOMETRY: u32 = {}u;
+const SPECULA_NORMALISATION: f32 = {scale};
+const SPECULA_GEOMETRY: u32 = {geometry}u;
 
 // {kind} at cosine t (n = {n}): 0 for t <= 0 or NaN, t above 1 counts as 1.
 fn specula_lobe(t: f32) -> f32 {{
@@ -226,17 +246,116 @@ fn specula_lobe(t: f32) -> f32 {{
     }}
     return specula_lobe_unit(min(t, 1.0));
 }}
-
-// The lobe's cosine ({cosine}) from unit vectors pointing away from the surface.
-fn specula_cos_lobe(normal: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {{
-    return cos_lobe(SPECULA_GEOMETRY, normal, wo, wi);
-}}
-
+{cos_lobe}
 // N(n) lobe(t): the specular BRDF term per unit ks.
 fn specula_specular(normal: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {{
     return SPECULA_NORMALISATION * specula_lobe(specula_cos_lobe(normal, wo, wi));
 }}
+{example}",
+        scale = float(scale),
+        geometry = geometry_code(geometry),
+        n = lobe.exponent(),
+        cos_lobe = cos_lobe_function(geometry),
+        example = example_shader(""),
+    );
+    source
+}
 
+/// The WGSL module of an export that takes `n` as an argument (`Options::n_input`): the
+/// lobe's constants and the normalisation computed from `n` in the shader, `n` kept within the
+/// range where the lobe's operations stay the same ([`Lobe::structural_range`]). `Err` says
+/// why the lobe cannot follow `n` there: its constants are fitted, or its own normalisation
+/// is only a numerical integral.
+pub fn export_wgsl_source_of_n(
+    lobe: &Lobe,
+    geometry: Geometry,
+    normalisation: Normalisation,
+) -> Result<String, String> {
+    let lobe_of_n = specula_targets::wgsl::lobe_function_of_n(lobe, "specula_lobe_unit")
+        .ok_or_else(|| {
+            format!(
+                "{}'s constants are fitted for n = {} and do not follow n",
+                lobe.kind(),
+                lobe.exponent()
+            )
+        })?;
+    let normalisation_of_n = specula_targets::wgsl::normalisation_function_of_n(
+        lobe,
+        normalisation,
+        "specula_normalisation",
+    )?;
+    let [low, high] = lobe.structural_range();
+    let kind = lobe.kind();
+    let mut source = format!(
+        "// specula: {kind}, n an argument in {} (exported at n = {}), geometry {}, \
+            normalisation {}\n",
+        specula_targets::code::describe_range([low, high]),
+        lobe.exponent(),
+        geometry.id(),
+        normalisation.id(),
+    );
+    if lobe.expression().has_bit_tricks() {
+        source.push_str(specula_targets::wgsl::BIT_TRICKS);
+    }
+    source.push_str(&lobe_of_n);
+    source.push_str(&normalisation_of_n);
+    source.push_str(wgsl::GEOMETRY);
+    let _ = write!(
+        source,
+        "
+// The exported n, which the example passes, and the range the functions keep n within.
+const SPECULA_N: f32 = {n};
+const SPECULA_N_LOW: f32 = {low};
+const SPECULA_N_HIGH: f32 = {high};
+const SPECULA_GEOMETRY: u32 = {geometry}u;
+
+// {kind} at cosine t for the exponent n: 0 for t <= 0 or NaN, t above 1 counts as 1.
+fn specula_lobe(n: f32, t: f32) -> f32 {{
+    if !(t > 0.0) {{
+        return 0.0;
+    }}
+    return specula_lobe_unit(clamp(n, SPECULA_N_LOW, SPECULA_N_HIGH), min(t, 1.0));
+}}
+{cos_lobe}
+// N(n) lobe(t): the specular BRDF term per unit ks, for the exponent n.
+fn specula_specular(n: f32, normal: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {{
+    let exponent = clamp(n, SPECULA_N_LOW, SPECULA_N_HIGH);
+    return specula_normalisation(exponent) * specula_lobe(exponent, specula_cos_lobe(normal, wo, wi));
+}}
+{example}",
+        n = float(lobe.exponent().get() as f32),
+        low = float(low as f32),
+        high = float(high as f32),
+        geometry = geometry_code(geometry),
+        cos_lobe = cos_lobe_function(geometry),
+        example = example_shader("SPECULA_N, "),
+    );
+    Ok(source)
+}
+
+fn geometry_code(geometry: Geometry) -> u32 {
+    match geometry {
+        Geometry::Phong => 0,
+        Geometry::Blinn => 1,
+    }
+}
+
+fn cos_lobe_function(geometry: Geometry) -> String {
+    format!(
+        "
+// The lobe's cosine ({}) from unit vectors pointing away from the surface.
+fn specula_cos_lobe(normal: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {{
+    return cos_lobe(SPECULA_GEOMETRY, normal, wo, wi);
+}}
+",
+        geometry.cosine_name()
+    )
+}
+
+/// The example fragment shader, calling `specula_specular` with `arguments_before` first.
+fn example_shader(arguments_before: &str) -> String {
+    format!(
+        "
 // Example: white specular reflection of a unit light, as radiance f(wo, wi) cos(theta_i).
 @fragment
 fn fs_main(
@@ -246,19 +365,11 @@ fn fs_main(
 ) -> @location(0) vec4<f32> {{
     let n = normalize(normal);
     let l = normalize(wi);
-    let value = specula_specular(n, normalize(wo), l) * max(dot(n, l), 0.0);
+    let value = specula_specular({arguments_before}n, normalize(wo), l) * max(dot(n, l), 0.0);
     return vec4<f32>(value, value, value, 1.0);
 }}
-",
-        float(scale),
-        match geometry {
-            Geometry::Phong => 0,
-            Geometry::Blinn => 1,
-        },
-        n = lobe.exponent(),
-        cosine = geometry.cosine_name(),
-    );
-    source
+"
+    )
 }
 
 /// naga's GLSL without the example: its stage's inputs and outputs (the globals naga names
@@ -286,7 +397,16 @@ pub fn export(
         language: language.id(),
         message,
     };
-    let source = export_wgsl_source(lobe, geometry, normalisation);
+    let source = if options.n_input {
+        export_wgsl_source_of_n(lobe, geometry, normalisation).map_err(|message| {
+            fail(format!(
+                "{message}; export with n baked in (without --n-input), or choose a lobe whose \
+                    constants are closed forms of n"
+            ))
+        })?
+    } else {
+        export_wgsl_source(lobe, geometry, normalisation)
+    };
     let (mut module, _) = wgsl::validate(&source).map_err(fail)?;
     naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
     let (module, info) = {

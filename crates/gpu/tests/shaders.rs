@@ -7,7 +7,9 @@ mod common;
 use std::process::Command;
 
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
-use specula_gpu::export::{export, export_wgsl_source, GlslVersion, Language, Options, ShaderCode};
+use specula_gpu::export::{
+    export, export_wgsl_source, export_wgsl_source_of_n, GlslVersion, Language, Options, ShaderCode,
+};
 use specula_gpu::{wgsl, LobeEvaluator};
 
 /// Every lobe of `LobeKind::ALL` has its function in the render module, which naga validates,
@@ -140,6 +142,7 @@ fn every_lobe_exports_to_every_language_and_validates() {
                 let options = Options {
                     example: true,
                     glsl: GlslVersion::Desktop450,
+                    n_input: false,
                 };
                 let code = export(&lobe, geometry, normalisation, language, options)
                     .unwrap_or_else(|e| panic!("{kind} {language:?}: {e}"));
@@ -215,4 +218,97 @@ fn the_exported_function_evaluates_like_the_library() {
         let library = evaluator.eval(&lobe, &ts).unwrap();
         assert_eq!(exported, library, "{kind} n = {}", lobe.exponent());
     }
+}
+
+/// The export that takes `n` (`--n-input`) computes, at an `n` other than the exported one
+/// inside the range it serves, the lobe prepared for that `n` and its normalisation: on the
+/// GPU through wrappers appended to the export, against the library's lobe (whose constants
+/// are prepared in `f64`, so within `f32` rounding of the constants rather than bit for bit)
+/// and the normalisation's `f64` constant. Every lobe whose constants follow `n`, every shape,
+/// every normalisation; a fitted lobe is refused with the reason.
+#[test]
+fn the_export_taking_n_computes_the_lobe_prepared_for_that_n() {
+    let Some(gpu) = common::gpu() else { return };
+    let evaluator = LobeEvaluator::new(&gpu).unwrap();
+    let directory = tempfile::tempdir().unwrap();
+    let glslang = tool("glslangValidator");
+    let ts: Vec<f32> = (0..=500)
+        .map(|i| 1.0 - (i as f32 / 500.0).powi(2))
+        .collect();
+    let mut taking = 0;
+    for exported in one_lobe_per_function(0.37) {
+        let kind = exported.kind();
+        let [low, high] = exported.structural_range();
+        let other = (low + 0.61 * (high.min(1000.0) - low)).max(exported.exponent().get());
+        let at = Lobe::new(kind, Exponent::new(other));
+        for normalisation in Normalisation::ALL {
+            let source = match export_wgsl_source_of_n(&exported, Geometry::Phong, normalisation) {
+                Ok(source) => source,
+                Err(reason) => {
+                    let fitted = at.parameters().iter().any(|p| p.preparation.is_none());
+                    let numerical = normalisation == Normalisation::Lobe
+                        && at.sampling_expressions().is_none()
+                        && at.newton_expressions().is_none();
+                    assert!(fitted || numerical, "{kind} {normalisation:?}: {reason}");
+                    assert!(reason.contains("fitted") || reason.contains("numerically"));
+                    continue;
+                }
+            };
+            taking += 1;
+            let options = Options {
+                example: true,
+                glsl: GlslVersion::Es300,
+                n_input: true,
+            };
+            let label = format!("{kind} {normalisation:?} GLSL ES 3.00 taking n");
+            let Ok(ShaderCode::Text(glsl)) = export(
+                &exported,
+                Geometry::Phong,
+                normalisation,
+                Language::Glsl,
+                options,
+            ) else {
+                panic!("{label}: no GLSL");
+            };
+            assert!(
+                glsl.contains("float specula_specular(float n, vec3 "),
+                "{label}"
+            );
+            if let Some(glslang) = glslang {
+                let path = directory.path().join("lobe.frag");
+                std::fs::write(&path, &glsl).unwrap();
+                let out = Command::new(glslang).arg(&path).output().unwrap();
+                let log = String::from_utf8_lossy(&out.stdout);
+                assert!(out.status.success(), "{label}: {log}");
+            }
+            let n = format!("{:?}", other as f32);
+            let source = format!(
+                "{source}\nfn lobe_at(t: f32) -> f32 {{ return specula_lobe({n}, t); }}\n\
+                    fn normalisation_at(t: f32) -> f32 {{ return specula_normalisation({n}); }}\n"
+            );
+            let label = format!(
+                "{kind} exported at n = {}, run at {other}",
+                exported.exponent()
+            );
+            let shader = specula_gpu::evaluate_wgsl_function(&gpu, &source, "lobe_at", &ts)
+                .unwrap_or_else(|e| panic!("{label}: {e}"));
+            let library = evaluator.eval(&at, &ts).unwrap();
+            let worst = shader
+                .iter()
+                .zip(&library)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0f32, f32::max);
+            assert!(worst <= 2e-5, "{label}: lobe differs by {worst}");
+            let constant =
+                specula_gpu::evaluate_wgsl_function(&gpu, &source, "normalisation_at", &[0.5])
+                    .unwrap()[0];
+            let expected = normalisation.constant_for(&at);
+            let relative = (f64::from(constant) - expected).abs() / expected;
+            assert!(
+                relative <= 1e-5,
+                "{label} {normalisation:?}: N = {constant}, expected {expected}"
+            );
+        }
+    }
+    assert!(taking > 20, "only {taking} exports took n");
 }

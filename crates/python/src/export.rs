@@ -23,6 +23,7 @@ pub fn shader(
     language: &str,
     glsl_version: &str,
     example: bool,
+    n_input: bool,
 ) -> PyResult<Py<PyAny>> {
     let format = ExportFormat::parse(language).map_err(value_error)?;
     let glsl = choose(
@@ -32,7 +33,16 @@ pub fn shader(
         "GLSL version",
     )?;
     let code = format
-        .write(lobe, geometry, normalisation, Options { example, glsl })
+        .write(
+            lobe,
+            geometry,
+            normalisation,
+            Options {
+                example,
+                glsl,
+                n_input,
+            },
+        )
         .map_err(value_error)?;
     Ok(match code {
         ShaderCode::Text(text) => text.into_pyobject(py)?.into_any().unbind(),

@@ -395,13 +395,18 @@ impl Lobe {
     ///     With GLSL: ``"450"``, ``"300es"`` or ``"100"``.
     /// example : bool
     ///     Include the example fragment shader that calls the functions.
-    #[pyo3(signature = (language, glsl_version = "450", example = false))]
+    /// n_input : bool
+    ///     Take ``n`` as the functions' first argument, the constants computed from it in the
+    ///     shader (``specula shader --n-input``; naga's languages, lobes whose constants are
+    ///     closed forms of ``n``).
+    #[pyo3(signature = (language, glsl_version = "450", example = false, n_input = false))]
     fn shader(
         &self,
         py: Python<'_>,
         language: &str,
         glsl_version: &str,
         example: bool,
+        n_input: bool,
     ) -> PyResult<Py<PyAny>> {
         guarded(|| {
             crate::export::shader(
@@ -411,6 +416,7 @@ impl Lobe {
                 language,
                 glsl_version,
                 example,
+                n_input,
             )
         })
     }

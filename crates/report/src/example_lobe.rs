@@ -129,6 +129,7 @@ fn every_export_writes_it() {
         let options = Options {
             example: true,
             glsl: GlslVersion::Desktop450,
+            n_input: false,
         };
         let code = export(
             &lobe,

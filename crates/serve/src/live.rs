@@ -2,9 +2,12 @@
 //! function from the shader export (`specula shader --lang glsl --glsl-version 300es`), and
 //! the one lit sphere both sides draw, described here once.
 //!
-//! - `GET /api/shader?lobe&n&geometry&normalisation`: `{glsl, tonemap}`, the lobe's exported
-//!   functions (`specula_specular(normal, wo, wi)` and what it calls; `n` is baked in as the
-//!   export's prepared constants) and the tone map the renders use with that normalisation;
+//! - `GET /api/shader?lobe&n&geometry&normalisation`: `{glsl, n_range, tonemap}`, the lobe's
+//!   exported functions and the tone map the renders use with that normalisation. Where the
+//!   lobe's constants and its normalisation are closed forms of `n`, the functions take it
+//!   (`specula_specular(n, normal, wo, wi)`, `--n-input`) and `n_range` is the range they
+//!   serve, so the page changes `n` as a uniform within it; elsewhere (`n_range` null) `n` is
+//!   baked in (`specula_specular(normal, wo, wi)`) and a new `n` fetches new functions;
 //! - `GET /api/live-sphere?lobe&n&geometry&normalisation&model&light_theta&light_phi&size`:
 //!   the sphere the page draws live, computed here per pixel with the renderer's shading
 //!   ([`Shader::shade`]) and display encoding, as a PNG: what the browser check compares the
@@ -34,24 +37,49 @@ use crate::scene_setup::{light_towards, tonemap_for, LIVE_SCENE};
 /// The largest live-sphere reference, in pixels a side.
 pub const MAX_LIVE_SIZE: u32 = 512;
 
-/// The lobe's GLSL ES 3.00 functions, without the `#version` line (the page's shaders put
-/// their own first) and without the example entry point.
+/// A lobe's GLSL ES 3.00 functions for the page.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LiveShader {
+    /// The functions, without the `#version` line (the page's shaders put their own first)
+    /// and without the example entry point.
+    pub glsl: String,
+    /// Where the functions take `n` as their first argument (`specula shader --n-input`):
+    /// the exponents they serve, `[low, high]`; `None` where `n` is baked in.
+    pub n_range: Option<[f64; 2]>,
+}
+
+/// The lobe's GLSL ES 3.00 functions, with `n` as an argument where the lobe's constants and
+/// the normalisation are closed forms of it (the page then changes `n` as a uniform), baked
+/// in otherwise.
 pub fn glsl_functions(
     lobe: &Lobe,
     geometry: Geometry,
     normalisation: Normalisation,
-) -> Result<String, String> {
-    let options = Options {
-        example: false,
-        glsl: GlslVersion::Es300,
+) -> Result<LiveShader, String> {
+    let write = |n_input: bool| {
+        let options = Options {
+            example: false,
+            glsl: GlslVersion::Es300,
+            n_input,
+        };
+        match export(lobe, geometry, normalisation, Language::Glsl, options) {
+            Ok(ShaderCode::Text(text)) => Ok(text
+                .split_once('\n')
+                .map_or(text.as_str(), |(_, body)| body)
+                .to_owned()),
+            Ok(ShaderCode::SpirV(_)) => Err("the GLSL export wrote SPIR-V".to_owned()),
+            Err(error) => Err(error.to_string()),
+        }
     };
-    match export(lobe, geometry, normalisation, Language::Glsl, options) {
-        Ok(ShaderCode::Text(text)) => Ok(text
-            .split_once('\n')
-            .map_or(text.as_str(), |(_, body)| body)
-            .to_owned()),
-        Ok(ShaderCode::SpirV(_)) => Err("the GLSL export wrote SPIR-V".to_owned()),
-        Err(error) => Err(error.to_string()),
+    match write(true) {
+        Ok(glsl) => Ok(LiveShader {
+            glsl,
+            n_range: Some(lobe.structural_range()),
+        }),
+        Err(_) => write(false).map(|glsl| LiveShader {
+            glsl,
+            n_range: None,
+        }),
     }
 }
 
@@ -137,7 +165,7 @@ pub async fn shader(
         params.geometry()?,
         params.normalisation(Normalisation::None)?,
     );
-    let glsl = compute_with(&state, kind, n, move |lobe| {
+    let shader = compute_with(&state, kind, n, move |lobe| {
         glsl_functions(&lobe, geometry, normalisation)
     })
     .await?
@@ -145,7 +173,8 @@ pub async fn shader(
     Ok(Json(json!({
         "lobe": kind.to_string(),
         "n": n.get(),
-        "glsl": glsl,
+        "glsl": shader.glsl,
+        "n_range": shader.n_range,
         "tonemap": tonemap_for(normalisation).id(),
     }))
     .into_response())

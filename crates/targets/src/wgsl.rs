@@ -3,9 +3,10 @@
 
 use core::fmt::Write as _;
 
-use specula::Lobe;
+use specula::expression::record;
+use specula::{Lobe, Normalisation};
 
-use crate::code::{body, straight_line, Dialect, Inputs, Parameters};
+use crate::code::{body, straight_line, straight_line_named, Dialect, Inputs, Parameters};
 
 struct Wgsl;
 
@@ -72,6 +73,61 @@ fn {name}(n: f32, t: f32) -> f32 {{
         body(&lines, &result, "    ", |r| format!("return {r};")),
     );
     Some(out)
+}
+
+/// `fn {name}(n: f32) -> f32`: `normalisation`'s constant `N(n)` for `lobe`, computed from `n`
+/// in the shader beside [`lobe_function_of_n`]. The analytic normalisations are their recorded
+/// formulas; the lobe's own (`1 / (2 pi int_0^1 lobe)`) needs the lobe's integral in closed
+/// form of its parameters, which the lobes sampled in closed form or by Newton's method record
+/// ([`Lobe::sampling_expressions`], [`Lobe::newton_expressions`]). `Err` says why not: a
+/// fitted lobe, or a lobe whose integral is only numerical.
+pub fn normalisation_function_of_n(
+    lobe: &Lobe,
+    normalisation: Normalisation,
+    name: &str,
+) -> Result<String, String> {
+    let inputs = Inputs::of(lobe);
+    if inputs.exponent.is_none() {
+        return Err(format!(
+            "{}'s constants are fitted for n = {} and do not follow n",
+            lobe.kind(),
+            lobe.exponent()
+        ));
+    }
+    let mut lines = Vec::new();
+    let result = if normalisation == Normalisation::Lobe {
+        let total = lobe
+            .sampling_expressions()
+            .map(|(_, total)| total)
+            .or_else(|| lobe.newton_expressions().map(|[.., total]| total))
+            .ok_or_else(|| {
+                format!(
+                    "{}'s own normalisation (lobe) is its integral computed numerically, not a \
+                        closed form of n",
+                    lobe.kind()
+                )
+            })?;
+        lines = inputs.preparation("n", &Wgsl);
+        let (statements, total) = straight_line_named(&total, "0.0", &Wgsl, Parameters::Named, "w");
+        lines.extend(statements);
+        format!("1.0 / (6.2831855 * ({total}))")
+    } else {
+        let formula = record(|n| normalisation.formula(n))
+            .unwrap_or_else(|_| unreachable!("the normalisations' formulas have no branch"));
+        let (statements, result) = straight_line(&formula, "n", &Wgsl, Parameters::Baked);
+        lines.extend(statements);
+        result
+    };
+    Ok(format!(
+        "
+// The normalisation {} of {} for the exponent n; generated from specula's description.
+fn {name}(n: f32) -> f32 {{
+{}}}
+",
+        normalisation.id(),
+        lobe.kind(),
+        body(&lines, &result, "    ", |r| format!("return {r};")),
+    ))
 }
 
 /// `fn {name}(t: f32) -> f32`: the lobe for `t` in `(0, 1]`, generated from

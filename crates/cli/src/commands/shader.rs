@@ -30,7 +30,9 @@ pub struct Args {
     normalisation: Normalisation,
     /// The shading language: wgsl, glsl, hlsl, msl, spirv (a function for one's own
     /// shader), osl (a Blender Cycles script node), mtlx (a MaterialX
-    /// document) or mitsuba (a Mitsuba 3 BSDF plugin in Python).
+    /// document), mitsuba (a Mitsuba 3 BSDF plugin in Python), threejs (an ES module patching
+    /// a MeshPhongMaterial or MeshPhongNodeMaterial) or babylon (an ES module with a
+    /// MaterialPluginBase for StandardMaterial).
     #[arg(long, value_parser = choice(&ExportFormat::ALL, ExportFormat::id))]
     lang: ExportFormat,
     /// The GLSL dialect (with --lang glsl): 450 (Vulkan, OpenGL 4.5), 300es (OpenGL ES 3,
@@ -41,6 +43,12 @@ pub struct Args {
     /// default, so the text pastes into a shader of one's own; the other languages keep it).
     #[arg(long)]
     example: bool,
+    /// Take n as the functions' first argument (`specula_specular(n, normal, wo, wi)`), the
+    /// lobe's constants and N(n) computed from it in the shader, so that n can be a uniform;
+    /// naga's languages only, for lobes whose constants are closed forms of n (kept within the
+    /// range where the lobe's operations stay the same, stated in the header).
+    #[arg(long)]
+    n_input: bool,
     /// Write to this file instead of standard output (required for SPIR-V, a binary).
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -55,6 +63,7 @@ pub fn run(args: &Args) -> CommandResult {
     let options = Options {
         example: args.example,
         glsl: args.glsl_version,
+        n_input: args.n_input,
     };
     let code = args
         .lang

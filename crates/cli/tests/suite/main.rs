@@ -11,6 +11,7 @@ mod bad_inputs;
 mod blender;
 mod cli;
 mod design;
+mod engines;
 mod enhanced_dicom;
 mod fit;
 mod gpu;

@@ -5,7 +5,7 @@
 // (app.js's schedule). Without WebGL2 the server's sphere image is shown instead.
 "use strict";
 
-const live = { spheres: null, lobe: null, slice: null, slicePow: null, teapot: null, chosen: null, frame: 0, key: "", lobes: [], drawnLobes: null, dragging: false };
+const live = { spheres: null, lobe: null, slice: null, slicePow: null, teapot: null, chosen: null, frame: 0, key: "", programs: "", lobes: [], drawnLobes: null, dragging: false };
 // The polar plot's outgoing angles while a drag redraws it from the GPU (-90 to 90 degrees).
 const LIVE_POLAR_DEG = Array.from({ length: 181 }, (_, k) => k - 90);
 
@@ -106,6 +106,11 @@ async function liveLobes(state, shown, lobes) {
   const names = [...new Set([shown || "pow", ...lobes, "pow"])];
   const texts = await Promise.all(names.map((name) => lobeShader(apiLobe(name), ...common).catch(() => null)));
   if (live.key !== key) return;
+  liveUniforms.u_n = Number(state.n);
+  // The same texts (every lobe taking n, inside the ranges they serve): nothing to compile.
+  const programs = JSON.stringify([shown, names, texts.map((text) => text?.glsl), state.model]);
+  if (programs === live.programs) return liveRedrawAll();
+  live.programs = programs;
   const byName = new Map(names.map((name, k) => [name, texts[k]]).filter(([, text]) => text));
   const chosen = byName.get(shown || "pow") ?? byName.get("pow");
   if (!chosen) return;
@@ -118,9 +123,14 @@ async function liveLobes(state, shown, lobes) {
   live.drawnLobes = lobes.filter((name) => byName.has(name));
   $("lobe3d-name").textContent = first;
   live.slice.setLobe(chosen.glsl);
+  live.slicePow.setLobe(byName.get("pow").glsl);
+  liveRedrawAll();
+}
+
+// Redraws every live view, the slices (which follow n, not the light) with them.
+function liveRedrawAll() {
   live.slice.draw();
   // pow's slice beside it, its axes labelled from its peak f(n, n) as the GPU evaluates it.
-  live.slicePow.setLobe(byName.get("pow").glsl);
   const peak = live.lobe.evaluate("pow", [[0, 0, 1]], [0, 0, 1]).values[0];
   drawSlice($("slice-pow"), { lobe: "pow", slice: [peak], slice_size: 1 }, true);
   live.slicePow.draw();

@@ -1,17 +1,39 @@
 // specula explorer, the views the browser draws itself (WebGL2): the lit sphere of the chosen
 // lobe beside pow's and their difference, from each lobe's GLSL ES 3.00 export (/api/shader,
 // what `specula shader --lang glsl --glsl-version 300es` writes). The lobe's formula is never
-// written here: its text is spliced into the shaders as the server exported it. n is baked
-// into that text (the export's prepared constants), so a new n fetches a new function; the
-// light and the camera are uniforms, so dragging the light redraws without the server.
+// written here: its text is spliced into the shaders as the server exported it. Where the
+// lobe's constants are closed forms of n, the export takes n as an argument (`--n-input`) and
+// the page passes the uniform u_n, so a new n inside the range the text serves redraws
+// without the server; a fitted lobe's text has n baked in, and a new n fetches a new one. The
+// light and the camera are uniforms, so dragging the light never asks the server.
 "use strict";
 
-// One GLSL ES 3.00 text per lobe, n, geometry and normalisation, fetched once.
+// The uniforms every live program reads where it declares them: n, for the texts that take it.
+const liveUniforms = { u_n: 64 };
+
+// Where the export takes n as its first argument, the page's calls without it read u_n.
+const N_UNIFORM = `
+uniform float u_n;
+float specula_specular(vec3 normal, vec3 wo, vec3 wi) { return specula_specular(u_n, normal, wo, wi); }
+`;
+
+// One GLSL ES 3.00 text per lobe, geometry and normalisation and the exponents it serves:
+// fetched for one n, kept for every n in its range (all of them, one at a time, where n is
+// baked in).
 const shaderTexts = new Map();
+const shaderRanges = new Map();
 function lobeShader(lobe, n, geometry, normalisation) {
-  const key = [lobe, n, geometry, normalisation].join("|");
+  const family = [lobe, geometry, normalisation].join("|");
+  const served = (shaderRanges.get(family) ?? []).find(({ n_range: [low, high] }) => low <= n && n <= high);
+  if (served) return Promise.resolve(served);
+  const key = [family, n].join("|");
   if (!shaderTexts.has(key)) {
-    const text = getJson("/api/shader?" + new URLSearchParams({ lobe, n, geometry, normalisation }));
+    const text = getJson("/api/shader?" + new URLSearchParams({ lobe, n, geometry, normalisation })).then((shader) => {
+      if (!shader.n_range) return shader;
+      const taking = { ...shader, glsl: shader.glsl + N_UNIFORM };
+      shaderRanges.set(family, [...(shaderRanges.get(family) ?? []), taking]);
+      return taking;
+    });
     text.catch(() => shaderTexts.delete(key));
     shaderTexts.set(key, text);
   }
@@ -34,9 +56,10 @@ function linkProgram(gl, vertex, fragment, varyings = null) {
   return program;
 }
 
-// Sets each uniform the program has; `values` maps names to numbers or arrays.
+// Sets each uniform the program has, the shared ones (liveUniforms) first; `values` maps
+// names to numbers or arrays.
 function setUniforms(gl, program, values) {
-  for (const [name, value] of Object.entries(values)) {
+  for (const [name, value] of Object.entries({ ...liveUniforms, ...values })) {
     const at = gl.getUniformLocation(program, name);
     if (at === null) continue;
     if (typeof value === "number") gl.uniform1f(at, value);
