@@ -112,14 +112,15 @@ try {
   // EDGE levels from them in the CPU's image: the outlines, outer and inner (the spout, handle
   // and lid over the body), depend on each rasterizer's edge rules.
   await page.waitForFunction(() => live.teapot !== null);
-  for (const [lobe, geometry, normalisation, n, theta, phi] of [["pow", "phong", "none", 32, 30, 45], ["schlick", "blinn", "lobe", 200, 50, -60], ["=exp2(n * (t - 1) * 1.4427)", "phong", "lobe", 64, 20, 100]]) {
-    const result = await page.evaluate(async ({ lobe, geometry, normalisation, n, theta, phi, edge }) => {
+  for (const [lobe, geometry, normalisation, n, theta, phi, shading] of [["pow", "phong", "none", 32, 30, 45, "phong"], ["schlick", "blinn", "lobe", 200, 50, -60, "phong"], ["=exp2(n * (t - 1) * 1.4427)", "phong", "lobe", 64, 20, 100, "phong"], ["cosquad", "phong", "none", 16, 40, 30, "gouraud"], ["logexp", "blinn", "lobe", 64, 20, -100, "gouraud"]]) {
+    const result = await page.evaluate(async ({ lobe, geometry, normalisation, n, theta, phi, shading, edge }) => {
       const mine = await lobeShader(lobe, n, geometry, normalisation);
       liveUniforms.u_n = n;
       live.teapot.setLobe(mine.glsl, mine.tonemap, false);
       live.teapot.light = lightTowards(theta, phi);
+      live.teapot.gouraud = shading === "gouraud";
       const { size, pixels } = live.teapot.read();
-      const query = new URLSearchParams({ object: "teapot", lobe, n, geometry, normalisation, shading: "phong", model: "classic", light_theta: theta, light_phi: phi, size });
+      const query = new URLSearchParams({ object: "teapot", lobe, n, geometry, normalisation, shading, model: "classic", light_theta: theta, light_phi: phi, size });
       const reference = await window.servedPixels("/api/render?" + query, size);
       const background = (data, k) => [0, 1, 2].every((c) => data[k + c] === data[c]);
       let [compared, worst, beyondOne] = [0, 0, 0];
@@ -141,8 +142,8 @@ try {
         }
       }
       return { size, compared, worst, share: beyondOne / Math.max(1, compared) };
-    }, { lobe, geometry, normalisation, n, theta, phi, edge: EDGE_LEVELS });
-    console.log(`teapot ${lobe} (${geometry}, ${normalisation}, n = ${n}, light ${theta}/${phi}): ${result.compared} inner pixels of ${result.size}^2, largest difference ${result.worst} levels, ${(100 * result.share).toFixed(3)} % beyond 1`);
+    }, { lobe, geometry, normalisation, n, theta, phi, shading, edge: EDGE_LEVELS });
+    console.log(`teapot ${lobe} ${shading} (${geometry}, ${normalisation}, n = ${n}, light ${theta}/${phi}): ${result.compared} inner pixels of ${result.size}^2, largest difference ${result.worst} levels, ${(100 * result.share).toFixed(3)} % beyond 1`);
     if (result.compared < 0.2 * result.size * result.size || result.share > MAX_TEAPOT_SHARE) failures.push(`the WebGL teapot of ${lobe} differs from specula render's: ${JSON.stringify(result)}`);
   }
 

@@ -300,7 +300,7 @@ async function update() {
       const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: apiLobe(shown.render), ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
       // The sphere is drawn live (linked.js); the server's is for a browser without WebGL2.
       const sphere = live.spheres ? Promise.resolve() : loadImage($("sphere"), render("sphere"));
-      const teapot = live.teapot && state.shading === "phong" ? Promise.resolve() : loadImage($("teapot"), render("teapot"));
+      const teapot = live.teapot && ["phong", "gouraud"].includes(state.shading) ? Promise.resolve() : loadImage($("teapot"), render("teapot"));
       await Promise.all([sphere, teapot]);
       if (mine !== generation) return;
       markFresh("teapot");

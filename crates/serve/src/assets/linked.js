@@ -148,12 +148,13 @@ function liveRedraw() {
     live.spheres.light = lightTowards(Number($("light_theta").value), Number($("light_phi").value));
     live.spheres.draw();
     live.lobe.draw(wi);
-    // The live teapot shades per pixel; gouraud shading is the server's.
-    const teapotLive = Boolean(live.teapot) && $("shading").value === "phong";
+    // The live teapot shades per pixel or per vertex; flat shading is the server's.
+    const teapotLive = Boolean(live.teapot) && ["phong", "gouraud"].includes($("shading").value);
     $("live-teapot").hidden = !teapotLive;
     $("teapot").hidden = teapotLive;
     $("teapot-by").textContent = teapotLive ? "drawn by WebGL2, the triangles specula render rasterizes" : "CPU renderer";
     if (teapotLive) {
+      live.teapot.gouraud = $("shading").value === "gouraud";
       live.teapot.light = live.spheres.light;
       live.teapot.draw();
     }

@@ -54,8 +54,17 @@ function plot(canvas, { series, x, y, logY = false, bands = [], xLabel = "", yLa
     g.beginPath(); g.moveTo(m.l - 4, py(v)); g.lineTo(m.l, py(v)); g.stroke();
     g.fillText(label, m.l - 6, py(v) + 4);
   }
+  // The axis label centred under the plot, its type smaller (never under 10 px) where the
+  // canvas is narrow, so it is never cut at the edge.
+  g.textAlign = "center";
+  for (let size = 11; size >= 10; size--) {
+    g.font = `${size}px sans-serif`;
+    if (g.measureText(xLabel).width <= w - 8) break;
+  }
+  const half = Math.min(g.measureText(xLabel).width, w - 8) / 2;
+  g.fillText(xLabel, Math.min(w - 4 - half, Math.max(4 + half, (m.l + w - m.r) / 2)), h - 6, w - 8);
+  g.font = "11px sans-serif";
   g.textAlign = "left";
-  g.fillText(xLabel, w / 2 - 40, h - 6);
   g.save(); g.translate(12, h / 2 + 30); g.rotate(-Math.PI / 2); g.fillText(yLabel, 0, 0); g.restore();
   g.save(); g.beginPath(); g.rect(m.l, m.t, w - m.l - m.r, h - m.t - m.b); g.clip();
   for (const s of series) {

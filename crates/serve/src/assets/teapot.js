@@ -1,23 +1,33 @@
 // specula explorer, the lit teapot drawn live (WebGL2): the triangles `specula render`
 // rasterizes (/api/teapot: its mesh in world space and its camera's matrix), each pixel shaded
 // by the renderer's formula (live.js's SHADING) with the chosen lobe's exported function, as
-// the CPU renderer's per-pixel (phong) shading does; the light is a uniform.
+// the CPU renderer's per-pixel (phong) shading does, or each vertex shaded and the linear
+// radiance interpolated across the triangle (perspective-correct, WebGL's default), as its
+// gouraud shading does; the light is a uniform.
 "use strict";
 
-const TEAPOT_VERTEX = `#version 300 es
+function teapotVertex(lobe) {
+  return `#version 300 es
+${lobe}
+${SHADING}
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 uniform mat4 u_view_projection;
+uniform vec3 u_eye;
 uniform float u_backdrop;
+uniform float u_gouraud;
 out vec3 v_position;
 out vec3 v_normal;
+out vec3 v_radiance;
 void main() {
   v_position = a_position;
   v_normal = a_normal;
+  v_radiance = u_gouraud > 0.5 ? shade(normalize(a_normal), normalize(u_eye - a_position)) : vec3(0.0);
   // The backdrop: one triangle over the whole image, behind everything.
   vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
   gl_Position = u_backdrop > 0.5 ? vec4(2.0 * corner - 1.0, 0.0, 1.0) : u_view_projection * vec4(a_position, 1.0);
 }`;
+}
 
 function teapotFragment(lobe) {
   return `#version 300 es
@@ -27,11 +37,14 @@ ${SHADING}
 uniform vec3 u_eye;
 uniform vec3 u_background;
 uniform float u_backdrop;
+uniform float u_gouraud;
 in vec3 v_position;
 in vec3 v_normal;
+in vec3 v_radiance;
 out vec4 colour;
 void main() {
-  colour = display(u_backdrop > 0.5 ? u_background : shade(normalize(v_normal), normalize(u_eye - v_position)));
+  vec3 radiance = u_gouraud > 0.5 ? v_radiance : shade(normalize(v_normal), normalize(u_eye - v_position));
+  colour = display(u_backdrop > 0.5 ? u_background : radiance);
 }`;
 }
 
@@ -56,12 +69,13 @@ class LiveTeapot {
     gl.bindVertexArray(null);
     this.program = null;
     this.light = [0, -1, 0];
+    this.gouraud = false;
   }
 
   setLobe(text, tonemap, physical) {
     const gl = this.gl;
     if (this.program) gl.deleteProgram(this.program);
-    this.program = linkProgram(gl, TEAPOT_VERTEX, teapotFragment(text));
+    this.program = linkProgram(gl, teapotVertex(text), teapotFragment(text));
     this.reinhard = tonemap === "reinhard" ? 1 : 0;
     this.physical = physical ? 1 : 0;
   }
@@ -81,7 +95,7 @@ class LiveTeapot {
     gl.uniformMatrix4fv(gl.getUniformLocation(this.program, "u_view_projection"), false, this.mesh.view_projection);
     setUniforms(gl, this.program, {
       u_light: this.light, u_eye: this.mesh.eye, u_colour: s.colour, u_ambient: s.ambient, u_background: s.background,
-      u_k: [s.ka, s.kd, s.ks], u_physical: this.physical, u_reinhard: this.reinhard,
+      u_k: [s.ka, s.kd, s.ks], u_physical: this.physical, u_reinhard: this.reinhard, u_gouraud: this.gouraud ? 1 : 0,
     });
     gl.bindVertexArray(this.array);
     gl.disable(gl.DEPTH_TEST);
