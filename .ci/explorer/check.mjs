@@ -37,8 +37,8 @@ try {
     };
     return {
       plots: ["cartesian", "error", "polar", "albedo", "slice"].map((id) => document.getElementById(id).toDataURL()),
-      sphere: document.getElementById("sphere").src,
-      teapot: document.getElementById("teapot").src,
+      sphere: document.getElementById("sphere").dataset.source,
+      teapot: document.getElementById("teapot").dataset.source,
       environment: pixels(document.getElementById("environment-image")),
       environmentPow: pixels(document.getElementById("environment-pow")),
       environmentPsnr: document.getElementById("environment-psnr").textContent,

@@ -270,10 +270,7 @@ fn the_export_taking_n_computes_the_lobe_prepared_for_that_n() {
             ) else {
                 panic!("{label}: no GLSL");
             };
-            assert!(
-                glsl.contains("float specula_specular(float n, vec3 "),
-                "{label}"
-            );
+            assert!(glsl.contains("float specula_specular(float n"), "{label}");
             if let Some(glslang) = glslang {
                 let path = directory.path().join("lobe.frag");
                 std::fs::write(&path, &glsl).unwrap();

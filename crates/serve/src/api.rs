@@ -136,6 +136,9 @@ pub(crate) async fn compute<T: Send + 'static>(
     work: impl FnOnce() -> T + Send + 'static,
 ) -> Result<T, Response> {
     let _turn = state.computations.turn().await?;
+    if crate::supersede::superseded() {
+        return Err(ApiError::superseded().into());
+    }
     tokio::task::spawn_blocking(work)
         .await
         .map_err(|e| ApiError::internal(format!("the computation failed: {e}")).into())

@@ -23,6 +23,7 @@ mod live;
 mod measured;
 mod query;
 mod scene_setup;
+mod supersede;
 #[cfg(test)]
 mod tests;
 mod volume;
@@ -108,6 +109,10 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/teapot", get(live::teapot))
         .fallback(api::not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
+        .layer(axum::middleware::from_fn_with_state(
+            supersede::Views::default(),
+            supersede::track,
+        ))
         .layer(axum::middleware::from_fn_with_state(
             hosts,
             guard::check_host,

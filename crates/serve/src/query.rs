@@ -56,6 +56,16 @@ impl ApiError {
         }
     }
 
+    /// A newer request for the same view came while this one waited ([`crate::supersede`]).
+    pub(crate) fn superseded() -> Self {
+        Self {
+            status: StatusCode::CONFLICT,
+            error: "superseded by a newer request for the same view".to_owned(),
+            parameter: None,
+            valid: None,
+        }
+    }
+
     pub(crate) fn internal(error: String) -> Self {
         Self {
             status: StatusCode::INTERNAL_SERVER_ERROR,

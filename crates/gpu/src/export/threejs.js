@@ -51,8 +51,10 @@ export function speculaPhong(material, { n = EXPORTED_N } = {}) {
 export async function speculaPhongNode(material, { n = EXPORTED_N } = {}) {
   if (!material?.isMeshPhongNodeMaterial) throw new TypeError(`speculaPhongNode patches a MeshPhongNodeMaterial, not ${material?.type ?? material}`);
   const [{ PhongLightingModel }, TSL] = await Promise.all([import("three/webgpu"), import("three/tsl")]);
-  const { BRDF_Lambert, F_Schlick, code, diffuseColor, glslFn, materialSpecularStrength, normalView, positionViewDirection, specularColor, uniform, wgslFn } = TSL;
-  const speculaN = uniform(checkedN(n));
+  const { BRDF_Lambert, F_Schlick, code, diffuseColor, glslFn, materialSpecularStrength, normalView, positionViewDirection, renderGroup, specularColor, uniform, wgslFn } = TSL;
+  // In the render group: a uniform read only inside a lighting model is otherwise uploaded
+  // once (three r187), and a new n would not reach the shader.
+  const speculaN = uniform(checkedN(n)).setGroup(renderGroup);
   const specular = {
     wgsl: wgslFn(`fn specula_tsl(n: f32, normal: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 { return {tsl_call}; }`, [code(WGSL, [], "wgsl")]),
     glsl: glslFn(`float specula_tsl(float n, vec3 normal, vec3 wo, vec3 wi) { return {tsl_call}; }`, [code(GLSL, [], "glsl")]),

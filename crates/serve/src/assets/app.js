@@ -181,8 +181,8 @@ function colourOf(id) { return lobeOf(id).colour; }
 function dashOf(id) { return lobeOf(id).dashed ? DASH : []; }
 
 // The API's JSON; a refusal throws an Error whose `refusal` is the API's one-line `error`.
-async function getJson(url, signal = undefined) {
-  const response = await fetch(url, { signal });
+async function getJson(url, signal = undefined, view = "") {
+  const response = await fetch(url, { signal, headers: view ? viewHeader(view) : {} });
   const text = await response.text();
   let body = null;
   try { body = JSON.parse(text); } catch { /* not JSON: an HTTP-level refusal (414) */ }
@@ -217,15 +217,31 @@ function analysisTable(reports) {
   return `<table><thead><tr><th>lobe</th><th>epicentre max rel</th><th>bloom max abs</th><th>rms</th><th>energy ratio</th><th>max albedo (lobe-normalised)</th>${costHeads}</tr></thead><tbody>${rows.join("")}</tbody></table>${units ? `<p class="note">Costs: each lobe's throughput over pow's at this n on the target, higher is better (each cell's own rate on hover); rates in ${units}.</p>` : ""}`;
 }
 
-// An image already showing `url` is left alone: the volume renders take the server a while,
-// and most controls do not change them.
-function loadImage(img, url) {
-  if (img.getAttribute("src") === url && img.complete && img.naturalWidth > 0) return Promise.resolve();
-  return new Promise((resolve, reject) => {
+// The page's name for itself in the views it asks for (supersede.rs): a newer request for
+// the same view makes the server skip an older one still waiting for its turn.
+const PAGE_ID = Math.random().toString(36).slice(2, 10);
+
+// The header naming a view, its name as URL-encoded ASCII (a formula lobe names views too).
+function viewHeader(view) {
+  return { "X-Specula-View": `${PAGE_ID}/${encodeURIComponent(view)}` };
+}
+
+// `url`'s image into `img` (its address kept in data-source), fetched with the view's name so
+// that the server drops a superseded one, and aborted with `signal`. An image already showing
+// `url` is left alone: the volume renders take the server a while, and most controls do not
+// change them.
+async function loadImage(img, url, signal = undefined) {
+  if (img.dataset.source === url && img.complete && img.naturalWidth > 0) return;
+  const response = await fetch(url, { signal, headers: viewHeader(img.id) });
+  if (!response.ok) throw new Error("render failed: " + url.split("?")[0] + ` (${response.status})`);
+  const address = URL.createObjectURL(await response.blob());
+  await new Promise((resolve, reject) => {
     img.onload = () => resolve();
     img.onerror = () => reject(new Error("render failed: " + url.split("?")[0]));
-    img.src = url;
+    if (img.src.startsWith("blob:")) URL.revokeObjectURL(img.src);
+    img.src = address;
   });
+  img.dataset.source = url;
 }
 
 // A control's refusal beside it (empty: none), and the control marked.
@@ -266,7 +282,11 @@ async function update() {
   inFlight?.abort();
   inFlight = new AbortController();
   const signal = inFlight.signal;
-  const json = (url) => getJson(url, signal);
+  // Each lobe's curves and analysis are a view of their own.
+  const json = (url) => {
+    const address = new URL(url, location.href);
+    return getJson(url, signal, address.pathname + "/" + address.searchParams.get("lobe"));
+  };
   const boxes = state.lobes ? state.lobes.split(",") : [];
   const common = { n: state.n, geometry: state.geometry, normalisation: state.normalisation };
   const evaluate = (name) => "/api/evaluate?" + new URLSearchParams({ lobe: apiLobe(name), ...common, theta_in: state.theta_in });
@@ -299,19 +319,19 @@ async function update() {
     if (shown.render) {
       const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: apiLobe(shown.render), ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
       // The sphere is drawn live (linked.js); the server's is for a browser without WebGL2.
-      const sphere = live.spheres ? Promise.resolve() : loadImage($("sphere"), render("sphere"));
-      const teapot = live.teapot && ["phong", "gouraud"].includes(state.shading) ? Promise.resolve() : loadImage($("teapot"), render("teapot"));
+      const sphere = live.spheres ? Promise.resolve() : loadImage($("sphere"), render("sphere"), signal);
+      const teapot = live.teapot && ["phong", "gouraud"].includes(state.shading) ? Promise.resolve() : loadImage($("teapot"), render("teapot"), signal);
       await Promise.all([sphere, teapot]);
       if (mine !== generation) return;
       markFresh("teapot");
       const environment = (lobe) => "/api/environment?" + new URLSearchParams({ lobe, ...common, size: "384", spp: "16" });
-      await Promise.all([loadImage($("environment-image"), environment(apiLobe(shown.render))), loadImage($("environment-pow"), environment("pow"))]);
+      await Promise.all([loadImage($("environment-image"), environment(apiLobe(shown.render)), signal), loadImage($("environment-pow"), environment("pow"), signal)]);
       if (mine !== generation) return;
       drawDifference($("environment-image"), $("environment-pow"), $("environment-diff"), $("environment-psnr"));
       markFresh("environment");
     }
     const volume = (lobe) => "/api/volume?" + new URLSearchParams({ volume: state.volume, view: state.view, lobe, ...common, size: "256" });
-    await Promise.all([loadImage($("volume-image"), volume(apiLobe(shown.render || "pow"))), loadImage($("volume-pow"), volume("pow"))]);
+    await Promise.all([loadImage($("volume-image"), volume(apiLobe(shown.render || "pow")), signal), loadImage($("volume-pow"), volume("pow"), signal)]);
     if (mine !== generation) return;
     drawDifference($("volume-image"), $("volume-pow"), $("volume-diff"), $("volume-psnr"));
     markFresh("volume");

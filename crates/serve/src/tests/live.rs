@@ -13,7 +13,9 @@ use crate::scene_setup::{light_towards, LIVE_SCENE};
 
 /// Every built-in lobe and a formula lobe export for WebGL 2: GLSL ES 3.00 functions with
 /// `specula_specular`, no `#version` line (the page's shader puts its own first), no entry
-/// point, and the normalisation the library computes for that lobe baked in.
+/// point; `n` an argument, with the range the text serves, exactly where every constant and
+/// the lobe's own normalisation are closed forms of `n`, and otherwise the normalisation the
+/// library computes for that lobe baked in.
 #[tokio::test]
 async fn every_lobe_and_a_formula_export_glsl_es_300() {
     let n = 64.0;
@@ -33,8 +35,19 @@ async fn every_lobe_and_a_formula_export_glsl_es_300() {
         let glsl = body["glsl"].as_str().expect("glsl text");
         assert!(!glsl.contains("#version"), "{name}: {glsl}");
         assert!(!glsl.contains("void main"), "{name}");
+        let lobe = Lobe::new(kind, Exponent::new(n));
+        let closed_forms = lobe.parameters().iter().all(|p| p.preparation.is_some())
+            && (lobe.sampling_expressions().is_some() || lobe.newton_expressions().is_some());
+        if closed_forms {
+            assert!(glsl.contains("float specula_specular(float n"), "{name}");
+            let range = lobe.structural_range();
+            assert_eq!(body["n_range"], serde_json::json!(range), "{name}");
+            assert!(range[0] <= n && n <= range[1], "{name}");
+            continue;
+        }
+        assert!(body["n_range"].is_null(), "{name}");
         assert!(glsl.contains("float specula_specular(vec3"), "{name}");
-        let expected = Normalisation::Lobe.constant_for(&Lobe::new(kind, Exponent::new(n)));
+        let expected = Normalisation::Lobe.constant_for(&lobe);
         let baked: f32 = glsl
             .lines()
             .find_map(|line| line.strip_prefix("const float SPECULA_NORMALISATION = "))
