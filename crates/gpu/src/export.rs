@@ -320,7 +320,8 @@ fn specula_lobe(n: f32, t: f32) -> f32 {{
 // N(n) lobe(t): the specular BRDF term per unit ks, for the exponent n.
 fn specula_specular(n: f32, normal: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {{
     let exponent = clamp(n, SPECULA_N_LOW, SPECULA_N_HIGH);
-    return specula_normalisation(exponent) * specula_lobe(exponent, specula_cos_lobe(normal, wo, wi));
+    let t = specula_cos_lobe(normal, wo, wi);
+    return specula_normalisation(exponent) * specula_lobe(exponent, t);
 }}
 {example}",
         n = float(lobe.exponent().get() as f32),

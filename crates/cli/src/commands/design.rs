@@ -48,6 +48,11 @@ pub struct Args {
     /// Output format.
     #[arg(long, value_enum, default_value_t = crate::args::OutputFormat::Table)]
     format: crate::args::OutputFormat,
+    /// Also print the limit: each verified design's epicentre error at five exponents of the
+    /// range beside its family's optimum there (Sollya's minimax, certified by its supnorm;
+    /// `sollya` must be installed).
+    #[arg(long)]
+    limit: bool,
 }
 
 /// The range of exponents, its ends.
@@ -90,6 +95,46 @@ pub fn run(args: &Args) -> CommandResult {
     }
     println!("{}", answer.verdict);
     print_table(&answer, args.format);
+    if args.limit {
+        print_limit(&answer, &request, args.format)?;
+    }
+    Ok(())
+}
+
+/// Each verified design against its family's optimum at five exponents of the range.
+fn print_limit(
+    answer: &Design,
+    request: &DesignRequest,
+    format: crate::args::OutputFormat,
+) -> CommandResult {
+    let verified: Vec<_> = answer
+        .designed
+        .iter()
+        .filter(|d| d.verified)
+        .cloned()
+        .collect();
+    let rows = specula_decide::design::limit::limit_table(&verified, request.range, 4)?;
+    let mut table = Table::new(&["family", "n", "designed", "optimum", "designed / optimum"]);
+    for row in &rows {
+        table.push(vec![
+            row.family.clone(),
+            format!("{:.1}", row.n),
+            format!("{:.3e}", row.designed),
+            format!("{:.3e}", row.optimum),
+            if row.optimum > 0.0 {
+                format!("{:.2}", row.designed / row.optimum)
+            } else {
+                "- (the family holds t^n)".to_owned()
+            },
+        ]);
+    }
+    println!();
+    table.print(format);
+    eprintln!(
+        "optimum: the least epicentre error any member of the family reaches at that n alone \
+            (Sollya's Remez, its error certified by supnorm); designed: one set of closed-form \
+            constants for the whole range"
+    );
     Ok(())
 }
 

@@ -15,6 +15,7 @@
 mod cache;
 pub mod families;
 mod fit;
+pub mod limit;
 mod verdict;
 
 pub use verdict::removed;
