@@ -24,8 +24,13 @@ pub struct Args {
     n: Range,
     /// The epicentre's largest relative error, as a percentage (`0.1%` or `0.1`): the error
     /// `recommend` counts.
-    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::parse_percent)]
-    max_error: f64,
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_parser = crate::args::parse_percent,
+        required_unless_present = "against_thesis"
+    )]
+    max_error: Option<f64>,
     /// The whole lobe's largest absolute error, as a percentage of the peak [default: 1%, or
     /// --max-error where that is larger].
     #[arg(long, allow_hyphen_values = true, value_parser = crate::args::parse_percent)]
@@ -53,6 +58,12 @@ pub struct Args {
     /// `sollya` must be installed).
     #[arg(long)]
     limit: bool,
+    /// Instead of one accuracy, the thesis's lobes (schlick-mod, cheb2-thesis, logexp,
+    /// cosquad) at their own: each one's largest epicentre and whole-lobe errors over the range
+    /// are the bounds, and the cheapest lobe meeting them (designed or built in, the thesis
+    /// lobe ranked too) is shown beside it.
+    #[arg(long, conflicts_with_all = ["max_error", "max_whole_error", "output", "limit"])]
+    against_thesis: bool,
 }
 
 /// The range of exponents, its ends.
@@ -66,23 +77,26 @@ fn parse_range(text: &str) -> Result<Range, String> {
 
 /// Searches, prints, and writes the lobe.
 pub fn run(args: &Args) -> CommandResult {
+    let progress = ProgressBar::new(0).with_style(
+        ProgressStyle::with_template("designing {bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let Some(max_error) = args.max_error else {
+        return print_against_thesis(args, &progress);
+    };
     let request = DesignRequest {
         target: args.target,
         range: (args.n.0, args.n.1),
         bounds: Bounds {
-            epicentre: args.max_error,
+            epicentre: max_error,
             whole: args
                 .max_whole_error
-                .unwrap_or_else(|| default_whole_error(args.max_error)),
+                .unwrap_or_else(|| default_whole_error(max_error)),
             energy: args.energy_tolerance,
         },
         no_transcendentals: args.no_transcendentals,
         also: crate::args::flatten(&args.lobe),
     };
-    let progress = ProgressBar::new(0).with_style(
-        ProgressStyle::with_template("designing {bar:30} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
     let answer = design(&request, &progress)?;
     if let Some(note) = &answer.note {
         eprintln!("note: {note}");
@@ -98,6 +112,54 @@ pub fn run(args: &Args) -> CommandResult {
     if args.limit {
         print_limit(&answer, &request, args.format)?;
     }
+    Ok(())
+}
+
+/// The thesis's lobes at their own accuracy, against the designer's answer there.
+fn print_against_thesis(args: &Args, progress: &ProgressBar) -> CommandResult {
+    let rows = specula_decide::design::thesis::against_thesis(
+        args.target,
+        (args.n.0, args.n.1),
+        progress,
+    )?;
+    progress.finish_and_clear();
+    if args.format == crate::args::OutputFormat::Json {
+        return super::print_json(&rows);
+    }
+    let mut table = Table::new(&[
+        "thesis lobe",
+        "epicentre",
+        "whole lobe",
+        "rate",
+        "answer",
+        "rate",
+        "x the thesis lobe's",
+        "answer's formula",
+    ]);
+    for row in &rows {
+        table.push(vec![
+            row.thesis.clone(),
+            format!("{:.4} %", 100.0 * row.epicentre_error),
+            format!("{:.4} %", 100.0 * row.whole_error),
+            format!("{:.3e}", row.thesis_rate),
+            format!(
+                "{}{}",
+                row.answer,
+                if row.designed { " (designed)" } else { "" }
+            ),
+            format!("{:.3e}", row.answer_rate),
+            format!("{:.2}", row.answer_rate / row.thesis_rate),
+            row.answer_formula.replace('\n', " "),
+        ]);
+    }
+    table.print(args.format);
+    eprintln!(
+        "each thesis lobe's largest errors over n = {}..{} are the bounds; the answer is the \
+            cheapest lobe meeting both on {} (the thesis lobe itself when none is cheaper)",
+        args.n.0,
+        args.n.1,
+        args.target.id()
+    );
     Ok(())
 }
 

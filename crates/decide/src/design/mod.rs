@@ -16,6 +16,7 @@ mod cache;
 pub mod families;
 mod fit;
 pub mod limit;
+pub mod thesis;
 mod verdict;
 
 pub use verdict::removed;
