@@ -373,6 +373,52 @@ fn fs_main(
     )
 }
 
+/// A lobe's functions for another program's shaders (the explorer's live views, the engines'
+/// modules): the text and the exponents it serves.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Functions {
+    /// The functions, without the example entry point and without GLSL's `#version` line
+    /// (the shader they go into has its own first).
+    pub text: String,
+    /// Where the functions take `n` first (`Options::n_input`), the exponents they serve,
+    /// `[low, high]`; `None` where `n` is baked in.
+    pub n_range: Option<[f64; 2]>,
+}
+
+/// `lobe`'s functions in `language` (WGSL or GLSL ES 3.00) with `n` as an argument where the
+/// lobe's constants and the normalisation are closed forms of it, baked in otherwise.
+pub fn functions_taking_n_where_possible(
+    lobe: &Lobe,
+    geometry: Geometry,
+    normalisation: Normalisation,
+    language: Language,
+) -> Result<Functions, ExportError> {
+    let write = |n_input: bool| {
+        let options = Options {
+            example: false,
+            glsl: GlslVersion::Es300,
+            n_input,
+        };
+        export(lobe, geometry, normalisation, language, options).map(|code| match code {
+            ShaderCode::Text(text) => text,
+            ShaderCode::SpirV(_) => unreachable!("callers ask for text languages"),
+        })
+    };
+    let (text, n_range) = match write(true) {
+        Ok(text) => (text, Some(lobe.structural_range())),
+        Err(_) => (write(false)?, None),
+    };
+    let text = match language {
+        Language::Glsl => text
+            .split_once('\n')
+            .map_or(text.as_str(), |(_, body)| body)
+            .to_owned(),
+        // naga writes the example's entry point last.
+        _ => text.split("@fragment").next().unwrap_or(&text).to_owned(),
+    };
+    Ok(Functions { text, n_range })
+}
+
 /// naga's GLSL without the example: its stage's inputs and outputs (the globals naga names
 /// `_vs2fs_*` and `_fs2p_*`) and its `void main()`, which naga writes last.
 fn without_example(text: &str) -> String {

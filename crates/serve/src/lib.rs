@@ -36,7 +36,7 @@ pub use design::{DesignModel, DesignQuery, DESIGN_TARGETS};
 pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
 pub use listen::{max_waiting, CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT};
-pub use live::{glsl_functions, sphere_radiance, MAX_LIVE_SIZE};
+pub use live::{sphere_radiance, MAX_LIVE_SIZE};
 pub use measured::{
     Materials, MAX_MATERIALS, MAX_MATERIAL_RENDER_SIZE, MAX_MATERIAL_RENDER_SPP, POLAR_POINTS,
 };

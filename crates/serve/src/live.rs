@@ -26,7 +26,7 @@ use axum::Json;
 use glam::Vec3;
 use serde_json::json;
 use specula::{Geometry, Lobe, Normalisation};
-use specula_gpu::export::{export, GlslVersion, Language, Options, ShaderCode};
+use specula_gpu::export::{functions_taking_n_where_possible, Language};
 use specula_render::{Display, IlluminationModel, Image, Light, Material, Shader};
 
 use crate::api::{compute, compute_with, png, AppState};
@@ -36,52 +36,6 @@ use crate::scene_setup::{light_towards, tonemap_for, LIVE_SCENE};
 
 /// The largest live-sphere reference, in pixels a side.
 pub const MAX_LIVE_SIZE: u32 = 512;
-
-/// A lobe's GLSL ES 3.00 functions for the page.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LiveShader {
-    /// The functions, without the `#version` line (the page's shaders put their own first)
-    /// and without the example entry point.
-    pub glsl: String,
-    /// Where the functions take `n` as their first argument (`specula shader --n-input`):
-    /// the exponents they serve, `[low, high]`; `None` where `n` is baked in.
-    pub n_range: Option<[f64; 2]>,
-}
-
-/// The lobe's GLSL ES 3.00 functions, with `n` as an argument where the lobe's constants and
-/// the normalisation are closed forms of it (the page then changes `n` as a uniform), baked
-/// in otherwise.
-pub fn glsl_functions(
-    lobe: &Lobe,
-    geometry: Geometry,
-    normalisation: Normalisation,
-) -> Result<LiveShader, String> {
-    let write = |n_input: bool| {
-        let options = Options {
-            example: false,
-            glsl: GlslVersion::Es300,
-            n_input,
-        };
-        match export(lobe, geometry, normalisation, Language::Glsl, options) {
-            Ok(ShaderCode::Text(text)) => Ok(text
-                .split_once('\n')
-                .map_or(text.as_str(), |(_, body)| body)
-                .to_owned()),
-            Ok(ShaderCode::SpirV(_)) => Err("the GLSL export wrote SPIR-V".to_owned()),
-            Err(error) => Err(error.to_string()),
-        }
-    };
-    match write(true) {
-        Ok(glsl) => Ok(LiveShader {
-            glsl,
-            n_range: Some(lobe.structural_range()),
-        }),
-        Err(_) => write(false).map(|glsl| LiveShader {
-            glsl,
-            n_range: None,
-        }),
-    }
-}
 
 /// What one live-sphere reference is drawn with.
 #[derive(Clone, Copy, Debug)]
@@ -166,14 +120,14 @@ pub async fn shader(
         params.normalisation(Normalisation::None)?,
     );
     let shader = compute_with(&state, kind, n, move |lobe| {
-        glsl_functions(&lobe, geometry, normalisation)
+        functions_taking_n_where_possible(&lobe, geometry, normalisation, Language::Glsl)
     })
     .await?
-    .map_err(ApiError::internal)?;
+    .map_err(|e| ApiError::internal(e.to_string()))?;
     Ok(Json(json!({
         "lobe": kind.to_string(),
         "n": n.get(),
-        "glsl": shader.glsl,
+        "glsl": shader.text,
         "n_range": shader.n_range,
         "tonemap": tonemap_for(normalisation).id(),
     }))

@@ -110,7 +110,8 @@ pub fn normalisation_function_of_n(
         lines = inputs.preparation("n", &Wgsl);
         let (statements, total) = straight_line_named(&total, "0.0", &Wgsl, Parameters::Named, "w");
         lines.extend(statements);
-        format!("1.0 / (6.2831855 * ({total}))")
+        let two_pi = crate::code::float_literal(core::f32::consts::TAU);
+        format!("1.0 / ({two_pi} * ({total}))")
     } else {
         let formula = record(|n| normalisation.formula(n))
             .unwrap_or_else(|_| unreachable!("the normalisations' formulas have no branch"));

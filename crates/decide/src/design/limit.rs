@@ -64,36 +64,24 @@ pub struct LimitRow {
 /// error bound (`delta` or `eps` above).
 fn script(family: Family, n: f64) -> String {
     let edge = 1.0 - (-1.0 / n).exp2();
-    let (target, weight, degree, mode) = match family {
+    // What is approximated, Remez's target and weight for `q` of degree `d - 1`, and the
+    // member whose error supnorm bounds.
+    let (g, target, weight, member, error, degree) = match family {
         Family::PolyPow { degree, squarings } => {
             let power = n / f64::from(1u32 << squarings);
-            let target = format!("(1 - x)^({power:e})");
-            (target, "relative", degree, "poly")
+            let g = format!("(1 - x)^({power:e})");
+            (g, "(g - 1) / g", "x / g", "1 + x * q", "relative", degree)
         }
         Family::Exp2Poly { degree } => {
-            (format!("-({n:e}) * log(1 - x)"), "absolute", degree, "exp")
+            let g = format!("-({n:e}) * log(1 - x)");
+            (g, "g", "x", "x * q", "absolute", degree)
         }
     };
-    let (approximation, bound) = if mode == "poly" {
-        (
-            format!(
-                "q = remez((g - 1) / g, {}, [{edge:e} * 2^-40; {edge:e}], x / g, {QUALITY:e});",
-                degree - 1
-            ),
-            format!("supnorm(1 + x * q, g, [0; {edge:e}], {weight}, 2^-40)"),
-        )
-    } else {
-        (
-            format!(
-                "q = remez(g, {}, [{edge:e} * 2^-40; {edge:e}], x, {QUALITY:e});",
-                degree - 1
-            ),
-            format!("supnorm(x * q, g, [0; {edge:e}], {weight}, 2^-40)"),
-        )
-    };
     format!(
-        "verbosity = 0;\nprec = 165;\ndisplay = decimal;\ng = {target};\n{approximation}\n\
-         print(sup({bound}));\nquit;\n"
+        "verbosity = 0;\nprec = 165;\ndisplay = decimal;\ng = {g};\n\
+         q = remez({target}, {}, [{edge:e} * 2^-40; {edge:e}], {weight}, {QUALITY:e});\n\
+         print(sup(supnorm({member}, g, [0; {edge:e}], {error}, 2^-40)));\nquit;\n",
+        degree - 1
     )
 }
 

@@ -6,7 +6,7 @@
 
 use specula::{Geometry, Lobe, Normalisation};
 
-use super::{export, ExportError, GlslVersion, Language, Options, ShaderCode};
+use super::{functions_taking_n_where_possible, ExportError, Language};
 
 /// A real-time engine whose Phong material the export patches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -37,15 +37,18 @@ impl Engine {
         geometry: Geometry,
         normalisation: Normalisation,
     ) -> Result<String, ExportError> {
-        let taking_n = export(lobe, geometry, normalisation, Language::Glsl, of_n(true)).is_ok();
-        let text = |language| match export(lobe, geometry, normalisation, language, of_n(taking_n))?
-        {
-            ShaderCode::Text(text) => Ok(text),
-            ShaderCode::SpirV(_) => unreachable!("a text language"),
-        };
-        let glsl = functions_only(&text(Language::Glsl)?, |line| {
-            line.starts_with("#version") || line.starts_with("precision ")
-        });
+        let functions =
+            |language| functions_taking_n_where_possible(lobe, geometry, normalisation, language);
+        let glsl = functions(Language::Glsl)?;
+        let range = glsl.n_range;
+        let taking_n = range.is_some();
+        // The engines' shaders state their own precision.
+        let glsl: String = glsl
+            .text
+            .lines()
+            .filter(|line| !line.starts_with("precision "))
+            .collect::<Vec<_>>()
+            .join("\n");
         let call = |prefix: &str| {
             let n = if taking_n {
                 format!("{prefix}n, ")
@@ -56,7 +59,6 @@ impl Engine {
                 format!("specula_specular({n}{normal}, {wo}, {wi})")
             }
         };
-        let range = lobe.structural_range();
         let template = match self {
             Engine::ThreeJs => include_str!("threejs.js")
                 .replace(
@@ -67,19 +69,19 @@ impl Engine {
             Engine::Babylon => include_str!("babylon.js")
                 .replace("{glsl_call}", &call("specula_")("normal", "wo", "wi")),
         };
-        let n_note = if taking_n {
-            format!(
-                "n a uniform in {} (exported at n = {})",
-                specula_targets::code::describe_range(range),
-                lobe.exponent()
-            )
-        } else {
-            format!("n = {} baked in", lobe.exponent())
-        };
-        let n_range = if taking_n {
-            format!("[{}, {}]", range[0], range[1])
-        } else {
-            "null".to_owned()
+        let (n_note, n_range) = match range {
+            Some(range) => (
+                format!(
+                    "n a uniform in {} (exported at n = {})",
+                    specula_targets::code::describe_range(range),
+                    lobe.exponent()
+                ),
+                format!("[{}, {}]", range[0], range[1]),
+            ),
+            None => (
+                format!("n = {} baked in", lobe.exponent()),
+                "null".to_owned(),
+            ),
         };
         let mut module = template
             .replace("{checked_n}", include_str!("checked_n.js"))
@@ -93,30 +95,11 @@ impl Engine {
             .replace("{cosine}", geometry.cosine_name());
         // The code last, so that no placeholder is looked for inside it.
         if self == Engine::ThreeJs {
-            let wgsl = text(Language::Wgsl)?;
-            // naga writes the example's entry point last.
-            let wgsl = wgsl.split("@fragment").next().unwrap_or(&wgsl);
-            module = module.replace("{wgsl}", &escaped(wgsl));
+            module = module.replace("{wgsl}", &escaped(&functions(Language::Wgsl)?.text));
         }
         let module = module.replace("{glsl}", &escaped(&glsl));
         Ok(module)
     }
-}
-
-fn of_n(n_input: bool) -> Options {
-    Options {
-        example: false,
-        glsl: GlslVersion::Es300,
-        n_input,
-    }
-}
-
-/// `text` without the lines `drop` picks.
-fn functions_only(text: &str, drop: impl Fn(&str) -> bool) -> String {
-    text.lines()
-        .filter(|line| !drop(line))
-        .collect::<Vec<_>>()
-        .join("\n")
 }
 
 /// `text` inside a JavaScript template literal.
