@@ -202,14 +202,26 @@ fn install_output_error_hook() {
             .or_else(|| info.payload().downcast_ref::<&str>().copied())
             .unwrap_or("");
         if let Some(cause) = message.strip_prefix("failed printing to stdout: ") {
-            if cause.contains("Broken pipe") {
-                std::process::exit(BROKEN_PIPE);
-            }
-            eprintln!("error: writing to standard output: {cause}");
-            std::process::exit(1);
+            end_on_output_error(cause.contains("Broken pipe"), &cause);
         }
         default(info);
     }));
+}
+
+/// Ends the process after an error writing standard output, as Unix tools end: quietly with
+/// [`BROKEN_PIPE`] when the reader has gone, with one line and status 1 otherwise.
+fn end_on_output_error(reader_gone: bool, cause: &dyn std::fmt::Display) -> ! {
+    if reader_gone {
+        std::process::exit(BROKEN_PIPE);
+    }
+    eprintln!("error: writing to standard output: {cause}");
+    std::process::exit(1);
+}
+
+/// What a command that writes standard output itself (rather than by `println!`) does with
+/// its write's error: the same as `println!`'s.
+pub(crate) fn output_error(error: &std::io::Error) -> ! {
+    end_on_output_error(error.kind() == std::io::ErrorKind::BrokenPipe, error)
 }
 
 /// Gives the Vulkan loader a private `XDG_RUNTIME_DIR` when the session has none (CI, SSH,

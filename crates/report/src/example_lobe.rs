@@ -160,15 +160,7 @@ fn every_export_writes_it() {
 #[test]
 fn the_reports_tables_list_it() {
     let directory = specula_temporaries::dir("example-lobe-").expect("a scratch folder");
-    let mut context = Context {
-        directory: directory.path().to_path_buf(),
-        sizes: sections::sizes(true),
-        bench: false,
-        files: Vec::new(),
-        lobes: LobeKind::ALL.to_vec(),
-        materials: None,
-        notes: Vec::new(),
-    };
+    let mut context = Context::for_tests(directory.path());
     let models = sections::models(&mut context).expect("the models section");
     assert!(models.contains("<td>example</td>"), "{models}");
     assert!(models.contains(example().info().formula), "{models}");

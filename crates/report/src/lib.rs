@@ -26,6 +26,7 @@ mod prose;
 mod real_scans;
 mod renders;
 mod sections;
+mod stored;
 mod verdict;
 mod volumes;
 pub mod vtk_peer;
@@ -146,6 +147,10 @@ pub(crate) struct Context {
     /// What this machine lacked (a tool, a GPU adapter, a scan), a sentence each: shown
     /// once, at the page's end, not in the answers.
     notes: Vec<String>,
+    /// Where sections that depend on the code and options alone are stored ([`stored`]).
+    store: Option<PathBuf>,
+    /// Whether the section was copied from the store rather than computed.
+    from_store: bool,
 }
 
 /// Every datapath's sweeps over word lengths, per hardware exponent.
@@ -192,6 +197,25 @@ impl Context {
             .iter()
             .map(|&n| Ok((n, specula_decide::hardware_sweeps(n)?)))
             .collect()
+    }
+}
+
+#[cfg(test)]
+impl Context {
+    /// A quick report's context writing into `directory`, on the built-in lobes, storing
+    /// nothing.
+    pub(crate) fn for_tests(directory: &std::path::Path) -> Self {
+        Self {
+            directory: directory.to_owned(),
+            sizes: sections::sizes(true),
+            bench: false,
+            files: Vec::new(),
+            lobes: LobeKind::ALL.to_vec(),
+            materials: None,
+            notes: Vec::new(),
+            store: None,
+            from_store: false,
+        }
     }
 }
 
@@ -274,7 +298,8 @@ type Section = (&'static str, fn(&mut Context) -> Result<String, String>);
 
 /// The sections that take longest, started first (the others in the order they are shown).
 const LONGEST_FIRST: [&str; 3] = [RENDERS, VOLUMES, CLAIMS];
-const RENDERS: &str = "Renders";
+pub(crate) const RENDERS: &str = "Renders";
+pub(crate) const MATERIALS: &str = "Real materials";
 const VOLUMES: &str = "Medical volumes";
 const CLAIMS: &str = "The thesis's claims";
 
@@ -296,7 +321,7 @@ const SECTIONS: [Section; 14] = [
     ("Energy and normalisation", energy::energy),
     ("Reciprocity and white furnace", energy::reciprocity),
     (RENDERS, renders::renders),
-    ("Real materials", materials::materials),
+    (MATERIALS, materials::materials),
     (VOLUMES, volumes::volumes),
     ("Into other renderers", other_renderers::other_renderers),
     (sections::COST, sections::cost),
@@ -341,6 +366,8 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
         files: Vec::new(),
         materials: options.materials.clone(),
         notes: Vec::new(),
+        store: stored::default_store(),
+        from_store: false,
     };
     let bar = ProgressBar::new(SECTIONS.len() as u64).with_style(
         ProgressStyle::with_template("report {bar:30} {pos}/{len} sections {elapsed}")
@@ -351,7 +378,10 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
         let begun = Instant::now();
         let body = section(&mut own);
         bar.inc(1);
-        body.map(|body| (heading, body, begun.elapsed(), own.files, own.notes))
+        body.map(|body| {
+            let took = begun.elapsed();
+            (heading, body, (took, own.from_store), own.files, own.notes)
+        })
     };
     let alone = |(heading, _): &&Section| options.bench && *heading == sections::COST;
     // The hardware sweeps run beside the sections that do not need them (waiting for them
@@ -411,8 +441,13 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
     let mut bodies = Vec::new();
     let mut timings = Vec::new();
     let mut notes: Vec<String> = Vec::new();
-    for (heading, body, took, written, noted) in done {
-        timings.push(format!("{heading} {:.1} s", took.as_secs_f64()));
+    for (heading, body, (took, from_store), written, noted) in done {
+        let stored = if from_store {
+            " (stored by this build)"
+        } else {
+            ""
+        };
+        timings.push(format!("{heading} {:.1} s{stored}", took.as_secs_f64()));
         bodies.push((heading.to_owned(), body));
         files.extend(written);
         for note in noted {

@@ -20,7 +20,8 @@ use super::html::{escape, figure, paragraph, table};
 use super::polar::{Polar, PolarCurve, PolarPanel, DASHED, DASH_DOT};
 use super::prose;
 use super::sections::colour;
-use super::Context;
+use super::stored;
+use super::{Context, MATERIALS};
 use specula_decide::material::{
     assess, lobes_to_fit, luminance, parameter_text, verdict_line, Assessment, FitRow,
     DEFAULT_MARGIN,
@@ -101,7 +102,19 @@ fn file_safe(name: &str) -> String {
 /// The section: each material in turn (assessed in parallel, each assessment's fits in
 /// parallel too), those of `--materials`, else the five specula carries (`data/rgl`, built
 /// into the binary), so that a report without a folder still answers for real materials.
+/// The section, or a run's of this build on the same lobes: the bundled materials' fits and
+/// renders are functions of those alone ([`stored`]); a folder of the user's is assessed
+/// anew.
 pub fn materials(context: &mut Context) -> Result<String, String> {
+    let store = context
+        .store
+        .clone()
+        .filter(|_| context.materials.is_none());
+    let (html, _) = stored::section(store.as_deref(), context, MATERIALS, "", assessed)?;
+    Ok(html)
+}
+
+fn assessed(context: &mut Context) -> Result<String, String> {
     let (materials, folder, more) = match context.materials.clone() {
         Some(directory) => {
             let (files, more) = material_files(&directory)?;

@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 use specula::LobeKind;
-use specula_gpu::{Gpu, GpuRenderer};
+use specula_gpu::{Gpu, GpuError, GpuRenderer};
 use specula_render::ibl::{render_ibl_grid, Environment, IblSettings, SKY_WIDTH};
 use specula_render::metrics::compare;
 use specula_render::{
@@ -15,7 +15,8 @@ use specula_render::{
 use super::comparison::{self, Compared};
 use super::html::{paragraph, table_with_files};
 use super::prose;
-use super::Context;
+use super::stored;
+use super::{Context, RENDERS};
 use crate::format::{psnr, psnr_db, sig};
 
 fn scene(context: &Context, overrides: Overrides) -> Scene {
@@ -157,16 +158,30 @@ fn grid_options(context: &Context) -> GridOptions {
     }
 }
 
+/// The section, or a run's of this build with the same sizes, lobes and adapter: the
+/// renders are functions of those alone ([`stored`]).
 pub fn renders(context: &mut Context) -> Result<String, String> {
-    // The environment-lit renders (most of the section's work) run beside the rest.
-    let mut lit = context.sibling();
-    let (html, environment) = rayon::join(|| default_scene(context), || environment_lit(&mut lit));
-    context.absorb(lit);
-    Ok(html? + &environment?)
+    let gpu = Gpu::new();
+    let adapter = match &gpu {
+        Ok(gpu) => gpu.adapter_name(),
+        Err(error) => format!("no adapter: {error}"),
+    };
+    let store = context.store.clone();
+    let (html, _) = stored::section(store.as_deref(), context, RENDERS, &adapter, |context| {
+        // The environment-lit renders (most of the section's work) run beside the rest.
+        let mut lit = context.sibling();
+        let (html, environment) = rayon::join(
+            || default_scene(context, &gpu),
+            || environment_lit(&mut lit),
+        );
+        context.absorb(lit);
+        Ok(html? + &environment?)
+    })?;
+    Ok(html)
 }
 
 /// The default scene: every lobe, the three shading methods, CPU against GPU.
-fn default_scene(context: &mut Context) -> Result<String, String> {
+fn default_scene(context: &mut Context, gpu: &Result<Gpu, GpuError>) -> Result<String, String> {
     let base = scene(context, Overrides::default());
     let (width, height, samples) = context.sizes.render;
     let mut html = paragraph(&format!(
@@ -202,10 +217,14 @@ fn default_scene(context: &mut Context) -> Result<String, String> {
         )?;
     }
 
-    match Gpu::new().and_then(|gpu| {
-        let image = GpuRenderer::new(&gpu).render(&base)?;
-        Ok((gpu.adapter_name(), image))
-    }) {
+    let rendered = match gpu {
+        Ok(gpu) => GpuRenderer::new(gpu)
+            .render(&base)
+            .map(|image| (gpu.adapter_name(), image))
+            .map_err(|e| e.to_string()),
+        Err(error) => Err(error.to_string()),
+    };
+    match rendered {
         Ok((adapter, image)) => {
             let d = compare(&reference_image, &image, base.display).map_err(|e| e.to_string())?;
             html += &paragraph(&format!(

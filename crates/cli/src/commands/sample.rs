@@ -135,9 +135,11 @@ pub fn run(args: &Args) -> CommandResult {
             .map_err(std::io::Error::other)
             .and_then(|()| std::io::Write::write_all(&mut out, b"\n")),
     };
+    // A reader that stops early (`| head`) ends the process as it ends any other command.
     written
         .and_then(|()| std::io::Write::flush(&mut out))
-        .map_err(|e| format!("cannot write the samples: {e}"))
+        .unwrap_or_else(|e| crate::output_error(&e));
+    Ok(())
 }
 
 fn write_csv(

@@ -372,34 +372,40 @@ fn interrupted_commands_leave_nothing_behind() {
 /// one line and status 1. Never a panic.
 #[test]
 fn standard_output_errors_end_like_unix_tools() {
-    let many: Vec<String> = (1..=200).map(|n| n.to_string()).collect();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_specula"))
-        .args(["analyze", "--format", "json", "--n", &many.join(",")])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("start");
-    drop(child.stdout.take());
-    let output = child.wait_with_output().expect("wait");
-    assert_eq!(output.status.code(), Some(141));
-    assert!(
-        output.stderr.is_empty(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let full = std::fs::OpenOptions::new()
-        .write(true)
-        .open("/dev/full")
-        .expect("/dev/full");
-    let output = Command::new(env!("CARGO_BIN_EXE_specula"))
-        .args(["models"])
-        .stdout(full)
-        .output()
-        .expect("run");
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(1), "{stderr}");
-    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
-    assert!(stderr.contains("writing to standard output"), "{stderr}");
+    // `models` prints with `println!`, `sample` writes its own buffered stream; the reader
+    // goes before either writes.
+    let commands = [&["models"][..], &["sample", "--lobe", "pow", "--n", "8"]];
+    for args in commands {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_specula"))
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("start");
+        drop(child.stdout.take());
+        let output = child.wait_with_output().expect("wait");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(141), "{args:?}: {stderr}");
+        assert!(output.stderr.is_empty(), "{args:?}: {stderr}");
+    }
+    for args in commands {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .expect("/dev/full");
+        let output = Command::new(env!("CARGO_BIN_EXE_specula"))
+            .args(args)
+            .stdout(full)
+            .output()
+            .expect("run");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("writing to standard output"),
+            "{args:?}: {stderr}"
+        );
+    }
 }
 
 /// A huge unknown key or id is quoted in part (its length named), and costs no edit-distance

@@ -1,0 +1,227 @@
+//! Sections whose page and images are functions of the code, the options and the GPU adapter
+//! alone (the renders and the bundled materials: images, fits and comparisons, no timing),
+//! stored beside the design searches by a first run and copied back by a later run of the
+//! same build, as the claims and the datapaths' sweeps are (`specula_decide`'s analyses).
+//!
+//! Keyed by the section, its sizes, the lobes, the adapter and `build.rs`'s fingerprint of
+//! the sources a render runs, so a change to any of them renders again. An entry is a folder
+//! (`$SPECULA_CACHE_DIR/sections/<key>/`: the section's files and `section.json`, its body
+//! and notes), made under a temporary name and renamed into place, so an interrupted run
+//! leaves no partial entry; one that cannot be read is rendered again, and one that cannot
+//! be written costs the next run. A user's lobes are never stored: their formulas are not in
+//! the fingerprint.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use specula_synth::cache::{key, Cache};
+
+use super::Context;
+
+/// Bumped when an entry's shape changes.
+const FORMAT: &str = "specula report section 1";
+
+/// What a stored section holds besides its files.
+#[derive(Serialize, Deserialize)]
+struct Entry {
+    key: String,
+    body: String,
+    notes: Vec<String>,
+    files: Vec<String>,
+}
+
+/// Where a section came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Origin {
+    /// Computed in this run (and stored, where the cache is writable).
+    Computed,
+    /// Copied from a run of this build with the same key.
+    Stored,
+}
+
+/// The sections' store: `$SPECULA_CACHE_DIR/sections`, where the design searches' cache
+/// would be; none when no cache location is known.
+pub(crate) fn default_store() -> Option<PathBuf> {
+    Cache::default_for("sections").map(|cache| cache.directory().to_owned())
+}
+
+/// `compute(context)`, or the section stored under the key of `heading`, `context`'s sizes
+/// and lobes, and `machine` (what else the section's output depends on: the GPU adapter).
+pub(crate) fn section(
+    store: Option<&Path>,
+    context: &mut Context,
+    heading: &str,
+    machine: &str,
+    compute: impl FnOnce(&mut Context) -> Result<String, String>,
+) -> Result<(String, Origin), String> {
+    let Some(store) = store.filter(|_| context.yours().is_empty()) else {
+        return Ok((compute(context)?, Origin::Computed));
+    };
+    let lobes: Vec<String> = context.lobes.iter().map(ToString::to_string).collect();
+    let key = key(&[
+        FORMAT,
+        env!("SPECULA_REPORT_SOURCES"),
+        heading,
+        &format!("{:?}", context.sizes),
+        &lobes.join(","),
+        machine,
+    ]);
+    let entry = store.join(&key);
+    if let Some(body) = load(&entry, &key, context) {
+        context.from_store = true;
+        return Ok((body, Origin::Stored));
+    }
+    let (files_before, notes_before) = (context.files.len(), context.notes.len());
+    let body = compute(context)?;
+    let _ = save(
+        store,
+        &entry,
+        &Entry {
+            key,
+            body: body.clone(),
+            notes: context.notes[notes_before..].to_vec(),
+            files: context.files[files_before..].to_vec(),
+        },
+        &context.directory,
+    );
+    Ok((body, Origin::Computed))
+}
+
+/// The entry at `entry` with `key`, its files written into the context's folder; none when
+/// it is missing or unreadable in any part (nothing is written then).
+fn load(entry: &Path, key: &str, context: &mut Context) -> Option<String> {
+    let text = std::fs::read_to_string(entry.join("section.json")).ok()?;
+    let stored: Entry = serde_json::from_str(&text).ok()?;
+    if stored.key != key || !stored.files.iter().all(|name| plain(name)) {
+        return None;
+    }
+    let files = stored
+        .files
+        .iter()
+        .map(|name| {
+            std::fs::read(entry.join(name))
+                .ok()
+                .map(|bytes| (name, bytes))
+        })
+        .collect::<Option<Vec<_>>>()?;
+    for (name, bytes) in files {
+        context.write(name, &bytes).ok()?;
+    }
+    context.notes.extend(stored.notes);
+    Some(stored.body)
+}
+
+/// Stores `stored`'s files, read from `written_to`, and its text under `entry`.
+fn save(store: &Path, entry: &Path, stored: &Entry, written_to: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(store)?;
+    let folder = specula_temporaries::dir_in(store, "section")?;
+    for name in &stored.files {
+        std::fs::copy(written_to.join(name), folder.path().join(name))?;
+    }
+    let text = serde_json::to_string(stored).map_err(std::io::Error::other)?;
+    std::fs::write(folder.path().join("section.json"), text)?;
+    // Another run may have stored the same entry meanwhile: theirs is as good.
+    folder.persist(entry)
+}
+
+/// A file name the section wrote beside the page (no folder, nothing hidden).
+fn plain(name: &str) -> bool {
+    !name.is_empty() && !name.starts_with('.') && !name.contains(['/', '\\'])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The section under `heading` and `machine`, from `store`, into `context`: a section
+    /// writing two files (the PNG's first byte `pixel`) and a note, counting its runs.
+    fn run(
+        store: &Path,
+        context: &mut Context,
+        (heading, machine): (&str, &str),
+        runs: &mut usize,
+        pixel: u8,
+    ) -> (String, Origin) {
+        section(Some(store), context, heading, machine, |context| {
+            *runs += 1;
+            context.write_png_file("a.png", 1, 1, &[pixel, 2, 3])?;
+            context.write("b.svg", b"<svg/>")?;
+            context.machine_note("no adapter");
+            Ok("<p>body</p>".into())
+        })
+        .unwrap()
+    }
+
+    /// The second run with the same key copies the first's files, bit for bit, with its body
+    /// and notes, and does not compute; another key (another adapter) computes again.
+    #[test]
+    fn a_stored_section_is_the_computed_one() {
+        let store = tempfile::tempdir().unwrap();
+        let outs: Vec<_> = (0..3).map(|_| tempfile::tempdir().unwrap()).collect();
+        let mut runs = 0;
+        let mut computed = Context::for_tests(outs[0].path());
+        let made = run(store.path(), &mut computed, ("S", "gpu A"), &mut runs, 7);
+        assert_eq!(
+            (made.0.as_str(), made.1, runs),
+            ("<p>body</p>", Origin::Computed, 1)
+        );
+        let mut copied = Context::for_tests(outs[1].path());
+        let read = run(store.path(), &mut copied, ("S", "gpu A"), &mut runs, 99);
+        assert_eq!(
+            (read.0.as_str(), read.1, runs),
+            ("<p>body</p>", Origin::Stored, 1)
+        );
+        assert!(copied.from_store && !computed.from_store);
+        assert_eq!(copied.files, computed.files);
+        assert_eq!(copied.notes, ["no adapter"]);
+        for name in ["a.png", "b.svg"] {
+            assert_eq!(
+                std::fs::read(outs[1].path().join(name)).unwrap(),
+                std::fs::read(outs[0].path().join(name)).unwrap(),
+                "{name}"
+            );
+        }
+        let mut elsewhere = Context::for_tests(outs[2].path());
+        let other = run(store.path(), &mut elsewhere, ("S", "gpu B"), &mut runs, 7);
+        assert_eq!((other.1, runs), (Origin::Computed, 2));
+    }
+
+    /// An entry missing a file is computed again, and a user's lobe is never stored.
+    #[test]
+    fn a_damaged_entry_or_a_users_lobe_computes() {
+        let store = tempfile::tempdir().unwrap();
+        let out = tempfile::tempdir().unwrap();
+        let mut runs = 0;
+        run(
+            store.path(),
+            &mut Context::for_tests(out.path()),
+            ("S", ""),
+            &mut runs,
+            1,
+        );
+        let entry = std::fs::read_dir(store.path())
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.join("section.json").exists())
+            .expect("an entry");
+        std::fs::remove_file(entry.join("b.svg")).unwrap();
+        let again = run(
+            store.path(),
+            &mut Context::for_tests(out.path()),
+            ("S", ""),
+            &mut runs,
+            1,
+        );
+        assert_eq!((again.1, runs), (Origin::Computed, 2));
+        let mut yours = Context::for_tests(out.path());
+        let kind = specula_render::lobe_file::parse_lobe("cosquad:v=5", None).unwrap();
+        yours.lobes.push(kind);
+        for _ in 0..2 {
+            assert_eq!(
+                run(store.path(), &mut yours, ("Y", ""), &mut runs, 1).1,
+                Origin::Computed
+            );
+        }
+        assert_eq!(runs, 4);
+    }
+}
