@@ -121,7 +121,37 @@ fn save(store: &Path, entry: &Path, stored: &Entry, written_to: &Path) -> std::i
     let text = serde_json::to_string(stored).map_err(std::io::Error::other)?;
     std::fs::write(folder.path().join("section.json"), text)?;
     // Another run may have stored the same entry meanwhile: theirs is as good.
-    folder.persist(entry)
+    folder.persist(entry)?;
+    prune(store, KEPT);
+    Ok(())
+}
+
+/// Entries kept: every build stores new ones (a full report's Renders are about 4 MB), so
+/// the oldest beyond these are removed, enough for the full and quick reports of a few builds.
+const KEPT: usize = 12;
+
+/// Removes all but the `kept` most recently stored entries of `store` (temporary folders of
+/// runs in progress are not entries and are left alone).
+fn prune(store: &Path, kept: usize) {
+    let Ok(listed) = std::fs::read_dir(store) else {
+        return;
+    };
+    let mut entries: Vec<(std::time::SystemTime, PathBuf)> = listed
+        .flatten()
+        .map(|e| e.path())
+        .filter(|path| {
+            path.file_name()
+                .is_some_and(|n| plain(&n.to_string_lossy()))
+        })
+        .filter_map(|path| {
+            let stored = std::fs::metadata(path.join("section.json")).ok()?;
+            Some((stored.modified().ok()?, path))
+        })
+        .collect();
+    entries.sort_by_key(|(stored, _)| std::cmp::Reverse(*stored));
+    for (_, path) in entries.into_iter().skip(kept) {
+        let _ = std::fs::remove_dir_all(path);
+    }
 }
 
 /// A file name the section wrote beside the page (no folder, nothing hidden).
@@ -184,6 +214,44 @@ mod tests {
         let mut elsewhere = Context::for_tests(outs[2].path());
         let other = run(store.path(), &mut elsewhere, ("S", "gpu B"), &mut runs, 7);
         assert_eq!((other.1, runs), (Origin::Computed, 2));
+    }
+
+    /// Storing beyond the entries kept removes the oldest, and only them.
+    #[test]
+    fn the_oldest_entries_are_removed() {
+        let store = tempfile::tempdir().unwrap();
+        let out = tempfile::tempdir().unwrap();
+        let mut runs = 0;
+        for machine in 0..=KEPT {
+            let heading = ("S", &*machine.to_string());
+            run(
+                store.path(),
+                &mut Context::for_tests(out.path()),
+                heading,
+                &mut runs,
+                1,
+            );
+            // Entries apart in time by more than a file system's clock step.
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let count = || std::fs::read_dir(store.path()).unwrap().count();
+        assert_eq!(count(), KEPT);
+        let newest = run(
+            store.path(),
+            &mut Context::for_tests(out.path()),
+            ("S", "12"),
+            &mut runs,
+            1,
+        );
+        let oldest = run(
+            store.path(),
+            &mut Context::for_tests(out.path()),
+            ("S", "0"),
+            &mut runs,
+            1,
+        );
+        assert_eq!((newest.1, oldest.1), (Origin::Stored, Origin::Computed));
+        assert_eq!(count(), KEPT);
     }
 
     /// An entry missing a file is computed again, and a user's lobe is never stored.
