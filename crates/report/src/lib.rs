@@ -1,6 +1,7 @@
 //! specula's report: one page that answers, for each lobe, what it costs, how wrong it is
 //! where, what it does to energy, and whether the thesis's claims hold; every number computed
-//! during the run. A product of its own, which the command line (`specula report`) and the
+//! by this build (the pure analyses and drawings kept from an earlier run of it, every timing
+//! measured in this one). A product of its own, which the command line (`specula report`) and the
 //! Python bindings both write ([`write_report`]); its answers ("Which lobe when", the real
 //! materials' verdicts) come from `specula-decide`, so they are the ones `specula recommend`
 //! and `specula fit` give.

@@ -99,21 +99,19 @@ fn file_safe(name: &str) -> String {
         .collect()
 }
 
-/// The section: each material in turn (assessed in parallel, each assessment's fits in
-/// parallel too), those of `--materials`, else the five specula carries (`data/rgl`, built
-/// into the binary), so that a report without a folder still answers for real materials.
 /// The section, or a run's of this build on the same lobes: the bundled materials' fits and
-/// renders are functions of those alone ([`stored`]); a folder of the user's is assessed
-/// anew.
+/// renders are functions of those alone ([`stored`]); a folder of the user's, whose files
+/// no key covers, is assessed anew.
 pub fn materials(context: &mut Context) -> Result<String, String> {
-    let store = context
-        .store
-        .clone()
-        .filter(|_| context.materials.is_none());
-    let (html, _) = stored::section(store.as_deref(), context, MATERIALS, "", assessed)?;
-    Ok(html)
+    if context.materials.is_some() {
+        return assessed(context);
+    }
+    stored::section(context, MATERIALS, "", assessed)
 }
 
+/// Each material in turn (assessed in parallel, each assessment's fits in parallel too),
+/// those of `--materials`, else the five specula carries (`data/rgl`, built into the binary),
+/// so that a report without a folder still answers for real materials.
 fn assessed(context: &mut Context) -> Result<String, String> {
     let (materials, folder, more) = match context.materials.clone() {
         Some(directory) => {

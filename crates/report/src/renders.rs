@@ -166,8 +166,7 @@ pub fn renders(context: &mut Context) -> Result<String, String> {
         Ok(gpu) => gpu.adapter_name(),
         Err(error) => format!("no adapter: {error}"),
     };
-    let store = context.store.clone();
-    let (html, _) = stored::section(store.as_deref(), context, RENDERS, &adapter, |context| {
+    stored::section(context, RENDERS, &adapter, |context| {
         // The environment-lit renders (most of the section's work) run beside the rest.
         let mut lit = context.sibling();
         let (html, environment) = rayon::join(
@@ -176,8 +175,7 @@ pub fn renders(context: &mut Context) -> Result<String, String> {
         );
         context.absorb(lit);
         Ok(html? + &environment?)
-    })?;
-    Ok(html)
+    })
 }
 
 /// The default scene: every lobe, the three shading methods, CPU against GPU.

@@ -4,10 +4,10 @@
 //! same build, as the claims and the datapaths' sweeps are (`specula_decide`'s analyses).
 //!
 //! Keyed by the section, its sizes, the lobes, the adapter and `build.rs`'s fingerprint of
-//! the sources a render runs, so a change to any of them renders again. An entry is a folder
+//! every crate beneath the report, so a change to any of them computes again. An entry is a folder
 //! (`$SPECULA_CACHE_DIR/sections/<key>/`: the section's files and `section.json`, its body
 //! and notes), made under a temporary name and renamed into place, so an interrupted run
-//! leaves no partial entry; one that cannot be read is rendered again, and one that cannot
+//! leaves no partial entry; one that cannot be read is computed again, and one that cannot
 //! be written costs the next run. A user's lobes are never stored: their formulas are not in
 //! the fingerprint.
 
@@ -30,32 +30,24 @@ struct Entry {
     files: Vec<String>,
 }
 
-/// Where a section came from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Origin {
-    /// Computed in this run (and stored, where the cache is writable).
-    Computed,
-    /// Copied from a run of this build with the same key.
-    Stored,
-}
-
 /// The sections' store: `$SPECULA_CACHE_DIR/sections`, where the design searches' cache
 /// would be; none when no cache location is known.
 pub(crate) fn default_store() -> Option<PathBuf> {
     Cache::default_for("sections").map(|cache| cache.directory().to_owned())
 }
 
-/// `compute(context)`, or the section stored under the key of `heading`, `context`'s sizes
-/// and lobes, and `machine` (what else the section's output depends on: the GPU adapter).
+/// `compute(context)`, or the section stored in the context's store under the key of
+/// `heading`, the context's sizes and lobes, and `machine` (what else the section's output
+/// depends on: the GPU adapter); `context.from_store` says which. A context showing a
+/// user's lobe is never stored.
 pub(crate) fn section(
-    store: Option<&Path>,
     context: &mut Context,
     heading: &str,
     machine: &str,
     compute: impl FnOnce(&mut Context) -> Result<String, String>,
-) -> Result<(String, Origin), String> {
-    let Some(store) = store.filter(|_| context.yours().is_empty()) else {
-        return Ok((compute(context)?, Origin::Computed));
+) -> Result<String, String> {
+    let Some(store) = context.store.clone().filter(|_| context.yours().is_empty()) else {
+        return compute(context);
     };
     let lobes: Vec<String> = context.lobes.iter().map(ToString::to_string).collect();
     let key = key(&[
@@ -69,12 +61,12 @@ pub(crate) fn section(
     let entry = store.join(&key);
     if let Some(body) = load(&entry, &key, context) {
         context.from_store = true;
-        return Ok((body, Origin::Stored));
+        return Ok(body);
     }
     let (files_before, notes_before) = (context.files.len(), context.notes.len());
     let body = compute(context)?;
     let _ = save(
-        store,
+        &store,
         &entry,
         &Entry {
             key,
@@ -84,7 +76,7 @@ pub(crate) fn section(
         },
         &context.directory,
     );
-    Ok((body, Origin::Computed))
+    Ok(body)
 }
 
 /// The entry at `entry` with `key`, its files written into the context's folder; none when
@@ -163,23 +155,42 @@ fn plain(name: &str) -> bool {
 mod tests {
     use super::*;
 
-    /// The section under `heading` and `machine`, from `store`, into `context`: a section
-    /// writing two files (the PNG's first byte `pixel`) and a note, counting its runs.
+    /// A context storing in `store` and writing into `out`, after the section under
+    /// `heading` and `machine` ran in it: a section writing two files (the PNG's first byte
+    /// `pixel`) and a note, counting its runs in `runs`.
     fn run(
-        store: &Path,
-        context: &mut Context,
+        (store, out): (&Path, &Path),
         (heading, machine): (&str, &str),
         runs: &mut usize,
         pixel: u8,
-    ) -> (String, Origin) {
-        section(Some(store), context, heading, machine, |context| {
+    ) -> Context {
+        run_in(
+            Context::for_tests(out),
+            store,
+            (heading, machine),
+            runs,
+            pixel,
+        )
+    }
+
+    fn run_in(
+        mut context: Context,
+        store: &Path,
+        (heading, machine): (&str, &str),
+        runs: &mut usize,
+        pixel: u8,
+    ) -> Context {
+        context.store = Some(store.to_owned());
+        let body = section(&mut context, heading, machine, |context| {
             *runs += 1;
             context.write_png_file("a.png", 1, 1, &[pixel, 2, 3])?;
             context.write("b.svg", b"<svg/>")?;
             context.machine_note("no adapter");
             Ok("<p>body</p>".into())
         })
-        .unwrap()
+        .unwrap();
+        assert_eq!(body, "<p>body</p>");
+        context
     }
 
     /// The second run with the same key copies the first's files, bit for bit, with its body
@@ -189,19 +200,15 @@ mod tests {
         let store = tempfile::tempdir().unwrap();
         let outs: Vec<_> = (0..3).map(|_| tempfile::tempdir().unwrap()).collect();
         let mut runs = 0;
-        let mut computed = Context::for_tests(outs[0].path());
-        let made = run(store.path(), &mut computed, ("S", "gpu A"), &mut runs, 7);
-        assert_eq!(
-            (made.0.as_str(), made.1, runs),
-            ("<p>body</p>", Origin::Computed, 1)
+        let computed = run((store.path(), outs[0].path()), ("S", "gpu A"), &mut runs, 7);
+        assert_eq!((computed.from_store, runs), (false, 1));
+        let copied = run(
+            (store.path(), outs[1].path()),
+            ("S", "gpu A"),
+            &mut runs,
+            99,
         );
-        let mut copied = Context::for_tests(outs[1].path());
-        let read = run(store.path(), &mut copied, ("S", "gpu A"), &mut runs, 99);
-        assert_eq!(
-            (read.0.as_str(), read.1, runs),
-            ("<p>body</p>", Origin::Stored, 1)
-        );
-        assert!(copied.from_store && !computed.from_store);
+        assert_eq!((copied.from_store, runs), (true, 1));
         assert_eq!(copied.files, computed.files);
         assert_eq!(copied.notes, ["no adapter"]);
         for name in ["a.png", "b.svg"] {
@@ -211,9 +218,8 @@ mod tests {
                 "{name}"
             );
         }
-        let mut elsewhere = Context::for_tests(outs[2].path());
-        let other = run(store.path(), &mut elsewhere, ("S", "gpu B"), &mut runs, 7);
-        assert_eq!((other.1, runs), (Origin::Computed, 2));
+        let elsewhere = run((store.path(), outs[2].path()), ("S", "gpu B"), &mut runs, 7);
+        assert_eq!((elsewhere.from_store, runs), (false, 2));
     }
 
     /// Storing beyond the entries kept removes the oldest, and only them.
@@ -221,36 +227,18 @@ mod tests {
     fn the_oldest_entries_are_removed() {
         let store = tempfile::tempdir().unwrap();
         let out = tempfile::tempdir().unwrap();
+        let places = (store.path(), out.path());
         let mut runs = 0;
         for machine in 0..=KEPT {
-            let heading = ("S", &*machine.to_string());
-            run(
-                store.path(),
-                &mut Context::for_tests(out.path()),
-                heading,
-                &mut runs,
-                1,
-            );
+            run(places, ("S", &machine.to_string()), &mut runs, 1);
             // Entries apart in time by more than a file system's clock step.
             std::thread::sleep(std::time::Duration::from_millis(20));
         }
         let count = || std::fs::read_dir(store.path()).unwrap().count();
         assert_eq!(count(), KEPT);
-        let newest = run(
-            store.path(),
-            &mut Context::for_tests(out.path()),
-            ("S", "12"),
-            &mut runs,
-            1,
-        );
-        let oldest = run(
-            store.path(),
-            &mut Context::for_tests(out.path()),
-            ("S", "0"),
-            &mut runs,
-            1,
-        );
-        assert_eq!((newest.1, oldest.1), (Origin::Stored, Origin::Computed));
+        let newest = run(places, ("S", &KEPT.to_string()), &mut runs, 1);
+        let oldest = run(places, ("S", "0"), &mut runs, 1);
+        assert_eq!((newest.from_store, oldest.from_store), (true, false));
         assert_eq!(count(), KEPT);
     }
 
@@ -259,36 +247,22 @@ mod tests {
     fn a_damaged_entry_or_a_users_lobe_computes() {
         let store = tempfile::tempdir().unwrap();
         let out = tempfile::tempdir().unwrap();
+        let places = (store.path(), out.path());
         let mut runs = 0;
-        run(
-            store.path(),
-            &mut Context::for_tests(out.path()),
-            ("S", ""),
-            &mut runs,
-            1,
-        );
+        run(places, ("S", ""), &mut runs, 1);
         let entry = std::fs::read_dir(store.path())
             .unwrap()
             .map(|e| e.unwrap().path())
             .find(|p| p.join("section.json").exists())
             .expect("an entry");
         std::fs::remove_file(entry.join("b.svg")).unwrap();
-        let again = run(
-            store.path(),
-            &mut Context::for_tests(out.path()),
-            ("S", ""),
-            &mut runs,
-            1,
-        );
-        assert_eq!((again.1, runs), (Origin::Computed, 2));
-        let mut yours = Context::for_tests(out.path());
-        let kind = specula_render::lobe_file::parse_lobe("cosquad:v=5", None).unwrap();
-        yours.lobes.push(kind);
+        assert!(!run(places, ("S", ""), &mut runs, 1).from_store);
+        assert_eq!(runs, 2);
         for _ in 0..2 {
-            assert_eq!(
-                run(store.path(), &mut yours, ("Y", ""), &mut runs, 1).1,
-                Origin::Computed
-            );
+            let mut yours = Context::for_tests(out.path());
+            let kind = specula_render::lobe_file::parse_lobe("cosquad:v=5", None).unwrap();
+            yours.lobes.push(kind);
+            assert!(!run_in(yours, store.path(), ("Y", ""), &mut runs, 1).from_store);
         }
         assert_eq!(runs, 4);
     }
