@@ -75,14 +75,14 @@ mod tests {
     /// file and an uncounted extension do not.
     #[test]
     fn counted_files_alone_make_the_fingerprint() {
-        let tree = std::env::temp_dir().join(format!("specula-fingerprint-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&tree);
+        let scratch = tempfile::tempdir().unwrap();
+        let tree = scratch.path();
         std::fs::create_dir_all(tree.join("src/tests")).unwrap();
         let filter = Filter {
             extensions: Some(&["rs"]),
             skipped_folders: &["tests"],
         };
-        let of = || sources(&tree, &[tree.join("src")], filter);
+        let of = || sources(tree, &[tree.join("src")], filter);
         std::fs::write(tree.join("src/a.rs"), "one").unwrap();
         let first = of();
         std::fs::write(tree.join("src/tests/t.rs"), "ignored").unwrap();
@@ -93,6 +93,5 @@ mod tests {
         assert_ne!(second, first);
         std::fs::rename(tree.join("src/a.rs"), tree.join("src/b.rs")).unwrap();
         assert_ne!(of(), second);
-        std::fs::remove_dir_all(&tree).unwrap();
     }
 }
