@@ -82,6 +82,13 @@ impl Gpu {
         format!("{} ({:?}, {})", info.name, info.backend, driver)
     }
 
+    /// Whether the adapter is a rasterizer in software (lavapipe, SwiftShader, WARP): its
+    /// frame times are the CPU's, not a GPU's.
+    #[must_use]
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
     /// Runs `work` and waits for the GPU, turning validation and memory errors into a
     /// [`GpuError`] instead of wgpu's default panic.
     pub(crate) fn checked<T>(&self, work: impl FnOnce() -> T) -> Result<T, GpuError> {

@@ -131,7 +131,13 @@ pub fn energy(context: &mut Context) -> Result<String, String> {
     Ok(html)
 }
 
+/// The section, or a run's of this build on the same sizes and lobes: its integrals and
+/// seeded pairs are functions of those alone ([`stored`](super::stored)).
 pub fn reciprocity(context: &mut Context) -> Result<String, String> {
+    super::stored::section(context, super::RECIPROCITY, "", measured_reciprocity)
+}
+
+fn measured_reciprocity(context: &mut Context) -> Result<String, String> {
     use rand::SeedableRng;
     let pairs = context.sizes.reciprocity_pairs;
     let exponents = [8.0, 64.0, 512.0].map(Exponent::new);

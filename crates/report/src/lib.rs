@@ -297,12 +297,25 @@ impl Context {
 
 type Section = (&'static str, fn(&mut Context) -> Result<String, String>);
 
-/// The sections that take longest, started first (the others in the order they are shown).
-const LONGEST_FIRST: [&str; 3] = [RENDERS, VOLUMES, CLAIMS];
+/// The sections that take longest, started first (the others in the order they are shown):
+/// the medical volumes and the designs' measured ranking on every run, the renders and the
+/// materials when the store lacks them, the claims when the synthesis cache does.
+const LONGEST_FIRST: [&str; 7] = [
+    VOLUMES,
+    RENDERS,
+    MATERIALS,
+    DESIGNED,
+    RECIPROCITY,
+    ERRORS,
+    CLAIMS,
+];
 pub(crate) const RENDERS: &str = "Renders";
 pub(crate) const MATERIALS: &str = "Real materials";
 const VOLUMES: &str = "Medical volumes";
 const CLAIMS: &str = "The thesis's claims";
+const DESIGNED: &str = "Designed lobes";
+pub(crate) const RECIPROCITY: &str = "Reciprocity and white furnace";
+pub(crate) const ERRORS: &str = "Error against the angle and against n";
 
 /// The sections that read the hardware sweeps.
 const HARDWARE_SECTIONS: [&str; 2] = [VERDICT, HARDWARE];
@@ -314,13 +327,13 @@ pub const NOTES: &str = "Notes on this machine";
 /// The answer first (which lobe when), then the thesis's claims, then the details.
 const SECTIONS: [Section; 14] = [
     (VERDICT, verdict::verdict),
-    ("Designed lobes", designed::designed),
+    (DESIGNED, designed::designed),
     (CLAIMS, sections::claims),
     ("Models", sections::models),
     ("Lobe shapes", sections::shapes),
-    ("Error against the angle and against n", sections::errors),
+    (ERRORS, sections::errors),
     ("Energy and normalisation", energy::energy),
-    ("Reciprocity and white furnace", energy::reciprocity),
+    (RECIPROCITY, energy::reciprocity),
     (RENDERS, renders::renders),
     (MATERIALS, materials::materials),
     (VOLUMES, volumes::volumes),

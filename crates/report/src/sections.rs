@@ -171,7 +171,13 @@ pub fn shapes(context: &mut Context) -> Result<String, String> {
     Ok(html + &multiples(&figures, SMALL.0 + LEGEND_WIDTH))
 }
 
+/// The section, or a run's of this build on the same lobes: its curves are functions of
+/// those alone ([`stored`](super::stored)).
 pub fn errors(context: &mut Context) -> Result<String, String> {
+    super::stored::section(context, super::ERRORS, "", error_curves)
+}
+
+fn error_curves(context: &mut Context) -> Result<String, String> {
     let mut html = paragraph(
         "Signed error lobe - t^n against the angle, scaled by the bloom's \
         edge so that every n fits one axis, for n = 8, 64 and 512: one small chart per lobe, each \

@@ -1,5 +1,6 @@
 //! Sections whose page and images are functions of the code, the options and the GPU adapter
-//! alone (the renders and the bundled materials: images, fits and comparisons, no timing),
+//! alone (the renders, the bundled materials' fits, the error curves, the white furnace and
+//! reciprocity: images, fits, integrals and comparisons, no timing),
 //! stored beside the design searches by a first run and copied back by a later run of the
 //! same build, as the claims and the datapaths' sweeps are (`specula_decide`'s analyses).
 //!
@@ -119,8 +120,9 @@ fn save(store: &Path, entry: &Path, stored: &Entry, written_to: &Path) -> std::i
 }
 
 /// Entries kept: every build stores new ones (a full report's Renders are about 4 MB), so
-/// the oldest beyond these are removed, enough for the full and quick reports of a few builds.
-const KEPT: usize = 12;
+/// the oldest beyond these are removed: four sections of a full and a quick report, of three
+/// builds.
+const KEPT: usize = 24;
 
 /// Removes all but the `kept` most recently stored entries of `store` (temporary folders of
 /// runs in progress are not entries and are left alone).

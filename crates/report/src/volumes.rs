@@ -119,8 +119,17 @@ fn phantom(context: &mut Context) -> Result<String, String> {
         together_ms,
         lobes.len(),
     ));
-    // The same on the GPU: every lobe's image from one march (up to 16 a march).
+    // The same on the GPU: every lobe's image from one march (up to 16 a march). A software
+    // rasterizer's frame is the CPU's work, slowed by the sections beside it, and no GPU's
+    // time: there the images are drawn once for the parity column, and timed with --bench.
+    let untimed = gpu.as_ref().is_ok_and(Gpu::is_software) && !context.bench;
     let gpu_images = match &renderer {
+        Some(renderer) if untimed => renderer
+            .render_lobes(&volume, &transfer, &settings_for(LobeKind::Pow)?, &lobes)
+            .map_err(|e| e.to_string())?
+            .into_iter()
+            .map(Some)
+            .collect(),
         Some(renderer) => {
             // Compiled beforehand, so that a frame's time is its upload, march and read-back.
             renderer
@@ -193,6 +202,14 @@ fn phantom(context: &mut Context) -> Result<String, String> {
         &[1],
     );
     match &gpu {
+        Ok(gpu) if untimed => {
+            html += &paragraph(&format!(
+                "GPU: {}, a rasterizer in software: its images are drawn once for the parity \
+                    column and its frames not timed, their time being the CPU's (`specula report \
+                    --bench` times them).",
+                gpu.adapter_name()
+            ));
+        }
         Ok(gpu) => html += &paragraph(&format!("GPU: {}.", gpu.adapter_name())),
         Err(error) => {
             html +=

@@ -125,6 +125,7 @@ fn the_quick_report_is_complete_and_well_formed() {
         check_row(&out, "volume", &row[0], &row[1], &row[2], &row[3]);
     }
     check_tiles(&document, &out, "volume");
+    phantom_on_the_gpu(&rows, &text);
     real_scans(&document, &text, &out);
     materials(&document, &out);
     one_answer(&document, d);
@@ -204,6 +205,39 @@ fn one_answer(document: &roxmltree::Document, directory: &std::path::Path) {
 
 /// The page opens with the answer: the first section leads with a box naming a lobe for each
 /// target, before any table; what the machine lacked is in the last section alone.
+/// The phantom's GPU column: every lobe's GPU image compared with its CPU image (the two
+/// marchers agree to FLIP 1e-3); its frames timed on a GPU, and on an adapter that wgpu calls
+/// a CPU (lavapipe here) drawn once and said not to be timed.
+fn phantom_on_the_gpu(rows: &[Vec<String>], text: &str) {
+    let software = match specula_gpu::Gpu::new() {
+        Ok(gpu) => gpu.is_software(),
+        Err(error) => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "CI=true: {error}"
+            );
+            return;
+        }
+    };
+    for row in rows {
+        let flip: f64 = row[4]
+            .parse()
+            .unwrap_or_else(|_| panic!("{}: CPU against GPU {:?}", row[0], row[4]));
+        assert!(
+            (0.0..1e-3).contains(&flip),
+            "{}: CPU against GPU {flip}",
+            row[0]
+        );
+    }
+    let timed = text.contains("One frame on the GPU");
+    let untimed = text.contains("a rasterizer in software");
+    assert_eq!(
+        (timed, untimed),
+        (!software, software),
+        "software adapter: {software}"
+    );
+}
+
 fn answer_first(document: &roxmltree::Document) {
     let sections: Vec<roxmltree::Node> = document
         .descendants()
