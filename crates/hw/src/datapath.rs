@@ -45,6 +45,8 @@ pub enum Op {
     Exp2Neg(NodeId, Exp2Unit),
     /// `min(a, b)`: a comparator and a multiplexer.
     Min(NodeId, NodeId),
+    /// `max(a, b)`: a comparator and a multiplexer.
+    Max(NodeId, NodeId),
     /// 1 if `a` is not zero, else 0: an OR of its bits.
     NonZero(NodeId),
     /// `table[index]`, the index clamped to the table.
@@ -170,7 +172,12 @@ impl Builder {
 pub fn operands(op: &Op) -> Vec<NodeId> {
     match op {
         Op::Input | Op::Const(_) => Vec::new(),
-        Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Min(a, b) => {
+        Op::Add(a, b)
+        | Op::Sub(a, b)
+        | Op::Mul(a, b)
+        | Op::Div(a, b)
+        | Op::Min(a, b)
+        | Op::Max(a, b) => {
             vec![*a, *b]
         }
         Op::Square(a) | Op::Shift(a, _) | Op::Log2(a, _) | Op::Exp2Neg(a, _) | Op::NonZero(a) => {
@@ -314,11 +321,16 @@ impl Datapath {
                     let (a, fa) = at(*a);
                     resize(unit.eval_with_table(&self.tables[k], a, fa, out.frac_bits))
                 }
-                Op::Min(a, b) => {
+                Op::Min(a, b) | Op::Max(a, b) => {
                     let ((a, fa), (b, fb)) = (at(*a), at(*b));
                     let (a_exact, _) = exact_add(a, fa, 0, fb);
                     let (b_exact, frac) = exact_add(b, fb, 0, fa);
-                    resize((a_exact.min(b_exact), frac))
+                    let chosen = if matches!(node.op, Op::Min(..)) {
+                        a_exact.min(b_exact)
+                    } else {
+                        a_exact.max(b_exact)
+                    };
+                    resize((chosen, frac))
                 }
                 Op::NonZero(a) => resize((i128::from(at(*a).0 != 0), 0)),
                 Op::Rom { index, table } => {
@@ -405,7 +417,7 @@ impl Datapath {
             match &node.op {
                 Op::Input | Op::Const(_) | Op::Shift(..) | Op::NonZero(_) => {}
                 Op::Add(..) | Op::Sub(..) => r.adders.push(bits),
-                Op::Min(a, b) => r.adders.push(width(a).max(width(b))),
+                Op::Min(a, b) | Op::Max(a, b) => r.adders.push(width(a).max(width(b))),
                 Op::Mul(a, b) => r.multipliers.push((width(a), width(b))),
                 Op::Square(a) => r.squarers.push(width(a)),
                 Op::Div(a, b) => r.dividers.push((width(a), width(b))),

@@ -13,9 +13,13 @@
 //!   co-simulation with Icarus Verilog the tests require to be bit-exact;
 //! - a block diagram, [`diagram::svg`].
 //!
+//! A lobe of yours whose formula is transcendental-free has a datapath too, compiled from its
+//! recorded expression a stage per operation ([`HwLobe::Formula`]).
+//!
 //! No I/O: the CLI writes the files.
 
 pub mod analysis;
+mod compiled;
 mod datapath;
 pub mod diagram;
 mod exp2;

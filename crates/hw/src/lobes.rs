@@ -12,8 +12,10 @@
 //! Every node rounds half to even and saturates.
 
 use serde::Serialize;
+use specula::lobe::FormulaId;
 use specula::{Exponent, Lobe, LobeKind};
 
+use crate::compiled;
 use crate::datapath::{Builder, Datapath, Op};
 use crate::exp2::Exp2Unit;
 use crate::fixed::{FixedPoint, Rounding};
@@ -43,7 +45,8 @@ const SG_RATE_INT_BITS: u32 = 11;
 /// The squarings `schlick-mod` can select: `a = 2^k` with `k <= 7` covers `n <= 1000`.
 const SCHLICK_MOD_MAX_SQUARINGS: u32 = 7;
 
-/// A hardware datapath: the lobe it implements and, for `logexp`, its log2 unit.
+/// A hardware datapath: the lobe it implements and, for `logexp`, its log2 unit; or a lobe of
+/// yours compiled from its formula ([`HwLobe::Formula`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum HwLobe {
     /// `t / (n (1 - t) + t)`: one multiply, two adds, a divider.
@@ -65,6 +68,9 @@ pub enum HwLobe {
     /// The engines' spherical Gaussian `2^-(r (1 - t))`, `r = log2(e) n` per material: a
     /// subtract, a multiply and an exp2 unit (and 0 at `t = 0`).
     Sg,
+    /// A lobe of yours (a lobe file, a designed lobe), compiled from its recorded expression
+    /// one stage per operation (`compiled.rs`): transcendental-free formulas only.
+    Formula(FormulaId),
 }
 
 impl Serialize for HwLobe {
@@ -83,15 +89,17 @@ pub enum HwError {
         hint = specula::did_you_mean(.0, HwLobe::ALL.map(HwLobe::id))
     )]
     UnknownLobe(String),
-    /// A user's lobe (a lobe file or a formula): no datapath is generated from a formula.
-    #[error(
-        "`{}` is a lobe of yours; the fixed-point datapaths are designed per model (word \
-         lengths, tables, shifts), not generated from a formula, so a user lobe has none; \
-         valid: {valid}",
-        specula::excerpt(.0),
-        valid = HwLobe::valid_ids()
-    )]
-    UserLobe(String),
+    /// A lobe of yours whose formula does not compile to a datapath.
+    #[error("`{lobe}` has no datapath: {why}; valid: a transcendental-free formula, or {valid}", valid = HwLobe::valid_ids())]
+    NotCompiled {
+        /// The lobe.
+        lobe: String,
+        /// Why: the operation no stage computes, or the width it would need.
+        why: String,
+    },
+    /// A built-in lobe that has no datapath.
+    #[error("`{0}` has no hardware datapath; valid: {valid}, or a lobe of yours whose formula is transcendental-free (@FILE.toml)", valid = HwLobe::valid_ids())]
+    NoDatapath(String),
     /// A word length outside [`BITS`].
     #[error("word length {0} is out of range; valid: 8 to 24 bits")]
     Bits(u32),
@@ -125,6 +133,7 @@ impl HwLobe {
             HwLobe::CosQuad => "cosquad",
             HwLobe::Pow => "pow",
             HwLobe::Sg => "sg",
+            HwLobe::Formula(id) => LobeKind::Formula(id).id(),
         }
     }
 
@@ -134,22 +143,31 @@ impl HwLobe {
         Self::ALL.map(HwLobe::id).join(", ")
     }
 
-    /// The datapath with id `text`.
+    /// The datapath with id `text`: a built-in's, or a lobe of yours named or written as
+    /// `=FORMULA` (a lobe file is read by the caller, who hands the lobe to
+    /// [`HwLobe::of_kind`]).
     pub fn parse(text: &str) -> Result<Self, HwError> {
+        let text = text.trim();
+        if let Some(lobe) = Self::ALL.into_iter().find(|lobe| lobe.id() == text) {
+            return Ok(lobe);
+        }
+        match LobeKind::parse(text) {
+            Ok(kind @ LobeKind::Formula(_)) => Self::of_kind(kind),
+            _ => Err(HwError::UnknownLobe(specula::excerpt(text))),
+        }
+    }
+
+    /// The datapath of `kind`: its built-in one (`logexp`'s table unit, not Mitchell's), or a
+    /// lobe of yours compiled from its formula, or why it has none.
+    pub fn of_kind(kind: LobeKind) -> Result<Self, HwError> {
+        if let LobeKind::Formula(id) = kind {
+            compiled::layout(id)?;
+            return Ok(HwLobe::Formula(id));
+        }
         Self::ALL
             .into_iter()
-            .find(|lobe| lobe.id() == text)
-            .ok_or_else(|| {
-                let text = text.trim();
-                let user = text.starts_with('@')
-                    || text.starts_with('=')
-                    || matches!(LobeKind::parse(text), Ok(LobeKind::Formula(_)));
-                if user {
-                    HwError::UserLobe(text.to_owned())
-                } else {
-                    HwError::UnknownLobe(specula::excerpt(text))
-                }
-            })
+            .find(|lobe| lobe.float_kind() == kind)
+            .ok_or_else(|| HwError::NoDatapath(kind.to_string()))
     }
 
     /// The float model it implements.
@@ -163,6 +181,7 @@ impl HwLobe {
             HwLobe::CosQuad => LobeKind::CosQuad { v: COSQUAD_V as u8 },
             HwLobe::Pow => LobeKind::Pow,
             HwLobe::Sg => LobeKind::Sg,
+            HwLobe::Formula(id) => LobeKind::Formula(id),
         }
     }
 
@@ -186,8 +205,17 @@ impl HwLobe {
         let frac = bits - 1;
         let unit = Self::unit_format(bits);
         let mut b = Builder::new(Rounding::HalfEven);
-        let name = format!("specula_{}_w{bits}", self.id().replace('-', "_"));
+        // A formula's name may hold what a Verilog identifier cannot.
+        let id: String = self
+            .id()
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        let name = format!("specula_{id}_w{bits}");
         let output = match self {
+            HwLobe::Formula(id) => {
+                return compiled::layout(id)?.build(&name, self.id(), bits);
+            }
             HwLobe::Schlick | HwLobe::SchlickMod => {
                 let t = b.input("t", unit);
                 let n = b.input("n", FixedPoint::unsigned(10, 0));
@@ -380,6 +408,9 @@ impl HwLobe {
                 vec![FixedPoint::unsigned(6, bits - 1)
                     .quantize(prepared("slope"), Rounding::HalfEven)]
             }
+            HwLobe::Formula(id) => compiled::layout(id)
+                .map(|layout| layout.material_inputs(self.float_kind(), bits, n))
+                .unwrap_or_default(),
         }
     }
 
@@ -398,6 +429,18 @@ impl HwLobe {
     pub fn value(bits: u32, raw: i64) -> f64 {
         Self::unit_format(bits).to_f64(raw)
     }
+}
+
+/// The datapath finished with [`zero_at_t_zero`]'s output.
+pub(crate) fn finish_zero_at_t_zero(
+    mut b: Builder,
+    name: &str,
+    t: crate::NodeId,
+    value: crate::NodeId,
+    unit: FixedPoint,
+) -> Datapath {
+    let output = zero_at_t_zero(&mut b, t, value, unit);
+    b.finish(name, output)
 }
 
 /// The output node: `value`, or 0 where `t = 0`, since every lobe is 0 there (SPEC section 1)

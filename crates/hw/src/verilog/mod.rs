@@ -92,7 +92,7 @@ impl Emitter<'_> {
             (format!("({expr} <<< {shift})"), format.width() + shift)
         };
         match &node.op {
-            Op::Add(a, b) | Op::Sub(a, b) | Op::Min(a, b) => {
+            Op::Add(a, b) | Op::Sub(a, b) | Op::Min(a, b) | Op::Max(a, b) => {
                 let (a, b) = (self.operand(id, *a), self.operand(id, *b));
                 let frac = a.1.frac_bits.max(b.1.frac_bits);
                 let ((ea, wa), (eb, wb)) = (aligned(a, frac), aligned(b, frac));
@@ -100,7 +100,8 @@ impl Emitter<'_> {
                 let expr = match node.op {
                     Op::Add(..) => format!("{ea} + {eb}"),
                     Op::Sub(..) => format!("{ea} - {eb}"),
-                    _ => format!("(({ea} < {eb}) ? {ea} : {eb})"),
+                    Op::Min(..) => format!("(({ea} < {eb}) ? {ea} : {eb})"),
+                    _ => format!("(({ea} > {eb}) ? {ea} : {eb})"),
                 };
                 (expr, frac, bits)
             }
@@ -430,6 +431,7 @@ pub fn describe(datapath: &Datapath, op: &Op) -> String {
         Op::Log2(a, unit) => format!("log2 {} ({})", name(a), unit.name()),
         Op::Exp2Neg(a, unit) => format!("2^-{} ({})", name(a), unit.name()),
         Op::Min(a, b) => format!("min({}, {})", name(a), name(b)),
+        Op::Max(a, b) => format!("max({}, {})", name(a), name(b)),
         Op::NonZero(a) => format!("{} != 0", name(a)),
         Op::Rom { index, table } => format!("ROM[{}] ({} words)", name(index), table.len()),
         Op::Select { index, options } => format!(

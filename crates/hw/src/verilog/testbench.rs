@@ -164,10 +164,10 @@ pub fn testbench_in(datapath: &Datapath, vectors: &[(Vec<i64>, i64)], form: Form
     );
     let _ = writeln!(v, "    integer i, j, errors;\n    initial begin");
     for (k, (values, expected)) in vectors.iter().enumerate() {
-        for ((input, _), value) in inputs.iter().zip(values) {
-            let _ = write!(v, "        vector_{input}[{k}] = {value};");
+        for ((input, width), &value) in inputs.iter().zip(values) {
+            let _ = write!(v, "        vector_{input}[{k}] = {};", sized(value, *width));
         }
-        let _ = writeln!(v, " expected[{k}] = {expected};");
+        let _ = writeln!(v, " expected[{k}] = {};", sized(*expected, output.width()));
     }
     let assign: Vec<String> = inputs
         .iter()
@@ -186,4 +186,10 @@ pub fn testbench_in(datapath: &Datapath, vectors: &[(Vec<i64>, i64)], form: Form
         assign.join(" ")
     );
     v
+}
+
+/// `raw` as a `width`-bit literal: its two's complement bits, so that a negative value or one
+/// beyond 32 bits (an unsized decimal's width) fills its port exactly.
+fn sized(raw: i64, width: u32) -> String {
+    format!("{width}'d{}", i128::from(raw).rem_euclid(1_i128 << width))
 }
