@@ -88,9 +88,37 @@ pub(crate) struct Chosen {
     pub cells: u64,
 }
 
-/// Of `kind`'s datapaths among `sweeps`, each at the smallest word length whose `zone` error
-/// is at most `max_error` (or at its widest, where none is), the one with the fewest estimated
-/// logic cells, those within the bound first; `None` where `kind` has no datapath.
+/// A lobe of yours compiled to a datapath ([`HwLobe::Formula`]): its sweep over every word
+/// length ([`BITS`]) at the integer exponent `n`, with [`SWEEP_SAMPLES`] angles per zone,
+/// computed once per lobe and exponent in a process; `None` where its formula has no datapath.
+fn compiled_sweep(kind: LobeKind, n: u32) -> Option<Arc<WidthSweep>> {
+    type Memo = Vec<((LobeKind, u32), Option<Arc<WidthSweep>>)>;
+    static MEMO: Mutex<Memo> = Mutex::new(Vec::new());
+    let memo = || MEMO.lock().unwrap_or_else(PoisonError::into_inner);
+    let known = |memo: &Memo| {
+        memo.iter()
+            .find(|(at, _)| *at == (kind, n))
+            .map(|(_, sweep)| sweep.clone())
+    };
+    if let Some(found) = known(&memo()) {
+        return found;
+    }
+    // Computed without the lock, as the built-ins' sweeps are.
+    let computed = HwLobe::of_kind(kind)
+        .ok()
+        .and_then(|lobe| sweep(lobe, n, BITS, SWEEP_SAMPLES, &mut |_| {}).ok())
+        .map(Arc::new);
+    let mut memo = memo();
+    if known(&memo).is_none() {
+        memo.push(((kind, n), computed));
+    }
+    known(&memo).flatten()
+}
+
+/// Of `kind`'s datapaths among `sweeps` (all at one exponent), or, for a lobe of yours, of its
+/// compiled datapath's sweep at that exponent, each at the smallest word length whose `zone`
+/// error is at most `max_error` (or at its widest, where none is), the one with the fewest
+/// estimated logic cells, those within the bound first; `None` where `kind` has no datapath.
 #[must_use]
 pub(crate) fn cheapest_datapath(
     sweeps: &[WidthSweep],
@@ -98,6 +126,11 @@ pub(crate) fn cheapest_datapath(
     zone: Zone,
     max_error: f64,
 ) -> Option<Chosen> {
+    let compiled = match (kind, sweeps.first()) {
+        (LobeKind::Formula(_), Some(built_in)) => compiled_sweep(kind, built_in.n),
+        _ => None,
+    };
+    let sweeps = compiled.as_deref().map_or(sweeps, core::slice::from_ref);
     sweeps
         .iter()
         .filter(|sweep| sweep.lobe.float_kind() == kind)
@@ -115,4 +148,28 @@ pub(crate) fn cheapest_datapath(
             })
         })
         .min_by_key(|chosen| (chosen.error > max_error, chosen.cells))
+}
+
+/// The datapath of `kind` (a built-in's cheapest, or a lobe of yours compiled) as one circuit
+/// serving every exponent of `low..=high`: the largest of the word lengths each of
+/// `recommend`'s sample exponents needs for an epicentre error of at most `max_error`; `None`
+/// where it has no datapath or some exponent's error is out of reach at every width.
+pub fn circuit_for_range(
+    kind: LobeKind,
+    (low, high): (specula::Exponent, specula::Exponent),
+    max_error: f64,
+) -> Result<Option<(HwLobe, u32)>, String> {
+    let mut circuit: Option<(HwLobe, u32)> = None;
+    for n in crate::sample_exponents(low, high) {
+        let n = n.get().round().clamp(1.0, 1000.0) as u32;
+        let sweeps = hardware_sweeps(n)?;
+        let Some(chosen) = cheapest_datapath(&sweeps, kind, Zone::Epicentre, max_error)
+            .filter(|chosen| chosen.error <= max_error)
+        else {
+            return Ok(None);
+        };
+        let bits = circuit.map_or(chosen.bits, |(_, bits)| bits.max(chosen.bits));
+        circuit = Some((chosen.lobe, bits));
+    }
+    Ok(circuit)
 }

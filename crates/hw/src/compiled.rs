@@ -18,9 +18,10 @@
 //! the expression is run in `f64` at every integer `n` over a grid of cosines dense near 1,
 //! and the largest magnitude gets a sixteenth of headroom. A signal too large to keep that
 //! least significant bit within a stage's [`MAX_WIDTH`] (a quadratic's curvature grows as
-//! `n^2`) gives up fraction bits instead: it still holds more significant bits than `W`. Inputs between the grid's points
-//! that would go beyond saturate, as every stage does; the sweeps then measure the datapath
-//! bit for bit at every representable input, so no such loss goes unseen.
+//! `n^2`) gives up fraction bits instead: it still holds more significant bits than `W`.
+//! Inputs between the grid's points that would go beyond saturate, as every stage does; the
+//! sweeps then measure the datapath bit for bit at every representable input of the exponents
+//! they sample, so such a loss shows in its error.
 //!
 //! **Per-material constants.** The expression's named parameters (the formula's `let`s of
 //! `n`: a slope, a curvature, a cut) are module inputs prepared on the host, exactly as the
@@ -108,7 +109,7 @@ fn measure(kind: LobeKind) -> Result<Layout, String> {
         .nodes()
         .iter()
         .map(|&node| {
-            supported(&node)?;
+            supported(&node, first.nodes())?;
             Ok(Step {
                 node,
                 low: f64::INFINITY,
@@ -152,9 +153,24 @@ fn cosine_grid() -> Vec<f64> {
         .collect()
 }
 
-/// Whether a stage computes `node`; `Err` names the operation it does not.
-fn supported(node: &Traced) -> Result<(), String> {
+/// The largest integer power a compiled datapath raises to, by squarings and products.
+const MAX_POWER: u32 = 1024;
+
+/// `node`'s power where it is a whole constant from 1 to [`MAX_POWER`] (the formula records
+/// powers above 64 as `pow`).
+fn whole_power(nodes: &[Traced], exponent: usize) -> Option<u32> {
+    match nodes[exponent] {
+        Traced::Constant(k) if k.fract() == 0.0 && (1.0..=f64::from(MAX_POWER)).contains(&k) => {
+            Some(k as u32)
+        }
+        _ => None,
+    }
+}
+
+/// Whether a stage computes `node` of `nodes`; `Err` names the operation it does not.
+fn supported(node: &Traced, nodes: &[Traced]) -> Result<(), String> {
     match node {
+        Traced::Pow(_, exponent) if whole_power(nodes, *exponent).is_some() => Ok(()),
         Traced::Input
         | Traced::Constant(_)
         | Traced::Parameter { .. }
@@ -223,6 +239,7 @@ fn run(nodes: &[Traced], t: f64, values: &mut [f64]) {
             Traced::Square(a) => v(a) * v(a),
             Traced::Max(a, b) => v(a).max(v(b)),
             Traced::Min(a, b) => v(a).min(v(b)),
+            Traced::Pow(a, b) => v(a).powf(v(b)),
             _ => f64::NAN,
         };
     }
@@ -253,9 +270,12 @@ impl Layout {
         self.parameters
             .iter()
             .map(|&wanted| {
+                let named = |step: &&Step| {
+                    matches!(step.node, Traced::Parameter { name, .. } if name == wanted)
+                };
                 self.steps
                     .iter()
-                    .find(|step| matches!(step.node, Traced::Parameter { name, .. } if name == wanted))
+                    .find(named)
                     .map_or(FixedPoint::unsigned(1, bits - 1), |step| {
                         Self::format(step.low, step.high, bits - 1)
                     })
@@ -326,6 +346,19 @@ impl Layout {
                     let zero = b.node(&label("zero"), Op::Const(0), unit);
                     b.node(&label("negation"), Op::Sub(zero, at(x)), format)
                 }
+                Traced::Pow(x, y) => {
+                    let power = whole_power(&self.nodes(), y)
+                        .unwrap_or_else(|| unreachable!("a real power was refused when laid out"));
+                    self.power(
+                        lobe,
+                        &mut b,
+                        at(x),
+                        (self.steps[x].low, self.steps[x].high),
+                        power,
+                        k,
+                        frac,
+                    )?
+                }
                 Traced::Div(x, y) => {
                     if self.steps[x].low < 0.0 || self.steps[y].low < 0.0 {
                         return Err(HwError::NotCompiled {
@@ -357,6 +390,69 @@ impl Layout {
         Ok(crate::lobes::finish_zero_at_t_zero(
             b, name, t, clamped, unit,
         ))
+    }
+
+    /// The recorded nodes, in order.
+    fn nodes(&self) -> Vec<Traced> {
+        self.steps.iter().map(|step| step.node).collect()
+    }
+
+    /// `x^power` by binary exponentiation, squarers and multipliers whose formats follow the
+    /// powers of `x`'s range; the nodes are named after step `k`.
+    #[allow(clippy::too_many_arguments)]
+    fn power(
+        &self,
+        lobe: &str,
+        b: &mut Builder,
+        x: NodeId,
+        (low, high): (f64, f64),
+        power: u32,
+        k: usize,
+        frac: u32,
+    ) -> Result<NodeId, HwError> {
+        // The range of x^e: a power of the range, from 0 where an even power crosses it.
+        let range = |e: u32| {
+            let (a, b) = (low.powi(e as i32), high.powi(e as i32));
+            if e.is_multiple_of(2) && low < 0.0 && high > 0.0 {
+                (0.0, a.max(b))
+            } else {
+                (a.min(b), a.max(b))
+            }
+        };
+        let mut result: Option<(NodeId, u32)> = None;
+        let (mut base, mut exponent, mut remaining) = (x, 1_u32, power);
+        loop {
+            if remaining & 1 == 1 {
+                result = Some(match result {
+                    None => (base, exponent),
+                    Some((product, e)) => {
+                        let (lo, hi) = range(e + exponent);
+                        let format = Self::format(lo, hi, frac);
+                        let name = format!("power_{k}_{}", e + exponent);
+                        (b.node(&name, Op::Mul(product, base), format), e + exponent)
+                    }
+                });
+            }
+            remaining >>= 1;
+            if remaining == 0 {
+                break;
+            }
+            exponent *= 2;
+            let (lo, hi) = range(exponent);
+            let format = Self::format(lo, hi, frac);
+            if format.width() > MAX_WIDTH {
+                return Err(HwError::NotCompiled {
+                    lobe: lobe.to_owned(),
+                    why: format!(
+                        "a power {exponent} needs {} bits, wider than the {MAX_WIDTH} a stage \
+                         may have",
+                        format.width()
+                    ),
+                });
+            }
+            base = b.node(&format!("square_{k}_{exponent}"), Op::Square(base), format);
+        }
+        Ok(result.map_or(x, |(node, _)| node))
     }
 
     /// The parameters' raw inputs for integer exponent `n` at word length `bits`, as the host

@@ -90,7 +90,10 @@ pub enum HwError {
     )]
     UnknownLobe(String),
     /// A lobe of yours whose formula does not compile to a datapath.
-    #[error("`{lobe}` has no datapath: {why}; valid: a transcendental-free formula, or {valid}", valid = HwLobe::valid_ids())]
+    #[error(
+        "`{lobe}` has no datapath: {why}; valid: a transcendental-free formula, or {valid}",
+        valid = HwLobe::valid_ids()
+    )]
     NotCompiled {
         /// The lobe.
         lobe: String,
@@ -98,7 +101,11 @@ pub enum HwError {
         why: String,
     },
     /// A built-in lobe that has no datapath.
-    #[error("`{0}` has no hardware datapath; valid: {valid}, or a lobe of yours whose formula is transcendental-free (@FILE.toml)", valid = HwLobe::valid_ids())]
+    #[error(
+        "`{0}` has no hardware datapath; valid: {valid}, or a lobe of yours whose formula is \
+         transcendental-free (@FILE.toml)",
+        valid = HwLobe::valid_ids()
+    )]
     NoDatapath(String),
     /// A word length outside [`BITS`].
     #[error("word length {0} is out of range; valid: 8 to 24 bits")]

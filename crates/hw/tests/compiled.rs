@@ -118,6 +118,20 @@ fn every_input_at_small_widths_gives_a_lobe_value() {
     }
 }
 
+/// A power above 64 (recorded as `pow` of a constant) is squarings: `^ 128` is seven squarers
+/// and follows its formula at 24 bits within its 128-fold amplified roundings.
+#[test]
+fn a_whole_power_above_64_is_squarings() {
+    let lobe = compiled("=max(0, 1 - (n / 128 + 0.25) * (1 - t)) ^ 128");
+    let resources = lobe.build(16).unwrap().resources();
+    assert_eq!(resources.squarers.len(), 7, "{resources:?}");
+    assert!(resources.multipliers.len() == 1, "{resources:?}");
+    for n in [1, 64, 1000] {
+        let worst = worst_difference(lobe, 24, n);
+        assert!(worst <= 256.0 * ulp(24), "n = {n}: {worst:e}");
+    }
+}
+
 /// A transcendental per evaluation is refused, naming it; a built-in without a datapath too.
 #[test]
 fn what_no_stage_computes_is_refused_by_name() {

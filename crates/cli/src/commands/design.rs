@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use specula_decide::design::{default_whole_error, design, Bounds, Design, DesignRequest};
+use specula_decide::hardware::circuit_for_range;
 use specula_decide::Target;
 
 use super::recommend::spread_versus_pow;
@@ -16,7 +17,8 @@ use crate::output::Table;
 /// Arguments of `specula design`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Where the lobe will run (the FPGA costs only the built-ins' datapaths).
+    /// Where the lobe will run (on the FPGA, the transcendental-free families, each compiled
+    /// to a fixed-point datapath and synthesized).
     #[arg(long, value_parser = described(&Target::ALL, Target::id, Target::summary))]
     target: Target,
     /// The exponent, or a range `LOW..HIGH` the lobe must hold over.
@@ -47,7 +49,8 @@ pub struct Args {
     #[arg(long, value_parser = crate::args::LobeListParser)]
     lobe: Vec<crate::args::LobeList>,
     /// Write the cheapest designed lobe meeting the request as a lobe file (TOML), for
-    /// `--lobe @FILE` everywhere.
+    /// `--lobe @FILE` everywhere; with --target fpga, its Verilog (.v) and structural diagram
+    /// (.svg) beside it.
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Output format.
@@ -241,7 +244,7 @@ fn print_table(answer: &Design, format: crate::args::OutputFormat) {
                 "-".to_owned()
             },
             if d.pareto { "front" } else { "" }.to_owned(),
-            d.why.clone(),
+            with_datapath(&d.why, d.datapath.as_deref()),
         ]);
     }
     for c in &answer.compared {
@@ -259,7 +262,7 @@ fn print_table(answer: &Design, format: crate::args::OutputFormat) {
             cost(c.rate),
             spread_versus_pow(c.rate, c.spread, answer.pow_rate),
             if c.pareto { "front" } else { "" }.to_owned(),
-            c.why.clone(),
+            with_datapath(&c.why, c.datapath.as_deref()),
         ]);
     }
     table.print(format);
@@ -267,6 +270,14 @@ fn print_table(answer: &Design, format: crate::args::OutputFormat) {
         "costs in {}; designed lobes verified at {} exponents of the range by the f64 analysis",
         answer.unit, answer.exponents_verified
     );
+}
+
+/// Why a lobe stands where it does, and on the FPGA the datapath costed.
+fn with_datapath(why: &str, datapath: Option<&str>) -> String {
+    match datapath {
+        Some(datapath) => format!("{why} [{datapath}]"),
+        None => why.to_owned(),
+    }
 }
 
 /// Writes the cheapest designed lobe that meets the request, or refuses (nothing written).
@@ -293,15 +304,68 @@ fn write_lobe(answer: &Design, request: &DesignRequest, path: &std::path::Path) 
         ),
     ];
     let text = specula_render::lobe_file::lobe_file_text(&best.definition(), &comments);
-    specula_render::write_atomically(path, |writer| {
-        std::io::Write::write_all(writer, text.as_bytes()).map_err(|e| e.to_string())
-    })
-    .map_err(|e| e.to_string())?;
+    // On the FPGA the datapath is part of the answer: its Verilog and diagram go beside the
+    // lobe, made before anything is written so that a failure leaves no file.
+    let hardware = match (request.target, best.kind()) {
+        (Target::Fpga, Some(kind)) => Some(datapath_files(kind, request, path)?),
+        _ => None,
+    };
+    write_text(path, &text)?;
     eprintln!(
         "wrote {}: the lobe '{}'; use it as --lobe @{}",
         path.display(),
         best.name,
         path.display()
     );
+    for (file, text, what) in hardware.into_iter().flatten() {
+        write_text(&file, &text)?;
+        eprintln!("wrote {}: {what}", file.display());
+    }
     Ok(())
+}
+
+/// The designed lobe's datapath as one circuit for the request's whole range (the widest
+/// word length its exponents need): the pipelined Verilog module and its structural diagram,
+/// each with the path beside `lobe_file` it goes to and what it is.
+fn datapath_files(
+    kind: specula::LobeKind,
+    request: &DesignRequest,
+    lobe_file: &std::path::Path,
+) -> Result<Vec<(PathBuf, String, String)>, String> {
+    let (lobe, bits) = circuit_for_range(kind, request.range, request.bounds.epicentre)?
+        .ok_or_else(|| {
+            format!(
+                "nothing written to {}: the designed lobe's datapath reaches the bound at no \
+                 word length from 8 to 24 bits",
+                lobe_file.display()
+            )
+        })?;
+    let datapath = lobe.build(bits).map_err(|e| e.to_string())?;
+    let (low, high) = request.range;
+    Ok(vec![
+        (
+            lobe_file.with_extension("v"),
+            specula_hw::verilog::module(&datapath, lobe, bits),
+            format!(
+                "its pipelined datapath at {bits} bits, for every n in {low}..{high} (specula hw \
+                 takes the lobe as --lobe @{})",
+                lobe_file.display()
+            ),
+        ),
+        (
+            lobe_file.with_extension("svg"),
+            specula_hw::diagram::svg(
+                &datapath,
+                &format!("{}: structural scheme at W = {bits}", lobe.id()),
+            ),
+            "its structural scheme".to_owned(),
+        ),
+    ])
+}
+
+fn write_text(path: &std::path::Path, text: &str) -> CommandResult {
+    specula_render::write_atomically(path, |writer| {
+        std::io::Write::write_all(writer, text.as_bytes()).map_err(|e| e.to_string())
+    })
+    .map_err(|e| e.to_string())
 }

@@ -32,8 +32,13 @@ enum Action {
     Synth(SynthArgs),
 }
 
-/// A datapath id, parsed with the valid ids in the message.
+/// A datapath id, parsed with the valid ids in the message; a lobe file (`@FILE.toml`, a
+/// designed lobe) is read and its formula compiled.
 fn parse_lobe(text: &str) -> Result<HwLobe, String> {
+    if text.trim().starts_with('@') {
+        let kind = specula_render::lobe_file::parse_lobe(text, None)?;
+        return HwLobe::of_kind(kind).map_err(|e| e.to_string());
+    }
     HwLobe::parse(text).map_err(|e| e.to_string())
 }
 
@@ -82,7 +87,8 @@ fn parse_integer_exponent(text: &str) -> Result<u32, String> {
 
 #[derive(Debug, clap::Args)]
 struct TableArgs {
-    /// Datapaths, comma separated (default: all).
+    /// Datapaths, comma separated (default: all built-ins); a lobe file of yours
+    /// (`@FILE.toml`, a designed lobe) is compiled from its formula.
     #[arg(long, value_parser = parse_lobe, value_delimiter = ',')]
     lobe: Vec<HwLobe>,
     /// Word lengths: LOW..HIGH or one width.
@@ -115,7 +121,7 @@ struct TableArgs {
 
 #[derive(Debug, clap::Args)]
 struct VerilogArgs {
-    /// The datapath.
+    /// The datapath: a built-in's id, or a lobe file of yours (`@FILE.toml`).
     #[arg(long, value_parser = parse_lobe)]
     lobe: HwLobe,
     /// The word length.
@@ -139,7 +145,8 @@ struct VerilogArgs {
 
 #[derive(Debug, clap::Args)]
 struct SynthArgs {
-    /// Datapaths, comma separated (default: all).
+    /// Datapaths, comma separated (default: all built-ins); a lobe file of yours
+    /// (`@FILE.toml`) is compiled from its formula.
     #[arg(long, value_parser = parse_lobe, value_delimiter = ',')]
     lobe: Vec<HwLobe>,
     /// The word length.
@@ -158,7 +165,7 @@ struct SynthArgs {
 
 #[derive(Debug, clap::Args)]
 struct DiagramArgs {
-    /// The datapath.
+    /// The datapath: a built-in's id, or a lobe file of yours (`@FILE.toml`).
     #[arg(long, value_parser = parse_lobe)]
     lobe: HwLobe,
     /// The word length the formats are shown for.

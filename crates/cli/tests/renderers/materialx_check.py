@@ -38,6 +38,7 @@ Prints one line per check: `ok validate`, `ok TARGET FILE...`, `ok glslang FILE`
 """
 
 import argparse
+import json
 import os
 import shutil
 import subprocess
@@ -191,49 +192,66 @@ def check_glslang(checker, files, required):
             checker.fail("glslang " + path, (run.stdout + run.stderr).strip())
 
 
-def bpy_osl_compile(src, dst):
-    """Compiles with Blender's OSL compiler in a child interpreter; (ok, log)."""
-    code = (
-        "import sys, bpy, _cycles\n"
-        "sys.exit(0 if _cycles.osl_compile(sys.argv[1], sys.argv[2]) else 1)\n"
-    )
-    run = subprocess.run([sys.executable, "-c", code, src, dst],
+# One child interpreter compiles every file: importing `bpy` takes about a second, which
+# three imports a document (a probe and one per file) spent three times.
+BPY_COMPILE = """
+import json, sys
+try:
+    import bpy, _cycles
+except ImportError as error:
+    print(json.dumps({"missing": str(error)}))
+    sys.exit(0)
+if not _cycles.with_osl:
+    print(json.dumps({"missing": "this bpy is built without OSL"}))
+    sys.exit(0)
+print(json.dumps({"compiled": [bool(_cycles.osl_compile(s, d)) for s, d in json.loads(sys.argv[1])]}))
+"""
+
+
+def bpy_osl_compile(pairs):
+    """Compiles each (src, dst) with Blender's OSL compiler in one child interpreter: a list
+    of (ok, log), or the reason it cannot (no bpy, or one without OSL)."""
+    run = subprocess.run([sys.executable, "-c", BPY_COMPILE, json.dumps(pairs)],
                          capture_output=True, text=True, timeout=300)
-    return run.returncode == 0 and os.path.isfile(dst), (run.stdout + run.stderr).strip()
-
-
-def find_osl_compiler():
-    oslc = shutil.which("oslc")
-    if oslc:
-        return "oslc", oslc
-    probe = subprocess.run(
-        [sys.executable, "-c", "import bpy, _cycles; assert _cycles.with_osl"],
-        capture_output=True, text=True, timeout=300)
-    if probe.returncode == 0:
-        return "bpy", None
-    return None, None
+    log = (run.stdout + run.stderr).strip()
+    lines = run.stdout.strip().splitlines()
+    try:
+        answer = json.loads(lines[-1])
+    except (IndexError, ValueError):
+        return [(False, log or "Blender's OSL compiler stopped")] * len(pairs)
+    if "missing" in answer:
+        return answer["missing"]
+    return [(ok and os.path.isfile(dst), "" if ok else log)
+            for ok, (_, dst) in zip(answer["compiled"], pairs)]
 
 
 def check_osl(checker, files, required):
-    kind, oslc = find_osl_compiler()
-    if kind is None:
-        checker.skip("oslc", "neither oslc nor Blender's bpy (with OSL) is available", required)
-        return
     include = os.path.join(library_root(), "libraries", "stdlib", "genosl", "include")
-    for path in files:
-        dst = os.path.splitext(path)[0] + ".oso"
-        with tempfile.TemporaryDirectory() as work:
+    oslc = shutil.which("oslc")
+    with tempfile.TemporaryDirectory() as work:
+        jobs = []
+        for k, path in enumerate(files):
             # The generated source includes "mx_funcs.h"; Blender's compiler only searches
             # its own shader folder and the source's folder, so the header goes beside it.
-            shutil.copy(os.path.join(include, "mx_funcs.h"), work)
-            src = os.path.join(work, os.path.basename(path))
+            folder = os.path.join(work, str(k))
+            os.mkdir(folder)
+            shutil.copy(os.path.join(include, "mx_funcs.h"), folder)
+            src = os.path.join(folder, os.path.basename(path))
             shutil.copy(path, src)
-            if kind == "oslc":
+            jobs.append((path, src, os.path.splitext(path)[0] + ".oso"))
+        if oslc:
+            kind, results = "oslc", []
+            for _, src, dst in jobs:
                 run = subprocess.run([oslc, "-q", "-I" + include, "-o", dst, src],
                                      capture_output=True, text=True)
-                ok, log = run.returncode == 0, (run.stdout + run.stderr).strip()
-            else:
-                ok, log = bpy_osl_compile(src, dst)
+                results.append((run.returncode == 0, (run.stdout + run.stderr).strip()))
+        else:
+            kind, results = "bpy", bpy_osl_compile([(src, dst) for _, src, dst in jobs])
+            if isinstance(results, str):
+                checker.skip("oslc", "no oslc, and Blender's bpy cannot compile OSL: " + results,
+                             required)
+                return
+    for (path, _, _), (ok, log) in zip(jobs, results):
         if ok:
             checker.ok("oslc", path, "(%s)" % kind)
         else:

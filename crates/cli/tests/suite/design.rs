@@ -147,6 +147,111 @@ fn a_polynomial_design_on_the_cpu_is_a_polynomial() {
     );
 }
 
+/// On the FPGA a designed lobe is a datapath compiled from its formula, synthesized and ranked
+/// in the built-ins' unit: the answer is at least as cheap as the cheapest built-in datapath
+/// meeting the bound, its Verilog and diagram are written beside the lobe file, `hw` takes the
+/// lobe file, and the written module simulates in Icarus Verilog bit for bit against the
+/// testbench `hw` makes from the Rust model.
+#[test]
+fn the_designed_fpga_lobe_is_a_datapath_as_cheap_as_the_built_ins() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let output = ok(
+        dir.path(),
+        &[
+            "design",
+            "--target",
+            "fpga",
+            "--n",
+            "64",
+            "--max-error",
+            "2%",
+            "-o",
+            "designed.toml",
+            "--format",
+            "json",
+        ],
+    );
+    let answer: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    let best = &answer["designed"][0];
+    assert_eq!(best["meets"], true, "{answer}");
+    let datapath = best["datapath"].as_str().expect("a datapath named");
+    assert!(datapath.contains(" bits"), "{datapath}");
+    // The cheapest built-in datapath meeting the bound: the design is at least as cheap, or
+    // the verdict names that built-in as the one to ship.
+    let compared = answer["compared"].as_array().unwrap();
+    let cheapest = compared
+        .iter()
+        .filter(|c| c["meets"] == true)
+        .max_by(|a, b| {
+            a["rate"]
+                .as_f64()
+                .unwrap()
+                .total_cmp(&b["rate"].as_f64().unwrap())
+        })
+        .expect("a built-in datapath meets 2 % at n = 64");
+    let verdict = answer["verdict"].as_str().unwrap();
+    assert!(
+        best["rate"].as_f64().unwrap() >= cheapest["rate"].as_f64().unwrap()
+            || (verdict.contains(cheapest["lobe"].as_str().unwrap())
+                && verdict.contains("ship the built-in")),
+        "a built-in datapath is cheaper and the verdict does not say so: {answer}"
+    );
+    // Against the transcendental-free built-ins, the datapaths it is made of, it is never
+    // costlier.
+    for c in compared.iter().filter(|c| c["meets"] == true) {
+        let lobe = c["lobe"].as_str().unwrap();
+        if ["cosquad", "schlick", "schlick-mod", "cheb2"].contains(&lobe) {
+            assert!(
+                best["rate"].as_f64() >= c["rate"].as_f64(),
+                "{lobe}: {answer}"
+            );
+        }
+    }
+    let verilog = std::fs::read_to_string(dir.path().join("designed.v")).expect("the module");
+    assert!(verilog.contains("module specula_"), "{verilog}");
+    let diagram = std::fs::read_to_string(dir.path().join("designed.svg")).expect("the diagram");
+    roxmltree::Document::parse(&diagram).expect("the diagram is well-formed SVG");
+    let bits = datapath
+        .rsplit(" at ")
+        .next()
+        .and_then(|w| w.split_whitespace().next())
+        .expect("a width");
+    ok(
+        dir.path(),
+        &[
+            "hw",
+            "verilog",
+            "--lobe",
+            "@designed.toml",
+            "--bits",
+            bits,
+            "-o",
+            "again.v",
+            "--testbench",
+            "again_tb.v",
+        ],
+    );
+    if !crate::common::have_tool("iverilog", "-V", "iverilog") {
+        return;
+    }
+    let simulation = dir.path().join("again.vvp");
+    let compiled = std::process::Command::new("iverilog")
+        .current_dir(dir.path())
+        .args(["-g2012", "-o"])
+        .arg(&simulation)
+        .args(["again.v", "again_tb.v"])
+        .output()
+        .expect("iverilog runs");
+    assert!(compiled.status.success(), "{compiled:?}");
+    let run = std::process::Command::new("vvp")
+        .arg("-n")
+        .arg(&simulation)
+        .output()
+        .expect("vvp runs");
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(text.contains("PASS"), "{text}");
+}
+
 #[test]
 fn bad_design_requests_are_refused_in_one_line_and_nothing_is_written() {
     let dir = tempfile::tempdir().expect("temporary folder");
@@ -162,9 +267,17 @@ fn bad_design_requests_are_refused_in_one_line_and_nothing_is_written() {
             ],
             "LOW < HIGH",
         ),
+        // Nor does any transcendental-free family, compiled, on the FPGA.
         (
-            &["--target", "fpga", "--n", "64", "--max-error", "1%"],
-            "valid targets",
+            &[
+                "--target",
+                "fpga",
+                "--n",
+                "8..512",
+                "--max-error",
+                "0.000001%",
+            ],
+            "searched",
         ),
         (
             &["--target", "gpu-nvidia", "--n", "64", "--max-error", "0%"],

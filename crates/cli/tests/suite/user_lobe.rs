@@ -463,7 +463,7 @@ fn bad_formulas_get_one_line_each() {
         ),
         (
             &["hw", "verilog", "--lobe", "@range.toml"],
-            "a lobe of yours",
+            "`range` has no datapath: it computes pow of a real exponent",
         ),
     ];
     for (args, says) in cases {

@@ -105,6 +105,10 @@ pub struct DesignedLobe {
     pub short_of_whole_only: bool,
     /// Its cost on the target in [`Design::unit`] (0 where not costed).
     pub rate: f64,
+    /// On the FPGA, the datapath compiled from its formula and the word length costed (at
+    /// the first exponent), as `recommend` names the built-ins'.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub datapath: Option<String>,
     /// Where the rate was measured (the CPU): the median and fastest passes' rates
     /// ([`Candidate::spread`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -186,12 +190,6 @@ impl Design {
     }
 }
 
-/// Why the FPGA cannot rank a designed lobe.
-pub const FPGA_DESIGN_REFUSAL: &str = "design cannot target fpga: the FPGA's costs are the \
-    synthesized fixed-point datapaths, which exist for the built-in lobes only (a designed formula \
-    has none); rank those with specula recommend --target fpga; valid targets: cpu, gpu-nvidia, \
-    gpu-amd";
-
 fn check(request: &DesignRequest) -> Result<(), String> {
     let fraction = |what: &str, value: f64| {
         if value.is_finite() && value > 0.0 && value <= 1.0 {
@@ -210,9 +208,6 @@ fn check(request: &DesignRequest) -> Result<(), String> {
             "the range of n is empty ({}..{}): give LOW..HIGH with LOW <= HIGH in [1, 1000]",
             request.range.0, request.range.1
         ));
-    }
-    if request.target == Target::Fpga {
-        return Err(FPGA_DESIGN_REFUSAL.to_owned());
     }
     Ok(())
 }
@@ -241,6 +236,12 @@ pub fn verification_exponents(low: Exponent, high: Exponent) -> Vec<Exponent> {
 /// ([`Cache::default_for`]`("design")`) where this build made it before.
 pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design, String> {
     check(request)?;
+    // On the FPGA a lobe is a datapath compiled from its formula, which takes no
+    // transcendental (those are the built-in table units' work).
+    let request = &DesignRequest {
+        no_transcendentals: request.no_transcendentals || request.target == Target::Fpga,
+        ..request.clone()
+    };
     let searched = search(request, Cache::default_for("design").as_ref(), progress);
     rank(request, searched, progress)
 }
@@ -335,6 +336,7 @@ fn rank(
         let costed = ranking.candidates.iter().find(|c| c.lobe == lobe.name);
         if let Some(costed) = costed {
             lobe.rate = costed.rate;
+            lobe.datapath.clone_from(&costed.datapath);
             lobe.spread = costed.spread;
             lobe.meets = lobe.verified && costed.meets;
             if lobe.meets {
@@ -426,6 +428,7 @@ fn unmeasured(family: Family, beta: &[f64], request: &DesignRequest) -> Designed
         verified: false,
         short_of_whole_only: false,
         rate: 0.0,
+        datapath: None,
         spread: None,
         tied: Vec::new(),
         meets: false,

@@ -197,7 +197,7 @@ def design(
 
     Parameters
     ----------
-    target : {"cpu", "gpu-nvidia", "gpu-amd"}
+    target : {"cpu", "gpu-nvidia", "gpu-amd", "fpga"}
     n : float or str
         An exponent, or a range ``"LOW..HIGH"`` the lobe must hold over.
     max_error : float
