@@ -38,7 +38,13 @@ fn request(target: Target, bound: f64, also: &[LobeKind]) -> DesignRequest {
     }
 }
 
+/// The section, stored by a first run of the build and copied back by a later one: its
+/// costs are the GPU cost model's arithmetic, no timing.
 pub fn designed(context: &mut Context) -> Result<String, String> {
+    super::stored::section(context, super::DESIGNED, "", designed_now)
+}
+
+fn designed_now(context: &mut Context) -> Result<String, String> {
     let bounds = context.sizes.design_bounds;
     // The user's lobes are ranked beside the built-ins and the designs.
     let yours = context.yours();
@@ -127,6 +133,11 @@ pub fn designed(context: &mut Context) -> Result<String, String> {
     );
     html += &verdicts;
     html += &formulas;
+    // The search does not depend on the target: one answer's designs are every target's.
+    if let Some(answer) = answers.first() {
+        html += &super::designer_checks::limit(context, answer, RANGE)?;
+    }
+    html += &super::designer_checks::thesis_table(&FAMILIES, RANGE)?;
     for (k, (target, name)) in FAMILIES.iter().enumerate() {
         // The tightest bound's answer for this family.
         let answer = &answers[k * bounds.len()];

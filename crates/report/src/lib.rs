@@ -12,6 +12,7 @@
 
 mod comparison;
 mod designed;
+mod designer_checks;
 mod energy;
 #[cfg(all(test, feature = "example-lobe"))]
 mod example_lobe;

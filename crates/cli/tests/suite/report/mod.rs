@@ -75,6 +75,33 @@ fn the_quick_report_is_complete_and_well_formed() {
         page[designed..heading("The thesis's claims")].contains("<pre>let "),
         "no designed formula"
     );
+    // The limit: no design beats its family's optimum at an n (Sollya's certified bound).
+    let limit_rows = table_rows(&document, "n = 8");
+    assert!(!limit_rows.is_empty(), "no limit table");
+    for row in &limit_rows {
+        for cell in &row[1..] {
+            if let Some(ratio) = cell.strip_suffix('x') {
+                let ratio: f64 = ratio.parse().unwrap_or_else(|_| panic!("'{cell}'"));
+                assert!(ratio >= 0.999, "{row:?}");
+            } else {
+                assert_eq!(cell, "holds t^n", "{row:?}");
+            }
+        }
+    }
+    // Against the thesis: a row per thesis lobe, each family's answer never costlier than it.
+    let thesis_rows = table_rows(&document, "its errors (epicentre, whole lobe)");
+    let lobes: Vec<&str> = thesis_rows.iter().map(|row| row[0].as_str()).collect();
+    assert_eq!(lobes, ["schlick-mod", "cheb2-thesis", "logexp", "cosquad"]);
+    for row in &thesis_rows {
+        for answer in &row[3..] {
+            let ratio: f64 = answer
+                .rsplit_once('(')
+                .and_then(|(_, r)| r.strip_suffix("x)"))
+                .and_then(|r| r.parse().ok())
+                .unwrap_or_else(|| panic!("no ratio in '{answer}'"));
+            assert!(ratio >= 1.0, "{row:?}");
+        }
+    }
     let sources: Vec<&str> = document
         .descendants()
         .filter(|n| n.has_tag_name("img"))

@@ -1,0 +1,136 @@
+//! The designer's two checks in "Designed lobes": how far each design lies from its family's
+//! optimum (Sollya's minimax at each `n` alone, what `specula design --limit` prints), and each
+//! of the thesis's lobes at its own accuracy over the range against what `specula design`
+//! returns there on each GPU family, with both formulas
+//! ([`specula_decide::design::thesis::against_thesis`], what `specula design --against-thesis`
+//! prints).
+
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+use specula::Exponent;
+use specula_decide::design::limit::limit_table;
+use specula_decide::design::thesis::{against_thesis, ThesisRow};
+use specula_decide::design::{percent, Design};
+use specula_decide::Target;
+
+use super::html::{escape, paragraph, table};
+use super::Context;
+
+/// Each verified design of `answer` against its family's optimum at five exponents of
+/// `low..high`; without Sollya, a machine note instead.
+pub(crate) fn limit(
+    context: &mut Context,
+    answer: &Design,
+    (low, high): (f64, f64),
+) -> Result<String, String> {
+    let verified: Vec<_> = answer
+        .designed
+        .iter()
+        .filter(|d| d.verified)
+        .cloned()
+        .collect();
+    let range = (Exponent::new(low), Exponent::new(high));
+    let rows = match limit_table(&verified, range, 4) {
+        Ok(rows) => rows,
+        Err(why) => {
+            context.machine_note(format!("Designed lobes' limit table: {why}"));
+            return Ok(String::new());
+        }
+    };
+    let mut exponents: Vec<f64> = rows.iter().map(|row| row.n).collect();
+    exponents.sort_by(f64::total_cmp);
+    exponents.dedup();
+    let mut header = vec!["family".to_owned()];
+    header.extend(exponents.iter().map(|n| format!("n = {n:.0}")));
+    let header: Vec<&str> = header.iter().map(String::as_str).collect();
+    let mut families: Vec<Vec<String>> = Vec::new();
+    for row in &rows {
+        let cell = if row.optimum > 0.0 {
+            format!("{:.2}x", row.designed / row.optimum)
+        } else {
+            "holds t^n".to_owned()
+        };
+        match families.last_mut() {
+            Some(last) if last[0] == row.family => last.push(cell),
+            _ => families.push(vec![row.family.clone(), cell]),
+        }
+    }
+    let mut html = paragraph(&format!(
+        "How far from the best each family can do: each design's epicentre error over its \
+         family's optimum at that n alone (Sollya's Remez, its error certified by supnorm), \
+         what one set of closed-form constants for n = {low}..{high} costs against a fit per n; \
+         specula design --target TARGET --n {low}..{high} --max-error BOUND --limit."
+    ));
+    html += &table(&header, &families);
+    Ok(html)
+}
+
+/// The table and the designed answers' formulas, for `families` (a target and its name) over
+/// `low..high`.
+pub(crate) fn thesis_table(
+    families: &[(Target, &str)],
+    (low, high): (f64, f64),
+) -> Result<String, String> {
+    let range = (Exponent::new(low), Exponent::new(high));
+    let answers: Vec<Vec<ThesisRow>> = families
+        .par_iter()
+        .map(|&(target, _)| against_thesis(target, range, &ProgressBar::hidden()))
+        .collect::<Result<_, _>>()?;
+    let mut html = paragraph(&format!(
+        "Against the thesis: each of its lobes asks for the accuracy it reaches itself over n = \
+         {low}..{high} (its largest epicentre error, and its largest whole-lobe error as the whole \
+         lobe's bound); the answer is the cheapest lobe meeting both, designed or built in, the \
+         thesis lobe ranked with them, so it is never costlier than the thesis lobe. Each column \
+         is specula design --target TARGET --n {low}..{high} --against-thesis."
+    ));
+    let mut header = vec![
+        "thesis lobe".to_owned(),
+        "its formula".to_owned(),
+        "its errors (epicentre, whole lobe)".to_owned(),
+    ];
+    header.extend(
+        families
+            .iter()
+            .map(|(_, name)| format!("{name}: the answer (x the thesis lobe's throughput)")),
+    );
+    let header: Vec<&str> = header.iter().map(String::as_str).collect();
+    let mut rows = Vec::new();
+    let mut formulas = String::new();
+    for (k, thesis) in answers
+        .first()
+        .map_or(&[][..], Vec::as_slice)
+        .iter()
+        .enumerate()
+    {
+        let mut row = vec![
+            thesis.thesis.clone(),
+            thesis.thesis_formula.clone(),
+            format!(
+                "{}, {}",
+                percent(thesis.epicentre_error),
+                percent(thesis.whole_error)
+            ),
+        ];
+        for (family, (_, name)) in answers.iter().zip(families) {
+            let answer = &family[k];
+            row.push(format!(
+                "{}{} ({:.2}x)",
+                answer.answer,
+                if answer.designed { ", designed" } else { "" },
+                answer.answer_rate / answer.thesis_rate
+            ));
+            if answer.designed {
+                formulas += &format!(
+                    "<p>{name}, at {}'s accuracy: <code>{}</code></p>\n<pre>{}</pre>\n",
+                    escape(&thesis.thesis),
+                    escape(&answer.answer),
+                    escape(&answer.answer_formula)
+                );
+            }
+        }
+        rows.push(row);
+    }
+    html += &table(&header, &rows);
+    html += &formulas;
+    Ok(html)
+}
