@@ -15,6 +15,13 @@
 //!   lobe is monotone and in `[0, 1]` at every `n`. Written in Horner form, which stays exact
 //!   where `c` crosses 0 (the vertex form's constants there run to infinity and cancel).
 //!
+//! - **`rational-powM`**: `(max(0, 1 - a u) / (1 + b u))^M`, the Padé `[1/1]` form of
+//!   `t^(n/M)` (`a = beta0 n + beta1`, `b = beta2 n + beta3`, started at Padé's own
+//!   `(n/M + 1) / 2` and `(n/M - 1) / 2`); `M = 1` is Schlick's shape, `t / (n (1 - t) + t)`
+//!   being `a = 1`, `b = n - 1`. A divide and squarings, no transcendental.
+//! - **`exp2-rational`**: `exp2(a1 u / (1 - b u))`, `-ln(1 - u)` by its Padé form
+//!   `u / (1 - u / 2)` with `b` nudged (`a1 = -log2(e) (n + beta0 / n)`, `b = 1/2 + beta1`).
+//!
 //! [`Family::eval`] is the formula's own arithmetic in `f64`, operation for operation, so that
 //! the fit sees what [`Family::formula`]'s text computes; the verification then runs the text
 //! through the analysis.
@@ -36,6 +43,13 @@ pub enum Family {
         /// The power is `2^squarings`.
         squarings: u8,
     },
+    /// `(max(0, 1 - a u) / (1 + b u))` raised to `2^squarings`.
+    RationalPow {
+        /// The power is `2^squarings`.
+        squarings: u8,
+    },
+    /// `exp2(a1 u / (1 - b u))`.
+    Exp2Rational,
 }
 
 impl Family {
@@ -51,6 +65,11 @@ impl Family {
             degree: 2,
             squarings,
         }));
+        all.push(Family::Exp2Rational);
+        all.extend((0..=5).map(|squarings| Family::RationalPow { squarings }));
+        // Transcendental-free last, as the doc says: the rational ones stand with the
+        // polynomials.
+        all.sort_by_key(|family| !family.transcendental());
         all
     }
 
@@ -62,6 +81,9 @@ impl Family {
             Family::PolyPow { degree, squarings } => {
                 format!("{}-pow{}", degree_name(degree), 1u32 << squarings)
             }
+            Family::RationalPow { squarings: 0 } => "rational".to_owned(),
+            Family::RationalPow { squarings } => format!("rational-pow{}", 1u32 << squarings),
+            Family::Exp2Rational => "exp2-rational".to_owned(),
         }
     }
 
@@ -69,7 +91,7 @@ impl Family {
     /// `sqrt` is per material, not per evaluation.
     #[must_use]
     pub fn transcendental(self) -> bool {
-        matches!(self, Family::Exp2Poly { .. })
+        matches!(self, Family::Exp2Poly { .. } | Family::Exp2Rational)
     }
 
     /// The coefficients the fit starts from: the truncated series, nudged by nothing.
@@ -85,6 +107,11 @@ impl Family {
                     vec![1.0 / m, 0.0, 0.5, 0.5]
                 }
             }
+            Family::RationalPow { squarings } => {
+                let half = 0.5 / f64::from(1u32 << squarings);
+                vec![half, 0.5, half, -0.5]
+            }
+            Family::Exp2Rational => vec![0.0, 0.0],
         }
     }
 
@@ -110,6 +137,16 @@ impl Family {
                     1.0 - v * (s - c * v)
                 };
                 (0..squarings).fold(base, |x, _| x * x)
+            }
+            Family::RationalPow { squarings } => {
+                let (a, b) = (beta[0] * n + beta[1], beta[2] * n + beta[3]);
+                let base = (1.0 - a * u).max(0.0) / (1.0 + b * u);
+                (0..squarings).fold(base, |x, _| x * x)
+            }
+            Family::Exp2Rational => {
+                let a1 = -LOG2_E * (n + beta[0] / n);
+                let b = 0.5 + beta[1];
+                (a1 * u / (1.0 - b * u)).exp2()
             }
         }
     }
@@ -158,6 +195,27 @@ impl Family {
                 signed(-beta[3]),
                 1u32 << squarings
             ),
+            Family::RationalPow { squarings } => {
+                let base = "max(0, 1 - a * u) / (1 + b * u)";
+                format!(
+                    "let a = {} * n {};\nlet b = {} * n {};\nlet u = 1 - t;\n{}",
+                    beta[0],
+                    signed(beta[1]),
+                    beta[2],
+                    signed(beta[3]),
+                    if squarings == 0 {
+                        base.to_owned()
+                    } else {
+                        format!("({base}) ^ {}", 1u32 << squarings)
+                    }
+                )
+            }
+            Family::Exp2Rational => format!(
+                "let a1 = -{LOG2_E} * (n {} / n);\nlet b = {};\nlet u = 1 - t;\n\
+                 exp2(a1 * u / (1 - b * u))",
+                signed(beta[0]),
+                0.5 + beta[1]
+            ),
         }
     }
 
@@ -195,6 +253,15 @@ impl Family {
                 degree_name(degree),
                 1u32 << squarings
             ),
+            Family::RationalPow { squarings } => format!(
+                "a ratio of linear functions of 1 - t (Padé's form of t^(n/{}), Schlick's \
+                 shape) raised to {} (squarings), cut at 0",
+                1u32 << squarings,
+                1u32 << squarings
+            ),
+            Family::Exp2Rational => "exp2 of a ratio of linear functions of 1 - t (Padé's form \
+                of n ln t, its coefficients fitted)"
+                .to_owned(),
         }
     }
 }

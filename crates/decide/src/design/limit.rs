@@ -76,6 +76,9 @@ fn script(family: Family, n: f64) -> String {
             let g = format!("-({n:e}) * log(1 - x)");
             (g, "g", "x", "x * q", "absolute", degree)
         }
+        Family::RationalPow { .. } | Family::Exp2Rational => {
+            unreachable!("family_optimum refuses the rational families before a script")
+        }
     };
     format!(
         "verbosity = 0;\nprec = 165;\ndisplay = decimal;\ng = {g};\n\
@@ -87,6 +90,12 @@ fn script(family: Family, n: f64) -> String {
 
 /// The family's optimum at `n`, from Sollya (`sollya` on the `PATH`); `Err` names what failed.
 pub fn family_optimum(family: Family, n: Exponent) -> Result<Optimum, String> {
+    if !has_optimum(family) {
+        return Err(format!(
+            "{} is rational, and Sollya's remez finds polynomial minimax approximations only",
+            family.id()
+        ));
+    }
     let n = n.get();
     // `(1 - u)^(n/M)` is itself a polynomial of the family's degree: the family holds `t^n`
     // (and Sollya's supnorm of a zero error fails).
@@ -142,10 +151,20 @@ pub fn family_optimum(family: Family, n: Exponent) -> Result<Optimum, String> {
             reached: bound.exp_m1(),
             lower: -(-least).exp_m1(),
         },
+        Family::RationalPow { .. } | Family::Exp2Rational => {
+            unreachable!("refused above")
+        }
     })
 }
 
-/// The limit table of `design`'s lobes over `[low, high]`: each designed lobe (one per family)
+/// Whether the family's optimum is a polynomial minimax, which Sollya's `remez` finds.
+#[must_use]
+pub fn has_optimum(family: Family) -> bool {
+    matches!(family, Family::PolyPow { .. } | Family::Exp2Poly { .. })
+}
+
+/// The limit table of `design`'s lobes over `[low, high]`: each designed lobe of a polynomial
+/// family ([`has_optimum`]; one per family)
 /// at `steps + 1` log-spaced exponents.
 pub fn limit_table(
     designed: &[super::DesignedLobe],
@@ -155,7 +174,11 @@ pub fn limit_table(
     let mut rows = Vec::new();
     let exponents = crate::log_spaced(low, high, steps);
     for lobe in designed {
-        let Some(family) = Family::all().into_iter().find(|f| f.id() == lobe.family) else {
+        let Some(family) = Family::all()
+            .into_iter()
+            .find(|f| f.id() == lobe.family)
+            .filter(|&f| has_optimum(f))
+        else {
             continue;
         };
         let Some(kind) = lobe.kind() else { continue };
