@@ -23,14 +23,8 @@ pub(crate) fn limit(
     answer: &Design,
     (low, high): (f64, f64),
 ) -> Result<String, String> {
-    let verified: Vec<_> = answer
-        .designed
-        .iter()
-        .filter(|d| d.verified)
-        .cloned()
-        .collect();
     let range = (Exponent::new(low), Exponent::new(high));
-    let rows = match limit_table(&verified, range, 4) {
+    let rows = match limit_table(&answer.designed, range, 4) {
         Ok(rows) => rows,
         Err(why) => {
             context.machine_note(format!("Designed lobes' limit table: {why}"));

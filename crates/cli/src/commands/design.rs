@@ -172,13 +172,7 @@ fn print_limit(
     request: &DesignRequest,
     format: crate::args::OutputFormat,
 ) -> CommandResult {
-    let verified: Vec<_> = answer
-        .designed
-        .iter()
-        .filter(|d| d.verified)
-        .cloned()
-        .collect();
-    let rows = specula_decide::design::limit::limit_table(&verified, request.range, 4)?;
+    let rows = specula_decide::design::limit::limit_table(&answer.designed, request.range, 4)?;
     let mut table = Table::new(&["family", "n", "designed", "optimum", "designed / optimum"]);
     for row in &rows {
         table.push(vec![

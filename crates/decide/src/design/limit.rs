@@ -163,9 +163,8 @@ pub fn has_optimum(family: Family) -> bool {
     matches!(family, Family::PolyPow { .. } | Family::Exp2Poly { .. })
 }
 
-/// The limit table of `design`'s lobes over `[low, high]`: each designed lobe of a polynomial
-/// family ([`has_optimum`]; one per family)
-/// at `steps + 1` log-spaced exponents.
+/// The limit table of `design`'s lobes over `[low, high]`: each verified design of a
+/// polynomial family ([`has_optimum`]; one per family) at `steps + 1` log-spaced exponents.
 pub fn limit_table(
     designed: &[super::DesignedLobe],
     (low, high): (Exponent, Exponent),
@@ -173,7 +172,7 @@ pub fn limit_table(
 ) -> Result<Vec<LimitRow>, String> {
     let mut rows = Vec::new();
     let exponents = crate::log_spaced(low, high, steps);
-    for lobe in designed {
+    for lobe in designed.iter().filter(|d| d.verified) {
         let Some(family) = Family::all()
             .into_iter()
             .find(|f| f.id() == lobe.family)
