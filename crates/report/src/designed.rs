@@ -162,8 +162,10 @@ fn groups(jobs: &[(Target, &str, f64)], answers: &[Design]) -> Vec<Vec<usize>> {
     groups
 }
 
-/// Error against modelled cost, the designed lobes and the built-ins, with their joint
-/// Pareto front.
+/// Error against modelled cost, the designed lobes on the joint Pareto front and the
+/// built-ins, with that front: a design another lobe dominates is in the table above, not on
+/// the chart, where a cluster of near-equal designs (the rational families' errors agree to
+/// two digits) made one label too long to place.
 fn pareto_plot(
     context: &mut Context,
     target: Target,
@@ -174,7 +176,7 @@ fn pareto_plot(
     let mut points: Vec<(LobeKind, (f64, f64), bool)> = answer
         .designed
         .iter()
-        .filter(|d| d.verified && d.rate > 0.0)
+        .filter(|d| d.verified && d.rate > 0.0 && d.pareto)
         .filter_map(|d| {
             Some((
                 d.kind()?,
@@ -216,9 +218,9 @@ fn pareto_plot(
         &format!("designed-{}.svg", target.id()),
         &chart,
         &format!(
-            "{name}: the designed lobes (within {}) and the built-ins, error against cost; higher \
-                left is better, the grey line joins the Pareto front over both, the red line is \
-                the bound",
+            "{name}: the designed lobes on the Pareto front (within {}; the others are in the \
+                table) and the built-ins, error against cost; higher left is better, the grey \
+                line joins the front over both, the red line is the bound",
             percent(bound)
         ),
     )

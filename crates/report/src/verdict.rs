@@ -104,7 +104,7 @@ pub(crate) fn pareto_chart(
     Chart {
         title,
         x_label: format!(
-            "epicentre max relative error, % (pow, exact, at {:e} %)",
+            "epicentre max relative error, % (pow, exact, at {:.0e} %)",
             100.0 * EXACT_FLOOR
         ),
         y_label: "modelled evaluations per clock per multiprocessor".into(),
