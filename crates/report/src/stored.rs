@@ -1,6 +1,7 @@
 //! Sections whose page and images are functions of the code, the options and the GPU adapter
 //! alone (the renders, the bundled materials' fits, the error curves, the white furnace and
-//! reciprocity: images, fits, integrals and comparisons, no timing),
+//! reciprocity, the designed lobes on the GPU cost model: images, fits, integrals, searches
+//! and comparisons, no timing),
 //! stored beside the design searches by a first run and copied back by a later run of the
 //! same build, as the claims and the datapaths' sweeps are (`specula_decide`'s analyses).
 //!
@@ -120,9 +121,10 @@ fn save(store: &Path, entry: &Path, stored: &Entry, written_to: &Path) -> std::i
 }
 
 /// Entries kept: every build stores new ones (a full report's Renders are about 4 MB), so
-/// the oldest beyond these are removed: four sections of a full and a quick report, of three
-/// builds.
-const KEPT: usize = 24;
+/// the oldest beyond these are removed: five sections (Renders, Real materials, the error
+/// curves, reciprocity and the white furnace, Designed lobes) of a full and a quick report, of
+/// three builds.
+const KEPT: usize = 30;
 
 /// Removes all but the `kept` most recently stored entries of `store` (temporary folders of
 /// runs in progress are not entries and are left alone).
