@@ -373,16 +373,18 @@ fn interrupted_commands_leave_nothing_behind() {
 #[test]
 fn standard_output_errors_end_like_unix_tools() {
     // `models` prints with `println!`, `sample` writes its own buffered stream; the reader
-    // goes before either writes.
+    // goes before either writes: it is closed before the command starts (closed after, a
+    // command whose output fits the pipe could write it all first, and did under load).
     let commands = [&["models"][..], &["sample", "--lobe", "pow", "--n", "8"]];
     for args in commands {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_specula"))
+        let (reader, writer) = std::io::pipe().expect("a pipe");
+        drop(reader);
+        let child = Command::new(env!("CARGO_BIN_EXE_specula"))
             .args(args)
-            .stdout(std::process::Stdio::piped())
+            .stdout(writer)
             .stderr(std::process::Stdio::piped())
             .spawn()
             .expect("start");
-        drop(child.stdout.take());
         let output = child.wait_with_output().expect("wait");
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(141), "{args:?}: {stderr}");
