@@ -35,7 +35,6 @@ use specula::{Exponent, Lobe, LobeKind};
 
 use crate::datapath::{Builder, Datapath, NodeId, Op};
 use crate::fixed::{FixedPoint, Rounding, MAX_WIDTH};
-use crate::lobes::HwError;
 
 /// The exponents a compiled datapath is laid out for: every integer the `n` input takes.
 const EXPONENTS: core::ops::RangeInclusive<u32> = 1..=1000;
@@ -63,20 +62,17 @@ struct Step {
 /// A formula's layout, or why it has none, laid out once per process.
 type Laid = Result<Arc<Layout>, String>;
 
-/// The layout of the formula lobe `id`, measured on first use and kept.
-pub(crate) fn layout(id: FormulaId) -> Result<Arc<Layout>, HwError> {
+/// The layout of the formula lobe `id`, measured on first use and kept; `Err` says why it
+/// has none (the caller names the lobe).
+pub(crate) fn layout(id: FormulaId) -> Laid {
     static LAID: Mutex<Vec<(FormulaId, Laid)>> = Mutex::new(Vec::new());
     let known = |laid: &[(FormulaId, Laid)]| {
         laid.iter()
             .find(|(at, _)| *at == id)
             .map(|(_, result)| result.clone())
     };
-    let refusal = |why: String| HwError::NotCompiled {
-        lobe: LobeKind::Formula(id).to_string(),
-        why,
-    };
     if let Some(found) = known(&LAID.lock().unwrap_or_else(PoisonError::into_inner)) {
-        return found.map_err(refusal);
+        return found;
     }
     // Measured without the lock: two threads asking at once both measure, the first kept.
     let measured = measure(LobeKind::Formula(id)).map(Arc::new);
@@ -84,9 +80,7 @@ pub(crate) fn layout(id: FormulaId) -> Result<Arc<Layout>, HwError> {
     if known(&laid).is_none() {
         laid.push((id, measured));
     }
-    known(&laid)
-        .unwrap_or_else(|| unreachable!("just laid out"))
-        .map_err(refusal)
+    known(&laid).unwrap_or_else(|| unreachable!("just laid out"))
 }
 
 /// The operations of `kind`'s expression and each one's range over every `n` and cosine.
@@ -156,10 +150,10 @@ fn cosine_grid() -> Vec<f64> {
 /// The largest integer power a compiled datapath raises to, by squarings and products.
 const MAX_POWER: u32 = 1024;
 
-/// `node`'s power where it is a whole constant from 1 to [`MAX_POWER`] (the formula records
-/// powers above 64 as `pow`).
-fn whole_power(nodes: &[Traced], exponent: usize) -> Option<u32> {
-    match nodes[exponent] {
+/// The power `exponent` (a `pow`'s second operand) raises to, where it is a whole constant
+/// from 1 to [`MAX_POWER`] (the formula records powers above 64 as `pow`).
+fn whole_power(exponent: &Traced) -> Option<u32> {
+    match *exponent {
         Traced::Constant(k) if k.fract() == 0.0 && (1.0..=f64::from(MAX_POWER)).contains(&k) => {
             Some(k as u32)
         }
@@ -170,7 +164,7 @@ fn whole_power(nodes: &[Traced], exponent: usize) -> Option<u32> {
 /// Whether a stage computes `node` of `nodes`; `Err` names the operation it does not.
 fn supported(node: &Traced, nodes: &[Traced]) -> Result<(), String> {
     match node {
-        Traced::Pow(_, exponent) if whole_power(nodes, *exponent).is_some() => Ok(()),
+        Traced::Pow(_, exponent) if whole_power(&nodes[*exponent]).is_some() => Ok(()),
         Traced::Input
         | Traced::Constant(_)
         | Traced::Parameter { .. }
@@ -285,7 +279,7 @@ impl Layout {
 
     /// The datapath at word length `bits`, named `name`: `t` and the parameters in, the
     /// lobe's value in `UQ1.(W-1)` out, 0 at `t = 0` as every lobe is there.
-    pub(crate) fn build(&self, name: &str, lobe: &str, bits: u32) -> Result<Datapath, HwError> {
+    pub(crate) fn build(&self, name: &str, bits: u32) -> Result<Datapath, String> {
         let frac = bits - 1;
         let unit = FixedPoint::unsigned(1, frac);
         let mut b = Builder::new(Rounding::HalfEven);
@@ -297,14 +291,13 @@ impl Layout {
             .zip(&formats)
             .map(|(name, &format)| b.input(name, format))
             .collect();
-        let too_wide = |what: &str, format: FixedPoint| HwError::NotCompiled {
-            lobe: lobe.to_owned(),
-            why: format!(
+        let too_wide = |what: &str, format: FixedPoint| {
+            format!(
                 "{what} needs {} ({} bits) at W = {bits}, wider than the {MAX_WIDTH} bits a \
                  stage may have",
                 format.name(),
                 format.width()
-            ),
+            )
         };
         if let Some((name, &format)) = self
             .parameters
@@ -347,10 +340,9 @@ impl Layout {
                     b.node(&label("negation"), Op::Sub(zero, at(x)), format)
                 }
                 Traced::Pow(x, y) => {
-                    let power = whole_power(&self.nodes(), y)
+                    let power = whole_power(&self.steps[y].node)
                         .unwrap_or_else(|| unreachable!("a real power was refused when laid out"));
-                    self.power(
-                        lobe,
+                    raise(
                         &mut b,
                         at(x),
                         (self.steps[x].low, self.steps[x].high),
@@ -361,12 +353,9 @@ impl Layout {
                 }
                 Traced::Div(x, y) => {
                     if self.steps[x].low < 0.0 || self.steps[y].low < 0.0 {
-                        return Err(HwError::NotCompiled {
-                            lobe: lobe.to_owned(),
-                            why: "it divides by or into a value that goes below 0, and the \
-                                  divider is unsigned"
-                                .to_owned(),
-                        });
+                        return Err("it divides by or into a value that goes below 0, and the \
+                                    divider is unsigned"
+                            .to_owned());
                     }
                     b.node(&label("quotient"), Op::Div(at(x), at(y)), format)
                 }
@@ -387,72 +376,8 @@ impl Layout {
                 b.node("clamped", Op::Min(result, one), unit)
             }
         };
-        Ok(crate::lobes::finish_zero_at_t_zero(
-            b, name, t, clamped, unit,
-        ))
-    }
-
-    /// The recorded nodes, in order.
-    fn nodes(&self) -> Vec<Traced> {
-        self.steps.iter().map(|step| step.node).collect()
-    }
-
-    /// `x^power` by binary exponentiation, squarers and multipliers whose formats follow the
-    /// powers of `x`'s range; the nodes are named after step `k`.
-    #[allow(clippy::too_many_arguments)]
-    fn power(
-        &self,
-        lobe: &str,
-        b: &mut Builder,
-        x: NodeId,
-        (low, high): (f64, f64),
-        power: u32,
-        k: usize,
-        frac: u32,
-    ) -> Result<NodeId, HwError> {
-        // The range of x^e: a power of the range, from 0 where an even power crosses it.
-        let range = |e: u32| {
-            let (a, b) = (low.powi(e as i32), high.powi(e as i32));
-            if e.is_multiple_of(2) && low < 0.0 && high > 0.0 {
-                (0.0, a.max(b))
-            } else {
-                (a.min(b), a.max(b))
-            }
-        };
-        let mut result: Option<(NodeId, u32)> = None;
-        let (mut base, mut exponent, mut remaining) = (x, 1_u32, power);
-        loop {
-            if remaining & 1 == 1 {
-                result = Some(match result {
-                    None => (base, exponent),
-                    Some((product, e)) => {
-                        let (lo, hi) = range(e + exponent);
-                        let format = Self::format(lo, hi, frac);
-                        let name = format!("power_{k}_{}", e + exponent);
-                        (b.node(&name, Op::Mul(product, base), format), e + exponent)
-                    }
-                });
-            }
-            remaining >>= 1;
-            if remaining == 0 {
-                break;
-            }
-            exponent *= 2;
-            let (lo, hi) = range(exponent);
-            let format = Self::format(lo, hi, frac);
-            if format.width() > MAX_WIDTH {
-                return Err(HwError::NotCompiled {
-                    lobe: lobe.to_owned(),
-                    why: format!(
-                        "a power {exponent} needs {} bits, wider than the {MAX_WIDTH} a stage \
-                         may have",
-                        format.width()
-                    ),
-                });
-            }
-            base = b.node(&format!("square_{k}_{exponent}"), Op::Square(base), format);
-        }
-        Ok(result.map_or(x, |(node, _)| node))
+        let output = b.zero_at_t_zero(t, clamped, unit);
+        Ok(b.finish(name, output))
     }
 
     /// The parameters' raw inputs for integer exponent `n` at word length `bits`, as the host
@@ -473,4 +398,56 @@ impl Layout {
             })
             .collect()
     }
+}
+
+/// `x^power` by binary exponentiation, squarers and multipliers whose formats follow the
+/// powers of `x`'s range `(low, high)`; the nodes are named after step `k`.
+fn raise(
+    b: &mut Builder,
+    x: NodeId,
+    (low, high): (f64, f64),
+    power: u32,
+    k: usize,
+    frac: u32,
+) -> Result<NodeId, String> {
+    // The range of x^e: a power of the range, from 0 where an even power crosses it.
+    let range = |e: u32| {
+        let (a, b) = (low.powi(e as i32), high.powi(e as i32));
+        if e.is_multiple_of(2) && low < 0.0 && high > 0.0 {
+            (0.0, a.max(b))
+        } else {
+            (a.min(b), a.max(b))
+        }
+    };
+    let mut result: Option<(NodeId, u32)> = None;
+    let (mut base, mut exponent, mut remaining) = (x, 1_u32, power);
+    loop {
+        if remaining & 1 == 1 {
+            result = Some(match result {
+                None => (base, exponent),
+                Some((product, e)) => {
+                    let (lo, hi) = range(e + exponent);
+                    let format = Layout::format(lo, hi, frac);
+                    let name = format!("power_{k}_{}", e + exponent);
+                    (b.node(&name, Op::Mul(product, base), format), e + exponent)
+                }
+            });
+        }
+        remaining >>= 1;
+        if remaining == 0 {
+            break;
+        }
+        exponent *= 2;
+        let (lo, hi) = range(exponent);
+        let format = Layout::format(lo, hi, frac);
+        if format.width() > MAX_WIDTH {
+            return Err(format!(
+                "a power {exponent} needs {} bits, wider than the {MAX_WIDTH} a stage may \
+                 have",
+                format.width()
+            ));
+        }
+        base = b.node(&format!("square_{k}_{exponent}"), Op::Square(base), format);
+    }
+    Ok(result.map_or(x, |(node, _)| node))
 }

@@ -145,6 +145,21 @@ impl Builder {
         self.node(name, Op::Input, format)
     }
 
+    /// The output node of a lobe's datapath: `value`, or 0 where `t = 0`, since every lobe is
+    /// 0 there (SPEC section 1) and some formulas are not.
+    pub fn zero_at_t_zero(&mut self, t: NodeId, value: NodeId, unit: FixedPoint) -> NodeId {
+        let lit = self.node("t_nonzero", Op::NonZero(t), FixedPoint::unsigned(1, 0));
+        let zero = self.node("zero", Op::Const(0), unit);
+        self.node(
+            "value",
+            Op::Select {
+                index: lit,
+                options: vec![zero, value],
+            },
+            unit,
+        )
+    }
+
     /// The finished datapath, with `output` as its result.
     #[must_use]
     pub fn finish(self, name: &str, output: NodeId) -> Datapath {

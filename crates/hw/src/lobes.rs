@@ -168,7 +168,10 @@ impl HwLobe {
     /// lobe of yours compiled from its formula, or why it has none.
     pub fn of_kind(kind: LobeKind) -> Result<Self, HwError> {
         if let LobeKind::Formula(id) = kind {
-            compiled::layout(id)?;
+            compiled::layout(id).map_err(|why| HwError::NotCompiled {
+                lobe: kind.to_string(),
+                why,
+            })?;
             return Ok(HwLobe::Formula(id));
         }
         Self::ALL
@@ -221,7 +224,12 @@ impl HwLobe {
         let name = format!("specula_{id}_w{bits}");
         let output = match self {
             HwLobe::Formula(id) => {
-                return compiled::layout(id)?.build(&name, self.id(), bits);
+                return compiled::layout(id)
+                    .and_then(|layout| layout.build(&name, bits))
+                    .map_err(|why| HwError::NotCompiled {
+                        lobe: self.id().to_owned(),
+                        why,
+                    });
             }
             HwLobe::Schlick | HwLobe::SchlickMod => {
                 let t = b.input("t", unit);
@@ -344,7 +352,7 @@ impl HwLobe {
                     value = b.node(&format!("power_{}", 1 << i), Op::Square(value), unit);
                 }
                 // The formula gives (1 - a)^16 at t = 0 for n < 16.
-                zero_at_t_zero(&mut b, t, value, unit)
+                b.zero_at_t_zero(t, value, unit)
             }
             HwLobe::Pow => {
                 let t = b.input("t", unit);
@@ -377,7 +385,7 @@ impl HwLobe {
                 let minus_y = b.node("minus_y", Op::Mul(rate, u), FixedPoint::unsigned(6, frac));
                 let value = b.node("gaussian", Op::Exp2Neg(minus_y, POW_EXP2_TABLE), unit);
                 // The Gaussian is exp(-n) at t = 0.
-                zero_at_t_zero(&mut b, t, value, unit)
+                b.zero_at_t_zero(t, value, unit)
             }
         };
         Ok(b.finish(&name, output))
@@ -436,38 +444,6 @@ impl HwLobe {
     pub fn value(bits: u32, raw: i64) -> f64 {
         Self::unit_format(bits).to_f64(raw)
     }
-}
-
-/// The datapath finished with [`zero_at_t_zero`]'s output.
-pub(crate) fn finish_zero_at_t_zero(
-    mut b: Builder,
-    name: &str,
-    t: crate::NodeId,
-    value: crate::NodeId,
-    unit: FixedPoint,
-) -> Datapath {
-    let output = zero_at_t_zero(&mut b, t, value, unit);
-    b.finish(name, output)
-}
-
-/// The output node: `value`, or 0 where `t = 0`, since every lobe is 0 there (SPEC section 1)
-/// and some formulas are not.
-fn zero_at_t_zero(
-    b: &mut Builder,
-    t: crate::NodeId,
-    value: crate::NodeId,
-    unit: FixedPoint,
-) -> crate::NodeId {
-    let lit = b.node("t_nonzero", Op::NonZero(t), FixedPoint::unsigned(1, 0));
-    let zero = b.node("zero", Op::Const(0), unit);
-    b.node(
-        "value",
-        Op::Select {
-            index: lit,
-            options: vec![zero, value],
-        },
-        unit,
-    )
 }
 
 /// The integer exponent the hardware takes, or why `n` is not one.
