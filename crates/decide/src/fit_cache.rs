@@ -8,18 +8,17 @@
 
 use serde::{Deserialize, Serialize};
 use specula::measured::fit::{Fit, Observations, Sharing, Specular};
-use specula::{Geometry, LobeKind};
+use specula::LobeKind;
 use specula_synth::cache::{key_of_bytes, Cache};
 
 /// Bumped when [`Stored`] changes shape.
-const FORMAT: &str = "specula material fits 1";
+const FORMAT: &str = "specula material fits 2";
 
 /// One fit as stored.
 #[derive(Serialize, Deserialize)]
 struct Stored {
-    /// The lobe's id, or `None` for GGX.
-    lobe: Option<String>,
-    blinn: bool,
+    /// The family's label (`pow/blinn`, `ggx`, `cosquad/microfacet`, `beckmann`).
+    family: String,
     per_channel: bool,
     parameter: [u64; 3],
     kd: [u64; 3],
@@ -32,16 +31,19 @@ struct Stored {
 /// before, else made by `fit` and stored.
 pub(crate) fn fits(
     observations: &Observations,
-    kinds: &[LobeKind],
+    families: &[Specular],
     fit: impl FnOnce() -> Vec<Fit>,
 ) -> Vec<Fit> {
-    let cache = Cache::default_for("fits")
-        .filter(|_| kinds.iter().all(|kind| LobeKind::ALL.contains(kind)));
+    let built_in = |specular: &Specular| match specular {
+        Specular::Lobe { kind, .. } | Specular::Microfacet { kind } => LobeKind::ALL.contains(kind),
+        Specular::Ggx | Specular::Beckmann => true,
+    };
+    let cache = Cache::default_for("fits").filter(|_| families.iter().all(built_in));
     let Some(cache) = cache else {
         return fit();
     };
-    let key = key_of(observations, kinds);
-    if let Some(found) = load(&cache, &key) {
+    let key = key_of(observations, families);
+    if let Some(found) = load(&cache, &key, families) {
         return found;
     }
     let made = fit();
@@ -50,40 +52,30 @@ pub(crate) fn fits(
     made
 }
 
-fn key_of(observations: &Observations, kinds: &[LobeKind]) -> String {
+fn key_of(observations: &Observations, families: &[Specular]) -> String {
     let values: Vec<u8> = observations
         .value
         .iter()
         .flat_map(|value| value.to_array())
         .flat_map(|channel| channel.to_bits().to_le_bytes())
         .collect();
-    let lobes: Vec<String> = kinds.iter().map(LobeKind::to_string).collect();
+    let labels: Vec<String> = families.iter().map(|f| f.label()).collect();
     key_of_bytes(&[
         FORMAT.as_bytes(),
         env!("SPECULA_SOURCES").as_bytes(),
         &values,
-        lobes.join(",").as_bytes(),
+        labels.join(",").as_bytes(),
     ])
 }
 
-fn load(cache: &Cache, key: &str) -> Option<Vec<Fit>> {
+/// The fits stored under `key`, each family found again among `families` by its label.
+fn load(cache: &Cache, key: &str, families: &[Specular]) -> Option<Vec<Fit>> {
     let stored: Vec<Stored> = cache.load(key)?;
     let bits = |values: [u64; 3]| values.map(f64::from_bits);
     stored
         .into_iter()
         .map(|entry| {
-            let geometry = if entry.blinn {
-                Geometry::Blinn
-            } else {
-                Geometry::Phong
-            };
-            let specular = match &entry.lobe {
-                Some(id) => Specular::Lobe {
-                    kind: LobeKind::parse(id).ok()?,
-                    geometry,
-                },
-                None => Specular::Ggx,
-            };
+            let specular = *families.iter().find(|f| f.label() == entry.family)?;
             Some(Fit {
                 specular,
                 sharing: if entry.per_channel {
@@ -103,13 +95,8 @@ fn load(cache: &Cache, key: &str) -> Option<Vec<Fit>> {
 
 fn stored(fit: &Fit) -> Stored {
     let bits = |values: [f64; 3]| values.map(f64::to_bits);
-    let (lobe, blinn) = match fit.specular {
-        Specular::Lobe { kind, geometry } => (Some(kind.to_string()), geometry == Geometry::Blinn),
-        Specular::Ggx => (None, false),
-    };
     Stored {
-        lobe,
-        blinn,
+        family: fit.specular.label(),
         per_channel: fit.sharing == Sharing::PerChannel,
         parameter: bits(fit.parameter),
         kd: bits(fit.kd),
@@ -122,8 +109,9 @@ fn stored(fit: &Fit) -> Stored {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use specula::Geometry;
 
-    /// A stored fit reads back as the same fit, bit for bit, GGX and both geometries alike.
+    /// A stored fit reads back as the same fit, bit for bit, every family alike.
     #[test]
     fn a_stored_fit_reads_back_bit_for_bit() {
         let directory = tempfile::tempdir().unwrap();
@@ -155,10 +143,19 @@ mod tests {
                 0.1,
             ),
             fit(Specular::Ggx, Sharing::Shared, 0.3),
+            fit(
+                Specular::Microfacet {
+                    kind: LobeKind::Schlick,
+                },
+                Sharing::Shared,
+                64.0,
+            ),
+            fit(Specular::Beckmann, Sharing::PerChannel, 0.2),
         ];
         cache
             .store("k", &fits.iter().map(stored).collect::<Vec<_>>())
             .unwrap();
-        assert_eq!(load(&cache, "k"), Some(fits));
+        let families: Vec<Specular> = fits.iter().map(|f| f.specular).collect();
+        assert_eq!(load(&cache, "k", &families), Some(fits));
     }
 }

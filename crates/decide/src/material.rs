@@ -8,9 +8,11 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::Serialize;
-use specula::measured::fit::verdict::{verdict, Verdict};
+pub use specula::measured::fit::verdict::Model;
+use specula::measured::fit::verdict::{verdict_of, Verdict};
 use specula::measured::fit::{
-    fit_all, Fit, Observations, Sharing, Specular, MAX_ELEVATION_DEGREES,
+    families, fit_families, microfacet_families, Fit, Observations, Sharing, Specular,
+    MAX_ELEVATION_DEGREES,
 };
 use specula::{Exponent, Lobe, LobeKind, Normalisation};
 use specula_render::measured::{material_name, MeasuredBrdf};
@@ -63,13 +65,20 @@ pub struct Assessment {
     pub target: Target,
     /// Its rate's unit.
     pub rate_unit: &'static str,
-    /// The margin over pow's error, as a fraction.
+    /// The margin over the reference's error, as a fraction.
     pub margin: f64,
+    /// The model the verdict ranks: the classic lobes against pow, or the lobes as
+    /// microfacet distributions against GGX (the classic fits beside them).
+    pub model: Model,
+    /// Whether the answer is within the margin of the reference: always in the classic model
+    /// (pow meets itself); in the microfacet model, where no distribution comes within the
+    /// margin of GGX, the answer is the closest distribution and this is false.
+    pub within_margin: bool,
     /// Every fit.
     pub fits: Vec<FitRow>,
     /// The index in `fits` of the lobe to ship.
     pub chosen: usize,
-    /// Pow's best shared-`n` fit error, the reference.
+    /// The reference's shared-`n` fit error (pow's best, or GGX's in the microfacet model).
     pub reference_error: f64,
 }
 
@@ -101,6 +110,20 @@ pub fn assess(
     target: Target,
     margin: f64,
 ) -> Result<Assessment, String> {
+    assess_model(material, path, kinds, target, margin, Model::Classic)
+}
+
+/// [`assess`] for `model`: in the microfacet model every lobe is fitted twice, classic and as
+/// a distribution, beside GGX and Beckmann, and the verdict names the cheapest distribution
+/// within the margin of GGX's fit.
+pub fn assess_model(
+    material: &MeasuredBrdf,
+    path: &Path,
+    kinds: &[LobeKind],
+    target: Target,
+    margin: f64,
+    model: Model,
+) -> Result<Assessment, String> {
     crate::costing::material_target(target)?;
     if !(0.0..=1.0).contains(&margin) {
         return Err(format!(
@@ -108,27 +131,68 @@ pub fn assess(
         ));
     }
     let observations = Observations::of(|wo, wi| material.f_cos(wo, wi));
-    let fits = crate::fit_cache::fits(&observations, kinds, || fit_all(&observations, kinds));
+    // The classic fits, and in the microfacet model the distributions' beside them, each set
+    // cached on its own: a classic assessment of the material reuses the first.
+    let classic = families(kinds);
+    let mut fits = crate::fit_cache::fits(&observations, &classic, || {
+        fit_families(&observations, &classic)
+    });
+    if model == Model::Microfacet {
+        let distributions: Vec<Specular> = microfacet_families(kinds)
+            .into_iter()
+            .filter(|f| *f != Specular::Ggx)
+            .collect();
+        fits.extend(crate::fit_cache::fits(
+            &observations,
+            &distributions,
+            || fit_families(&observations, &distributions),
+        ));
+    }
     let mut rates = Vec::with_capacity(fits.len());
     for fit in &fits {
         rates.push(match (fit.specular, fit.sharing) {
-            (Specular::Lobe { kind, .. }, Sharing::Shared) => {
+            (Specular::Lobe { kind, .. } | Specular::Microfacet { kind }, Sharing::Shared) => {
                 let n = Exponent::clamped(fit.parameter[0]);
                 Some(lobe_rate(target, &Lobe::new(kind, n))?)
             }
             _ => None,
         });
     }
-    let Some(Verdict {
-        standings,
-        chosen,
-        reference_error,
-        ..
-    }) = verdict(&fits, margin, &rates)
+    // In the microfacet model no distribution may come within the margin of GGX: the answer
+    // is then the closest distribution, and the verdict says that none is within it.
+    let found = verdict_of(model, &fits, margin, &rates).map(|v| (v, true));
+    let found = found.or_else(|| {
+        let closest = fits
+            .iter()
+            .filter(|f| {
+                matches!(f.specular, Specular::Microfacet { .. }) && f.sharing == Sharing::Shared
+            })
+            .map(|f| f.error)
+            .min_by(f64::total_cmp)?;
+        let reference = fits
+            .iter()
+            .find(|f| f.specular == Specular::Ggx && f.sharing == Sharing::Shared)?
+            .error;
+        let admitting = (closest / reference - 1.0).max(0.0) * (1.0 + 1e-12);
+        verdict_of(model, &fits, admitting, &rates).map(|v| (v, false))
+    });
+    let Some((
+        Verdict {
+            standings,
+            chosen,
+            reference_error,
+            ..
+        },
+        within_margin,
+    )) = found
     else {
         return Err(format!(
-            "{}: no verdict: pow's fit or every rate on the target is missing",
-            path.display()
+            "{}: no verdict: the reference's fit ({}) or every rate on the target is missing",
+            path.display(),
+            match model {
+                Model::Classic => "pow",
+                Model::Microfacet => "GGX",
+            }
         ));
     };
     let normal = glam::DVec3::Z;
@@ -146,7 +210,7 @@ pub fn assess(
             relative_to_pow: standing.relative_to_pow,
             relative_to_ggx: standing.relative_to_ggx,
             rate: standing.rate,
-            meets: standing.meets,
+            meets: standing.meets && within_margin,
             fit,
         })
         .collect();
@@ -163,6 +227,8 @@ pub fn assess(
         target,
         rate_unit: rate_unit(target),
         margin,
+        model,
+        within_margin,
         fits: rows,
         chosen,
         reference_error,
@@ -179,9 +245,12 @@ pub fn parameter_text(fit: &Fit) -> String {
 
 fn parameter_values(fit: &Fit) -> String {
     let p = fit.parameter;
-    let one = |v: f64| match fit.specular {
-        Specular::Ggx => format!("{v:.4}"),
-        Specular::Lobe { .. } => format!("{v:.1}"),
+    let one = |v: f64| {
+        if fit.specular.takes_alpha() {
+            format!("{v:.4}")
+        } else {
+            format!("{v:.1}")
+        }
     };
     if p[0] == p[1] && p[1] == p[2] {
         one(p[0])
@@ -190,18 +259,15 @@ fn parameter_values(fit: &Fit) -> String {
     }
 }
 
-/// Pow's rate on the target (its better geometry's, at its fitted `n`).
+/// Pow's rate on the target at its fitted `n` (its better geometry's; in the microfacet
+/// model, pow's distribution's).
 fn pow_rate(a: &Assessment) -> f64 {
     a.fits
         .iter()
-        .filter(|r| {
-            matches!(
-                r.fit.specular,
-                Specular::Lobe {
-                    kind: LobeKind::Pow,
-                    ..
-                }
-            )
+        .filter(|r| match (a.model, r.fit.specular) {
+            (Model::Classic, Specular::Lobe { kind, .. }) => kind == LobeKind::Pow,
+            (Model::Microfacet, Specular::Microfacet { kind }) => kind == LobeKind::Pow,
+            _ => false,
         })
         .filter_map(|r| r.rate)
         .fold(f64::NAN, f64::max)
@@ -212,17 +278,34 @@ fn pow_rate(a: &Assessment) -> f64 {
 pub fn verdict_line(a: &Assessment) -> String {
     let chosen = &a.fits[a.chosen];
     let pow_rate = pow_rate(a);
-    format!(
-        "{}, n = {}: the cheapest lobe on {} whose fit is within {} % of pow's (E = {:.4}, {:.3}x \
-            pow's best; {:.2}x pow's throughput)",
+    let rate = chosen.rate.unwrap_or(f64::NAN);
+    // The figures every verdict gives: the lobe and its n, the fit error and its ratio to
+    // the reference's, and the throughput against pow's.
+    let (label, n, error, ratio, versus_pow) = (
         chosen.fit.specular.label(),
         parameter_text(&chosen.fit),
-        a.target,
-        100.0 * a.margin,
         chosen.fit.error,
         chosen.fit.error / a.reference_error,
-        chosen.rate.unwrap_or(f64::NAN) / pow_rate,
-    )
+        rate / pow_rate,
+    );
+    let (target, margin) = (a.target, 100.0 * a.margin);
+    match (a.model, a.within_margin) {
+        (Model::Microfacet, false) => format!(
+            "no distribution's microfacet fit on {target} is within {margin} % of GGX's; the \
+                closest is {label}, n = {n} (E = {error:.4}, {ratio:.3}x GGX's; \
+                {versus_pow:.2}x the pow distribution's throughput)"
+        ),
+        (Model::Microfacet, true) => format!(
+            "{label}, n = {n}: the cheapest distribution on {target} whose microfacet fit is \
+                within {margin} % of GGX's (E = {error:.4}, {ratio:.3}x GGX's); \
+                {versus_pow:.2}x the pow distribution's throughput, so {:.0} % of its cost saved",
+            100.0 * (1.0 - pow_rate / rate)
+        ),
+        (Model::Classic, _) => format!(
+            "{label}, n = {n}: the cheapest lobe on {target} whose fit is within {margin} % of \
+                pow's (E = {error:.4}, {ratio:.3}x pow's best; {versus_pow:.2}x pow's throughput)"
+        ),
+    }
 }
 
 /// One candidate of a material's ranking (`recommend --material`).

@@ -76,8 +76,9 @@ pub fn design_json(
 ) -> PyResult<String> {
     guarded(|| {
         let ends = parse_exponent_range(n, 1).map_err(value_error)?;
+        let target = Target::from_str(target).map_err(value_error)?;
         let request = DesignRequest {
-            target: Target::from_str(target).map_err(value_error)?,
+            target,
             range: (ends[0], ends[ends.len() - 1]),
             bounds: Bounds {
                 epicentre: max_error,
@@ -86,6 +87,7 @@ pub fn design_json(
             },
             no_transcendentals,
             also: lobes(&extra_lobes)?,
+            max_operations: specula_decide::design::grammar::default_max_operations(target),
         };
         let answer = py
             .detach(|| design(&request, &ProgressBar::hidden()))

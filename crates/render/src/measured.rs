@@ -6,14 +6,14 @@
 //! in the same scene with the same random numbers, each scored by FLIP against the
 //! measurement ([`render_comparison`]).
 
-use core::f64::consts::{FRAC_1_PI, TAU};
+use core::f64::consts::FRAC_1_PI;
 use std::path::Path;
 
 use glam::DVec3;
 use specula::brdf::luminance;
-use specula::fit::ggx;
 use specula::measured::fit::{Fit, FittedModel, Specular};
 pub use specula::measured::MeasuredBrdf;
+use specula::microfacet::Distribution;
 use specula::sampling::SpecularSampler;
 use specula::{Exponent, Lobe, Normalisation};
 
@@ -85,8 +85,9 @@ impl Reflectance for MeasuredReflectance<'_> {
 enum SpecularDraw {
     /// The lobe's own sampler.
     Lobe(SpecularSampler),
-    /// GGX normals in proportion to `D(h) cos(theta_h)`.
-    Ggx { alpha: f64 },
+    /// A microfacet distribution's normals (GGX's, Beckmann's, a lobe's) in proportion to
+    /// `D(h) cos(theta_h)`.
+    Microfacet(Distribution),
 }
 
 /// A fitted model as the environment renderer's BRDF, drawn from a mixture of the cosine and
@@ -107,9 +108,13 @@ impl FittedReflectance {
                 geometry,
                 Normalisation::None,
             )),
-            Specular::Ggx => SpecularDraw::Ggx {
-                alpha: fit.parameter[0],
-            },
+            Specular::Ggx | Specular::Beckmann | Specular::Microfacet { .. } => {
+                SpecularDraw::Microfacet(fit.specular.distribution(fit.parameter[0]).unwrap_or(
+                    Distribution::Ggx {
+                        alpha: fit.parameter[0],
+                    },
+                ))
+            }
         };
         let (d, total) = (
             luminance(DVec3::from_array(fit.kd)),
@@ -129,9 +134,9 @@ impl FittedReflectance {
     fn specular_pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
         match &self.draw {
             SpecularDraw::Lobe(sampler) => sampler.pdf(wo, wi),
-            SpecularDraw::Ggx { alpha } => {
+            SpecularDraw::Microfacet(distribution) => {
                 let h = (wo + wi).normalize();
-                ggx(*alpha, h.z) * h.z / (4.0 * wo.dot(h).abs())
+                distribution.pdf_normal(h) / (4.0 * wo.dot(h).abs())
             }
         }
     }
@@ -139,10 +144,8 @@ impl FittedReflectance {
     fn specular_direction(&self, wo: DVec3, u: [f64; 2]) -> Option<DVec3> {
         match &self.draw {
             SpecularDraw::Lobe(sampler) => Some(sampler.sample(wo, u)?.wi),
-            SpecularDraw::Ggx { alpha } => {
-                let theta = (alpha * (u[0] / (1.0 - u[0])).sqrt()).atan();
-                let (s, c) = (TAU * u[1]).sin_cos();
-                let h = DVec3::new(theta.sin() * c, theta.sin() * s, theta.cos());
+            SpecularDraw::Microfacet(distribution) => {
+                let h = distribution.sample_normal(u);
                 Some(2.0 * wo.dot(h) * h - wo)
             }
         }

@@ -35,6 +35,7 @@ fn request(target: Target, bound: f64, also: &[LobeKind]) -> DesignRequest {
         },
         no_transcendentals: false,
         also: also.to_vec(),
+        max_operations: specula_decide::design::grammar::DEFAULT_MAX_OPERATIONS,
     }
 }
 
@@ -135,6 +136,10 @@ fn designed_now(context: &mut Context) -> Result<String, String> {
     html += &formulas;
     // The search does not depend on the target: one answer's designs are every target's.
     if let Some(answer) = answers.first() {
+        html += &super::designer_checks::enumeration(
+            answer,
+            specula_decide::design::grammar::DEFAULT_MAX_OPERATIONS,
+        );
         html += &super::designer_checks::limit(context, answer, RANGE)?;
     }
     html += &super::designer_checks::thesis_table(&FAMILIES, RANGE)?;

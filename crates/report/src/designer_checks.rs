@@ -8,6 +8,7 @@
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use specula::Exponent;
+use specula_decide::design::grammar::{self, Fate};
 use specula_decide::design::limit::limit_table;
 use specula_decide::design::thesis::{against_thesis, ThesisRow};
 use specula_decide::design::{percent, Design};
@@ -127,4 +128,48 @@ pub(crate) fn thesis_table(
     html += &table(&header, &rows);
     html += &formulas;
     Ok(html)
+}
+
+/// What the search enumerated for `answer` and what became of each structure: its grammar's
+/// structures grouped by fate, each with its operations (`specula design --verbose`).
+pub(crate) fn enumeration(answer: &Design, max_operations: usize) -> String {
+    let [enumerated, pruned, missed, kept] = grammar::counts(&answer.enumerated);
+    let listed = |keep: fn(&Fate) -> bool| {
+        let names: Vec<String> = answer
+            .enumerated
+            .iter()
+            .filter(|e| keep(&e.fate))
+            .map(|e| format!("{} ({})", e.structure, e.operations))
+            .collect();
+        if names.is_empty() {
+            "-".to_owned()
+        } else {
+            names.join(", ")
+        }
+    };
+    let mut html = paragraph(&format!(
+        "The search's structures, enumerated from the formula language's operations (exp2 of a \
+         series of n ln t; a power of two of a peak-shaped function of 1 - t) within the cost \
+         bound of {max_operations} operations per evaluation: {enumerated} enumerated, {pruned} \
+         pruned before their fit, {missed} by their fit, {kept} kept. Each structure is named \
+         with its operations; specula design --verbose prints this list with the reasons."
+    ));
+    html += &table(
+        &["fate", "structures (operations)"],
+        &[
+            vec![
+                format!("kept: fitted, verified, costed ({kept})"),
+                listed(|f| matches!(f, Fate::Kept)),
+            ],
+            vec![
+                format!("pruned by its fit: the coarse grids' best misses the bounds ({missed})"),
+                listed(|f| matches!(f, Fate::FitMissed)),
+            ],
+            vec![
+                format!("pruned before its fit: over the cost bound ({pruned})"),
+                listed(|f| matches!(f, Fate::Pruned(_))),
+            ],
+        ],
+    );
+    html
 }

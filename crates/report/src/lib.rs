@@ -21,6 +21,7 @@ mod hardware;
 mod html;
 mod materials;
 mod medical;
+mod microfacet_table;
 mod other_renderers;
 mod plot;
 mod polar;

@@ -23,8 +23,8 @@ use super::sections::colour;
 use super::stored;
 use super::{Context, MATERIALS};
 use specula_decide::material::{
-    assess, lobes_to_fit, luminance, parameter_text, verdict_line, Assessment, FitRow,
-    DEFAULT_MARGIN,
+    assess, assess_model, lobes_to_fit, luminance, parameter_text, verdict_line, Assessment,
+    FitRow, Model, DEFAULT_MARGIN,
 };
 use specula_decide::Target;
 
@@ -141,12 +141,19 @@ fn assessed(context: &mut Context) -> Result<String, String> {
         .par_iter()
         .map(|(measured, path)| assess(measured, path, &kinds, TARGET, MARGIN))
         .collect::<Result<Vec<_>, String>>()?;
+    let microfacet = materials
+        .par_iter()
+        .map(|(measured, path)| {
+            assess_model(measured, path, &kinds, TARGET, MARGIN, Model::Microfacet)
+        })
+        .collect::<Result<Vec<_>, String>>()?;
     let mut shown = String::new();
     let mut error_measure = String::new();
     for (index, ((measured, path), assessment)) in materials.iter().zip(&assessed).enumerate() {
         shown += &material(context, index, path, measured, assessment, &sky)?;
         error_measure.clone_from(&assessment.error_measure);
     }
+    shown += &super::microfacet_table::microfacet_section(&microfacet, &kinds);
     let (width, spp) = context.sizes.materials;
     let height = material_scene(width).settings.height;
     let more = if more > 0 {
@@ -185,11 +192,12 @@ fn bundled() -> Result<Vec<(MeasuredBrdf, PathBuf)>, String> {
         .collect()
 }
 
-/// The shape parameter's name: `n` for a lobe, `alpha` for GGX.
+/// The shape parameter's name: `n` for a lobe, `alpha` for GGX and Beckmann.
 fn parameter_name(specular: Specular) -> &'static str {
-    match specular {
-        Specular::Ggx => "alpha",
-        Specular::Lobe { .. } => "n",
+    if specular.takes_alpha() {
+        "alpha"
+    } else {
+        "n"
     }
 }
 
@@ -214,6 +222,8 @@ fn shown_fits(a: &Assessment) -> Vec<&FitRow> {
                 }
             }
             Specular::Ggx => ggx = Some(row),
+            // The microfacet model's fits are its own table's.
+            Specular::Microfacet { .. } | Specular::Beckmann => {}
         }
     }
     best.extend(ggx);
@@ -353,7 +363,8 @@ fn polar(
                             &[]
                         },
                     ),
-                    Specular::Ggx => (GGX_GREY, DASH_DOT),
+                    Specular::Microfacet { kind } => (colour(kind), DASH_DOT),
+                    Specular::Ggx | Specular::Beckmann => (GGX_GREY, DASH_DOT),
                 };
                 let model = fit.prepare();
                 curves.push(PolarCurve {

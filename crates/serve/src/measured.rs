@@ -460,7 +460,24 @@ fn summary(fit: &Fit, reference_error: f64, ggx_error: f64, costs: &CostModel) -
                 Some(costs_versus_pow(costs, &lobe)),
             )
         }
-        Specular::Ggx => ("ggx".to_owned(), None, None, Some(fit.parameter[0]), None),
+        Specular::Microfacet { kind } => {
+            let n = fit.parameter[0];
+            let lobe = Lobe::new(kind, Exponent::clamped(n));
+            (
+                kind.to_string(),
+                Some("microfacet"),
+                Some(n),
+                None,
+                Some(costs_versus_pow(costs, &lobe)),
+            )
+        }
+        Specular::Ggx | Specular::Beckmann => (
+            fit.specular.label(),
+            None,
+            None,
+            Some(fit.parameter[0]),
+            None,
+        ),
     };
     let (costs, cost_error) = match priced {
         Some(Ok(costs)) => (costs, None),

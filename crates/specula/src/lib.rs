@@ -46,6 +46,7 @@ pub mod geometry;
 pub mod gpu_cost;
 pub mod lobe;
 pub mod measured;
+pub mod microfacet;
 pub mod normalisation;
 pub mod ops;
 pub mod quadrature;

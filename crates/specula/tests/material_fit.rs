@@ -9,7 +9,8 @@
 use core::f64::consts::PI;
 
 use glam::DVec3;
-use specula::measured::fit::{fit, verdict::verdict, Fit, Observations, Sharing, Specular};
+use specula::measured::fit::verdict::{verdict, verdict_of, Model};
+use specula::measured::fit::{fit, Fit, Observations, Sharing, Specular};
 use specula::{Brdf, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
 
 fn close(a: f64, b: f64, relative: f64) -> bool {
@@ -96,13 +97,19 @@ fn ggx_f(alpha: f64, wo: DVec3, wi: DVec3) -> f64 {
 #[test]
 fn ggx_is_fitted_back_to_its_roughness() {
     let alpha = 0.12;
+    fitted_back(Specular::Ggx, alpha, |wo, wi| ggx_f(alpha, wo, wi));
+}
+
+/// `specular` fitted to `kd / pi + K spec` (fixed `kd` and `K`) finds `parameter`, `kd` and
+/// `K` again, at rounding level.
+fn fitted_back(specular: Specular, parameter: f64, spec: impl Fn(DVec3, DVec3) -> f64 + Sync) {
     let observations = Observations::of(|wo, wi| {
-        (Rgb::new(0.1, 0.2, 0.3) / PI + Rgb::new(0.9, 0.7, 0.5) * ggx_f(alpha, wo, wi)) * wi.z
+        (Rgb::new(0.1, 0.2, 0.3) / PI + Rgb::new(0.9, 0.7, 0.5) * spec(wo, wi)) * wi.z
     });
-    let fitted = fit(&observations, Specular::Ggx, Sharing::Shared);
+    let fitted = fit(&observations, specular, Sharing::Shared);
     assert!(fitted.error < 1e-6, "{}", fitted.error);
     assert!(
-        close(fitted.parameter[0], alpha, 1e-3),
+        close(fitted.parameter[0], parameter, 1e-3),
         "{:?}",
         fitted.parameter
     );
@@ -185,4 +192,67 @@ fn pure_terms_are_fitted_at_their_bounds() {
             "{fitted:?}"
         );
     }
+}
+
+/// Beckmann's microfacet model written out here (its `D` and its exact `Lambda` by `erfc`) is
+/// fitted back to its roughness by the microfacet model's Beckmann family; and the lobes as
+/// distributions fit a model made of `pow`'s distribution back to its `n`.
+#[test]
+fn microfacet_models_are_fitted_back_to_their_parameters() {
+    let alpha: f64 = 0.2;
+    let lambda = |cos: f64| {
+        let a = cos / (alpha * (1.0 - cos * cos).sqrt());
+        0.5 * ((-a * a).exp() / (a * PI.sqrt()) - libm::erfc(a))
+    };
+    let beckmann = |wo: DVec3, wi: DVec3| {
+        let h = (wo + wi).normalize();
+        let tan2 = (1.0 - h.z * h.z) / (h.z * h.z);
+        let d = (-tan2 / (alpha * alpha)).exp() / (PI * alpha * alpha * h.z.powi(4));
+        d / (1.0 + lambda(wo.z) + lambda(wi.z)) / (4.0 * wo.z * wi.z)
+    };
+    fitted_back(Specular::Beckmann, alpha, beckmann);
+    let pow = specula::microfacet::Distribution::lobe(LobeKind::Pow, Exponent::new(40.0));
+    fitted_back(
+        Specular::Microfacet {
+            kind: LobeKind::Pow,
+        },
+        40.0,
+        |wo, wi| specula::measured::fit::microfacet_specular(&pow, wo, wi),
+    );
+}
+
+/// In the microfacet model the candidates are the distributions and the reference GGX's fit:
+/// the cheapest distribution within the margin of GGX wins, and none within it is no verdict.
+#[test]
+fn the_microfacet_verdict_is_the_cheapest_distribution_near_ggx() {
+    let distribution = |kind, error| Fit {
+        specular: Specular::Microfacet { kind },
+        ..stub(kind, error)
+    };
+    let mut ggx = stub(LobeKind::Pow, 0.100);
+    ggx.specular = Specular::Ggx;
+    let fits = vec![
+        stub(LobeKind::Pow, 0.090),
+        distribution(LobeKind::Pow, 0.101),
+        distribution(LobeKind::Schlick, 0.104),
+        distribution(LobeKind::Sg, 0.2),
+        ggx,
+    ];
+    let rate = [Some(5.0), Some(1.0), Some(2.0), Some(9.0), None];
+    let within_5 = verdict_of(Model::Microfacet, &fits, 0.05, &rate).expect("ggx is there");
+    // The classic pow fit, cheaper still, is no candidate of this model.
+    assert_eq!(within_5.chosen, 2);
+    assert!(close(within_5.reference_error, 0.100, 1e-12));
+    assert!(close(
+        within_5.standings[2].relative_to_pow,
+        0.104 / 0.101,
+        1e-12
+    ));
+    assert_eq!(
+        verdict_of(Model::Microfacet, &fits, 0.02, &rate)
+            .unwrap()
+            .chosen,
+        1
+    );
+    assert!(verdict_of(Model::Microfacet, &fits, 0.005, &rate).is_none());
 }

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
+use specula_decide::design::grammar::{self, Fate};
 use specula_decide::design::{default_whole_error, design, Bounds, Design, DesignRequest};
 use specula_decide::hardware::circuit_for_range;
 use specula_decide::Target;
@@ -53,6 +54,15 @@ pub struct Args {
     /// (.svg) beside it.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// The cost bound: the most operations per evaluation a searched structure may have (the
+    /// formula's own count, once n's constants are prepared) [default: 16, the whole grammar;
+    /// 10 on the FPGA, where every verified structure is synthesized].
+    #[arg(long, value_parser = parse_operations)]
+    max_operations: Option<usize>,
+    /// Also print every structure the grammar enumerated, with its operations and what became
+    /// of it: pruned before its fit (and why), pruned by its fit, or kept (verified).
+    #[arg(short, long)]
+    verbose: bool,
     /// Output format.
     #[arg(long, value_enum, default_value_t = crate::args::OutputFormat::Table)]
     format: crate::args::OutputFormat,
@@ -72,6 +82,17 @@ pub struct Args {
 /// The range of exponents, its ends.
 #[derive(Clone, Copy, Debug)]
 pub struct Range(specula::Exponent, specula::Exponent);
+
+fn parse_operations(text: &str) -> Result<usize, String> {
+    text.parse()
+        .ok()
+        .filter(|&bound| (1..=1000).contains(&bound))
+        .ok_or_else(|| {
+            format!(
+                "the cost bound must be a whole number of operations in [1, 1000], not '{text}'"
+            )
+        })
+}
 
 fn parse_range(text: &str) -> Result<Range, String> {
     let ends = specula_decide::parse_exponent_range(text, 1)?;
@@ -99,6 +120,9 @@ pub fn run(args: &Args) -> CommandResult {
         },
         no_transcendentals: args.no_transcendentals,
         also: crate::args::flatten(&args.lobe),
+        max_operations: args
+            .max_operations
+            .unwrap_or_else(|| grammar::default_max_operations(args.target)),
     };
     let answer = design(&request, &progress)?;
     if let Some(note) = &answer.note {
@@ -112,6 +136,9 @@ pub fn run(args: &Args) -> CommandResult {
     }
     println!("{}", answer.verdict);
     print_table(&answer, args.format);
+    if args.verbose {
+        print_enumeration(&answer, args.format);
+    }
     if args.limit {
         print_limit(&answer, &request, args.format)?;
     }
@@ -263,6 +290,31 @@ fn print_table(answer: &Design, format: crate::args::OutputFormat) {
     eprintln!(
         "costs in {}; designed lobes verified at {} exponents of the range by the f64 analysis",
         answer.unit, answer.exponents_verified
+    );
+}
+
+/// Every structure the grammar wrote, its operations and its fate.
+fn print_enumeration(answer: &Design, format: crate::args::OutputFormat) {
+    let mut table = Table::new(&["structure", "operations", "fate"]);
+    for e in &answer.enumerated {
+        table.push(vec![
+            e.structure.clone(),
+            e.operations.to_string(),
+            match &e.fate {
+                Fate::Pruned(why) => format!("pruned: {why}"),
+                Fate::FitMissed => "pruned by its fit: the coarse grids' best misses the \
+                    bounds (not verified)"
+                    .to_owned(),
+                Fate::Kept => "kept: fitted, verified and costed".to_owned(),
+            },
+        ]);
+    }
+    println!();
+    table.print(format);
+    let [enumerated, pruned, missed, kept] = grammar::counts(&answer.enumerated);
+    eprintln!(
+        "{enumerated} structures enumerated: {pruned} pruned before their fit, {missed} by \
+            their fit, {kept} kept"
     );
 }
 

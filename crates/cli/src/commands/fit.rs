@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use indicatif::{ProgressBar, ProgressStyle};
 use specula::measured::fit::Sharing;
 use specula_decide::material::{
-    assess, lobes_to_fit, luminance, parameter_text, verdict_line, Assessment, Ranked,
+    assess_model, lobes_to_fit, luminance, parameter_text, verdict_line, Assessment, Model, Ranked,
 };
 use specula_decide::Target;
 use specula_render::measured::{load_measured, material_name};
@@ -48,9 +48,26 @@ pub struct Args {
     /// parameters (`cosquad:v=5`); comma separated.
     #[arg(long, value_parser = crate::args::LobeListParser)]
     lobe: Vec<crate::args::LobeList>,
+    /// The model whose fits the verdict ranks: `classic`, `kd / pi + K lobe(t)` against pow's
+    /// fit; `microfacet`, each lobe also as the normal distribution of `D G2 / (4 cos cos)`,
+    /// beside Beckmann's and GGX's, against GGX's fit.
+    #[arg(long, value_enum, default_value_t = FitModel::Classic)]
+    model: FitModel,
     /// Output format.
     #[arg(long, value_enum, default_value_t = FitFormat::Table)]
     format: FitFormat,
+}
+
+/// `--model`'s choices.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum FitModel {
+    /// The lobe as the specular term, in the Phong and Blinn geometries; the verdict against
+    /// pow's fit.
+    #[default]
+    Classic,
+    /// The lobe as a microfacet normal distribution with Smith masking; the verdict against
+    /// GGX's fit.
+    Microfacet,
 }
 
 fn triple(v: [f64; 3]) -> String {
@@ -155,12 +172,17 @@ pub fn run(args: &Args) -> CommandResult {
     );
     for path in &args.material {
         progress.set_message(material_name(path));
-        let assessment = assess(
+        let model = match args.model {
+            FitModel::Classic => Model::Classic,
+            FitModel::Microfacet => Model::Microfacet,
+        };
+        let assessment = assess_model(
             &load_measured(path)?,
             path,
             &kinds,
             args.target,
             args.margin,
+            model,
         )?;
         progress.suspend(|| match args.format {
             FitFormat::Json => serde_json::to_string(&assessment)

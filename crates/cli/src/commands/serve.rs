@@ -98,6 +98,7 @@ fn designer() -> DesignModel {
             },
             no_transcendentals: false,
             also: Vec::new(),
+            max_operations: specula_decide::design::grammar::default_max_operations(target),
         };
         let answer = design(&request, &ProgressBar::hidden())?;
         let value = serde_json::to_value(&answer).map_err(|e| e.to_string())?;

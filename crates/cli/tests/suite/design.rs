@@ -4,30 +4,30 @@
 
 use crate::common::{have_python_module, ok, python, renderer_script, specula};
 
-/// `specula design --target TARGET --n N --max-error BOUND -o designed.toml` in `dir`: its JSON
-/// answer.
+/// `specula design --target TARGET --n N --max-error BOUND -o designed.toml` and `more` in
+/// `dir`: its JSON answer.
 fn design_to_file(
     dir: &std::path::Path,
     target: &str,
     n: &str,
     max_error: &str,
+    more: &[&str],
 ) -> serde_json::Value {
-    let output = ok(
-        dir,
-        &[
-            "design",
-            "--target",
-            target,
-            "--n",
-            n,
-            "--max-error",
-            max_error,
-            "-o",
-            "designed.toml",
-            "--format",
-            "json",
-        ],
-    );
+    let mut args = vec![
+        "design",
+        "--target",
+        target,
+        "--n",
+        n,
+        "--max-error",
+        max_error,
+        "-o",
+        "designed.toml",
+        "--format",
+        "json",
+    ];
+    args.extend_from_slice(more);
+    let output = ok(dir, &args);
     serde_json::from_slice(&output.stdout).expect("JSON")
 }
 
@@ -36,7 +36,7 @@ fn design_to_file(
 #[test]
 fn the_designed_gpu_lobe_meets_its_bounds_by_numpy_and_beats_pow() {
     let dir = tempfile::tempdir().expect("temporary folder");
-    let answer = design_to_file(dir.path(), "gpu-nvidia", "8..512", "0.1%");
+    let answer = design_to_file(dir.path(), "gpu-nvidia", "8..512", "0.1%", &[]);
     let best = &answer["designed"][0];
     assert_eq!(best["meets"], true, "{answer}");
     let versus_pow = best["rate"].as_f64().unwrap() / answer["pow_rate"].as_f64().unwrap();
@@ -126,6 +126,8 @@ fn a_polynomial_design_on_the_cpu_is_a_polynomial() {
             "--max-error",
             "0.5%",
             "--no-transcendentals",
+            "--max-operations",
+            "9",
             "-o",
             "polynomial.toml",
             "--format",
@@ -138,6 +140,25 @@ fn a_polynomial_design_on_the_cpu_is_a_polynomial() {
     for lobe in designed {
         let formula = lobe["formula"].as_str().unwrap();
         assert!(!formula.contains("exp2"), "{formula}");
+    }
+    // The cost bound: what was searched is within 9 operations; the exp2 structures and those
+    // over the bound were pruned before their fit, saying why.
+    let enumerated = answer["enumerated"].as_array().expect("the enumeration");
+    for structure in enumerated {
+        let name = structure["structure"].as_str().unwrap();
+        let operations = structure["operations"].as_u64().unwrap();
+        let why = structure["fate"]["why"].as_str().unwrap_or_default();
+        let pruned = structure["fate"]["fate"] == "pruned";
+        assert_eq!(
+            pruned,
+            name.starts_with("exp2") || operations > 9,
+            "{structure}"
+        );
+        if pruned && !name.starts_with("exp2") {
+            assert!(why.contains("cost bound"), "{structure}");
+        }
+        let searched = designed.iter().any(|d| d["family"] == name);
+        assert_eq!(searched, !pruned, "{structure}");
     }
     assert_eq!(designed[0]["meets"], true, "{answer}");
     assert!(answer["verdict"].as_str().unwrap().contains("on cpu"));
@@ -162,11 +183,24 @@ fn a_polynomial_design_on_the_cpu_is_a_polynomial() {
 /// in the built-ins' unit: the answer is at least as cheap as the cheapest built-in datapath
 /// meeting the bound, its Verilog and diagram are written beside the lobe file, `hw` takes the
 /// lobe file, and the written module simulates in Icarus Verilog bit for bit against the
-/// testbench `hw` makes from the Rust model.
+/// testbench `hw` makes from the Rust model. The FPGA's default cost bound, 10 operations,
+/// keeps 21 of the grammar's 44 structures (every verified design is synthesized, a few Yosys
+/// and nextpnr runs each from an empty cache): the answer says so.
 #[test]
 fn the_designed_fpga_lobe_is_a_datapath_as_cheap_as_the_built_ins() {
     let dir = tempfile::tempdir().expect("temporary folder");
-    let answer = design_to_file(dir.path(), "fpga", "64", "2%");
+    let answer = design_to_file(dir.path(), "fpga", "64", "2%", &[]);
+    let over_the_bound = answer["enumerated"]
+        .as_array()
+        .expect("the enumeration")
+        .iter()
+        .filter(|e| {
+            e["fate"]["why"]
+                .as_str()
+                .is_some_and(|w| w.contains("cost bound of 10"))
+        })
+        .count();
+    assert!(over_the_bound > 0, "{answer}");
     let best = &answer["designed"][0];
     assert_eq!(best["meets"], true, "{answer}");
     let datapath = best["datapath"].as_str().expect("a datapath named");
@@ -236,10 +270,55 @@ fn the_designed_fpga_lobe_is_a_datapath_as_cheap_as_the_built_ins() {
     assert!(text.contains("PASS"), "{text}");
 }
 
+/// `--verbose` lists every structure the grammar wrote with its fate, and its counts add up.
+#[test]
+fn verbose_lists_what_was_enumerated_pruned_and_kept() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let output = ok(
+        dir.path(),
+        &[
+            "design",
+            "--target",
+            "gpu-amd",
+            "--n",
+            "64",
+            "--max-error",
+            "1%",
+            "--max-operations",
+            "7",
+            "--verbose",
+        ],
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let listing: Vec<&str> = stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("structure"))
+        .skip(2)
+        .collect();
+    let count = |fate: &str| listing.iter().filter(|l| l.contains(fate)).count();
+    let (pruned, missed, kept) = (
+        count("pruned: "),
+        count("pruned by its fit"),
+        count("kept: "),
+    );
+    assert!(pruned > 0 && kept > 0, "{stdout}");
+    assert_eq!(pruned + missed + kept, listing.len(), "{stdout}");
+    let summary = format!(
+        "{} structures enumerated: {pruned} pruned before their fit, {missed} by their fit, \
+         {kept} kept",
+        listing.len()
+    );
+    assert!(stderr.contains(&summary), "{summary}\n{stderr}");
+    for line in listing.iter().filter(|l| l.contains("pruned: ")) {
+        assert!(line.contains("over the cost bound of 7"), "{line}");
+    }
+}
+
 #[test]
 fn bad_design_requests_are_refused_in_one_line_and_nothing_is_written() {
     let dir = tempfile::tempdir().expect("temporary folder");
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 5] = [
         (
             &[
                 "--target",
@@ -266,6 +345,17 @@ fn bad_design_requests_are_refused_in_one_line_and_nothing_is_written() {
         (
             &["--target", "gpu-nvidia", "--n", "64", "--max-error", "0%"],
             "(0, 100]",
+        ),
+        (
+            &[
+                "--target",
+                "gpu-nvidia",
+                "--max-error",
+                "1%",
+                "--max-operations",
+                "0",
+            ],
+            "[1, 1000]",
         ),
         // Nothing in the search space reaches a millionth of a per cent over this range.
         (

@@ -173,3 +173,51 @@ fn a_users_lobe_is_fitted_beside_the_built_in_ones() {
         assert!((n - m).abs() <= 1e-6 * n, "{geometry}: n {n} vs {m}");
     }
 }
+
+/// `fit --model microfacet` on the material: every lobe fitted as a distribution
+/// beside its classic fit, Beckmann and GGX; the verdict is the cheapest distribution within
+/// the margin of GGX's shared fit (checked from the JSON's own figures), or, where none is,
+/// the closest one, said so.
+#[test]
+fn the_microfacet_model_fits_every_lobe_as_a_distribution() {
+    let dir = tempfile::tempdir().unwrap();
+    let fit_paper = |more: &[&str]| {
+        let paper = text(&rgl("paper_white_rgb"));
+        let mut args = vec!["fit", "--material", &paper, "--model", "microfacet"];
+        args.extend_from_slice(more);
+        ok(dir.path(), &args)
+    };
+    let report: Value =
+        serde_json::from_slice(&fit_paper(&["--format", "json"]).stdout).expect("JSON");
+    assert_eq!(report["model"], "microfacet");
+    let fits = report["fits"].as_array().unwrap();
+    let family = |f: &Value| f["specular"]["family"].as_str().unwrap().to_owned();
+    let shared: Vec<&Value> = fits.iter().filter(|f| f["sharing"] == "shared").collect();
+    let distributions: Vec<&&Value> = shared
+        .iter()
+        .filter(|f| family(f) == "microfacet")
+        .collect();
+    // Every built-in lobe as a distribution, beside its two classic fits, Beckmann and GGX.
+    assert_eq!(distributions.len(), 13, "{report}");
+    assert_eq!(shared.iter().filter(|f| family(f) == "lobe").count(), 26);
+    let ggx = shared.iter().find(|f| family(f) == "ggx").expect("GGX");
+    assert!(shared.iter().any(|f| family(f) == "beckmann"));
+    let ggx_error = number(&ggx["error"]);
+    let margin = number(&report["margin"]);
+    let chosen = &fits[report["chosen"].as_u64().unwrap() as usize];
+    assert_eq!(family(chosen), "microfacet");
+    let within = |f: &Value| number(&f["error"]) <= (1.0 + margin) * ggx_error;
+    if report["within_margin"] == true {
+        assert!(within(chosen));
+        // No distribution within the margin is cheaper on the target.
+        for d in distributions.iter().filter(|d| within(d)) {
+            assert!(number(&d["rate"]) <= number(&chosen["rate"]), "{d}");
+        }
+    } else {
+        assert!(distributions.iter().all(|d| !within(d)));
+    }
+    // The table's verdict line names the model's reference.
+    let table = fit_paper(&[]);
+    let stdout = String::from_utf8_lossy(&table.stdout);
+    assert!(stdout.contains("GGX's"), "{stdout}");
+}

@@ -17,7 +17,7 @@ use crate::analyses::{figure_bits, figures_of};
 use crate::figures;
 
 /// Bumped when [`Stored`] changes shape.
-const FORMAT: &str = "specula design search 2";
+const FORMAT: &str = "specula design search 3";
 
 /// One family as searched.
 #[derive(Serialize, Deserialize)]
@@ -27,6 +27,7 @@ pub(super) struct Stored {
     epicentre_error: u64,
     whole_error: u64,
     energy_deviation: u64,
+    checked: bool,
     verified: bool,
     short_of_whole_only: bool,
     why: String,
@@ -46,6 +47,7 @@ pub(super) fn key(request: &DesignRequest) -> String {
         &bits(request.bounds.epicentre),
         &bits(request.bounds.whole),
         &request.bounds.energy.map_or("none".to_owned(), bits),
+        &request.max_operations.to_string(),
         if request.no_transcendentals {
             "no transcendentals"
         } else {
@@ -72,6 +74,7 @@ pub(super) fn load(cache: &Cache, key: &str, request: &DesignRequest) -> Option<
                 epicentre_error: f64::from_bits(entry.epicentre_error),
                 whole_error: f64::from_bits(entry.whole_error),
                 energy_deviation: f64::from_bits(entry.energy_deviation),
+                checked: entry.checked,
                 verified: entry.verified,
                 short_of_whole_only: entry.short_of_whole_only,
                 why: entry.why,
@@ -101,6 +104,7 @@ pub(super) fn store(cache: &Cache, key: &str, searched: &[DesignedLobe]) -> std:
             epicentre_error: lobe.epicentre_error.to_bits(),
             whole_error: lobe.whole_error.to_bits(),
             energy_deviation: lobe.energy_deviation.to_bits(),
+            checked: lobe.checked,
             verified: lobe.verified,
             short_of_whole_only: lobe.short_of_whole_only,
             why: lobe.why.clone(),

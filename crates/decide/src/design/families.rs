@@ -15,6 +15,16 @@
 //!   lobe is monotone and in `[0, 1]` at every `n`. Written in Horner form, which stays exact
 //!   where `c` crosses 0 (the vertex form's constants there run to infinity and cancel).
 //!
+//! - **`cubic-powM`**: `max(0, 1 - s v + c v^2 + d v^3)^M` with `v = min(u, u_stop)`, the
+//!   cubic's Taylor form of `t^(n/M)` (`s`, `c` as the quadratic's, `d = -(beta4 s - beta5)
+//!   s^2`) cut at its first stationary point, the smallest positive root of its derivative,
+//!   `s / (c + sqrt(c^2 + 3 d s))` (1 where it has none below 1), and at 0: monotone and in
+//!   `[0, 1]` at every `n`.
+//! - **`hinge-powM`**: `max(0, 1 - s u + d max(0, u - k))^M`, a two-piece linear function
+//!   (`select(u < k, 1 - s u, 1 - s u + d (u - k))`, written with `max` so that it compiles to
+//!   one comparator and multiplexer) under squarings: a steeper slope `s = beta0 n + beta1`
+//!   near the peak, flattened by `d = beta3 s` beyond the knot `k = beta2 / s`, following the
+//!   convex `t^(n/M)` further than one line does.
 //! - **`rational-powM`**: `(max(0, 1 - a u) / (1 + b u))^M`, the Padé `[1/1]` form of
 //!   `t^(n/M)` (`a = beta0 n + beta1`, `b = beta2 n + beta3`, started at Padé's own
 //!   `(n/M + 1) / 2` and `(n/M - 1) / 2`); `M = 1` is Schlick's shape, `t / (n (1 - t) + t)`
@@ -28,6 +38,9 @@
 
 use core::f64::consts::{LN_2, LOG2_E};
 
+/// The largest power of the grammar is `2^MAX_SQUARINGS` (`cosquad`'s 128).
+pub const MAX_SQUARINGS: u8 = 7;
+
 /// A family, its structure fixed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Family {
@@ -38,8 +51,13 @@ pub enum Family {
     },
     /// A polynomial of `u`, cut where it stops falling, raised to `2^squarings`.
     PolyPow {
-        /// 1 or 2.
+        /// 1 to 3.
         degree: u8,
+        /// The power is `2^squarings`.
+        squarings: u8,
+    },
+    /// A two-piece linear function of `u`, cut at 0, raised to `2^squarings`.
+    HingePow {
         /// The power is `2^squarings`.
         squarings: u8,
     },
@@ -53,23 +71,19 @@ pub enum Family {
 }
 
 impl Family {
-    /// Every family searched, the transcendental-free ones last.
+    /// Every family the grammar writes (`grammar.rs`): `exp2` of each inner function that is
+    /// a series of `n ln t`, then each peak-shaped one under every power up to
+    /// `2^MAX_SQUARINGS`, the transcendental-free ones last. What is searched is the part of it
+    /// within the cost bound.
     #[must_use]
     pub fn all() -> Vec<Family> {
         let mut all: Vec<Family> = (1..=3).map(|degree| Family::Exp2Poly { degree }).collect();
-        all.extend((2..=7).map(|squarings| Family::PolyPow {
-            degree: 1,
-            squarings,
-        }));
-        all.extend((1..=5).map(|squarings| Family::PolyPow {
-            degree: 2,
-            squarings,
-        }));
         all.push(Family::Exp2Rational);
-        all.extend((0..=5).map(|squarings| Family::RationalPow { squarings }));
-        // Transcendental-free last, as the doc says: the rational ones stand with the
-        // polynomials.
-        all.sort_by_key(|family| !family.transcendental());
+        for squarings in 0..=MAX_SQUARINGS {
+            all.extend((1..=3).map(|degree| Family::PolyPow { degree, squarings }));
+            all.push(Family::HingePow { squarings });
+            all.push(Family::RationalPow { squarings });
+        }
         all
     }
 
@@ -78,9 +92,15 @@ impl Family {
     pub fn id(self) -> String {
         match self {
             Family::Exp2Poly { degree } => format!("exp2-{}", degree_name(degree)),
+            Family::PolyPow {
+                degree,
+                squarings: 0,
+            } => degree_name(degree).to_owned(),
             Family::PolyPow { degree, squarings } => {
                 format!("{}-pow{}", degree_name(degree), 1u32 << squarings)
             }
+            Family::HingePow { squarings: 0 } => "hinge".to_owned(),
+            Family::HingePow { squarings } => format!("hinge-pow{}", 1u32 << squarings),
             Family::RationalPow { squarings: 0 } => "rational".to_owned(),
             Family::RationalPow { squarings } => format!("rational-pow{}", 1u32 << squarings),
             Family::Exp2Rational => "exp2-rational".to_owned(),
@@ -101,11 +121,15 @@ impl Family {
             Family::Exp2Poly { degree } => vec![0.0; usize::from(degree)],
             Family::PolyPow { degree, squarings } => {
                 let m = f64::from(1u32 << squarings);
-                if degree == 1 {
-                    vec![1.0 / m, 0.0]
-                } else {
-                    vec![1.0 / m, 0.0, 0.5, 0.5]
+                match degree {
+                    1 => vec![1.0 / m, 0.0],
+                    2 => vec![1.0 / m, 0.0, 0.5, 0.5],
+                    _ => vec![1.0 / m, 0.0, 0.5, 0.5, 1.0 / 6.0, 0.5],
                 }
+            }
+            Family::HingePow { squarings } => {
+                let m = f64::from(1u32 << squarings);
+                vec![1.0 / m, 0.0, 1.0 / m, 0.1]
             }
             Family::RationalPow { squarings } => {
                 let half = 0.5 / f64::from(1u32 << squarings);
@@ -128,14 +152,28 @@ impl Family {
                 }
             }
             Family::PolyPow { degree, squarings } => {
-                let base = if degree == 1 {
-                    let s = beta[0] * n + beta[1];
-                    (1.0 - s * u).max(0.0)
-                } else {
-                    let (s, c, stop) = quadratic_constants(beta, n);
-                    let v = u.min(stop);
-                    1.0 - v * (s - c * v)
+                let base = match degree {
+                    1 => {
+                        let s = beta[0] * n + beta[1];
+                        (1.0 - s * u).max(0.0)
+                    }
+                    2 => {
+                        let (s, c, stop) = quadratic_constants(beta, n);
+                        let v = u.min(stop);
+                        1.0 - v * (s - c * v)
+                    }
+                    _ => {
+                        let (s, c, d, stop) = cubic_constants(beta, n);
+                        let v = u.min(stop);
+                        (1.0 - v * (s - v * (c + v * d))).max(0.0)
+                    }
                 };
+                (0..squarings).fold(base, |x, _| x * x)
+            }
+            Family::HingePow { squarings } => {
+                let s = beta[0] * n + beta[1];
+                let (k, d) = (beta[2] / s, beta[3] * s);
+                let base = (1.0 - s * u + d * (u - k).max(0.0)).max(0.0);
                 (0..squarings).fold(base, |x, _| x * x)
             }
             Family::RationalPow { squarings } => {
@@ -177,37 +215,57 @@ impl Family {
                 degree: 1,
                 squarings,
             } => format!(
-                "let s = {} * n {};\nmax(0, 1 - s * (1 - t)) ^ {}",
+                "let s = {} * n {};\n{}",
                 beta[0],
                 signed(beta[1]),
-                1u32 << squarings
+                powered("max(0, 1 - s * (1 - t))", squarings)
             ),
-            Family::PolyPow { squarings, .. } => format!(
+            Family::PolyPow {
+                degree: 2,
+                squarings,
+            } => format!(
                 "let s = {} * n {} / n;\n\
                  let c = ({} * s {}) * s;\n\
                  let disc = s * s - 4 * c;\n\
                  let stop = select(disc < 0, s / (2 * c), 2 / (s + sqrt(max(disc, 0))));\n\
-                 let v = min(1 - t, stop);\n\
-                 (1 - v * (s - c * v)) ^ {}",
+                 let v = min(1 - t, stop);\n{}",
                 beta[0],
                 signed(beta[1]),
                 beta[2],
                 signed(-beta[3]),
-                1u32 << squarings
+                powered("(1 - v * (s - c * v))", squarings)
+            ),
+            Family::PolyPow { squarings, .. } => format!(
+                "let s = {} * n {} / n;\n\
+                 let c = ({} * s {}) * s;\n\
+                 let d = ({} {} * s) * s * s;\n\
+                 let disc = c * c + 3 * d * s;\n\
+                 let stop = select(disc < 0, 1, s / max(c + sqrt(max(disc, 0)), s));\n\
+                 let v = min(1 - t, stop);\n{}",
+                beta[0],
+                signed(beta[1]),
+                beta[2],
+                signed(-beta[3]),
+                beta[5],
+                signed(-beta[4]),
+                powered("max(0, 1 - v * (s - v * (c + v * d)))", squarings)
+            ),
+            Family::HingePow { squarings } => format!(
+                "let s = {} * n {};\nlet k = {} / s;\nlet d = {} * s;\nlet u = 1 - t;\n{}",
+                beta[0],
+                signed(beta[1]),
+                beta[2],
+                beta[3],
+                powered("max(0, 1 - s * u + d * max(0, u - k))", squarings)
             ),
             Family::RationalPow { squarings } => {
-                let base = "max(0, 1 - a * u) / (1 + b * u)";
                 format!(
                     "let a = {} * n {};\nlet b = {} * n {};\nlet u = 1 - t;\n{}",
                     beta[0],
                     signed(beta[1]),
                     beta[2],
                     signed(beta[3]),
-                    if squarings == 0 {
-                        base.to_owned()
-                    } else {
-                        format!("({base}) ^ {}", 1u32 << squarings)
-                    }
+                    powered("(max(0, 1 - a * u) / (1 + b * u))", squarings)
                 )
             }
             Family::Exp2Rational => format!(
@@ -253,6 +311,11 @@ impl Family {
                 degree_name(degree),
                 1u32 << squarings
             ),
+            Family::HingePow { squarings } => format!(
+                "a two-piece linear function of 1 - t (a select at a knot, written with max) \
+                 raised to {}, cut at 0",
+                1u32 << squarings
+            ),
             Family::RationalPow { squarings } => format!(
                 "a ratio of linear functions of 1 - t (Padé's form of t^(n/{}), Schlick's \
                  shape) raised to {} (squarings), cut at 0",
@@ -271,6 +334,15 @@ fn degree_name(degree: u8) -> &'static str {
         1 => "linear",
         2 => "quadratic",
         _ => "cubic",
+    }
+}
+
+/// `base` raised to `2^squarings` as formula text (`base` parenthesised or a call).
+fn powered(base: &str, squarings: u8) -> String {
+    if squarings == 0 {
+        base.to_owned()
+    } else {
+        format!("{base} ^ {}", 1u32 << squarings)
     }
 }
 
@@ -312,4 +384,21 @@ fn quadratic_constants(beta: &[f64], n: f64) -> (f64, f64, f64) {
         2.0 / (s + disc.max(0.0).sqrt())
     };
     (s, c, stop)
+}
+
+/// `s`, `c`, `d` and the cut `stop` of a cubic family at `n`, as the formula's `let`s compute
+/// them: `stop` is the cubic's first stationary point, `s / (c + sqrt(c^2 + 3 d s))` (the
+/// smaller positive root of `3 d v^2 + 2 c v - s`, in the form without cancellation), or 1
+/// where that lies beyond 1 or does not exist.
+pub(super) fn cubic_constants(beta: &[f64], n: f64) -> (f64, f64, f64, f64) {
+    let s = beta[0] * n + beta[1] / n;
+    let c = (beta[2] * s - beta[3]) * s;
+    let d = (beta[5] - beta[4] * s) * s * s;
+    let disc = c * c + 3.0 * d * s;
+    let stop = if disc < 0.0 {
+        1.0
+    } else {
+        s / (c + disc.max(0.0).sqrt()).max(s)
+    };
+    (s, c, d, stop)
 }

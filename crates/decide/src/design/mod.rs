@@ -15,6 +15,7 @@
 mod cache;
 pub mod families;
 mod fit;
+pub mod grammar;
 pub mod limit;
 pub mod thesis;
 mod verdict;
@@ -75,6 +76,9 @@ pub struct DesignRequest {
     pub no_transcendentals: bool,
     /// Lobes ranked beside the built-ins and the designs (a user's own).
     pub also: Vec<LobeKind>,
+    /// The cost bound: the most operations per evaluation a searched structure may have
+    /// ([`grammar::DEFAULT_MAX_OPERATIONS`] by default).
+    pub max_operations: usize,
 }
 
 /// One family's designed lobe and its figures.
@@ -98,6 +102,8 @@ pub struct DesignedLobe {
     pub whole_error: f64,
     /// The worst `|energy ratio - 1|`.
     pub energy_deviation: f64,
+    /// Whether the verification ran: the fit came within its bounds on the coarse grids.
+    pub checked: bool,
     /// Whether it passed every check at every exponent.
     pub verified: bool,
     /// It passed every check but the whole lobe's bound: what a looser
@@ -156,6 +162,9 @@ pub struct Design {
     pub unit: &'static str,
     /// How many exponents each lobe was verified at.
     pub exponents_verified: usize,
+    /// Every structure the grammar wrote, with what became of it (the search's record:
+    /// enumerated, pruned, kept).
+    pub enumerated: Vec<grammar::Enumerated>,
     /// The designed lobes.
     pub designed: Vec<DesignedLobe>,
     /// The built-ins (and the request's other lobes) as `recommend` ranks them on the same
@@ -243,7 +252,26 @@ pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design,
         ..request.clone()
     };
     let searched = search(request, Cache::default_for("design").as_ref(), progress);
-    rank(request, searched, progress)
+    let enumerated = enumeration(request, &searched);
+    let mut answer = rank(request, searched, progress)?;
+    answer.enumerated = enumerated;
+    Ok(answer)
+}
+
+/// The grammar's structures for `request`, each with its fate in `searched`.
+fn enumeration(request: &DesignRequest, searched: &[DesignedLobe]) -> Vec<grammar::Enumerated> {
+    grammar::enumerate(request.max_operations, request.no_transcendentals)
+        .into_iter()
+        .map(|(family, mut enumerated)| {
+            let fitted = searched.iter().find(|d| d.family == family.id());
+            if let (grammar::Fate::Kept, Some(lobe)) = (&enumerated.fate, fitted) {
+                if !lobe.checked {
+                    enumerated.fate = grammar::Fate::FitMissed;
+                }
+            }
+            enumerated
+        })
+        .collect()
 }
 
 /// Every family fitted and verified for `request`'s range and bounds (the target plays no
@@ -271,10 +299,12 @@ pub(crate) fn search(
 
 fn search_now(request: &DesignRequest, progress: &ProgressBar) -> Vec<DesignedLobe> {
     let (low, high) = request.range;
-    let families: Vec<Family> = Family::all()
-        .into_iter()
-        .filter(|f| !(request.no_transcendentals && f.transcendental()))
-        .collect();
+    let families: Vec<Family> =
+        grammar::enumerate(request.max_operations, request.no_transcendentals)
+            .into_iter()
+            .filter(|(_, enumerated)| enumerated.fate == grammar::Fate::Kept)
+            .map(|(family, _)| family)
+            .collect();
     let grids: Vec<fit::Grid> = if low == high {
         vec![low]
     } else {
@@ -366,6 +396,7 @@ fn rank(
     let removed_by_whole = removed.iter().map(|d| d.name.clone()).collect();
     let mut answer = Design {
         unit: ranking.unit,
+        enumerated: Vec::new(),
         exponents_verified: verification_exponents(low, high).len(),
         designed,
         compared,
@@ -425,6 +456,7 @@ fn unmeasured(family: Family, beta: &[f64], request: &DesignRequest) -> Designed
         epicentre_error: f64::INFINITY,
         whole_error: f64::INFINITY,
         energy_deviation: f64::INFINITY,
+        checked: false,
         verified: false,
         short_of_whole_only: false,
         rate: 0.0,
@@ -485,6 +517,7 @@ fn verified(
     let Some(kind) = lobe.kind else {
         return lobe;
     };
+    lobe.checked = true;
     match check_lobe(kind, exponents, request.bounds, &mut lobe) {
         Checked::Holds => {
             lobe.verified = true;

@@ -21,6 +21,7 @@ fn request(target: Target, low: f64, high: f64, epicentre: f64, whole: f64) -> D
         },
         no_transcendentals: false,
         also: Vec::new(),
+        max_operations: super::grammar::DEFAULT_MAX_OPERATIONS,
     }
 }
 
@@ -244,6 +245,141 @@ fn schlicks_lobe_is_a_member_of_the_rational_family() {
                 (member - schlick.eval(t)).abs() <= 1e-14,
                 "n = {n}, t = {t}"
             );
+        }
+    }
+}
+
+/// Each structure's operations as counted by hand from its formula: `u = 1 - t` (or `t - 1`'s
+/// negation) and the inner function's sums, products and cuts, then the power's squarings
+/// (up to 64, the language's multiplied powers) or one `pow` (128: log2, product, exp2).
+fn operations_by_hand(family: Family) -> usize {
+    let power = |squarings: u8| {
+        if squarings == 7 {
+            3
+        } else {
+            usize::from(squarings)
+        }
+    };
+    match family {
+        // `u`, then `a1 * u` (1), Horner's `u * (a1 + u * a2)` (4), its cubic (6), and exp2.
+        Family::Exp2Poly { degree } => 1 + 2 * usize::from(degree) - 1 + 1,
+        // `u`, `a1 * u`, `b * u`, `1 - bu`, the quotient, exp2.
+        Family::Exp2Rational => 6,
+        // `1 - t`, `s * (1 - t)`, `1 - ...`, `max`.
+        Family::PolyPow {
+            degree: 1,
+            squarings,
+        } => 4 + power(squarings),
+        // `1 - t`, `min`, `c * v`, `s - cv`, `v * (...)`, `1 - ...`.
+        Family::PolyPow {
+            degree: 2,
+            squarings,
+        } => 6 + power(squarings),
+        // `1 - t`, `min`, `v * d`, `c + vd`, `v * (...)`, `s - ...`, `v * (...)`, `1 - ...`, `max`.
+        Family::PolyPow { squarings, .. } => 9 + power(squarings),
+        // `u`, `s * u`, `1 - su`, `u - k`, `max`, `d * max`, `+`, `max`.
+        Family::HingePow { squarings } => 8 + power(squarings),
+        // `u`, `a * u`, `1 - au`, `max`, `b * u`, `1 + bu`, the quotient.
+        Family::RationalPow { squarings } => 7 + power(squarings),
+    }
+}
+
+/// The grammar's count of each structure's operations is the hand count; the default bound
+/// admits the whole grammar; a bound prunes exactly the structures over it, saying so; and
+/// a target without transcendentals prunes exactly the `exp2` ones.
+#[test]
+fn the_cost_bound_prunes_exactly_the_structures_over_it() {
+    for family in Family::all() {
+        assert_eq!(
+            grammar::operations(family),
+            operations_by_hand(family),
+            "{}",
+            family.id()
+        );
+    }
+    let all = grammar::enumerate(grammar::DEFAULT_MAX_OPERATIONS, false);
+    assert_eq!(all.len(), Family::all().len());
+    assert!(all.iter().all(|(_, e)| e.fate == grammar::Fate::Kept));
+    for bound in [5, 8, 11] {
+        for (family, e) in grammar::enumerate(bound, false) {
+            let over = operations_by_hand(family) > bound;
+            match &e.fate {
+                grammar::Fate::Pruned(why) => {
+                    assert!(over && why.contains("cost bound"), "{}: {why}", e.structure);
+                }
+                fate => assert!(!over, "{} kept at bound {bound}: {fate:?}", e.structure),
+            }
+        }
+    }
+    for (family, e) in grammar::enumerate(grammar::DEFAULT_MAX_OPERATIONS, true) {
+        let pruned = matches!(&e.fate, grammar::Fate::Pruned(why) if why.contains("exp2"));
+        assert_eq!(pruned, family.transcendental(), "{}", e.structure);
+    }
+}
+
+/// The cubic, cut at its first stationary point and at 0, is a lobe's shape for any
+/// coefficients near its start: in `[0, 1]`, 1 at `u = 0`, never rising; and where the cut
+/// falls inside `(0, 1)`, the cubic's derivative is 0 there and negative before it.
+#[test]
+fn the_cubic_is_cut_where_it_stops_falling() {
+    for squarings in [1, 4] {
+        let family = Family::PolyPow {
+            degree: 3,
+            squarings,
+        };
+        let start = family.start();
+        for trial in 0..40_u32 {
+            // Coefficients nudged by up to 40 % each, deterministically.
+            let beta: Vec<f64> = start
+                .iter()
+                .enumerate()
+                .map(|(k, b)| {
+                    let nudge = ((trial * 7 + k as u32 * 13) % 17) as f64 / 16.0 - 0.5;
+                    b * (1.0 + 0.8 * nudge) + 0.01 * nudge
+                })
+                .collect();
+            for n in [8.0, 64.0, 700.0] {
+                assert_eq!(family.eval(&beta, n, 0.0), 1.0);
+                let mut previous = 1.0;
+                for k in 0..=4000 {
+                    let u = f64::from(k) / 4000.0;
+                    let value = family.eval(&beta, n, u);
+                    assert!((0.0..=1.0).contains(&value), "{beta:?} n = {n}, u = {u}");
+                    assert!(value <= previous, "{beta:?} rises at n = {n}, u = {u}");
+                    previous = value;
+                }
+                let (s, c, d, stop) = super::families::cubic_constants(&beta, n);
+                let slope = |v: f64| -s + 2.0 * c * v + 3.0 * d * v * v;
+                if stop < 1.0 && s > 0.0 {
+                    assert!(slope(stop).abs() <= 1e-9 * s, "{beta:?} n = {n}");
+                    for k in 0..100 {
+                        assert!(slope(stop * f64::from(k) / 100.0) < 0.0, "{beta:?} n = {n}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The hinge is the two-piece select it stands for: `1 - s u` before the knot `k`, then the
+/// line through that point with slope `-(s - d)`, cut at 0 and raised to the power.
+#[test]
+fn the_hinge_is_a_two_piece_select() {
+    let family = Family::HingePow { squarings: 3 };
+    let beta = [0.13, 0.4, 0.2, 0.3];
+    for n in [8.0, 100.0, 900.0] {
+        let s = beta[0] * n + beta[1];
+        let (k, d) = (beta[2] / s, beta[3] * s);
+        for step in 0..=1000 {
+            let u = f64::from(step) / 1000.0;
+            let piece = if u < k {
+                1.0 - s * u
+            } else {
+                (1.0 - s * k) - (s - d) * (u - k)
+            };
+            let expected = piece.max(0.0).powi(8);
+            let got = family.eval(&beta, n, u);
+            assert!((got - expected).abs() <= 1e-12, "n = {n}, u = {u}");
         }
     }
 }

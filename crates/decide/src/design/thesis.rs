@@ -84,6 +84,7 @@ pub fn against_thesis(
             },
             no_transcendentals: false,
             also: vec![kind],
+            max_operations: crate::design::grammar::default_max_operations(target),
         };
         let answer = design(&request, progress)?;
         let thesis = answer

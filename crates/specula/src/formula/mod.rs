@@ -263,13 +263,24 @@ impl Formula {
         &self.slot_names
     }
 
-    /// Operations of the varying part (what one evaluation runs once `n` is prepared).
+    /// Operations of the varying part (what one evaluation runs once `n` is prepared), a whole
+    /// power `x^k` counted as the multiplications it takes: `floor(log2 |k|)` squarings and a
+    /// product per further bit of `|k|` (a negative power's reciprocal one more), and a real
+    /// power as the three it runs (`exp2(y log2 x)`).
     #[must_use]
     pub fn operations(&self) -> usize {
         self.body
             .iter()
-            .filter(|op| !op.operands().is_empty())
-            .count()
+            .map(|op| match *op {
+                Op::Powi(_, k) => {
+                    let magnitude = k.unsigned_abs().max(1);
+                    let multiplications = magnitude.ilog2() + magnitude.count_ones() - 1;
+                    (multiplications + u32::from(k < 0)).max(1) as usize
+                }
+                Op::Pow(..) => 3,
+                ref op => usize::from(!op.operands().is_empty()),
+            })
+            .sum()
     }
 
     /// Whether it has a closed-form tail.

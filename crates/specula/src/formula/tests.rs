@@ -392,3 +392,21 @@ fn inline_formulas_are_named_and_shared() {
     );
     assert_eq!(LobeKind::parse("=t ^ (n / 2)").unwrap(), a);
 }
+
+/// A whole power counts the multiplications of binary exponentiation, a real one the three
+/// operations of `exp2(y log2 x)`; the per-material `let`s of `n` count nothing.
+#[test]
+fn operations_count_what_an_evaluation_multiplies() {
+    let count = |text: &str| {
+        Formula::compile(definition("counted", text))
+            .expect("a valid formula")
+            .operations()
+    };
+    // t^8: three squarings; t^7: t^2, t^4, then t^4 t^2 and that times t.
+    assert_eq!(count("t ^ 8"), 3);
+    assert_eq!(count("t ^ 7"), 4);
+    assert_eq!(count("t ^ -4"), 3);
+    // `1 - t`, `s * u`, `1 - su`, `max`, then four squarings; `s` is prepared once per n.
+    assert_eq!(count("let s = n / 16;\nmax(0, 1 - s * (1 - t)) ^ 16"), 8);
+    assert_eq!(count("pow(t, n)"), 3);
+}

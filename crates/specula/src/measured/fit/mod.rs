@@ -9,6 +9,11 @@
 //! with Smith's height-correlated masking, `alpha` in place of `n` and no Fresnel term (the
 //! lobes have none either; `K` plays a constant `F0`).
 //!
+//! **The microfacet model** ([`microfacet_families`]) puts each lobe where GGX's `D` is: `kd /
+//! pi + K D_lobe(h) G2(wo, wi) / (4 cos(theta_o) cos(theta_i))`, with the lobe's own
+//! normalisation and masking ([`crate::microfacet`]), `n` its parameter; Beckmann's
+//! distribution stands beside GGX. Fitted exactly as the classic model is.
+//!
 //! **Error**, in the spirit of Ngan, Durand and Matusik (2005): the material and the model
 //! are compared as `f cos(theta_i)`, the radiance a unit irradiance reflects, at the
 //! [`comparison_pairs`] (half/difference angles, weighted by solid angle, grazing pairs
@@ -45,6 +50,7 @@ pub use observations::{comparison_pairs, Observations, GRID, MAX_ELEVATION_DEGRE
 
 use crate::analysis::albedo::specular_albedo_per_unit;
 use crate::fit::ggx;
+use crate::microfacet::Distribution;
 use crate::quadrature::integrate_pieces;
 use crate::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 
@@ -68,6 +74,15 @@ pub enum Specular {
     },
     /// The GGX microfacet model.
     Ggx,
+    /// One of specula's lobes as the normal distribution of a microfacet model,
+    /// `D G2 / (4 cos_o cos_i)` ([`crate::microfacet`]), `n` its parameter.
+    Microfacet {
+        /// The lobe.
+        #[serde(serialize_with = "serialize_kind")]
+        kind: LobeKind,
+    },
+    /// Beckmann's distribution in the same microfacet model, `alpha` its parameter.
+    Beckmann,
 }
 
 fn serialize_kind<S: serde::Serializer>(kind: &LobeKind, s: S) -> Result<S::Ok, S::Error> {
@@ -81,14 +96,38 @@ impl Specular {
         match self {
             Specular::Lobe { kind, geometry } => format!("{kind}/{}", geometry.id()),
             Specular::Ggx => "ggx".into(),
+            Specular::Microfacet { kind } => format!("{kind}/microfacet"),
+            Specular::Beckmann => "beckmann".into(),
+        }
+    }
+
+    /// Whether the shape parameter is a roughness `alpha` (else an exponent `n`).
+    #[must_use]
+    pub fn takes_alpha(self) -> bool {
+        matches!(self, Specular::Ggx | Specular::Beckmann)
+    }
+
+    /// The microfacet distribution of this family at `parameter` (`None` for the classic
+    /// lobes, which are no distribution of normals).
+    #[must_use]
+    pub fn distribution(self, parameter: f64) -> Option<Distribution> {
+        match self {
+            Specular::Lobe { .. } => None,
+            Specular::Ggx => Some(Distribution::Ggx { alpha: parameter }),
+            Specular::Beckmann => Some(Distribution::Beckmann { alpha: parameter }),
+            Specular::Microfacet { kind } => {
+                Some(Distribution::lobe(kind, Exponent::clamped(parameter)))
+            }
         }
     }
 
     /// The searched range of the shape parameter's logarithm.
     fn log_range(self) -> [f64; 2] {
         match self {
-            Specular::Lobe { .. } => [Exponent::MIN.ln(), Exponent::MAX.ln()],
-            Specular::Ggx => ALPHA_RANGE.map(f64::ln),
+            Specular::Lobe { .. } | Specular::Microfacet { .. } => {
+                [Exponent::MIN.ln(), Exponent::MAX.ln()]
+            }
+            Specular::Ggx | Specular::Beckmann => ALPHA_RANGE.map(f64::ln),
         }
     }
 
@@ -108,8 +147,29 @@ impl Specular {
                 .iter()
                 .map(|&(wo, wi)| ggx_specular(parameter, wo, wi))
                 .collect(),
+            Specular::Microfacet { .. } | Specular::Beckmann => {
+                let Some(distribution) = self.distribution(parameter) else {
+                    return Vec::new();
+                };
+                observations
+                    .pairs
+                    .iter()
+                    .map(|&(wo, wi)| microfacet_specular(&distribution, wo, wi))
+                    .collect()
+            }
         }
     }
+}
+
+/// A distribution's `D G2 / (4 cos_o cos_i)`, no Fresnel (the fit's `K` plays a constant
+/// `F0`, as for GGX).
+#[must_use]
+pub fn microfacet_specular(distribution: &Distribution, wo: DVec3, wi: DVec3) -> f64 {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return 0.0;
+    }
+    let h = (wo + wi).normalize();
+    distribution.d(h.z) * distribution.g2(wo.z, wi.z) / (4.0 * wo.z * wi.z)
 }
 
 /// Smith's `Lambda` for GGX at a direction of cosine `c`.
@@ -193,6 +253,10 @@ impl Fit {
                     specular_albedo_per_unit(&lobe, geometry, 0.0)
                 }
                 Specular::Ggx => ggx_albedo_at_normal(self.parameter[c]),
+                Specular::Microfacet { .. } | Specular::Beckmann => self
+                    .specular
+                    .distribution(self.parameter[c])
+                    .map_or(0.0, |d| microfacet_albedo_at_normal(&d)),
             };
             self.kd[c] + self.k[c] * specular
         })
@@ -216,6 +280,13 @@ impl Fit {
                 Specular::Ggx => FittedShape::Ggx {
                     alpha: self.parameter,
                 },
+                Specular::Microfacet { .. } | Specular::Beckmann => {
+                    FittedShape::Microfacet(Box::new(self.parameter.map(|p| {
+                        self.specular
+                            .distribution(p)
+                            .unwrap_or(Distribution::Ggx { alpha: p })
+                    })))
+                }
             },
         }
     }
@@ -239,6 +310,7 @@ enum FittedShape {
     Ggx {
         alpha: [f64; 3],
     },
+    Microfacet(Box<[Distribution; 3]>),
 }
 
 impl FittedModel {
@@ -253,6 +325,11 @@ impl FittedModel {
             FittedShape::Ggx { alpha } => {
                 DVec3::from_array(alpha.map(|alpha| ggx_specular(alpha, wo, wi)))
             }
+            FittedShape::Microfacet(distributions) => DVec3::new(
+                microfacet_specular(&distributions[0], wo, wi),
+                microfacet_specular(&distributions[1], wo, wi),
+                microfacet_specular(&distributions[2], wo, wi),
+            ),
         }
     }
 
@@ -283,6 +360,16 @@ fn ggx_albedo_at_normal(alpha: f64) -> f64 {
     };
     let peak = alpha.atan().min(FRAC_PI_4);
     integrate_pieces(integrand, &[0.0, peak * 0.5, peak, FRAC_PI_4], 1e-10)
+}
+
+/// `int D G2 / (4 cos_o cos_i) cos_i dwi` for `wo` along the normal, as for GGX.
+fn microfacet_albedo_at_normal(distribution: &Distribution) -> f64 {
+    let integrand = |theta_h: f64| {
+        let (s, c) = theta_h.sin_cos();
+        let cos_i = (2.0 * theta_h).cos();
+        TAU * distribution.d(c) * c * s * distribution.g2(1.0, cos_i)
+    };
+    integrate_pieces(integrand, &[0.0, 0.05, 0.1, 0.2, 0.4, FRAC_PI_4], 1e-10)
 }
 
 /// One shape parameter's profile: its best error over `(kd, K)` for some channels.
@@ -444,12 +531,29 @@ pub fn families(kinds: &[LobeKind]) -> Vec<Specular> {
         .collect()
 }
 
+/// The families of the microfacet model: each of `kinds` as a normal distribution, then
+/// Beckmann's and GGX's.
+#[must_use]
+pub fn microfacet_families(kinds: &[LobeKind]) -> Vec<Specular> {
+    kinds
+        .iter()
+        .map(|&kind| Specular::Microfacet { kind })
+        .chain([Specular::Beckmann, Specular::Ggx])
+        .collect()
+}
+
 /// Every family in `kinds` in both geometries, and GGX, each shared and per channel, fitted
 /// in parallel; in that order (lobes in `kinds`' order, Phong before Blinn, shared first).
 #[must_use]
 pub fn fit_all(observations: &Observations, kinds: &[LobeKind]) -> Vec<Fit> {
+    fit_families(observations, &families(kinds))
+}
+
+/// Each of `families`, shared and per channel, fitted in parallel, in that order.
+#[must_use]
+pub fn fit_families(observations: &Observations, families: &[Specular]) -> Vec<Fit> {
     let prepared = Prepared::new(observations);
-    families(kinds)
+    families
         .par_iter()
         .flat_map_iter(|&specular| fit_family(&prepared, specular))
         .collect()

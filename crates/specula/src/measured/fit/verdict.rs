@@ -1,16 +1,28 @@
 //! The verdict on a material: which lobe to ship.
 //!
-//! A renderer's material has one `n`, so candidates are the shared-`n` fits. The reference is
-//! `pow`'s better fit of the two geometries; a lobe *meets* when its fit error is within
-//! `margin` of it (`E <= (1 + margin) E_pow`), and the verdict is the meeting lobe with the
-//! highest rate on the target, the rate given by the caller (a cost model, a benchmark):
-//! the core decides, the face measures. `pow` meets by definition, so wherever the target can
-//! run it there is a verdict.
+//! A renderer's material has one `n`, so candidates are the shared-`n` fits. In the classic
+//! model the reference is `pow`'s better fit of the two geometries; a lobe *meets* when its
+//! fit error is within `margin` of it (`E <= (1 + margin) E_pow`), and the verdict is the
+//! meeting lobe with the highest rate on the target, the rate given by the caller (a cost
+//! model, a benchmark): the core decides, the face measures. `pow` meets by definition, so
+//! wherever the target can run it there is a verdict. In the microfacet model the candidates
+//! are the lobes as distributions and the reference is GGX's fit, the distribution engines
+//! ship: a lobe meets within `margin` of GGX, and where none does there is no verdict.
 
 use serde::Serialize;
 
 use super::{Fit, Sharing, Specular};
 use crate::LobeKind;
+
+/// Which model's fits a verdict ranks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Model {
+    /// `kd / pi + K lobe(t)`, against `pow`'s fit.
+    Classic,
+    /// `kd / pi + K D G2 / (4 cos_o cos_i)` with each lobe as `D`, against GGX's fit.
+    Microfacet,
+}
 
 /// One candidate's standing.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -18,7 +30,7 @@ pub struct Standing {
     /// Its index in the fits given.
     pub fit: usize,
     /// `E / E_pow`: pow's fit in the same geometry and sharing (for GGX, pow's better
-    /// geometry with the same sharing).
+    /// geometry with the same sharing; for a distribution, pow's distribution).
     pub relative_to_pow: f64,
     /// `E / E_ggx` (GGX's fit with the same sharing).
     pub relative_to_ggx: f64,
@@ -31,9 +43,9 @@ pub struct Standing {
 /// The ranking of a material's fits on one target.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Verdict {
-    /// The margin allowed over pow's error, as a fraction.
+    /// The margin allowed over the reference's error, as a fraction.
     pub margin: f64,
-    /// Pow's best shared-`n` error, the reference.
+    /// The reference's shared-`n` error (pow's best, or GGX's in the microfacet model).
     pub reference_error: f64,
     /// Every fit's standing, in the fits' order.
     pub standings: Vec<Standing>,
@@ -56,16 +68,41 @@ fn best_error(fits: &[Fit], pick: impl Fn(&Fit) -> bool) -> f64 {
 /// a rate.
 #[must_use]
 pub fn verdict(fits: &[Fit], margin: f64, rates: &[Option<f64>]) -> Option<Verdict> {
-    let is_pow = |f: &Fit| {
-        matches!(
+    verdict_of(Model::Classic, fits, margin, rates)
+}
+
+/// [`verdict`] for `model`'s candidates and reference (see the module page).
+#[must_use]
+pub fn verdict_of(
+    model: Model,
+    fits: &[Fit],
+    margin: f64,
+    rates: &[Option<f64>],
+) -> Option<Verdict> {
+    let is_pow = |f: &Fit| match model {
+        Model::Classic => matches!(
             f.specular,
             Specular::Lobe {
                 kind: LobeKind::Pow,
                 ..
             }
-        )
+        ),
+        Model::Microfacet => {
+            f.specular
+                == Specular::Microfacet {
+                    kind: LobeKind::Pow,
+                }
+        }
     };
-    let reference_error = best_error(fits, |f| is_pow(f) && f.sharing == Sharing::Shared);
+    let is_candidate = |f: &Fit| match model {
+        Model::Classic => matches!(f.specular, Specular::Lobe { .. }),
+        Model::Microfacet => matches!(f.specular, Specular::Microfacet { .. }),
+    };
+    let is_reference = |f: &Fit| match model {
+        Model::Classic => is_pow(f),
+        Model::Microfacet => f.specular == Specular::Ggx,
+    };
+    let reference_error = best_error(fits, |f| is_reference(f) && f.sharing == Sharing::Shared);
     if !reference_error.is_finite() {
         return None;
     }
@@ -73,22 +110,26 @@ pub fn verdict(fits: &[Fit], margin: f64, rates: &[Option<f64>]) -> Option<Verdi
         .iter()
         .enumerate()
         .map(|(index, fit)| {
+            // A classic lobe against pow in its geometry; a distribution, GGX and Beckmann
+            // against the model's pow.
             let pow = best_error(fits, |f| {
-                is_pow(f)
-                    && f.sharing == fit.sharing
-                    && match (f.specular, fit.specular) {
+                f.sharing == fit.sharing
+                    && match (fit.specular, f.specular) {
                         (
                             Specular::Lobe { geometry: a, .. },
-                            Specular::Lobe { geometry: b, .. },
+                            Specular::Lobe {
+                                kind: LobeKind::Pow,
+                                geometry: b,
+                            },
                         ) => a == b,
-                        _ => true,
+                        (Specular::Lobe { .. }, _) => false,
+                        _ => is_pow(f),
                     }
             });
             let ggx = best_error(fits, |f| {
                 f.specular == Specular::Ggx && f.sharing == fit.sharing
             });
-            let candidate =
-                fit.sharing == Sharing::Shared && matches!(fit.specular, Specular::Lobe { .. });
+            let candidate = fit.sharing == Sharing::Shared && is_candidate(fit);
             let rate = if candidate {
                 rates.get(index).copied().flatten()
             } else {

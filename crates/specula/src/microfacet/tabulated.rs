@@ -1,0 +1,176 @@
+//! A normal distribution known only as a shape, `D(h) = C shape(cos theta_h)`, made a
+//! microfacet distribution by quadrature, once per shape and exponent:
+//!
+//! - **`C`**, so that the projected microfacet area is one: `int D cos theta_h dw = 1`;
+//! - **Smith's `Lambda`** from the projected area a direction sees,
+//!   `int D(m) <wo, m>+ dm = (1 + Lambda(wo)) cos theta_o` (Heitz 2014, eq. 15, the identity
+//!   Smith's masking is built to satisfy). Its azimuthal integral is closed:
+//!   `int_0^2pi max(0, a cos phi + b) dphi` is `2 pi b` when `b >= a`, else
+//!   `2 (a sin phi_c + b phi_c)` with `cos phi_c = -b / a` (`a = sin theta_o sin theta_m`,
+//!   `b = cos theta_o cos theta_m`), so each `Lambda` is one integral over `theta_m`, tabulated
+//!   at [`ANGLES`] angles of `theta_o`, closer together towards the horizon, and interpolated;
+//! - **sampling** of `D cos theta_h`: its cumulative distribution over `theta_h` on a grid
+//!   dense where the lobe lives, inverted by interpolation.
+//!
+//! The integrals are adaptive Gauss-Kronrod ([`crate::quadrature`]) split at breakpoints that
+//! follow the lobe's own width (`sqrt(2 / (n + 2))`, Beckmann's `alpha` at Walter's
+//! correspondence), doubling outwards, and where `wo` begins to see the microfacets' backs;
+//! bisection finds the lobes' own kinks (a cut to 0).
+
+use core::f64::consts::{FRAC_PI_2, PI, TAU};
+
+use crate::quadrature::integrate_pieces;
+
+/// Angles `theta_o` in `[0, pi/2]` at which `Lambda` is tabulated.
+pub const ANGLES: usize = 257;
+
+/// The `theta_m` integrals' absolute tolerance (adaptive Gauss-Kronrod).
+const TOLERANCE: f64 = 1e-10;
+
+/// Points of the sampling table over `theta_h`.
+const SAMPLING_POINTS: usize = 4096;
+
+/// A shape made a microfacet distribution.
+#[derive(Clone, Debug)]
+pub struct Tabulated {
+    /// `C`: `D = C shape`.
+    normaliser: f64,
+    /// `int D(m) <wo, m>+ dm` at `theta_o` = [`table_angle`]`(k)`.
+    projected: Vec<f64>,
+    /// `theta_h` of the sampling table, increasing from 0 to `pi / 2`.
+    sample_angles: Vec<f64>,
+    /// The cumulative probability of `D cos theta_h` at each of `sample_angles`, 0 to 1.
+    cumulative: Vec<f64>,
+}
+
+impl Tabulated {
+    /// `shape` (of `cos theta_h`, non-negative, peaked at 1) made a distribution; `width`
+    /// the angle its peak spans (radians).
+    #[must_use]
+    pub fn new(shape: impl Fn(f64) -> f64, width: f64) -> Self {
+        let points = breakpoints(width);
+        let area = TAU
+            * integrate_pieces(
+                |theta: f64| {
+                    let (s, c) = theta.sin_cos();
+                    shape(c) * c * s
+                },
+                &points,
+                TOLERANCE,
+            );
+        let normaliser = 1.0 / area;
+        let projected = (0..ANGLES)
+            .map(|k| {
+                let theta_o = table_angle(k);
+                let (sin_o, cos_o) = theta_o.sin_cos();
+                // The integrand has a kink where `wo` starts to see the microfacets' backs,
+                // `theta_m = pi / 2 - theta_o`: a breakpoint there.
+                let mut points = points.clone();
+                points.push(FRAC_PI_2 - theta_o);
+                normaliser
+                    * integrate_pieces(
+                        |theta_m: f64| {
+                            let (s, c) = theta_m.sin_cos();
+                            shape(c) * s * azimuthal(sin_o * s, cos_o * c)
+                        },
+                        &points,
+                        TOLERANCE,
+                    )
+            })
+            .collect();
+        let sample_angles: Vec<f64> = (0..SAMPLING_POINTS)
+            .map(|k| FRAC_PI_2 * (k as f64 / (SAMPLING_POINTS - 1) as f64).powi(2))
+            .collect();
+        let density = |theta: f64| {
+            let (s, c) = theta.sin_cos();
+            shape(c) * c * s
+        };
+        // Trapezoids on the table's own grid, then scaled to end at 1: the table draws what
+        // it integrates, and `pdf` reports the exact density.
+        let mut cumulative = Vec::with_capacity(SAMPLING_POINTS);
+        let mut total = 0.0;
+        cumulative.push(0.0);
+        for pair in sample_angles.windows(2) {
+            total += 0.5 * (pair[1] - pair[0]) * (density(pair[0]) + density(pair[1]));
+            cumulative.push(total);
+        }
+        for c in &mut cumulative {
+            *c /= total;
+        }
+        Self {
+            normaliser,
+            projected,
+            sample_angles,
+            cumulative,
+        }
+    }
+
+    /// `C`.
+    #[must_use]
+    pub fn normaliser(&self) -> f64 {
+        self.normaliser
+    }
+
+    /// Smith's `Lambda` at a direction of cosine `cos_theta` (infinite at or below the
+    /// horizon, where nothing is seen).
+    #[must_use]
+    pub fn lambda(&self, cos_theta: f64) -> f64 {
+        if cos_theta <= 0.0 {
+            return f64::INFINITY;
+        }
+        let theta = cos_theta.min(1.0).acos();
+        let x = (1.0 - (1.0 - theta / FRAC_PI_2).max(0.0).sqrt()) * (ANGLES - 1) as f64;
+        let k = (x.floor() as usize).min(ANGLES - 2);
+        let (a, b) = (table_angle(k), table_angle(k + 1));
+        let f = ((theta - a) / (b - a)).clamp(0.0, 1.0);
+        let projected = self.projected[k] * (1.0 - f) + self.projected[k + 1] * f;
+        (projected / cos_theta - 1.0).max(0.0)
+    }
+
+    /// `theta_h` drawn with density `D cos theta_h` (per solid angle; the azimuth is the
+    /// caller's, uniform) from `u` in `[0, 1)`.
+    #[must_use]
+    pub fn sample_theta(&self, u: f64) -> f64 {
+        let k = self
+            .cumulative
+            .partition_point(|&c| c <= u)
+            .clamp(1, SAMPLING_POINTS - 1);
+        let (c0, c1) = (self.cumulative[k - 1], self.cumulative[k]);
+        let f = if c1 > c0 { (u - c0) / (c1 - c0) } else { 0.0 };
+        self.sample_angles[k - 1] + f * (self.sample_angles[k] - self.sample_angles[k - 1])
+    }
+}
+
+/// The `k`-th angle of the `Lambda` table: `pi/2 (1 - (1 - k / (ANGLES - 1))^2)`, closer
+/// together towards the horizon, where a narrow distribution's masking changes within a few
+/// of its widths.
+fn table_angle(k: usize) -> f64 {
+    let from_horizon = 1.0 - k as f64 / (ANGLES - 1) as f64;
+    FRAC_PI_2 * (1.0 - from_horizon * from_horizon)
+}
+
+/// `int_0^2pi max(0, a cos phi + b) dphi` for `a, b >= 0`.
+fn azimuthal(a: f64, b: f64) -> f64 {
+    if b >= a {
+        TAU * b
+    } else {
+        let phi_c = (-b / a).acos();
+        2.0 * (a * phi_c.sin() + b * phi_c)
+    }
+}
+
+/// Breakpoints over `theta` in `[0, pi/2]`: the width's quarters, doubling outwards.
+fn breakpoints(width: f64) -> Vec<f64> {
+    let mut points: Vec<f64> = (0..16)
+        .map(|k| width * 0.25 * 2f64.powi(k))
+        .filter(|p| *p < FRAC_PI_2)
+        .collect();
+    points.extend([0.0, FRAC_PI_2]);
+    points
+}
+
+/// The width a lobe of exponent `n` spans: Beckmann's `alpha` at Walter's correspondence.
+#[must_use]
+pub fn lobe_width(n: f64) -> f64 {
+    (2.0 / (n + 2.0)).sqrt().min(PI / 2.0)
+}
