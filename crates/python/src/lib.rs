@@ -14,6 +14,7 @@ mod decide;
 mod errors;
 mod export;
 mod lobe;
+mod microfacet;
 mod options;
 mod render;
 mod volume;
@@ -25,6 +26,7 @@ use pyo3::prelude::*;
 fn _specula(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<lobe::Lobe>()?;
     module.add_class::<volume::Volume>()?;
+    module.add_class::<microfacet::Microfacet>()?;
     module.add_function(wrap_pyfunction!(lobe::lobe_ids, module)?)?;
     module.add_function(wrap_pyfunction!(lobe::models_json, module)?)?;
     module.add_function(wrap_pyfunction!(analysis::zones_json, module)?)?;

@@ -27,12 +27,13 @@ from typing import Any, Dict, List, Optional, Sequence, Union
 import numpy as _np
 
 from . import _specula
-from ._specula import Lobe, Volume, default_scene, render, render_volume
+from ._specula import Lobe, Microfacet, Volume, default_scene, render, render_volume
 
 __version__: str = _specula.__version__
 
 __all__ = [
     "Lobe",
+    "Microfacet",
     "Volume",
     "analyze",
     "claims",

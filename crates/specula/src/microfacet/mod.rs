@@ -18,6 +18,7 @@
 //! microfacet model is a model beside the classic `ks N(n) lobe(t)`, not a replacement.
 
 pub mod closed;
+pub mod energy;
 pub mod tabulated;
 
 use std::sync::Arc;

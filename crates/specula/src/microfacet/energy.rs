@@ -1,0 +1,66 @@
+//! What a microfacet model loses to single scattering, as Kulla and Conty (2017) plot it: the
+//! directional albedo `E(mu) = int f(wo, wi) cos theta_i dwi` of the BRDF with Fresnel 1 (the
+//! rest is light the masking stops, which real surfaces scatter again), and its cosine-weighted
+//! average `E_avg = 2 int_0^1 E(mu) mu dmu`.
+
+use core::f64::consts::{FRAC_PI_2, TAU};
+
+use super::Distribution;
+use crate::quadrature::integrate_pieces;
+
+/// Azimuths of the inner, periodic trapezoid rule over the half vector.
+const AZIMUTHS: usize = 64;
+
+/// Gauss-Legendre nodes and weights on `[0, 1]` (8 points) for the average over `mu`.
+const NODES: [(f64, f64); 8] = [
+    (0.019_855_071_751_231_8, 0.050_614_268_145_188_1),
+    (0.101_666_761_293_186_6, 0.111_190_517_226_687_2),
+    (0.237_233_795_041_835_5, 0.156_853_322_938_943_6),
+    (0.408_282_678_752_175_1, 0.181_341_891_689_181_0),
+    (0.591_717_321_247_824_9, 0.181_341_891_689_181_0),
+    (0.762_766_204_958_164_5, 0.156_853_322_938_943_6),
+    (0.898_333_238_706_813_4, 0.111_190_517_226_687_2),
+    (0.980_144_928_248_768_2, 0.050_614_268_145_188_1),
+];
+
+/// `E(mu)` of `distribution`'s BRDF with Fresnel 1 at `cos_o = mu`, integrated over the half
+/// vector (`dwi = 4 |wo . h| dh`): `int D(h) G2(wo, wi) (wo . h) / cos_o dh` where `wi`, the
+/// reflection of `wo` about `h`, is above the horizon. `width` places the breakpoints.
+#[must_use]
+pub fn directional_albedo(distribution: &Distribution, cos_o: f64, width: f64) -> f64 {
+    let cos_o = cos_o.clamp(1e-6, 1.0);
+    let sin_o = (1.0 - cos_o * cos_o).sqrt();
+    let ring = |theta: f64| {
+        let (s, c) = theta.sin_cos();
+        let seen: f64 = (0..AZIMUTHS)
+            .map(|k| {
+                let cos_phi = (TAU * k as f64 / AZIMUTHS as f64).cos();
+                // `wo . h` and the reflected direction's height from `h`'s angles (`wo` lies
+                // in the xz plane).
+                let cos = sin_o * s * cos_phi + cos_o * c;
+                let wi_z = 2.0 * cos * c - cos_o;
+                if cos <= 0.0 || wi_z <= 0.0 {
+                    0.0
+                } else {
+                    distribution.g2(cos_o, wi_z) * cos
+                }
+            })
+            .sum();
+        distribution.d(c) * s * seen * TAU / AZIMUTHS as f64 / cos_o
+    };
+    let mut points: Vec<f64> = (0..12)
+        .map(|k| width * 0.25 * 2f64.powi(k))
+        .filter(|p| *p < FRAC_PI_2)
+        .collect();
+    points.extend([0.0, FRAC_PI_2]);
+    integrate_pieces(ring, &points, 1e-7)
+}
+
+/// `E_avg = 2 int_0^1 E(mu) mu dmu` (8-point Gauss-Legendre over `mu`).
+#[must_use]
+pub fn average_albedo(distribution: &Distribution, width: f64) -> f64 {
+    NODES
+        .iter()
+        .map(|&(mu, weight)| 2.0 * weight * mu * directional_albedo(distribution, mu, width))
+        .sum()
+}
