@@ -11,16 +11,13 @@ use crate::quadrature::integrate_pieces;
 /// Azimuths of the inner, periodic trapezoid rule over the half vector.
 const AZIMUTHS: usize = 64;
 
-/// Gauss-Legendre nodes and weights on `[0, 1]` (8 points) for the average over `mu`.
-const NODES: [(f64, f64); 8] = [
-    (0.019_855_071_751_231_8, 0.050_614_268_145_188_1),
-    (0.101_666_761_293_186_6, 0.111_190_517_226_687_2),
-    (0.237_233_795_041_835_5, 0.156_853_322_938_943_6),
-    (0.408_282_678_752_175_1, 0.181_341_891_689_181_0),
-    (0.591_717_321_247_824_9, 0.181_341_891_689_181_0),
-    (0.762_766_204_958_164_5, 0.156_853_322_938_943_6),
-    (0.898_333_238_706_813_4, 0.111_190_517_226_687_2),
-    (0.980_144_928_248_768_2, 0.050_614_268_145_188_1),
+/// The 8-point Gauss-Legendre rule on `[-1, 1]`: the positive nodes and their weights (the
+/// rule is symmetric), mapped to `[0, 1]` for the average over `mu`.
+const GAUSS_LEGENDRE: [(f64, f64); 4] = [
+    (0.183_434_642_495_649_8, 0.362_683_783_378_362),
+    (0.525_532_409_916_329, 0.313_706_645_877_887_3),
+    (0.796_666_477_413_626_7, 0.222_381_034_453_374_5),
+    (0.960_289_856_497_536_3, 0.101_228_536_290_376_3),
 ];
 
 /// `E(mu)` of `distribution`'s BRDF with Fresnel 1 at `cos_o = mu`, integrated over the half
@@ -59,8 +56,9 @@ pub fn directional_albedo(distribution: &Distribution, cos_o: f64, width: f64) -
 /// `E_avg = 2 int_0^1 E(mu) mu dmu` (8-point Gauss-Legendre over `mu`).
 #[must_use]
 pub fn average_albedo(distribution: &Distribution, width: f64) -> f64 {
-    NODES
+    GAUSS_LEGENDRE
         .iter()
-        .map(|&(mu, weight)| 2.0 * weight * mu * directional_albedo(distribution, mu, width))
+        .flat_map(|&(x, w)| [(0.5 - 0.5 * x, 0.5 * w), (0.5 + 0.5 * x, 0.5 * w)])
+        .map(|(mu, weight)| 2.0 * weight * mu * directional_albedo(distribution, mu, width))
         .sum()
 }
