@@ -150,6 +150,30 @@ pub(super) fn real_scans(document: &roxmltree::Document, text: &str, out: &std::
     }
 }
 
+/// The microfacet table: a column per material (after the lobe's), a row per lobe, then GGX
+/// and Beckmann, each cell a fit error and its parameter; one verdict at most per material
+/// (none where no distribution is within the margin of GGX, which the verdict line says).
+fn microfacet_table(table: roxmltree::Node) {
+    let cells = cells(table);
+    assert_eq!(cells.len(), specula::LobeKind::ALL.len() + 2, "{cells:?}");
+    assert_eq!(cells[cells.len() - 2][0], "ggx");
+    assert_eq!(cells[cells.len() - 1][0], "beckmann");
+    for column in 1..=MATERIALS.len() {
+        let verdicts = cells
+            .iter()
+            .filter(|row| row[column].ends_with("(verdict)"))
+            .count();
+        assert!(verdicts <= 1, "{cells:?}");
+        for row in &cells {
+            let error: f64 = row[column]
+                .split(['/', ' '])
+                .find_map(|word| word.parse().ok())
+                .expect("a fit error");
+            assert!(error > 0.0 && error < 1.0, "{row:?}");
+        }
+    }
+}
+
 /// The real materials' section: every material in name order, each with its table (every
 /// lobe and GGX, one verdict), its polar plot and its renders, each fit's captioned with a mean
 /// FLIP against the measured render.
@@ -169,11 +193,13 @@ pub(super) fn materials(document: &roxmltree::Document, out: &std::path::Path) {
         .filter_map(|n| n.text())
         .collect();
     assert_eq!(names, MATERIALS);
-    let tables: Vec<roxmltree::Node> = section
+    let mut tables: Vec<roxmltree::Node> = section
         .children()
         .filter(|n| n.has_tag_name("table"))
         .collect();
-    assert_eq!(tables.len(), MATERIALS.len());
+    // A table per material, then the lobes as microfacet distributions across them.
+    assert_eq!(tables.len(), MATERIALS.len() + 1);
+    microfacet_table(tables.pop().expect("the microfacet table"));
     for table in tables {
         let cells = cells(table);
         // Every lobe in its better geometry, then GGX; one verdict, a lobe that meets.
