@@ -8,6 +8,7 @@ use specula::{Exponent, Lobe};
 
 use crate::hardware::SWEEP_SAMPLES;
 
+use super::rank::break_tie;
 use super::*;
 
 fn request(target: Target, low: f64, high: f64, epicentre: f64, whole: f64) -> DesignRequest {
