@@ -150,41 +150,23 @@ pub fn assess_model(
     }
     let mut rates = Vec::with_capacity(fits.len());
     for fit in &fits {
-        rates.push(match (fit.specular, fit.sharing) {
-            (Specular::Lobe { kind, .. } | Specular::Microfacet { kind }, Sharing::Shared) => {
+        rates.push(match (fit.specular.kind(), fit.sharing) {
+            (Some(kind), Sharing::Shared) => {
                 let n = Exponent::clamped(fit.parameter[0]);
                 Some(lobe_rate(target, &Lobe::new(kind, n))?)
             }
             _ => None,
         });
     }
-    // In the microfacet model no distribution may come within the margin of GGX: the answer
-    // is then the closest distribution, and the verdict says that none is within it.
-    let found = verdict_of(model, &fits, margin, &rates).map(|v| (v, true));
-    let found = found.or_else(|| {
-        let closest = fits
-            .iter()
-            .filter(|f| {
-                matches!(f.specular, Specular::Microfacet { .. }) && f.sharing == Sharing::Shared
-            })
-            .map(|f| f.error)
-            .min_by(f64::total_cmp)?;
-        let reference = fits
-            .iter()
-            .find(|f| f.specular == Specular::Ggx && f.sharing == Sharing::Shared)?
-            .error;
-        let admitting = (closest / reference - 1.0).max(0.0) * (1.0 + 1e-12);
-        verdict_of(model, &fits, admitting, &rates).map(|v| (v, false))
-    });
-    let Some((
-        Verdict {
-            standings,
-            chosen,
-            reference_error,
-            ..
-        },
+    // In the microfacet model no distribution may come within the margin of GGX: the verdict
+    // is then the closest distribution, not within it (`within_margin`).
+    let Some(Verdict {
+        standings,
+        chosen,
+        reference_error,
         within_margin,
-    )) = found
+        ..
+    }) = verdict_of(model, &fits, margin, &rates)
     else {
         return Err(format!(
             "{}: no verdict: the reference's fit ({}) or every rate on the target is missing",
@@ -210,7 +192,7 @@ pub fn assess_model(
             relative_to_pow: standing.relative_to_pow,
             relative_to_ggx: standing.relative_to_ggx,
             rate: standing.rate,
-            meets: standing.meets && within_margin,
+            meets: standing.meets,
             fit,
         })
         .collect();

@@ -212,14 +212,14 @@ fn energy_loss(context: &mut Context) -> Result<String, String> {
     use specula::microfacet::tabulated::lobe_width;
     use specula::microfacet::Distribution;
     let grid = exponents(7);
-    let loss = |d: &Distribution, n: f64| 1.0 - average_albedo(d, lobe_width(n));
+    let loss = |d: &Distribution| 1.0 - average_albedo(d);
     let mut curves: Vec<Series> = context
         .lobes
         .par_iter()
         .map(|&kind| {
             let points = grid
                 .iter()
-                .map(|&n| (n.get(), loss(&Distribution::lobe(kind, n), n.get())))
+                .map(|&n| (n.get(), loss(&Distribution::lobe(kind, n))))
                 .collect();
             series(kind, points)
         })
@@ -236,7 +236,7 @@ fn energy_loss(context: &mut Context) -> Result<String, String> {
             name: format!("{name} (Walter)"),
             points: grid
                 .par_iter()
-                .map(|&n| (n.get(), loss(&make(lobe_width(n.get())), n.get())))
+                .map(|&n| (n.get(), loss(&make(lobe_width(n.get())))))
                 .collect(),
             colour: plotters::style::RGBColor(grey, grey, grey),
             width: 3,

@@ -10,9 +10,9 @@ use specula_decide::material::{verdict_line, Assessment, FitRow};
 
 use super::html::{paragraph, table};
 
-/// The shared-`n` fit error of the family `pick` chooses (the better geometry for a classic
+/// The best shared-`n` fit of the families `pick` chooses (the better geometry for a classic
 /// lobe), if fitted.
-fn error_of(a: &Assessment, pick: impl Fn(Specular) -> bool) -> Option<&FitRow> {
+fn best_shared(a: &Assessment, pick: impl Fn(Specular) -> bool) -> Option<&FitRow> {
     a.fits
         .iter()
         .filter(|r| r.fit.sharing == Sharing::Shared && pick(r.fit.specular))
@@ -39,11 +39,11 @@ pub(crate) fn microfacet_section(assessed: &[Assessment], kinds: &[LobeKind]) ->
         .map(|&kind| {
             let mut row = vec![kind.to_string()];
             row.extend(assessed.iter().map(|a| {
-                let classic = error_of(
+                let classic = best_shared(
                     a,
                     |s| matches!(s, Specular::Lobe { kind: k, .. } if k == kind),
                 );
-                let microfacet = error_of(a, |s| s == Specular::Microfacet { kind });
+                let microfacet = best_shared(a, |s| s == Specular::Microfacet { kind });
                 let mark = a
                     .fits
                     .get(a.chosen)
@@ -60,7 +60,11 @@ pub(crate) fn microfacet_section(assessed: &[Assessment], kinds: &[LobeKind]) ->
         .collect();
     for (name, family) in [("ggx", Specular::Ggx), ("beckmann", Specular::Beckmann)] {
         let mut row = vec![name.to_owned()];
-        row.extend(assessed.iter().map(|a| cell(error_of(a, |s| s == family))));
+        row.extend(
+            assessed
+                .iter()
+                .map(|a| cell(best_shared(a, |s| s == family))),
+        );
         rows.push(row);
     }
     let mut html = paragraph(

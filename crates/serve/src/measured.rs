@@ -448,36 +448,23 @@ fn assess(name: &str, material: &MeasuredBrdf, costs: &CostModel) -> Result<Asse
 }
 
 fn summary(fit: &Fit, reference_error: f64, ggx_error: f64, costs: &CostModel) -> FitSummary {
-    let (family, geometry, n, alpha, priced) = match fit.specular {
-        Specular::Lobe { kind, geometry } => {
-            let n = fit.parameter[0];
-            let lobe = Lobe::new(kind, Exponent::clamped(n));
+    let parameter = fit.parameter[0];
+    let (family, geometry, n, alpha, priced) = match fit.specular.kind() {
+        Some(kind) => {
+            let lobe = Lobe::new(kind, Exponent::clamped(parameter));
+            let geometry = match fit.specular {
+                Specular::Lobe { geometry, .. } => geometry.id(),
+                _ => "microfacet",
+            };
             (
                 kind.to_string(),
-                Some(geometry.id()),
-                Some(n),
+                Some(geometry),
+                Some(parameter),
                 None,
                 Some(costs_versus_pow(costs, &lobe)),
             )
         }
-        Specular::Microfacet { kind } => {
-            let n = fit.parameter[0];
-            let lobe = Lobe::new(kind, Exponent::clamped(n));
-            (
-                kind.to_string(),
-                Some("microfacet"),
-                Some(n),
-                None,
-                Some(costs_versus_pow(costs, &lobe)),
-            )
-        }
-        Specular::Ggx | Specular::Beckmann => (
-            fit.specular.label(),
-            None,
-            None,
-            Some(fit.parameter[0]),
-            None,
-        ),
+        None => (fit.specular.label(), None, None, Some(parameter), None),
     };
     let (costs, cost_error) = match priced {
         Some(Ok(costs)) => (costs, None),

@@ -23,14 +23,8 @@ pub struct MicrofacetFit {
     pub relative_error: f64,
 }
 
-/// GGX's (Trowbridge-Reitz) normal distribution at `cos theta`.
-#[must_use]
-pub fn ggx(alpha: f64, cos_theta: f64) -> f64 {
-    let a2 = alpha * alpha;
-    let c2 = cos_theta * cos_theta;
-    let denominator = c2 * (a2 - 1.0) + 1.0;
-    a2 / (core::f64::consts::PI * denominator * denominator)
-}
+/// GGX's (Trowbridge-Reitz) normal distribution at `cos theta`: the microfacet model's.
+pub use crate::microfacet::closed::ggx_d as ggx;
 
 /// The GGX `alpha` closest to `lobe` in `geometry` (see the module page).
 #[must_use]

@@ -22,9 +22,10 @@ const GAUSS_LEGENDRE: [(f64, f64); 4] = [
 
 /// `E(mu)` of `distribution`'s BRDF with Fresnel 1 at `cos_o = mu`, integrated over the half
 /// vector (`dwi = 4 |wo . h| dh`): `int D(h) G2(wo, wi) (wo . h) / cos_o dh` where `wi`, the
-/// reflection of `wo` about `h`, is above the horizon. `width` places the breakpoints.
+/// reflection of `wo` about `h`, is above the horizon.
 #[must_use]
-pub fn directional_albedo(distribution: &Distribution, cos_o: f64, width: f64) -> f64 {
+pub fn directional_albedo(distribution: &Distribution, cos_o: f64) -> f64 {
+    let width = distribution.width();
     let cos_o = cos_o.clamp(1e-6, 1.0);
     let sin_o = (1.0 - cos_o * cos_o).sqrt();
     let ring = |theta: f64| {
@@ -55,10 +56,10 @@ pub fn directional_albedo(distribution: &Distribution, cos_o: f64, width: f64) -
 
 /// `E_avg = 2 int_0^1 E(mu) mu dmu` (8-point Gauss-Legendre over `mu`).
 #[must_use]
-pub fn average_albedo(distribution: &Distribution, width: f64) -> f64 {
+pub fn average_albedo(distribution: &Distribution) -> f64 {
     GAUSS_LEGENDRE
         .iter()
         .flat_map(|&(x, w)| [(0.5 - 0.5 * x, 0.5 * w), (0.5 + 0.5 * x, 0.5 * w)])
-        .map(|(mu, weight)| 2.0 * weight * mu * directional_albedo(distribution, mu, width))
+        .map(|(mu, weight)| 2.0 * weight * mu * directional_albedo(distribution, mu))
         .sum()
 }

@@ -73,6 +73,16 @@ impl Distribution {
         }
     }
 
+    /// The angle (radians) its peak spans, where quadratures place their breakpoints: a
+    /// lobe's Walter width `sqrt(2 / (n + 2))`, Beckmann's and GGX's `alpha`.
+    #[must_use]
+    pub fn width(&self) -> f64 {
+        match self {
+            Self::Lobe { lobe, .. } => tabulated::lobe_width(lobe.exponent().get()),
+            Self::Beckmann { alpha } | Self::Ggx { alpha } => *alpha,
+        }
+    }
+
     /// `D` at the half vector's cosine `cos_h` (0 at or below the horizon).
     #[must_use]
     pub fn d(&self, cos_h: f64) -> f64 {

@@ -38,7 +38,7 @@ pub mod verdict;
 
 use channel::Prepared;
 
-use core::f64::consts::{FRAC_1_PI, FRAC_PI_4, TAU};
+use core::f64::consts::FRAC_1_PI;
 
 use argmin::core::{CostFunction, Executor};
 use argmin::solver::brent::BrentOpt;
@@ -49,9 +49,8 @@ use serde::Serialize;
 pub use observations::{comparison_pairs, Observations, GRID, MAX_ELEVATION_DEGREES};
 
 use crate::analysis::albedo::specular_albedo_per_unit;
-use crate::fit::ggx;
+use crate::microfacet::energy::directional_albedo;
 use crate::microfacet::Distribution;
-use crate::quadrature::integrate_pieces;
 use crate::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 
 /// Points of the global scan over `ln n` (or `ln alpha`).
@@ -101,6 +100,15 @@ impl Specular {
         }
     }
 
+    /// The lobe of a classic or microfacet family (`None` for Beckmann and GGX).
+    #[must_use]
+    pub fn kind(self) -> Option<LobeKind> {
+        match self {
+            Specular::Lobe { kind, .. } | Specular::Microfacet { kind } => Some(kind),
+            Specular::Ggx | Specular::Beckmann => None,
+        }
+    }
+
     /// Whether the shape parameter is a roughness `alpha` (else an exponent `n`).
     #[must_use]
     pub fn takes_alpha(self) -> bool {
@@ -142,27 +150,21 @@ impl Specular {
                 };
                 t.iter().map(|&t| lobe.eval(t)).collect()
             }
-            Specular::Ggx => observations
-                .pairs
-                .iter()
-                .map(|&(wo, wi)| ggx_specular(parameter, wo, wi))
-                .collect(),
-            Specular::Microfacet { .. } | Specular::Beckmann => {
-                let Some(distribution) = self.distribution(parameter) else {
-                    return Vec::new();
-                };
-                observations
-                    .pairs
-                    .iter()
-                    .map(|&(wo, wi)| microfacet_specular(&distribution, wo, wi))
-                    .collect()
-            }
+            Specular::Ggx | Specular::Microfacet { .. } | Specular::Beckmann => self
+                .distribution(parameter)
+                .map_or_else(Vec::new, |distribution| {
+                    observations
+                        .pairs
+                        .iter()
+                        .map(|&(wo, wi)| microfacet_specular(&distribution, wo, wi))
+                        .collect()
+                }),
         }
     }
 }
 
 /// A distribution's `D G2 / (4 cos_o cos_i)`, no Fresnel (the fit's `K` plays a constant
-/// `F0`, as for GGX).
+/// `F0`).
 #[must_use]
 pub fn microfacet_specular(distribution: &Distribution, wo: DVec3, wi: DVec3) -> f64 {
     if wo.z <= 0.0 || wi.z <= 0.0 {
@@ -170,23 +172,6 @@ pub fn microfacet_specular(distribution: &Distribution, wo: DVec3, wi: DVec3) ->
     }
     let h = (wo + wi).normalize();
     distribution.d(h.z) * distribution.g2(wo.z, wi.z) / (4.0 * wo.z * wi.z)
-}
-
-/// Smith's `Lambda` for GGX at a direction of cosine `c`.
-fn smith_lambda(alpha: f64, c: f64) -> f64 {
-    let tan2 = (1.0 - c * c).max(0.0) / (c * c);
-    0.5 * (-1.0 + (1.0 + alpha * alpha * tan2).sqrt())
-}
-
-/// GGX's `D G2 / (4 cos_o cos_i)`.
-#[must_use]
-pub fn ggx_specular(alpha: f64, wo: DVec3, wi: DVec3) -> f64 {
-    if wo.z <= 0.0 || wi.z <= 0.0 {
-        return 0.0;
-    }
-    let h = (wo + wi).normalize();
-    let masking = 1.0 / (1.0 + smith_lambda(alpha, wo.z) + smith_lambda(alpha, wi.z));
-    ggx(alpha, h.z) * masking / (4.0 * wo.z * wi.z)
 }
 
 /// One `n` per material, or one per channel.
@@ -252,11 +237,10 @@ impl Fit {
                     let lobe = Lobe::new(kind, Exponent::clamped(self.parameter[c]));
                     specular_albedo_per_unit(&lobe, geometry, 0.0)
                 }
-                Specular::Ggx => ggx_albedo_at_normal(self.parameter[c]),
-                Specular::Microfacet { .. } | Specular::Beckmann => self
+                Specular::Ggx | Specular::Microfacet { .. } | Specular::Beckmann => self
                     .specular
                     .distribution(self.parameter[c])
-                    .map_or(0.0, |d| microfacet_albedo_at_normal(&d)),
+                    .map_or(0.0, |d| directional_albedo(&d, 1.0)),
             };
             self.kd[c] + self.k[c] * specular
         })
@@ -277,10 +261,7 @@ impl Fit {
                     ),
                     geometry,
                 },
-                Specular::Ggx => FittedShape::Ggx {
-                    alpha: self.parameter,
-                },
-                Specular::Microfacet { .. } | Specular::Beckmann => {
+                Specular::Ggx | Specular::Microfacet { .. } | Specular::Beckmann => {
                     FittedShape::Microfacet(Box::new(self.parameter.map(|p| {
                         self.specular
                             .distribution(p)
@@ -307,9 +288,7 @@ enum FittedShape {
         lobes: Box<[Lobe; 3]>,
         geometry: Geometry,
     },
-    Ggx {
-        alpha: [f64; 3],
-    },
+    /// A distribution per channel (GGX's, Beckmann's, a lobe's).
     Microfacet(Box<[Distribution; 3]>),
 }
 
@@ -321,9 +300,6 @@ impl FittedModel {
             FittedShape::Lobe { lobes, geometry } => {
                 let t = geometry.cos_lobe_local(wo, wi);
                 DVec3::new(lobes[0].eval(t), lobes[1].eval(t), lobes[2].eval(t))
-            }
-            FittedShape::Ggx { alpha } => {
-                DVec3::from_array(alpha.map(|alpha| ggx_specular(alpha, wo, wi)))
             }
             FittedShape::Microfacet(distributions) => DVec3::new(
                 microfacet_specular(&distributions[0], wo, wi),
@@ -347,29 +323,6 @@ impl FittedModel {
     pub fn f_cos(&self, wo: DVec3, wi: DVec3) -> DVec3 {
         self.f(wo, wi) * wi.z.max(0.0)
     }
-}
-
-/// `int D G2 / (4 cos_o cos_i) cos_i dwi` for `wo` along the normal: with `wi` the mirror
-/// of `wo` about `h`, `dwi = 4 cos(theta_h) dwh`, and `wi` stays above the horizon while
-/// `theta_h < pi / 4`.
-fn ggx_albedo_at_normal(alpha: f64) -> f64 {
-    let integrand = |theta_h: f64| {
-        let (s, c) = theta_h.sin_cos();
-        let cos_i = (2.0 * theta_h).cos();
-        TAU * ggx(alpha, c) * c * s / (1.0 + smith_lambda(alpha, cos_i))
-    };
-    let peak = alpha.atan().min(FRAC_PI_4);
-    integrate_pieces(integrand, &[0.0, peak * 0.5, peak, FRAC_PI_4], 1e-10)
-}
-
-/// `int D G2 / (4 cos_o cos_i) cos_i dwi` for `wo` along the normal, as for GGX.
-fn microfacet_albedo_at_normal(distribution: &Distribution) -> f64 {
-    let integrand = |theta_h: f64| {
-        let (s, c) = theta_h.sin_cos();
-        let cos_i = (2.0 * theta_h).cos();
-        TAU * distribution.d(c) * c * s * distribution.g2(1.0, cos_i)
-    };
-    integrate_pieces(integrand, &[0.0, 0.05, 0.1, 0.2, 0.4, FRAC_PI_4], 1e-10)
 }
 
 /// One shape parameter's profile: its best error over `(kd, K)` for some channels.

@@ -49,8 +49,11 @@ pub struct Verdict {
     pub reference_error: f64,
     /// Every fit's standing, in the fits' order.
     pub standings: Vec<Standing>,
-    /// The index (in the fits) of the cheapest meeting shared-`n` lobe.
+    /// The index (in the fits) of the cheapest meeting shared-`n` lobe; where none meets,
+    /// the candidate with a rate whose fit is closest to the reference's.
     pub chosen: usize,
+    /// Whether the chosen lobe meets (always in the classic model, where pow meets itself).
+    pub within_margin: bool,
 }
 
 /// The best error among `fits` matching `pick`, or NaN where none does.
@@ -64,8 +67,8 @@ fn best_error(fits: &[Fit], pick: impl Fn(&Fit) -> bool) -> f64 {
 
 /// Ranks `fits` (as [`super::fit_all`] returns them, pow among the lobes) with `rates[i]`
 /// the rate of `fits[i]` on the target (read for shared-`n` lobes only; `None` where the
-/// target cannot run it). `None` when pow's shared fit is missing or no lobe that meets has
-/// a rate.
+/// target cannot run it). `None` when the reference's shared fit is missing or no candidate
+/// has a rate.
 #[must_use]
 pub fn verdict(fits: &[Fit], margin: f64, rates: &[Option<f64>]) -> Option<Verdict> {
     verdict_of(Model::Classic, fits, margin, rates)
@@ -144,19 +147,24 @@ pub fn verdict_of(
             }
         })
         .collect();
-    let chosen = standings
-        .iter()
-        .filter(|s| s.meets)
-        .max_by(|a, b| {
-            let (ra, rb) = (a.rate.unwrap_or(0.0), b.rate.unwrap_or(0.0));
-            ra.total_cmp(&rb)
-                .then_with(|| fits[b.fit].error.total_cmp(&fits[a.fit].error))
-        })?
-        .fit;
+    let cheapest_meeting = standings.iter().filter(|s| s.meets).max_by(|a, b| {
+        let (ra, rb) = (a.rate.unwrap_or(0.0), b.rate.unwrap_or(0.0));
+        ra.total_cmp(&rb)
+            .then_with(|| fits[b.fit].error.total_cmp(&fits[a.fit].error))
+    });
+    let closest = || {
+        standings
+            .iter()
+            .filter(|s| s.rate.is_some())
+            .min_by(|a, b| fits[a.fit].error.total_cmp(&fits[b.fit].error))
+    };
+    let within_margin = cheapest_meeting.is_some();
+    let chosen = cheapest_meeting.or_else(closest)?.fit;
     Some(Verdict {
         margin,
         reference_error,
         standings,
         chosen,
+        within_margin,
     })
 }
