@@ -12,17 +12,18 @@ use specula::LobeKind;
 use specula_synth::cache::{key_of_bytes, Cache};
 
 /// Bumped when [`Stored`] changes shape.
-const FORMAT: &str = "specula material fits 2";
+const FORMAT: &str = "specula material fits 3";
 
 /// One fit as stored.
 #[derive(Serialize, Deserialize)]
 struct Stored {
-    /// The family's label (`pow/blinn`, `ggx`, `cosquad/microfacet`, `beckmann`).
+    /// The family's label (`pow/blinn`, `ggx`, `cosquad/microfacet`, `beckmann/microfacet`).
     family: String,
     per_channel: bool,
     parameter: [u64; 3],
     kd: [u64; 3],
     k: [u64; 3],
+    f0: Option<[u64; 3]>,
     error: u64,
     channel_error: [u64; 3],
 }
@@ -34,10 +35,7 @@ pub(crate) fn fits(
     families: &[Specular],
     fit: impl FnOnce() -> Vec<Fit>,
 ) -> Vec<Fit> {
-    let built_in = |specular: &Specular| match specular {
-        Specular::Lobe { kind, .. } | Specular::Microfacet { kind } => LobeKind::ALL.contains(kind),
-        Specular::Ggx | Specular::Beckmann => true,
-    };
+    let built_in = |specular: &Specular| specular.kind().is_none_or(|k| LobeKind::ALL.contains(&k));
     let cache = Cache::default_for("fits").filter(|_| families.iter().all(built_in));
     let Some(cache) = cache else {
         return fit();
@@ -86,6 +84,7 @@ fn load(cache: &Cache, key: &str, families: &[Specular]) -> Option<Vec<Fit>> {
                 parameter: bits(entry.parameter),
                 kd: bits(entry.kd),
                 k: bits(entry.k),
+                f0: entry.f0.map(bits),
                 error: f64::from_bits(entry.error),
                 channel_error: bits(entry.channel_error),
             })
@@ -101,6 +100,7 @@ fn stored(fit: &Fit) -> Stored {
         parameter: bits(fit.parameter),
         kd: bits(fit.kd),
         k: bits(fit.k),
+        f0: fit.f0.map(bits),
         error: fit.error.to_bits(),
         channel_error: bits(fit.channel_error),
     }
@@ -109,6 +109,7 @@ fn stored(fit: &Fit) -> Stored {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use specula::measured::fit::Normals;
     use specula::Geometry;
 
     /// A stored fit reads back as the same fit, bit for bit, every family alike.
@@ -122,6 +123,9 @@ mod tests {
             parameter: [x, x * 2.0, x / 3.0],
             kd: [0.1, 0.2, 0.3],
             k: [x.sqrt(), 1.0 / 7.0, f64::MIN_POSITIVE],
+            f0: specular
+                .has_fresnel()
+                .then_some([0.04, x.fract(), 1.0 / 3.0]),
             error: x.ln(),
             channel_error: [1e-300, 0.5, 2.0 / 3.0],
         };
@@ -145,12 +149,18 @@ mod tests {
             fit(Specular::Ggx, Sharing::Shared, 0.3),
             fit(
                 Specular::Microfacet {
-                    kind: LobeKind::Schlick,
+                    normals: Normals::Lobe(LobeKind::Schlick),
                 },
                 Sharing::Shared,
                 64.0,
             ),
-            fit(Specular::Beckmann, Sharing::PerChannel, 0.2),
+            fit(
+                Specular::Microfacet {
+                    normals: Normals::Beckmann,
+                },
+                Sharing::PerChannel,
+                0.2,
+            ),
         ];
         cache
             .store("k", &fits.iter().map(stored).collect::<Vec<_>>())

@@ -18,6 +18,7 @@ mod fit_cache;
 pub mod fpga_estimate;
 pub mod hardware;
 pub mod material;
+pub mod microfacet_cost;
 pub mod percent;
 mod pinned;
 pub mod rates;

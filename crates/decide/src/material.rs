@@ -11,12 +11,13 @@ use serde::Serialize;
 pub use specula::measured::fit::verdict::Model;
 use specula::measured::fit::verdict::{verdict_of, Verdict};
 use specula::measured::fit::{
-    families, fit_families, microfacet_families, Fit, Observations, Sharing, Specular,
+    families, fit_families, microfacet_families, Fit, Normals, Observations, Sharing, Specular,
     MAX_ELEVATION_DEGREES,
 };
 use specula::{Exponent, Lobe, LobeKind, Normalisation};
 use specula_render::measured::{material_name, MeasuredBrdf};
 
+use crate::microfacet_cost::{ggx_microfacet_rate, microfacet_rate};
 use crate::{lobe_rate, log_spaced, rate_unit, Target};
 
 /// The fit error allowed over pow's by default: 5 %.
@@ -42,6 +43,10 @@ pub struct FitRow {
     /// The rate on the target at the fitted `n` (shared-`n` lobes only; higher is cheaper).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rate: Option<f64>,
+    /// In the microfacet model, the rate of the whole specular term on the target
+    /// ([`crate::microfacet_cost`]; shared-`n` distributions and GGX only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub brdf_rate: Option<f64>,
     /// Within the margin of pow's best fit (shared-`n` lobes only).
     pub meets: bool,
 }
@@ -138,10 +143,7 @@ pub fn assess_model(
         fit_families(&observations, &classic)
     });
     if model == Model::Microfacet {
-        let distributions: Vec<Specular> = microfacet_families(kinds)
-            .into_iter()
-            .filter(|f| *f != Specular::Ggx)
-            .collect();
+        let distributions = microfacet_families(kinds);
         fits.extend(crate::fit_cache::fits(
             &observations,
             &distributions,
@@ -179,10 +181,15 @@ pub fn assess_model(
     };
     let normal = glam::DVec3::Z;
     let measured = material.albedo(normal, 256);
+    let mut brdf_rates = Vec::with_capacity(fits.len());
+    for fit in &fits {
+        brdf_rates.push(brdf_rate(model, target, fit)?);
+    }
     let rows = fits
         .into_iter()
         .zip(standings)
-        .map(|(fit, standing)| FitRow {
+        .zip(brdf_rates)
+        .map(|((fit, standing), brdf_rate)| FitRow {
             ks: Normalisation::ALL
                 .iter()
                 .filter_map(|&norm| Some((norm.id(), fit.ks(norm)?)))
@@ -192,6 +199,7 @@ pub fn assess_model(
             relative_to_pow: standing.relative_to_pow,
             relative_to_ggx: standing.relative_to_ggx,
             rate: standing.rate,
+            brdf_rate,
             meets: standing.meets,
             fit,
         })
@@ -214,6 +222,26 @@ pub fn assess_model(
         fits: rows,
         chosen,
         reference_error,
+    })
+}
+
+/// The rate of `fit`'s whole microfacet specular term on `target`, for the shared-`n` fits of
+/// the microfacet model with a cost: a lobe's distribution, and GGX's.
+fn brdf_rate(model: Model, target: Target, fit: &Fit) -> Result<Option<f64>, String> {
+    if model != Model::Microfacet || fit.sharing != Sharing::Shared {
+        return Ok(None);
+    }
+    Ok(match fit.specular {
+        Specular::Microfacet {
+            normals: Normals::Lobe(kind),
+        } => {
+            let lobe = Lobe::new(kind, Exponent::clamped(fit.parameter[0]));
+            Some(microfacet_rate(target, &lobe)?)
+        }
+        Specular::Microfacet {
+            normals: Normals::Ggx,
+        } => Some(ggx_microfacet_rate(target)?),
+        _ => None,
     })
 }
 
@@ -248,11 +276,44 @@ fn pow_rate(a: &Assessment) -> f64 {
         .iter()
         .filter(|r| match (a.model, r.fit.specular) {
             (Model::Classic, Specular::Lobe { kind, .. }) => kind == LobeKind::Pow,
-            (Model::Microfacet, Specular::Microfacet { kind }) => kind == LobeKind::Pow,
+            (Model::Microfacet, Specular::Microfacet { normals }) => {
+                normals == Normals::Lobe(LobeKind::Pow)
+            }
             _ => false,
         })
         .filter_map(|r| r.rate)
         .fold(f64::NAN, f64::max)
+}
+
+/// In the microfacet model, what the chosen distribution saves of the whole specular term:
+/// against the `pow` distribution's and GGX's.
+fn brdf_saving(a: &Assessment) -> String {
+    let rate_of = |pick: &dyn Fn(&Specular) -> bool| {
+        a.fits
+            .iter()
+            .filter(|r| pick(&r.fit.specular))
+            .find_map(|r| r.brdf_rate)
+    };
+    let chosen = a.fits[a.chosen].brdf_rate;
+    let pow = rate_of(&|s| {
+        *s == Specular::Microfacet {
+            normals: Normals::Lobe(LobeKind::Pow),
+        }
+    });
+    let ggx = rate_of(&|s| {
+        *s == Specular::Microfacet {
+            normals: Normals::Ggx,
+        }
+    });
+    match (chosen, pow, ggx) {
+        (Some(chosen), Some(pow), Some(ggx)) => format!(
+            "; of the whole microfacet specular term (D, G2, Fresnel), {:.0} % of the pow \
+                distribution's cost saved, {:.2}x GGX's throughput",
+            100.0 * (1.0 - pow / chosen),
+            chosen / ggx
+        ),
+        _ => String::new(),
+    }
 }
 
 /// The sentence naming the lobe to ship.
@@ -280,8 +341,10 @@ pub fn verdict_line(a: &Assessment) -> String {
         (Model::Microfacet, true) => format!(
             "{label}, n = {n}: the cheapest distribution on {target} whose microfacet fit is \
                 within {margin} % of GGX's (E = {error:.4}, {ratio:.3}x GGX's); \
-                {versus_pow:.2}x the pow distribution's throughput, so {:.0} % of its cost saved",
-            100.0 * (1.0 - pow_rate / rate)
+                {versus_pow:.2}x the pow distribution's throughput, so {:.0} % of its cost \
+                saved{}",
+            100.0 * (1.0 - pow_rate / rate),
+            brdf_saving(a)
         ),
         (Model::Classic, _) => format!(
             "{label}, n = {n}: the cheapest lobe on {target} whose fit is within {margin} % of \

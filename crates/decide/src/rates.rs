@@ -151,7 +151,7 @@ pub(crate) fn kernel_rates(lobes: &[Vec<Lobe>], progress: &ProgressBar) -> Vec<V
 }
 
 /// Evaluations per second of `work` over an L1-sized buffer, on one thread (best of 3).
-fn l1_rate(work: &(dyn Fn(&[f32], &mut [f32]) + Sync)) -> f64 {
+pub(crate) fn l1_rate(work: &(dyn Fn(&[f32], &mut [f32]) + Sync)) -> f64 {
     (0..3)
         .map(|_| timed_rate(MIN_SECONDS, work))
         .fold(0.0, f64::max)

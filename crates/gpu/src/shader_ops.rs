@@ -7,8 +7,11 @@
 //! an `if`, the costlier branch counts (a divergent warp runs both; a uniform one, at most
 //! that).
 
+use std::sync::OnceLock;
+
 use naga::{
     BinaryOperator, Block, Expression, Handle, MathFunction, Module, ScalarKind, Statement,
+    TypeInner,
 };
 use specula::gpu_cost::ShaderOps;
 use specula::{Geometry, Lobe, Normalisation};
@@ -25,6 +28,36 @@ pub fn lobe_shader_ops(lobe: &Lobe) -> Result<ShaderOps, String> {
         info: &info,
     };
     let entry = find(&module, "specula_lobe").ok_or("no specula_lobe in the exported shader")?;
+    Ok(counter.function(entry))
+}
+
+/// The instructions `lobe`'s microfacet BRDF takes per evaluation of its specular term: the
+/// lobe ([`lobe_shader_ops`]) and what the microfacet model adds to it, `brdf.wgsl`'s
+/// `microfacet_factor` (the normaliser, the two masking-table lookups and `G2`, Schlick's
+/// Fresnel per channel, the division by `4 N.wo`). The cosines both take (`N.h`, `wo.h`) are
+/// not counted, as they are not for GGX's ([`ggx_microfacet_ops`]); nor are the table's loads,
+/// which the cost model, counting arithmetic, leaves out.
+pub fn microfacet_shader_ops(lobe: &Lobe) -> Result<ShaderOps, String> {
+    // The same function for every lobe: parsed and counted once.
+    static FACTOR: OnceLock<Result<ShaderOps, String>> = OnceLock::new();
+    let factor = FACTOR.get_or_init(|| function_ops(&wgsl::render_module(), "microfacet_factor"));
+    Ok(lobe_shader_ops(lobe)? + factor.clone()?)
+}
+
+/// The instructions of GGX's microfacet specular term written as three.js writes it
+/// (`shaders/ggx_cost.wgsl`), the peer of [`microfacet_shader_ops`].
+pub fn ggx_microfacet_ops() -> Result<ShaderOps, String> {
+    function_ops(wgsl::GGX_COST, "ggx_factor")
+}
+
+/// The instructions of the function `name` in the WGSL `source`, callees included.
+fn function_ops(source: &str, name: &str) -> Result<ShaderOps, String> {
+    let (module, info) = wgsl::validate(source)?;
+    let counter = Counter {
+        module: &module,
+        info: &info,
+    };
+    let entry = find(&module, name).ok_or_else(|| format!("no {name} in the shader"))?;
     Ok(counter.function(entry))
 }
 
@@ -96,6 +129,14 @@ impl Counter<'_> {
                 .scalar_kind()
                 == Some(ScalarKind::Float)
         };
+        // A vector operation is one instruction per lane on the scalar ALUs GPUs have.
+        let lanes = match self.info[function][handle]
+            .ty
+            .inner_with(&self.module.types)
+        {
+            TypeInner::Vector { size, .. } => u32::from(*size),
+            _ => 1,
+        };
         let mut ops = ShaderOps::default();
         match &f.expressions[handle] {
             Expression::Binary { op, left, .. } => match op {
@@ -148,6 +189,6 @@ impl Counter<'_> {
             },
             _ => {}
         }
-        ops
+        ops * lanes
     }
 }

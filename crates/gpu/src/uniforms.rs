@@ -4,7 +4,9 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use specula::{Geometry, Lobe};
-use specula_render::{IlluminationModel, Light, Material, Shader};
+use specula_render::{
+    IlluminationModel, Light, Material, MicrofacetTerms, Shader, MASKING_ENTRIES,
+};
 
 use crate::lobe_library::FunctionKey;
 
@@ -52,17 +54,20 @@ pub fn geometry_id(geometry: Geometry) -> u32 {
     }
 }
 
-/// `struct Material` of brdf.wgsl (80 bytes).
+/// `struct Material` of brdf.wgsl (352 bytes).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct MaterialBlock {
     ambient: [f32; 3],
     geometry: u32,
     diffuse: [f32; 3],
     model: u32,
     specular: [f32; 3],
+    normaliser: f32,
+    grazing: [f32; 3],
     padding: u32,
     lobe: LobeBlock,
+    masking: [f32; MASKING_ENTRIES],
 }
 
 impl MaterialBlock {
@@ -80,10 +85,18 @@ impl MaterialBlock {
             model: match model {
                 IlluminationModel::Classic => 0,
                 IlluminationModel::Physical => 1,
+                IlluminationModel::Microfacet => 2,
             },
             specular: specular.to_array(),
+            normaliser: shader.microfacet().map_or(0.0, MicrofacetTerms::normaliser),
+            grazing: shader
+                .microfacet()
+                .map_or([0.0; 3], |m| m.grazing().to_array()),
             padding: 0,
             lobe: LobeBlock::new(shader.lobe()),
+            masking: shader
+                .microfacet()
+                .map_or([0.0; MASKING_ENTRIES], |m| *m.masking()),
         }
     }
 
@@ -170,7 +183,7 @@ mod tests {
     fn blocks_match_the_wgsl_layout() {
         let size_of = wgsl_size_of(&crate::wgsl::render_module());
         assert_eq!(size_of("Lobe"), size_of_val(&LobeBlock::default()));
-        assert_eq!(size_of("Material"), size_of_val(&MaterialBlock::default()));
+        assert_eq!(size_of("Material"), size_of_val(&MaterialBlock::zeroed()));
         assert_eq!(size_of("Light"), size_of_val(&LightBlock::default()));
         assert_eq!(size_of("Frame"), size_of_val(&FrameBlock::default()));
     }

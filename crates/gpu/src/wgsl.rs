@@ -19,6 +19,8 @@ pub const RENDER: &str = include_str!("../shaders/render.wgsl");
 pub const VOLUME: &str = include_str!("../shaders/volume.wgsl");
 /// The lobe-evaluation compute shader.
 pub const EVALUATE: &str = include_str!("../shaders/evaluate.wgsl");
+/// GGX's microfacet term as three.js writes it, for the cost model's comparison.
+pub const GGX_COST: &str = include_str!("../shaders/ggx_cost.wgsl");
 
 /// The lobe library, generated from every lobe's recorded expression: each built-in shape's
 /// function, the user's lobes defined so far (a module built before a formula was defined

@@ -11,10 +11,31 @@ mod common;
 use common::Parity;
 use specula::LobeKind;
 use specula_gpu::GpuRenderer;
-use specula_render::{render, Overrides, Scene, Shading};
+use specula_render::{render, IlluminationModel, Overrides, Scene, Shading};
 
 const MAX_MEAN_FLIP: f64 = 1e-3;
 const MIN_PSNR_DB: f64 = 70.0;
+
+/// The default scene at 320x180 with 2x2 samples under `overrides`, drawn by both renderers
+/// and checked.
+fn check_default_scene(
+    parity: &mut Parity,
+    gpu: &specula_gpu::Gpu,
+    renderer: &GpuRenderer,
+    overrides: Overrides,
+    what: &str,
+) {
+    let mut scene = Scene::default_scene();
+    scene.apply(&Overrides {
+        width: Some(320),
+        height: Some(180),
+        samples: Some(2),
+        ..overrides
+    });
+    let cpu = render(&scene, &|_, _| {}).unwrap();
+    let gpu_image = renderer.render(&scene).unwrap();
+    parity.check(what, gpu, &cpu, &gpu_image, scene.display);
+}
 
 #[test]
 fn gpu_renders_match_the_cpu_for_every_lobe_and_shading_method() {
@@ -23,20 +44,33 @@ fn gpu_renders_match_the_cpu_for_every_lobe_and_shading_method() {
     let mut parity = Parity::new(MAX_MEAN_FLIP, MIN_PSNR_DB);
     for kind in LobeKind::ALL {
         for shading in Shading::ALL {
-            let mut scene = Scene::default_scene();
-            scene.apply(&Overrides {
+            let overrides = Overrides {
                 lobe: Some(kind),
                 shading: Some(shading),
-                width: Some(320),
-                height: Some(180),
-                samples: Some(2),
                 ..Overrides::default()
-            });
-            let cpu = render(&scene, &|_, _| {}).unwrap();
-            let gpu_image = renderer.render(&scene).unwrap();
+            };
             let what = format!("{kind} {}", shading.id());
-            parity.check(&what, &gpu, &cpu, &gpu_image, scene.display);
+            check_default_scene(&mut parity, &gpu, &renderer, overrides, &what);
         }
+    }
+    parity.report();
+}
+
+/// The microfacet model (every lobe as a distribution, its masking table and Fresnel in the
+/// material's uniform block) draws as the CPU does, Phong shading, the same thresholds.
+#[test]
+fn gpu_microfacet_renders_match_the_cpu_for_every_lobe() {
+    let Some(gpu) = common::gpu() else { return };
+    let renderer = GpuRenderer::new(&gpu);
+    let mut parity = Parity::new(MAX_MEAN_FLIP, MIN_PSNR_DB);
+    for kind in LobeKind::ALL {
+        let overrides = Overrides {
+            lobe: Some(kind),
+            model: Some(IlluminationModel::Microfacet),
+            ..Overrides::default()
+        };
+        let what = format!("{kind} microfacet");
+        check_default_scene(&mut parity, &gpu, &renderer, overrides, &what);
     }
     parity.report();
 }

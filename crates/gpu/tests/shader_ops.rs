@@ -3,7 +3,7 @@
 
 use specula::gpu_cost::{GpuFamily, ShaderOps};
 use specula::{Exponent, Lobe, LobeKind};
-use specula_gpu::shader_ops::lobe_shader_ops;
+use specula_gpu::shader_ops::{ggx_microfacet_ops, lobe_shader_ops, microfacet_shader_ops};
 
 fn ops(kind: LobeKind, n: f64) -> ShaderOps {
     lobe_shader_ops(&Lobe::new(kind, Exponent::new(n))).unwrap()
@@ -76,4 +76,56 @@ fn modelled_rates_follow_from_the_counts() {
     // cosquad: 11 instructions, none special: issue-bound.
     assert_eq!(rate("gpu-nvidia", LobeKind::CosQuad { v: 4 }), 128.0 / 11.0);
     assert_eq!(rate("gpu-amd", LobeKind::CosQuad { v: 4 }), 64.0 / 11.0);
+}
+
+/// A lobe's microfacet BRDF adds `brdf.wgsl`'s `microfacet_factor` to the lobe, counted by
+/// hand (vector operations one instruction a lane); GGX's term (`ggx_cost.wgsl`, as three.js
+/// writes it) likewise.
+#[test]
+fn hand_counted_microfacet_terms() {
+    // G1 from the table: clamp, sqrt, * 63; u32(), min; f32(), -; + 1u, two shifts and two
+    // masks; the interpolation's -, *, +.
+    let g1 = ShaderOps {
+        arithmetic: 5,
+        compare: 2,
+        transcendental: 1,
+        conversion: 2,
+        integer: 5,
+        ..ShaderOps::default()
+    };
+    // G2: two G1s; a + b - a b (3), a b again, a divide, `> 0` and the select.
+    let g2 = g1 * 2
+        + ShaderOps {
+            arithmetic: 3 + 1 + 1,
+            compare: 2,
+            transcendental: 1,
+            ..ShaderOps::default()
+        };
+    // C lobe G2 / (4 N.wo): three multiplies and a divide; 1 - clamp(); four multiplies for
+    // the fifth power; (F0 (1 - S) + ks S) base: 1 - S, then three vec3 operations of three
+    // lanes and the scaling by base, three lanes.
+    let factor = g2
+        + ShaderOps {
+            arithmetic: 4 + 1 + 4 + 1 + 3 * 3 + 3,
+            compare: 1,
+            transcendental: 1,
+            ..ShaderOps::default()
+        };
+    let pow = Lobe::new(LobeKind::Pow, Exponent::new(64.0));
+    assert_eq!(
+        microfacet_shader_ops(&pow).unwrap(),
+        ops(LobeKind::Pow, 64.0) + factor
+    );
+    // GGX: a2; each of the two visibility roots 1 - a2, two multiplies, +, sqrt, the outer
+    // multiply; their sum, max, 0.5 / x; D's denominator (4) and a2 / pi / d^2 (two
+    // multiplies and a divide); Fresnel as above; V D N.wi (2).
+    assert_eq!(
+        ggx_microfacet_ops().unwrap(),
+        ShaderOps {
+            arithmetic: 1 + 2 * 5 + 1 + 1 + 4 + 3 + 1 + 4 + 1 + 3 * 3 + 2 + 3,
+            compare: 1 + 1,
+            transcendental: 2 + 1 + 1,
+            ..ShaderOps::default()
+        }
+    );
 }

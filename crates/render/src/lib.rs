@@ -57,7 +57,9 @@ pub use image::{
 };
 pub use image_error::ImageError;
 pub use load::{load_mesh, parse_mesh, LoadError, LoadedMesh, MeshFormat, MESH_EXTENSIONS};
-pub use material::{IlluminationModel, Light, Material, Shader, Shading};
+pub use material::{
+    IlluminationModel, Light, Material, MicrofacetTerms, Shader, Shading, MASKING_ENTRIES,
+};
 pub use mesh::{Mesh, MeshError};
 pub use mitsuba_scene::write_mitsuba_scene;
 pub use output::{write_atomically, SeekWrite};

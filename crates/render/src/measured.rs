@@ -11,11 +11,11 @@ use std::path::Path;
 
 use glam::DVec3;
 use specula::brdf::luminance;
-use specula::measured::fit::{Fit, FittedModel, Specular};
+use specula::measured::fit::{Fit, FittedModel, Shape};
 pub use specula::measured::MeasuredBrdf;
 use specula::microfacet::Distribution;
 use specula::sampling::SpecularSampler;
-use specula::{Exponent, Lobe, Normalisation};
+use specula::Normalisation;
 
 use crate::ibl::{
     cosine_direction, render_ibl_with, Environment, IblSettings, Reflectance, Strategy,
@@ -102,19 +102,11 @@ impl FittedReflectance {
     /// Prepares `fit` for rendering.
     #[must_use]
     pub fn new(fit: &Fit) -> Self {
-        let draw = match fit.specular {
-            Specular::Lobe { kind, geometry } => SpecularDraw::Lobe(SpecularSampler::new(
-                Lobe::new(kind, Exponent::clamped(fit.parameter[0])),
-                geometry,
-                Normalisation::None,
-            )),
-            Specular::Ggx | Specular::Beckmann | Specular::Microfacet { .. } => {
-                SpecularDraw::Microfacet(fit.specular.distribution(fit.parameter[0]).unwrap_or(
-                    Distribution::Ggx {
-                        alpha: fit.parameter[0],
-                    },
-                ))
+        let draw = match fit.specular.shape(fit.parameter[0]) {
+            Shape::Lobe { lobe, geometry } => {
+                SpecularDraw::Lobe(SpecularSampler::new(lobe, geometry, Normalisation::None))
             }
+            Shape::Microfacet(distribution) => SpecularDraw::Microfacet(distribution),
         };
         let (d, total) = (
             luminance(DVec3::from_array(fit.kd)),

@@ -35,6 +35,11 @@ pub(crate) struct Scratch {
     lobe: Vec<f32>,
     diffuse_weight: Vec<f32>,
     specular_weight: Vec<f32>,
+    /// The microfacet model's `N.wo`, `N.wi`, `wo.h` and the lobe's share at grazing.
+    cos_out: Vec<f32>,
+    cos_in: Vec<f32>,
+    cos_half: Vec<f32>,
+    grazing_lobe: Vec<f32>,
 }
 
 /// What one visible sample brings from the rasterizer: its slot in the tile, its material,
@@ -79,6 +84,10 @@ pub(crate) fn shade(
         lobe,
         diffuse_weight,
         specular_weight,
+        cos_out,
+        cos_in,
+        cos_half,
+        grazing_lobe,
     } = scratch;
     for field in [
         &mut *face_normal,
@@ -97,6 +106,10 @@ pub(crate) fn shade(
         &mut *lobe,
         &mut *diffuse_weight,
         &mut *specular_weight,
+        &mut *cos_out,
+        &mut *cos_in,
+        &mut *cos_half,
+        &mut *grazing_lobe,
     ] {
         buffer.resize(count, 0.0);
     }
@@ -143,6 +156,11 @@ pub(crate) fn shade(
                 t: &mut t[range.clone()],
                 diffuse_weight: &mut diffuse_weight[range.clone()],
                 specular_weight: &mut specular_weight[range.clone()],
+                cosines: [
+                    &mut cos_out[range.clone()],
+                    &mut cos_in[range.clone()],
+                    &mut cos_half[range.clone()],
+                ],
             });
             let lobe = &mut lobe[range.clone()];
             if shader.has_specular() {
@@ -153,6 +171,28 @@ pub(crate) fn shade(
             let intensity = match *light {
                 Light::Directional { intensity, .. } | Light::Point { intensity, .. } => intensity,
             };
+            if let Some(terms) = shader.microfacet() {
+                let grazing_lobe = &mut grazing_lobe[range.clone()];
+                terms.factors(
+                    [
+                        &cos_out[range.clone()],
+                        &cos_in[range.clone()],
+                        &cos_half[range.clone()],
+                    ],
+                    lobe,
+                    grazing_lobe,
+                );
+                // Fresnel's grazing part, `ks (1 - F0) (1 - wo.h)^5`, as a second specular
+                // term on its own share of the lobe.
+                arch.dispatch(Accumulate {
+                    diffuse: Vec3::ZERO,
+                    specular: terms.grazing() * intensity,
+                    diffuse_weight: &diffuse_weight[range.clone()],
+                    specular_weight: &specular_weight[range.clone()],
+                    lobe: grazing_lobe,
+                    radiance: view_mut(radiance, range.clone()),
+                });
+            }
             arch.dispatch(Accumulate {
                 diffuse: diffuse * intensity,
                 specular: specular * intensity,
@@ -305,7 +345,14 @@ struct Cosines<'a> {
     t: &'a mut [f32],
     diffuse_weight: &'a mut [f32],
     specular_weight: &'a mut [f32],
+    /// `N.wo`, `N.wi` and `wo.h`, written in the microfacet model only.
+    cosines: [&'a mut [f32]; 3],
 }
+
+/// The illumination models as [`Cosines::run`]'s constant.
+const CLASSIC: u8 = 0;
+const PHYSICAL: u8 = 1;
+const MICROFACET: u8 = 2;
 
 impl pulp::WithSimd for Cosines<'_> {
     type Output = ();
@@ -313,23 +360,34 @@ impl pulp::WithSimd for Cosines<'_> {
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
         let point = matches!(self.light, Light::Point { .. });
+        // The microfacet model's geometry is Blinn's whatever the material says.
         match (point, self.geometry, self.model) {
             (false, Geometry::Phong, IlluminationModel::Classic) => {
-                self.run::<false, false, false>()
+                self.run::<false, false, CLASSIC>()
             }
             (false, Geometry::Phong, IlluminationModel::Physical) => {
-                self.run::<false, false, true>()
+                self.run::<false, false, PHYSICAL>()
             }
             (false, Geometry::Blinn, IlluminationModel::Classic) => {
-                self.run::<false, true, false>()
+                self.run::<false, true, CLASSIC>()
             }
             (false, Geometry::Blinn, IlluminationModel::Physical) => {
-                self.run::<false, true, true>()
+                self.run::<false, true, PHYSICAL>()
             }
-            (true, Geometry::Phong, IlluminationModel::Classic) => self.run::<true, false, false>(),
-            (true, Geometry::Phong, IlluminationModel::Physical) => self.run::<true, false, true>(),
-            (true, Geometry::Blinn, IlluminationModel::Classic) => self.run::<true, true, false>(),
-            (true, Geometry::Blinn, IlluminationModel::Physical) => self.run::<true, true, true>(),
+            (false, _, IlluminationModel::Microfacet) => self.run::<false, true, MICROFACET>(),
+            (true, Geometry::Phong, IlluminationModel::Classic) => {
+                self.run::<true, false, CLASSIC>()
+            }
+            (true, Geometry::Phong, IlluminationModel::Physical) => {
+                self.run::<true, false, PHYSICAL>()
+            }
+            (true, Geometry::Blinn, IlluminationModel::Classic) => {
+                self.run::<true, true, CLASSIC>()
+            }
+            (true, Geometry::Blinn, IlluminationModel::Physical) => {
+                self.run::<true, true, PHYSICAL>()
+            }
+            (true, _, IlluminationModel::Microfacet) => self.run::<true, true, MICROFACET>(),
         }
     }
 }
@@ -337,7 +395,7 @@ impl pulp::WithSimd for Cosines<'_> {
 impl Cosines<'_> {
     /// The loop for one light kind, geometry and model, with each choice a constant.
     #[inline(always)]
-    fn run<const POINT: bool, const BLINN: bool, const PHYSICAL: bool>(self) {
+    fn run<const POINT: bool, const BLINN: bool, const MODEL: u8>(self) {
         // As `Shader::incoming`: a directional light without a direction lights nothing
         // (a zero `wi` makes every cosine 0).
         let (at, towards) = match *self.light {
@@ -350,6 +408,7 @@ impl Cosines<'_> {
         let [ox, oy, oz] = self.wo.map(|s| &s[..len]);
         let diffuse_weight = &mut self.diffuse_weight[..len];
         let specular_weight = &mut self.specular_weight[..len];
+        let [cos_out, cos_ins, cos_half] = self.cosines;
         for (i, t) in self.t.iter_mut().enumerate() {
             let normal = Vec3::new(nx[i], ny[i], nz[i]);
             let wo = Vec3::new(ox[i], oy[i], oz[i]);
@@ -358,7 +417,7 @@ impl Cosines<'_> {
             let (wi, attenuation, reaches) = if POINT {
                 let offset = at - Vec3::new(px[i], py[i], pz[i]);
                 let distance_squared = offset.length_squared();
-                let attenuation = if PHYSICAL {
+                let attenuation = if MODEL != CLASSIC {
                     1.0 / distance_squared.max(crate::material::MIN_DISTANCE_SQUARED)
                 } else {
                     1.0
@@ -374,24 +433,37 @@ impl Cosines<'_> {
             // `Shader::cosines`.
             let cos_in = normal.dot(wi);
             let lit = reaches && normal.dot(wo) > 0.0 && cos_in > 0.0;
-            let cosine = if BLINN {
+            let (cosine, wo_dot_h) = if BLINN {
                 let sum = wi + wo;
                 let length_squared = sum.length_squared();
-                let n_dot_h = normal.dot(sum) / length_squared.sqrt();
+                let inverse_length = 1.0 / length_squared.sqrt();
                 if length_squared > 0.0 {
-                    n_dot_h
+                    (
+                        normal.dot(sum) * inverse_length,
+                        wo.dot(sum) * inverse_length,
+                    )
                 } else {
-                    0.0
+                    (0.0, 0.0)
                 }
             } else {
-                2.0 * normal.dot(wi) * normal.dot(wo) - wi.dot(wo)
+                (2.0 * normal.dot(wi) * normal.dot(wo) - wi.dot(wo), 0.0)
             };
-            // `Shader::contribution`: the classic model has no cosine on the specular term.
+            // `Shader::contribution`: the classic model has no cosine on the specular term; the
+            // microfacet model's `1 / (4 N.wo N.wi)` cancels it (`MicrofacetTerms::factors`).
             let diffuse = attenuation * cos_in;
-            let specular = if PHYSICAL { diffuse } else { attenuation };
+            let specular = if MODEL == PHYSICAL {
+                diffuse
+            } else {
+                attenuation
+            };
             *t = if lit { cosine } else { 0.0 };
             diffuse_weight[i] = if lit { diffuse } else { 0.0 };
             specular_weight[i] = if lit { specular } else { 0.0 };
+            if MODEL == MICROFACET {
+                cos_out[i] = normal.dot(wo);
+                cos_ins[i] = cos_in;
+                cos_half[i] = wo_dot_h;
+            }
         }
     }
 }

@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use glam::Vec3;
-use specula::measured::fit::{Fit, Sharing, Specular};
+use specula::measured::fit::{Fit, Normals, Sharing, Specular};
 use specula::{Geometry, LobeKind};
 use specula_render::ibl::{render_ibl_with, Environment, IblSettings, Reflectance, Strategy};
 use specula_render::measured::{load_measured, FittedReflectance, MeasuredReflectance};
@@ -115,6 +115,7 @@ fn fitted_models_reflect_their_quadrature_albedo() {
         parameter: [20.0, 60.0, 200.0],
         kd: [0.3, 0.2, 0.1],
         k: [0.5, 1.5, 4.0],
+        f0: None,
         error: 0.0,
         channel_error: [0.0; 3],
     };
@@ -131,7 +132,17 @@ fn fitted_models_reflect_their_quadrature_albedo() {
         parameter: [8.0, 20.0, 50.0],
         ..lobe.clone()
     };
-    for fit in [lobe, ggx, phong] {
+    // A lobe as a distribution with Schlick's Fresnel: its albedo at normal incidence is the
+    // Fresnel-weighted integral, its sampling the distribution's.
+    let distribution = Fit {
+        specular: Specular::Microfacet {
+            normals: Normals::Lobe(LobeKind::CosQuad { v: 2 }),
+        },
+        parameter: [10.0, 40.0, 120.0],
+        f0: Some([0.04, 0.5, 0.9]),
+        ..lobe.clone()
+    };
+    for fit in [lobe, ggx, phong, distribution] {
         // At normal incidence against the closed-form albedo; at 60 degrees, where the
         // half vector leaves the normal, against a quadrature of the model itself.
         let at_normal = Vec3::from_array(fit.albedo_at_normal().map(|v| v as f32));

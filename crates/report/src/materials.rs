@@ -8,7 +8,9 @@
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
-use specula::measured::fit::{plane_of_incidence, Fit, Sharing, Specular, POLAR_ANGLES_DEGREES};
+use specula::measured::fit::{
+    plane_of_incidence, Fit, Normals, Sharing, Specular, POLAR_ANGLES_DEGREES,
+};
 use specula::measured::MeasuredBrdf;
 use specula::LobeKind;
 use specula_render::ibl::{Environment, SKY_WIDTH};
@@ -223,7 +225,7 @@ fn shown_fits(a: &Assessment) -> Vec<&FitRow> {
             }
             Specular::Ggx => ggx = Some(row),
             // The microfacet model's fits are its own table's.
-            Specular::Microfacet { .. } | Specular::Beckmann => {}
+            Specular::Microfacet { .. } => {}
         }
     }
     best.extend(ggx);
@@ -363,8 +365,10 @@ fn polar(
                             &[]
                         },
                     ),
-                    Specular::Microfacet { kind } => (colour(kind), DASH_DOT),
-                    Specular::Ggx | Specular::Beckmann => (GGX_GREY, DASH_DOT),
+                    Specular::Microfacet {
+                        normals: Normals::Lobe(kind),
+                    } => (colour(kind), DASH_DOT),
+                    Specular::Ggx | Specular::Microfacet { .. } => (GGX_GREY, DASH_DOT),
                 };
                 let model = fit.prepare();
                 curves.push(PolarCurve {

@@ -4,9 +4,12 @@
 //! material) and, per material, the verdict: the cheapest distribution within the margin of
 //! GGX's fit and what it saves against the `pow` distribution.
 
-use specula::measured::fit::{Sharing, Specular};
-use specula::LobeKind;
+use specula::brdf::luminance;
+use specula::measured::fit::{Normals, Sharing, Specular};
+use specula::{Exponent, Lobe, LobeKind};
 use specula_decide::material::{verdict_line, Assessment, FitRow};
+use specula_decide::microfacet_cost::{ggx_microfacet_rate, microfacet_rate};
+use specula_decide::Target;
 
 use super::html::{paragraph, table};
 
@@ -27,8 +30,11 @@ pub(crate) fn microfacet_section(assessed: &[Assessment], kinds: &[LobeKind]) ->
     let header: Vec<&str> = header.iter().map(String::as_str).collect();
     let cell = |row: Option<&FitRow>| {
         row.map_or("-".to_owned(), |r| {
+            let f0 = r.fit.f0.map_or(String::new(), |f0| {
+                format!(", F0 {:.3}", luminance(glam::DVec3::from_array(f0)))
+            });
             format!(
-                "{:.4} ({})",
+                "{:.4} ({}{f0})",
                 r.fit.error,
                 specula_decide::material::parameter_text(&r.fit)
             )
@@ -43,11 +49,14 @@ pub(crate) fn microfacet_section(assessed: &[Assessment], kinds: &[LobeKind]) ->
                     a,
                     |s| matches!(s, Specular::Lobe { kind: k, .. } if k == kind),
                 );
-                let microfacet = best_shared(a, |s| s == Specular::Microfacet { kind });
+                let family = Specular::Microfacet {
+                    normals: Normals::Lobe(kind),
+                };
+                let microfacet = best_shared(a, |s| s == family);
                 let mark = a
                     .fits
                     .get(a.chosen)
-                    .filter(|c| c.fit.specular == Specular::Microfacet { kind })
+                    .filter(|c| c.fit.specular == family)
                     .map_or("", |_| " (verdict)");
                 format!(
                     "{} / {}{mark}",
@@ -58,8 +67,9 @@ pub(crate) fn microfacet_section(assessed: &[Assessment], kinds: &[LobeKind]) ->
             row
         })
         .collect();
-    for (name, family) in [("ggx", Specular::Ggx), ("beckmann", Specular::Beckmann)] {
-        let mut row = vec![name.to_owned()];
+    for normals in [Normals::Ggx, Normals::Beckmann] {
+        let family = Specular::Microfacet { normals };
+        let mut row = vec![normals.id()];
         row.extend(
             assessed
                 .iter()
@@ -70,13 +80,76 @@ pub(crate) fn microfacet_section(assessed: &[Assessment], kinds: &[LobeKind]) ->
     let mut html = paragraph(
         "The lobes as microfacet distributions (specula fit --model microfacet): each lobe's \
          fit error in the classic model (its better geometry) and as the normal distribution \
-         of kd / pi + K D G2 / (4 cos_o cos_i), its own normalisation and Smith masking, the \
-         shape parameter after it; GGX's and Beckmann's in the same model below. Lower is \
-         better; (verdict) marks each material's answer.",
+         of kd / pi + K F D G2 / (4 cos_o cos_i), its own normalisation and Smith masking, \
+         Schlick's Fresnel F with its F0 fitted per channel; after each error, the shape \
+         parameter and the F0's luminance. GGX's and Beckmann's in the same model below. \
+         Lower is better; (verdict) marks each material's answer.",
     );
     html += &table(&header, &rows);
     for a in assessed {
         html += &paragraph(&format!("{}: {}", a.material, verdict_line(a)));
     }
+    html += &cost_section(kinds);
     html
+}
+
+/// The exponent the cost table compares the distributions at.
+const COST_EXPONENT: f64 = 64.0;
+
+/// What each lobe's whole microfacet specular term costs on the modelled GPUs, against the
+/// `pow` distribution's and GGX's (`specula_decide::microfacet_cost`); a sentence where a cost
+/// cannot be had.
+fn cost_section(kinds: &[LobeKind]) -> String {
+    let targets = [Target::GpuNvidia, Target::GpuAmd];
+    let pow = Lobe::new(LobeKind::Pow, Exponent::new(COST_EXPONENT));
+    let costed = targets.map(|target| -> Result<(f64, f64, Vec<f64>), String> {
+        let rates = kinds
+            .iter()
+            .map(|&kind| microfacet_rate(target, &Lobe::new(kind, Exponent::new(COST_EXPONENT))))
+            .collect::<Result<Vec<f64>, String>>()?;
+        Ok((
+            microfacet_rate(target, &pow)?,
+            ggx_microfacet_rate(target)?,
+            rates,
+        ))
+    });
+    let [Ok(nvidia), Ok(amd)] = &costed else {
+        let why = costed
+            .iter()
+            .find_map(|c| c.as_ref().err())
+            .cloned()
+            .unwrap_or_default();
+        return paragraph(&format!(
+            "The microfacet terms' costs are not available: {why}"
+        ));
+    };
+    let rows: Vec<Vec<String>> = kinds
+        .iter()
+        .enumerate()
+        .map(|(k, kind)| {
+            let mut row = vec![kind.to_string()];
+            for (pow_rate, ggx_rate, rates) in [nvidia, amd] {
+                row.push(format!("{:.2}", rates[k] / pow_rate));
+                row.push(format!("{:.2}", rates[k] / ggx_rate));
+            }
+            row
+        })
+        .collect();
+    let header = [
+        "lobe as D (n = 64)",
+        "gpu-nvidia: x pow's",
+        "x GGX's",
+        "gpu-amd: x pow's",
+        "x GGX's",
+    ];
+    paragraph(
+        "What the whole microfacet specular term costs with each lobe as the distribution \
+         (the lobe, the normaliser, G2 from the 64-entry masking table, Schlick's Fresnel per \
+         channel, the division by 4 N.wo: the functions the GPU renderer runs), as throughput \
+         in the GPU cost model against the pow distribution's term and against GGX's (its D \
+         and Smith's correlated visibility in closed form, as three.js writes them, the same \
+         Fresnel). Above 1 is cheaper. The lobe is a small part of the term: what it saves \
+         against pow shrinks accordingly, and the masking table's lookups cost more than \
+         GGX's closed form.",
+    ) + &table(&header, &rows)
 }

@@ -10,7 +10,7 @@ use core::f64::consts::PI;
 
 use glam::DVec3;
 use specula::measured::fit::verdict::{verdict, verdict_of, Model};
-use specula::measured::fit::{fit, Fit, Observations, Sharing, Specular};
+use specula::measured::fit::{fit, Fit, Normals, Observations, Sharing, Specular};
 use specula::{Brdf, Exponent, Geometry, Lobe, LobeKind, Normalisation, Rgb};
 
 fn close(a: f64, b: f64, relative: f64) -> bool {
@@ -100,11 +100,26 @@ fn ggx_is_fitted_back_to_its_roughness() {
     fitted_back(Specular::Ggx, alpha, |wo, wi| ggx_f(alpha, wo, wi));
 }
 
-/// `specular` fitted to `kd / pi + K spec` (fixed `kd` and `K`) finds `parameter`, `kd` and
-/// `K` again, at rounding level.
+/// Schlick's Fresnel factor per channel for `F0 = (0.04, 0.5, 0.95)` (a dielectric, a
+/// coloured metal's red and green), written out here.
+fn fresnel(wo: DVec3, wi: DVec3) -> Rgb {
+    let cos = wo.dot((wo + wi).normalize());
+    let s = (1.0 - cos).powi(5);
+    Rgb::new(0.04, 0.5, 0.95) * (1.0 - s) + Rgb::splat(s)
+}
+
+/// `specular` fitted to `kd / pi + K spec` (fixed `kd` and `K`; times [`fresnel`] where the
+/// family has a Fresnel term) finds `parameter`, `kd`, `K` (and `F0`) again, at rounding
+/// level.
 fn fitted_back(specular: Specular, parameter: f64, spec: impl Fn(DVec3, DVec3) -> f64 + Sync) {
+    let with_fresnel = specular.has_fresnel();
     let observations = Observations::of(|wo, wi| {
-        (Rgb::new(0.1, 0.2, 0.3) / PI + Rgb::new(0.9, 0.7, 0.5) * spec(wo, wi)) * wi.z
+        let f = if with_fresnel {
+            fresnel(wo, wi)
+        } else {
+            Rgb::ONE
+        };
+        (Rgb::new(0.1, 0.2, 0.3) / PI + Rgb::new(0.9, 0.7, 0.5) * f * spec(wo, wi)) * wi.z
     });
     let fitted = fit(&observations, specular, Sharing::Shared);
     assert!(fitted.error < 1e-6, "{}", fitted.error);
@@ -114,6 +129,15 @@ fn fitted_back(specular: Specular, parameter: f64, spec: impl Fn(DVec3, DVec3) -
         fitted.parameter
     );
     assert!(close(fitted.k[1], 0.7, 1e-3) && close(fitted.kd[2], 0.3, 1e-3));
+    match fitted.f0 {
+        Some(f0) => {
+            assert!(with_fresnel);
+            for (c, expected) in [0.04, 0.5, 0.95].into_iter().enumerate() {
+                assert!(close(f0[c], expected, 1e-3), "F0 {f0:?}");
+            }
+        }
+        None => assert!(!with_fresnel, "no F0 fitted"),
+    }
 }
 
 fn stub(kind: LobeKind, error: f64) -> Fit {
@@ -126,6 +150,7 @@ fn stub(kind: LobeKind, error: f64) -> Fit {
         parameter: [10.0; 3],
         kd: [0.0; 3],
         k: [0.0; 3],
+        f0: None,
         error,
         channel_error: [error; 3],
     }
@@ -194,9 +219,10 @@ fn pure_terms_are_fitted_at_their_bounds() {
     }
 }
 
-/// Beckmann's microfacet model written out here (its `D` and its exact `Lambda` by `erfc`) is
-/// fitted back to its roughness by the microfacet model's Beckmann family; and the lobes as
-/// distributions fit a model made of `pow`'s distribution back to its `n`.
+/// Beckmann's microfacet model written out here (its `D`, its exact `Lambda` by `erfc` and
+/// Schlick's Fresnel) is fitted back to its roughness and `F0` by the microfacet model's
+/// Beckmann family; and the lobes as distributions fit a model made of `pow`'s distribution
+/// back to its `n`.
 #[test]
 fn microfacet_models_are_fitted_back_to_their_parameters() {
     let alpha: f64 = 0.2;
@@ -210,11 +236,17 @@ fn microfacet_models_are_fitted_back_to_their_parameters() {
         let d = (-tan2 / (alpha * alpha)).exp() / (PI * alpha * alpha * h.z.powi(4));
         d / (1.0 + lambda(wo.z) + lambda(wi.z)) / (4.0 * wo.z * wi.z)
     };
-    fitted_back(Specular::Beckmann, alpha, beckmann);
+    fitted_back(
+        Specular::Microfacet {
+            normals: Normals::Beckmann,
+        },
+        alpha,
+        beckmann,
+    );
     let pow = specula::microfacet::Distribution::lobe(LobeKind::Pow, Exponent::new(40.0));
     fitted_back(
         Specular::Microfacet {
-            kind: LobeKind::Pow,
+            normals: Normals::Lobe(LobeKind::Pow),
         },
         40.0,
         |wo, wi| specula::measured::fit::microfacet_specular(&pow, wo, wi),
@@ -227,11 +259,15 @@ fn microfacet_models_are_fitted_back_to_their_parameters() {
 #[test]
 fn the_microfacet_verdict_is_the_cheapest_distribution_near_ggx() {
     let distribution = |kind, error| Fit {
-        specular: Specular::Microfacet { kind },
+        specular: Specular::Microfacet {
+            normals: Normals::Lobe(kind),
+        },
         ..stub(kind, error)
     };
     let mut ggx = stub(LobeKind::Pow, 0.100);
-    ggx.specular = Specular::Ggx;
+    ggx.specular = Specular::Microfacet {
+        normals: Normals::Ggx,
+    };
     let fits = vec![
         stub(LobeKind::Pow, 0.090),
         distribution(LobeKind::Pow, 0.101),

@@ -6,10 +6,18 @@ Import this file, then use `"type": "{name}"` (or `<bsdf type="{name}">`) with p
 - kd, ks: diffuse and specular reflectance (float or rgb), default 0 and 1;
 - geometry: "phong" (t = r.wi about the mirror direction) or "blinn" (t = n.h), default
   "{geometry}";
-- normalisation: one of {normalisations}, default "{normalisation}".
+- normalisation: one of {normalisations}, default "{normalisation}";
+- model: "classic" (default) or "microfacet";
+- f0: Fresnel's reflectance at normal incidence (float or rgb, default 1), microfacet only.
 
-The BRDF is f = kd / pi + ks N(n) lobe(t), and `eval` returns f cos(theta_i), as Mitsuba
-expects; the context's component and type masks are not consulted (both terms are always
+The classic BRDF is f = kd / pi + ks N(n) lobe(t). The microfacet BRDF is specula's microfacet
+model (`specula::microfacet`): f = kd / pi + ks F(wo.h) D(h) G2(wo, wi) / (4 cos_o cos_i), the
+lobe as the normal distribution D = C(n) lobe(cos theta_h) normalised to a projected area of
+one, Smith's height-correlated G2 from the distribution's own Lambda (its projected area,
+tabulated at set-up at 64 cosines (k/63)^2 and read linearly in sqrt(cos), as specula's
+renderers read it), Schlick's F with `f0` (geometry and normalisation do not apply); its draws
+sample D cos theta_h from a table of lobe(t) t and reflect wo about the normal drawn.
+`eval` returns f cos(theta_i), as Mitsuba expects; the context's component and type masks are not consulted (both terms are always
 on, which is what the direct and path integrators ask for). Written in Dr.Jit operations only, so the same file runs in the scalar and the JIT
 (llvm, cuda) variants. The lobe's cosine is drawn as specula draws it: {warp}; about the
 mirror direction (Phong) or the normal (Blinn's half vector). Diffuse draws are
@@ -25,6 +33,11 @@ import mitsuba as mi
 NAME = "{name}"
 N_RANGE = ({low}, {high})
 GEOMETRIES = ("phong", "blinn")
+MODELS = ("classic", "microfacet")
+# The masking table's entries, at the cosines (k / 63)^2 (specula's `MASKING_ENTRIES`).
+MASKING_ENTRIES = 64
+# Simpson intervals of the set-up's integrals over theta = (pi / 2) s^2, s in [0, 1].
+QUADRATURE = 2048
 NORMALISATIONS = ({normalisations})
 TABLE_BINS = 1024
 # How the lobe's cosine is drawn: "closed-form", "newton" or "table".
@@ -95,8 +108,13 @@ class SpeculaBsdf(mi.BSDF):
         self.ks_rgb = _rgb(props, "ks", 1.0)
         self.geometry = _choice(props, "geometry", "{geometry}", GEOMETRIES)
         self.normalisation = _choice(props, "normalisation", "{normalisation}", NORMALISATIONS)
+        self.model = _choice(props, "model", "classic", MODELS)
+        self.f0_rgb = _rgb(props, "f0", 1.0)
         self.kd = mi.Color3f(*self.kd_rgb)
         self.ks = mi.Color3f(*self.ks_rgb)
+        self.f0 = mi.Color3f(*self.f0_rgb)
+        if self.model == "microfacet":
+            self._prepare_microfacet()
         if SAMPLING != "table":
             self.total = _total_math(0.0, {arguments})
         else:
@@ -120,6 +138,68 @@ class SpeculaBsdf(mi.BSDF):
                 edges.append(edge)
         values = [self._lobe_math(t) for t in edges]
         return mi.IrregularContinuousDistribution(_array(edges), _array(values))
+
+    def _prepare_microfacet(self):
+        """The distribution's normaliser C, its masking table and its sampling table, in double
+        precision: Simpson's rule over theta = (pi / 2) s^2, which crowds the nodes towards the
+        peak. The projected area seen from theta_o is int D(m) max(0, wo.m) dm, the azimuth
+        integrated in closed form, and G1 = cos theta_o / area (Smith)."""
+        nodes = []
+        for k in range(QUADRATURE + 1):
+            s = k / QUADRATURE
+            theta = 0.5 * math.pi * s * s
+            weight = (1.0 if k in (0, QUADRATURE) else 4.0 if k % 2 else 2.0) / (3.0 * QUADRATURE)
+            # d theta = pi s ds; the solid angle's sin theta.
+            weight *= math.pi * s * math.sin(theta)
+            nodes.append((math.cos(theta), math.sin(theta), weight * self._lobe_math(math.cos(theta))))
+        projected = 2.0 * math.pi * sum(c * w for c, _, w in nodes)
+        self.normaliser = 1.0 / projected
+
+        def area(cos_o):
+            sin_o = math.sqrt(max(0.0, 1.0 - cos_o * cos_o))
+            total = 0.0
+            for c, s, w in nodes:
+                a, b = cos_o * c, sin_o * s
+                if a >= b:
+                    ring = 2.0 * math.pi * a
+                elif a <= -b:
+                    ring = 0.0
+                else:
+                    phi = math.acos(-a / b)
+                    ring = 2.0 * (a * phi + b * math.sin(phi))
+                total += w * ring
+            return self.normaliser * total
+
+        masking = [0.0]
+        for k in range(1, MASKING_ENTRIES):
+            cos_o = (k / (MASKING_ENTRIES - 1)) ** 2
+            masking.append(min(1.0, cos_o / area(cos_o)))
+        self.masking = mi.ContinuousDistribution([0.0, 1.0], _array(masking))
+        edges = []
+        for k in range(TABLE_BINS, -1, -1):
+            edge = 0.0 if k == TABLE_BINS else _float32(math.cos(0.5 * math.pi * (k / TABLE_BINS) ** 2))
+            if not edges or edge > edges[-1]:
+                edges.append(edge)
+        self.normals = mi.IrregularContinuousDistribution(
+            _array(edges), _array([self._lobe_math(t) * t for t in edges]))
+
+    def _g1(self, cos):
+        return self.masking.eval_pdf(dr.sqrt(dr.clip(cos, 0.0, 1.0)))
+
+    def _g2(self, cos_o, cos_i):
+        a, b = self._g1(cos_o), self._g1(cos_i)
+        denominator = a + b - a * b
+        return dr.select(denominator > 0.0, a * b / dr.select(denominator > 0.0, denominator, 1.0), 0.0)
+
+    def _microfacet_brdf(self, wo, wi):
+        """ks F D G2 / (4 cos_o cos_i)."""
+        h = dr.normalize(wo + wi)
+        d = self.normaliser * self._lobe(h.z)
+        m = 1.0 - dr.clip(dr.dot(wo, h), 0.0, 1.0)
+        s = m * m * m * m * m
+        fresnel = self.f0 * (1.0 - s) + s
+        scale = d * self._g2(wo.z, wi.z) / (4.0 * wo.z * wi.z)
+        return self.ks * fresnel * scale
 
     def _lobe_math(self, t):
         return _lobe_unit_math(min(t, 1.0), {arguments}) if t > 0.0 else 0.0
@@ -181,6 +261,12 @@ class SpeculaBsdf(mi.BSDF):
         return _newton_cosine(x, {arguments})
 
     def _spec_pdf(self, wo, wi):
+        if self.model == "microfacet":
+            h = dr.normalize(wo + wi)
+            cos_oh = dr.dot(wo, h)
+            inside = (h.z > 0.0) & (cos_oh > 0.0)
+            density = self.normals.eval_pdf_normalized(dr.clip(h.z, 0.0, 1.0)) / (2.0 * dr.pi)
+            return dr.select(inside, density / (4.0 * dr.select(inside, cos_oh, 1.0)), 0.0)
         if self.geometry == "phong":
             return self._cosine_density(dr.dot(mi.reflect(wo), wi))
         h = dr.normalize(wo + wi)
@@ -193,13 +279,24 @@ class SpeculaBsdf(mi.BSDF):
         return dr.select(valid, p, 0.0)
 
     def _brdf_cos(self, wo, wi, valid):
-        f = self.kd * dr.inv_pi + self.ks * (self.norm * self._lobe(self._cosine(wo, wi)))
+        if self.model == "microfacet":
+            f = self.kd * dr.inv_pi + self._microfacet_brdf(wo, wi)
+        else:
+            f = self.kd * dr.inv_pi + self.ks * (self.norm * self._lobe(self._cosine(wo, wi)))
         return dr.select(valid, f * mi.Frame3f.cos_theta(wi), mi.Color3f(0.0))
 
     def _valid(self, wo, wi, active):
         return active & (mi.Frame3f.cos_theta(wo) > 0.0) & (mi.Frame3f.cos_theta(wi) > 0.0)
 
     def _sample_lobe(self, wo, u):
+        if self.model == "microfacet":
+            # A normal drawn with density D cos theta_h, wo reflected about it.
+            t = dr.clip(self.normals.sample(u.x), 0.0, 1.0)
+            sin_t = dr.safe_sqrt(dr.fma(-t, t, 1.0))
+            s, c = dr.sincos(dr.two_pi * u.y)
+            h = mi.Vector3f(sin_t * c, sin_t * s, t)
+            cos_oh = dr.dot(wo, h)
+            return 2.0 * cos_oh * h - wo, cos_oh > 0.0
         t = self._draw_cosine(u.x)
         sin_t = dr.safe_sqrt(dr.fma(-t, t, 1.0))
         s, c = dr.sincos(dr.two_pi * u.y)
@@ -251,8 +348,9 @@ class SpeculaBsdf(mi.BSDF):
         self._set_flags()
 
     def to_string(self):
-        return "%s[n=%g, geometry=%s, normalisation=%s, N=%g, kd=%s, ks=%s]" % (
-            NAME, self.n, self.geometry, self.normalisation, self.norm, self.kd_rgb, self.ks_rgb)
+        return "%s[n=%g, model=%s, geometry=%s, normalisation=%s, N=%g, kd=%s, ks=%s, f0=%s]" % (
+            NAME, self.n, self.model, self.geometry, self.normalisation, self.norm, self.kd_rgb,
+            self.ks_rgb, self.f0_rgb)
 
 
 mi.register_bsdf(NAME, lambda props: SpeculaBsdf(props))

@@ -65,8 +65,8 @@ pub enum FitModel {
     /// pow's fit.
     #[default]
     Classic,
-    /// The lobe as a microfacet normal distribution with Smith masking; the verdict against
-    /// GGX's fit.
+    /// The lobe as a microfacet normal distribution with Smith masking and Schlick's Fresnel
+    /// (F0 fitted); the verdict against GGX's fit in the same model.
     Microfacet,
 }
 
@@ -88,6 +88,7 @@ fn print_table(a: &Assessment) {
         "n",
         "kd",
         "K = ks N(n)",
+        "F0",
         "E",
         "vs pow",
         "vs ggx",
@@ -105,6 +106,7 @@ fn print_table(a: &Assessment) {
             parameter_text(&row.fit),
             triple(row.fit.kd),
             triple(row.fit.k),
+            row.fit.f0.map_or_else(|| "-".to_owned(), triple),
             format!("{:.5}", row.fit.error),
             format!("{:.3}", row.relative_to_pow),
             format!("{:.3}", row.relative_to_ggx),
@@ -116,7 +118,8 @@ fn print_table(a: &Assessment) {
     }
     table.print(crate::args::OutputFormat::Table);
     println!(
-        "E: {}; albedo: the fit's at normal incidence (luminance); rate: {}; *: at an end of the \
+        "E: {}; F0: Schlick's, fitted in the microfacet model (K is then ks, Fresnel's scale); \
+            albedo: the fit's at normal incidence (luminance); rate: {}; *: at an end of the \
             range searched.\n",
         a.error_measure, a.rate_unit
     );

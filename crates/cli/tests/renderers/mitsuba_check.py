@@ -3,6 +3,8 @@
 
     python mitsuba_check.py chi2 --plugin FILE.py --bsdf specula_pow --variant llvm_ad_rgb \
         [--n 8 64 512] [--theta 0 35 70] [--geometry phong blinn] [--kd 0] [--ks 1]
+    python mitsuba_check.py eval --plugin FILE.py --bsdf specula_pow --model microfacet \
+        [--n 64] [--kd 0] [--ks 1] [--f0 1] < PAIRS.json
     python mitsuba_check.py render --plugin FILE.py --bsdf specula_pow --scene SCENE.json \
         --output OUT.exr --variant scalar_rgb|llvm_ad_rgb [--frames N] [--threads T]
 
@@ -119,9 +121,10 @@ def rgb(value):
     return [float(v) for v in value]
 
 
-def bsdf_dict(bsdf, n, geometry, kd, ks, normalisation="lobe"):
+def bsdf_dict(bsdf, n, geometry, kd, ks, normalisation="lobe", model="classic", f0=1.0):
     return {"type": bsdf, "n": float(n), "geometry": geometry,
-            "normalisation": normalisation, "kd": rgb(kd), "ks": rgb(ks)}
+            "normalisation": normalisation, "kd": rgb(kd), "ks": rgb(ks), "model": model,
+            "f0": rgb(f0)}
 
 
 # --------------------------------------------------------------------------- chi-square
@@ -297,9 +300,11 @@ def cmd_chi2(args):
     override_settings(settings, args)
     cases = [(n, g, t) for n in args.n for g in args.geometry for t in args.theta]
     jobs = [(args.variant, os.path.abspath(args.plugin),
-             bsdf_dict(args.bsdf, n, g, args.kd, args.ks), t, args.seed, len(cases), settings)
+             bsdf_dict(args.bsdf, n, g, args.kd, args.ks, model=args.model, f0=args.f0), t,
+             args.seed, len(cases), settings)
             for n, g, t in cases]
-    print("# chi2 variant=%s kd=%s ks=%s %s" % (args.variant, args.kd, args.ks, settings))
+    print("# chi2 variant=%s model=%s kd=%s ks=%s %s" % (
+        args.variant, args.model, args.kd, args.ks, settings))
     failed = 0
     for (n, geometry, theta), (passed, p, messages, seconds) in zip(
             cases, run_cases(jobs, scalar)):
@@ -394,16 +399,53 @@ def cmd_render(args):
     return 0
 
 
+# --------------------------------------------------------------------------- eval
+
+def cmd_eval(args):
+    """The plugin's `eval` (f cos theta_i, Mitsuba's wo being specula's wi) and `pdf` at the
+    direction pairs read from stdin as JSON, [[wo, wi], ...] in the local frame; prints them
+    as JSON, [r, g, b, pdf] per pair."""
+    import json
+    mi = init_mitsuba(args.variant)
+    load_plugin(args.plugin)
+    bsdf = mi.load_dict(bsdf_dict(args.bsdf, args.n, args.geometry, args.kd, args.ks,
+                                  model=args.model, f0=args.f0))
+    ctx, si = mi.BSDFContext(), mi.SurfaceInteraction3f()
+    values = []
+    for wo, wi in json.load(sys.stdin):
+        si.wi = mi.Vector3f(*wo)
+        value = bsdf.eval(ctx, si, mi.Vector3f(*wi))
+        pdf = bsdf.pdf(ctx, si, mi.Vector3f(*wi))
+        values.append([float(dr_index(value, c)) for c in range(3)] + [float(dr_scalar(pdf))])
+    print(json.dumps(values))
+    return 0
+
+
+def dr_index(value, channel):
+    """One channel of a Color3f as a Python float, in any variant."""
+    return dr_scalar(value[channel])
+
+
+def dr_scalar(value):
+    """A one-element Dr.Jit value as a Python float, in any variant."""
+    import drjit as dr
+    return dr.slice(value) if dr.is_jit_v(value) else value
+
+
 # --------------------------------------------------------------------------- main
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
-    for name in ("chi2", "render"):
+    for name in ("chi2", "render", "eval"):
         p = sub.add_parser(name)
         p.add_argument("--plugin", required=True)
         p.add_argument("--bsdf", required=True)
         p.add_argument("--variant", default="scalar_rgb")
+    for name in ("chi2", "eval"):
+        p = sub.choices[name]
+        p.add_argument("--model", choices=["classic", "microfacet"], default="classic")
+        p.add_argument("--f0", type=float, nargs="+", default=[1.0])
     c = sub.choices["chi2"]
     c.add_argument("--n", type=float, nargs="+", default=[8, 64, 512])
     c.add_argument("--theta", type=float, nargs="+", default=[0, 35, 70])
@@ -415,6 +457,11 @@ def parse_args(argv):
     c.add_argument("--res", type=int, help="grid rows in cos theta (default: per variant kind)")
     c.add_argument("--ires", type=int, help="integration points per cell side (JIT only)")
     c.add_argument("--verbose", action="store_true")
+    e = sub.choices["eval"]
+    e.add_argument("--n", type=float, default=64.0)
+    e.add_argument("--geometry", default="blinn")
+    e.add_argument("--kd", type=float, nargs="+", default=[0.0])
+    e.add_argument("--ks", type=float, nargs="+", default=[1.0])
     r = sub.choices["render"]
     r.add_argument("--scene", required=True)
     r.add_argument("--output", required=True)
@@ -426,7 +473,7 @@ def parse_args(argv):
 
 def main(argv=None):
     args = parse_args(sys.argv[1:] if argv is None else argv)
-    return cmd_chi2(args) if args.command == "chi2" else cmd_render(args)
+    return {"chi2": cmd_chi2, "eval": cmd_eval, "render": cmd_render}[args.command](args)
 
 
 if __name__ == "__main__":

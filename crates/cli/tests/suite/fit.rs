@@ -192,20 +192,43 @@ fn the_microfacet_model_fits_every_lobe_as_a_distribution() {
     assert_eq!(report["model"], "microfacet");
     let fits = report["fits"].as_array().unwrap();
     let family = |f: &Value| f["specular"]["family"].as_str().unwrap().to_owned();
+    let normals = |f: &Value| f["specular"]["normals"].as_str().unwrap_or("").to_owned();
     let shared: Vec<&Value> = fits.iter().filter(|f| f["sharing"] == "shared").collect();
-    let distributions: Vec<&&Value> = shared
+    let in_model: Vec<&&Value> = shared
         .iter()
         .filter(|f| family(f) == "microfacet")
+        .collect();
+    let distributions: Vec<&&Value> = in_model
+        .iter()
+        .copied()
+        .filter(|f| !["ggx", "beckmann"].contains(&normals(f).as_str()))
         .collect();
     // Every built-in lobe as a distribution, beside its two classic fits, Beckmann and GGX.
     assert_eq!(distributions.len(), 13, "{report}");
     assert_eq!(shared.iter().filter(|f| family(f) == "lobe").count(), 26);
-    let ggx = shared.iter().find(|f| family(f) == "ggx").expect("GGX");
-    assert!(shared.iter().any(|f| family(f) == "beckmann"));
+    let ggx = in_model
+        .iter()
+        .find(|f| normals(f) == "ggx")
+        .expect("GGX's distribution");
+    assert!(in_model.iter().any(|f| normals(f) == "beckmann"));
+    // Every fit of the model has its Fresnel F0 per channel, in [0, 1]; the classic ones none.
+    for f in &shared {
+        let f0 = &f["f0"];
+        if family(f) == "microfacet" {
+            let f0: Vec<f64> = f0.as_array().expect("an F0").iter().map(number).collect();
+            assert!(
+                f0.len() == 3 && f0.iter().all(|v| (0.0..=1.0).contains(v)),
+                "{f}"
+            );
+        } else {
+            assert!(f0.is_null(), "{f}");
+        }
+    }
     let ggx_error = number(&ggx["error"]);
     let margin = number(&report["margin"]);
     let chosen = &fits[report["chosen"].as_u64().unwrap() as usize];
     assert_eq!(family(chosen), "microfacet");
+    assert!(!["ggx", "beckmann"].contains(&normals(chosen).as_str()));
     let within = |f: &Value| number(&f["error"]) <= (1.0 + margin) * ggx_error;
     if report["within_margin"] == true {
         assert!(within(chosen));

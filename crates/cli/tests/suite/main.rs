@@ -20,6 +20,7 @@ mod interrupt;
 mod materialx;
 mod measured;
 mod mitsuba;
+mod mitsuba_microfacet;
 mod python;
 mod readme;
 mod real_scans;

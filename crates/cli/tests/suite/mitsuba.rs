@@ -12,7 +12,7 @@ use specula_render::metrics::{mean_radiance, rms_difference};
 const EXPONENTS: [f64; 3] = [8.0, 64.0, 512.0];
 
 /// Runs the harness's chi-square test of `plugin` (in `dir`) and returns its output.
-fn chi2(
+pub(crate) fn chi2(
     dir: &std::path::Path,
     plugin: &str,
     name: &str,
@@ -39,7 +39,7 @@ fn chi2(
         .expect("python runs")
 }
 
-fn export(dir: &std::path::Path, lobe: &str, n: f64, file: &str) {
+pub(crate) fn export(dir: &std::path::Path, lobe: &str, n: f64, file: &str) {
     export_lobe(dir, lobe, n, "phong", "mitsuba", file);
 }
 

@@ -5,7 +5,7 @@
 
 use core::f64::consts::{FRAC_PI_2, TAU};
 
-use super::Distribution;
+use super::{fresnel_schlick, Distribution};
 use crate::quadrature::integrate_pieces;
 
 /// Azimuths of the inner, periodic trapezoid rule over the half vector.
@@ -25,6 +25,12 @@ const GAUSS_LEGENDRE: [(f64, f64); 4] = [
 /// reflection of `wo` about `h`, is above the horizon.
 #[must_use]
 pub fn directional_albedo(distribution: &Distribution, cos_o: f64) -> f64 {
+    directional_albedo_with_fresnel(distribution, cos_o, 1.0)
+}
+
+/// [`directional_albedo`] with Schlick's Fresnel of `f0` inside the integral.
+#[must_use]
+pub fn directional_albedo_with_fresnel(distribution: &Distribution, cos_o: f64, f0: f64) -> f64 {
     let width = distribution.width();
     let cos_o = cos_o.clamp(1e-6, 1.0);
     let sin_o = (1.0 - cos_o * cos_o).sqrt();
@@ -40,7 +46,7 @@ pub fn directional_albedo(distribution: &Distribution, cos_o: f64) -> f64 {
                 if cos <= 0.0 || wi_z <= 0.0 {
                     0.0
                 } else {
-                    distribution.g2(cos_o, wi_z) * cos
+                    distribution.g2(cos_o, wi_z) * cos * fresnel_schlick(f0, cos)
                 }
             })
             .sum();

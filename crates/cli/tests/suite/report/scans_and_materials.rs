@@ -174,6 +174,28 @@ fn microfacet_table(table: roxmltree::Node) {
     }
 }
 
+/// The microfacet costs: a row per lobe, per modelled GPU its term's throughput against the
+/// pow distribution's and against GGX's; pow's own is 1, and within a GPU the two columns'
+/// ratio is one number for every lobe (GGX's throughput over pow's).
+fn microfacet_costs(table: roxmltree::Node) {
+    let cells = cells(table);
+    assert_eq!(cells.len(), specula::LobeKind::ALL.len(), "{cells:?}");
+    let number = |text: &str| -> f64 { text.parse().expect("a number") };
+    let pow = cells.iter().find(|row| row[0] == "pow").expect("pow's row");
+    for column in [1, 3] {
+        assert_eq!(number(&pow[column]), 1.0, "{pow:?}");
+        let ratio = |row: &Vec<String>| number(&row[column]) / number(&row[column + 1]);
+        for row in &cells {
+            assert!(number(&row[column]) > 0.0, "{row:?}");
+            // Both printed to two places: the ratio agrees to their rounding.
+            assert!(
+                (ratio(row) - ratio(pow)).abs() < 0.03 * ratio(pow),
+                "{row:?} {pow:?}"
+            );
+        }
+    }
+}
+
 /// The real materials' section: every material in name order, each with its table (every
 /// lobe and GGX, one verdict), its polar plot and its renders, each fit's captioned with a mean
 /// FLIP against the measured render.
@@ -197,8 +219,10 @@ pub(super) fn materials(document: &roxmltree::Document, out: &std::path::Path) {
         .children()
         .filter(|n| n.has_tag_name("table"))
         .collect();
-    // A table per material, then the lobes as microfacet distributions across them.
-    assert_eq!(tables.len(), MATERIALS.len() + 1);
+    // A table per material, then the lobes as microfacet distributions across them, then
+    // what their whole microfacet terms cost.
+    assert_eq!(tables.len(), MATERIALS.len() + 2);
+    microfacet_costs(tables.pop().expect("the microfacet costs"));
     microfacet_table(tables.pop().expect("the microfacet table"));
     for table in tables {
         let cells = cells(table);

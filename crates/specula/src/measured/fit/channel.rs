@@ -1,4 +1,5 @@
-//! One channel's best `(kd, K)` for given specular values: the observations prepared once
+//! One channel's best linear coefficients for given specular columns: `kd` and `K` (and, with
+//! Fresnel, `K`'s split into `K F0` and `K (1 - F0)`), from the observations prepared once
 //! (cosines, lobe cosines, the data's cube roots), the weighted linear start and the projected
 //! Gauss-Newton steps on the cube-root error (see the module page of `fit`).
 
@@ -8,6 +9,9 @@ use glam::DVec3;
 
 use super::Observations;
 use crate::Geometry;
+
+/// The most coefficients a channel has: `kd` and two specular columns.
+pub(super) const MAX_COEFFICIENTS: usize = 3;
 
 /// Observations with what every fit needs computed once.
 pub(super) struct Prepared<'a> {
@@ -21,6 +25,112 @@ pub(super) struct Prepared<'a> {
     pub(super) target: [Vec<f64>; 3],
     /// Per channel, the weight that linearises the cube root at the data.
     pub(super) linearised: [Vec<f64>; 3],
+}
+
+/// A symmetric system of up to [`MAX_COEFFICIENTS`] unknowns, of which the first `size` are
+/// used: `minimise x' N x - 2 x' r`.
+#[derive(Clone, Copy)]
+struct Quadratic {
+    normal: [[f64; MAX_COEFFICIENTS]; MAX_COEFFICIENTS],
+    rhs: [f64; MAX_COEFFICIENTS],
+    size: usize,
+}
+
+impl Quadratic {
+    fn new(size: usize) -> Self {
+        Self {
+            normal: [[0.0; MAX_COEFFICIENTS]; MAX_COEFFICIENTS],
+            rhs: [0.0; MAX_COEFFICIENTS],
+            size,
+        }
+    }
+
+    /// Adds the row `row` with weight `w` and value `y`.
+    fn add(&mut self, row: &[f64; MAX_COEFFICIENTS], w: f64, y: f64) {
+        for a in 0..self.size {
+            for b in a..self.size {
+                self.normal[a][b] += w * row[a] * row[b];
+            }
+            self.rhs[a] += w * row[a] * y;
+        }
+    }
+
+    fn value(&self, x: &[f64; MAX_COEFFICIENTS]) -> f64 {
+        let mut value = 0.0;
+        for a in 0..self.size {
+            value -= 2.0 * x[a] * self.rhs[a];
+            for b in 0..self.size {
+                let (i, j) = if a <= b { (a, b) } else { (b, a) };
+                value += x[a] * self.normal[i][j] * x[b];
+            }
+        }
+        value
+    }
+
+    /// The minimiser with `x >= lower`: every choice of unknowns held at their bound is
+    /// tried (at most eight), the others solved freely with them held, and the best feasible
+    /// one kept. All held is always feasible, so there is an answer.
+    fn minimise_above(&self, lower: &[f64; MAX_COEFFICIENTS]) -> [f64; MAX_COEFFICIENTS] {
+        let mut best = (*lower, self.value(lower));
+        for free_set in 1..(1usize << self.size) {
+            let free: Vec<usize> = (0..self.size).filter(|i| free_set >> i & 1 == 1).collect();
+            let Some(x) = self.solve_with_held(&free, lower) else {
+                continue;
+            };
+            if (0..self.size).all(|i| x[i] >= lower[i]) {
+                let value = self.value(&x);
+                if value < best.1 {
+                    best = (x, value);
+                }
+            }
+        }
+        best.0
+    }
+
+    /// The unknowns in `free` solved with the others held at `held`, by Gaussian elimination;
+    /// `None` when the reduced system is singular.
+    fn solve_with_held(
+        &self,
+        free: &[usize],
+        held: &[f64; MAX_COEFFICIENTS],
+    ) -> Option<[f64; MAX_COEFFICIENTS]> {
+        let entry = |a: usize, b: usize| self.normal[a.min(b)][a.max(b)];
+        let k = free.len();
+        let mut system = [[0.0; MAX_COEFFICIENTS + 1]; MAX_COEFFICIENTS];
+        for (r, &a) in free.iter().enumerate() {
+            for (c, &b) in free.iter().enumerate() {
+                system[r][c] = entry(a, b);
+            }
+            let pushed: f64 = (0..self.size)
+                .filter(|i| !free.contains(i))
+                .map(|i| entry(a, i) * held[i])
+                .sum();
+            system[r][k] = self.rhs[a] - pushed;
+        }
+        // The system is positive semi-definite, so elimination needs no pivoting; a pivot is
+        // judged against its own diagonal entry (the columns' scales differ by many orders:
+        // the cube root's weights are huge where the data are dark).
+        for column in 0..k {
+            let own = entry(free[column], free[column]);
+            let pivot = system[column][column];
+            if pivot.is_nan() || pivot <= 1e-12 * own {
+                return None;
+            }
+            let pivot_row = system[column];
+            for row in &mut system[column + 1..k] {
+                let factor = row[column] / pivot;
+                for (value, &above) in row.iter_mut().zip(&pivot_row).skip(column) {
+                    *value -= factor * above;
+                }
+            }
+        }
+        let mut x = *held;
+        for row in (0..k).rev() {
+            let known: f64 = (row + 1..k).map(|c| system[row][c] * x[free[c]]).sum();
+            x[free[row]] = (system[row][k] - known) / system[row][row];
+        }
+        x.iter().all(|v| v.is_finite()).then_some(x)
+    }
 }
 
 impl<'a> Prepared<'a> {
@@ -59,59 +169,69 @@ impl<'a> Prepared<'a> {
         }
     }
 
-    /// The error sum of channel `c` with `(kd, K)` over specular values `specular`; the
+    /// Observation `j`'s row: the diffuse term's and each specular column's `f cos` per unit
+    /// coefficient.
+    fn row(&self, columns: &[Vec<f64>], j: usize) -> [f64; MAX_COEFFICIENTS] {
+        let mut row = [0.0; MAX_COEFFICIENTS];
+        row[0] = FRAC_1_PI * self.cosine[j];
+        for (slot, column) in row[1..].iter_mut().zip(columns) {
+            *slot = column[j] * self.cosine[j];
+        }
+        row
+    }
+
+    /// The error sum of channel `c` with coefficients `x` over specular `columns`; the
     /// model's cube roots are left in `roots` for the next Gauss-Newton step.
-    fn cost(&self, c: usize, specular: &[f64], [kd, k]: [f64; 2], roots: &mut [f64]) -> f64 {
+    fn cost(
+        &self,
+        c: usize,
+        columns: &[Vec<f64>],
+        x: &[f64; MAX_COEFFICIENTS],
+        roots: &mut [f64],
+    ) -> f64 {
         let mut sum = 0.0;
         for (j, root) in roots.iter_mut().enumerate() {
-            *root = cube_root((kd * FRAC_1_PI + k * specular[j]) * self.cosine[j]);
+            let row = self.row(columns, j);
+            let model: f64 = row.iter().zip(x).map(|(a, b)| a * b).sum();
+            *root = cube_root(model);
             let r = self.target[c][j] - *root;
             sum += self.weight[j] * r * r;
         }
         sum
     }
 
-    /// The best `(kd, K) >= 0` of channel `c` for these specular values, and its cost.
-    pub(super) fn solve_channel(&self, c: usize, specular: &[f64]) -> ([f64; 2], f64) {
-        let p = |j: usize| FRAC_1_PI * self.cosine[j];
-        let q = |j: usize| specular[j] * self.cosine[j];
+    /// The best coefficients `>= 0` of channel `c` for these specular `columns` (one or two):
+    /// `[kd, K]` or `[kd, K F0, K (1 - F0)]`, unused ones 0, and the cost.
+    pub(super) fn solve_channel(
+        &self,
+        c: usize,
+        columns: &[Vec<f64>],
+    ) -> ([f64; MAX_COEFFICIENTS], f64) {
+        let size = 1 + columns.len();
+        let count = self.cosine.len();
         // The start: weighted least squares in f cos with the cube root's slope as weight.
-        let mut normal = [[0.0; 2]; 2];
-        let mut rhs = [0.0; 2];
-        for j in 0..specular.len() {
-            let (a, b, w) = (p(j), q(j), self.linearised[c][j]);
+        let mut start = Quadratic::new(size);
+        for j in 0..count {
             let y = self.target[c][j].powi(3);
-            normal[0][0] += w * a * a;
-            normal[0][1] += w * a * b;
-            normal[1][1] += w * b * b;
-            rhs[0] += w * a * y;
-            rhs[1] += w * b * y;
+            start.add(&self.row(columns, j), self.linearised[c][j], y);
         }
-        let mut x = solve_nonnegative(normal, rhs);
-        let (mut roots, mut trial_roots) = (vec![0.0; specular.len()], vec![0.0; specular.len()]);
-        let mut cost = self.cost(c, specular, x, &mut roots);
+        let mut x = start.minimise_above(&[0.0; MAX_COEFFICIENTS]);
+        let (mut roots, mut trial_roots) = (vec![0.0; count], vec![0.0; count]);
+        let mut cost = self.cost(c, columns, &x, &mut roots);
         for _ in 0..6 {
-            let mut normal = [[0.0; 2]; 2];
-            let mut rhs = [0.0; 2];
+            let mut step = Quadratic::new(size);
             for (j, &root) in roots.iter().enumerate() {
                 // The root's slope, bounded where the model vanishes.
                 let slope = 1.0 / (3.0 * root.max(1e-4).powi(2));
-                let (a, b) = (slope * p(j), slope * q(j));
-                let (w, r) = (self.weight[j], self.target[c][j] - root);
-                normal[0][0] += w * a * a;
-                normal[0][1] += w * a * b;
-                normal[1][1] += w * b * b;
-                rhs[0] += w * a * r;
-                rhs[1] += w * b * r;
+                let row = self.row(columns, j).map(|a| slope * a);
+                step.add(&row, self.weight[j], self.target[c][j] - root);
             }
-            let step = solve_nonnegative_step(normal, rhs, x);
+            let direction = step.minimise_above(&x.map(|v| -v));
             let mut scale = 1.0;
             let improved = loop {
-                let trial = [
-                    (x[0] + scale * step[0]).max(0.0),
-                    (x[1] + scale * step[1]).max(0.0),
-                ];
-                let trial_cost = self.cost(c, specular, trial, &mut trial_roots);
+                let trial: [f64; MAX_COEFFICIENTS] =
+                    core::array::from_fn(|i| (x[i] + scale * direction[i]).max(0.0));
+                let trial_cost = self.cost(c, columns, &trial, &mut trial_roots);
                 if trial_cost < cost {
                     break Some((trial, trial_cost));
                 }
@@ -149,80 +269,61 @@ fn cube_root(x: f64) -> f64 {
     y
 }
 
-/// The 2x2 symmetric system `normal x = rhs` solved with `x >= 0` (each bound tried when
-/// the unconstrained solution breaks it).
-fn solve_nonnegative(normal: [[f64; 2]; 2], rhs: [f64; 2]) -> [f64; 2] {
-    let det = normal[0][0] * normal[1][1] - normal[0][1] * normal[0][1];
-    if det > 1e-300 {
-        let x = [
-            (rhs[0] * normal[1][1] - rhs[1] * normal[0][1]) / det,
-            (rhs[1] * normal[0][0] - rhs[0] * normal[0][1]) / det,
-        ];
-        if x[0] >= 0.0 && x[1] >= 0.0 {
-            return x;
-        }
-    }
-    let only_diffuse = [(rhs[0] / normal[0][0]).max(0.0), 0.0];
-    let only_specular = [0.0, (rhs[1] / normal[1][1]).max(0.0)];
-    let residual = |x: [f64; 2]| {
-        // The quadratic's value up to a constant: x' N x - 2 x' rhs.
-        x[0] * x[0] * normal[0][0] + 2.0 * x[0] * x[1] * normal[0][1] + x[1] * x[1] * normal[1][1]
-            - 2.0 * (x[0] * rhs[0] + x[1] * rhs[1])
-    };
-    let candidates = [only_diffuse, only_specular].map(|x| {
-        if x.iter().all(|v| v.is_finite()) {
-            x
-        } else {
-            [0.0; 2]
-        }
-    });
-    if residual(candidates[0]) <= residual(candidates[1]) {
-        candidates[0]
-    } else {
-        candidates[1]
-    }
-}
-
-/// The Gauss-Newton step from `x` within `x + step >= 0`: the free step where it stays
-/// inside, else the better (by the Gauss-Newton model) of the two steps with one parameter
-/// moved to its bound 0 and the other solved with it there.
-fn solve_nonnegative_step(normal: [[f64; 2]; 2], rhs: [f64; 2], x: [f64; 2]) -> [f64; 2] {
-    let det = normal[0][0] * normal[1][1] - normal[0][1] * normal[0][1];
-    if det > 1e-300 {
-        let free = [
-            (rhs[0] * normal[1][1] - rhs[1] * normal[0][1]) / det,
-            (rhs[1] * normal[0][0] - rhs[0] * normal[0][1]) / det,
-        ];
-        if x[0] + free[0] >= 0.0 && x[1] + free[1] >= 0.0 {
-            return free;
-        }
-    }
-    // The model's value of a step, up to a constant: step' N step - 2 step' rhs.
-    let model = |d: [f64; 2]| {
-        d[0] * d[0] * normal[0][0] + 2.0 * d[0] * d[1] * normal[0][1] + d[1] * d[1] * normal[1][1]
-            - 2.0 * (d[0] * rhs[0] + d[1] * rhs[1])
-    };
-    let pinned = |at: usize| {
-        let other = 1 - at;
-        let mut step = [0.0; 2];
-        step[at] = -x[at];
-        if normal[other][other] > 0.0 {
-            step[other] =
-                ((rhs[other] - normal[0][1] * step[at]) / normal[other][other]).max(-x[other]);
-        }
-        step
-    };
-    let (a, b) = (pinned(0), pinned(1));
-    if model(a) <= model(b) {
-        a
-    } else {
-        b
-    }
-}
-
 #[cfg(test)]
 mod tests {
-    use super::cube_root;
+    use super::{cube_root, Quadratic, MAX_COEFFICIENTS};
+
+    /// The bounded minimiser meets Karush, Kuhn and Tucker's conditions, the second method:
+    /// the gradient `2 (N x - r)` vanishes in every unknown off its bound and points up
+    /// (is non-negative) in every unknown at it, on random positive definite systems with
+    /// random bounds, the unknowns' scales apart by up to eight orders (as a dark channel's
+    /// cube-root weights make them).
+    #[test]
+    fn the_bounded_minimiser_meets_the_optimality_conditions() {
+        let mut state = 0x9E37_79B9_7F4A_7C15_u64;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut held_somewhere = 0;
+        for case in 0..2000 {
+            let size = 2 + case % 2;
+            let mut q = Quadratic::new(size);
+            let scales: [f64; MAX_COEFFICIENTS] =
+                core::array::from_fn(|_| 10f64.powf(4.0 * uniform()));
+            for _ in 0..6 {
+                let row: [f64; MAX_COEFFICIENTS] = core::array::from_fn(|i| uniform() * scales[i]);
+                q.add(&row, 1.0, 3.0 * uniform());
+            }
+            let lower: [f64; MAX_COEFFICIENTS] =
+                core::array::from_fn(|i| (uniform() - 0.5) / scales[i]);
+            let x = q.minimise_above(&lower);
+            for a in 0..size {
+                let gradient: f64 = (0..size)
+                    .map(|b| q.normal[a.min(b)][a.max(b)] * x[b])
+                    .sum::<f64>()
+                    - q.rhs[a];
+                // The gradient's scale: its terms' sizes.
+                let scale: f64 = (0..size)
+                    .map(|b| (q.normal[a.min(b)][a.max(b)] * x[b]).abs())
+                    .sum::<f64>()
+                    + q.rhs[a].abs();
+                assert!(x[a] >= lower[a], "case {case}: below the bound");
+                if x[a] > lower[a] {
+                    assert!(gradient.abs() < 1e-9 * scale, "case {case}: {gradient}");
+                } else {
+                    held_somewhere += 1;
+                    assert!(gradient > -1e-9 * scale, "case {case}: {gradient}");
+                }
+            }
+        }
+        assert!(
+            held_somewhere > 100,
+            "the bounds never bound: {held_somewhere}"
+        );
+    }
 
     #[test]
     fn the_cube_root_agrees_with_the_library_to_rounding() {

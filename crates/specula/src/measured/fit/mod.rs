@@ -9,10 +9,12 @@
 //! with Smith's height-correlated masking, `alpha` in place of `n` and no Fresnel term (the
 //! lobes have none either; `K` plays a constant `F0`).
 //!
-//! **The microfacet model** ([`microfacet_families`]) puts each lobe where GGX's `D` is: `kd /
-//! pi + K D_lobe(h) G2(wo, wi) / (4 cos(theta_o) cos(theta_i))`, with the lobe's own
-//! normalisation and masking ([`crate::microfacet`]), `n` its parameter; Beckmann's
-//! distribution stands beside GGX. Fitted exactly as the classic model is.
+//! **The microfacet model** ([`microfacet_families`]) puts each lobe where GGX's `D` is,
+//! with Schlick's Fresnel: `kd / pi + K F(wo.h) D_lobe(h) G2(wo, wi) / (4 cos(theta_o)
+//! cos(theta_i))`, `F = F0 + (1 - F0) (1 - wo.h)^5`, with the lobe's own normalisation and
+//! masking ([`crate::microfacet`]), `n` its parameter; Beckmann's and GGX's distributions
+//! stand beside them, in the same model. `K F` is linear in `K F0` and `K (1 - F0)`, so the
+//! Fresnel term adds a third linear coefficient, not a search dimension ([`Fit::f0`]).
 //!
 //! **Error**, in the spirit of Ngan, Durand and Matusik (2005): the material and the model
 //! are compared as `f cos(theta_i)`, the radiance a unit irradiance reflects, at the
@@ -23,10 +25,10 @@
 //! `E = sqrt( sum_j w_j sum_c (cbrt(y_jc cos_j) - cbrt(m_jc cos_j))^2 / 3 )`, weights summing
 //! to 1. [`Fit::error`] is that `E`; the per-channel figures split it.
 //!
-//! **Optimiser.** For a given `n` the best `(kd, K)` of a channel is a two-parameter
-//! problem that is linear but for the cube root: it starts from the weighted linear least
-//! squares that linearises the root at the data and takes projected Gauss-Newton steps
-//! (`kd, K >= 0`). Over `n` the error is not convex (a lobe can fit the sheen or the peak),
+//! **Optimiser.** For a given `n` the best `(kd, K)` of a channel (with Fresnel, `(kd, K F0,
+//! K (1 - F0))`) is a problem that is linear but for the cube root: it starts from the
+//! weighted linear least squares that linearises the root at the data and takes projected
+//! Gauss-Newton steps (every coefficient `>= 0`, so `F0` lies in `[0, 1]`). Over `n` the error is not convex (a lobe can fit the sheen or the peak),
 //! so `ln n` is first scanned on a grid of [`GRID_POINTS`] over `[1, 1000]`, then refined by
 //! Brent's method (the `argmin` crate) between the best grid point's neighbours: a global
 //! start, then a local polish. The same procedure fits GGX's `ln alpha` over
@@ -36,7 +38,10 @@ mod channel;
 mod observations;
 pub mod verdict;
 
-use channel::Prepared;
+use channel::{Prepared, MAX_COEFFICIENTS};
+
+/// A channel's coefficients (`kd`, then the specular columns') and its error sum.
+type Solution = ([f64; MAX_COEFFICIENTS], f64);
 
 use core::f64::consts::FRAC_1_PI;
 
@@ -49,8 +54,8 @@ use serde::Serialize;
 pub use observations::{comparison_pairs, Observations, GRID, MAX_ELEVATION_DEGREES};
 
 use crate::analysis::albedo::specular_albedo_per_unit;
-use crate::microfacet::energy::directional_albedo;
-use crate::microfacet::Distribution;
+use crate::microfacet::energy::directional_albedo_with_fresnel;
+use crate::microfacet::{fresnel_schlick, Distribution};
 use crate::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 
 /// Points of the global scan over `ln n` (or `ln alpha`).
@@ -71,17 +76,44 @@ pub enum Specular {
         /// Phong or Blinn.
         geometry: Geometry,
     },
-    /// The GGX microfacet model.
+    /// GGX in the classic model's comparison: `D G2 / (4 cos_o cos_i)` without Fresnel, `K`
+    /// a constant `F0`, as the lobes have no Fresnel term either.
     Ggx,
-    /// One of specula's lobes as the normal distribution of a microfacet model,
-    /// `D G2 / (4 cos_o cos_i)` ([`crate::microfacet`]), `n` its parameter.
+    /// The microfacet model, `D G2 F / (4 cos_o cos_i)` with Schlick's Fresnel, its `F0`
+    /// fitted ([`crate::microfacet`]).
     Microfacet {
-        /// The lobe.
-        #[serde(serialize_with = "serialize_kind")]
-        kind: LobeKind,
+        /// The distribution of normals.
+        normals: Normals,
     },
-    /// Beckmann's distribution in the same microfacet model, `alpha` its parameter.
+}
+
+/// The normal distribution of a [`Specular::Microfacet`] family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Normals {
+    /// One of specula's lobes, `n` its parameter.
+    Lobe(LobeKind),
+    /// Beckmann's, `alpha` its parameter.
     Beckmann,
+    /// GGX's (Trowbridge and Reitz's), `alpha` its parameter.
+    Ggx,
+}
+
+impl Normals {
+    /// The lobe's id, `beckmann` or `ggx`.
+    #[must_use]
+    pub fn id(self) -> String {
+        match self {
+            Normals::Lobe(kind) => kind.to_string(),
+            Normals::Beckmann => "beckmann".into(),
+            Normals::Ggx => "ggx".into(),
+        }
+    }
+}
+
+impl Serialize for Normals {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.id())
+    }
 }
 
 fn serialize_kind<S: serde::Serializer>(kind: &LobeKind, s: S) -> Result<S::Ok, S::Error> {
@@ -89,82 +121,135 @@ fn serialize_kind<S: serde::Serializer>(kind: &LobeKind, s: S) -> Result<S::Ok, 
 }
 
 impl Specular {
-    /// A short name: `pow/phong`, `ggx`.
+    /// A short name: `pow/phong`, `ggx`, `pow/microfacet`, `ggx/microfacet`.
     #[must_use]
     pub fn label(self) -> String {
         match self {
             Specular::Lobe { kind, geometry } => format!("{kind}/{}", geometry.id()),
             Specular::Ggx => "ggx".into(),
-            Specular::Microfacet { kind } => format!("{kind}/microfacet"),
-            Specular::Beckmann => "beckmann".into(),
+            Specular::Microfacet { normals } => format!("{}/microfacet", normals.id()),
         }
     }
 
-    /// The lobe of a classic or microfacet family (`None` for Beckmann and GGX).
+    /// The lobe of a classic family or a lobe's distribution (`None` for Beckmann and GGX).
     #[must_use]
     pub fn kind(self) -> Option<LobeKind> {
         match self {
-            Specular::Lobe { kind, .. } | Specular::Microfacet { kind } => Some(kind),
-            Specular::Ggx | Specular::Beckmann => None,
+            Specular::Lobe { kind, .. }
+            | Specular::Microfacet {
+                normals: Normals::Lobe(kind),
+            } => Some(kind),
+            Specular::Ggx | Specular::Microfacet { .. } => None,
         }
     }
 
     /// Whether the shape parameter is a roughness `alpha` (else an exponent `n`).
     #[must_use]
     pub fn takes_alpha(self) -> bool {
-        matches!(self, Specular::Ggx | Specular::Beckmann)
+        matches!(
+            self,
+            Specular::Ggx
+                | Specular::Microfacet {
+                    normals: Normals::Beckmann | Normals::Ggx
+                }
+        )
+    }
+
+    /// Whether the family has Schlick's Fresnel term with a fitted `F0`.
+    #[must_use]
+    pub fn has_fresnel(self) -> bool {
+        matches!(self, Specular::Microfacet { .. })
+    }
+
+    /// This family's specular shape at `parameter`: a lobe in its geometry, or a
+    /// distribution of normals.
+    #[must_use]
+    pub fn shape(self, parameter: f64) -> Shape {
+        let exponent = Exponent::clamped(parameter);
+        match self {
+            Specular::Lobe { kind, geometry } => Shape::Lobe {
+                lobe: Lobe::new(kind, exponent),
+                geometry,
+            },
+            Specular::Ggx
+            | Specular::Microfacet {
+                normals: Normals::Ggx,
+            } => Shape::Microfacet(Distribution::Ggx { alpha: parameter }),
+            Specular::Microfacet {
+                normals: Normals::Beckmann,
+            } => Shape::Microfacet(Distribution::Beckmann { alpha: parameter }),
+            Specular::Microfacet {
+                normals: Normals::Lobe(kind),
+            } => Shape::Microfacet(Distribution::lobe(kind, exponent)),
+        }
     }
 
     /// The microfacet distribution of this family at `parameter` (`None` for the classic
     /// lobes, which are no distribution of normals).
     #[must_use]
     pub fn distribution(self, parameter: f64) -> Option<Distribution> {
-        match self {
-            Specular::Lobe { .. } => None,
-            Specular::Ggx => Some(Distribution::Ggx { alpha: parameter }),
-            Specular::Beckmann => Some(Distribution::Beckmann { alpha: parameter }),
-            Specular::Microfacet { kind } => {
-                Some(Distribution::lobe(kind, Exponent::clamped(parameter)))
-            }
+        match self.shape(parameter) {
+            Shape::Lobe { .. } => None,
+            Shape::Microfacet(distribution) => Some(distribution),
         }
     }
 
     /// The searched range of the shape parameter's logarithm.
     fn log_range(self) -> [f64; 2] {
-        match self {
-            Specular::Lobe { .. } | Specular::Microfacet { .. } => {
-                [Exponent::MIN.ln(), Exponent::MAX.ln()]
-            }
-            Specular::Ggx | Specular::Beckmann => ALPHA_RANGE.map(f64::ln),
+        if self.takes_alpha() {
+            ALPHA_RANGE.map(f64::ln)
+        } else {
+            [Exponent::MIN.ln(), Exponent::MAX.ln()]
         }
     }
 
-    /// The specular term per unit `K` at every observation (without the cosine).
-    fn values(self, parameter: f64, observations: &Prepared) -> Vec<f64> {
-        match self {
-            Specular::Lobe { kind, geometry } => {
-                let lobe = Lobe::new(kind, Exponent::clamped(parameter));
+    /// The specular term's columns per unit coefficient at every observation (without the
+    /// cosine): the lobe, or `D G2 / (4 cos_o cos_i)`; with Fresnel, that term and the same
+    /// times Schlick's `(1 - wo.h)^5`, the model being `K F0 M + K (1 - F0) M S`.
+    fn columns(self, parameter: f64, observations: &Prepared) -> Vec<Vec<f64>> {
+        let distribution = match self.shape(parameter) {
+            Shape::Lobe { lobe, geometry } => {
                 let t = match geometry {
                     Geometry::Phong => &observations.t_phong,
                     Geometry::Blinn => &observations.t_blinn,
                 };
-                t.iter().map(|&t| lobe.eval(t)).collect()
+                return vec![t.iter().map(|&t| lobe.eval(t)).collect()];
             }
-            Specular::Ggx | Specular::Microfacet { .. } | Specular::Beckmann => self
-                .distribution(parameter)
-                .map_or_else(Vec::new, |distribution| {
-                    observations
-                        .pairs
-                        .iter()
-                        .map(|&(wo, wi)| microfacet_specular(&distribution, wo, wi))
-                        .collect()
-                }),
+            Shape::Microfacet(distribution) => distribution,
+        };
+        let term: Vec<f64> = observations
+            .pairs
+            .iter()
+            .map(|&(wo, wi)| microfacet_specular(&distribution, wo, wi))
+            .collect();
+        if !self.has_fresnel() {
+            return vec![term];
         }
+        let schlick = observations
+            .pairs
+            .iter()
+            .zip(&term)
+            .map(|(&(wo, wi), m)| m * fresnel_schlick(0.0, wo.dot((wo + wi).normalize())))
+            .collect();
+        vec![term, schlick]
     }
 }
 
-/// A distribution's `D G2 / (4 cos_o cos_i)`, no Fresnel (the fit's `K` plays a constant
-/// `F0`).
+/// A family's specular shape at one parameter.
+#[derive(Clone, Debug)]
+pub enum Shape {
+    /// A lobe of the cosine `t` in a geometry.
+    Lobe {
+        /// The lobe at its `n`.
+        lobe: Lobe,
+        /// Phong or Blinn.
+        geometry: Geometry,
+    },
+    /// A distribution of normals in the microfacet model.
+    Microfacet(Distribution),
+}
+
+/// A distribution's `D G2 / (4 cos_o cos_i)`, without Fresnel.
 #[must_use]
 pub fn microfacet_specular(distribution: &Distribution, wo: DVec3, wi: DVec3) -> f64 {
     if wo.z <= 0.0 || wi.z <= 0.0 {
@@ -195,8 +280,11 @@ pub struct Fit {
     pub parameter: [f64; 3],
     /// Diffuse reflectance per channel.
     pub kd: [f64; 3],
-    /// `K = ks N(n)`, the specular scale of the peak-1 lobe, per channel.
+    /// `K = ks N(n)`, the specular scale of the peak-1 lobe, per channel (a microfacet
+    /// family's `ks`, its Fresnel factor's scale).
     pub k: [f64; 3],
+    /// Schlick's `F0` per channel, in the microfacet model (`None` in the classic one).
+    pub f0: Option<[f64; 3]>,
     /// The fit error `E` (see the module page).
     pub error: f64,
     /// Each channel's share, `sqrt(sum_j w_j r_jc^2)`.
@@ -232,15 +320,11 @@ impl Fit {
     #[must_use]
     pub fn albedo_at_normal(&self) -> [f64; 3] {
         core::array::from_fn(|c| {
-            let specular = match self.specular {
-                Specular::Lobe { kind, geometry } => {
-                    let lobe = Lobe::new(kind, Exponent::clamped(self.parameter[c]));
-                    specular_albedo_per_unit(&lobe, geometry, 0.0)
+            let specular = match self.specular.shape(self.parameter[c]) {
+                Shape::Lobe { lobe, geometry } => specular_albedo_per_unit(&lobe, geometry, 0.0),
+                Shape::Microfacet(d) => {
+                    directional_albedo_with_fresnel(&d, 1.0, self.f0.map_or(1.0, |f0| f0[c]))
                 }
-                Specular::Ggx | Specular::Microfacet { .. } | Specular::Beckmann => self
-                    .specular
-                    .distribution(self.parameter[c])
-                    .map_or(0.0, |d| directional_albedo(&d, 1.0)),
             };
             self.kd[c] + self.k[c] * specular
         })
@@ -253,60 +337,36 @@ impl Fit {
         FittedModel {
             kd: DVec3::from_array(self.kd),
             k: DVec3::from_array(self.k),
-            shape: match self.specular {
-                Specular::Lobe { kind, geometry } => FittedShape::Lobe {
-                    lobes: Box::new(
-                        self.parameter
-                            .map(|n| Lobe::new(kind, Exponent::clamped(n))),
-                    ),
-                    geometry,
-                },
-                Specular::Ggx | Specular::Microfacet { .. } | Specular::Beckmann => {
-                    FittedShape::Microfacet(Box::new(self.parameter.map(|p| {
-                        self.specular
-                            .distribution(p)
-                            .unwrap_or(Distribution::Ggx { alpha: p })
-                    })))
-                }
-            },
+            f0: self.f0.map(DVec3::from_array),
+            shapes: Box::new(self.parameter.map(|p| self.specular.shape(p))),
         }
     }
 }
 
-/// A [`Fit`] ready to evaluate: `f = kd / pi + K spec(wo, wi)` per channel.
+/// A [`Fit`] ready to evaluate: `f = kd / pi + K spec(wo, wi)` per channel, the specular
+/// term times Schlick's Fresnel where the fit has an `F0`.
 #[derive(Clone, Debug)]
 pub struct FittedModel {
     kd: DVec3,
     k: DVec3,
-    shape: FittedShape,
-}
-
-/// The specular term's prepared form, per channel.
-#[derive(Clone, Debug)]
-enum FittedShape {
-    Lobe {
-        lobes: Box<[Lobe; 3]>,
-        geometry: Geometry,
-    },
-    /// A distribution per channel (GGX's, Beckmann's, a lobe's).
-    Microfacet(Box<[Distribution; 3]>),
+    f0: Option<DVec3>,
+    /// Each channel's shape.
+    shapes: Box<[Shape; 3]>,
 }
 
 impl FittedModel {
-    /// The specular term per unit `K`, per channel (without the cosine).
+    /// The specular term per unit `K`, per channel (without the cosine), Fresnel included.
     #[must_use]
     pub fn specular(&self, wo: DVec3, wi: DVec3) -> DVec3 {
-        match &self.shape {
-            FittedShape::Lobe { lobes, geometry } => {
-                let t = geometry.cos_lobe_local(wo, wi);
-                DVec3::new(lobes[0].eval(t), lobes[1].eval(t), lobes[2].eval(t))
-            }
-            FittedShape::Microfacet(distributions) => DVec3::new(
-                microfacet_specular(&distributions[0], wo, wi),
-                microfacet_specular(&distributions[1], wo, wi),
-                microfacet_specular(&distributions[2], wo, wi),
-            ),
-        }
+        let fresnel = self.f0.map_or(DVec3::ONE, |f0| {
+            let cos = wo.dot((wo + wi).normalize());
+            f0.to_array().map(|f0| fresnel_schlick(f0, cos)).into()
+        });
+        let value = |shape: &Shape| match shape {
+            Shape::Lobe { lobe, geometry } => lobe.eval(geometry.cos_lobe_local(wo, wi)),
+            Shape::Microfacet(distribution) => microfacet_specular(distribution, wo, wi),
+        };
+        fresnel * DVec3::from_array(self.shapes.each_ref().map(value))
     }
 
     /// `f(wo, wi)` per channel; zero when either direction is at or below the horizon.
@@ -325,7 +385,8 @@ impl FittedModel {
     }
 }
 
-/// One shape parameter's profile: its best error over `(kd, K)` for some channels.
+/// One shape parameter's profile: its best error over the linear coefficients for some
+/// channels.
 struct Profile<'p, 'a> {
     prepared: &'p Prepared<'a>,
     specular: Specular,
@@ -333,12 +394,12 @@ struct Profile<'p, 'a> {
 }
 
 impl Profile<'_, '_> {
-    fn solve(&self, log_parameter: f64) -> (Vec<([f64; 2], f64)>, f64) {
-        let values = self.specular.values(log_parameter.exp(), self.prepared);
-        let solutions: Vec<([f64; 2], f64)> = self
+    fn solve(&self, log_parameter: f64) -> (Vec<Solution>, f64) {
+        let columns = self.specular.columns(log_parameter.exp(), self.prepared);
+        let solutions: Vec<Solution> = self
             .channels
             .iter()
-            .map(|&c| self.prepared.solve_channel(c, &values))
+            .map(|&c| self.prepared.solve_channel(c, &columns))
             .collect();
         let total = solutions.iter().map(|s| s.1).sum();
         (solutions, total)
@@ -364,8 +425,8 @@ fn scan(prepared: &Prepared, specular: Specular) -> (Vec<f64>, Vec<[f64; 3]>) {
     let costs = grid
         .iter()
         .map(|&p| {
-            let values = specular.values(p.exp(), prepared);
-            core::array::from_fn(|c| prepared.solve_channel(c, &values).1)
+            let columns = specular.columns(p.exp(), prepared);
+            core::array::from_fn(|c| prepared.solve_channel(c, &columns).1)
         })
         .collect();
     (grid, costs)
@@ -412,14 +473,27 @@ pub fn fit(observations: &Observations, specular: Specular, sharing: Sharing) ->
 /// Both fits of one family, from one scan.
 fn fit_family(prepared: &Prepared, specular: Specular) -> [Fit; 2] {
     let (grid, costs) = scan(prepared, specular);
-    let fit = |sharing, parameter: [f64; 3], solutions: [([f64; 2], f64); 3]| {
+    let fit = |sharing, parameter: [f64; 3], solutions: [Solution; 3]| {
         let channel_error = solutions.map(|(_, cost)| cost.sqrt());
+        // With Fresnel the coefficients are `K F0` and `K (1 - F0)`; `F0` is 0 (any) where
+        // `K` is.
+        let k = solutions.map(|(x, _)| x[1] + x[2]);
+        let f0 = specular.has_fresnel().then(|| {
+            core::array::from_fn(|c| {
+                if k[c] > 0.0 {
+                    solutions[c].0[1] / k[c]
+                } else {
+                    0.0
+                }
+            })
+        });
         Fit {
             specular,
             sharing,
             parameter: parameter.map(f64::exp),
-            kd: solutions.map(|([kd, _], _)| kd),
-            k: solutions.map(|([_, k], _)| k),
+            kd: solutions.map(|(x, _)| x[0]),
+            k,
+            f0,
             error: (channel_error.iter().map(|e| e * e).sum::<f64>() / 3.0).sqrt(),
             channel_error,
         }
@@ -490,8 +564,9 @@ pub fn families(kinds: &[LobeKind]) -> Vec<Specular> {
 pub fn microfacet_families(kinds: &[LobeKind]) -> Vec<Specular> {
     kinds
         .iter()
-        .map(|&kind| Specular::Microfacet { kind })
-        .chain([Specular::Beckmann, Specular::Ggx])
+        .map(|&kind| Normals::Lobe(kind))
+        .chain([Normals::Beckmann, Normals::Ggx])
+        .map(|normals| Specular::Microfacet { normals })
         .collect()
 }
 

@@ -11,7 +11,12 @@
 
 use serde::Serialize;
 
-use super::{Fit, Sharing, Specular};
+use super::{Fit, Normals, Sharing, Specular};
+
+/// GGX's family in the microfacet model, the reference there.
+const GGX_DISTRIBUTION: Specular = Specular::Microfacet {
+    normals: Normals::Ggx,
+};
 use crate::LobeKind;
 
 /// Which model's fits a verdict ranks.
@@ -20,7 +25,8 @@ use crate::LobeKind;
 pub enum Model {
     /// `kd / pi + K lobe(t)`, against `pow`'s fit.
     Classic,
-    /// `kd / pi + K D G2 / (4 cos_o cos_i)` with each lobe as `D`, against GGX's fit.
+    /// `kd / pi + K F D G2 / (4 cos_o cos_i)` with each lobe as `D`, against GGX's fit in
+    /// the same model.
     Microfacet,
 }
 
@@ -32,7 +38,8 @@ pub struct Standing {
     /// `E / E_pow`: pow's fit in the same geometry and sharing (for GGX, pow's better
     /// geometry with the same sharing; for a distribution, pow's distribution).
     pub relative_to_pow: f64,
-    /// `E / E_ggx` (GGX's fit with the same sharing).
+    /// `E / E_ggx` (GGX's fit with the same sharing, in the same model: with Fresnel for a
+    /// microfacet family).
     pub relative_to_ggx: f64,
     /// The target's rate at the fitted `n` (higher is cheaper); `None` where it cannot run.
     pub rate: Option<f64>,
@@ -93,17 +100,22 @@ pub fn verdict_of(
         Model::Microfacet => {
             f.specular
                 == Specular::Microfacet {
-                    kind: LobeKind::Pow,
+                    normals: Normals::Lobe(LobeKind::Pow),
                 }
         }
     };
     let is_candidate = |f: &Fit| match model {
         Model::Classic => matches!(f.specular, Specular::Lobe { .. }),
-        Model::Microfacet => matches!(f.specular, Specular::Microfacet { .. }),
+        Model::Microfacet => matches!(
+            f.specular,
+            Specular::Microfacet {
+                normals: Normals::Lobe(_)
+            }
+        ),
     };
     let is_reference = |f: &Fit| match model {
         Model::Classic => is_pow(f),
-        Model::Microfacet => f.specular == Specular::Ggx,
+        Model::Microfacet => f.specular == GGX_DISTRIBUTION,
     };
     let reference_error = best_error(fits, |f| is_reference(f) && f.sharing == Sharing::Shared);
     if !reference_error.is_finite() {
@@ -129,8 +141,14 @@ pub fn verdict_of(
                         _ => is_pow(f),
                     }
             });
+            // GGX in the fit's own model: with Fresnel for the microfacet families.
+            let ggx_family = if fit.specular.has_fresnel() {
+                GGX_DISTRIBUTION
+            } else {
+                Specular::Ggx
+            };
             let ggx = best_error(fits, |f| {
-                f.specular == Specular::Ggx && f.sharing == fit.sharing
+                f.specular == ggx_family && f.sharing == fit.sharing
             });
             let candidate = fit.sharing == Sharing::Shared && is_candidate(fit);
             let rate = if candidate {
