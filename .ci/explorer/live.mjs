@@ -1,6 +1,7 @@
 // Drives the explorer's live views (WebGL2, on SwiftShader in headless Chromium): the sphere
 // WebGL draws from each lobe's exported GLSL agrees with /api/live-sphere (the renderer's
-// shading, computed by the server) pixel by pixel; the 3D lobe's vertex program gives the
+// shading, computed by the server) pixel by pixel, in the classic model and with lobes as
+// microfacet distributions; the 3D lobe's vertex program gives the
 // BRDF values /api/evaluate gives; a drag over the sphere changes the light and the image and
 // sends no request while it moves; every view of the first screen lies inside 1400 x 900; a
 // bad n is marked at its control and the views marked stale. Prints frame times (never
@@ -16,9 +17,10 @@ const [binary, screenshot] = process.argv.slice(2);
 const MAX_LEVELS = 1;
 const MAX_SHARE_BEYOND_ONE = 0;
 // The share of the teapot's inner pixels that may differ from the CPU renderer's by more than
-// one level: measured, 0 to 0.022 %, one to five single pixels at the patches' seams, where
-// SwiftShader's rasterizer leaves a crack the CPU's does not and the surface behind shows
-// (see docs/explorer.md). EDGE_LEVELS: a step between neighbours that marks an outline.
+// one level: measured, 0 to 0.024 % (0.045 % for a microfacet teapot lit elsewhere), single
+// pixels at the patches' seams, where SwiftShader's rasterizer leaves a crack the CPU's does
+// not and the surface behind shows (see docs/explorer.md). EDGE_LEVELS: a step between
+// neighbours that marks an outline.
 const MAX_TEAPOT_SHARE = 0.0005;
 const EDGE_LEVELS = 24;
 // The 3D lobe's f32 values against the API's f64, relative to the lobe's peak.
@@ -54,8 +56,9 @@ try {
     throw new Error(`no WebGL2 context in Chromium: ${note}`);
   }
 
-  // The RGBA pixels of the square PNG the server answers `url` with, `size` a side.
-  await page.evaluate(() => {
+  // The RGBA pixels of the square PNG the server answers `url` with, `size` a side (defined
+  // again after each page load).
+  const defineServedPixels = () => page.evaluate(() => {
     window.servedPixels = async (url, size) => {
       const image = new Image();
       image.src = url;
@@ -66,24 +69,24 @@ try {
       return g.getImageData(0, 0, size, size).data;
     };
   });
+  await defineServedPixels();
 
-  // Every lobe, and a formula, against the server's sphere: same lobe, n, geometry,
-  // normalisation and light.
-  const lobes = await page.evaluate(() => registry.lobes.map((l) => l.id));
-  lobes.push("=let a = (n + 1) / 17; max(0, a * (t - 1) + 1) ^ 16");
-  const settings = [["phong", "none", 30, 45, 32], ["blinn", "lobe", 50, -60, 200], ["phong", "lobe", 15, 120, 8]];
-  let worstLevels = 0;
-  let worstShare = 0;
-  for (const [k, lobe] of lobes.entries()) {
-    const [geometry, normalisation, theta, phi, n] = settings[k % settings.length];
-    const result = await page.evaluate(async ({ lobe, geometry, normalisation, theta, phi, n }) => {
-      const [mine, pow] = await Promise.all([lobeShader(lobe, n, geometry, normalisation), lobeShader("pow", n, geometry, normalisation)]);
+  // The WebGL sphere of `lobe` against the server's (/api/live-sphere): same lobe, n,
+  // geometry, normalisation, model and light; in the microfacet model with the terms
+  // /api/microfacet gives for the lobe and pow.
+  await page.evaluate(() => {
+    window.compareSphere = async ({ lobe, geometry, normalisation, theta, phi, n, model }) => {
+      const microfacet = model === "microfacet";
+      const [mine, pow, mineTerms, powTerms] = await Promise.all([
+        lobeShader(lobe, n, geometry, normalisation), lobeShader("pow", n, geometry, normalisation),
+        microfacet ? lobeMicrofacet(lobe, n) : null, microfacet ? lobeMicrofacet("pow", n) : null,
+      ]);
       liveUniforms.u_n = n;
-      live.spheres.setLobes(mine.glsl, pow.glsl, mine.tonemap, false);
+      live.spheres.setLobes(mine.glsl, pow.glsl, mine.tonemap, model, microfacet ? { lobe: mineTerms, pow: powTerms } : null);
       live.spheres.light = lightTowards(theta, phi);
       live.spheres.draw();
       const { size, pixels } = live.spheres.read(0);
-      const query = new URLSearchParams({ lobe, n, geometry, normalisation, model: "classic", light_theta: theta, light_phi: phi, size });
+      const query = new URLSearchParams({ lobe, n, geometry, normalisation, model, light_theta: theta, light_phi: phi, size });
       const reference = await window.servedPixels("/api/live-sphere?" + query, size);
       let worst = 0;
       let beyondOne = 0;
@@ -93,16 +96,35 @@ try {
         if (d > 1) beyondOne++;
       }
       return { size, worst, share: beyondOne / (size * size) };
-    }, { lobe, geometry, normalisation, theta, phi, n });
+    };
+  });
+
+  // Every lobe, and a formula, in the classic model; then lobes as microfacet distributions
+  // (the Blinn export, normalisation none, as D).
+  const lobes = await page.evaluate(() => registry.lobes.map((l) => l.id));
+  lobes.push("=let a = (n + 1) / 17; max(0, a * (t - 1) + 1) ^ 16");
+  const settings = [["phong", "none", 30, 45, 32], ["blinn", "lobe", 50, -60, 200], ["phong", "lobe", 15, 120, 8]];
+  const cases = lobes.map((lobe, k) => {
+    const [geometry, normalisation, theta, phi, n] = settings[k % settings.length];
+    return { lobe, geometry, normalisation, theta, phi, n, model: "classic" };
+  });
+  for (const [lobe, n, theta, phi] of [["pow", 32, 30, 45], ["cosquad", 8, 50, -60], ["schlick-mod", 200, 15, 120], ["sg-karis", 64, 60, 30], ["=exp2(n * (t - 1) * 1.4427)", 16, 40, 90]]) {
+    cases.push({ lobe, geometry: "blinn", normalisation: "none", theta, phi, n, model: "microfacet" });
+  }
+  let worstLevels = 0;
+  let worstShare = 0;
+  for (const sphere of cases) {
+    const result = await page.evaluate((sphere) => window.compareSphere(sphere), sphere);
+    const { lobe, geometry, normalisation, theta, phi, n, model } = sphere;
     worstLevels = Math.max(worstLevels, result.worst);
     worstShare = Math.max(worstShare, result.share);
-    console.log(`sphere ${lobe} (${geometry}, ${normalisation}, n = ${n}, light ${theta}/${phi}): ${result.size}^2 px, largest difference ${result.worst} levels, ${(100 * result.share).toFixed(3)} % beyond 1`);
-    if (result.worst > MAX_LEVELS || result.share > MAX_SHARE_BEYOND_ONE) failures.push(`the WebGL sphere of ${lobe} differs from the server's: ${result.worst} levels, ${(100 * result.share).toFixed(3)} % of pixels beyond 1`);
+    console.log(`sphere ${lobe} (${model}, ${geometry}, ${normalisation}, n = ${n}, light ${theta}/${phi}): ${result.size}^2 px, largest difference ${result.worst} levels, ${(100 * result.share).toFixed(3)} % beyond 1`);
+    if (result.worst > MAX_LEVELS || result.share > MAX_SHARE_BEYOND_ONE) failures.push(`the WebGL sphere of ${lobe} (${model}) differs from the server's: ${result.worst} levels, ${(100 * result.share).toFixed(3)} % of pixels beyond 1`);
   }
   console.log(`spheres: largest difference ${worstLevels} levels, at most ${(100 * worstShare).toFixed(3)} % of pixels beyond 1 level`);
   // pow's constants are closed forms of n: its text, fetched once per geometry and
   // normalisation, served every n the loop asked (n as the uniform u_n).
-  const powFamilies = new Set(lobes.map((_, k) => settings[k % settings.length].slice(0, 2).join("|")));
+  const powFamilies = new Set(cases.map(({ geometry, normalisation }) => [geometry, normalisation].join("|")));
   const powFetches = shaderRequests.filter((query) => query.get("lobe") === "pow").length;
   console.log(`pow's shader fetched ${powFetches} times for ${lobes.length} spheres at ${new Set(settings.map((s) => s[4])).size} values of n`);
   if (powFetches !== powFamilies.size) failures.push(`pow's shader was fetched ${powFetches} times, not once per geometry and normalisation (${powFamilies.size}): n is not a uniform`);
@@ -112,15 +134,16 @@ try {
   // EDGE levels from them in the CPU's image: the outlines, outer and inner (the spout, handle
   // and lid over the body), depend on each rasterizer's edge rules.
   await page.waitForFunction(() => live.teapot !== null);
-  for (const [lobe, geometry, normalisation, n, theta, phi, shading] of [["pow", "phong", "none", 32, 30, 45, "phong"], ["schlick", "blinn", "lobe", 200, 50, -60, "phong"], ["=exp2(n * (t - 1) * 1.4427)", "phong", "lobe", 64, 20, 100, "phong"], ["cosquad", "phong", "none", 16, 40, 30, "gouraud"], ["logexp", "blinn", "lobe", 64, 20, -100, "gouraud"]]) {
-    const result = await page.evaluate(async ({ lobe, geometry, normalisation, n, theta, phi, shading, edge }) => {
+  for (const [lobe, geometry, normalisation, n, theta, phi, shading, model = "classic"] of [["pow", "phong", "none", 32, 30, 45, "phong"], ["schlick", "blinn", "lobe", 200, 50, -60, "phong"], ["=exp2(n * (t - 1) * 1.4427)", "phong", "lobe", 64, 20, 100, "phong"], ["cosquad", "phong", "none", 16, 40, 30, "gouraud"], ["logexp", "blinn", "lobe", 64, 20, -100, "gouraud"], ["sg-karis", "blinn", "none", 32, 30, 45, "phong", "microfacet"]]) {
+    const result = await page.evaluate(async ({ lobe, geometry, normalisation, n, theta, phi, shading, model, edge }) => {
       const mine = await lobeShader(lobe, n, geometry, normalisation);
+      const terms = model === "microfacet" ? await lobeMicrofacet(lobe, n) : null;
       liveUniforms.u_n = n;
-      live.teapot.setLobe(mine.glsl, mine.tonemap, false);
+      live.teapot.setLobe(mine.glsl, mine.tonemap, model, terms);
       live.teapot.light = lightTowards(theta, phi);
       live.teapot.gouraud = shading === "gouraud";
       const { size, pixels } = live.teapot.read();
-      const query = new URLSearchParams({ object: "teapot", lobe, n, geometry, normalisation, shading, model: "classic", light_theta: theta, light_phi: phi, size });
+      const query = new URLSearchParams({ object: "teapot", lobe, n, geometry, normalisation, shading, model, light_theta: theta, light_phi: phi, size });
       const reference = await window.servedPixels("/api/render?" + query, size);
       const background = (data, k) => [0, 1, 2].every((c) => data[k + c] === data[c]);
       let [compared, worst, beyondOne] = [0, 0, 0];
@@ -142,7 +165,7 @@ try {
         }
       }
       return { size, compared, worst, share: beyondOne / Math.max(1, compared) };
-    }, { lobe, geometry, normalisation, n, theta, phi, shading, edge: EDGE_LEVELS });
+    }, { lobe, geometry, normalisation, n, theta, phi, shading, model, edge: EDGE_LEVELS });
     console.log(`teapot ${lobe} ${shading} (${geometry}, ${normalisation}, n = ${n}, light ${theta}/${phi}): ${result.compared} inner pixels of ${result.size}^2, largest difference ${result.worst} levels, ${(100 * result.share).toFixed(3)} % beyond 1`);
     if (result.compared < 0.2 * result.size * result.size || result.share > MAX_TEAPOT_SHARE) failures.push(`the WebGL teapot of ${lobe} differs from specula render's: ${JSON.stringify(result)}`);
   }
@@ -308,6 +331,23 @@ try {
     const share = Math.max(0, 1 - fps / rates.nothing.fps);
     console.log(`frames (${what}): ${fps.toFixed(1)} per second (${rates.nothing.fps.toFixed(1)} drawing nothing); the draw takes ${(100 * share).toFixed(0)} % of a frame, ${script.toFixed(1)} ms of it in JavaScript (spheres: 3 panes of ${paneSide} px)`);
   }
+
+  // The page itself in the microfacet model: its own controls' state drives the spheres
+  // (liveLobes: the Blinn exports and /api/microfacet's terms), which must be the server's.
+  await page.goto(url + "?lobes=schlick,cosquad&render=cosquad&n=24&model=microfacet&light_theta=35&light_phi=50");
+  await drawn("model", "microfacet");
+  await page.waitForFunction(() => live.spheres?.model === 2 && live.spheres.terms !== null);
+  await defineServedPixels();
+  const byPage = await page.evaluate(async () => {
+    const { size, pixels } = live.spheres.read(0);
+    const query = new URLSearchParams({ lobe: "cosquad", n: 24, geometry: "phong", normalisation: $("normalisation").value, model: "microfacet", light_theta: 35, light_phi: 50, size });
+    const reference = await window.servedPixels("/api/live-sphere?" + query, size);
+    let worst = 0;
+    for (let i = 0; i < reference.length; i += 4) worst = Math.max(worst, ...[0, 1, 2].map((c) => Math.abs(reference[i + c] - pixels[i + c])));
+    return { size, worst };
+  });
+  console.log(`the page in the microfacet model: cosquad's sphere ${byPage.size}^2 px, largest difference from the server's ${byPage.worst} levels`);
+  if (byPage.worst > MAX_LEVELS) failures.push(`the page's microfacet sphere differs from the server's by ${byPage.worst} levels`);
 
   const noisy = messages.filter(counts);
   if (noisy.length) failures.push("console: " + noisy.join(" | "));

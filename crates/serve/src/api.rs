@@ -163,7 +163,7 @@ pub async fn not_found() -> ApiError {
         "no such page or endpoint".into(),
         "/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume, /api/environment, \
             /api/materials, /api/fits, /api/material-render, /api/design, /api/shader, \
-            /api/live-sphere, /api/teapot"
+            /api/microfacet, /api/live-sphere, /api/teapot"
             .into(),
     )
 }

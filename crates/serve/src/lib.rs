@@ -105,6 +105,7 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/material-render", get(api::render_material))
         .route("/api/design", get(api::design_lobe))
         .route("/api/shader", get(live::shader))
+        .route("/api/microfacet", get(live::microfacet))
         .route("/api/live-sphere", get(live::live_sphere))
         .route("/api/teapot", get(live::teapot))
         .fallback(api::not_found)

@@ -8,6 +8,9 @@
 //!   (`specula_specular(n, normal, wo, wi)`, `--n-input`) and `n_range` is the range they
 //!   serve, so the page changes `n` as a uniform within it; elsewhere (`n_range` null) `n` is
 //!   baked in (`specula_specular(normal, wo, wi)`) and a new `n` fetches new functions;
+//! - `GET /api/microfacet?lobe&n`: `{normaliser, masking}`, what the microfacet model adds to
+//!   the lobe at `n` ([`MicrofacetTerms`]: `C(n)` and the 64-entry `G1` table the renderers
+//!   read), for the page's live microfacet shading, which draws the lobe's Blinn export as `D`;
 //! - `GET /api/live-sphere?lobe&n&geometry&normalisation&model&light_theta&light_phi&size`:
 //!   the sphere the page draws live, computed here per pixel with the renderer's shading
 //!   ([`Shader::shade`]) and display encoding, as a PNG: what the browser check compares the
@@ -27,7 +30,7 @@ use glam::Vec3;
 use serde_json::json;
 use specula::{Geometry, Lobe, Normalisation};
 use specula_gpu::export::{functions_taking_n_where_possible, Language};
-use specula_render::{Display, IlluminationModel, Image, Light, Material, Shader};
+use specula_render::{Display, IlluminationModel, Image, Light, Material, MicrofacetTerms, Shader};
 
 use crate::api::{compute, compute_with, png, AppState};
 use crate::explorer::{scene, Object, RenderRequest};
@@ -130,6 +133,23 @@ pub async fn shader(
         "glsl": shader.text,
         "n_range": shader.n_range,
         "tonemap": tonemap_for(normalisation).id(),
+    }))
+    .into_response())
+}
+
+/// `GET /api/microfacet`: the lobe's microfacet terms at `n`.
+pub async fn microfacet(
+    State(state): State<AppState>,
+    query: QueryPairs,
+) -> Result<Response, Response> {
+    let params = Params::new(pairs(query)?, &["lobe", "n"])?;
+    let (kind, n) = (params.lobe()?, params.exponent()?);
+    let terms = compute_with(&state, kind, n, |lobe| MicrofacetTerms::new(&lobe, 1.0)).await?;
+    Ok(Json(json!({
+        "lobe": kind.to_string(),
+        "n": n.get(),
+        "normaliser": terms.normaliser(),
+        "masking": terms.masking().to_vec(),
     }))
     .into_response())
 }

@@ -96,7 +96,10 @@ function pointerDrag(element, move, end = () => {}) {
 }
 
 // Compiles the shown lobe and pow (the spheres), and every drawn lobe (the 3D lobe and the
-// polar plot while dragging), once their GLSL has arrived; a newer call wins.
+// polar plot while dragging), once their GLSL has arrived; a newer call wins. In the
+// microfacet model the spheres and the teapot draw each lobe's Blinn export (normalisation
+// none) as the distribution, with its terms at n (/api/microfacet); the 3D lobe and the
+// slices keep showing the lobe itself.
 async function liveLobes(state, shown, lobes) {
   if (!live.spheres) return;
   const common = [state.n, state.geometry, state.normalisation];
@@ -104,18 +107,28 @@ async function liveLobes(state, shown, lobes) {
   if (key === live.key) return liveRedraw();
   live.key = key;
   const names = [...new Set([shown || "pow", ...lobes, "pow"])];
-  const texts = await Promise.all(names.map((name) => lobeShader(apiLobe(name), ...common).catch(() => null)));
+  const microfacet = state.model === "microfacet";
+  const shaded = [...new Set([shown || "pow", "pow"])];
+  const [texts, shadedTexts, terms] = await Promise.all([
+    Promise.all(names.map((name) => lobeShader(apiLobe(name), ...common).catch(() => null))),
+    microfacet ? Promise.all(shaded.map((name) => lobeShader(apiLobe(name), state.n, "blinn", "none").catch(() => null))) : null,
+    microfacet ? Promise.all(shaded.map((name) => lobeMicrofacet(apiLobe(name), state.n).catch(() => null))) : null,
+  ]);
   if (live.key !== key) return;
   liveUniforms.u_n = Number(state.n);
-  // The same texts (every lobe taking n, inside the ranges they serve): nothing to compile.
-  const programs = JSON.stringify([shown, names, texts.map((text) => text?.glsl), state.model]);
+  // The same texts (every lobe taking n, inside the ranges they serve) and terms: nothing to
+  // compile.
+  const programs = JSON.stringify([shown, names, texts.map((text) => text?.glsl), shadedTexts?.map((text) => text?.glsl), terms, state.model]);
   if (programs === live.programs) return liveRedrawAll();
   live.programs = programs;
   const byName = new Map(names.map((name, k) => [name, texts[k]]).filter(([, text]) => text));
   const chosen = byName.get(shown || "pow") ?? byName.get("pow");
   if (!chosen) return;
-  live.spheres.setLobes(chosen.glsl, byName.get("pow").glsl, chosen.tonemap, state.model === "physical");
-  live.chosen = [chosen.glsl, chosen.tonemap, state.model === "physical"];
+  const [lobeText, powText] = microfacet ? [shadedTexts[0], shadedTexts.at(-1)] : [chosen, byName.get("pow")];
+  const [lobeTerms, powTerms] = microfacet ? [terms[0], terms.at(-1)] : [null, null];
+  if (!lobeText || !powText || (microfacet && (!lobeTerms || !powTerms))) return;
+  live.spheres.setLobes(lobeText.glsl, powText.glsl, chosen.tonemap, state.model, microfacet ? { lobe: lobeTerms, pow: powTerms } : null);
+  live.chosen = [lobeText.glsl, chosen.tonemap, state.model, lobeTerms];
   live.teapot?.setLobe(...live.chosen);
   const first = byName.has(shown) ? shown : "pow";
   live.lobes = [first, ...[...byName.keys()].filter((name) => name !== first)];

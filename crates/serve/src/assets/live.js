@@ -11,6 +11,26 @@
 // The uniforms every live program reads where it declares them: n, for the texts that take it.
 const liveUniforms = { u_n: 64 };
 
+// The illumination models as SHADING's u_model.
+const MODEL_IDS = { classic: 0, physical: 1, microfacet: 2 };
+
+// The microfacet model's uniforms from an /api/microfacet answer (none for the other models).
+function microfacetUniforms(terms) {
+  return terms ? { u_normaliser: terms.normaliser, u_masking: terms.masking } : {};
+}
+
+// The lobe's microfacet terms at n (/api/microfacet), fetched once per lobe and n.
+const microfacetTerms = new Map();
+function lobeMicrofacet(lobe, n) {
+  const key = [lobe, n].join("|");
+  if (!microfacetTerms.has(key)) {
+    const terms = getJson("/api/microfacet?" + new URLSearchParams({ lobe, n }));
+    terms.catch(() => microfacetTerms.delete(key));
+    microfacetTerms.set(key, terms);
+  }
+  return microfacetTerms.get(key);
+}
+
 // Where the export takes n as its first argument, the page's calls without it read u_n.
 const N_UNIFORM = `
 uniform float u_n;
@@ -63,6 +83,8 @@ function setUniforms(gl, program, values) {
     const at = gl.getUniformLocation(program, name);
     if (at === null) continue;
     if (typeof value === "number") gl.uniform1f(at, value);
+    // A longer array is an array of floats (the microfacet model's masking table).
+    else if (value.length > 4) gl.uniform1fv(at, value);
     else [null, gl.uniform1fv, gl.uniform2fv, gl.uniform3fv, gl.uniform4fv][value.length].call(gl, at, value);
   }
 }
@@ -77,22 +99,44 @@ void main() {
 // The renderer's shading (Shader::shade) of one point for the directional light: ambient,
 // then the light's diffuse and N(n) lobe(t) terms when it and the viewer are above the
 // surface; tone mapped and sRGB-encoded as the renders' PNGs are. Spliced after a lobe's
-// exported functions.
+// exported functions. The illumination model u_model is 0 (classic), 1 (physical) or 2
+// (microfacet: the lobe's Blinn export, normalisation none, as the distribution D, scaled by
+// /api/microfacet's normaliser, with G2 from its masking table; the scene's specular colour is
+// white, so Fresnel is 1: Shader::microfacet_contribution).
 const SHADING = `
 uniform vec3 u_light;
 uniform vec3 u_colour;
 uniform vec3 u_ambient;
 uniform vec3 u_k;
-uniform float u_physical;
+uniform float u_model;
 uniform float u_reinhard;
+uniform float u_normaliser;
+uniform float u_masking[64];
+
+// G1 from the table at the cosines (k / 63)^2, linear in sqrt(cos): MicrofacetTerms::g1.
+float maskingG1(float c) {
+  float x = sqrt(clamp(c, 0.0, 1.0)) * 63.0;
+  int at = min(int(x), 62);
+  return u_masking[at] + (x - float(at)) * (u_masking[at + 1] - u_masking[at]);
+}
 
 vec3 shade(vec3 normal, vec3 wo) {
   vec3 radiance = u_k.x * u_colour * u_ambient;
   float cosIn = dot(normal, u_light);
-  if (dot(normal, wo) > 0.0 && cosIn > 0.0) {
-    vec3 diffuse = u_k.y * u_colour * (u_physical > 0.5 ? 0.3183098862 : 1.0);
-    float specular = u_k.z * specula_specular(normal, wo, u_light);
-    radiance += u_physical > 0.5 ? (diffuse + specular) * cosIn : diffuse * cosIn + specular;
+  float cosOut = dot(normal, wo);
+  if (cosOut > 0.0 && cosIn > 0.0) {
+    vec3 diffuse = u_k.y * u_colour * (u_model > 0.5 ? 0.3183098862 : 1.0);
+    float lobe = specula_specular(normal, wo, u_light);
+    if (u_model > 1.5) {
+      float a = maskingG1(cosOut);
+      float b = maskingG1(cosIn);
+      float denominator = a + b - a * b;
+      float g2 = denominator > 0.0 ? a * b / denominator : 0.0;
+      radiance += diffuse * cosIn + u_k.z * (u_normaliser * lobe * g2 / (4.0 * cosOut));
+    } else {
+      float specular = u_k.z * lobe;
+      radiance += u_model > 0.5 ? (diffuse + specular) * cosIn : diffuse * cosIn + specular;
+    }
   }
   return radiance;
 }
@@ -220,8 +264,9 @@ class LiveSpheres {
     texture.size = size;
   }
 
-  // Compiles the chosen lobe's and pow's spheres from their exported functions.
-  setLobes(lobeText, powText, tonemap, physical) {
+  // Compiles the chosen lobe's and pow's spheres from their exported functions, for `model`
+  // (classic, physical, microfacet: then `terms` holds each one's /api/microfacet answer).
+  setLobes(lobeText, powText, tonemap, model, terms = null) {
     const gl = this.gl;
     for (const p of Object.values(this.programs)) if (p) gl.deleteProgram(p);
     this.programs = {
@@ -229,7 +274,8 @@ class LiveSpheres {
       pow: linkProgram(gl, FULL_SCREEN_VERTEX, sphereFragment(powText)),
     };
     this.reinhard = tonemap === "reinhard" ? 1 : 0;
-    this.physical = physical ? 1 : 0;
+    this.model = MODEL_IDS[model];
+    this.terms = terms;
   }
 
   // The pane side in pixels, for the canvas's width on the page.
@@ -261,7 +307,8 @@ class LiveSpheres {
       setUniforms(gl, this.programs[which], {
         u_origin: [0, 0], u_size: size, u_light: this.light, u_eye: s.eye_distance,
         u_tan_half: Math.tan((s.fov_y_deg * Math.PI) / 360), u_colour: s.colour, u_ambient: s.ambient,
-        u_background: s.background, u_k: [s.ka, s.kd, s.ks], u_physical: this.physical, u_reinhard: this.reinhard,
+        u_background: s.background, u_k: [s.ka, s.kd, s.ks], u_model: this.model, u_reinhard: this.reinhard,
+        ...microfacetUniforms(this.terms?.[which]),
       });
       gl.drawArrays(gl.TRIANGLES, 0, 3);
     }

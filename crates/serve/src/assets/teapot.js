@@ -72,12 +72,15 @@ class LiveTeapot {
     this.gouraud = false;
   }
 
-  setLobe(text, tonemap, physical) {
+  // The lobe's program for `model` (classic, physical, microfacet: then `terms` is its
+  // /api/microfacet answer).
+  setLobe(text, tonemap, model, terms = null) {
     const gl = this.gl;
     if (this.program) gl.deleteProgram(this.program);
     this.program = linkProgram(gl, teapotVertex(text), teapotFragment(text));
     this.reinhard = tonemap === "reinhard" ? 1 : 0;
-    this.physical = physical ? 1 : 0;
+    this.model = MODEL_IDS[model];
+    this.terms = terms;
   }
 
   // Square, as wide as its box allows (at most 320 pixels), never scaled.
@@ -95,7 +98,8 @@ class LiveTeapot {
     gl.uniformMatrix4fv(gl.getUniformLocation(this.program, "u_view_projection"), false, this.mesh.view_projection);
     setUniforms(gl, this.program, {
       u_light: this.light, u_eye: this.mesh.eye, u_colour: s.colour, u_ambient: s.ambient, u_background: s.background,
-      u_k: [s.ka, s.kd, s.ks], u_physical: this.physical, u_reinhard: this.reinhard, u_gouraud: this.gouraud ? 1 : 0,
+      u_k: [s.ka, s.kd, s.ks], u_model: this.model, u_reinhard: this.reinhard, u_gouraud: this.gouraud ? 1 : 0,
+      ...microfacetUniforms(this.terms),
     });
     gl.bindVertexArray(this.array);
     gl.disable(gl.DEPTH_TEST);

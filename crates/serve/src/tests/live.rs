@@ -215,3 +215,40 @@ async fn the_teapot_route_serves_a_mesh_the_camera_sees() {
     let (status, _) = json("/api/teapot?size=3").await;
     assert_eq!(status, StatusCode::BAD_REQUEST);
 }
+
+/// `/api/microfacet` gives the lobe's distribution terms at `n`: for `pow` the closed-form
+/// normaliser `(n + 2) / (2 pi)` (Walter's), a masking table from 0 at the horizon to 1 at the
+/// normal, never falling; a bad `n` or lobe refused.
+#[tokio::test]
+async fn the_microfacet_route_serves_the_distributions_terms() {
+    for n in [4.0, 64.0, 700.0] {
+        let (status, body) = json(&format!("/api/microfacet?lobe=pow&n={n}")).await;
+        assert_eq!(status, StatusCode::OK, "{body}");
+        let normaliser = body["normaliser"].as_f64().expect("a normaliser");
+        let walter = (n + 2.0) / core::f64::consts::TAU;
+        assert!(
+            (normaliser - walter).abs() < 1e-5 * walter,
+            "n = {n}: {normaliser}"
+        );
+        let masking: Vec<f64> = body["masking"]
+            .as_array()
+            .expect("the masking table")
+            .iter()
+            .map(|v| v.as_f64().expect("a number"))
+            .collect();
+        assert_eq!(masking.len(), specula_render::MASKING_ENTRIES);
+        assert_eq!(masking[0], 0.0);
+        assert!(
+            (masking[masking.len() - 1] - 1.0).abs() < 1e-6,
+            "{masking:?}"
+        );
+        assert!(masking.windows(2).all(|w| w[0] <= w[1]), "{masking:?}");
+    }
+    for bad in [
+        "/api/microfacet?lobe=pow&n=0",
+        "/api/microfacet?lobe=nope&n=8",
+    ] {
+        let (status, _) = json(bad).await;
+        assert_eq!(status, StatusCode::BAD_REQUEST, "{bad}");
+    }
+}
