@@ -35,6 +35,7 @@ mod material;
 pub mod measured;
 mod mesh;
 pub mod metrics;
+pub mod microfacet_scene;
 mod mitsuba_scene;
 mod output;
 mod phong;

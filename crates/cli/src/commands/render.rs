@@ -9,6 +9,7 @@ use specula_gpu::{Gpu, GpuRenderer};
 use specula_render::ibl::{
     render_ibl, render_ibl_grid, Environment, IblSettings, Strategy, MAX_SPP,
 };
+use specula_render::microfacet_scene::render_ibl_microfacet;
 use specula_render::{
     check_output_path, made_renders, render, render_grid_with, write_image, write_png_srgb8,
     GridOptions, IlluminationModel, Image, LoadedScene, Overrides, Scene, Shading, DEFAULT_SCENE,
@@ -73,9 +74,10 @@ pub struct Args {
     backend: RendererArg,
     /// Light the scene by an environment instead of its lights: `sky` (built in; a file named
     /// sky is `./sky`) or an equirectangular .hdr, .exr or .png file (at most 4096 x 4096),
-    /// rendered by Monte Carlo with multiple importance sampling on the CPU, physical model.
-    /// Without a scene file, the embedded environment scene (a sphere and the teapot).
-    #[arg(long, value_name = "sky|FILE", conflicts_with_all = ["shading", "model"])]
+    /// rendered by Monte Carlo with multiple importance sampling on the CPU, physical model
+    /// (or, with --model microfacet, the microfacet model). Without a scene file, the
+    /// embedded environment scene (a sphere and the teapot).
+    #[arg(long, value_name = "sky|FILE", conflicts_with_all = ["shading"])]
     env: Option<PathBuf>,
     /// Samples per pixel with --env.
     #[arg(
@@ -156,9 +158,20 @@ pub fn run(args: &Args) -> CommandResult {
     let scene = load(args)?;
     let started = Instant::now();
     let bar = progress_bar("rendering");
+    let microfacet = args.model == Some(IlluminationModel::Microfacet);
     let environment = match &args.env {
         Some(_) if args.backend == RendererArg::Gpu => {
             return Err("--env renders on the CPU only; drop --backend gpu".into())
+        }
+        Some(_) if args.model == Some(IlluminationModel::Classic) => {
+            return Err(
+                "--env renders the physical or the microfacet model, not the classic \
+                one; valid --model values with --env: physical, microfacet"
+                    .into(),
+            )
+        }
+        Some(_) if microfacet && args.grid.is_some() => {
+            return Err("--env --model microfacet renders one image; drop --grid".into())
         }
         Some(name) => Some(Environment::named(name).map_err(|e| e.to_string())?),
         None => None,
@@ -185,6 +198,10 @@ pub fn run(args: &Args) -> CommandResult {
                 let image = renderer.render(scene).map_err(|e| e.to_string());
                 progress(1, 1);
                 image
+            }
+            (None, Some(environment)) if microfacet => {
+                render_ibl_microfacet(scene, environment, &ibl, &progress)
+                    .map_err(|e| e.to_string())
             }
             (None, Some(environment)) => {
                 render_ibl(scene, environment, &ibl, &progress).map_err(|e| e.to_string())
@@ -235,7 +252,12 @@ pub fn run(args: &Args) -> CommandResult {
     };
     let device = gpu.map_or_else(|| "CPU".to_owned(), |gpu| gpu.adapter_name());
     let method = match &args.env {
-        Some(env) => format!("{} spp, lit by {}", args.spp, env.display()),
+        Some(env) => format!(
+            "{} spp, lit by {}, {} model",
+            args.spp,
+            env.display(),
+            if microfacet { "microfacet" } else { "physical" }
+        ),
         None => format!(
             "{} shading, {} model",
             scene.settings.shading.id(),

@@ -240,7 +240,7 @@ fn renders_lit_by_an_environment_and_refuses_bad_ones() {
     specula_render::write_image(&d.join("nan.exr"), &exr, specula_render::Display::default())
         .unwrap();
     let before = files(d);
-    let cases: [(&[&str], &str); 9] = [
+    let cases: [(&[&str], &str); 11] = [
         (&["--env", "missing.hdr"], "missing.hdr"),
         (&["--env", "folder.hdr"], "a directory"),
         (&["--env", "nan.exr"], "pixel (1, 0) is NaN"),
@@ -253,6 +253,21 @@ fn renders_lit_by_an_environment_and_refuses_bad_ones() {
             "cannot be used with",
         ),
         (&["--env", "sky", "--backend", "gpu"], "CPU only"),
+        (
+            &["--env", "sky", "--model", "classic"],
+            "valid --model values with --env: physical, microfacet",
+        ),
+        (
+            &[
+                "--env",
+                "sky",
+                "--model",
+                "microfacet",
+                "--grid",
+                "lobes=pow,sg",
+            ],
+            "drop --grid",
+        ),
     ];
     for (args, message) in cases {
         let mut command = vec!["render", "-o", "out.png"];

@@ -45,8 +45,8 @@ pub use crate::pipeline::MAX_SPP;
 pub use environment::{Environment, EnvironmentError, EnvironmentSample};
 pub use sky::{sun_direction, SKY_WIDTH, SUN_RADIANCE, SUN_RADIUS};
 pub use trace::{
-    cosine_direction, render_ibl, render_ibl_grid, render_ibl_lobes, render_ibl_with,
-    MaterialReflectance, Reflectance,
+    cosine_direction, render_ibl, render_ibl_each, render_ibl_grid, render_ibl_lobes,
+    render_ibl_with, MaterialReflectance, Reflectance,
 };
 
 /// How each sample of the reflected radiance is drawn.

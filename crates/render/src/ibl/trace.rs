@@ -325,11 +325,31 @@ pub fn render_ibl_with(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Image, RenderError> {
     let reflectances = vec![reflectance; scene.objects.len()];
+    render_ibl_each(scene, environment, settings, &reflectances, progress)
+}
+
+/// [`render_ibl_with`] with each object's own [`Reflectance`] (`reflectances[i]` for
+/// `scene.objects[i]`).
+///
+/// # Panics
+/// If there is not one reflectance per object.
+pub fn render_ibl_each(
+    scene: &Scene,
+    environment: &Environment,
+    settings: &IblSettings,
+    reflectances: &[&dyn Reflectance],
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Image, RenderError> {
+    assert_eq!(
+        reflectances.len(),
+        scene.objects.len(),
+        "one reflectance per object"
+    );
     render_one(
         scene,
         environment,
         settings,
-        Shading::Reflectances(&reflectances),
+        Shading::Reflectances(reflectances),
         progress,
     )
 }
