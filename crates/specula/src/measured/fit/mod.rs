@@ -28,8 +28,9 @@
 //! **Optimiser.** For a given `n` the best `(kd, K)` of a channel (with Fresnel, `(kd, K F0,
 //! K (1 - F0))`) is a problem that is linear but for the cube root: it starts from the
 //! weighted linear least squares that linearises the root at the data and takes projected
-//! Gauss-Newton steps (every coefficient `>= 0`, so `F0` lies in `[0, 1]`). Over `n` the error is not convex (a lobe can fit the sheen or the peak),
-//! so `ln n` is first scanned on a grid of [`GRID_POINTS`] over `[1, 1000]`, then refined by
+//! Gauss-Newton steps (every coefficient `>= 0`, so `F0` lies in `[0, 1]`). Over `n` the
+//! error is not convex (a lobe can fit the sheen or the peak), so `ln n` is first scanned on a
+//! grid of [`GRID_POINTS`] over `[1, 1000]`, then refined by
 //! Brent's method (the `argmin` crate) between the best grid point's neighbours: a global
 //! start, then a local polish. The same procedure fits GGX's `ln alpha` over
 //! `[ALPHA_RANGE]`. Everything is deterministic, so a fit is reproducible to the last bit.
