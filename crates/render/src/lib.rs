@@ -36,6 +36,7 @@ pub mod measured;
 mod mesh;
 pub mod metrics;
 pub mod microfacet_scene;
+mod microfacet_terms;
 mod mitsuba_scene;
 mod output;
 mod phong;
@@ -58,10 +59,9 @@ pub use image::{
 };
 pub use image_error::ImageError;
 pub use load::{load_mesh, parse_mesh, LoadError, LoadedMesh, MeshFormat, MESH_EXTENSIONS};
-pub use material::{
-    IlluminationModel, Light, Material, MicrofacetTerms, Shader, Shading, MASKING_ENTRIES,
-};
+pub use material::{IlluminationModel, Light, Material, Shader, Shading};
 pub use mesh::{Mesh, MeshError};
+pub use microfacet_terms::{MicrofacetTerms, MASKING_ENTRIES};
 pub use mitsuba_scene::write_mitsuba_scene;
 pub use output::{write_atomically, SeekWrite};
 pub use pipeline::{

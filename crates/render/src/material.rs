@@ -25,8 +25,9 @@ use std::sync::Arc;
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
-use specula::microfacet::Distribution;
 use specula::{Geometry, Lobe, Normalisation};
+
+use crate::microfacet_terms::MicrofacetTerms;
 
 /// The physical model's inverse square stops growing inside this squared distance (1e-4
 /// scene units): a point light on the surface would otherwise send infinite radiance (a
@@ -154,114 +155,6 @@ pub struct Shader {
     microfacet: Option<Arc<MicrofacetTerms>>,
 }
 
-/// Entries of the masking table [`MicrofacetTerms`] carries.
-pub const MASKING_ENTRIES: usize = 64;
-
-/// What the microfacet model adds to a lobe: its normaliser `C(n)`, its Smith masking as a
-/// table both renderers read, and the specular scale that Fresnel's grazing part takes.
-///
-/// The table holds `G1 = 1 / (1 + Lambda)` from the distribution's own `Lambda`
-/// (`specula::microfacet`) at [`MASKING_ENTRIES`] cosines `(k / 63)^2`, closer together
-/// towards the horizon where `G1` falls to 0, read with linear interpolation in `sqrt(cos)`:
-/// the CPU and the GPU interpolate the same `f32` numbers, so both draw the same masking
-/// (within a stated bound of the distribution's, tested).
-#[derive(Clone, Debug, PartialEq)]
-pub struct MicrofacetTerms {
-    normaliser: f32,
-    grazing: Vec3,
-    masking: [f32; MASKING_ENTRIES],
-}
-
-impl MicrofacetTerms {
-    /// The terms of `lobe`'s distribution with Fresnel's grazing scale `ks`.
-    #[must_use]
-    pub fn new(lobe: &Lobe, ks: f32) -> Self {
-        let distribution = Distribution::lobe(lobe.kind(), lobe.exponent());
-        let last = (MASKING_ENTRIES - 1) as f64;
-        Self {
-            normaliser: distribution.d(1.0) as f32,
-            grazing: Vec3::splat(ks),
-            masking: core::array::from_fn(|k| {
-                let x = k as f64 / last;
-                distribution.g1(x * x) as f32
-            }),
-        }
-    }
-
-    /// The distribution's normaliser `C(n)`.
-    #[must_use]
-    pub fn normaliser(&self) -> f32 {
-        self.normaliser
-    }
-
-    /// `ks`, per channel: the scale of Fresnel's `(1 - F0) (1 - wo.h)^5`.
-    #[must_use]
-    pub fn grazing(&self) -> Vec3 {
-        self.grazing
-    }
-
-    /// The masking table, `G1` at the cosines `(k / 63)^2`.
-    #[must_use]
-    pub fn masking(&self) -> &[f32; MASKING_ENTRIES] {
-        &self.masking
-    }
-
-    /// Smith's `G1` at a direction of cosine `cos` to the normal, from the table.
-    #[must_use]
-    pub fn g1(&self, cos: f32) -> f32 {
-        let x = cos.clamp(0.0, 1.0).sqrt() * (MASKING_ENTRIES - 1) as f32;
-        let at = (x as usize).min(MASKING_ENTRIES - 2);
-        let fraction = x - at as f32;
-        self.masking[at] + fraction * (self.masking[at + 1] - self.masking[at])
-    }
-
-    /// The lobe's values at `N.h` turned into the model's specular factors over a batch, from
-    /// `N.wo`, `N.wi` and `wo.h`: `lobe` becomes `C(n) lobe G2 / (4 N.wo) (1 - S)` and
-    /// `grazing` the same times `S` instead, `S = (1 - wo.h)^5` Schlick's grazing weight, so
-    /// that `ks F0` scales the first and `ks` the second (per light, times the arriving
-    /// intensity: [`Shader::microfacet_contribution`], term for term). `Lambda` is a table
-    /// lookup, so this loop is scalar.
-    pub fn factors(
-        &self,
-        [cos_out, cos_in, cos_half]: [&[f32]; 3],
-        lobe: &mut [f32],
-        grazing: &mut [f32],
-    ) {
-        for (i, (value, grazing)) in lobe.iter_mut().zip(grazing.iter_mut()).enumerate() {
-            if cos_out[i] <= 0.0 || cos_in[i] <= 0.0 || *value == 0.0 {
-                (*value, *grazing) = (0.0, 0.0);
-                continue;
-            }
-            let base =
-                self.normaliser * *value * self.g2(cos_out[i], cos_in[i]) / (4.0 * cos_out[i]);
-            let s = schlick_weight(cos_half[i]);
-            (*value, *grazing) = (base * (1.0 - s), base * s);
-        }
-    }
-
-    /// The height-correlated `G2 = 1 / (1 + Lambda_o + Lambda_i)` of directions with cosines
-    /// `cos_o` and `cos_i`, from the table's `G1`s (`Lambda = 1 / G1 - 1`); 0 where either
-    /// is fully masked.
-    #[must_use]
-    pub fn g2(&self, cos_o: f32, cos_i: f32) -> f32 {
-        let (a, b) = (self.g1(cos_o), self.g1(cos_i));
-        let denominator = a + b - a * b;
-        if denominator > 0.0 {
-            a * b / denominator
-        } else {
-            0.0
-        }
-    }
-}
-
-/// Schlick's `(1 - cos)^5`, the grazing weight of his Fresnel.
-#[must_use]
-pub fn schlick_weight(cos: f32) -> f32 {
-    let m = 1.0 - cos.clamp(0.0, 1.0);
-    let m2 = m * m;
-    m2 * m2 * m
-}
-
 impl Shader {
     /// Prepares `material` for `model` (the normalisation constant, and in the microfacet
     /// model the distribution's tables, are computed here, once).
@@ -320,7 +213,7 @@ impl Shader {
     /// exactly, since the lobe is finite.
     #[must_use]
     pub fn has_specular(&self) -> bool {
-        self.specular != Vec3::ZERO || self.microfacet().is_some_and(|m| m.grazing != Vec3::ZERO)
+        self.specular != Vec3::ZERO || self.microfacet().is_some_and(|m| m.grazing() != Vec3::ZERO)
     }
 
     /// The lobe.
@@ -383,9 +276,8 @@ impl Shader {
         [cos_out, cos_in, cos_half]: [f32; 3],
         lobe: f32,
     ) -> Vec3 {
-        let base = terms.normaliser * lobe * terms.g2(cos_out, cos_in) / (4.0 * cos_out);
-        let s = schlick_weight(cos_half);
-        intensity * (self.diffuse * cos_in + (self.specular * (1.0 - s) + terms.grazing * s) * base)
+        let (toward_f0, grazing) = terms.split(lobe, [cos_out, cos_in, cos_half]);
+        intensity * (self.diffuse * cos_in + self.specular * toward_f0 + terms.grazing() * grazing)
     }
 
     /// Radiance leaving `position` towards `wo`, for the surface `normal`. Both directions
@@ -562,30 +454,6 @@ mod tests {
                 );
             }
         }
-    }
-
-    /// The masking table's `G2` against the distribution's own (its `Lambda` table, built by
-    /// quadrature), for every built-in lobe from rough to sharp: the bound was measured,
-    /// then stated.
-    #[test]
-    fn the_masking_table_keeps_the_distributions_g2() {
-        let mut worst = 0.0_f64;
-        for kind in LobeKind::ALL {
-            for n in [1.0, 8.0, 64.0, 1000.0] {
-                let lobe = Lobe::new(kind, Exponent::new(n));
-                let terms = MicrofacetTerms::new(&lobe, 1.0);
-                let exact = specula::microfacet::Distribution::lobe(kind, Exponent::new(n));
-                for i in 1..=200 {
-                    for j in [1, 5, 20, 60, 120, 200] {
-                        let (a, b) = (f64::from(i) / 200.0, f64::from(j) / 200.0);
-                        let table = f64::from(terms.g2(a as f32, b as f32));
-                        worst = worst.max((table - exact.g2(a, b)).abs());
-                    }
-                }
-            }
-        }
-        // Measured: 2.6e-3 at worst over these cases.
-        assert!(worst < 4e-3, "G2 off by {worst}");
     }
 
     #[test]

@@ -102,7 +102,9 @@ impl FittedReflectance {
     /// Prepares `fit` for rendering.
     #[must_use]
     pub fn new(fit: &Fit) -> Self {
-        let draw = match fit.specular.shape(fit.parameter[0]) {
+        let model = fit.prepare();
+        // The draw's shape is the model's first channel's, tables and all.
+        let draw = match model.first_shape().clone() {
             Shape::Lobe { lobe, geometry } => {
                 SpecularDraw::Lobe(SpecularSampler::new(lobe, geometry, Normalisation::None))
             }
@@ -113,7 +115,7 @@ impl FittedReflectance {
             luminance(DVec3::from_array(fit.albedo_at_normal())),
         );
         Self {
-            model: fit.prepare(),
+            model,
             draw,
             specular_share: if total > 0.0 {
                 ((total - d) / total).clamp(0.0, 1.0)

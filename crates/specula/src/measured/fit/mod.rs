@@ -185,16 +185,6 @@ impl Specular {
         }
     }
 
-    /// The microfacet distribution of this family at `parameter` (`None` for the classic
-    /// lobes, which are no distribution of normals).
-    #[must_use]
-    pub fn distribution(self, parameter: f64) -> Option<Distribution> {
-        match self.shape(parameter) {
-            Shape::Lobe { .. } => None,
-            Shape::Microfacet(distribution) => Some(distribution),
-        }
-    }
-
     /// The searched range of the shape parameter's logarithm.
     fn log_range(self) -> [f64; 2] {
         if self.takes_alpha() {
@@ -339,8 +329,21 @@ impl Fit {
             kd: DVec3::from_array(self.kd),
             k: DVec3::from_array(self.k),
             f0: self.f0.map(DVec3::from_array),
-            shapes: Box::new(self.parameter.map(|p| self.specular.shape(p))),
+            shapes: Box::new(self.shapes()),
         }
+    }
+
+    /// Each channel's shape; channels sharing a parameter share one (a lobe's distribution
+    /// builds its tables once, not per channel).
+    fn shapes(&self) -> [Shape; 3] {
+        let first = self.specular.shape(self.parameter[0]);
+        self.parameter.map(|p| {
+            if p == self.parameter[0] {
+                first.clone()
+            } else {
+                self.specular.shape(p)
+            }
+        })
     }
 }
 
@@ -356,6 +359,12 @@ pub struct FittedModel {
 }
 
 impl FittedModel {
+    /// The first channel's specular shape (what a renderer draws its directions from).
+    #[must_use]
+    pub fn first_shape(&self) -> &Shape {
+        &self.shapes[0]
+    }
+
     /// The specular term per unit `K`, per channel (without the cosine), Fresnel included.
     #[must_use]
     pub fn specular(&self, wo: DVec3, wi: DVec3) -> DVec3 {
