@@ -23,8 +23,10 @@ use crate::wgsl;
 
 mod engines;
 mod es100;
+mod kernel;
 
 pub use engines::Engine;
+pub use kernel::{compute_kernel_spirv, compute_kernel_wgsl, WORKGROUP_SIZE};
 
 /// A shading language naga writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -27,6 +27,10 @@ pub trait Dialect {
     fn expm1(&self, x: &str) -> String {
         format!("({} - 1.0)", self.call("exp", &[x.to_owned()]))
     }
+    /// `a / b`, fully parenthesised.
+    fn divide(&self, a: &str, b: &str) -> String {
+        format!("({a} / {b})")
+    }
     /// `then` where `a < b`, else `otherwise`.
     fn select_less(&self, a: &str, b: &str, then: &str, otherwise: &str) -> String;
     /// A constant, computed by the model in `f64`; targets in `f32` round it.
@@ -106,7 +110,7 @@ pub fn straight_line_named(
             Node::Add(a, b) => format!("({} + {})", at(a), at(b)),
             Node::Sub(a, b) => format!("({} - {})", at(a), at(b)),
             Node::Mul(a, b) => format!("({} * {})", at(a), at(b)),
-            Node::Div(a, b) => format!("({} / {})", at(a), at(b)),
+            Node::Div(a, b) => dialect.divide(&at(a), &at(b)),
             // `-x`, parenthesised where x is itself a negative literal.
             Node::Neg(a) if at(a).starts_with('-') => format!("(-({}))", at(a)),
             Node::Neg(a) => format!("(-{})", at(a)),

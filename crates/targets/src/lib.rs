@@ -8,9 +8,12 @@
 //! - [`osl`]: a Blender Cycles script node (OSL);
 //! - [`materialx`]: a MaterialX document (the lobe as a node graph, and a BSDF);
 //! - [`mitsuba`]: a Mitsuba 3 BSDF plugin (Python, Dr.Jit), with the lobe's sampling;
+//! - [`compute`]: CUDA C and OpenCL C compute kernels, what NVIDIA's and Intel's compilers
+//!   are given (`specula-isa`);
 //! - [`code`]: the straight-line writer they share, and the inputs a node or plugin exposes.
 
 pub mod code;
+pub mod compute;
 pub mod materialx;
 pub mod mitsuba;
 pub mod osl;

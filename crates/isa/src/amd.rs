@@ -1,0 +1,256 @@
+//! AMD: the exported SPIR-V kernel through Mesa's RADV on a null device (no GPU needed), which
+//! compiles it with ACO for the chip `RADV_FORCE_FAMILY` names; the assembly, ACO's statistics
+//! (its estimated latency and inverse throughput among them) and the registers come back
+//! through `VK_KHR_pipeline_executable_properties`, asked by a small Vulkan program
+//! (`vulkan_helper.c`, built here with `gcc` once a process). The same program runs a kernel
+//! on Mesa's lavapipe, which is how the SPIR-V is tested to compute the lobe.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::OnceLock;
+
+use specula_synth::cache::{key, Cache};
+
+use crate::gpus::Gpu;
+use crate::tools;
+use crate::{Disassembly, Estimate, IsaError};
+
+/// The helper's source.
+const HELPER: &str = include_str!("vulkan_helper.c");
+
+/// The built helper: beside the cached results (`vulkan_helper-<hash of its source>`), built
+/// once with `gcc` and renamed into place, so a process finds it built.
+fn helper() -> Result<PathBuf, IsaError> {
+    static BUILT: OnceLock<Result<PathBuf, IsaError>> = OnceLock::new();
+    BUILT.get_or_init(build_helper).clone()
+}
+
+fn build_helper() -> Result<PathBuf, IsaError> {
+    let folder = Cache::default_for("isa")
+        .map_or_else(std::env::temp_dir, |cache| cache.directory().to_owned());
+    let program = folder.join(format!("vulkan_helper-{}", key(&[HELPER])));
+    if program.is_file() {
+        return Ok(program);
+    }
+    std::fs::create_dir_all(&folder).map_err(IsaError::scratch)?;
+    let scratch =
+        specula_temporaries::dir_in(&folder, "vulkan-helper-").map_err(IsaError::scratch)?;
+    let source = scratch.path().join("vulkan_helper.c");
+    let built = scratch.path().join("vulkan_helper");
+    std::fs::write(&source, HELPER).map_err(IsaError::scratch)?;
+    let mut command = Command::new("gcc");
+    command
+        .arg("-O1")
+        .arg("-o")
+        .arg(&built)
+        .arg(&source)
+        .arg("-lvulkan");
+    tools::run(command, "building the Vulkan helper with gcc").map_err(|error| match error {
+        IsaError::Failed { message, .. }
+            if message.contains("vulkan/vulkan.h") || message.contains("-lvulkan") =>
+        {
+            IsaError::Missing {
+                tool: "the Vulkan headers and loader".to_owned(),
+                install: "apt-get install libvulkan-dev".to_owned(),
+            }
+        }
+        IsaError::Failed { message, .. } if message.contains("No such file") => IsaError::Missing {
+            tool: "gcc".to_owned(),
+            install: "apt-get install gcc".to_owned(),
+        },
+        other => other,
+    })?;
+    std::fs::rename(&built, &program).map_err(IsaError::scratch)?;
+    Ok(program)
+}
+
+/// The helper run on `driver`'s ICD (`radeon` for ACO, `lvp` for lavapipe) with `family`
+/// forced where given.
+fn helper_command(driver: &Path, family: Option<&str>) -> Result<Command, IsaError> {
+    let mut command = Command::new(helper()?);
+    command
+        .env("VK_ICD_FILENAMES", driver)
+        .env("VK_DRIVER_FILES", driver)
+        // Compiled afresh every time, and no cache written into the user's home.
+        .env("MESA_SHADER_CACHE_DISABLE", "true")
+        .env_remove("RADV_DEBUG")
+        .env_remove("RADV_PERFTEST");
+    if let Some(family) = family {
+        command.env("RADV_FORCE_FAMILY", family);
+    }
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        command.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    Ok(command)
+}
+
+/// RADV's device line for `gpu` (`Null hardware (RADV NAVI21) (Mesa driver 22.3.6)`), asked
+/// once per process: the compiler's version in a cache key.
+pub fn version(gpu: &Gpu) -> Result<String, IsaError> {
+    static VERSIONS: std::sync::Mutex<Vec<(&'static str, String)>> =
+        std::sync::Mutex::new(Vec::new());
+    let mut known = VERSIONS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if let Some((_, version)) = known.iter().find(|(id, _)| *id == gpu.id) {
+        return Ok(version.clone());
+    }
+    let radeon = tools::vulkan_driver("radeon", "mesa-vulkan-drivers")?;
+    let mut command = helper_command(&radeon, Some(gpu.compiler_target))?;
+    command.arg("device");
+    let output = tools::run(command, "RADV's null device")?;
+    let line = String::from_utf8_lossy(&output.stdout);
+    let version = line
+        .trim()
+        .strip_prefix("device ")
+        .unwrap_or(line.trim())
+        .to_owned();
+    known.push((gpu.id, version.clone()));
+    Ok(version)
+}
+
+/// The assembly and statistics ACO makes of `spirv` (entry point `entry`) for `gpu`.
+pub fn compile(spirv: &[u32], entry: &str, gpu: &Gpu) -> Result<Disassembly, IsaError> {
+    let radeon = tools::vulkan_driver("radeon", "mesa-vulkan-drivers")?;
+    let scratch = specula_temporaries::dir("isa-amd-").map_err(IsaError::scratch)?;
+    let file = scratch.path().join("kernel.spv");
+    let bytes: Vec<u8> = spirv.iter().flat_map(|word| word.to_le_bytes()).collect();
+    std::fs::write(&file, bytes).map_err(IsaError::scratch)?;
+    let mut command = helper_command(&radeon, Some(gpu.compiler_target))?;
+    command.arg("isa").arg(&file).arg(entry);
+    let output = tools::run(command, "RADV (ACO)")?;
+    let report = Report::read(&String::from_utf8_lossy(&output.stdout))?;
+    let wave = report.statistic("Subgroup size").unwrap_or(64.0) as u32;
+    let assembly = report
+        .representation("Assembly")
+        .ok_or_else(|| IsaError::Unreadable("RADV returned no assembly".to_owned()))?;
+    let estimates = [
+        ("Latency", "ACO's estimated latency, cycles"),
+        (
+            "Inverse Throughput",
+            "ACO's estimated inverse throughput, cycles per wave",
+        ),
+        ("Instructions", "ACO's instruction count"),
+        ("SGPRs", "scalar registers"),
+        ("Subgroup size", "wave size"),
+    ]
+    .into_iter()
+    .filter_map(|(statistic, name)| {
+        report.statistic(statistic).map(|value| Estimate {
+            name: name.to_owned(),
+            value,
+        })
+    })
+    .collect();
+    Ok(Disassembly {
+        compiler: format!("ACO in {}", report.device),
+        text: assembly.to_owned(),
+        simd: wave,
+        registers: report.statistic("VGPRs").map(|v| v as u32),
+        estimates,
+    })
+}
+
+/// Runs `spirv`'s kernel on Mesa's lavapipe over `inputs`, `per_thread` floats a thread: one
+/// output a thread.
+pub fn run_on_lavapipe(
+    spirv: &[u32],
+    entry: &str,
+    inputs: &[f32],
+    per_thread: usize,
+) -> Result<Vec<f32>, IsaError> {
+    let lavapipe = tools::vulkan_driver("lvp", "mesa-vulkan-drivers")?;
+    let scratch = specula_temporaries::dir("isa-run-").map_err(IsaError::scratch)?;
+    let file = scratch.path().join("kernel.spv");
+    let bytes: Vec<u8> = spirv.iter().flat_map(|word| word.to_le_bytes()).collect();
+    std::fs::write(&file, bytes).map_err(IsaError::scratch)?;
+    let mut command = helper_command(&lavapipe, None)?;
+    command
+        .arg("run")
+        .arg(&file)
+        .arg(entry)
+        .arg(per_thread.to_string())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let failed = |message: String| IsaError::Failed {
+        what: "the kernel on lavapipe".to_owned(),
+        message,
+    };
+    let mut child = command.spawn().map_err(|e| failed(e.to_string()))?;
+    let input: Vec<u8> = inputs.iter().flat_map(|v| v.to_le_bytes()).collect();
+    child
+        .stdin
+        .take()
+        .ok_or_else(|| failed("no standard input".to_owned()))?
+        .write_all(&input)
+        .map_err(|e| failed(e.to_string()))?;
+    let output = child
+        .wait_with_output()
+        .map_err(|e| failed(e.to_string()))?;
+    if !output.status.success() {
+        return Err(failed(
+            String::from_utf8_lossy(&output.stderr).trim().to_owned(),
+        ));
+    }
+    Ok(output
+        .stdout
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect())
+}
+
+/// The helper's `isa` output read back.
+struct Report {
+    device: String,
+    statistics: Vec<(String, f64)>,
+    representations: Vec<(String, String)>,
+}
+
+impl Report {
+    fn read(text: &str) -> Result<Report, IsaError> {
+        let unreadable = |what: &str| IsaError::Unreadable(format!("the Vulkan helper's {what}"));
+        let mut report = Report {
+            device: String::new(),
+            statistics: Vec::new(),
+            representations: Vec::new(),
+        };
+        let mut rest = text;
+        while let Some((line, after)) = rest.split_once('\n') {
+            rest = after;
+            if let Some(device) = line.strip_prefix("device ") {
+                device.clone_into(&mut report.device);
+            } else if let Some(statistic) = line.strip_prefix("stat ") {
+                let (name, value) = statistic
+                    .split_once('\t')
+                    .ok_or_else(|| unreadable("statistics"))?;
+                let value = value.trim().parse().map_err(|_| unreadable("statistics"))?;
+                report.statistics.push((name.to_owned(), value));
+            } else if let Some(ir) = line.strip_prefix("ir ") {
+                let (name, length) = ir.split_once('\t').ok_or_else(|| unreadable("assembly"))?;
+                let length: usize = length.trim().parse().map_err(|_| unreadable("assembly"))?;
+                let body = rest.get(..length).ok_or_else(|| unreadable("assembly"))?;
+                report
+                    .representations
+                    .push((name.to_owned(), body.to_owned()));
+                rest = rest.get(length..).unwrap_or("").trim_start_matches('\n');
+            }
+        }
+        Ok(report)
+    }
+
+    fn statistic(&self, name: &str) -> Option<f64> {
+        self.statistics
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| *v)
+    }
+
+    fn representation(&self, name: &str) -> Option<&str> {
+        self.representations
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, text)| text.as_str())
+    }
+}
