@@ -134,6 +134,18 @@ enum Command {
                             cosquad,pow,sg"
     )]
     Hw(commands::hw::Args),
+    /// A lobe's machine code beside pow's, as NVIDIA's, AMD's or Intel's compiler writes it
+    /// for a named GPU: instructions by class, registers, the compiler's estimates.
+    #[command(
+        after_help = "Examples:\n  specula isa --lobe sg --n 64 --gpu sm_89\n  \
+                            specula isa --lobe schlick --n 64 --gpu gfx1100 --context shading\n  \
+                            specula isa --lobe cosquad --n 100 --gpu tgllp --format json\n\n\
+                      The compilers need no GPU: nvcc and nvdisasm from PyPI \
+                      (nvidia-cuda-nvcc, nvidia-nvvm, nvidia-cuda-crt, nvidia-cuda-runtime, \
+                      nvidia-cuda-nvdisasm), Mesa's RADV (mesa-vulkan-drivers, with \
+                      libvulkan-dev and gcc for its helper), Intel's ocloc (intel-opencl-icd)."
+    )]
+    Isa(commands::isa::Args),
     /// Render a volume (the Shepp-Logan head, Marschner-Lobb, NIfTI, a DICOM series) by ray
     /// marching or as an isosurface, any lobe as its specular term, on the CPU or GPU.
     #[command(
@@ -290,6 +302,7 @@ fn main() -> ExitCode {
         Command::Shader(args) => commands::shader::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
         Command::Hw(args) => commands::hw::run(&args),
+        Command::Isa(args) => commands::isa::run(&args),
         Command::Sky(args) => commands::sky::run(&args),
         Command::Serve(args) => commands::serve::run(&args),
     };

@@ -7,6 +7,7 @@ use core::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 use specula::analysis::ErrorFigures;
+use specula::gpus::{Gpu, Vendor};
 
 /// Where the lobe will run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -14,10 +15,12 @@ use specula::analysis::ErrorFigures;
 pub enum Target {
     /// This machine's CPU: measured SIMD throughput.
     Cpu,
-    /// NVIDIA GPUs (compute capability 8.6-9.0): modelled from the shader's instructions.
+    /// NVIDIA GPUs: the SASS `nvcc` compiles for a generation (`sm_89` unless named).
     GpuNvidia,
-    /// AMD RDNA GPUs: modelled from the shader's instructions.
+    /// AMD GPUs: the ISA ACO compiles for a chip (`gfx1100` unless named).
     GpuAmd,
+    /// Intel GPUs: the ISA IGC compiles for a device (`dg2` unless named).
+    GpuIntel,
     /// FPGA: the fixed-point datapaths synthesized on an iCE40 HX8K (Yosys, nextpnr; cached),
     /// or estimated from their operators where the tools are missing.
     Fpga,
@@ -25,16 +28,65 @@ pub enum Target {
 
 impl Target {
     /// Every target, in the order faces list them.
-    pub const ALL: [Target; 4] = [Target::Cpu, Target::GpuNvidia, Target::GpuAmd, Target::Fpga];
+    pub const ALL: [Target; 5] = [
+        Target::Cpu,
+        Target::GpuNvidia,
+        Target::GpuAmd,
+        Target::GpuIntel,
+        Target::Fpga,
+    ];
 
-    /// The id every face parses and prints: `cpu`, `gpu-nvidia`, `gpu-amd`, `fpga`.
+    /// The GPU targets, in the order faces list them.
+    pub const GPUS: [Target; 3] = [Target::GpuNvidia, Target::GpuAmd, Target::GpuIntel];
+
+    /// The id every face parses and prints: `cpu`, `gpu-nvidia`, `gpu-amd`, `gpu-intel`,
+    /// `fpga`.
     #[must_use]
     pub fn id(self) -> &'static str {
         match self {
             Target::Cpu => "cpu",
             Target::GpuNvidia => "gpu-nvidia",
             Target::GpuAmd => "gpu-amd",
+            Target::GpuIntel => "gpu-intel",
             Target::Fpga => "fpga",
+        }
+    }
+
+    /// A GPU target's vendor.
+    #[must_use]
+    pub fn vendor(self) -> Option<Vendor> {
+        match self {
+            Target::GpuNvidia => Some(Vendor::Nvidia),
+            Target::GpuAmd => Some(Vendor::Amd),
+            Target::GpuIntel => Some(Vendor::Intel),
+            Target::Cpu | Target::Fpga => None,
+        }
+    }
+
+    /// The GPU a GPU target is costed on: `gpu` where given (refused where it is another
+    /// vendor's), else the vendor's current generation ([`Vendor::default_gpu`]).
+    pub fn gpu(self, gpu: Option<Gpu>) -> Result<Option<Gpu>, String> {
+        let Some(vendor) = self.vendor() else {
+            return match gpu {
+                Some(gpu) => Err(format!(
+                    "--gpu {} names a GPU and the target is {}; choose gpu-{} with it",
+                    gpu.id,
+                    self.id(),
+                    gpu.vendor.id()
+                )),
+                None => Ok(None),
+            };
+        };
+        match gpu {
+            Some(gpu) if gpu.vendor != vendor => Err(format!(
+                "--gpu {} is an {} GPU, not for --target {}; valid GPUs: {}",
+                gpu.id,
+                gpu.vendor.name(),
+                self.id(),
+                Gpu::of(vendor).map(|g| g.id).collect::<Vec<_>>().join(", ")
+            )),
+            Some(gpu) => Ok(Some(gpu)),
+            None => Ok(Some(vendor.default_gpu())),
         }
     }
 
@@ -44,9 +96,17 @@ impl Target {
         match self {
             Target::Cpu => "This machine's CPU: measured SIMD throughput",
             Target::GpuNvidia => {
-                "NVIDIA GPUs (compute capability 8.6-9.0): modelled from the shader's instructions"
+                "NVIDIA GPUs: the SASS nvcc compiles for --gpu (sm_75 to sm_120; sm_89 unless \
+                 named), each class at its published rate"
             }
-            Target::GpuAmd => "AMD RDNA GPUs: modelled from the shader's instructions",
+            Target::GpuAmd => {
+                "AMD GPUs: the ISA ACO (Mesa RADV) compiles for --gpu (gfx900 to gfx1100; \
+                 gfx1100 unless named), each class at its published rate, and ACO's estimate"
+            }
+            Target::GpuIntel => {
+                "Intel GPUs: the ISA IGC (ocloc) compiles for --gpu (tgllp, dg2; dg2 unless \
+                 named), each class at its published rate"
+            }
             Target::Fpga => {
                 "FPGA: the fixed-point datapaths synthesized on an iCE40 HX8K (Yosys and \
                  nextpnr, cached), or estimated from their operators without the tools"
@@ -108,7 +168,7 @@ impl Zone {
 impl FromStr for Target {
     type Err = String;
 
-    /// `cpu`, `gpu-nvidia`, `gpu-amd` or `fpga`.
+    /// `cpu`, `gpu-nvidia`, `gpu-amd`, `gpu-intel` or `fpga`.
     fn from_str(text: &str) -> Result<Self, String> {
         specula::choose(&Target::ALL, Target::id, text, "target", "targets")
     }
@@ -150,7 +210,10 @@ mod tests {
         }
         assert_eq!(
             "tpu".parse::<Target>(),
-            Err("unknown target 'tpu'; valid targets: cpu, gpu-nvidia, gpu-amd, fpga".to_owned())
+            Err(
+                "unknown target 'tpu'; valid targets: cpu, gpu-nvidia, gpu-amd, gpu-intel, fpga"
+                    .to_owned()
+            )
         );
         let refusal = "x\ny".parse::<Zone>().unwrap_err();
         assert_eq!(refusal.lines().count(), 1, "{refusal}");

@@ -1,15 +1,17 @@
 //! What a lobe costs on a target (higher is cheaper): on the CPU, its SIMD kernel's measured
 //! rate on this machine (every candidate timed beside the others, [`crate::rates::kernel_rates`]);
-//! on a GPU family, the modelled
-//! evaluations per clock of its exported shader; on the FPGA, the datapath
-//! [`cheapest_datapath`] picks at the width the error needs, synthesized (cached) or, without
-//! the tools, estimated. `recommend.rs` ranks by these; a material's verdict
-//! (`material.rs`) takes [`lobe_rate`], which refuses the FPGA.
+//! on a GPU generation, the evaluations per clock of the machine code its vendor's compiler
+//! writes for the lobe's kernel (`specula-isa`), each class at the generation's published
+//! rate, or, where the compiler is missing, of the naga-IR model's counts (said so); on the
+//! FPGA, the datapath [`cheapest_datapath`] picks at the width the error needs, synthesized
+//! (cached) or, without the tools, estimated. `recommend.rs` ranks by these; a material's
+//! verdict (`material.rs`) takes [`lobe_rate`], which refuses the FPGA.
 
 use indicatif::ProgressBar;
-use specula::gpu_cost::GpuFamily;
+use specula::gpus::{Gpu, Vendor};
 use specula::{Exponent, Lobe, LobeKind};
 use specula_hw::analysis::WidthSweep;
+use specula_isa::{IsaError, Work};
 
 use crate::hardware::{cheapest_datapath, hardware_sweeps};
 use crate::{Target, Zone};
@@ -19,13 +21,23 @@ pub(crate) enum Costing {
     /// Timed on this machine's CPU: the rates [`Costing::time_kernels`] took, each lobe's
     /// against every other's in one measurement, and any other lobe timed when costed.
     Measured(Vec<TimedRate>),
-    /// The GPU cost model of one family.
-    Modelled(GpuFamily),
+    /// One GPU generation, costed on the basis its compilers allow.
+    Gpu(Gpu, GpuBasis),
     /// Estimated from the fixed-point datapaths' sweeps, per exponent (without Yosys).
     Estimated(Vec<(Exponent, std::sync::Arc<Vec<WidthSweep>>)>),
     /// Synthesized and placed (Yosys, nextpnr-ice40 on an iCE40 HX8K; cached), at the word
     /// lengths the sweeps choose.
     Synthesized(Vec<(Exponent, std::sync::Arc<Vec<WidthSweep>>)>),
+}
+
+/// What a GPU's costs are read off.
+#[derive(Clone, Debug)]
+pub(crate) enum GpuBasis {
+    /// The machine code the vendor's compiler (named, with its version) writes.
+    Compiled(String),
+    /// The naga-IR model: the compiler is missing (the note says which and how to install
+    /// it).
+    Modelled,
 }
 
 /// A kernel's rates timed beside the others', one a pass ([`crate::rates::kernel_rates`]).
@@ -49,6 +61,9 @@ pub(crate) struct Point {
     /// Measured on the CPU: the median and the fastest of the timing's passes (the rate is
     /// the fastest: noise only ever slows a kernel down).
     pub(crate) spread: Option<[f64; 2]>,
+    /// On AMD, ACO's estimated inverse throughput of the lobe's kernel beyond the baseline's,
+    /// cycles a wave.
+    pub(crate) aco_inverse_throughput: Option<f64>,
 }
 
 /// The integer exponent the datapaths take for `n`.
@@ -57,19 +72,32 @@ fn datapath_exponent(n: Exponent) -> u32 {
 }
 
 impl Costing {
-    /// The costing of `target` at `exponents`, and a note for the user where the FPGA's tools
-    /// are missing.
+    /// The costing of `target` (on `gpu`, a GPU target's generation, its vendor's current
+    /// one if `None`) at `exponents`, and a note for the user where a tool is missing (the
+    /// FPGA's, a GPU's compiler).
     pub(crate) fn new(
         target: Target,
+        gpu: Option<Gpu>,
         exponents: &[Exponent],
     ) -> Result<(Self, Option<String>), String> {
-        let family = |id: &str| {
-            GpuFamily::find(id).ok_or_else(|| format!("no GPU family '{id}' in the model"))
-        };
+        if let Some(gpu) = target.gpu(gpu)? {
+            return Ok(match specula_isa::compiler_version(&gpu) {
+                Ok(compiler) => (Costing::Gpu(gpu, GpuBasis::Compiled(compiler)), None),
+                Err(missing @ IsaError::Missing { .. }) => (
+                    Costing::Gpu(gpu, GpuBasis::Modelled),
+                    Some(format!(
+                        "{missing}; {} costs are the naga-IR model's instead of the compiler's",
+                        gpu.id
+                    )),
+                ),
+                Err(error) => return Err(error.to_string()),
+            });
+        }
         Ok(match target {
             Target::Cpu => (Costing::Measured(Vec::new()), None),
-            Target::GpuNvidia => (Costing::Modelled(family("gpu-nvidia")?), None),
-            Target::GpuAmd => (Costing::Modelled(family("gpu-amd")?), None),
+            Target::GpuNvidia | Target::GpuAmd | Target::GpuIntel => {
+                unreachable!("a GPU target has a GPU")
+            }
             Target::Fpga => {
                 let sweeps = exponents
                     .iter()
@@ -159,7 +187,16 @@ impl Costing {
     pub(crate) fn unit(&self) -> &'static str {
         match self {
             Costing::Measured(_) => "evals/s, 1 thread",
-            Costing::Modelled(_) => "evals/clock/multiprocessor (modelled)",
+            Costing::Gpu(gpu, GpuBasis::Compiled(_)) => match gpu.vendor {
+                Vendor::Nvidia => "evals/clock/SM (nvcc's SASS)",
+                Vendor::Amd => "evals/clock/CU (ACO's ISA)",
+                Vendor::Intel => "evals/clock/EU (IGC's ISA)",
+            },
+            Costing::Gpu(gpu, GpuBasis::Modelled) => match gpu.vendor {
+                Vendor::Nvidia => "evals/clock/SM (modelled)",
+                Vendor::Amd => "evals/clock/CU (modelled)",
+                Vendor::Intel => "evals/clock/EU (modelled)",
+            },
             Costing::Estimated(_) => "evals/clock per 1000 logic cells (estimated)",
             Costing::Synthesized(_) => "results/us per 1000 LUTs (synthesized, iCE40 HX8K)",
         }
@@ -187,14 +224,19 @@ impl Costing {
                     rate: spread.map_or_else(|| crate::rates::kernel_rate(lobe), |[_, best]| best),
                     datapath: None,
                     spread,
+                    aco_inverse_throughput: None,
                 })
             }
-            Costing::Modelled(family) => Some(Point {
-                error: float_error(),
-                rate: modelled_rate(family, lobe)?,
-                datapath: None,
-                spread: None,
-            }),
+            Costing::Gpu(gpu, basis) => {
+                let (rate, aco_inverse_throughput) = gpu_rate(*gpu, basis, lobe)?;
+                Some(Point {
+                    error: float_error(),
+                    rate,
+                    datapath: None,
+                    spread: None,
+                    aco_inverse_throughput,
+                })
+            }
             Costing::Estimated(hardware) | Costing::Synthesized(hardware) => {
                 let Some(chosen) = hardware
                     .iter()
@@ -233,6 +275,7 @@ impl Costing {
                     rate,
                     datapath: Some(datapath),
                     spread: None,
+                    aco_inverse_throughput: None,
                 })
             }
         })
@@ -264,13 +307,52 @@ fn synthesized_rate(synthesis: &specula_synth::Synthesis) -> (f64, Option<&'stat
 /// Why a material's verdict refuses the FPGA.
 pub const FPGA_MATERIAL_REFUSAL: &str = "a material verdict cannot target fpga: the fixed-point \
     datapaths take an integer n and a word length chosen for an error against t^n, which a \
-    material's fit does not give; valid targets: cpu, gpu-nvidia, gpu-amd";
+    material's fit does not give; valid targets: cpu, gpu-nvidia, gpu-amd, gpu-intel";
 
-/// `lobe`'s evaluations per clock per multiprocessor on `family`, by the GPU cost model over
-/// the instructions of its exported shader (higher is cheaper).
-pub fn modelled_rate(family: &GpuFamily, lobe: &Lobe) -> Result<f64, String> {
+/// `lobe`'s evaluations per clock per multiprocessor on `gpu`, by the GPU cost model over
+/// the instructions of its exported shader (higher is cheaper): the fallback where the
+/// vendor's compiler is missing.
+pub fn modelled_rate(gpu: &Gpu, lobe: &Lobe) -> Result<f64, String> {
     let ops = specula_gpu::shader_ops::lobe_shader_ops(lobe)?;
-    Ok(family.cost(&ops).evals_per_clock)
+    Ok(specula::gpu_cost::modelled(&ops, &gpu.rates).evals_per_clock)
+}
+
+/// `lobe`'s evaluations per clock per multiprocessor on `gpu` on `basis`, and on AMD, ACO's
+/// estimated inverse throughput beyond the baseline kernel's.
+fn gpu_rate(gpu: Gpu, basis: &GpuBasis, lobe: &Lobe) -> Result<(f64, Option<f64>), String> {
+    match basis {
+        GpuBasis::Compiled(_) => {
+            let compiled =
+                specula_isa::compile(lobe, gpu, Work::Lobe).map_err(|e| e.to_string())?;
+            Ok((
+                compiled.evals_per_clock().0,
+                compiled.aco_inverse_throughput(),
+            ))
+        }
+        GpuBasis::Modelled => Ok((modelled_rate(&gpu, lobe)?, None)),
+    }
+}
+
+/// What `target`'s GPU costs are read off, in a sentence for the reader, where the target is
+/// a GPU: the compiler and generation, or the model and why.
+pub fn gpu_basis(target: Target, gpu: Option<Gpu>) -> Result<Option<String>, String> {
+    let (costing, note) = Costing::new(target, gpu, &[])?;
+    Ok(match costing {
+        Costing::Gpu(gpu, GpuBasis::Compiled(compiler)) => Some(format!(
+            "{} ({}): the machine code {compiler} writes for each lobe's kernel, beyond a \
+             kernel that only loads and stores, each class at the rate of {}",
+            gpu.id, gpu.name, gpu.source
+        )),
+        Costing::Gpu(gpu, GpuBasis::Modelled) => Some(format!(
+            "{} ({}): the naga-IR model of the exported shader, each class at the rate of {} \
+             ({})",
+            gpu.id,
+            gpu.name,
+            gpu.source,
+            note.unwrap_or_default()
+        )),
+        _ => None,
+    })
 }
 
 /// `target` if a material's verdict can be given on it: every target but the FPGA
@@ -283,13 +365,14 @@ pub(crate) fn material_target(target: Target) -> Result<Target, String> {
 }
 
 /// A lobe's rate on `target` for a material's verdict (higher is cheaper): measured on the
-/// CPU, modelled on a GPU; the FPGA is refused ([`FPGA_MATERIAL_REFUSAL`]) before any
-/// costing starts (costing it would run its sweeps).
+/// CPU, from the compiled machine code (or the model) on a GPU, the vendor's current
+/// generation; the FPGA is refused ([`FPGA_MATERIAL_REFUSAL`]) before any costing starts
+/// (costing it would run its sweeps).
 pub fn lobe_rate(target: Target, lobe: &Lobe) -> Result<f64, String> {
     let target = material_target(target)?;
-    match Costing::new(target, &[lobe.exponent()])?.0 {
+    match Costing::new(target, None, &[lobe.exponent()])?.0 {
         Costing::Measured(_) => Ok(crate::rates::kernel_rate(lobe)),
-        Costing::Modelled(family) => modelled_rate(&family, lobe),
+        Costing::Gpu(gpu, basis) => Ok(gpu_rate(gpu, &basis, lobe)?.0),
         Costing::Estimated(_) | Costing::Synthesized(_) => Err(FPGA_MATERIAL_REFUSAL.to_owned()),
     }
 }
@@ -300,44 +383,21 @@ pub fn rate_unit(target: Target) -> &'static str {
     match target {
         // Costing the FPGA would run its sweeps; material verdicts refuse it anyway.
         Target::Fpga => "",
-        _ => Costing::new(target, &[]).map_or("", |(costing, _)| costing.unit()),
+        _ => Costing::new(target, None, &[]).map_or("", |(costing, _)| costing.unit()),
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn synthesis(fmax_mhz: Option<f64>) -> specula_synth::Synthesis {
-        specula_synth::Synthesis {
-            lobe: "schlick-mod".to_owned(),
-            bits: 16,
-            target: FPGA_TARGET,
-            tools: specula_synth::ToolVersions {
-                yosys: "Yosys 0.23".to_owned(),
-                nextpnr: Some("nextpnr-ice40 0.4".to_owned()),
-            },
-            cells: specula_synth::report::Cells {
-                logic: 2000,
-                ..Default::default()
-            },
-            fmax_mhz,
-            fmax_note: fmax_mhz
-                .is_none()
-                .then(|| "does not fit the HX8K once packed".to_owned()),
-            logic_cells_placed: None,
-            latency: 11,
-        }
-    }
-
-    /// 2000 LUTs at 10 MHz cost 2000 x 100 ns = 200,000 LUT x ns per result: 5 results per
-    /// microsecond per 1000 LUTs. Placed nowhere, the datapath costs nothing it could run.
-    #[test]
-    fn a_placed_datapath_is_costed_by_its_area_and_clock_and_an_unplaced_one_not_at_all() {
-        let (rate, unfit) = synthesized_rate(&synthesis(Some(10.0)));
-        assert!((rate - 5.0).abs() < 1e-12 && unfit.is_none(), "{rate}");
-        let (rate, unfit) = synthesized_rate(&synthesis(None));
-        assert_eq!(rate, 0.0);
-        assert!(unfit.unwrap().contains("does not fit the iCE40 HX8K"));
-    }
+/// Compiles every lobe the ranking will cost on a GPU in one run of the compiler, so that the
+/// ranking finds each in the cache (a compiler's process is most of a compile's time, and a
+/// range needs dozens of kernels). A failure is left for the ranking, which compiles the lobes
+/// one by one and reports the one that fails.
+pub(crate) fn compile_ahead(costing: &Costing, lobes: &[LobeKind], exponents: &[Exponent]) {
+    let Costing::Gpu(gpu, GpuBasis::Compiled(_)) = costing else {
+        return;
+    };
+    let all: Vec<Lobe> = lobes
+        .iter()
+        .flat_map(|&kind| exponents.iter().map(move |&n| Lobe::new(kind, n)))
+        .collect();
+    let _ = specula_isa::compile_all(&all, *gpu, Work::Lobe);
 }

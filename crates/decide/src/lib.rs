@@ -25,7 +25,7 @@ pub mod rates;
 mod recommend;
 
 pub use choice::{Target, Zone};
-pub use costing::{lobe_rate, modelled_rate, rate_unit, FPGA_MATERIAL_REFUSAL};
+pub use costing::{gpu_basis, lobe_rate, modelled_rate, rate_unit, FPGA_MATERIAL_REFUSAL};
 pub use hardware::{hardware_sweeps, sweeps};
 pub use recommend::{
     pareto_front, recommend, recommend_each, versus_pow, Candidate, Recommendation, Request,

@@ -3,18 +3,20 @@
 //! Every lobe is measured against `t^n` at each exponent asked for; a lobe's error is its
 //! worst over them. Those within the allowed error are ranked by cost on the target: on the
 //! CPU, the measured throughput of its SIMD kernel on this machine (one thread, L1, the
-//! slowest over the exponents); on a GPU family, the modelled evaluations per clock per
-//! multiprocessor of its exported shader; on the FPGA, its cheapest datapath at the width the
+//! slowest over the exponents); on a GPU generation, the evaluations per clock per
+//! multiprocessor of the machine code its vendor's compiler writes for the lobe (the naga-IR
+//! model where the compiler is missing, said so); on the FPGA, its cheapest datapath at the width the
 //! error needs, synthesized or estimated ([`crate::costing`]). The Pareto front is taken over
 //! every lobe, met or not.
 
 use indicatif::ProgressBar;
 use serde::Serialize;
 use specula::analysis::energy_ratio;
+use specula::gpus::Gpu;
 use specula::{Exponent, Lobe, LobeKind};
 use specula_hw::analysis::WidthSweep;
 
-use crate::costing::{Costing, Point, FPGA_TARGET};
+use crate::costing::{compile_ahead, Costing, Point, FPGA_TARGET};
 use crate::hardware::cheapest_datapath;
 use crate::{check_lobes, Target, Zone};
 
@@ -23,6 +25,8 @@ use crate::{check_lobes, Target, Zone};
 pub struct Request {
     /// Where the lobe will run.
     pub target: Target,
+    /// A GPU target's generation (its vendor's current one where `None`).
+    pub gpu: Option<Gpu>,
     /// The exponents the answer must hold at (at least one; see [`crate::sample_exponents`]
     /// for a range).
     pub exponents: Vec<Exponent>,
@@ -43,6 +47,7 @@ impl Request {
     pub fn new(target: Target, exponents: Vec<Exponent>, max_error: f64) -> Self {
         Self {
             target,
+            gpu: None,
             exponents,
             max_error,
             zone: Zone::Epicentre,
@@ -73,6 +78,10 @@ pub struct Candidate {
     /// cannot be told apart by this run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spread: Option<[f64; 2]>,
+    /// On AMD, ACO's own estimate beside the rate: the lobe kernel's inverse throughput beyond
+    /// a kernel that only loads and stores, in cycles a wave (the worst over the exponents).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub aco_inverse_throughput: Option<f64>,
     /// Its unit.
     pub unit: &'static str,
     /// The worst energy ratio against `t^n` over the exponents.
@@ -93,6 +102,9 @@ pub struct Recommendation {
     /// What a face should tell its user about how the costs were obtained (the FPGA's tools
     /// missing, so its costs are the formula estimate), if anything.
     pub note: Option<String>,
+    /// On a GPU: what the costs are read off, the generation and compiler named.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub basis: Option<String>,
     /// Every candidate: those that meet the request first, the answer first among them, then
     /// by rate, highest first.
     pub candidates: Vec<Candidate>,
@@ -206,8 +218,13 @@ pub fn recommend_each(
             ..*request
         })?;
     }
-    let (mut costing, note) = Costing::new(request.target, &request.exponents)?;
+    let (mut costing, note) = Costing::new(request.target, request.gpu, &request.exponents)?;
+    let basis = crate::costing::gpu_basis(request.target, request.gpu)?;
     costing.time_kernels(&request.lobes, &request.exponents, progress);
+    if matches!(costing, Costing::Gpu(..)) {
+        progress.set_message("compiling the lobes");
+        compile_ahead(&costing, &request.lobes, &request.exponents);
+    }
     let per_bound = matches!(costing, Costing::Estimated(_) | Costing::Synthesized(_));
     if let Costing::Synthesized(hardware) = &costing {
         for &max_error in bounds {
@@ -253,7 +270,9 @@ pub fn recommend_each(
                 .into_iter()
                 .map(|tally| tally.candidate(unit, max_error, request.energy_conserving))
                 .collect();
-            rank(candidates, unit, note.clone(), request.target, max_error)
+            let mut answer = rank(candidates, unit, note.clone(), request.target, max_error);
+            answer.basis.clone_from(&basis);
+            answer
         })
         .collect())
 }
@@ -272,6 +291,8 @@ struct Tally {
     spread: Option<[f64; 2]>,
     /// Some exponent has no datapath.
     unavailable: bool,
+    /// ACO's estimate, the worst over the exponents.
+    aco_inverse_throughput: Option<f64>,
     energy: f64,
 }
 
@@ -282,6 +303,12 @@ impl Tally {
             return;
         };
         self.error = self.error.max(point.error);
+        if let Some(cycles) = point.aco_inverse_throughput {
+            self.aco_inverse_throughput = Some(
+                self.aco_inverse_throughput
+                    .map_or(cycles, |c| c.max(cycles)),
+            );
+        }
         // The spread is the slowest exponent's, the one that sets the rate.
         if self.cheapest.is_none_or(|c| point.rate < c) {
             self.spread = point.spread;
@@ -316,6 +343,7 @@ impl Tally {
             error,
             rate,
             spread: spread.filter(|_| !self.unavailable),
+            aco_inverse_throughput: self.aco_inverse_throughput,
             unit,
             energy_ratio: self.energy,
             meets,
@@ -354,6 +382,7 @@ fn rank(
     let mut recommendation = Recommendation {
         unit,
         note,
+        basis: None,
         candidates,
         tied,
     };
@@ -494,6 +523,7 @@ mod tests {
                 rate,
                 datapath: Some(datapath.to_owned()),
                 spread: None,
+                aco_inverse_throughput: None,
             }));
             tally.candidate("unit", 0.05, false)
         };

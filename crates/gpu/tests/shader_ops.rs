@@ -1,7 +1,8 @@
 //! The GPU cost model's instruction counts against shaders counted by hand from each lobe's
 //! formula and the exported wrapper (`if !(t > 0) { return 0 }`, `min(t, 1)`).
 
-use specula::gpu_cost::{GpuFamily, ShaderOps};
+use specula::gpu_cost::{modelled, ShaderOps};
+use specula::gpus::Gpu;
 use specula::{Exponent, Lobe, LobeKind};
 use specula_gpu::shader_ops::{ggx_microfacet_ops, lobe_shader_ops, microfacet_shader_ops};
 
@@ -60,22 +61,21 @@ fn hand_counted_shaders() {
 /// The modelled rates follow from those counts and the published rates by hand.
 #[test]
 fn modelled_rates_follow_from_the_counts() {
-    let rate = |family: &str, kind| {
-        GpuFamily::find(family)
-            .unwrap()
-            .cost(&ops(kind, 64.0))
-            .evals_per_clock
+    let rate = |gpu: &str, kind| {
+        modelled(&ops(kind, 64.0), &Gpu::find(gpu).unwrap().rates).evals_per_clock
     };
-    // pow: 2 special functions at 16 per clock on both families.
-    assert_eq!(rate("gpu-nvidia", LobeKind::Pow), 8.0);
-    assert_eq!(rate("gpu-amd", LobeKind::Pow), 8.0);
+    // pow: 2 special functions at 16 per clock on an Ada SM and an RDNA 3 CU.
+    assert_eq!(rate("sm_89", LobeKind::Pow), 8.0);
+    assert_eq!(rate("gfx1100", LobeKind::Pow), 8.0);
     // schlick: 1 special function (16 per clock) and 8 instructions (128 issued per clock on
     // an SM, 64 on a CU).
-    assert_eq!(rate("gpu-nvidia", LobeKind::Schlick), 16.0);
-    assert_eq!(rate("gpu-amd", LobeKind::Schlick), 8.0);
+    assert_eq!(rate("sm_89", LobeKind::Schlick), 16.0);
+    assert_eq!(rate("gfx1100", LobeKind::Schlick), 8.0);
     // cosquad: 11 instructions, none special: issue-bound.
-    assert_eq!(rate("gpu-nvidia", LobeKind::CosQuad { v: 4 }), 128.0 / 11.0);
-    assert_eq!(rate("gpu-amd", LobeKind::CosQuad { v: 4 }), 64.0 / 11.0);
+    assert_eq!(rate("sm_89", LobeKind::CosQuad { v: 4 }), 128.0 / 11.0);
+    assert_eq!(rate("gfx1100", LobeKind::CosQuad { v: 4 }), 64.0 / 11.0);
+    // On Xe's 8-lane EU, pow's 2 special functions at 2 lanes a clock: 1 per clock.
+    assert_eq!(rate("tgllp", LobeKind::Pow), 1.0);
 }
 
 /// A lobe's microfacet BRDF adds `brdf.wgsl`'s `microfacet_factor` to the lobe, counted by

@@ -12,9 +12,9 @@ use std::sync::OnceLock;
 
 use specula_synth::cache::{key, Cache};
 
-use crate::gpus::Gpu;
 use crate::tools;
 use crate::{Disassembly, Estimate, IsaError};
+use specula::gpus::Gpu;
 
 /// The helper's source.
 const HELPER: &str = include_str!("vulkan_helper.c");
@@ -101,55 +101,40 @@ pub fn version(gpu: &Gpu) -> Result<String, IsaError> {
     command.arg("device");
     let output = tools::run(command, "RADV's null device")?;
     let line = String::from_utf8_lossy(&output.stdout);
-    let version = line
-        .trim()
-        .strip_prefix("device ")
-        .unwrap_or(line.trim())
-        .to_owned();
+    let version = format!(
+        "ACO in {}",
+        line.trim().strip_prefix("device ").unwrap_or(line.trim())
+    );
     known.push((gpu.id, version.clone()));
     Ok(version)
 }
 
-/// The assembly and statistics ACO makes of `spirv` (entry point `entry`) for `gpu`.
-pub fn compile(spirv: &[u32], entry: &str, gpu: &Gpu) -> Result<Disassembly, IsaError> {
+/// The assembly and statistics ACO makes of each of `modules` (entry point `entry`) for
+/// `gpu`, in one run of the helper (one device for all: the process is most of the time).
+pub fn compile(modules: &[&[u32]], entry: &str, gpu: &Gpu) -> Result<Vec<Disassembly>, IsaError> {
     let radeon = tools::vulkan_driver("radeon", "mesa-vulkan-drivers")?;
     let scratch = specula_temporaries::dir("isa-amd-").map_err(IsaError::scratch)?;
-    let file = scratch.path().join("kernel.spv");
-    let bytes: Vec<u8> = spirv.iter().flat_map(|word| word.to_le_bytes()).collect();
-    std::fs::write(&file, bytes).map_err(IsaError::scratch)?;
     let mut command = helper_command(&radeon, Some(gpu.compiler_target))?;
-    command.arg("isa").arg(&file).arg(entry);
+    command.arg("isa").arg(entry);
+    for (k, words) in modules.iter().enumerate() {
+        let file = scratch.path().join(format!("kernel{k}.spv"));
+        let bytes: Vec<u8> = words.iter().flat_map(|word| word.to_le_bytes()).collect();
+        std::fs::write(&file, bytes).map_err(IsaError::scratch)?;
+        command.arg(file);
+    }
     let output = tools::run(command, "RADV (ACO)")?;
-    let report = Report::read(&String::from_utf8_lossy(&output.stdout))?;
-    let wave = report.statistic("Subgroup size").unwrap_or(64.0) as u32;
-    let assembly = report
-        .representation("Assembly")
-        .ok_or_else(|| IsaError::Unreadable("RADV returned no assembly".to_owned()))?;
-    let estimates = [
-        ("Latency", "ACO's estimated latency, cycles"),
-        (
-            "Inverse Throughput",
-            "ACO's estimated inverse throughput, cycles per wave",
-        ),
-        ("Instructions", "ACO's instruction count"),
-        ("SGPRs", "scalar registers"),
-        ("Subgroup size", "wave size"),
-    ]
-    .into_iter()
-    .filter_map(|(statistic, name)| {
-        report.statistic(statistic).map(|value| Estimate {
-            name: name.to_owned(),
-            value,
-        })
-    })
-    .collect();
-    Ok(Disassembly {
-        compiler: format!("ACO in {}", report.device),
-        text: assembly.to_owned(),
-        simd: wave,
-        registers: report.statistic("VGPRs").map(|v| v as u32),
-        estimates,
-    })
+    let (device, reports) = Report::read(&String::from_utf8_lossy(&output.stdout))?;
+    if reports.len() != modules.len() {
+        return Err(IsaError::Unreadable(format!(
+            "RADV's report: {} kernels for {} modules",
+            reports.len(),
+            modules.len()
+        )));
+    }
+    reports
+        .into_iter()
+        .map(|report| report.disassembly(&device))
+        .collect()
 }
 
 /// Runs `spirv`'s kernel on Mesa's lavapipe over `inputs`, `per_thread` floats a thread: one
@@ -201,43 +186,45 @@ pub fn run_on_lavapipe(
         .collect())
 }
 
-/// The helper's `isa` output read back.
+/// One kernel of the helper's `isa` output read back.
+#[derive(Default)]
 struct Report {
-    device: String,
     statistics: Vec<(String, f64)>,
     representations: Vec<(String, String)>,
 }
 
 impl Report {
-    fn read(text: &str) -> Result<Report, IsaError> {
+    /// The device line and each kernel's report, in order.
+    fn read(text: &str) -> Result<(String, Vec<Report>), IsaError> {
         let unreadable = |what: &str| IsaError::Unreadable(format!("the Vulkan helper's {what}"));
-        let mut report = Report {
-            device: String::new(),
-            statistics: Vec::new(),
-            representations: Vec::new(),
-        };
+        let mut device = String::new();
+        let mut reports: Vec<Report> = Vec::new();
         let mut rest = text;
         while let Some((line, after)) = rest.split_once('\n') {
             rest = after;
-            if let Some(device) = line.strip_prefix("device ") {
-                device.clone_into(&mut report.device);
+            if let Some(name) = line.strip_prefix("device ") {
+                name.clone_into(&mut device);
+            } else if line.starts_with("kernel ") {
+                reports.push(Report::default());
             } else if let Some(statistic) = line.strip_prefix("stat ") {
                 let (name, value) = statistic
                     .split_once('\t')
                     .ok_or_else(|| unreadable("statistics"))?;
                 let value = value.trim().parse().map_err(|_| unreadable("statistics"))?;
+                let report = reports.last_mut().ok_or_else(|| unreadable("statistics"))?;
                 report.statistics.push((name.to_owned(), value));
             } else if let Some(ir) = line.strip_prefix("ir ") {
                 let (name, length) = ir.split_once('\t').ok_or_else(|| unreadable("assembly"))?;
                 let length: usize = length.trim().parse().map_err(|_| unreadable("assembly"))?;
                 let body = rest.get(..length).ok_or_else(|| unreadable("assembly"))?;
+                let report = reports.last_mut().ok_or_else(|| unreadable("assembly"))?;
                 report
                     .representations
                     .push((name.to_owned(), body.to_owned()));
                 rest = rest.get(length..).unwrap_or("").trim_start_matches('\n');
             }
         }
-        Ok(report)
+        Ok((device, reports))
     }
 
     fn statistic(&self, name: &str) -> Option<f64> {
@@ -247,10 +234,38 @@ impl Report {
             .map(|(_, v)| *v)
     }
 
-    fn representation(&self, name: &str) -> Option<&str> {
-        self.representations
+    /// The kernel's assembly, registers and ACO's estimates.
+    fn disassembly(self, device: &str) -> Result<Disassembly, IsaError> {
+        let assembly = self
+            .representations
             .iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, text)| text.as_str())
+            .find(|(name, _)| name == "Assembly")
+            .map(|(_, text)| text.clone())
+            .ok_or_else(|| IsaError::Unreadable("RADV returned no assembly".to_owned()))?;
+        let estimates = [
+            ("Latency", "ACO's estimated latency, cycles"),
+            (
+                "Inverse Throughput",
+                "ACO's estimated inverse throughput, cycles per wave",
+            ),
+            ("Instructions", "ACO's instruction count"),
+            ("SGPRs", "scalar registers"),
+            ("Subgroup size", "wave size"),
+        ]
+        .into_iter()
+        .filter_map(|(statistic, name)| {
+            self.statistic(statistic).map(|value| Estimate {
+                name: name.to_owned(),
+                value,
+            })
+        })
+        .collect();
+        Ok(Disassembly {
+            compiler: format!("ACO in {device}"),
+            text: assembly,
+            simd: self.statistic("Subgroup size").unwrap_or(64.0) as u32,
+            registers: self.statistic("VGPRs").map(|v| v as u32),
+            estimates,
+        })
     }
 }

@@ -12,10 +12,10 @@
 //! none of which needs the GPU. The instructions are classed ([`listing`]) as the GPU cost
 //! model classes them; a kernel that only loads and stores is compiled beside every kernel,
 //! and what the lobe's kernel has beyond it is the lobe's ([`Compiled::counts`]), weighed by
-//! the generation's published rates ([`gpus`]). Results are cached like the syntheses
+//! the generation's published rates ([`specula::gpus`]). Results are cached like the syntheses
 //! (`$SPECULA_CACHE_DIR/isa`), keyed by the source and the compiler's version.
 
-pub mod gpus;
+pub mod comparison;
 pub mod listing;
 
 mod amd;
@@ -25,11 +25,13 @@ mod tools;
 
 use serde::{Deserialize, Serialize};
 use specula::Lobe;
-use specula_synth::cache::{key, key_of_bytes, Cache};
+pub use specula_synth::cache::Cache;
+use specula_synth::cache::{key, key_of_bytes};
 use thiserror::Error;
 
-pub use gpus::{Gpu, Rates, Vendor};
+pub use comparison::{compare, Comparison, KernelView};
 pub use listing::{Class, Counts, Instruction};
+pub use specula::gpus::{Gpu, Rates, Vendor};
 pub use specula_targets::compute::Work;
 
 /// Why a lobe could not be compiled for a GPU.
@@ -229,33 +231,97 @@ pub fn compiler_version(gpu: &Gpu) -> Result<String, IsaError> {
 
 /// `lobe`'s kernel computing `work` and the baseline kernel, compiled for `gpu` (cached).
 pub fn compile(lobe: &Lobe, gpu: Gpu, work: Work) -> Result<Compiled, IsaError> {
-    let cache = Cache::default_for("isa");
-    let source = source(lobe, gpu.vendor, work)?;
-    let kernel = listing(&source, &gpu, cache.as_ref())?;
-    let baseline = listing(
-        &self::source(lobe, gpu.vendor, Work::Baseline)?,
-        &gpu,
-        cache.as_ref(),
-    )?;
-    Ok(Compiled {
-        gpu,
-        work,
-        source,
-        kernel,
-        baseline,
-    })
+    let mut compiled = compile_all(std::slice::from_ref(lobe), gpu, work)?;
+    Ok(compiled.remove(0))
 }
 
-/// The listing of `source` for `gpu`, from the cache or the compiler.
-fn listing(source: &Source, gpu: &Gpu, cache: Option<&Cache>) -> Result<Listing, IsaError> {
-    let version = compiler_version(gpu)?;
+/// Every one of `lobes`' kernels computing `work`, and the baseline, compiled for `gpu`:
+/// what the cache lacks in one run of the compiler (its process is most of a compile's time),
+/// each kernel still cached on its own.
+pub fn compile_all(lobes: &[Lobe], gpu: Gpu, work: Work) -> Result<Vec<Compiled>, IsaError> {
+    compile_all_in(lobes, gpu, work, Cache::default_for("isa").as_ref())
+}
+
+/// [`compile_all`] with the results kept in `cache` (none: every kernel compiled).
+pub fn compile_all_in(
+    lobes: &[Lobe],
+    gpu: Gpu,
+    work: Work,
+    cache: Option<&Cache>,
+) -> Result<Vec<Compiled>, IsaError> {
+    let Some(first) = lobes.first() else {
+        return Ok(Vec::new());
+    };
+    let version = compiler_version(&gpu)?;
+    let mut sources = lobes
+        .iter()
+        .map(|lobe| source(lobe, gpu.vendor, work))
+        .collect::<Result<Vec<_>, _>>()?;
+    // The baseline kernel is the same for every lobe.
+    sources.push(source(first, gpu.vendor, Work::Baseline)?);
+    let keys: Vec<String> = sources
+        .iter()
+        .map(|s| cache_key(s, &gpu, &version))
+        .collect();
+    let mut found: Vec<Option<Disassembly>> = keys
+        .iter()
+        .map(|key| cache.and_then(|cache| cache.load::<Disassembly>(key)))
+        .collect();
+    // What the cache lacks, each key once.
+    let mut missing: Vec<usize> = Vec::new();
+    for (k, entry) in found.iter().enumerate() {
+        if entry.is_none() && !missing.iter().any(|&m| keys[m] == keys[k]) {
+            missing.push(k);
+        }
+    }
+    if !missing.is_empty() {
+        let compiled = compile_sources(
+            &missing.iter().map(|&k| &sources[k]).collect::<Vec<_>>(),
+            &gpu,
+        )?;
+        for (&k, disassembly) in missing.iter().zip(compiled) {
+            if let Some(cache) = cache {
+                // A cache that cannot be written costs the next run a compile, nothing more.
+                let _ = cache.store(&keys[k], &disassembly);
+            }
+            for (slot, key) in found.iter_mut().zip(&keys) {
+                if slot.is_none() && *key == keys[k] {
+                    *slot = Some(disassembly.clone());
+                }
+            }
+        }
+    }
+    let mut listings = found
+        .into_iter()
+        .map(|d| d.map(|d| d.listing(gpu.vendor)))
+        .collect::<Option<Vec<Listing>>>()
+        .ok_or_else(|| IsaError::Unreadable("a kernel the compiler was given".to_owned()))?;
+    let baseline = listings
+        .pop()
+        .unwrap_or_else(|| unreachable!("the baseline was pushed"));
+    sources.pop();
+    Ok(listings
+        .into_iter()
+        .zip(sources)
+        .map(|(kernel, source)| Compiled {
+            gpu,
+            work,
+            source,
+            kernel,
+            baseline: baseline.clone(),
+        })
+        .collect())
+}
+
+/// The cache key of `source` compiled for `gpu` by the compiler of `version`.
+fn cache_key(source: &Source, gpu: &Gpu, version: &str) -> String {
     let flags = match gpu.vendor {
         Vendor::Nvidia => nvidia::FLAGS.join(" "),
         Vendor::Amd => String::new(),
         Vendor::Intel => intel::OPTIONS.to_owned(),
     };
-    let key = match source {
-        Source::Text(text) => key(&["isa 1", gpu.id, gpu.compiler_target, &version, &flags, text]),
+    match source {
+        Source::Text(text) => key(&["isa 1", gpu.id, gpu.compiler_target, version, &flags, text]),
         Source::SpirV { words, .. } => {
             let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
             key_of_bytes(&[
@@ -266,20 +332,34 @@ fn listing(source: &Source, gpu: &Gpu, cache: Option<&Cache>) -> Result<Listing,
                 &bytes,
             ])
         }
-    };
-    if let Some(disassembly) = cache.and_then(|cache| cache.load::<Disassembly>(&key)) {
-        return Ok(disassembly.listing(gpu.vendor));
     }
-    let disassembly = match source {
-        Source::Text(text) if gpu.vendor == Vendor::Nvidia => nvidia::compile(text, gpu)?,
-        Source::Text(text) => intel::compile(text, gpu)?,
-        Source::SpirV { words, .. } => amd::compile(words, specula_targets::compute::KERNEL, gpu)?,
+}
+
+/// `sources`, all of `gpu`'s vendor, compiled in one run.
+fn compile_sources(sources: &[&Source], gpu: &Gpu) -> Result<Vec<Disassembly>, IsaError> {
+    let texts = || {
+        sources
+            .iter()
+            .map(|source| match source {
+                Source::Text(text) => Ok(text.as_str()),
+                Source::SpirV { .. } => Err(IsaError::Source("C source expected".to_owned())),
+            })
+            .collect::<Result<Vec<&str>, IsaError>>()
     };
-    if let Some(cache) = cache {
-        // A cache that cannot be written costs the next run a compile, nothing more.
-        let _ = cache.store(&key, &disassembly);
+    match gpu.vendor {
+        Vendor::Nvidia => nvidia::compile(&texts()?, gpu),
+        Vendor::Intel => intel::compile(&texts()?, gpu),
+        Vendor::Amd => {
+            let modules = sources
+                .iter()
+                .map(|source| match source {
+                    Source::SpirV { words, .. } => Ok(words.as_slice()),
+                    Source::Text(_) => Err(IsaError::Source("SPIR-V expected".to_owned())),
+                })
+                .collect::<Result<Vec<&[u32]>, IsaError>>()?;
+            amd::compile(&modules, specula_targets::compute::KERNEL, gpu)
+        }
     }
-    Ok(disassembly.listing(gpu.vendor))
 }
 
 /// Runs `lobe`'s SPIR-V kernel computing `work` on Mesa's lavapipe over `inputs`

@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::gpus::{Rates, Vendor};
+use specula::gpus::{Rates, Vendor};
 
 /// What an instruction does, for costing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -495,7 +495,7 @@ mod tests {
             class,
             share: 1.0,
         });
-        let rates = crate::gpus::Gpu::find("sm_89").unwrap().rates;
+        let rates = specula::gpus::Gpu::find("sm_89").unwrap().rates;
         // Two special-function results at 16 per clock: 8 evaluations per clock.
         assert_eq!(
             Counts::of(&pow).evals_per_clock(&rates),

@@ -8,10 +8,10 @@
 use std::process::Command;
 use std::sync::OnceLock;
 
-use crate::gpus::{Gpu, Vendor};
 use crate::listing::{instruction, Instruction};
 use crate::tools;
 use crate::{Disassembly, IsaError};
+use specula::gpus::{Gpu, Vendor};
 
 /// What `nvcc` is given besides the source.
 pub const FLAGS: [&str; 4] = ["-use_fast_math", "-cubin", "-Xptxas", "-v"];
@@ -37,13 +37,25 @@ pub fn version() -> Result<String, IsaError> {
     Ok(VERSION.get_or_init(|| format!("nvcc {release}")).clone())
 }
 
-/// The SASS `nvcc` makes of the CUDA C `source` for `gpu`.
-pub fn compile(source: &str, gpu: &Gpu) -> Result<Disassembly, IsaError> {
+/// `source` with every `specula_` name made `specula{k}_`, so that several kernels share one
+/// file (the compiler's process is most of a compile's time).
+pub(crate) fn renamed(source: &str, k: usize) -> String {
+    source.replace("specula_", &format!("specula{k}_"))
+}
+
+/// The SASS `nvcc` makes of each CUDA C kernel of `sources` for `gpu`, in one run.
+pub fn compile(sources: &[&str], gpu: &Gpu) -> Result<Vec<Disassembly>, IsaError> {
     let [nvcc, nvdisasm] = tools::cuda()?;
     let scratch = specula_temporaries::dir("isa-nvidia-").map_err(IsaError::scratch)?;
-    let cu = scratch.path().join("kernel.cu");
-    let cubin = scratch.path().join("kernel.cubin");
-    std::fs::write(&cu, source).map_err(IsaError::scratch)?;
+    let cu = scratch.path().join("kernels.cu");
+    let cubin = scratch.path().join("kernels.cubin");
+    let combined: String = sources
+        .iter()
+        .enumerate()
+        .map(|(k, source)| renamed(source, k))
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&cu, combined).map_err(IsaError::scratch)?;
     let mut command = Command::new(&nvcc);
     command
         .arg(format!("-arch={}", gpu.compiler_target))
@@ -55,22 +67,56 @@ pub fn compile(source: &str, gpu: &Gpu) -> Result<Disassembly, IsaError> {
     let compiled = tools::run(command, "nvcc")?;
     let report = String::from_utf8_lossy(&compiled.stderr).into_owned()
         + &String::from_utf8_lossy(&compiled.stdout);
-    // `ptxas info    : Used 10 registers, used 0 barriers, ...`
-    let registers = report.lines().find_map(|line| {
-        let (_, after) = line.split_once("Used ")?;
-        after.split_whitespace().next()?.parse().ok()
-    });
+    let registers = registers(&report);
     let mut command = Command::new(&nvdisasm);
     command.arg("-c").arg(&cubin);
     let disassembled = tools::run(command, "nvdisasm")?;
     let text = String::from_utf8_lossy(&disassembled.stdout);
-    Ok(Disassembly {
-        compiler: format!("{} ({}, {})", version()?, gpu.compiler_target, FLAGS[0]),
-        text: text.into_owned(),
-        simd: 32,
-        registers,
-        estimates: Vec::new(),
-    })
+    let compiler = format!("{} ({}, {})", version()?, gpu.compiler_target, FLAGS[0]);
+    (0..sources.len())
+        .map(|k| {
+            let name = format!("specula{k}_evaluate");
+            let section = function(&text, &name)
+                .ok_or_else(|| IsaError::Unreadable(format!("nvdisasm's listing of {name}")))?;
+            Ok(Disassembly {
+                compiler: compiler.clone(),
+                text: section.to_owned(),
+                simd: 32,
+                registers: registers.iter().find(|(n, _)| *n == name).map(|(_, r)| *r),
+                estimates: Vec::new(),
+            })
+        })
+        .collect()
+}
+
+/// Each entry function's registers from `ptxas -v` (`Compiling entry function 'NAME' for
+/// 'sm_89'`, then `Used 10 registers, ...`).
+fn registers(report: &str) -> Vec<(String, u32)> {
+    let mut found = Vec::new();
+    let mut function = None;
+    for line in report.lines() {
+        if let Some((_, after)) = line.split_once("entry function '") {
+            function = after.split('\'').next().map(str::to_owned);
+        } else if let Some((_, after)) = line.split_once("Used ") {
+            if let (Some(name), Some(count)) = (
+                function.take(),
+                after.split_whitespace().next().and_then(|n| n.parse().ok()),
+            ) {
+                found.push((name, count));
+            }
+        }
+    }
+    found
+}
+
+/// The part of nvdisasm's listing that is the function `name`: from its section header
+/// (`//------- .text.NAME -------`) to the next.
+fn function<'a>(listing: &'a str, name: &str) -> Option<&'a str> {
+    let header = format!(".text.{name} ");
+    let start = listing.find(&header)?;
+    let body = &listing[start + header.len()..];
+    let end = body.find("//----").unwrap_or(body.len());
+    Some(&body[..end])
 }
 
 /// The instructions up to the last `EXIT`: what follows it (a branch to itself, `NOP`s) pads
@@ -106,5 +152,36 @@ mod tests {
 ";
         let mnemonics: Vec<_> = executed(text).into_iter().map(|i| i.mnemonic).collect();
         assert_eq!(mnemonics, ["MUFU.EX2", "STG.E", "EXIT"]);
+    }
+
+    #[test]
+    fn a_batchs_registers_and_functions_are_found_by_name() {
+        let report = "ptxas info    : Compiling entry function 'specula1_evaluate' for 'sm_89'
+ptxas info    : Function properties for specula1_evaluate
+ptxas info    : Used 12 registers, used 0 barriers, 364 bytes cmem[0]
+ptxas info    : Compiling entry function 'specula0_evaluate' for 'sm_89'
+ptxas info    : Used 10 registers, used 0 barriers, 364 bytes cmem[0]";
+        assert_eq!(
+            registers(report),
+            [
+                ("specula1_evaluate".to_owned(), 12),
+                ("specula0_evaluate".to_owned(), 10)
+            ]
+        );
+        let listing = "//--------------------- .text.specula1_evaluate --------------------------
+        /*0000*/ MUFU.EX2 R0, R0 ;
+//--------------------- .text.specula0_evaluate --------------------------
+        /*0000*/ FMUL R0, R0, R0 ;
+";
+        assert!(function(listing, "specula0_evaluate")
+            .unwrap()
+            .contains("FMUL"));
+        assert!(!function(listing, "specula1_evaluate")
+            .unwrap()
+            .contains("FMUL"));
+        assert_eq!(
+            renamed("void specula_evaluate(", 3),
+            "void specula3_evaluate("
+        );
     }
 }

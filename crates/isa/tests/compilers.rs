@@ -155,6 +155,58 @@ fn the_shading_context_holds_the_lobe_and_more() {
     }
 }
 
+/// Kernels compiled together in one run are the kernels compiled alone: the batch renames
+/// them apart and reads each back, and nothing of one leaks into another.
+#[test]
+fn a_batch_compiles_each_kernel_as_it_compiles_alone() {
+    let lobes: Vec<Lobe> = [LobeKind::Pow, LobeKind::Sg, LobeKind::FastPow]
+        .into_iter()
+        .map(|kind| Lobe::new(kind, Exponent::new(32.0)))
+        .collect();
+    for vendor in Vendor::ALL {
+        let gpu = vendor.default_gpu();
+        let batch_cache = tempfile::tempdir().unwrap();
+        let batch = match specula_isa::compile_all_in(
+            &lobes,
+            gpu,
+            Work::Lobe,
+            Some(&specula_isa::Cache::new(batch_cache.path())),
+        ) {
+            Ok(batch) => batch,
+            Err(IsaError::Missing { tool, .. }) if std::env::var("CI").as_deref() != Ok("true") => {
+                eprintln!("skipped on {}: {tool} is missing", gpu.id);
+                continue;
+            }
+            Err(error) => panic!("{}: {error}", gpu.id),
+        };
+        for (lobe, batched) in lobes.iter().zip(&batch) {
+            let alone =
+                specula_isa::compile_all_in(std::slice::from_ref(lobe), gpu, Work::Lobe, None)
+                    .unwrap()
+                    .remove(0);
+            let texts = |c: &Compiled| {
+                c.kernel
+                    .instructions
+                    .iter()
+                    .map(|i| i.text.clone())
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(
+                texts(batched),
+                texts(&alone),
+                "{} on {}",
+                lobe.kind(),
+                gpu.id
+            );
+            assert_eq!(
+                batched.kernel.registers, alone.kernel.registers,
+                "{}",
+                gpu.id
+            );
+        }
+    }
+}
+
 fn listing(compiled: &Compiled) -> String {
     compiled
         .kernel

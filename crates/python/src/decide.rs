@@ -24,7 +24,8 @@ fn lobes(texts: &[String]) -> PyResult<Vec<LobeKind>> {
 /// `specula recommend --format json`'s rows (every candidate ranked on `target`) and the
 /// note the CLI prints on standard error, if any.
 #[pyfunction]
-#[pyo3(signature = (target, n, max_error, zone, energy_conserving, extra_lobes))]
+#[pyo3(signature = (target, n, max_error, zone, energy_conserving, extra_lobes, gpu=None))]
+#[allow(clippy::too_many_arguments)] // one per keyword of `specula.recommend`
 pub fn recommend_json(
     py: Python<'_>,
     target: &str,
@@ -33,10 +34,15 @@ pub fn recommend_json(
     zone: &str,
     energy_conserving: bool,
     extra_lobes: Vec<String>,
+    gpu: Option<&str>,
 ) -> PyResult<String> {
     guarded(|| {
         let request = Request {
             target: Target::from_str(target).map_err(value_error)?,
+            gpu: gpu
+                .map(specula::gpus::Gpu::parse)
+                .transpose()
+                .map_err(value_error)?,
             exponents: parse_exponents(n).map_err(value_error)?,
             max_error,
             zone: Zone::from_str(zone).map_err(value_error)?,
@@ -46,7 +52,11 @@ pub fn recommend_json(
         let answer = py
             .detach(|| recommend(&request, &ProgressBar::hidden()))
             .map_err(value_error)?;
-        let reply = serde_json::json!({ "note": answer.note, "candidates": answer.candidates });
+        let reply = serde_json::json!({
+            "note": answer.note,
+            "basis": answer.basis,
+            "candidates": answer.candidates,
+        });
         Ok(reply.to_string())
     })
 }
@@ -79,6 +89,7 @@ pub fn design_json(
         let target = Target::from_str(target).map_err(value_error)?;
         let request = DesignRequest {
             target,
+            gpu: None,
             range: (ends[0], ends[ends.len() - 1]),
             bounds: Bounds {
                 epicentre: max_error,

@@ -1,4 +1,4 @@
-//! "Designed lobes", beside "Which lobe when": for each GPU family of the cost model, the
+//! "Designed lobes", beside "Which lobe when": for each GPU vendor's current generation, the
 //! lobe `specula design` searches out over `n` from 8 to 512 at a few epicentre bounds, next
 //! to the cheapest built-in that meets the same bound, with its formula and figures, and the
 //! Pareto plot of both kinds at the tightest bound. Every figure is
@@ -21,12 +21,12 @@ use super::prose;
 use super::verdict::{pareto_chart, EXACT_FLOOR};
 use super::Context;
 
-const FAMILIES: [(Target, &str); 2] = [(Target::GpuNvidia, "NVIDIA"), (Target::GpuAmd, "AMD RDNA")];
 const RANGE: (f64, f64) = (8.0, 512.0);
 
 fn request(target: Target, bound: f64, also: &[LobeKind]) -> DesignRequest {
     DesignRequest {
         target,
+        gpu: None,
         range: (Exponent::new(RANGE.0), Exponent::new(RANGE.1)),
         bounds: Bounds {
             epicentre: bound,
@@ -40,16 +40,41 @@ fn request(target: Target, bound: f64, also: &[LobeKind]) -> DesignRequest {
 }
 
 /// The section, stored by a first run of the build and copied back by a later one: its
-/// costs are the GPU cost model's arithmetic, no timing.
+/// costs are the compilers' machine code (or the model's), no timing; the compilers found are
+/// part of the key.
 pub fn designed(context: &mut Context) -> Result<String, String> {
-    super::stored::section(context, super::DESIGNED, "", designed_now)
+    super::stored::section(context, super::DESIGNED, &tools_found()?, designed_now)
+}
+
+/// The tools the section's answers depend on, as this machine has them (each GPU's compiler
+/// and version, or the model; Sollya or not): part of the stored section's key, so that a
+/// tool installed after a first report changes the next one.
+fn tools_found() -> Result<String, String> {
+    let mut found = Target::GPUS
+        .into_iter()
+        .map(|target| specula_decide::gpu_basis(target, None).map(Option::unwrap_or_default))
+        .collect::<Result<Vec<String>, String>>()?;
+    found.push(format!(
+        "sollya {}",
+        if specula_decide::design::limit::sollya_found() {
+            "found"
+        } else {
+            "missing"
+        }
+    ));
+    Ok(found.join("; "))
 }
 
 fn designed_now(context: &mut Context) -> Result<String, String> {
     let bounds = context.sizes.design_bounds;
     // The user's lobes are ranked beside the built-ins and the designs.
     let yours = context.yours();
-    let jobs: Vec<(Target, &str, f64)> = FAMILIES
+    let families = super::verdict::families();
+    let named: Vec<(Target, &str)> = families
+        .iter()
+        .map(|(target, name)| (*target, name.as_str()))
+        .collect();
+    let jobs: Vec<(Target, &str, f64)> = named
         .iter()
         .flat_map(|&(target, name)| bounds.iter().map(move |&b| (target, name, b)))
         .collect();
@@ -142,8 +167,8 @@ fn designed_now(context: &mut Context) -> Result<String, String> {
         );
         html += &super::designer_checks::limit(context, answer, RANGE)?;
     }
-    html += &super::designer_checks::thesis_table(&FAMILIES, RANGE)?;
-    for (k, (target, name)) in FAMILIES.iter().enumerate() {
+    html += &super::designer_checks::thesis_table(&named, RANGE)?;
+    for (k, (target, name)) in named.iter().enumerate() {
         // The tightest bound's answer for this family.
         let answer = &answers[k * bounds.len()];
         html += &pareto_plot(context, *target, name, bounds[0], answer)?;
@@ -218,6 +243,7 @@ fn pareto_plot(
         ),
         &points,
         vec![bound_line],
+        answer.unit,
     );
     context.svg(
         &format!("designed-{}.svg", target.id()),

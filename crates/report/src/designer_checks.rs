@@ -69,7 +69,7 @@ pub(crate) fn thesis_table(
     let range = (Exponent::new(low), Exponent::new(high));
     let answers: Vec<Vec<ThesisRow>> = families
         .par_iter()
-        .map(|&(target, _)| against_thesis(target, range, &ProgressBar::hidden()))
+        .map(|&(target, _)| against_thesis(target, None, range, &ProgressBar::hidden()))
         .collect::<Result<_, _>>()?;
     let mut html = paragraph(&format!(
         "Against the thesis: each of its lobes asks for the accuracy it reaches itself over n = \

@@ -108,7 +108,10 @@ pub fn materials(context: &mut Context) -> Result<String, String> {
     if context.materials.is_some() {
         return assessed(context);
     }
-    stored::section(context, MATERIALS, "", assessed)
+    // The verdicts' costs are NVIDIA's compiler's (or the model's where it is missing): the
+    // compiler found is part of the key.
+    let basis = specula_decide::gpu_basis(TARGET, None)?.unwrap_or_default();
+    stored::section(context, MATERIALS, &basis, assessed)
 }
 
 /// Each material in turn (assessed in parallel, each assessment's fits in parallel too),

@@ -401,17 +401,18 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
     let mut points = Vec::new();
     let pow = Lobe::new(LobeKind::Pow, n);
     let pow_instructions = pow.batch_instructions().total();
-    let pow_shader = specula_gpu::shader_ops::lobe_shader_ops(&pow)?;
-    let pow_rates: Vec<f64> = specula::gpu_cost::GpuFamily::ALL
+    // Each vendor's current generation, costed as `recommend` costs it: from the machine code
+    // its compiler writes (the model where the compiler is missing, which the unit says).
+    let gpu_targets = specula_decide::Target::GPUS;
+    let pow_rates = gpu_targets
         .iter()
-        .map(|family| family.cost(&pow_shader).evals_per_clock)
-        .collect();
+        .map(|&target| specula_decide::lobe_rate(target, &pow))
+        .collect::<Result<Vec<f64>, String>>()?;
     for kind in context.lobes.clone() {
         let lobe = Lobe::new(kind, n);
         let error = error_figures(&lobe, &mut Precision::F64, context.sizes.samples_per_zone)
             .epicentre_max_rel;
         let instructions = lobe.batch_instructions();
-        let shader = specula_gpu::shader_ops::lobe_shader_ops(&lobe)?;
         let mut row = vec![
             kind.to_string(),
             format!("{:.3}%", 100.0 * error),
@@ -420,15 +421,10 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
                 f64::from(pow_instructions) / f64::from(instructions.total().max(1))
             ),
         ];
-        row.extend(
-            specula::gpu_cost::GpuFamily::ALL
-                .iter()
-                .zip(&pow_rates)
-                .map(|(family, pow_rate)| {
-                    let rate = family.cost(&shader).evals_per_clock;
-                    format!("{:.2}x ({rate:.2})", rate / pow_rate)
-                }),
-        );
+        for (&target, pow_rate) in gpu_targets.iter().zip(&pow_rates) {
+            let rate = specula_decide::lobe_rate(target, &lobe)?;
+            row.push(format!("{:.2}x ({rate:.2})", rate / pow_rate));
+        }
         row.push(format!("{} ({instructions})", instructions.total()));
         if let Some(measured) = &measured {
             // The measured lobes are the built-in ones and K4's formula: a lobe of the
@@ -448,14 +444,25 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
         }
         rows.push(row);
     }
+    let gpu_headers: Vec<String> = gpu_targets
+        .iter()
+        .map(|&target| {
+            let gpu = target.gpu(None).ok().flatten();
+            format!(
+                "{} {}: x pow's throughput ({})",
+                gpu.map_or("", |g| g.vendor.name()),
+                gpu.map_or("", |g| g.id),
+                specula_decide::rate_unit(target)
+            )
+        })
+        .collect();
     let mut header = vec![
         "lobe",
         "epicentre max rel error (n = 64)",
         "CPU, counted: x pow's throughput (SIMD instructions)",
-        "NVIDIA: x pow's throughput (evals/clock/SM, modelled)",
-        "AMD RDNA: x pow's throughput (evals/clock/CU, modelled)",
-        "SIMD instructions per 8 lanes (counted from the kernel)",
     ];
+    header.extend(gpu_headers.iter().map(String::as_str));
+    header.push("SIMD instructions per 8 lanes (counted from the kernel)");
     let mut html = paragraph(&prose::fill(prose::COST, &[])?);
     if let Some(measured) = &measured {
         header.extend([

@@ -1,6 +1,7 @@
-//! The report's first section, "Which lobe when": for each GPU family of the cost model and the
-//! FPGA, the cheapest lobe within a few epicentre accuracies at a few exponents, and for the
-//! GPUs the Pareto plot of error against modelled cost. Every cell is `specula recommend`'s
+//! The report's first section, "Which lobe when": for each GPU vendor's current generation
+//! (costed from the machine code its compiler writes) and the FPGA, the cheapest lobe within a
+//! few epicentre accuracies at a few exponents, and for the GPUs the Pareto plot of error
+//! against cost. Every cell is `specula recommend`'s
 //! answer for its target, exponent and bound ([`specula_decide::recommend_each`]: `recommend`
 //! at a row's three bounds, each lobe measured once, over the report's lobes), so the page and the
 //! command cannot disagree. The CPU's answer needs timing
@@ -20,7 +21,17 @@ use super::Context;
 use crate::format::sig;
 use specula_decide::percent::percent;
 
-const FAMILIES: [(Target, &str); 2] = [(Target::GpuNvidia, "NVIDIA"), (Target::GpuAmd, "AMD RDNA")];
+/// Each GPU target, named by its vendor and the generation it is costed on (the vendor's
+/// current one).
+pub(crate) fn families() -> Vec<(Target, String)> {
+    Target::GPUS
+        .into_iter()
+        .filter_map(|target| {
+            let gpu = target.gpu(None).ok().flatten()?;
+            Some((target, format!("{} {}", gpu.vendor.name(), gpu.id)))
+        })
+        .collect()
+}
 const EXPONENTS: [f64; 3] = [8.0, 64.0, 512.0];
 const ACCURACIES: [f64; 3] = [0.005, 0.02, 0.10];
 /// The exponent of the Pareto plots.
@@ -64,7 +75,7 @@ fn fpga_cell(answer: &Recommendation) -> String {
     })
 }
 
-/// Error against modelled cost: a marker per lobe in its colour, the grey line through the
+/// Error against cost (in `unit`): a marker per lobe in its colour, the grey line through the
 /// points flagged as the Pareto front, then `extra` series; log axes from the exact floor.
 /// Errors come as fractions and are drawn in %, the tables' unit (`extra`'s too); the axis
 /// ends a step past the largest error shown.
@@ -72,6 +83,7 @@ pub(crate) fn pareto_chart(
     title: String,
     points: &[(LobeKind, (f64, f64), bool)],
     extra: Vec<Series>,
+    unit: &str,
 ) -> Chart {
     let percent = |(error, rate): (f64, f64)| (100.0 * error, rate);
     let mut front: Vec<(f64, f64)> = points
@@ -107,7 +119,7 @@ pub(crate) fn pareto_chart(
             "epicentre max relative error, % (pow, exact, at {:.0e} %)",
             100.0 * EXACT_FLOOR
         ),
-        y_label: "modelled evaluations per clock per multiprocessor".into(),
+        y_label: unit.to_owned(),
         // The legend stands beside the plot, so the axis ends just past the largest error.
         x: (50.0 * EXACT_FLOOR, 200.0 * widest),
         y: (0.1, most * 2.0),
@@ -137,7 +149,8 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
     // One row per GPU family and n, each lobe measured once for the row's bounds; the rows
     // in parallel. The FPGA's one after another, so that a design two rows share is
     // synthesized once and then read from the cache.
-    let gpu_rows: Vec<(Target, f64)> = FAMILIES
+    let families = families();
+    let gpu_rows: Vec<(Target, f64)> = families
         .iter()
         .flat_map(|&(target, _)| EXPONENTS.iter().map(move |&n| (target, n)))
         .collect();
@@ -164,11 +177,12 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
             .map(|k| &gpu[k])
             .ok_or("every GPU row was answered")
     };
-    let answer = answer(&gpu_rows, &gpu, &hardware, &fpga)?;
+    let answer = answer(&families, &gpu_rows, &gpu, &hardware, &fpga)?;
     let mut rows = Vec::new();
-    for (target, name) in FAMILIES {
+    for (target, name) in &families {
+        let target = *target;
         for n in EXPONENTS {
-            let mut row = vec![name.to_owned(), n.to_string()];
+            let mut row = vec![name.clone(), n.to_string()];
             row.extend(gpu_answers(target, n)?.iter().map(gpu_cell));
             rows.push(row);
         }
@@ -182,6 +196,19 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
         &["target", "n", "within 0.5 %", "within 2 %", "within 10 %"],
         &rows,
     );
+    // What each GPU row is read off: the compiler and generation, or the model and why.
+    let bases: Vec<String> = families
+        .iter()
+        .filter_map(|&(target, _)| gpu_answers(target, EXPONENTS[0]).ok())
+        .filter_map(|answers| answers[0].basis.clone())
+        .collect();
+    html += &paragraph(&format!(
+        "The GPU rows are costed on {}.",
+        bases.join("; on ")
+    ));
+    for note in gpu.iter().flatten().filter_map(|a| a.note.as_deref()) {
+        context.machine_note(format!("GPU costs: {note}."));
+    }
     html += &paragraph(&prose::fill(prose::FPGA_ROWS, &[])?);
     for note in fpga
         .iter()
@@ -191,7 +218,8 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
     {
         context.machine_note(format!("FPGA costs: {note}."));
     }
-    for (target, name) in FAMILIES {
+    for (target, name) in &families {
+        let target = *target;
         let plotted_answer = &gpu_answers(target, PLOTTED)?[0];
         let candidates: Vec<(LobeKind, &specula_decide::Candidate)> = context
             .lobes
@@ -207,9 +235,10 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
             .map(|(kind, c)| (*kind, (c.error.max(EXACT_FLOOR), c.rate), c.pareto))
             .collect();
         let chart = pareto_chart(
-            format!("{name}: epicentre error against modelled cost, n = {PLOTTED}"),
+            format!("{name}: epicentre error against cost, n = {PLOTTED}"),
             &points,
             Vec::new(),
+            plotted_answer.unit,
         );
         html += &context.svg(
             &format!("verdict-{}.svg", target.id()),
@@ -230,6 +259,7 @@ const HEADLINE_BOUND: f64 = 0.02;
 /// within 2 % and the figure that decides it; the CPU's measured answer named, not guessed,
 /// as the command that gives it over the table's exponents.
 fn answer(
+    families: &[(Target, String)],
     gpu_rows: &[(Target, f64)],
     gpu: &[Vec<Recommendation>],
     hardware: &[u32],
@@ -242,7 +272,9 @@ fn answer(
         .ok_or("the headline bound is one of the table's")?;
     let within = format!("epicentre error within {}", percent(bound));
     let mut lines = Vec::new();
-    for (target, name) in FAMILIES {
+    for (target, name) in families {
+        let target = *target;
+        let mut unit = "";
         let cells = EXPONENTS
             .iter()
             .map(|&n| {
@@ -251,6 +283,7 @@ fn answer(
                     .position(|&row| row == (target, n))
                     .map(|k| &gpu[k][column])
                     .ok_or("every exponent of the table has its row")?;
+                unit = answer.unit;
                 Ok(match answer.best_candidate() {
                     Some(best) => format!(
                         "n = {n}: {} ({} pow's throughput)",
@@ -262,7 +295,7 @@ fn answer(
             })
             .collect::<Result<Vec<_>, String>>()?;
         lines.push(format!(
-            "{name} GPUs ({within}, modelled; higher is better): {}.",
+            "{name} ({within}; {unit}, higher is better): {}.",
             cells.join("; ")
         ));
     }

@@ -44,6 +44,7 @@ pub mod fit;
 pub mod formula;
 pub mod geometry;
 pub mod gpu_cost;
+pub mod gpus;
 pub mod lobe;
 pub mod measured;
 pub mod microfacet;

@@ -177,6 +177,13 @@ impl ComputeLanguage {
 /// The source of `lobe`'s kernel in `language` computing `work`.
 #[must_use]
 pub fn kernel(lobe: &Lobe, language: ComputeLanguage, work: Work) -> String {
+    if work == Work::Baseline {
+        // The same text whatever the lobe, so that one baseline serves every lobe.
+        return format!(
+            "/* specula: the loads and stores alone. */\n\n{}    output[i] = input[i];\n}}\n",
+            language.kernel_head()
+        );
+    }
     let mut out = format!(
         "/* specula: {}, n = {}; {}, generated from specula's description of the lobe. */\n",
         lobe.kind(),
@@ -188,12 +195,10 @@ pub fn kernel(lobe: &Lobe, language: ComputeLanguage, work: Work) -> String {
                 geometry.id(),
                 normalisation.id()
             ),
-            Work::Baseline => "the loads and stores alone".to_owned(),
+            Work::Baseline => unreachable!("written above"),
         }
     );
-    if work != Work::Baseline {
-        out.push_str(&lobe_functions(lobe, language));
-    }
+    out.push_str(&lobe_functions(lobe, language));
     if let Work::Shading(geometry, normalisation) = work {
         out.push_str(&specular_function(lobe, language, geometry, normalisation));
     }
@@ -205,7 +210,7 @@ pub fn kernel(lobe: &Lobe, language: ComputeLanguage, work: Work) -> String {
             "    const float* v = input + 9 * i;\n    \
              output[i] = specula_specular(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]);\n"
         }
-        Work::Baseline => "    output[i] = input[i];\n",
+        Work::Baseline => unreachable!("written above"),
     });
     out.push_str("}\n");
     if language == ComputeLanguage::OpenCl {

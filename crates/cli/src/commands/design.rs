@@ -22,6 +22,10 @@ pub struct Args {
     /// to a fixed-point datapath and synthesized).
     #[arg(long, value_parser = described(&Target::ALL, Target::id, Target::summary))]
     target: Target,
+    /// A GPU target's generation, by its vendor's name (sm_75 .. sm_120, gfx900 .. gfx1100,
+    /// tgllp, dg2) [default: sm_89, gfx1100, dg2].
+    #[arg(long, value_parser = crate::args::choice(&specula::gpus::Gpu::ALL, |gpu| gpu.id))]
+    gpu: Option<specula::gpus::Gpu>,
     /// The exponent, or a range `LOW..HIGH` the lobe must hold over.
     #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = parse_range)]
     n: Range,
@@ -110,6 +114,7 @@ pub fn run(args: &Args) -> CommandResult {
     };
     let request = DesignRequest {
         target: args.target,
+        gpu: args.gpu,
         range: (args.n.0, args.n.1),
         bounds: Bounds {
             epicentre: max_error,
@@ -149,6 +154,7 @@ pub fn run(args: &Args) -> CommandResult {
 fn print_against_thesis(args: &Args, progress: &ProgressBar) -> CommandResult {
     let rows = specula_decide::design::thesis::against_thesis(
         args.target,
+        args.gpu,
         (args.n.0, args.n.1),
         progress,
     )?;

@@ -8,6 +8,7 @@ pub mod diff;
 pub mod eval;
 pub mod fit;
 pub mod hw;
+pub mod isa;
 pub mod lobe;
 pub mod models;
 pub mod recommend;

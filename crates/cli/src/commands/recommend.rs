@@ -17,6 +17,15 @@ pub struct Args {
     /// Where the lobe will run.
     #[arg(long, value_parser = described(&Target::ALL, Target::id, Target::summary))]
     target: Target,
+    /// A GPU target's generation, by its vendor's name: NVIDIA sm_75, sm_86, sm_89, sm_90,
+    /// sm_120; AMD gfx900, gfx1010, gfx1030, gfx1100; Intel tgllp, dg2 [default: sm_89,
+    /// gfx1100, dg2].
+    #[arg(
+        long,
+        value_parser = crate::args::choice(&specula::gpus::Gpu::ALL, |gpu| gpu.id),
+        conflicts_with = "material"
+    )]
+    gpu: Option<specula::gpus::Gpu>,
     /// The exponent, or a range `LOW..HIGH` over which the answer must hold.
     #[arg(long, allow_hyphen_values = true, default_value = "64", value_parser = parse_exponents)]
     n: Exponents,
@@ -82,6 +91,7 @@ pub fn run(args: &Args) -> CommandResult {
     let exponents = &args.n.0;
     let request = Request {
         target: args.target,
+        gpu: args.gpu,
         exponents: exponents.clone(),
         max_error: args
             .max_error
@@ -171,18 +181,21 @@ pub fn run(args: &Args) -> CommandResult {
         return Ok(());
     }
     println!("{verdict}");
-    let mut table = Table::new(&[
-        "lobe",
-        "meets",
-        "error",
-        "rate",
-        "x pow's throughput",
-        "energy ratio",
-        "pareto",
-        "why",
-    ]);
+    if let Some(basis) = &answer.basis {
+        println!("costed on {basis}");
+    }
+    let aco = answer
+        .candidates
+        .iter()
+        .any(|c| c.aco_inverse_throughput.is_some());
+    let mut header = vec!["lobe", "meets", "error", "rate", "x pow's throughput"];
+    if aco {
+        header.push("ACO's inverse throughput beyond the baseline (cycles/wave)");
+    }
+    header.extend(["energy ratio", "pareto", "why"]);
+    let mut table = Table::new(&header);
     for c in &answer.candidates {
-        table.push(vec![
+        let mut row = vec![
             c.lobe.clone(),
             if c.meets { "yes" } else { "no" }.to_owned(),
             if c.error.is_finite() {
@@ -192,10 +205,19 @@ pub fn run(args: &Args) -> CommandResult {
             },
             format!("{:.3e} {}", c.rate, c.unit),
             spread_versus_pow(c.rate, c.spread, pow_rate),
+        ];
+        if aco {
+            row.push(
+                c.aco_inverse_throughput
+                    .map_or("-".to_owned(), |v| format!("{v}")),
+            );
+        }
+        row.extend([
             format!("{:.4}", c.energy_ratio),
             if c.pareto { "front" } else { "" }.to_owned(),
             c.why.clone(),
         ]);
+        table.push(row);
     }
     table.print(args.format);
     if answer.candidates.iter().any(|c| c.spread.is_some()) {

@@ -8,7 +8,6 @@ use std::collections::HashMap;
 use std::sync::Mutex;
 
 use indicatif::ProgressBar;
-use specula::gpu_cost::GpuFamily;
 use specula::{Exponent, Lobe};
 use specula_decide::design::{default_whole_error, design, Bounds, DesignRequest};
 use specula_decide::Target;
@@ -90,6 +89,7 @@ fn designer() -> DesignModel {
         let n = |value: f64| Exponent::try_new(value).map_err(|e| e.to_string());
         let request = DesignRequest {
             target,
+            gpu: None,
             range: (n(query.range.0)?, n(query.range.1)?),
             bounds: Bounds {
                 epicentre: query.max_error,
@@ -110,14 +110,19 @@ fn designer() -> DesignModel {
     })
 }
 
-/// A lobe's costs: the CPU's counted SIMD instructions and the GPU families' modelled rates.
+/// A lobe's costs: the CPU's counted SIMD instructions and each GPU vendor's current
+/// generation as `recommend` costs it (the machine code its compiler writes, or the model
+/// where the compiler is missing, which the unit says).
 pub fn costs(lobe: &Lobe) -> Result<Vec<TargetRate>, String> {
-    let gpus = GpuFamily::ALL.iter().map(|family| {
+    let gpus = Target::GPUS.into_iter().map(|target| {
+        let gpu = target.gpu(None)?.map_or("", |gpu| gpu.id);
         Ok(TargetRate {
-            target: family.id.to_owned(),
-            value: specula_decide::modelled_rate(family, lobe)?,
-            unit: "evaluations per clock per multiprocessor (modelled; higher is better)"
-                .to_owned(),
+            target: target.id().to_owned(),
+            value: specula_decide::lobe_rate(target, lobe)?,
+            unit: format!(
+                "{gpu}: {} (higher is better)",
+                specula_decide::rate_unit(target)
+            ),
         })
     });
     std::iter::once(Ok(cpu_cost(lobe))).chain(gpus).collect()

@@ -104,7 +104,7 @@ fn recommend_names_the_verdict_and_refuses_the_fpga() {
     let stderr = String::from_utf8_lossy(&refused.stderr);
     assert!(!refused.status.success());
     assert!(
-        stderr.contains("valid targets: cpu, gpu-nvidia, gpu-amd"),
+        stderr.contains("valid targets: cpu, gpu-nvidia, gpu-amd, gpu-intel"),
         "{stderr}"
     );
 }

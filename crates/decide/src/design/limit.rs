@@ -94,6 +94,13 @@ fn script(family: Family, n: f64) -> String {
     )
 }
 
+/// Whether Sollya runs on this machine: what a stored answer that needs it is keyed by, so that
+/// installing it changes the next answer.
+#[must_use]
+pub fn sollya_found() -> bool {
+    Command::new("sollya").arg("--help").output().is_ok()
+}
+
 /// The family's optimum at `n`, from Sollya (`sollya` on the `PATH`); `Err` names what failed.
 pub fn family_optimum(family: Family, n: Exponent) -> Result<Optimum, String> {
     if !has_optimum(family) {
@@ -222,7 +229,7 @@ mod tests {
 
     /// Whether `sollya` runs; under `CI=true` (where `.ci/run` installs it) its absence fails.
     fn have_sollya() -> bool {
-        let found = Command::new("sollya").arg("--help").output().is_ok();
+        let found = sollya_found();
         assert!(
             found || std::env::var("CI").as_deref() != Ok("true"),
             "sollya is not installed, and CI=true requires it: apt-get install sollya"
@@ -308,6 +315,7 @@ mod tests {
         }
         let request = DesignRequest {
             target: Target::GpuAmd,
+            gpu: None,
             range: (Exponent::new(16.0), Exponent::new(128.0)),
             bounds: Bounds {
                 epicentre: 0.005,

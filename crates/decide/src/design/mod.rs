@@ -68,6 +68,8 @@ const FIT_STEPS: u32 = 16;
 pub struct DesignRequest {
     /// Where the lobe will run.
     pub target: Target,
+    /// A GPU target's generation (its vendor's current one where `None`).
+    pub gpu: Option<specula::gpus::Gpu>,
     /// The exponents the lobe must hold over, from the first to the second.
     pub range: (Exponent, Exponent),
     /// The bounds: the epicentre's (the error `recommend` counts), the whole lobe's, and the

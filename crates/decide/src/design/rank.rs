@@ -29,6 +29,7 @@ pub(super) fn rank(
     let ranking = recommend(
         &Request {
             target: request.target,
+            gpu: request.gpu,
             exponents: sample_exponents(low, high),
             max_error: request.bounds.epicentre,
             zone: Zone::Epicentre,

@@ -14,6 +14,7 @@ use super::*;
 fn request(target: Target, low: f64, high: f64, epicentre: f64, whole: f64) -> DesignRequest {
     DesignRequest {
         target,
+        gpu: None,
         range: (Exponent::new(low), Exponent::new(high)),
         bounds: Bounds {
             epicentre,

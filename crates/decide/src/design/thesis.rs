@@ -65,6 +65,7 @@ fn errors(kind: LobeKind, exponents: &[Exponent]) -> Result<(f64, f64), String> 
 /// Every thesis lobe on `target` over `range`, against the design at its accuracy.
 pub fn against_thesis(
     target: Target,
+    gpu: Option<specula::gpus::Gpu>,
     range: (Exponent, Exponent),
     progress: &ProgressBar,
 ) -> Result<Vec<ThesisRow>, String> {
@@ -76,6 +77,7 @@ pub fn against_thesis(
         let bound = (epicentre * (1.0 + 1e-9)).min(1.0);
         let request = DesignRequest {
             target,
+            gpu,
             range,
             bounds: Bounds {
                 epicentre: bound,
@@ -136,7 +138,7 @@ mod tests {
     #[test]
     fn the_design_is_never_costlier_than_a_thesis_lobe_at_its_accuracy() {
         let range = (Exponent::new(16.0), Exponent::new(128.0));
-        let rows = against_thesis(Target::GpuAmd, range, &ProgressBar::hidden()).unwrap();
+        let rows = against_thesis(Target::GpuAmd, None, range, &ProgressBar::hidden()).unwrap();
         assert_eq!(rows.len(), 4);
         for row in &rows {
             assert!(row.answer_rate >= row.thesis_rate, "{row:?}");

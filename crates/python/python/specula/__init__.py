@@ -148,13 +148,14 @@ def recommend(
     zone: str = "epicentre",
     energy_conserving: bool = False,
     lobes: Sequence[str] = (),
+    gpu: Optional[str] = None,
 ) -> List[Dict[str, Any]]:
     """Which lobe to ship on ``target`` at an accuracy: the ranked rows of ``specula
     recommend --format json``.
 
     Parameters
     ----------
-    target : {"cpu", "gpu-nvidia", "gpu-amd", "fpga"}
+    target : {"cpu", "gpu-nvidia", "gpu-amd", "gpu-intel", "fpga"}
     n : float or str
         An exponent, or a range ``"LOW..HIGH"`` the answer must hold over.
     max_error : float
@@ -165,6 +166,9 @@ def recommend(
     lobes : sequence of str
         More candidates: your own (``"=t^n"``, ``"@lobe.toml"``) or built-ins with other
         parameters.
+    gpu : str, optional
+        A GPU target's generation by its vendor's name (``"sm_89"``, ``"gfx1100"``,
+        ``"tgllp"``, ...); the vendor's current one if omitted.
 
     Returns
     -------
@@ -176,7 +180,7 @@ def recommend(
         lobes = [lobes]
     reply = _json.loads(
         _specula.recommend_json(
-            target, str(n), float(max_error), zone, bool(energy_conserving), list(lobes)
+            target, str(n), float(max_error), zone, bool(energy_conserving), list(lobes), gpu
         )
     )
     if reply["note"]:

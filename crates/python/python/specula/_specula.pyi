@@ -100,7 +100,13 @@ def claims_json(
     seed: Optional[int] = None,
 ) -> str: ...
 def recommend_json(
-    target: str, n: str, max_error: float, zone: str, energy_conserving: bool, lobes: List[str]
+    target: str,
+    n: str,
+    max_error: float,
+    zone: str,
+    energy_conserving: bool,
+    lobes: List[str],
+    gpu: Optional[str] = None,
 ) -> str: ...
 def design_json(
     target: str,

@@ -305,7 +305,9 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
         args.n,
         throughput::CHAIN
     ));
-    let families = specula::gpu_cost::GpuFamily::ALL;
+    // Each vendor's current generation as `recommend` costs it (the compiled machine code, or
+    // the model where the compiler is missing), beside what this adapter measures.
+    let targets = specula_decide::Target::GPUS;
     let mut headers = vec![
         "lobe".to_owned(),
         "G evals/s".to_owned(),
@@ -314,11 +316,13 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
         "ms".to_owned(),
         "shader ops".to_owned(),
     ];
-    headers.extend(
-        families
-            .iter()
-            .map(|f| format!("modelled x pow's throughput, {}", f.id)),
-    );
+    headers.extend(targets.iter().map(|&target| {
+        format!(
+            "x pow's throughput, {} ({})",
+            target.gpu(None).ok().flatten().map_or("", |gpu| gpu.id),
+            specula_decide::rate_unit(target)
+        )
+    }));
     let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
     let mut table = Table::new(&headers);
     let mut pow: Option<(f64, Vec<f64>)> = None;
@@ -326,10 +330,10 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
         let lobe = specula::Lobe::new(kind, args.n);
         let (rate, _) = throughput::measure(&gpu, &lobe).map_err(|e| e.to_string())?;
         let ops = specula_gpu::shader_ops::lobe_shader_ops(&lobe)?;
-        let modelled: Vec<f64> = families
+        let modelled = targets
             .iter()
-            .map(|family| family.cost(&ops).evals_per_clock)
-            .collect();
+            .map(|&target| specula_decide::lobe_rate(target, &lobe))
+            .collect::<Result<Vec<f64>, String>>()?;
         let (pow_rate, pow_modelled) = pow
             .get_or_insert_with(|| (rate.evals_per_second, modelled.clone()))
             .clone();

@@ -1,5 +1,6 @@
-//! The GPUs specula compiles for, by their vendors' names, and what each generation executes
-//! per clock: the published rates the compiled instructions are weighed by.
+//! The GPUs specula costs lobes on, by their vendors' names, and what each generation executes
+//! per clock: the published rates that instructions are weighed by, whether a vendor's
+//! compiler wrote them (`specula-isa`) or the model counted them ([`crate::gpu_cost`]).
 
 use serde::Serialize;
 
@@ -28,6 +29,16 @@ impl Vendor {
             Vendor::Nvidia => "nvidia",
             Vendor::Amd => "amd",
             Vendor::Intel => "intel",
+        }
+    }
+
+    /// The vendor's name as a reader knows it.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Vendor::Nvidia => "NVIDIA",
+            Vendor::Amd => "AMD",
+            Vendor::Intel => "Intel",
         }
     }
 
