@@ -339,16 +339,19 @@ pub fn gpu_basis(target: Target, gpu: Option<Gpu>) -> Result<Option<String>, Str
     let (costing, note) = Costing::new(target, gpu, &[])?;
     Ok(match costing {
         Costing::Gpu(gpu, GpuBasis::Compiled(compiler)) => Some(format!(
-            "{} ({}): the machine code {compiler} writes for each lobe's kernel, beyond a \
-             kernel that only loads and stores, each class at the rate of {}",
-            gpu.id, gpu.name, gpu.source
-        )),
-        Costing::Gpu(gpu, GpuBasis::Modelled) => Some(format!(
-            "{} ({}): the naga-IR model of the exported shader, each class at the rate of {} \
-             ({})",
+            "{} ({}): the machine code {compiler} writes for each lobe's kernel beyond a kernel \
+             that only loads and stores (specula isa shows it), each class at its published \
+             rate ({})",
             gpu.id,
             gpu.name,
-            gpu.source,
+            gpu.source_name()
+        )),
+        Costing::Gpu(gpu, GpuBasis::Modelled) => Some(format!(
+            "{} ({}): the naga-IR model of the exported shader, each class at its published \
+             rate ({}), because {}",
+            gpu.id,
+            gpu.name,
+            gpu.source_name(),
             note.unwrap_or_default()
         )),
         _ => None,

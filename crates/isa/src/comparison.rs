@@ -32,6 +32,8 @@ pub struct KernelView {
     pub bound: &'static str,
     /// The whole kernel's machine code: each instruction's class and text.
     pub listing: Vec<(&'static str, String)>,
+    /// The baseline kernel's, what `counts` is beyond.
+    pub baseline_listing: Vec<(&'static str, String)>,
     /// The source the compiler was given (CUDA C, OpenCL C, or the WGSL the SPIR-V was
     /// written from).
     pub source: String,
@@ -62,6 +64,12 @@ impl KernelView {
             bound,
             listing: compiled
                 .kernel
+                .instructions
+                .iter()
+                .map(|i| (i.class.id(), i.text.clone()))
+                .collect(),
+            baseline_listing: compiled
+                .baseline
                 .instructions
                 .iter()
                 .map(|i| (i.class.id(), i.text.clone()))
@@ -129,4 +137,77 @@ pub fn compare(lobe: &Lobe, gpu: Gpu, work: Work) -> Result<Comparison, IsaError
         pow: pow_view,
         lobe_share,
     })
+}
+
+/// One lobe on one GPU: the compiler's rate and the naga-IR model's, each over `pow`'s on the
+/// same basis, and the transcendental instructions each counts.
+#[derive(Clone, Debug, Serialize)]
+pub struct Against {
+    /// The GPU's id.
+    pub gpu: &'static str,
+    /// The compiled kernel's evaluations per clock over `pow`'s.
+    pub compiled_vs_pow: f64,
+    /// The model's over `pow`'s.
+    pub modelled_vs_pow: f64,
+    /// Transcendental instructions per work item in the compiled kernel (beyond the baseline).
+    pub compiled_transcendentals: f64,
+    /// Transcendental instructions the model counts (`acos` expanded).
+    pub modelled_transcendentals: u32,
+    /// Instructions per work item in the compiled kernel beyond the baseline, every class
+    /// that issues.
+    pub compiled_instructions: f64,
+    /// Instructions the model counts.
+    pub modelled_instructions: u32,
+}
+
+/// Every one of `lobes` at `n` on every GPU of `gpus`: the compilers beside the model
+/// (docs/gpu.md's table). Each GPU's kernels are compiled in one run.
+pub fn model_against_compilers(
+    lobes: &[Lobe],
+    gpus: &[Gpu],
+) -> Result<Vec<(String, Vec<Against>)>, IsaError> {
+    let modelled = |lobe: &Lobe| {
+        specula_gpu::shader_ops::lobe_shader_ops(lobe)
+            .map_err(IsaError::Source)
+            .map(|ops| (ops, ops.expanded()))
+    };
+    let mut rows: Vec<(String, Vec<Against>)> = lobes
+        .iter()
+        .map(|l| (l.kind().to_string(), Vec::new()))
+        .collect();
+    for &gpu in gpus {
+        let Some(first) = lobes.first() else { break };
+        let pow = Lobe::new(LobeKind::Pow, first.exponent());
+        let mut all = lobes.to_vec();
+        all.push(pow);
+        let compiled = crate::compile_all(&all, gpu, Work::Lobe)?;
+        let pow_compiled = compiled
+            .last()
+            .map(|c| c.evals_per_clock().0)
+            .unwrap_or(f64::NAN);
+        let (pow_ops, _) = modelled(&pow)?;
+        let pow_model = specula::gpu_cost::modelled(&pow_ops, &gpu.rates).evals_per_clock;
+        for ((lobe, compiled), row) in lobes.iter().zip(&compiled).zip(&mut rows) {
+            let (ops, expanded) = modelled(lobe)?;
+            let counts = compiled.counts();
+            let at = |class: Class| {
+                counts.per_item[Class::ALL.iter().position(|&c| c == class).unwrap_or(0)]
+            };
+            row.1.push(Against {
+                gpu: gpu.id,
+                compiled_vs_pow: compiled.evals_per_clock().0 / pow_compiled,
+                modelled_vs_pow: specula::gpu_cost::modelled(&ops, &gpu.rates).evals_per_clock
+                    / pow_model,
+                compiled_transcendentals: at(Class::Transcendental),
+                modelled_transcendentals: expanded.transcendental,
+                compiled_instructions: Class::ALL
+                    .iter()
+                    .filter(|&&c| !matches!(c, Class::Scalar | Class::Memory | Class::Other))
+                    .map(|&c| at(c))
+                    .sum(),
+                modelled_instructions: expanded.total(),
+            });
+        }
+    }
+    Ok(rows)
 }

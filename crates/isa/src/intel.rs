@@ -81,7 +81,8 @@ pub fn compile(sources: &[&str], gpu: &Gpu) -> Result<Vec<Disassembly>, IsaError
                 .ok_or_else(|| IsaError::Unreadable(format!("IGC's dump of {name}")))?;
             Ok(Disassembly {
                 compiler: format!("{compiler}, SIMD{simd})"),
-                text,
+                // Named as it would be compiled alone.
+                text: text.replace(&format!("specula{k}_"), "specula_"),
                 simd,
                 registers: None,
                 estimates: Vec::new(),

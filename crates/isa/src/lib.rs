@@ -29,7 +29,7 @@ pub use specula_synth::cache::Cache;
 use specula_synth::cache::{key, key_of_bytes};
 use thiserror::Error;
 
-pub use comparison::{compare, Comparison, KernelView};
+pub use comparison::{compare, model_against_compilers, Against, Comparison, KernelView};
 pub use listing::{Class, Counts, Instruction};
 pub use specula::gpus::{Gpu, Rates, Vendor};
 pub use specula_targets::compute::Work;
@@ -127,7 +127,8 @@ impl Disassembly {
     fn listing(self, vendor: Vendor) -> Listing {
         let instructions = match vendor {
             Vendor::Nvidia => nvidia::executed(&self.text),
-            _ => self
+            Vendor::Amd => listing::amd_listing(&self.text, self.simd),
+            Vendor::Intel => self
                 .text
                 .lines()
                 .filter_map(|line| listing::instruction(vendor, line, self.simd))

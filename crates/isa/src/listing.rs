@@ -351,6 +351,27 @@ fn nvidia_instruction(line: &str) -> Option<Instruction> {
     })
 }
 
+/// ACO's assembly read into instructions: its disassembler writes a run of identical
+/// instructions once, followed by `(then repeated 3 times)`, which is expanded here.
+#[must_use]
+pub fn amd_listing(text: &str, wave: u32) -> Vec<Instruction> {
+    let mut instructions: Vec<Instruction> = Vec::new();
+    for line in text.lines() {
+        let repeats = line
+            .trim()
+            .strip_prefix("(then repeated ")
+            .and_then(|rest| rest.split_whitespace().next())
+            .and_then(|count| count.parse::<usize>().ok());
+        match (repeats, instructions.last().cloned()) {
+            (Some(count), Some(previous)) => {
+                instructions.extend(std::iter::repeat_n(previous, count));
+            }
+            _ => instructions.extend(instruction(Vendor::Amd, line, wave)),
+        }
+    }
+    instructions
+}
+
 /// `v_log_f32_e32 v1, v1     ; 7e024f01` (ACO, indented by a tab).
 fn amd_instruction(line: &str) -> Option<Instruction> {
     let code = line.split(';').next()?.trim();
@@ -464,6 +485,23 @@ mod tests {
         .unwrap();
         assert_eq!(amd.class, Class::Transcendental);
         assert!(instruction(Vendor::Amd, "BB0:", 32).is_none());
+        let squarings = amd_listing(
+            "\tv_max_f32_e32 v1, 0, v1   ; 20020280\n\tv_mul_f32_e32 v1, v1, v1   ; 10020301\n\
+             \t(then repeated 3 times)\n\ts_endpgm   ; bfb00000\n",
+            32,
+        );
+        let mnemonics: Vec<&str> = squarings.iter().map(|i| i.mnemonic.as_str()).collect();
+        assert_eq!(
+            mnemonics,
+            [
+                "v_max_f32_e32",
+                "v_mul_f32_e32",
+                "v_mul_f32_e32",
+                "v_mul_f32_e32",
+                "v_mul_f32_e32",
+                "s_endpgm"
+            ]
+        );
         let intel = instruction(
             Vendor::Intel,
             "(f1.0)  sel (16|M0)              r27.0<1>:f    r19.0<8;8,1>:f    -r19.0<8;8,1>:f  \

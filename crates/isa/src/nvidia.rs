@@ -80,7 +80,8 @@ pub fn compile(sources: &[&str], gpu: &Gpu) -> Result<Vec<Disassembly>, IsaError
                 .ok_or_else(|| IsaError::Unreadable(format!("nvdisasm's listing of {name}")))?;
             Ok(Disassembly {
                 compiler: compiler.clone(),
-                text: section.to_owned(),
+                // Named as it would be compiled alone.
+                text: section.replace(&format!("specula{k}_"), "specula_"),
                 simd: 32,
                 registers: registers.iter().find(|(n, _)| *n == name).map(|(_, r)| *r),
                 estimates: Vec::new(),

@@ -248,6 +248,13 @@ impl Gpu {
         },
     ];
 
+    /// Where the rates come from, named without the figures (the source up to its first
+    /// colon).
+    #[must_use]
+    pub fn source_name(&self) -> &'static str {
+        self.source.split(':').next().unwrap_or(self.source)
+    }
+
     /// The GPU named `id`.
     #[must_use]
     pub fn find(id: &str) -> Option<Gpu> {

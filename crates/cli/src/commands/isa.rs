@@ -33,11 +33,16 @@ pub enum Format {
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The lobe: a built-in id, @FILE.toml or =FORMULA.
-    #[arg(long, value_parser = LobeParser)]
-    lobe: LobeKind,
+    #[arg(long, value_parser = LobeParser, required_unless_present = "versus_model")]
+    lobe: Option<LobeKind>,
     /// The exponent, in [1, 1000]; the lobe's constants are prepared for it.
-    #[arg(long, value_parser = parse_exponent, allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_exponent, allow_hyphen_values = true, default_value = "64")]
     n: Exponent,
+    /// Every built-in lobe on every GPU instead: the compilers' throughput over pow's beside
+    /// the naga-IR model's, and the transcendental instructions each counts (docs/gpu.md's
+    /// table).
+    #[arg(long, conflicts_with_all = ["lobe", "gpu", "context"])]
+    versus_model: bool,
     /// The GPU, by its vendor's name: NVIDIA sm_75, sm_86, sm_89, sm_90, sm_120 (nvcc); AMD
     /// gfx900, gfx1010, gfx1030, gfx1100 (ACO in Mesa's RADV); Intel tgllp, dg2 (IGC through
     /// ocloc).
@@ -64,7 +69,11 @@ pub struct Args {
 
 /// Compiles and prints.
 pub fn run(args: &Args) -> CommandResult {
-    let lobe = Lobe::checked(args.lobe, args.n).map_err(|e| e.to_string())?;
+    if args.versus_model {
+        return versus_model(args);
+    }
+    let kind = args.lobe.ok_or("--lobe names the lobe to compile")?;
+    let lobe = Lobe::checked(kind, args.n).map_err(|e| e.to_string())?;
     let work = match args.context {
         Context::Lobe => Work::Lobe,
         Context::Shading => Work::Shading(args.geometry, args.normalisation),
@@ -162,4 +171,52 @@ fn listing(out: &mut String, view: &KernelView) {
         let mark = if *class == "transcendental" { '*' } else { ' ' };
         let _ = writeln!(out, "  {mark} {class:<15} {text}");
     }
+}
+
+/// Every built-in lobe on every GPU, the compilers beside the model.
+fn versus_model(args: &Args) -> CommandResult {
+    let lobes: Vec<Lobe> = LobeKind::ALL
+        .into_iter()
+        .map(|kind| Lobe::new(kind, args.n))
+        .collect();
+    let rows =
+        specula_isa::model_against_compilers(&lobes, &Gpu::ALL).map_err(|e| e.to_string())?;
+    if args.format == Format::Json {
+        let value: Vec<serde_json::Value> = rows
+            .iter()
+            .map(|(lobe, cells)| serde_json::json!({ "lobe": lobe, "gpus": cells }))
+            .collect();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&value).map_err(|e| e.to_string())?
+        );
+        return Ok(());
+    }
+    let mut out = format!(
+        "x pow's throughput at n = {}, compiled (modelled); transcendental instructions per \
+         evaluation, compiled/modelled\n\n| lobe |",
+        args.n
+    );
+    for gpu in Gpu::ALL {
+        let _ = write!(out, " {} |", gpu.id);
+    }
+    out.push_str("\n|---|");
+    out.push_str(&"---|".repeat(Gpu::ALL.len()));
+    out.push('\n');
+    for (lobe, cells) in &rows {
+        let _ = write!(out, "| {lobe} |");
+        for cell in cells {
+            let _ = write!(
+                out,
+                " {:.2} ({:.2}); {}/{} |",
+                cell.compiled_vs_pow,
+                cell.modelled_vs_pow,
+                cell.compiled_transcendentals,
+                cell.modelled_transcendentals
+            );
+        }
+        out.push('\n');
+    }
+    print!("{out}");
+    Ok(())
 }

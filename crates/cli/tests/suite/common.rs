@@ -184,3 +184,22 @@ pub fn export_lobe(directory: &Path, lobe: &str, n: f64, geometry: &str, lang: &
         ],
     );
 }
+
+/// Whether every GPU vendor's compiler `specula-isa` runs is here (nvcc, RADV's null device,
+/// ocloc). Without one a test is skipped, except under `CI=true`, where `.ci/run` installs
+/// them and a missing one is a failure.
+pub fn have_gpu_compilers() -> bool {
+    for vendor in specula::gpus::Vendor::ALL {
+        match specula_isa::compiler_version(&vendor.default_gpu()) {
+            Ok(_) => {}
+            Err(error) if std::env::var("CI").as_deref() == Ok("true") => {
+                panic!("CI=true requires every GPU compiler: {error}")
+            }
+            Err(error) => {
+                eprintln!("skipped: {error}");
+                return false;
+            }
+        }
+    }
+    true
+}

@@ -17,6 +17,7 @@ mod fit;
 mod gpu;
 mod hw;
 mod interrupt;
+mod isa;
 mod materialx;
 mod measured;
 mod mitsuba;
