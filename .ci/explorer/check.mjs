@@ -74,6 +74,21 @@ try {
   if (relobed.environmentPow !== moved.environmentPow) failures.push("changing the lobes changed the environment's pow image");
   if (!/^PSNR [0-9.]+ dB against pow/.test(relobed.environmentPsnr)) failures.push(`logexp under the sky has no PSNR against pow: '${relobed.environmentPsnr}'`);
 
+  // The machine-code view follows the chosen lobe (logexp) and the GPU: the compiler's code
+  // beside pow's, the special-function instructions marked (SASS's MUFU, AMD's v_exp/v_log).
+  const code = () => page.evaluate(() => ({
+    lobe: document.getElementById("isa-lobe").textContent,
+    lines: document.querySelectorAll("#isa-code .isa-line").length,
+    marked: [...document.querySelectorAll("#isa-code .isa-transcendental")].map((line) => line.textContent.trim()),
+    error: document.getElementById("isa-error").textContent,
+  }));
+  const sass = await code();
+  if (sass.lobe !== "logexp" || sass.error || !sass.marked.length || !sass.marked.every((line) => line.includes("MUFU."))) failures.push(`the machine code on sm_89: ${JSON.stringify(sass)}`);
+  await page.locator("#gpu").selectOption("gfx1100");
+  await drawn("gpu", "gfx1100");
+  const rdna = await code();
+  if (rdna.error || !rdna.marked.length || !rdna.marked.every((line) => /v_(exp|log|rcp|sqrt|rsq)_f32/.test(line))) failures.push(`the machine code on gfx1100: ${JSON.stringify(rdna)}`);
+
   // The volume follows the chosen lobe as every panel does: logexp's image, pow's unchanged;
   // pow chosen, the two agree; the volume selector changes both.
   if (relobed.volume === moved.volume) failures.push("changing the lobes: the volume did not re-render the chosen lobe");
@@ -205,4 +220,4 @@ if (failures.length) {
   console.error("explorer check failed:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`explorer check: loaded, moved n, changed lobes (and the environment view), the volume followed the chosen lobe, changed the volume, the controls stayed in view, the plots filled their sections, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, typed a formula (drawn and rendered) and two refused ones (their errors beside the box), ran a design (its lobe drawn from the box), round ticks; no console message; screenshot ${screenshot}`);
+console.log(`explorer check: loaded, moved n, changed lobes (and the environment view), the machine code followed the lobe and the GPU, the volume followed the chosen lobe, changed the volume, the controls stayed in view, the plots filled their sections, restored from the address, warned about albedo above 1, reported a corrected address, changed cosquad's v, typed a formula (drawn and rendered) and two refused ones (their errors beside the box), ran a design (its lobe drawn from the box), round ticks; no console message; screenshot ${screenshot}`);

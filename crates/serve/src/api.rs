@@ -24,7 +24,9 @@
 //! /api/material-render?material&fit&size&spp`:
 //!   the measured materials of the `--data` folder, by name (`measured.rs`);
 //! - `GET /api/design?target&low&high&max_error`: a lobe designed for a GPU family, by the
-//!   search the server was handed (`design.rs`).
+//!   search the server was handed (`design.rs`);
+//! - `GET /api/isa?lobe&n&gpu`: the lobe's and `pow`'s machine code for a GPU, by the compilers
+//!   the server was handed (`isa.rs`).
 
 use std::sync::Arc;
 
@@ -65,6 +67,7 @@ pub struct AppState {
     computations: Limiter,
     pub(crate) costs: CostModel,
     pub(crate) designer: Option<crate::design::DesignModel>,
+    pub(crate) isa: Option<crate::isa::IsaModel>,
     hosts: Hosts,
     pub(crate) materials: Arc<Materials>,
 }
@@ -77,6 +80,7 @@ impl AppState {
             computations: Limiter::default(),
             costs,
             designer: None,
+            isa: None,
             hosts: Hosts::default(),
             materials: Arc::new(Materials::none()),
         }
@@ -96,6 +100,15 @@ impl AppState {
     pub fn with_designer(self, designer: crate::design::DesignModel) -> Self {
         Self {
             designer: Some(designer),
+            ..self
+        }
+    }
+
+    /// The state answering `/api/isa` with `isa`, the GPU vendors' compilers.
+    #[must_use]
+    pub fn with_isa(self, isa: crate::isa::IsaModel) -> Self {
+        Self {
+            isa: Some(isa),
             ..self
         }
     }
@@ -162,8 +175,8 @@ pub async fn not_found() -> ApiError {
     ApiError::not_found(
         "no such page or endpoint".into(),
         "/, /api/models, /api/evaluate, /api/analyze, /api/render, /api/volume, /api/environment, \
-            /api/materials, /api/fits, /api/material-render, /api/design, /api/shader, \
-            /api/microfacet, /api/live-sphere, /api/teapot"
+            /api/materials, /api/fits, /api/material-render, /api/design, /api/isa, \
+            /api/shader, /api/microfacet, /api/live-sphere, /api/teapot"
             .into(),
     )
 }
@@ -212,6 +225,9 @@ pub async fn models() -> impl IntoResponse {
         "max_volume_size": MAX_VOLUME_SIZE,
         "max_environment_size": MAX_ENVIRONMENT_SIZE,
         "max_environment_spp": MAX_ENVIRONMENT_SPP,
+        // The GPUs the machine-code view compiles for, by their vendors' names.
+        "gpus": specula::gpus::Gpu::ALL.map(|gpu| json!({ "id": gpu.id, "name": gpu.name })),
+        "gpu": crate::isa::DEFAULT_GPU,
         // The sphere the page draws itself (live.js) and /api/live-sphere draws here.
         "live": crate::scene_setup::LIVE_SCENE,
         // The text box's language and limit (a formula is sent as `lobe==FORMULA`).

@@ -10,7 +10,7 @@ use crate::query::{ApiError, Params};
 /// What a design request asks for.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DesignQuery {
-    /// `gpu-nvidia` or `gpu-amd`.
+    /// `gpu-nvidia`, `gpu-amd` or `gpu-intel`.
     pub target: String,
     /// The range of `n`, its ends.
     pub range: (f64, f64),
@@ -21,9 +21,10 @@ pub struct DesignQuery {
 /// The search: `specula design --format json`'s answer for a query, or a one-line refusal.
 pub type DesignModel = Arc<dyn Fn(&DesignQuery) -> Result<serde_json::Value, String> + Send + Sync>;
 
-/// The targets the explorer designs for: the modelled ones (the CPU's costs are timed, tens
-/// of seconds a design, so `specula design --target cpu` is for a quiet machine).
-pub const DESIGN_TARGETS: [&str; 2] = ["gpu-nvidia", "gpu-amd"];
+/// The targets the explorer designs for: the GPUs, costed from their compilers' code (the
+/// CPU's costs are timed, tens of seconds a design, so `specula design --target cpu` is for a
+/// quiet machine).
+pub const DESIGN_TARGETS: [&str; 3] = ["gpu-nvidia", "gpu-amd", "gpu-intel"];
 
 /// The request's design query, refused with the parameter at fault.
 pub(crate) fn query(params: &Params) -> Result<DesignQuery, ApiError> {

@@ -18,6 +18,7 @@ mod design;
 mod environment;
 mod explorer;
 mod guard;
+mod isa;
 mod listen;
 mod live;
 mod measured;
@@ -35,6 +36,7 @@ pub use costs::{cpu_cost, CostModel, TargetCost, TargetRate};
 pub use design::{DesignModel, DesignQuery, DESIGN_TARGETS};
 pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
+pub use isa::{IsaModel, DEFAULT_GPU};
 pub use listen::{max_waiting, CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT};
 pub use live::{sphere_radiance, MAX_LIVE_SIZE};
 pub use measured::{
@@ -53,8 +55,9 @@ use axum::Router;
 const MAX_BODY_BYTES: usize = 16 * 1024;
 
 /// The page's scripts, in the order it loads them: the 2D plots, the differences, the measured
-/// materials, the WebGL2 views (spheres, 3D lobe, slice, teapot), the pointer and the page itself.
-const SCRIPTS: [(&str, &str); 9] = [
+/// materials, the WebGL2 views (spheres, 3D lobe, slice, teapot), the pointer, the machine code
+/// and the page itself.
+const SCRIPTS: [(&str, &str); 10] = [
     ("/plots.js", include_str!("assets/plots.js")),
     ("/difference.js", include_str!("assets/difference.js")),
     ("/measured.js", include_str!("assets/measured.js")),
@@ -63,6 +66,7 @@ const SCRIPTS: [(&str, &str); 9] = [
     ("/slice.js", include_str!("assets/slice.js")),
     ("/teapot.js", include_str!("assets/teapot.js")),
     ("/linked.js", include_str!("assets/linked.js")),
+    ("/isa.js", include_str!("assets/isa.js")),
     ("/app.js", include_str!("assets/app.js")),
 ];
 
@@ -104,6 +108,7 @@ pub fn router_with(state: api::AppState) -> Router {
         .route("/api/fits", get(api::fits))
         .route("/api/material-render", get(api::render_material))
         .route("/api/design", get(api::design_lobe))
+        .route("/api/isa", get(isa::isa))
         .route("/api/shader", get(live::shader))
         .route("/api/microfacet", get(live::microfacet))
         .route("/api/live-sphere", get(live::live_sphere))
@@ -122,14 +127,15 @@ pub fn router_with(state: api::AppState) -> Router {
 }
 
 /// Serves on `address` until Ctrl-C, printing the URL; `open` also opens it in a browser;
-/// `costs` prices each lobe on each target; `designer` answers `/api/design`; `materials` are
-/// the measured materials offered (`--data`).
+/// `costs` prices each lobe on each target; `designer` answers `/api/design`, `isa`
+/// `/api/isa`; `materials` are the measured materials offered (`--data`).
 /// Anything but a loopback address is warned about: the explorer has no authentication.
 pub fn serve(
     address: SocketAddr,
     open: bool,
     costs: CostModel,
     designer: design::DesignModel,
+    isa: IsaModel,
     materials: Materials,
 ) -> Result<(), String> {
     if !address.ip().is_loopback() {
@@ -153,6 +159,7 @@ pub fn serve(
         }
         let state = api::AppState::with_costs(costs)
             .with_designer(designer)
+            .with_isa(isa)
             .with_materials(materials)
             .answering(Hosts::new(Some(local.ip()), Some(local.port())));
         listen::serve(listener, router_with(state), async {

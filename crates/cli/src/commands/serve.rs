@@ -62,6 +62,11 @@ pub fn run(args: &Args) -> CommandResult {
         args.open,
         Arc::new(costs),
         designer(),
+        Arc::new(|lobe: &Lobe, gpu| {
+            let answer = specula_isa::compare(lobe, gpu, specula_isa::Work::Lobe)
+                .map_err(|e| e.to_string())?;
+            serde_json::to_value(answer).map_err(|e| e.to_string())
+        }),
         materials,
     )
 }

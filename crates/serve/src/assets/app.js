@@ -6,7 +6,7 @@
 const DASH = [7, 4];
 // Phong geometry with the lobe's own normalisation: energy-conserving (albedo <= 1) for every
 // lobe, so the first view is physically sensible.
-const DEFAULTS = { lobes: "pow,schlick,schlick-mod", formula: "", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "", volume: "phantom", view: "anterior" };
+const DEFAULTS = { lobes: "pow,schlick,schlick-mod", formula: "", n: "64", geometry: "phong", normalisation: "lobe", shading: "phong", model: "classic", theta_in: "30", light_theta: "30", light_phi: "45", log: "0", render: "", volume: "phantom", view: "anterior", gpu: "sm_89" };
 const $ = (id) => document.getElementById(id);
 let registry = null;
 let generation = 0;
@@ -76,6 +76,7 @@ function currentState() {
     render: names[ids.indexOf(renderLobe)] ?? "",
     volume: $("volume").value,
     view: $("view").value,
+    gpu: $("gpu").value,
     // The measured-materials view's (measured.js), when a material is chosen.
     ...measuredAddress(),
   };
@@ -132,6 +133,7 @@ function buildControls(state) {
   select("model", registry.models);
   select("volume", registry.volumes);
   select("view", registry.views);
+  select("gpu", registry.gpus.map((gpu) => gpu.id));
   // An address from before every panel followed the chosen lobe.
   if (new URLSearchParams(location.search).has("volume_lobe")) notes.push("volume_lobe is no longer a choice of its own: the volume shows the chosen lobe, as every panel does");
   $("formula").value = state.formula;
@@ -316,6 +318,8 @@ async function update() {
     warnAboutAlbedo(data, state);
     $("analysis").innerHTML = lobes.length ? analysisTable(reports) : "<p>Choose a lobe.</p>";
     markFresh("plots", "analysis");
+    await updateIsa(apiLobe(shown.render || "pow"), shown.render || "pow", state.n, signal);
+    if (mine !== generation) return;
     if (shown.render) {
       const render = (object) => "/api/render?" + new URLSearchParams({ object, lobe: apiLobe(shown.render), ...common, shading: state.shading, model: state.model, light_theta: state.light_theta, light_phi: state.light_phi, size: "512" });
       // The sphere is drawn live (linked.js); the server's is for a browser without WebGL2.
@@ -420,7 +424,7 @@ async function start() {
     const n = Number($("n-box").value);
     if (n >= 1 && n <= 1000) $("n").value = sliderFromN(n);
   });
-  document.querySelectorAll("#controls input, #controls select, #volume-controls select").forEach((el) => el.addEventListener("input", schedule));
+  document.querySelectorAll("#controls input, #controls select, #volume-controls select, #isa-controls select").forEach((el) => el.addEventListener("input", schedule));
   $("lobes").addEventListener("change", schedule);
   $("render-choice").addEventListener("change", () => { renderLobe = $("render-choice").value; schedule(); });
   $("design-run").addEventListener("click", runDesign);

@@ -503,3 +503,58 @@ async fn a_design_request_reaches_the_search_as_asked() {
         assert_eq!(body["parameter"], parameter, "{uri}: {body}");
     }
 }
+
+/// `/api/isa` checks its query (the lobe, n and the GPU by its vendor's name), hands the
+/// compilers the prepared lobe and the GPU as asked, answers with their JSON, passes a
+/// compiler's refusal on as one line, and says so when the server has no compilers.
+#[tokio::test]
+async fn a_machine_code_request_reaches_the_compilers_as_asked() {
+    let (status, body) = json("/api/isa?lobe=sg&n=64&gpu=sm_89").await;
+    assert_eq!(status, StatusCode::SERVICE_UNAVAILABLE, "{body}");
+    let model: crate::IsaModel = std::sync::Arc::new(|lobe: &specula::Lobe, gpu| {
+        if gpu.id == "tgllp" {
+            return Err("ocloc is not installed: apt-get install intel-opencl-icd".to_owned());
+        }
+        Ok(
+            serde_json::json!({ "lobe": lobe.kind().to_string(), "n": lobe.exponent().get(), "gpu": gpu.id }),
+        )
+    });
+    let app = crate::router_with(crate::AppState::default().with_isa(model));
+    let ask = |uri: &'static str| {
+        let app = app.clone();
+        async move {
+            let (status, bytes) = get_from(&app, uri).await;
+            (
+                status,
+                serde_json::from_slice::<Value>(&bytes).expect("json"),
+            )
+        }
+    };
+    let (status, body) = ask("/api/isa?lobe=cosquad:v=5&n=100&gpu=gfx1030").await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    assert_eq!(
+        body,
+        serde_json::json!({ "lobe": "cosquad:v=5", "n": 100.0, "gpu": "gfx1030" })
+    );
+    // The GPU the page starts with.
+    let (_, body) = ask("/api/isa?lobe=pow&n=8").await;
+    assert_eq!(body["gpu"], crate::DEFAULT_GPU);
+    let (status, body) = ask("/api/isa?lobe=pow&n=8&gpu=navi31").await;
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
+    assert_eq!(body["parameter"], "gpu");
+    assert!(
+        body["valid"].as_str().unwrap().contains("gfx1100"),
+        "{body}"
+    );
+    let (status, body) = ask("/api/isa?lobe=pow&n=8&gpu=tgllp").await;
+    assert_eq!(status, StatusCode::SERVICE_UNAVAILABLE, "{body}");
+    assert!(
+        body["error"].as_str().unwrap().contains("intel-opencl-icd"),
+        "{body}"
+    );
+    let (status, body) = ask("/api/isa?lobe=pow&n=0&gpu=sm_89").await;
+    assert_eq!(
+        (status, body["parameter"].as_str()),
+        (StatusCode::BAD_REQUEST, Some("n"))
+    );
+}
