@@ -36,7 +36,21 @@ pub struct LobeThroughput {
     pub evaluations: u64,
     /// The best of the timed dispatches.
     pub time: Duration,
+    /// Their median: with the best, the spread of a rate (a run whose spreads overlap
+    /// another's cannot tell the two apart).
+    pub median: Duration,
 }
+
+impl LobeThroughput {
+    /// Evaluations per second at the median dispatch.
+    #[must_use]
+    pub fn median_evals_per_second(&self) -> f64 {
+        self.evaluations as f64 / self.median.as_secs_f64()
+    }
+}
+
+/// Timed dispatches per lobe, after the size is found.
+pub const TIMED: usize = 9;
 
 /// The benchmark's WGSL: the exported lobe and an entry point `throughput`.
 #[must_use]
@@ -135,12 +149,11 @@ pub fn measure(gpu: &Gpu, lobe: &Lobe) -> Result<(LobeThroughput, f32), GpuError
     while workgroups < MOST_WORKGROUPS && dispatch(workgroups)? < LONG_ENOUGH {
         workgroups *= 2;
     }
-    let time = (0..5)
+    let mut times = (0..TIMED)
         .map(|_| dispatch(workgroups))
-        .collect::<Result<Vec<_>, _>>()?
-        .into_iter()
-        .min()
-        .unwrap_or(Duration::MAX);
+        .collect::<Result<Vec<_>, _>>()?;
+    times.sort();
+    let (time, median) = (times[0], times[TIMED / 2]);
     let bytes = gpu.read_buffer(&readback)?;
     let first = f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
     let evaluations = u64::from(workgroups) * u64::from(WORKGROUP) * u64::from(CHAIN);
@@ -149,6 +162,7 @@ pub fn measure(gpu: &Gpu, lobe: &Lobe) -> Result<(LobeThroughput, f32), GpuError
             evals_per_second: evaluations as f64 / time.as_secs_f64(),
             evaluations,
             time,
+            median,
         },
         first,
     ))

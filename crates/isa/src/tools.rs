@@ -2,7 +2,8 @@
 //!
 //! - NVIDIA's `nvcc` and `nvdisasm` come from PyPI (`nvidia-cuda-nvcc`, `nvidia-nvvm`,
 //!   `nvidia-cuda-crt`, `nvidia-cuda-runtime`, `nvidia-cuda-nvdisasm`: NVIDIA's licence, so
-//!   installed, never shipped): `$SPECULA_CUDA/bin`, else `nvcc` on the `PATH`, else the
+//!   installed, never shipped): `$SPECULA_CUDA/bin` where it is set, else `nvcc` on the `PATH`,
+//!   else the
 //!   `nvidia/cu*/bin` of the active virtual environment (`$VIRTUAL_ENV`) or of the checkout's
 //!   `target/venv`, where `.ci/run` installs them.
 //! - AMD's ACO is Mesa's RADV (`mesa-vulkan-drivers`), reached through the Vulkan loader
@@ -14,11 +15,13 @@ use std::process::{Command, Output};
 
 use crate::IsaError;
 
-/// The folders NVIDIA's tools may be in, most specific first.
+/// The folders NVIDIA's tools may be in, most specific first: `$SPECULA_CUDA/bin` alone where
+/// it is set (so that it can also say "none here").
 fn cuda_folders() -> Vec<PathBuf> {
     let mut folders = Vec::new();
     if let Some(root) = std::env::var_os("SPECULA_CUDA").filter(|v| !v.is_empty()) {
         folders.push(Path::new(&root).join("bin"));
+        return folders;
     }
     if let Some(path) = std::env::var_os("PATH") {
         folders.extend(std::env::split_paths(&path));

@@ -96,8 +96,8 @@ fn the_projected_microfacet_area_is_one() {
 #[test]
 fn tabulated_masking_is_the_closed_forms_for_beckmann_and_ggx() {
     for alpha in [0.05, 0.2, 0.5, 0.9] {
-        let beckmann = Tabulated::new(|c| closed::beckmann_d(alpha, c), alpha);
-        let ggx = Tabulated::new(|c| closed::ggx_d(alpha, c), alpha);
+        let beckmann = Tabulated::new(move |c| closed::beckmann_d(alpha, c), alpha);
+        let ggx = Tabulated::new(move |c| closed::ggx_d(alpha, c), alpha);
         for k in 0..=178 {
             let theta = (f64::from(k) * 0.5).to_radians();
             let cos = theta.cos();

@@ -56,7 +56,8 @@ impl Distribution {
     #[must_use]
     pub fn lobe(kind: LobeKind, n: Exponent) -> Self {
         let lobe = Lobe::new(kind, n);
-        let table = Tabulated::new(|c| lobe.eval(c), tabulated::lobe_width(n.get()));
+        let shape = lobe.clone();
+        let table = Tabulated::new(move |c| shape.eval(c), tabulated::lobe_width(n.get()));
         Self::Lobe {
             lobe,
             table: Arc::new(table),

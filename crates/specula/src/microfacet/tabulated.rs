@@ -25,21 +25,39 @@ use crate::quadrature::integrate_pieces;
 pub const ANGLES: usize = 257;
 
 /// The `theta_m` integrals' absolute tolerance (adaptive Gauss-Kronrod).
-const TOLERANCE: f64 = 1e-10;
+const TOLERANCE: f64 = 1e-8;
 
 /// Points of the sampling table over `theta_h`.
 const SAMPLING_POINTS: usize = 4096;
 
 /// A shape made a microfacet distribution.
-#[derive(Clone, Debug)]
 pub struct Tabulated {
     /// `C`: `D = C shape`.
     normaliser: f64,
     /// `int D(m) <wo, m>+ dm` at `theta_o` = [`table_angle`]`(k)`.
     projected: Vec<f64>,
-    /// `theta_h` of the sampling table, increasing from 0 to `pi / 2`.
-    sample_angles: Vec<f64>,
-    /// The cumulative probability of `D cos theta_h` at each of `sample_angles`, 0 to 1.
+    /// The shape, kept for the sampling table.
+    shape: Box<dyn Fn(f64) -> f64 + Send + Sync>,
+    /// The sampling table, made when a direction is first drawn (a fit evaluates hundreds of
+    /// distributions and draws from none).
+    sampling: std::sync::OnceLock<Sampling>,
+}
+
+impl core::fmt::Debug for Tabulated {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Tabulated")
+            .field("normaliser", &self.normaliser)
+            .field("projected", &self.projected.len())
+            .finish_non_exhaustive()
+    }
+}
+
+/// The sampling table: the cumulative distribution of `D cos theta_h`.
+#[derive(Debug)]
+struct Sampling {
+    /// `theta_h`, increasing from 0 to `pi / 2`.
+    angles: Vec<f64>,
+    /// The cumulative probability at each of `angles`, 0 to 1.
     cumulative: Vec<f64>,
 }
 
@@ -47,62 +65,88 @@ impl Tabulated {
     /// `shape` (of `cos theta_h`, non-negative, peaked at 1) made a distribution; `width`
     /// the angle its peak spans (radians).
     #[must_use]
-    pub fn new(shape: impl Fn(f64) -> f64, width: f64) -> Self {
+    pub fn new(shape: impl Fn(f64) -> f64 + Send + Sync + 'static, width: f64) -> Self {
         let points = breakpoints(width);
-        let area = TAU
-            * integrate_pieces(
-                |theta: f64| {
-                    let (s, c) = theta.sin_cos();
-                    shape(c) * c * s
-                },
-                &points,
-                TOLERANCE,
-            );
-        let normaliser = 1.0 / area;
-        let projected = (0..ANGLES)
-            .map(|k| {
-                let theta_o = table_angle(k);
-                let (sin_o, cos_o) = theta_o.sin_cos();
-                // The integrand has a kink where `wo` starts to see the microfacets' backs,
-                // `theta_m = pi / 2 - theta_o`: a breakpoint there.
-                let mut points = points.clone();
-                points.push(FRAC_PI_2 - theta_o);
-                normaliser
-                    * integrate_pieces(
-                        |theta_m: f64| {
-                            let (s, c) = theta_m.sin_cos();
-                            shape(c) * s * azimuthal(sin_o * s, cos_o * c)
-                        },
-                        &points,
-                        TOLERANCE,
-                    )
-            })
-            .collect();
-        let sample_angles: Vec<f64> = (0..SAMPLING_POINTS)
-            .map(|k| FRAC_PI_2 * (k as f64 / (SAMPLING_POINTS - 1) as f64).powi(2))
-            .collect();
-        let density = |theta: f64| {
+        // The projected area splits at `theta_m = pi / 2 - theta_o`: below it every microfacet
+        // faces `wo` (`b >= a`), and the azimuthal integral is `2 pi cos theta_o cos theta_m`,
+        // so that part is `cos theta_o` times the area's share up to there; above it, the
+        // integral is taken. One pass over the pieces between every table angle's split gives
+        // the area up to each (and the whole area, `C`), where 257 integrals over the whole
+        // range redid it per angle.
+        let splits: Vec<f64> = (0..ANGLES).map(|k| FRAC_PI_2 - table_angle(k)).collect();
+        let mut cuts: Vec<f64> = points.iter().chain(&splits).copied().collect();
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        let area_density = |theta: f64| {
             let (s, c) = theta.sin_cos();
             shape(c) * c * s
         };
-        // Trapezoids on the table's own grid, then scaled to end at 1: the table draws what
-        // it integrates, and `pdf` reports the exact density.
-        let mut cumulative = Vec::with_capacity(SAMPLING_POINTS);
-        let mut total = 0.0;
-        cumulative.push(0.0);
-        for pair in sample_angles.windows(2) {
-            total += 0.5 * (pair[1] - pair[0]) * (density(pair[0]) + density(pair[1]));
-            cumulative.push(total);
+        // The area below each cut, `int_0^cut shape cos sin`.
+        let mut below = Vec::with_capacity(cuts.len());
+        let mut running = 0.0;
+        below.push(0.0);
+        let piece_tolerance = TOLERANCE / cuts.len() as f64;
+        for pair in cuts.windows(2) {
+            running += integrate_pieces(area_density, pair, piece_tolerance);
+            below.push(running);
         }
-        for c in &mut cumulative {
-            *c /= total;
-        }
+        let area = TAU * running;
+        let normaliser = 1.0 / area;
+        let area_below = |x: f64| below[cuts.partition_point(|&c| c < x).min(cuts.len() - 1)];
+        let projected = splits
+            .iter()
+            .enumerate()
+            .map(|(k, &split)| {
+                let (sin_o, cos_o) = table_angle(k).sin_cos();
+                let facing = TAU * cos_o * area_below(split);
+                let beyond: Vec<f64> = points
+                    .iter()
+                    .copied()
+                    .filter(|&p| p > split)
+                    .chain([split, FRAC_PI_2])
+                    .collect();
+                let seen_edge_on = integrate_pieces(
+                    |theta_m: f64| {
+                        let (s, c) = theta_m.sin_cos();
+                        shape(c) * s * azimuthal(sin_o * s, cos_o * c)
+                    },
+                    &beyond,
+                    TOLERANCE,
+                );
+                normaliser * (facing + seen_edge_on)
+            })
+            .collect();
         Self {
             normaliser,
             projected,
-            sample_angles,
-            cumulative,
+            shape: Box::new(shape),
+            sampling: std::sync::OnceLock::new(),
         }
+    }
+
+    /// The sampling table of `D cos theta_h`: trapezoids on the table's own grid, then scaled
+    /// to end at 1 (the table draws what it integrates, and `pdf` reports the exact density).
+    fn sampling(&self) -> &Sampling {
+        self.sampling.get_or_init(|| {
+            let angles: Vec<f64> = (0..SAMPLING_POINTS)
+                .map(|k| FRAC_PI_2 * (k as f64 / (SAMPLING_POINTS - 1) as f64).powi(2))
+                .collect();
+            let density = |theta: f64| {
+                let (s, c) = theta.sin_cos();
+                (self.shape)(c) * c * s
+            };
+            let mut cumulative = Vec::with_capacity(SAMPLING_POINTS);
+            let mut total = 0.0;
+            cumulative.push(0.0);
+            for pair in angles.windows(2) {
+                total += 0.5 * (pair[1] - pair[0]) * (density(pair[0]) + density(pair[1]));
+                cumulative.push(total);
+            }
+            for c in &mut cumulative {
+                *c /= total;
+            }
+            Sampling { angles, cumulative }
+        })
     }
 
     /// `C`.
@@ -131,13 +175,13 @@ impl Tabulated {
     /// caller's, uniform) from `u` in `[0, 1)`.
     #[must_use]
     pub fn sample_theta(&self, u: f64) -> f64 {
-        let k = self
-            .cumulative
+        let Sampling { angles, cumulative } = self.sampling();
+        let k = cumulative
             .partition_point(|&c| c <= u)
             .clamp(1, SAMPLING_POINTS - 1);
-        let (c0, c1) = (self.cumulative[k - 1], self.cumulative[k]);
+        let (c0, c1) = (cumulative[k - 1], cumulative[k]);
         let f = if c1 > c0 { (u - c0) / (c1 - c0) } else { 0.0 };
-        self.sample_angles[k - 1] + f * (self.sample_angles[k] - self.sample_angles[k - 1])
+        angles[k - 1] + f * (angles[k] - angles[k - 1])
     }
 }
 

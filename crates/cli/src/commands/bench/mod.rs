@@ -300,10 +300,13 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
     };
     note(format!(
         "{}\nevery lobe at n = {}, its constants baked into a compute shader; each invocation \
-         sums the lobe at {} cosines; dispatches grow until one takes 20 ms, best of 5",
+         sums the lobe at {} cosines (bound by arithmetic, not memory); dispatches grow until \
+         one takes 20 ms, then {} are timed: the rate is the fastest, the spread runs from the \
+         median; a lobe whose spread overlaps pow's is a tie",
         gpu.adapter_name(),
         args.n,
-        throughput::CHAIN
+        throughput::CHAIN,
+        throughput::TIMED
     ));
     // Each vendor's current generation as `recommend` costs it (the compiled machine code, or
     // the model where the compiler is missing), beside what this adapter measures.
@@ -311,7 +314,8 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
     let mut headers = vec![
         "lobe".to_owned(),
         "G evals/s".to_owned(),
-        "x pow's throughput".to_owned(),
+        "x pow's throughput (median-fastest)".to_owned(),
+        "vs pow".to_owned(),
         "evaluations timed".to_owned(),
         "ms".to_owned(),
         "shader ops".to_owned(),
@@ -325,7 +329,7 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
     }));
     let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
     let mut table = Table::new(&headers);
-    let mut pow: Option<(f64, Vec<f64>)> = None;
+    let mut pow: Option<(throughput::LobeThroughput, Vec<f64>)> = None;
     for kind in LobeKind::ALL {
         let lobe = specula::Lobe::new(kind, args.n);
         let (rate, _) = throughput::measure(&gpu, &lobe).map_err(|e| e.to_string())?;
@@ -334,9 +338,19 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
             .iter()
             .map(|&target| specula_decide::lobe_rate(target, &lobe))
             .collect::<Result<Vec<f64>, String>>()?;
-        let (pow_rate, pow_modelled) = pow
-            .get_or_insert_with(|| (rate.evals_per_second, modelled.clone()))
-            .clone();
+        let (pow_rate, pow_modelled) = pow.get_or_insert_with(|| (rate, modelled.clone())).clone();
+        let spread =
+            |r: &throughput::LobeThroughput| [r.median_evals_per_second(), r.evals_per_second];
+        let ([low, high], [pow_low, pow_high]) = (spread(&rate), spread(&pow_rate));
+        let standing = if kind == LobeKind::Pow {
+            "the reference"
+        } else if low <= pow_high && pow_low <= high {
+            "tie"
+        } else if low > pow_high {
+            "faster"
+        } else {
+            "slower"
+        };
         let mut row = vec![
             kind.to_string(),
             if csv {
@@ -344,7 +358,17 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
             } else {
                 format!("{:.1}", rate.evals_per_second / 1e9)
             },
-            ratio(rate.evals_per_second / pow_rate),
+            if csv {
+                number(high / pow_rate.evals_per_second)
+            } else {
+                format!(
+                    "{:.2}x ({:.2}-{:.2})",
+                    high / pow_rate.evals_per_second,
+                    low / pow_rate.evals_per_second,
+                    high / pow_rate.evals_per_second
+                )
+            },
+            standing.to_owned(),
             rate.evaluations.to_string(),
             if csv {
                 number(rate.time.as_secs_f64() * 1e3)
@@ -362,8 +386,9 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
         table.push(row);
     }
     note(
-        "modelled: the shader's instructions (naga IR, acos expanded) at published per-clock \
-         rates (crates/specula/src/gpu_cost.rs names the sources)"
+        "each vendor's column: the machine code its compiler writes for the lobe (specula isa), \
+         at the generation's published per-clock rates (crates/specula/src/gpus.rs names the \
+         sources); the naga-IR model where the compiler is missing, as the unit says"
             .to_owned(),
     );
     table.print(args.format);

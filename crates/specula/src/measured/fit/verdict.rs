@@ -165,16 +165,25 @@ pub fn verdict_of(
             }
         })
         .collect();
+    // Errors closer than a millionth of each other are one error (the optimiser converges no
+    // closer): between them the lobe listed first, in the registry's order, is chosen.
+    let more_accurate = |a: &Standing, b: &Standing| {
+        let (ea, eb) = (fits[a.fit].error, fits[b.fit].error);
+        if (ea - eb).abs() <= 1e-6 * ea.max(eb) {
+            b.fit.cmp(&a.fit)
+        } else {
+            eb.total_cmp(&ea)
+        }
+    };
     let cheapest_meeting = standings.iter().filter(|s| s.meets).max_by(|a, b| {
         let (ra, rb) = (a.rate.unwrap_or(0.0), b.rate.unwrap_or(0.0));
-        ra.total_cmp(&rb)
-            .then_with(|| fits[b.fit].error.total_cmp(&fits[a.fit].error))
+        ra.total_cmp(&rb).then_with(|| more_accurate(a, b))
     });
     let closest = || {
         standings
             .iter()
             .filter(|s| s.rate.is_some())
-            .min_by(|a, b| fits[a.fit].error.total_cmp(&fits[b.fit].error))
+            .max_by(|a, b| more_accurate(a, b))
     };
     let within_margin = cheapest_meeting.is_some();
     let chosen = cheapest_meeting.or_else(closest)?.fit;
