@@ -27,6 +27,7 @@ use glam::DVec3;
 
 use crate::{Exponent, Lobe, LobeKind};
 
+pub use tabulated::TableIndex;
 use tabulated::Tabulated;
 
 /// A normal distribution, its parameter set.
@@ -56,8 +57,7 @@ impl Distribution {
     #[must_use]
     pub fn lobe(kind: LobeKind, n: Exponent) -> Self {
         let lobe = Lobe::new(kind, n);
-        let shape = lobe.clone();
-        let table = Tabulated::new(move |c| shape.eval(c), tabulated::lobe_width(n.get()));
+        let table = Tabulated::new(move |c| lobe.eval(c), tabulated::lobe_width(n.get()));
         Self::Lobe {
             lobe,
             table: Arc::new(table),
@@ -117,6 +117,17 @@ impl Distribution {
     #[must_use]
     pub fn g2(&self, cos_o: f64, cos_i: f64) -> f64 {
         1.0 / (1.0 + self.lambda(cos_o) + self.lambda(cos_i))
+    }
+
+    /// [`Distribution::g2`] of two directions placed in the lobes' `Lambda` table once (a
+    /// fit evaluates hundreds of distributions at the same directions).
+    #[must_use]
+    pub fn g2_at(&self, wo: &TableIndex, wi: &TableIndex) -> f64 {
+        let lambda = |index: &TableIndex| match self {
+            Self::Lobe { table, .. } => table.lambda_at(index),
+            _ => self.lambda(index.cos_theta()),
+        };
+        1.0 / (1.0 + lambda(wo) + lambda(wi))
     }
 
     /// A normal drawn with density `D(h) cos theta_h` from `u` in `[0, 1)^2`.

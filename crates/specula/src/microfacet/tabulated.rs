@@ -159,14 +159,17 @@ impl Tabulated {
     /// horizon, where nothing is seen).
     #[must_use]
     pub fn lambda(&self, cos_theta: f64) -> f64 {
+        self.lambda_at(&TableIndex::of(cos_theta))
+    }
+
+    /// [`Tabulated::lambda`] at a direction already placed in the table: every distribution
+    /// shares the table's angles, so a fit places its directions once.
+    #[must_use]
+    pub fn lambda_at(&self, index: &TableIndex) -> f64 {
+        let TableIndex { k, f, cos_theta } = *index;
         if cos_theta <= 0.0 {
             return f64::INFINITY;
         }
-        let theta = cos_theta.min(1.0).acos();
-        let x = (1.0 - (1.0 - theta / FRAC_PI_2).max(0.0).sqrt()) * (ANGLES - 1) as f64;
-        let k = (x.floor() as usize).min(ANGLES - 2);
-        let (a, b) = (table_angle(k), table_angle(k + 1));
-        let f = ((theta - a) / (b - a)).clamp(0.0, 1.0);
         let projected = self.projected[k] * (1.0 - f) + self.projected[k + 1] * f;
         (projected / cos_theta - 1.0).max(0.0)
     }
@@ -185,6 +188,41 @@ impl Tabulated {
     }
 }
 
+/// A direction's place in the `Lambda` table, the same for every distribution: the entry
+/// below it and the fraction of the way to the next.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TableIndex {
+    k: usize,
+    f: f64,
+    cos_theta: f64,
+}
+
+impl TableIndex {
+    /// The place of a direction of cosine `cos_theta`.
+    #[must_use]
+    pub fn of(cos_theta: f64) -> Self {
+        if cos_theta <= 0.0 {
+            return Self {
+                k: 0,
+                f: 0.0,
+                cos_theta,
+            };
+        }
+        let theta = cos_theta.min(1.0).acos();
+        let x = (1.0 - (1.0 - theta / FRAC_PI_2).max(0.0).sqrt()) * (ANGLES - 1) as f64;
+        let k = (x.floor() as usize).min(ANGLES - 2);
+        let (a, b) = (table_angle(k), table_angle(k + 1));
+        let f = ((theta - a) / (b - a)).clamp(0.0, 1.0);
+        Self { k, f, cos_theta }
+    }
+
+    /// The direction's cosine.
+    #[must_use]
+    pub fn cos_theta(&self) -> f64 {
+        self.cos_theta
+    }
+}
+
 /// The `k`-th angle of the `Lambda` table: `pi/2 (1 - (1 - k / (ANGLES - 1))^2)`, closer
 /// together towards the horizon, where a narrow distribution's masking changes within a few
 /// of its widths.
@@ -193,13 +231,14 @@ fn table_angle(k: usize) -> f64 {
     FRAC_PI_2 * (1.0 - from_horizon * from_horizon)
 }
 
-/// `int_0^2pi max(0, a cos phi + b) dphi` for `a, b >= 0`.
+/// `int_0^2pi max(0, a cos phi + b) dphi` for `a, b >= 0`: `a sin phi_c` is
+/// `sqrt(a^2 - b^2)`, as `cos phi_c = -b / a`.
 fn azimuthal(a: f64, b: f64) -> f64 {
     if b >= a {
         TAU * b
     } else {
         let phi_c = (-b / a).acos();
-        2.0 * (a * phi_c.sin() + b * phi_c)
+        2.0 * ((a * a - b * b).sqrt() + b * phi_c)
     }
 }
 

@@ -8,6 +8,7 @@ use core::f64::consts::FRAC_1_PI;
 use glam::DVec3;
 
 use super::Observations;
+use crate::microfacet::{fresnel_schlick, TableIndex};
 use crate::simd::{self, Job, Lanes};
 use crate::Geometry;
 
@@ -16,16 +17,31 @@ pub(super) const MAX_COEFFICIENTS: usize = 3;
 
 /// Observations with what every fit needs computed once.
 pub(super) struct Prepared<'a> {
-    pub(super) pairs: Vec<(DVec3, DVec3)>,
     pub(super) weight: &'a [f64],
     /// `cos(theta_i)`.
     pub(super) cosine: Vec<f64>,
     pub(super) t_phong: Vec<f64>,
     pub(super) t_blinn: Vec<f64>,
+    /// What a microfacet term needs of each pair besides the distribution, made once: the
+    /// half vector's cosine, `4 cos(theta_o) cos(theta_i)`, Schlick's `(1 - wo.h)^5`, and
+    /// both directions' places in the lobes' `Lambda` table.
+    pub(super) microfacet: Vec<MicrofacetPair>,
     /// Per channel, the cube root of the material's `f cos`.
     pub(super) target: [Vec<f64>; 3],
     /// Per channel, the weight that linearises the cube root at the data.
     pub(super) linearised: [Vec<f64>; 3],
+}
+
+/// A direction pair as every microfacet term sees it.
+#[derive(Clone, Copy)]
+pub(super) struct MicrofacetPair {
+    /// Both directions above the horizon.
+    pub(super) above: bool,
+    pub(super) cos_h: f64,
+    pub(super) four_cosines: f64,
+    pub(super) schlick: f64,
+    pub(super) wo: TableIndex,
+    pub(super) wi: TableIndex,
 }
 
 /// The rows of the model at every observation for one shape parameter ([`Prepared::rows`]).
@@ -160,7 +176,22 @@ impl<'a> Prepared<'a> {
                 .map(|(v, w)| w / (9.0 * v[c].abs().max(1e-4).powf(4.0 / 3.0)))
                 .collect()
         };
+        let microfacet = pairs
+            .iter()
+            .map(|&(wo, wi)| {
+                let h = (wo + wi).normalize();
+                MicrofacetPair {
+                    above: wo.z > 0.0 && wi.z > 0.0,
+                    cos_h: h.z,
+                    four_cosines: 4.0 * wo.z * wi.z,
+                    schlick: fresnel_schlick(0.0, wo.dot(h)),
+                    wo: TableIndex::of(wo.z),
+                    wi: TableIndex::of(wi.z),
+                }
+            })
+            .collect();
         Self {
+            microfacet,
             cosine: pairs.iter().map(|(_, wi)| wi.z).collect(),
             t_phong: pairs
                 .iter()
@@ -170,7 +201,6 @@ impl<'a> Prepared<'a> {
                 .iter()
                 .map(|&(wo, wi)| Geometry::Blinn.cos_lobe_local(wo, wi))
                 .collect(),
-            pairs,
             weight: &observations.weight,
             target: [channel(0), channel(1), channel(2)],
             linearised: [linearised(0), linearised(1), linearised(2)],
@@ -353,8 +383,8 @@ fn cost_sum(
             model[k] = rows[k][0] * x[0] + rows[k][1] * x[1] + rows[k][2] * x[2];
         }
         let root = cube_roots(model);
+        roots.copy_from_slice(&root);
         for k in 0..LANES {
-            roots[k] = root[k];
             let r = target[k] - root[k];
             sums[k] += weight[k] * r * r;
         }
@@ -468,7 +498,8 @@ fn cube_roots(x: [f64; 4]) -> [f64; 4] {
         }
     }
     for k in 0..4 {
-        if !(x[k] > 0.0) {
+        // 0 for 0 (and for a NaN, which no model gives).
+        if x[k].partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
             y[k] = 0.0;
         }
     }

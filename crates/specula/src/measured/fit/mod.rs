@@ -208,19 +208,27 @@ impl Specular {
             }
             Shape::Microfacet(distribution) => distribution,
         };
+        // microfacet_specular's terms, each pair's part of them made once (`Prepared`).
         let term: Vec<f64> = observations
-            .pairs
+            .microfacet
             .iter()
-            .map(|&(wo, wi)| microfacet_specular(&distribution, wo, wi))
+            .map(|pair| {
+                if pair.above {
+                    distribution.d(pair.cos_h) * distribution.g2_at(&pair.wo, &pair.wi)
+                        / pair.four_cosines
+                } else {
+                    0.0
+                }
+            })
             .collect();
         if !self.has_fresnel() {
             return vec![term];
         }
         let schlick = observations
-            .pairs
+            .microfacet
             .iter()
             .zip(&term)
-            .map(|(&(wo, wi), m)| m * fresnel_schlick(0.0, wo.dot((wo + wi).normalize())))
+            .map(|(pair, m)| m * pair.schlick)
             .collect();
         vec![term, schlick]
     }
@@ -491,7 +499,9 @@ fn minimise(profile: &Profile, grid: &[f64], costs: &[[f64; 3]]) -> f64 {
     let mut polished = brent(a, b, COARSE_TOLERANCE);
     if let Some((p, cost)) = polished.filter(|&(_, cost)| cost < EXACT_COST) {
         let (low, high) = (p - 4.0 * COARSE_TOLERANCE, p + 4.0 * COARSE_TOLERANCE);
-        polished = brent(low.max(a), high.min(b), 1e-7).filter(|q| q.1 <= cost).or(polished);
+        polished = brent(low.max(a), high.min(b), 1e-7)
+            .filter(|q| q.1 <= cost)
+            .or(polished);
     }
     match polished {
         Some((p, cost)) if cost <= total(best) => p,
