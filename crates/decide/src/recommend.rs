@@ -5,9 +5,9 @@
 //! CPU, the measured throughput of its SIMD kernel on this machine (one thread, L1, the
 //! slowest over the exponents); on a GPU generation, the evaluations per clock per
 //! multiprocessor of the machine code its vendor's compiler writes for the lobe (the naga-IR
-//! model where the compiler is missing, said so); on the FPGA, its cheapest datapath at the width the
-//! error needs, synthesized or estimated ([`crate::costing`]). The Pareto front is taken over
-//! every lobe, met or not.
+//! model where the compiler is missing, said so); on the FPGA, its cheapest datapath at the
+//! width the error needs, synthesized or estimated ([`crate::costing`]). The Pareto front is
+//! taken over every lobe, met or not.
 
 use indicatif::ProgressBar;
 use serde::Serialize;

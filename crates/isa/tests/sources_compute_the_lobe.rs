@@ -24,8 +24,12 @@ const CUDA_PRELUDE: &str = r#"
 #define __restrict__
 struct Dim { unsigned int x; };
 static Dim blockIdx, blockDim, threadIdx;
-static inline float __uint_as_float(unsigned int u) { float f; std::memcpy(&f, &u, 4); return f; }
-static inline unsigned int __float_as_uint(float f) { unsigned int u; std::memcpy(&u, &f, 4); return u; }
+static inline float __uint_as_float(unsigned int u) {
+    float f; std::memcpy(&f, &u, 4); return f;
+}
+static inline unsigned int __float_as_uint(float f) {
+    unsigned int u; std::memcpy(&u, &f, 4); return u;
+}
 "#;
 
 const CUDA_DRIVER: &str = r#"

@@ -515,9 +515,11 @@ async fn a_machine_code_request_reaches_the_compilers_as_asked() {
         if gpu.id == "tgllp" {
             return Err("ocloc is not installed: apt-get install intel-opencl-icd".to_owned());
         }
-        Ok(
-            serde_json::json!({ "lobe": lobe.kind().to_string(), "n": lobe.exponent().get(), "gpu": gpu.id }),
-        )
+        Ok(serde_json::json!({
+            "lobe": lobe.kind().to_string(),
+            "n": lobe.exponent().get(),
+            "gpu": gpu.id,
+        }))
     });
     let app = crate::router_with(crate::AppState::default().with_isa(model));
     let ask = |uri: &'static str| {

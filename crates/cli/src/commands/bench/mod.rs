@@ -301,8 +301,8 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
     note(format!(
         "{}\nevery lobe at n = {}, its constants baked into a compute shader; each invocation \
          sums the lobe at {} cosines (bound by arithmetic, not memory); dispatches grow until \
-         one takes 20 ms, then {} are timed: the rate is the fastest, the spread runs from the \
-         median; a lobe whose spread overlaps pow's is a tie",
+         one takes 20 ms, then {} are timed: the rate is the fastest, the spread (in brackets) \
+         runs from the median; a lobe whose spread overlaps pow's is a tie",
         gpu.adapter_name(),
         args.n,
         throughput::CHAIN,
@@ -314,7 +314,7 @@ fn bench_gpu_lobes(args: &Args) -> CommandResult {
     let mut headers = vec![
         "lobe".to_owned(),
         "G evals/s".to_owned(),
-        "x pow's throughput (median-fastest)".to_owned(),
+        "x pow's throughput".to_owned(),
         "vs pow".to_owned(),
         "evaluations timed".to_owned(),
         "ms".to_owned(),
