@@ -109,6 +109,76 @@ pub fn version(gpu: &Gpu) -> Result<String, IsaError> {
     Ok(version)
 }
 
+/// LLVM's machine-code analyser (`llvm-mca-19`, else `llvm-mca`, from Debian's `llvm-19`) and
+/// its version line, where it runs: its estimate stands beside ACO's own, and its presence
+/// keys the cache (installing it changes the next answer).
+pub fn llvm_mca() -> Option<&'static (String, String)> {
+    static FOUND: OnceLock<Option<(String, String)>> = OnceLock::new();
+    FOUND
+        .get_or_init(|| {
+            ["llvm-mca-19", "llvm-mca"].into_iter().find_map(|program| {
+                let output = Command::new(program).arg("--version").output().ok()?;
+                let text = String::from_utf8_lossy(&output.stdout);
+                let version = text.lines().find(|line| line.contains("LLVM version"))?;
+                Some((program.to_owned(), version.trim().to_owned()))
+            })
+        })
+        .as_ref()
+}
+
+/// llvm-mca's figures for the kernel's vector instructions (the scalar unit, memory and waits
+/// left out: llvm-mca 19 cannot take ACO's buffer instructions), run as a loop: the block's
+/// reciprocal throughput and the cycles an iteration takes, in cycles of a wave.
+fn mca_estimates(text: &str, gpu: &Gpu, wave: u32) -> Vec<Estimate> {
+    let Some((program, _)) = llvm_mca() else {
+        return Vec::new();
+    };
+    let vector: Vec<String> = crate::listing::amd_listing(text, wave)
+        .into_iter()
+        .filter(|instruction| instruction.mnemonic.starts_with("v_"))
+        .map(|instruction| instruction.text)
+        .collect();
+    let Ok(scratch) = specula_temporaries::dir("isa-mca-") else {
+        return Vec::new();
+    };
+    let file = scratch.path().join("kernel.s");
+    if vector.is_empty() || std::fs::write(&file, vector.join("\n") + "\n").is_err() {
+        return Vec::new();
+    }
+    let mut command = Command::new(program);
+    command
+        .args(["-mtriple=amdgcn", &format!("-mcpu={}", gpu.id)])
+        .arg(&file);
+    if wave == 64 && gpu.id.starts_with("gfx1") {
+        command.arg("-mattr=+wavefrontsize64");
+    }
+    let Ok(output) = command.output() else {
+        return Vec::new();
+    };
+    let report = String::from_utf8_lossy(&output.stdout);
+    let figure = |name: &str| {
+        report
+            .lines()
+            .find_map(|line| line.strip_prefix(name))
+            .and_then(|value| value.trim().parse::<f64>().ok())
+    };
+    let mut estimates = Vec::new();
+    if let Some(value) = figure("Block RThroughput:") {
+        estimates.push(Estimate {
+            name: "llvm-mca's block reciprocal throughput of the vector instructions, cycles"
+                .to_owned(),
+            value,
+        });
+    }
+    if let (Some(cycles), Some(iterations)) = (figure("Total Cycles:"), figure("Iterations:")) {
+        estimates.push(Estimate {
+            name: "llvm-mca's cycles per iteration of the vector instructions".to_owned(),
+            value: cycles / iterations,
+        });
+    }
+    estimates
+}
+
 /// The assembly and statistics ACO makes of each of `modules` (entry point `entry`) for
 /// `gpu`, in one run of the helper (one device for all: the process is most of the time).
 pub fn compile(modules: &[&[u32]], entry: &str, gpu: &Gpu) -> Result<Vec<Disassembly>, IsaError> {
@@ -133,7 +203,12 @@ pub fn compile(modules: &[&[u32]], entry: &str, gpu: &Gpu) -> Result<Vec<Disasse
     }
     reports
         .into_iter()
-        .map(|report| report.disassembly(&device))
+        .map(|report| {
+            let mut disassembly = report.disassembly(&device)?;
+            let mca = mca_estimates(&disassembly.text, gpu, disassembly.simd);
+            disassembly.estimates.extend(mca);
+            Ok(disassembly)
+        })
         .collect()
 }
 

@@ -318,7 +318,8 @@ pub fn compile_all_in(
 fn cache_key(source: &Source, gpu: &Gpu, version: &str) -> String {
     let flags = match gpu.vendor {
         Vendor::Nvidia => nvidia::FLAGS.join(" "),
-        Vendor::Amd => String::new(),
+        // llvm-mca's estimate is kept with ACO's listing: whether it ran keys the entry.
+        Vendor::Amd => amd::llvm_mca().map_or_else(String::new, |(_, version)| version.clone()),
         Vendor::Intel => intel::OPTIONS.to_owned(),
     };
     match source {
@@ -330,6 +331,7 @@ fn cache_key(source: &Source, gpu: &Gpu, version: &str) -> String {
                 gpu.id.as_bytes(),
                 gpu.compiler_target.as_bytes(),
                 version.as_bytes(),
+                flags.as_bytes(),
                 &bytes,
             ])
         }
