@@ -1,4 +1,5 @@
-// The README's "Use a lobe in three.js" and "Use a lobe in Babylon.js", run as printed: each
+// docs/engines.md's "Use a lobe in three.js" and "Use a lobe in Babylon.js" (the README's tour
+// points there), run as printed: each
 // section's shell command writes the module (with the binary checked), its JavaScript runs as
 // a page's module beside it (an import map gives it the packages, a canvas is on the page), and
 // the page must log no error, draw a lit object, and change its image as the snippet sweeps n
@@ -10,12 +11,12 @@ import * as lib from "./lib.mjs";
 
 const BIN = process.argv[2];
 if (!BIN) { console.error("usage: node .ci/engines/readme.mjs SPECULA_BIN"); process.exit(2); }
-const readme = await readFile(new URL("../../README.md", import.meta.url), "utf8");
+const readme = await readFile(new URL("../../docs/engines.md", import.meta.url), "utf8");
 
 // The first ```sh and ```js blocks after `heading`.
 function section(heading) {
   const rest = readme.split(`\n${heading}\n`)[1];
-  if (!rest) throw new Error(`the README has no section "${heading}"`);
+  if (!rest) throw new Error(`docs/engines.md has no section "${heading}"`);
   const block = (language) => rest.split("\n```" + language + "\n")[1]?.split("\n```")[0];
   return { sh: block("sh"), js: block("js") };
 }
@@ -36,7 +37,7 @@ const failures = [];
 const browser = await lib.launchChromium("README engines check");
 const { server, url } = await lib.startServer(work);
 try {
-  for (const [name, heading] of [["three", "### Use a lobe in three.js"], ["babylon", "### Use a lobe in Babylon.js"]]) {
+  for (const [name, heading] of [["three", "## Use a lobe in three.js"], ["babylon", "## Use a lobe in Babylon.js"]]) {
     const { sh, js } = section(heading);
     if (!sh || !js) { failures.push(`${heading}: no sh or js block`); continue; }
     for (const line of sh.split("\n").filter((l) => l.trim() && !l.startsWith("#"))) {

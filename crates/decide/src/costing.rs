@@ -64,6 +64,9 @@ pub(crate) struct Point {
     /// On AMD, ACO's estimated inverse throughput of the lobe's kernel beyond the baseline's,
     /// cycles a wave.
     pub(crate) aco_inverse_throughput: Option<f64>,
+    /// On the FPGA, the rate is a bound, not a synthesis: the lobe could not win
+    /// (`synthesis_plan`).
+    pub(crate) at_most: bool,
 }
 
 /// The integer exponent the datapaths take for `n`.
@@ -202,6 +205,20 @@ impl Costing {
         }
     }
 
+    /// On the FPGA, `lobe`'s point by its datapath's estimate, synthesizing nothing (`None`
+    /// elsewhere, or where it has no datapath).
+    pub(crate) fn estimated_point(&self, lobe: &Lobe, zone: Zone, max_error: f64) -> Option<Point> {
+        match self {
+            Costing::Estimated(hardware) | Costing::Synthesized(hardware) => {
+                Costing::Estimated(hardware.clone())
+                    .point(lobe, zone, max_error)
+                    .ok()
+                    .flatten()
+            }
+            _ => None,
+        }
+    }
+
     /// `lobe` at its exponent, or `None` where the target cannot run it (no datapath).
     pub(crate) fn point(
         &self,
@@ -225,6 +242,7 @@ impl Costing {
                     datapath: None,
                     spread,
                     aco_inverse_throughput: None,
+                    at_most: false,
                 })
             }
             Costing::Gpu(gpu, basis) => {
@@ -235,6 +253,7 @@ impl Costing {
                     datapath: None,
                     spread: None,
                     aco_inverse_throughput,
+                    at_most: false,
                 })
             }
             Costing::Estimated(hardware) | Costing::Synthesized(hardware) => {
@@ -276,6 +295,7 @@ impl Costing {
                     datapath: Some(datapath),
                     spread: None,
                     aco_inverse_throughput: None,
+                    at_most: false,
                 })
             }
         })
@@ -297,7 +317,9 @@ pub(crate) fn median(values: &[f64]) -> f64 {
 /// A synthesized datapath's rate in results per microsecond per 1000 LUTs, and what its name
 /// gains where nextpnr placed it nowhere: it does not fit the part (the synthesis's note says
 /// why), and a rate of 0 keeps it from meeting any request.
-fn synthesized_rate(synthesis: &specula_synth::Synthesis) -> (f64, Option<&'static str>) {
+pub(crate) fn synthesized_rate(
+    synthesis: &specula_synth::Synthesis,
+) -> (f64, Option<&'static str>) {
     match synthesis.logic_ns_per_result() {
         Some(lut_ns) => (1e6 / lut_ns, None),
         None => (0.0, Some(" (does not fit the iCE40 HX8K)")),
@@ -378,6 +400,19 @@ pub fn lobe_rate(target: Target, lobe: &Lobe) -> Result<f64, String> {
         Costing::Gpu(gpu, basis) => Ok(gpu_rate(gpu, &basis, lobe)?.0),
         Costing::Estimated(_) | Costing::Synthesized(_) => Err(FPGA_MATERIAL_REFUSAL.to_owned()),
     }
+}
+
+/// [`lobe_rate`] for each of `lobes`, their kernels compiled in one run of the compiler
+/// where it is found (a compiler's process is most of a compile's time: a material's
+/// verdict costs a dozen lobes, one by one a dozen processes).
+pub fn lobe_rates(target: Target, lobes: &[Lobe]) -> Result<Vec<f64>, String> {
+    let target = material_target(target)?;
+    let (costing, _) = Costing::new(target, None, &[])?;
+    if let Costing::Gpu(gpu, GpuBasis::Compiled(_)) = &costing {
+        // A failure is left for the lobes' own compiles, which name the one that fails.
+        let _ = specula_isa::compile_all(lobes, *gpu, Work::Lobe);
+    }
+    lobes.iter().map(|lobe| lobe_rate(target, lobe)).collect()
 }
 
 /// The unit of [`lobe_rate`] on `target` (empty for the FPGA, which it refuses).

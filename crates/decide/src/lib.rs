@@ -23,12 +23,16 @@ pub mod percent;
 mod pinned;
 pub mod rates;
 mod recommend;
+mod synthesis_plan;
 
 pub use choice::{Target, Zone};
-pub use costing::{gpu_basis, lobe_rate, modelled_rate, rate_unit, FPGA_MATERIAL_REFUSAL};
+pub use costing::{
+    gpu_basis, lobe_rate, lobe_rates, modelled_rate, rate_unit, FPGA_MATERIAL_REFUSAL,
+};
 pub use hardware::{hardware_sweeps, sweeps};
 pub use recommend::{
-    pareto_front, recommend, recommend_each, versus_pow, Candidate, Recommendation, Request,
+    pareto_front, recommend, recommend_each, recommend_each_cached, versus_pow, Candidate,
+    Recommendation, Request,
 };
 
 use specula::{Exponent, LobeKind};

@@ -18,7 +18,7 @@ use specula::{Exponent, Lobe, LobeKind, Normalisation};
 use specula_render::measured::{material_name, MeasuredBrdf};
 
 use crate::microfacet_cost::{ggx_microfacet_rate, microfacet_rate};
-use crate::{lobe_rate, log_spaced, rate_unit, Target};
+use crate::{lobe_rates, log_spaced, rate_unit, Target};
 
 /// The fit error allowed over pow's by default: 5 %.
 pub const DEFAULT_MARGIN: f64 = 0.05;
@@ -150,16 +150,22 @@ pub fn assess_model(
             || fit_families(&observations, &distributions),
         ));
     }
-    let mut rates = Vec::with_capacity(fits.len());
-    for fit in &fits {
-        rates.push(match (fit.specular.kind(), fit.sharing) {
+    // The shared-n lobes at their fitted n, costed together (one compile on a GPU).
+    let costed: Vec<Option<Lobe>> = fits
+        .iter()
+        .map(|fit| match (fit.specular.kind(), fit.sharing) {
             (Some(kind), Sharing::Shared) => {
-                let n = Exponent::clamped(fit.parameter[0]);
-                Some(lobe_rate(target, &Lobe::new(kind, n))?)
+                Some(Lobe::new(kind, Exponent::clamped(fit.parameter[0])))
             }
             _ => None,
-        });
-    }
+        })
+        .collect();
+    let lobes: Vec<Lobe> = costed.iter().flatten().copied().collect();
+    let mut lobe_rates = lobe_rates(target, &lobes)?.into_iter();
+    let rates: Vec<Option<f64>> = costed
+        .iter()
+        .map(|lobe| lobe.and_then(|_| lobe_rates.next()))
+        .collect();
     // In the microfacet model no distribution may come within the margin of GGX: the verdict
     // is then the closest distribution, not within it (`within_margin`).
     let Some(Verdict {

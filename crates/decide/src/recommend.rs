@@ -14,11 +14,10 @@ use serde::Serialize;
 use specula::analysis::energy_ratio;
 use specula::gpus::Gpu;
 use specula::{Exponent, Lobe, LobeKind};
-use specula_hw::analysis::WidthSweep;
 
-use crate::costing::{compile_ahead, Costing, Point, FPGA_TARGET};
-use crate::hardware::cheapest_datapath;
+use crate::costing::{compile_ahead, Costing, Point};
 use crate::{check_lobes, Target, Zone};
+use specula_synth::OnMiss;
 
 /// What to decide: the cheapest of `lobes` on `target` within `max_error` at every exponent.
 #[derive(Clone, Debug, PartialEq)]
@@ -90,6 +89,10 @@ pub struct Candidate {
     pub meets: bool,
     /// No other lobe is at least as accurate and at least as cheap, and better in one.
     pub pareto: bool,
+    /// On the FPGA, `rate` is an upper bound, not a synthesis: the lobe was left out of the
+    /// synthesis as it could not win, and is on no Pareto front.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub at_most: bool,
     /// Why it stands where it does.
     pub why: String,
 }
@@ -163,35 +166,6 @@ fn check(request: &Request) -> Result<(), String> {
     check_lobes(&request.lobes, &request.exponents)
 }
 
-/// Synthesizes, in parallel, every design the ranking of `request` will cost, so that the
-/// ranking finds each in the cache: Yosys and nextpnr run one thread each, and a request
-/// over a range needs dozens of designs on an empty cache. A failure is left for the
-/// ranking, which reports it.
-fn synthesize_ahead(
-    hardware: &[(Exponent, std::sync::Arc<Vec<WidthSweep>>)],
-    lobes: &[LobeKind],
-    zone: Zone,
-    max_error: f64,
-) {
-    use rayon::prelude::*;
-    let mut designs: Vec<(specula_hw::HwLobe, u32)> = hardware
-        .iter()
-        .flat_map(|(_, sweeps)| {
-            lobes.iter().filter_map(|&kind| {
-                cheapest_datapath(sweeps, kind, zone, max_error)
-                    .filter(|chosen| chosen.error <= max_error)
-                    .map(|chosen| (chosen.lobe, chosen.bits))
-            })
-        })
-        .collect();
-    designs.sort_by_key(|&(lobe, bits)| (lobe.id(), bits));
-    designs.dedup();
-    let cache = specula_synth::cache::Cache::default_location();
-    designs.par_iter().for_each(|&(lobe, bits)| {
-        let _ = specula_synth::synthesize(lobe, bits, FPGA_TARGET, cache.as_ref());
-    });
-}
-
 /// Measures every candidate of `request` on its target and ranks them: those that meet the
 /// request first, cheapest first, each with why it stands there. `progress` counts the
 /// lobes, names the one being measured, and is cleared at the end (pass
@@ -210,6 +184,27 @@ pub fn recommend_each(
     bounds: &[f64],
     progress: &ProgressBar,
 ) -> Result<Vec<Recommendation>, String> {
+    recommend_each_or(request, bounds, progress, OnMiss::Synthesize).map(|(answers, _)| answers)
+}
+
+/// [`recommend_each`] without running Yosys or nextpnr: on the FPGA, where the synthesis that
+/// decides the answers is not all in the cache, the answers are the formula estimate's (their
+/// note says so) and the count of designs still to synthesize comes with them (0 where nothing
+/// is missing, and off the FPGA). A report answers at once this way, and synthesizes after.
+pub fn recommend_each_cached(
+    request: &Request,
+    bounds: &[f64],
+    progress: &ProgressBar,
+) -> Result<(Vec<Recommendation>, usize), String> {
+    recommend_each_or(request, bounds, progress, OnMiss::Skip)
+}
+
+fn recommend_each_or(
+    request: &Request,
+    bounds: &[f64],
+    progress: &ProgressBar,
+    on_miss: OnMiss,
+) -> Result<(Vec<Recommendation>, usize), String> {
     for &max_error in bounds {
         check(&Request {
             max_error,
@@ -218,7 +213,7 @@ pub fn recommend_each(
             ..*request
         })?;
     }
-    let (mut costing, note) = Costing::new(request.target, request.gpu, &request.exponents)?;
+    let (mut costing, mut note) = Costing::new(request.target, request.gpu, &request.exponents)?;
     let basis = crate::costing::gpu_basis(request.target, request.gpu)?;
     costing.time_kernels(&request.lobes, &request.exponents, progress);
     if matches!(costing, Costing::Gpu(..)) {
@@ -226,10 +221,26 @@ pub fn recommend_each(
         compile_ahead(&costing, &request.lobes, &request.exponents);
     }
     let per_bound = matches!(costing, Costing::Estimated(_) | Costing::Synthesized(_));
-    if let Costing::Synthesized(hardware) = &costing {
-        for &max_error in bounds {
-            synthesize_ahead(hardware, request.lobes.as_slice(), request.zone, max_error);
-        }
+    // On the FPGA, synthesis only where it can decide; the rest costed by their estimates.
+    let mut plan = match &costing {
+        Costing::Synthesized(hardware) => crate::synthesis_plan::synthesize_what_can_win(
+            hardware,
+            &request.lobes,
+            request.zone,
+            bounds,
+            on_miss,
+            progress,
+        ),
+        _ => crate::synthesis_plan::Plan::default(),
+    };
+    let pending = plan.missing;
+    if let (Costing::Synthesized(hardware), true) = (&costing, pending > 0) {
+        costing = Costing::Estimated(hardware.clone());
+        plan = crate::synthesis_plan::Plan::default();
+        note = Some(format!(
+            "the synthesis that decides these answers has not run yet ({pending} or more \
+             datapaths not in the cache): FPGA costs are the formula estimate until it has"
+        ));
     }
     progress.set_length(request.lobes.len() as u64);
     let mut tallies: Vec<Vec<Tally>> = vec![Vec::new(); bounds.len()];
@@ -246,9 +257,19 @@ pub fn recommend_each(
                 Some(costing.point(&lobe, request.zone, bounds[0])?)
             };
             for (tally, &max_error) in lobe_tallies.iter_mut().zip(bounds) {
-                let point = match &shared {
-                    Some(point) => point.clone(),
-                    None => costing.point(&lobe, request.zone, max_error)?,
+                let point = match (&shared, plan.ruled_out(kind, max_error)) {
+                    (Some(point), _) => point.clone(),
+                    (None, Some((at_most, why))) => costing
+                        .estimated_point(&lobe, request.zone, max_error)
+                        .map(|point| Point {
+                            rate: at_most,
+                            at_most: true,
+                            datapath: point
+                                .datapath
+                                .map(|datapath| format!("{datapath} ({})", why.says(at_most))),
+                            ..point
+                        }),
+                    (None, None) => costing.point(&lobe, request.zone, max_error)?,
                 };
                 tally.add(point);
             }
@@ -262,7 +283,7 @@ pub fn recommend_each(
     }
     progress.finish_and_clear();
     let unit = costing.unit();
-    Ok(tallies
+    let answers = tallies
         .into_iter()
         .zip(bounds)
         .map(|(tallies, &max_error)| {
@@ -270,11 +291,16 @@ pub fn recommend_each(
                 .into_iter()
                 .map(|tally| tally.candidate(unit, max_error, request.energy_conserving))
                 .collect();
-            let mut answer = rank(candidates, unit, note.clone(), request.target, max_error);
+            let note = match (note.clone(), plan.note(max_error)) {
+                (Some(note), Some(plan)) => Some(format!("{note}; {plan}")),
+                (note, plan) => note.or(plan),
+            };
+            let mut answer = rank(candidates, unit, note, request.target, max_error);
             answer.basis.clone_from(&basis);
             answer
         })
-        .collect())
+        .collect();
+    Ok((answers, pending))
 }
 
 /// One lobe's measurements over the request's exponents, at one bound.
@@ -293,6 +319,8 @@ struct Tally {
     unavailable: bool,
     /// ACO's estimate, the worst over the exponents.
     aco_inverse_throughput: Option<f64>,
+    /// Some exponent's rate is a bound, not a synthesis.
+    at_most: bool,
     energy: f64,
 }
 
@@ -303,6 +331,7 @@ impl Tally {
             return;
         };
         self.error = self.error.max(point.error);
+        self.at_most |= point.at_most;
         if let Some(cycles) = point.aco_inverse_throughput {
             self.aco_inverse_throughput = Some(
                 self.aco_inverse_throughput
@@ -348,6 +377,7 @@ impl Tally {
             energy_ratio: self.energy,
             meets,
             pareto: false,
+            at_most: self.at_most,
             why: String::new(),
         }
     }
@@ -362,14 +392,21 @@ fn rank(
     target: Target,
     max_error: f64,
 ) -> Recommendation {
+    // A bound is no point of the front: it neither stands on it nor pushes others off.
     let front = pareto_front(
         &candidates
             .iter()
-            .map(|c| (c.error, c.rate))
+            .map(|c| {
+                if c.at_most {
+                    (f64::INFINITY, 0.0)
+                } else {
+                    (c.error, c.rate)
+                }
+            })
             .collect::<Vec<_>>(),
     );
     for (candidate, on_front) in candidates.iter_mut().zip(front) {
-        candidate.pareto = on_front;
+        candidate.pareto = on_front && !candidate.at_most;
     }
     candidates.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
     let tie = break_tie(&mut candidates, |c| Standing {
@@ -390,6 +427,12 @@ fn rank(
     let best = recommendation.best_candidate().map(|c| c.lobe.clone());
     for candidate in &mut recommendation.candidates {
         candidate.why = why(candidate, best.as_deref(), pow_rate, target, max_error);
+        if candidate.at_most && candidate.meets {
+            candidate.why = format!(
+                "meets it, at most {} pow's throughput: not synthesized whole, as it cannot win",
+                versus_pow(candidate.rate, pow_rate)
+            );
+        }
         if recommendation.tied.contains(&candidate.lobe) {
             candidate.why += if Some(&candidate.lobe) == best.as_ref() {
                 "; tied with the fastest (rates overlap), the most accurate of the tie"
@@ -524,6 +567,7 @@ mod tests {
                 datapath: Some(datapath.to_owned()),
                 spread: None,
                 aco_inverse_throughput: None,
+                at_most: false,
             }));
             tally.candidate("unit", 0.05, false)
         };

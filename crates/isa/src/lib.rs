@@ -276,7 +276,18 @@ pub fn compile_all_in(
         }
     }
     if !missing.is_empty() {
-        let compiled = compile_sources(
+        // One compile of a GPU's kernels at a time in this process: a caller beside this one
+        // (the report's sections, a design's bounds) waits, then finds them in the cache,
+        // rather than compiling the same kernels again beside it. No rayon work runs under
+        // the lock, so a waiting pool thread cannot hold what the holder needs.
+        let _compiling = compile_lock(&gpu);
+        if let Some(cache) = cache {
+            for &k in &missing {
+                found[k] = cache.load::<Disassembly>(&keys[k]);
+            }
+            missing.retain(|&k| found[k].is_none());
+        }
+        let compiled = compile_in_parallel(
             &missing.iter().map(|&k| &sources[k]).collect::<Vec<_>>(),
             &gpu,
         )?;
@@ -339,6 +350,69 @@ fn cache_key(source: &Source, gpu: &Gpu, version: &str) -> String {
 }
 
 /// `sources`, all of `gpu`'s vendor, compiled in one run.
+/// The in-process lock on compiling for `gpu`'s generation.
+fn compile_lock(gpu: &Gpu) -> std::sync::MutexGuard<'static, ()> {
+    static LOCKS: std::sync::Mutex<Vec<(&'static str, &'static std::sync::Mutex<()>)>> =
+        std::sync::Mutex::new(Vec::new());
+    let lock = {
+        let mut locks = LOCKS
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        match locks.iter().find(|(id, _)| *id == gpu.id) {
+            Some((_, lock)) => *lock,
+            None => {
+                // One per generation for the process's life: a dozen at most.
+                let lock: &'static std::sync::Mutex<()> =
+                    Box::leak(Box::new(std::sync::Mutex::new(())));
+                locks.push((gpu.id, lock));
+                lock
+            }
+        }
+    };
+    lock.lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Kernels per compiler process below which a batch is not split: a process's start-up is
+/// most of a small batch's time.
+const KERNELS_PER_PROCESS: usize = 24;
+
+/// [`compile_sources`] split across the machine's cores, one compiler process a share (each
+/// compiler compiles its kernels one after the other: a report's first run hands it hundreds).
+fn compile_in_parallel(sources: &[&Source], gpu: &Gpu) -> Result<Vec<Disassembly>, IsaError> {
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
+    let processes = sources.len().div_ceil(KERNELS_PER_PROCESS).clamp(1, cores);
+    if sources.is_empty() {
+        return Ok(Vec::new());
+    }
+    if processes == 1 {
+        return compile_sources(sources, gpu);
+    }
+    let share = sources.len().div_ceil(processes);
+    let results: Vec<Result<Vec<Disassembly>, IsaError>> = std::thread::scope(|scope| {
+        let running: Vec<_> = sources
+            .chunks(share)
+            .map(|chunk| scope.spawn(move || compile_sources(chunk, gpu)))
+            .collect();
+        running
+            .into_iter()
+            .map(|process| {
+                process.join().unwrap_or_else(|_| {
+                    Err(IsaError::Failed {
+                        what: "a compiler's run".to_owned(),
+                        message: "its thread panicked".to_owned(),
+                    })
+                })
+            })
+            .collect()
+    });
+    let mut all = Vec::with_capacity(sources.len());
+    for result in results {
+        all.extend(result?);
+    }
+    Ok(all)
+}
+
 fn compile_sources(sources: &[&Source], gpu: &Gpu) -> Result<Vec<Disassembly>, IsaError> {
     let texts = || {
         sources

@@ -150,9 +150,10 @@ pub fn report(
             bench,
             lobes: lobes(&extra_lobes)?,
             materials,
+            synthesize: true,
         };
         let summary = py
-            .detach(|| specula_report::write_report(&options))
+            .detach(|| specula_report::write_report_then_synthesize(&options, &|_| {}))
             .map_err(value_error)?;
         Ok(summary.page.display().to_string())
     })

@@ -63,6 +63,11 @@ pub struct Options {
     /// Also fit every lobe to the measured materials in this folder (RGL isotropic RGB
     /// `.bsdf` files, the first 16 by name).
     pub materials: Option<PathBuf>,
+    /// Run Yosys and nextpnr for what the FPGA rows and the hardware claim need; else read
+    /// the synthesis cache only, answer the FPGA rows by the formula estimate where it lacks
+    /// a design, and count what is still to synthesize ([`Summary::pending_synthesis`]): a
+    /// first report is written at once, then again once the synthesis is done.
+    pub synthesize: bool,
 }
 
 impl Options {
@@ -75,6 +80,7 @@ impl Options {
             bench: false,
             lobes: Vec::new(),
             materials: None,
+            synthesize: false,
         }
     }
 }
@@ -90,6 +96,9 @@ pub struct Summary {
     pub took: Duration,
     /// The time each section took, in words (they overlap: sections run concurrently).
     pub timings: String,
+    /// Designs the FPGA answers need that were not synthesized ([`Options::synthesize`]
+    /// off): the page says they are coming, and a report with it on answers from them.
+    pub pending_synthesis: usize,
 }
 
 /// How much each section computes.
@@ -154,6 +163,10 @@ pub(crate) struct Context {
     store: Option<PathBuf>,
     /// Whether the section was copied from the store rather than computed.
     from_store: bool,
+    /// Whether Yosys and nextpnr may run ([`Options::synthesize`]).
+    synthesize: bool,
+    /// Designs the FPGA answers need that the synthesis cache lacks (none synthesized now).
+    pending_synthesis: usize,
 }
 
 /// Every datapath's sweeps over word lengths, per hardware exponent.
@@ -175,6 +188,7 @@ impl Context {
         Self {
             files: Vec::new(),
             notes: Vec::new(),
+            pending_synthesis: 0,
             ..self.clone()
         }
     }
@@ -183,6 +197,7 @@ impl Context {
     fn absorb(&mut self, mut sibling: Self) {
         self.files.append(&mut sibling.files);
         self.notes.append(&mut sibling.notes);
+        self.pending_synthesis += sibling.pending_synthesis;
     }
 
     /// A note about this machine (a missing tool, no GPU adapter): the page gathers them at
@@ -218,6 +233,8 @@ impl Context {
             notes: Vec::new(),
             store: None,
             from_store: false,
+            synthesize: false,
+            pending_synthesis: 0,
         }
     }
 }
@@ -344,7 +361,32 @@ const SECTIONS: [Section; 14] = [
     (HARDWARE, hardware::hardware),
 ];
 
-/// Writes the report: what `specula report` does, progress bar included.
+/// Writes the report at once from what the synthesis cache holds, then, where the FPGA's
+/// answers wait on synthesis ([`Summary::pending_synthesis`]), runs it and writes the report
+/// again: what `specula report` does. `written` is told of each page as it is written (an
+/// interrupted second pass leaves the first page whole: pages are written atomically).
+pub fn write_report_then_synthesize(
+    options: &Options,
+    written: &dyn Fn(&Summary),
+) -> Result<Summary, String> {
+    let first = write_report(&Options {
+        synthesize: false,
+        ..options.clone()
+    })?;
+    written(&first);
+    if first.pending_synthesis == 0 {
+        return Ok(first);
+    }
+    let second = write_report(&Options {
+        synthesize: true,
+        ..options.clone()
+    })?;
+    written(&second);
+    Ok(second)
+}
+
+/// Writes the report once, progress bar included ([`Options::synthesize`] says whether
+/// Yosys and nextpnr run).
 ///
 /// The sections are independent, so they run concurrently, each writing its own files; the
 /// cost section's throughput measurement (`bench`) runs alone afterwards, on a quiet machine.
@@ -384,19 +426,43 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
         notes: Vec::new(),
         store: stored::default_store(),
         from_store: false,
+        synthesize: options.synthesize,
+        pending_synthesis: 0,
     };
     let bar = ProgressBar::new(SECTIONS.len() as u64).with_style(
         ProgressStyle::with_template("report {bar:30} {pos}/{len} sections {elapsed}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
+    // Without a terminal (a CI log, nohup, a notebook) the bar draws nothing: a line per
+    // section instead, as each finishes.
+    let lines = !std::io::IsTerminal::is_terminal(&std::io::stderr());
     let run_section = |&(heading, section): &Section| {
         let mut own = context();
         let begun = Instant::now();
         let body = section(&mut own);
         bar.inc(1);
+        if lines {
+            eprintln!(
+                "report: {heading} ({:.1} s{}; {}/{} sections)",
+                begun.elapsed().as_secs_f64(),
+                if own.from_store {
+                    ", stored by this build"
+                } else {
+                    ""
+                },
+                bar.position(),
+                SECTIONS.len()
+            );
+        }
         body.map(|body| {
             let took = begun.elapsed();
-            (heading, body, (took, own.from_store), own.files, own.notes)
+            (
+                heading,
+                body,
+                (took, own.from_store),
+                own.files,
+                (own.notes, own.pending_synthesis),
+            )
         })
     };
     let alone = |(heading, _): &&Section| options.bench && *heading == sections::COST;
@@ -457,7 +523,9 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
     let mut bodies = Vec::new();
     let mut timings = Vec::new();
     let mut notes: Vec<String> = Vec::new();
-    for (heading, body, (took, from_store), written, noted) in done {
+    let mut pending_synthesis = 0;
+    for (heading, body, (took, from_store), written, (noted, pending)) in done {
+        pending_synthesis += pending;
         let stored = if from_store {
             " (stored by this build)"
         } else {
@@ -490,6 +558,7 @@ pub fn write_report(options: &Options) -> Result<Summary, String> {
         images: files.len(),
         took: started.elapsed(),
         timings,
+        pending_synthesis,
     })
 }
 

@@ -404,11 +404,16 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
     // Each vendor's current generation, costed as `recommend` costs it: from the machine code
     // its compiler writes (the model where the compiler is missing, which the unit says).
     let gpu_targets = specula_decide::Target::GPUS;
-    let pow_rates = gpu_targets
+    // Each target's rates for pow and every lobe, compiled in one batch per compiler.
+    let costed: Vec<Lobe> = std::iter::once(pow)
+        .chain(context.lobes.iter().map(|&kind| Lobe::new(kind, n)))
+        .collect();
+    let gpu_rates = gpu_targets
         .iter()
-        .map(|&target| specula_decide::lobe_rate(target, &pow))
-        .collect::<Result<Vec<f64>, String>>()?;
-    for kind in context.lobes.clone() {
+        .map(|&target| specula_decide::lobe_rates(target, &costed))
+        .collect::<Result<Vec<Vec<f64>>, String>>()?;
+    let pow_rates: Vec<f64> = gpu_rates.iter().map(|rates| rates[0]).collect();
+    for (index, kind) in context.lobes.clone().into_iter().enumerate() {
         let lobe = Lobe::new(kind, n);
         let error = error_figures(&lobe, &mut Precision::F64, context.sizes.samples_per_zone)
             .epicentre_max_rel;
@@ -421,8 +426,8 @@ pub fn cost(context: &mut Context) -> Result<String, String> {
                 f64::from(pow_instructions) / f64::from(instructions.total().max(1))
             ),
         ];
-        for (&target, pow_rate) in gpu_targets.iter().zip(&pow_rates) {
-            let rate = specula_decide::lobe_rate(target, &lobe)?;
+        for (rates, pow_rate) in gpu_rates.iter().zip(&pow_rates) {
+            let rate = rates[index + 1];
             row.push(format!("{:.2}x ({rate:.2})", rate / pow_rate));
         }
         row.push(format!("{} ({instructions})", instructions.total()));

@@ -11,7 +11,9 @@
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use specula::{Exponent, LobeKind};
-use specula_decide::{recommend_each, versus_pow, Recommendation, Request, Target};
+use specula_decide::{
+    recommend_each, recommend_each_cached, versus_pow, Recommendation, Request, Target,
+};
 
 use super::html::{paragraph, table};
 use super::plot::{Chart, Series};
@@ -39,13 +41,27 @@ const PLOTTED: f64 = 64.0;
 /// Where exact `pow` is drawn on the log axis.
 pub(crate) const EXACT_FLOOR: f64 = 1e-6;
 
-/// `specula recommend --target TARGET --n N --max-error BOUND` over the report's lobes.
-fn answers(lobes: &[LobeKind], target: Target, n: f64) -> Result<Vec<Recommendation>, String> {
+/// `specula recommend --target TARGET --n N --max-error BOUND` over the report's lobes, and
+/// the designs still to synthesize where `synthesize` is off (the FPGA's answers are then the
+/// formula estimate's until the cache holds what decides them).
+fn answers(
+    lobes: &[LobeKind],
+    target: Target,
+    n: f64,
+    synthesize: bool,
+) -> Result<(Vec<Recommendation>, usize), String> {
     let request = Request {
         lobes: lobes.to_vec(),
         ..Request::new(target, vec![Exponent::new(n)], ACCURACIES[0])
     };
-    recommend_each(&request, &ACCURACIES, &ProgressBar::hidden())
+    if synthesize {
+        Ok((
+            recommend_each(&request, &ACCURACIES, &ProgressBar::hidden())?,
+            0,
+        ))
+    } else {
+        recommend_each_cached(&request, &ACCURACIES, &ProgressBar::hidden())
+    }
 }
 
 /// A GPU cell: the best lobe and its modelled rate over pow's, or `-`.
@@ -155,21 +171,25 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
         .flat_map(|&(target, _)| EXPONENTS.iter().map(move |&n| (target, n)))
         .collect();
     let hardware: Vec<u32> = context.sizes.hardware_exponents.to_vec();
+    let synthesize = context.synthesize;
     let (gpu, fpga) = rayon::join(
         || {
             gpu_rows
                 .par_iter()
-                .map(|&(target, n)| answers(&lobes, target, n))
+                .map(|&(target, n)| Ok(answers(&lobes, target, n, false)?.0))
                 .collect::<Result<Vec<_>, String>>()
         },
         || {
             hardware
                 .iter()
-                .map(|&n| answers(&lobes, Target::Fpga, f64::from(n)))
+                .map(|&n| answers(&lobes, Target::Fpga, f64::from(n), synthesize))
                 .collect::<Result<Vec<_>, String>>()
         },
     );
-    let (gpu, fpga) = (gpu?, fpga?);
+    let gpu = gpu?;
+    let (fpga, pending): (Vec<Vec<Recommendation>>, Vec<usize>) = fpga?.into_iter().unzip();
+    let pending: usize = pending.iter().sum();
+    context.pending_synthesis += pending;
     let gpu_answers = |target: Target, n: f64| {
         gpu_rows
             .iter()
@@ -210,6 +230,14 @@ pub fn verdict(context: &mut Context) -> Result<String, String> {
         context.machine_note(format!("GPU costs: {note}."));
     }
     html += &paragraph(&prose::fill(prose::FPGA_ROWS, &[])?);
+    if pending > 0 {
+        html += &paragraph(&format!(
+            "Still coming: the FPGA rows above are the formula estimate, because the synthesis \
+             that decides them was not in the cache when this page was written ({pending} or \
+             more datapaths). specula report synthesizes them after writing the page, then \
+             writes it again with the synthesized rows; an interrupted run keeps this page."
+        ));
+    }
     for note in fpga
         .iter()
         .flatten()

@@ -146,7 +146,7 @@ fn fasterpow_is_lifted_by_its_offset_and_fastpow_is_not() {
     }
 }
 
-/// What the README says of the published offset: worse than none in the epicentre, and a
+/// What docs/decisions.md says of the published offset: worse than none in the epicentre, and a
 /// constant near 0.288 (found here on the closed form by golden-section search) six times
 /// better than either.
 #[test]

@@ -1,6 +1,6 @@
 //! `specula claims`: the thesis's claims with measured figures and verdicts.
 
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use specula::claims::{ClaimId, ClaimOptions, ClaimResult};
 
 use specula_hw::{HwLobe, BITS};
@@ -57,11 +57,8 @@ pub fn hardware_claim(
 /// measured, and the others stand).
 pub fn run(args: &Args) -> CommandResult {
     let options = ClaimOptions::default();
-    let progress = ProgressBar::new_spinner().with_style(
-        ProgressStyle::with_template("{spinner} testing {msg} claims {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-    );
-    progress.set_message(ClaimId::ALL.len().to_string());
+    let progress = crate::progress::bar("claims", 0, "{spinner} testing {msg} {elapsed}");
+    progress.set_message(format!("{} claims", ClaimId::ALL.len()));
     progress.enable_steady_tick(std::time::Duration::from_millis(100));
     let results: Vec<ClaimResult> = specula_decide::analyses::claims(&options);
     progress.set_message("the hardware claim: synthesizing, 8");

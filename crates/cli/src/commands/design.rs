@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use specula_decide::design::grammar::{self, Fate};
 use specula_decide::design::{default_whole_error, design, Bounds, Design, DesignRequest};
 use specula_decide::hardware::circuit_for_range;
@@ -105,10 +105,7 @@ fn parse_range(text: &str) -> Result<Range, String> {
 
 /// Searches, prints, and writes the lobe.
 pub fn run(args: &Args) -> CommandResult {
-    let progress = ProgressBar::new(0).with_style(
-        ProgressStyle::with_template("designing {bar:30} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let progress = crate::progress::bar("design", 0, "designing {bar:30} {pos}/{len} {msg}");
     let Some(max_error) = args.max_error else {
         return print_against_thesis(args, &progress);
     };

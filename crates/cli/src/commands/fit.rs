@@ -5,7 +5,6 @@
 
 use std::path::PathBuf;
 
-use indicatif::{ProgressBar, ProgressStyle};
 use specula::measured::fit::Sharing;
 use specula_decide::material::{
     assess_model, lobes_to_fit, luminance, parameter_text, verdict_line, Assessment, Model, Ranked,
@@ -169,9 +168,10 @@ pub fn run(args: &Args) -> CommandResult {
     for path in &args.material {
         load_measured(path)?;
     }
-    let progress = ProgressBar::new(args.material.len() as u64).with_style(
-        ProgressStyle::with_template("fitting {bar:30} {pos}/{len} materials {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    let progress = crate::progress::bar(
+        "fit",
+        args.material.len() as u64,
+        "fitting {bar:30} {pos}/{len} materials {msg}",
     );
     for path in &args.material {
         progress.set_message(material_name(path));

@@ -25,21 +25,33 @@ pub struct Args {
     materials: Option<PathBuf>,
 }
 
-/// Writes the report and says where.
+/// Writes the report and says where; where the FPGA's answers wait on synthesis, says so,
+/// synthesizes and writes it again.
 pub fn run(args: &Args) -> CommandResult {
-    let summary = specula_report::write_report(&specula_report::Options {
+    let options = specula_report::Options {
         out: args.out.clone(),
         quick: args.quick,
         bench: args.bench,
         lobes: crate::args::flatten(&args.lobe),
         materials: args.materials.clone(),
+        synthesize: true,
+    };
+    specula_report::write_report_then_synthesize(&options, &|summary| {
+        eprintln!(
+            "wrote {} and {} images ({:.1} s; {})",
+            summary.page.display(),
+            summary.images,
+            summary.took.as_secs_f64(),
+            summary.timings
+        );
+        if summary.pending_synthesis > 0 {
+            eprintln!(
+                "still coming: the FPGA answers are the formula estimate until {} or more \
+                 datapaths are synthesized; synthesizing them now, then writing the report \
+                 again (Ctrl-C keeps the page as written)",
+                summary.pending_synthesis
+            );
+        }
     })?;
-    eprintln!(
-        "wrote {} and {} images ({:.1} s; {})",
-        summary.page.display(),
-        summary.images,
-        summary.took.as_secs_f64(),
-        summary.timings
-    );
     Ok(())
 }

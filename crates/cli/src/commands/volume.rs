@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use specula_gpu::{Gpu, GpuRenderer, GpuVolumeRenderer};
 use specula_render::{check_output_path, render, write_image, Display, Image};
@@ -280,10 +280,7 @@ pub fn run(args: &Args) -> CommandResult {
         RendererArg::Cpu => None,
         RendererArg::Gpu => Some(Gpu::new().map_err(|e| e.to_string())?),
     };
-    let bar = ProgressBar::new(1).with_style(
-        ProgressStyle::with_template("{msg} {bar:30} {percent}% {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = crate::progress::bar("volume", 1, "{msg} {bar:30} {percent}% {elapsed}");
     let (image, drawn) = match args.mode {
         Mode::Dvr => {
             let transfer = transfer(args, &volume)?;

@@ -207,6 +207,7 @@ fn earlier_outputs_survive_failed_and_interrupted_renders() {
     );
     // A render killed part-way.
     let mut child = Command::new(env!("CARGO_BIN_EXE_specula"))
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .current_dir(path)
         .args(SLOW_RENDER)
         .spawn()
@@ -340,6 +341,7 @@ fn interrupted_commands_leave_nothing_behind() {
     std::fs::write(path.join("out.png"), "the previous output").expect("write");
     for signal in ["-INT", "-TERM"] {
         let child = Command::new(env!("CARGO_BIN_EXE_specula"))
+            .env("SPECULA_CACHE_DIR", crate::common::test_cache())
             .current_dir(path)
             .args(SLOW_RENDER)
             .stderr(std::process::Stdio::piped())
@@ -380,6 +382,7 @@ fn standard_output_errors_end_like_unix_tools() {
         let (reader, writer) = std::io::pipe().expect("a pipe");
         drop(reader);
         let child = Command::new(env!("CARGO_BIN_EXE_specula"))
+            .env("SPECULA_CACHE_DIR", crate::common::test_cache())
             .args(args)
             .stdout(writer)
             .stderr(std::process::Stdio::piped())
@@ -396,6 +399,7 @@ fn standard_output_errors_end_like_unix_tools() {
             .open("/dev/full")
             .expect("/dev/full");
         let output = Command::new(env!("CARGO_BIN_EXE_specula"))
+            .env("SPECULA_CACHE_DIR", crate::common::test_cache())
             .args(args)
             .stdout(full)
             .output()

@@ -7,6 +7,7 @@ use serde_json::Value;
 fn specula(args: &[&str]) -> std::process::Output {
     Command::cargo_bin("specula")
         .expect("binary built")
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .args(args)
         .output()
         .expect("runs")

@@ -5,10 +5,18 @@ use std::path::Path;
 
 use assert_cmd::Command;
 
+/// The suite's own cache folder (`SPECULA_CACHE_DIR` for every program it runs): never the
+/// user's `~/.cache/specula`, so that what a user ran before cannot change what a test sees;
+/// kept between runs of the suite, whose keys hold the tools found.
+pub fn test_cache() -> std::path::PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join("specula-cache")
+}
+
 /// Runs `specula args` in `directory`.
 pub fn specula(directory: &Path, args: &[&str]) -> std::process::Output {
     Command::cargo_bin("specula")
         .expect("binary built")
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .current_dir(directory)
         .args(args)
         .output()
@@ -72,6 +80,7 @@ pub fn python() -> std::path::PathBuf {
 /// the package, and any other run prints `skipped: ...` and the caller skips.
 pub fn have_python_module(module: &str, package: &str) -> bool {
     let found = std::process::Command::new(python())
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .args(["-c", &format!("import {module}")])
         .output()
         .is_ok_and(|o| o.status.success());
@@ -97,6 +106,7 @@ pub fn renderer_script(name: &str) -> std::path::PathBuf {
 /// Runs [`python`] on `script` with `args` in `directory`, requiring success.
 pub fn run_python(directory: &Path, script: &str, args: &[String]) -> std::process::Output {
     let output = std::process::Command::new(python())
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .current_dir(directory)
         .arg(renderer_script(script))
         .args(args)

@@ -89,6 +89,7 @@ fn the_designed_gpu_lobe_meets_its_bounds_by_numpy_and_beats_pow() {
         .map(|k| format!("{}", 8.0 * 64f64.powf(f64::from(k) / 36.0)))
         .collect();
     let checked = std::process::Command::new(python())
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .arg(renderer_script("designed_lobe_check.py"))
         .arg(&file)
         .args(["0.001", "0.01"])
@@ -167,6 +168,7 @@ fn a_polynomial_design_on_the_cpu_is_a_polynomial() {
     }
     // The epicentre's 0.5 % and the whole lobe's default 1 %, by NumPy on the written text.
     let checked = std::process::Command::new(python())
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .arg(renderer_script("designed_lobe_check.py"))
         .arg(dir.path().join("polynomial.toml"))
         .args(["0.005", "0.01", "64"])

@@ -23,6 +23,7 @@ fn have_packages() -> bool {
 /// Runs the Python `script` with `args`, requiring success, and gives its standard output.
 fn run(script: &str, args: &[&str]) -> String {
     let output = std::process::Command::new(python())
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .args(["-c", script])
         .args(args)
         .output()

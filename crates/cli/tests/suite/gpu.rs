@@ -45,6 +45,7 @@ fn no_adapter_is_a_clear_error_and_no_file() {
     let directory = tempfile::tempdir().unwrap();
     let output = Command::cargo_bin("specula")
         .unwrap()
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .current_dir(directory.path())
         .env("WGPU_BACKEND", "metal")
         .args(["render", "--backend", "gpu", "-o", "x.png"])
@@ -282,6 +283,7 @@ fn the_gpu_path_keeps_stderr_clean() {
     let directory = tempfile::tempdir().unwrap();
     let output = Command::cargo_bin("specula")
         .unwrap()
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .current_dir(directory.path())
         .env_remove("XDG_RUNTIME_DIR")
         .args([

@@ -126,6 +126,7 @@ fn synth_json_carries_the_tools_figures_and_versions() {
     let run = || {
         let output = assert_cmd::Command::cargo_bin("specula")
             .expect("binary built")
+            .env("SPECULA_CACHE_DIR", crate::common::test_cache())
             .env("SPECULA_CACHE_DIR", &cache)
             .args(words(
                 "hw synth --target generic --bits 8 --lobe cosquad,sg --format json",
@@ -160,6 +161,7 @@ fn synth_without_yosys_names_the_package() {
     let directory = tempfile::tempdir().expect("temporary directory");
     let output = assert_cmd::Command::cargo_bin("specula")
         .expect("binary built")
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .env("PATH", directory.path())
         .args(words("hw synth --lobe cosquad --bits 8"))
         .output()

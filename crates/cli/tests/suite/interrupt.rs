@@ -63,6 +63,7 @@ fn broken(path: &Path) -> Option<String> {
 fn report(out: &Path, temporary: &Path) -> Command {
     let mut command = Command::new(env!("CARGO_BIN_EXE_specula"));
     command
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .args(["report", "--quick", "--out"])
         .arg(out)
         .env("TMPDIR", temporary)

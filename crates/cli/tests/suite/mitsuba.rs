@@ -32,6 +32,7 @@ pub(crate) fn chi2(
     .to_vec();
     args.extend(extra.iter().map(|s| (*s).to_owned()));
     std::process::Command::new(common::python())
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .current_dir(dir)
         .arg(common::renderer_script("mitsuba_check.py"))
         .args(&args)

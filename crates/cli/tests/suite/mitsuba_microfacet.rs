@@ -89,6 +89,7 @@ fn plugin_values(
     args.extend(["llvm_ad_rgb", "--model", "microfacet", "--n", &n]);
     args.extend_from_slice(material);
     let mut child = std::process::Command::new(common::python())
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .current_dir(dir)
         .arg(common::renderer_script("mitsuba_check.py"))
         .args(&args)

@@ -113,6 +113,7 @@ fn the_package_installs_offline_and_its_tests_pass() {
     run(
         "pip install ./crates/python",
         Command::new(python())
+            .env("SPECULA_CACHE_DIR", crate::common::test_cache())
             .current_dir(&root)
             .args([
                 "-m",
@@ -133,6 +134,7 @@ fn the_package_installs_offline_and_its_tests_pass() {
     run(
         "pytest crates/python/tests",
         Command::new(python())
+            .env("SPECULA_CACHE_DIR", crate::common::test_cache())
             .current_dir(scratch.path())
             .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
             .arg(root.join("crates/python/tests"))

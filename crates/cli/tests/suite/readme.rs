@@ -116,6 +116,7 @@ fn serve(line: &str, directory: &Path, path: &str) {
         .args(["-c", &format!("exec {line}")])
         .current_dir(directory)
         .env("PATH", path)
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -208,6 +209,7 @@ fn every_command_in_the_readme_and_docs_runs_as_written() {
                 .args(["-o", "pipefail", "-c", &line])
                 .current_dir(directory.path())
                 .env("PATH", &path)
+                .env("SPECULA_CACHE_DIR", crate::common::test_cache())
                 .stdin(Stdio::null())
                 .output()
                 .unwrap();
@@ -234,6 +236,7 @@ fn every_command_in_the_readme_and_docs_runs_as_written() {
 /// `specula <args> --help`.
 fn help(args: &[&str]) -> String {
     let output = Command::new(env!("CARGO_BIN_EXE_specula"))
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .args(args)
         .arg("--help")
         .output()

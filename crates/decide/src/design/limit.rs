@@ -94,11 +94,27 @@ fn script(family: Family, n: f64) -> String {
     )
 }
 
-/// Whether Sollya runs on this machine: what a stored answer that needs it is keyed by, so that
-/// installing it changes the next answer.
+/// Whether Sollya runs on this machine and computes (`print(1+1)` answers `2`; a program of
+/// that name that fails, or says anything else, is not it): what a stored answer that needs
+/// it is keyed by, so that installing it changes the next answer.
 #[must_use]
 pub fn sollya_found() -> bool {
-    Command::new("sollya").arg("--help").output().is_ok()
+    use std::io::Write;
+    let Ok(mut child) = Command::new("sollya")
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+    else {
+        return false;
+    };
+    if let Some(mut stdin) = child.stdin.take() {
+        // A broken pipe is read as "not Sollya" below.
+        let _ = stdin.write_all(b"print(1+1);\nquit;\n");
+    }
+    child.wait_with_output().is_ok_and(|output| {
+        output.status.success() && String::from_utf8_lossy(&output.stdout).trim() == "2"
+    })
 }
 
 /// The family's optimum at `n`, from Sollya (`sollya` on the `PATH`); `Err` names what failed.

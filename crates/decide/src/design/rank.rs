@@ -46,7 +46,13 @@ pub(super) fn rank(
             lobe.datapath.clone_from(&costed.datapath);
             lobe.spread = costed.spread;
             lobe.meets = lobe.verified && costed.meets;
-            if lobe.meets {
+            if lobe.meets && costed.at_most {
+                lobe.why = format!(
+                    "meets every bound, at most {:.2}x pow's throughput: not synthesized \
+                     whole, as it cannot win",
+                    costed.rate / pow_rate
+                );
+            } else if lobe.meets {
                 lobe.why = format!(
                     "meets every bound at {:.2}x pow's throughput",
                     costed.rate / pow_rate
@@ -62,7 +68,13 @@ pub(super) fn rank(
         .filter(|c| compared_ids.contains(&c.lobe))
         .cloned()
         .collect();
-    mark_front(&mut designed, &compared);
+    let bounds_only: Vec<String> = ranking
+        .candidates
+        .iter()
+        .filter(|c| c.at_most)
+        .map(|c| c.lobe.clone())
+        .collect();
+    mark_front(&mut designed, &compared, &bounds_only);
     designed.sort_by(|a, b| b.meets.cmp(&a.meets).then(b.rate.total_cmp(&a.rate)));
     break_tie(&mut designed);
     let removed: Vec<&DesignedLobe> = designed
@@ -103,16 +115,23 @@ pub(super) fn break_tie(sorted: &mut [DesignedLobe]) {
 }
 
 /// Marks the designed lobes no lobe (designed or built in) dominates in error and rate.
-fn mark_front(designed: &mut [DesignedLobe], compared: &[Candidate]) {
+fn mark_front(designed: &mut [DesignedLobe], compared: &[Candidate], bounds_only: &[String]) {
+    // A rate that is only a bound (FPGA, not synthesized whole) is no point of the front.
+    let placed = |d: &DesignedLobe| d.rate > 0.0 && !bounds_only.contains(&d.name);
     let points: Vec<(f64, f64)> = designed
         .iter()
-        .filter(|d| d.rate > 0.0)
+        .filter(|d| placed(d))
         .map(|d| (d.epicentre_error, d.rate))
-        .chain(compared.iter().map(|c| (c.error, c.rate)))
+        .chain(
+            compared
+                .iter()
+                .filter(|c| !c.at_most)
+                .map(|c| (c.error, c.rate)),
+        )
         .collect();
     let front = pareto_front(&points);
     let mut on_front = front.into_iter();
-    for lobe in designed.iter_mut().filter(|d| d.rate > 0.0) {
-        lobe.pareto = on_front.next().unwrap_or(false);
+    for lobe in designed.iter_mut() {
+        lobe.pareto = placed(lobe) && on_front.next().unwrap_or(false);
     }
 }

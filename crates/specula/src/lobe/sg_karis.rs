@@ -12,7 +12,7 @@
 //! `f = n ln((n + c)/n) - c`: both closed forms are tested. The offset 0.775 is the published
 //! one, kept because it is what engines ship; for the epicentre's largest relative error it is
 //! not the best: it is worse than no offset (0.46 % against 0.37 % at `n = 64`), and the
-//! best constant, about 0.288 at every `n`, would cut the error sixfold (README).
+//! best constant, about 0.288 at every `n`, would cut the error sixfold (docs/decisions.md).
 //!
 //! - **Parameters**: the exponent `n`.
 //! - **Domain**: `t in (0, 1]`; the value lies in `(0, 1]`.

@@ -11,6 +11,7 @@ use super::CommandResult;
 use crate::output::{number, Table};
 
 pub mod environment;
+mod first_run;
 pub mod lobes;
 mod mitsuba_peer;
 pub mod volume;
@@ -33,6 +34,9 @@ pub enum Target {
     /// beside Mitsuba 3 (llvm_ad_rgb) rendering the same views when the `mitsuba` wheel is
     /// present.
     Environment,
+    /// What a newcomer meets first: `report --quick`, `report` and `fit` (both models) on a
+    /// bundled material, each this binary on an empty cache folder, with each section's time.
+    FirstRun,
     /// The volume renderer on the CPU: frames per second of `--input` (512 x 512 unless
     /// `--width`/`--height` say otherwise), beside VTK's CPU ray caster when the `vtk` wheel
     /// is present.
@@ -113,6 +117,7 @@ pub fn run(args: &Args) -> CommandResult {
         Target::GpuLobes => bench_gpu_lobes(args),
         Target::Volume => volume::run(args),
         Target::Environment => environment::run(args),
+        Target::FirstRun => first_run::run(),
     }
 }
 

@@ -31,6 +31,7 @@ fn png_bytes(path: &Path) -> Pixels {
 /// cannot render (no EGL), which fails under `CI=true`.
 fn bench_images(d: &Path, input: &Path, transfer: &str) -> Option<(Pixels, Pixels)> {
     let output = std::process::Command::new(assert_cmd::cargo::cargo_bin("specula"))
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .current_dir(d)
         .env("SPECULA_PYTHON", python())
         .args([

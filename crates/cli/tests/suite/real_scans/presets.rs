@@ -223,6 +223,7 @@ fn the_skull_defect_renders_as_background_with_ct_bone() {
     let d = directory.path();
     let crop = d.join("anterior-half.nii.gz");
     let output = std::process::Command::new(python())
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .args(["-c", CROP, text(&scans.ct_nifti), text(&crop), "0"])
         .output()
         .unwrap();

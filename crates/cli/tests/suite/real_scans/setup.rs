@@ -17,6 +17,7 @@ pub fn script() -> PathBuf {
 /// Runs `real_scans.py args` in `directory`: its standard output, or its one error line.
 pub fn try_real_scans(directory: &Path, args: &[&str]) -> Result<String, String> {
     let output = std::process::Command::new(python())
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .current_dir(directory)
         .arg(script())
         .args(args)

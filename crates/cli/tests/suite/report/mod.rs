@@ -26,6 +26,7 @@ fn the_quick_report_is_complete_and_well_formed() {
     // The Python with the `vtk` wheel runs VTK for the medical section's comparison.
     let output = assert_cmd::Command::cargo_bin("specula")
         .expect("binary built")
+        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
         .current_dir(d)
         .env("SPECULA_PYTHON", python())
         .args(["report", "--quick", "--out", "out", "--materials"])
@@ -76,7 +77,7 @@ fn the_quick_report_is_complete_and_well_formed() {
         "no designed formula"
     );
     // The limit: no design beats its family's optimum at an n (Sollya's certified bound).
-    let limit_rows = table_rows(&document, "n = 8");
+    let limit_rows = table_rows(&document, &["family", "n = 8"]);
     assert!(!limit_rows.is_empty(), "no limit table");
     for row in &limit_rows {
         for cell in &row[1..] {
@@ -90,7 +91,7 @@ fn the_quick_report_is_complete_and_well_formed() {
     }
     // Against the thesis: a row per thesis lobe and an answer per GPU (that a designed answer
     // meets the thesis lobe's accuracy is decide's test, re-measured there).
-    let thesis_rows = table_rows(&document, "its errors (epicentre, whole lobe)");
+    let thesis_rows = table_rows(&document, &["its errors (epicentre, whole lobe)"]);
     let lobes: Vec<&str> = thesis_rows.iter().map(|row| row[0].as_str()).collect();
     assert_eq!(lobes, ["schlick-mod", "cheb2-thesis", "logexp", "cosquad"]);
     assert!(
@@ -130,7 +131,7 @@ fn the_quick_report_is_complete_and_well_formed() {
         ("PSNR vs pow (dB)", "render"),
         ("PSNR vs pow, lit by the sky (dB)", "environment"),
     ] {
-        let rows = table_rows(&document, header);
+        let rows = table_rows(&document, &[header]);
         assert_eq!(
             rows.len(),
             specula::LobeKind::ALL.len() - 1,
@@ -142,7 +143,7 @@ fn the_quick_report_is_complete_and_well_formed() {
         }
         check_tiles(&document, &out, prefix);
     }
-    let rows = table_rows(&document, "PSNR vs the pow image (dB)");
+    let rows = table_rows(&document, &["PSNR vs the pow image (dB)"]);
     assert_eq!(rows.len(), specula::LobeKind::ALL.len(), "every lobe");
     for row in &rows {
         assert_eq!(row.len(), 5, "{row:?}");
@@ -175,7 +176,7 @@ fn one_answer(document: &roxmltree::Document, directory: &std::path::Path) {
     let synthesized = have_tool("yosys", "-V", "yosys")
         && have_tool("nextpnr-ice40", "--version", "nextpnr-ice40");
     let bounds = ["0.5%", "2%", "10%"];
-    let rows = table_rows(document, "within 0.5 %");
+    let rows = table_rows(document, &["within 0.5 %"]);
     let mut checked = [0; 2];
     for row in &rows {
         assert_eq!(row.len(), 2 + bounds.len(), "{row:?}");
@@ -417,16 +418,80 @@ fn flip_in(source: &str, caption: &str) -> f64 {
 }
 
 /// The cells of the table with a column headed `header`, below its header row.
-fn table_rows(document: &roxmltree::Document, header: &str) -> Vec<Vec<String>> {
-    let table = document
+fn table_rows(document: &roxmltree::Document, headers: &[&str]) -> Vec<Vec<String>> {
+    find_table(document, headers)
+        .map(cells)
+        .unwrap_or_else(|| panic!("a table headed {headers:?}"))
+}
+
+/// The table whose header row holds every one of `headers` (what only that table has).
+fn find_table<'a>(
+    document: &'a roxmltree::Document,
+    headers: &[&str],
+) -> Option<roxmltree::Node<'a, 'a>> {
+    document
         .descendants()
         .filter(|n| n.has_tag_name("table"))
         .find(|t| {
-            t.descendants()
-                .any(|n| n.has_tag_name("th") && n.text() == Some(header))
+            headers.iter().all(|&header| {
+                t.descendants()
+                    .any(|n| n.has_tag_name("th") && n.text() == Some(header))
+            })
         })
-        .unwrap_or_else(|| panic!("a table with '{header}'"));
-    cells(table)
+}
+
+/// Installing Sollya after a first report changes the next one: a report made where
+/// `sollya` fails (a program of that name first on the `PATH` that exits 1) says so and has
+/// no limit table, and the next, with the real Sollya, has it (the stored "Designed lobes"
+/// is keyed by whether Sollya runs).
+#[test]
+fn installing_sollya_after_a_report_brings_the_limit_table() {
+    if !have_tool("sollya", "--help", "sollya") {
+        return;
+    }
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    let fake = d.join("fake-sollya");
+    std::fs::create_dir(&fake).unwrap();
+    let script = fake.join("sollya");
+    std::fs::write(&script, "#!/bin/sh\nexit 1\n").unwrap();
+    std::fs::set_permissions(&script, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    let path = std::env::var("PATH").unwrap_or_default();
+    let report = |out: &str, path: String| {
+        let output = assert_cmd::Command::cargo_bin("specula")
+            .expect("binary built")
+            .env("SPECULA_CACHE_DIR", crate::common::test_cache())
+            .env("PATH", path)
+            .current_dir(d)
+            .args(["report", "--quick", "--out", out])
+            .output()
+            .expect("runs");
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        std::fs::read_to_string(d.join(out).join("index.html")).unwrap()
+    };
+    let parse = |page: &str| -> bool {
+        let document = roxmltree::Document::parse_with_options(
+            page,
+            roxmltree::ParsingOptions {
+                allow_dtd: true,
+                ..roxmltree::ParsingOptions::default()
+            },
+        )
+        .expect("well formed");
+        find_table(&document, &["family", "n = 8"]).is_some()
+    };
+    let without = report("without", format!("{}:{path}", fake.display()));
+    assert!(!parse(&without), "a limit table without Sollya");
+    assert!(
+        without.contains("Designed lobes' limit table"),
+        "the missing Sollya is not said"
+    );
+    let with = report("with", path);
+    assert!(parse(&with), "no limit table once Sollya runs");
 }
 
 /// A table's cells, below its header row.

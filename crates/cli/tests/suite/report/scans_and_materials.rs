@@ -53,7 +53,8 @@ pub(super) fn real_scans(document: &roxmltree::Document, text: &str, out: &std::
             continue;
         }
         let prefix = format!("real-{}", name.to_lowercase());
-        let rows = table_rows(document, &format!("PSNR vs pow on the real {name} (dB)"));
+        let header = format!("PSNR vs pow on the real {name} (dB)");
+        let rows = table_rows(document, &[header.as_str()]);
         let lobes: Vec<&str> = rows.iter().map(|row| row[0].as_str()).collect();
         assert_eq!(lobes, QUICK_REAL_SCAN_LOBES, "the real {name}'s lobes");
         for row in &rows {
@@ -117,7 +118,7 @@ pub(super) fn real_scans(document: &roxmltree::Document, text: &str, out: &std::
     }
     // --quick compares the first scan alone with VTK (the full report every scan).
     let compared = &shown[..1];
-    let rows = table_rows(document, "mean FLIP, specula vs VTK");
+    let rows = table_rows(document, &["mean FLIP, specula vs VTK"]);
     assert_eq!(rows.len(), compared.len(), "{rows:?}");
     for (row, (name, prefix)) in rows.iter().zip(compared) {
         assert_eq!(row.len(), 9, "{row:?}");
