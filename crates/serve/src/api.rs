@@ -61,13 +61,23 @@ use crate::costs::{costs_versus_pow, cpu_cost, CostModel};
 /// The largest render side, in pixels.
 pub const MAX_RENDER_SIZE: u32 = 1024;
 
+/// The compilers (`/api/isa`): `specula isa --format json`'s answer for a lobe on the GPU
+/// named by its vendor's id, or a one-line refusal (a compiler missing, naming how to install
+/// it).
+pub type IsaModel = std::sync::Arc<
+    dyn Fn(&specula::Lobe, specula::gpus::Gpu) -> Result<serde_json::Value, String> + Send + Sync,
+>;
+
+/// The GPU the machine-code view compiles for unless the page names one.
+pub const DEFAULT_GPU: &str = "sm_89";
+
 /// What the handlers share.
 #[derive(Clone)]
 pub struct AppState {
     computations: Limiter,
     pub(crate) costs: CostModel,
     pub(crate) designer: Option<crate::design::DesignModel>,
-    pub(crate) isa: Option<crate::isa::IsaModel>,
+    pub(crate) isa: Option<IsaModel>,
     hosts: Hosts,
     pub(crate) materials: Arc<Materials>,
 }
@@ -106,7 +116,7 @@ impl AppState {
 
     /// The state answering `/api/isa` with `isa`, the GPU vendors' compilers.
     #[must_use]
-    pub fn with_isa(self, isa: crate::isa::IsaModel) -> Self {
+    pub fn with_isa(self, isa: IsaModel) -> Self {
         Self {
             isa: Some(isa),
             ..self
@@ -227,7 +237,7 @@ pub async fn models() -> impl IntoResponse {
         "max_environment_spp": MAX_ENVIRONMENT_SPP,
         // The GPUs the machine-code view compiles for, by their vendors' names.
         "gpus": specula::gpus::Gpu::ALL.map(|gpu| json!({ "id": gpu.id, "name": gpu.name })),
-        "gpu": crate::isa::DEFAULT_GPU,
+        "gpu": DEFAULT_GPU,
         // The sphere the page draws itself (live.js) and /api/live-sphere draws here.
         "live": crate::scene_setup::LIVE_SCENE,
         // The text box's language and limit (a formula is sent as `lobe==FORMULA`).

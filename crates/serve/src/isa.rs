@@ -3,23 +3,13 @@
 //! above this crate, so the server is handed them ([`IsaModel`]) by the command that starts
 //! it; a server without them says so.
 
-use std::sync::Arc;
-
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use specula::gpus::Gpu;
-use specula::Lobe;
 
-use crate::api::{compute_with, AppState};
+use crate::api::{compute_with, AppState, DEFAULT_GPU};
 use crate::query::{pairs, ApiError, Params, QueryPairs};
-
-/// The compilers: `specula isa --format json`'s answer for a lobe on the GPU named by its
-/// vendor's id, or a one-line refusal (a compiler missing, naming how to install it).
-pub type IsaModel = Arc<dyn Fn(&Lobe, Gpu) -> Result<serde_json::Value, String> + Send + Sync>;
-
-/// The GPU the view compiles for unless the page names one.
-pub const DEFAULT_GPU: &str = "sm_89";
 
 /// `GET /api/isa?lobe&n&gpu`: the lobe's and `pow`'s machine code for `gpu`.
 pub async fn isa(State(state): State<AppState>, query: QueryPairs) -> Result<Response, Response> {

@@ -32,11 +32,11 @@ mod volume;
 use std::net::SocketAddr;
 
 pub use api::{AppState, MAX_RENDER_SIZE};
+pub use api::{IsaModel, DEFAULT_GPU};
 pub use costs::{cpu_cost, CostModel, TargetCost, TargetRate};
 pub use design::{DesignModel, DesignQuery, DESIGN_TARGETS};
 pub use environment::{MAX_ENVIRONMENT_SIZE, MAX_ENVIRONMENT_SPP};
 pub use guard::{Hosts, CONCURRENT_COMPUTATIONS, QUEUED_COMPUTATIONS};
-pub use isa::{IsaModel, DEFAULT_GPU};
 pub use listen::{max_waiting, CONNECTION_TIMEOUT, HEADER_TIMEOUT, IDLE_TIMEOUT};
 pub use live::{sphere_radiance, MAX_LIVE_SIZE};
 pub use measured::{

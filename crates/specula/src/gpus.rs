@@ -1,6 +1,6 @@
 //! The GPUs specula costs lobes on, by their vendors' names, and what each generation executes
 //! per clock: the published rates that instructions are weighed by, whether a vendor's
-//! compiler wrote them (`specula-isa`) or the model counted them ([`crate::gpu_cost`]).
+//! compiler wrote them (`specula-isa`) or the model counted them (`gpu_cost`).
 
 use serde::Serialize;
 
