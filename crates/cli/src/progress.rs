@@ -3,6 +3,8 @@
 //! message the bar showed) with its time on stderr, written by a thread that watches the bar.
 
 use std::io::IsTerminal;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -16,15 +18,24 @@ pub fn bar(what: &'static str, len: u64, template: &str) -> Progress {
     let bar = ProgressBar::new(len).with_style(
         ProgressStyle::with_template(template).unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let watcher = (!std::io::stderr().is_terminal()).then(|| watch(what, &bar));
-    Progress { bar, watcher }
+    let dropped = Arc::new(AtomicBool::new(false));
+    let watcher =
+        (!std::io::stderr().is_terminal()).then(|| watch(what, &bar, Arc::clone(&dropped)));
+    Progress {
+        bar,
+        watcher,
+        dropped,
+    }
 }
 
-/// A progress bar and, without a terminal, the thread writing its lines; dropping it writes
-/// the last of them before the command's process can end.
+/// A progress bar and, without a terminal, the thread writing its lines. The last stage's
+/// line and the total are written when the command finishes the bar (`finish_and_clear`
+/// and the like); a bar dropped unfinished (the command failed) writes no more, so that a
+/// refusal stays one line.
 pub struct Progress {
     bar: ProgressBar,
     watcher: Option<std::thread::JoinHandle<()>>,
+    dropped: Arc<AtomicBool>,
 }
 
 impl std::ops::Deref for Progress {
@@ -37,9 +48,8 @@ impl std::ops::Deref for Progress {
 
 impl Drop for Progress {
     fn drop(&mut self) {
+        self.dropped.store(true, Ordering::Release);
         if let Some(watcher) = self.watcher.take() {
-            // Only where nothing is drawn: finishing tells the watcher to write its last line.
-            self.bar.finish();
             // A watcher that panicked has nothing more to write.
             let _ = watcher.join();
         }
@@ -47,8 +57,13 @@ impl Drop for Progress {
 }
 
 /// Prints a line for each stage of `bar` (a message it showed) when the next begins or the
-/// bar finishes, with the stage's time, then the whole time.
-fn watch(what: &'static str, bar: &ProgressBar) -> std::thread::JoinHandle<()> {
+/// bar finishes, with the stage's time, then the whole time; stops without a word once
+/// `dropped` is set while the bar is unfinished.
+fn watch(
+    what: &'static str,
+    bar: &ProgressBar,
+    dropped: Arc<AtomicBool>,
+) -> std::thread::JoinHandle<()> {
     let weak = bar.downgrade();
     std::thread::spawn(move || {
         let started = Instant::now();
@@ -61,7 +76,7 @@ fn watch(what: &'static str, bar: &ProgressBar) -> std::thread::JoinHandle<()> {
         };
         loop {
             std::thread::sleep(POLL);
-            let Some(bar) = weak.upgrade() else { break };
+            let Some(bar) = weak.upgrade() else { return };
             let message = bar.message();
             if message != stage {
                 finished_stage(&stage, stage_began);
@@ -69,6 +84,9 @@ fn watch(what: &'static str, bar: &ProgressBar) -> std::thread::JoinHandle<()> {
             }
             if bar.is_finished() {
                 break;
+            }
+            if dropped.load(Ordering::Acquire) {
+                return;
             }
         }
         finished_stage(&stage, stage_began);
