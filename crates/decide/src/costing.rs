@@ -410,7 +410,9 @@ pub fn lobe_rates(target: Target, lobes: &[Lobe]) -> Result<Vec<f64>, String> {
     let (costing, _) = Costing::new(target, None, &[])?;
     if let Costing::Gpu(gpu, GpuBasis::Compiled(_)) = &costing {
         // A failure is left for the lobes' own compiles, which name the one that fails.
-        let _ = specula_isa::compile_all(lobes, *gpu, Work::Lobe);
+        if let Ok(compiled) = specula_isa::compile_all(lobes, *gpu, Work::Lobe) {
+            return Ok(compiled.iter().map(|c| c.evals_per_clock().0).collect());
+        }
     }
     lobes.iter().map(|lobe| lobe_rate(target, lobe)).collect()
 }

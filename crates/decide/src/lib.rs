@@ -21,6 +21,7 @@ pub mod material;
 pub mod microfacet_cost;
 pub mod percent;
 mod pinned;
+mod ranking;
 pub mod rates;
 mod recommend;
 mod synthesis_plan;
@@ -30,9 +31,9 @@ pub use costing::{
     gpu_basis, lobe_rate, lobe_rates, modelled_rate, rate_unit, FPGA_MATERIAL_REFUSAL,
 };
 pub use hardware::{hardware_sweeps, sweeps};
+pub use ranking::{pareto_front, versus_pow};
 pub use recommend::{
-    pareto_front, recommend, recommend_each, recommend_each_cached, versus_pow, Candidate,
-    Recommendation, Request,
+    recommend, recommend_each, recommend_each_cached, Candidate, Recommendation, Request,
 };
 
 use specula::{Exponent, LobeKind};

@@ -150,6 +150,15 @@ impl Candidate {
     }
 }
 
+/// The candidates' lobes, named for a progress message.
+fn names<'c>(candidates: impl IntoIterator<Item = &'c Candidate>) -> String {
+    candidates
+        .into_iter()
+        .map(|c| c.kind.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// What the plan asks of the tools: synthesize designs side by side, then their rates.
 trait Synthesizer {
     /// Synthesizes those of `designs` not yet done.
@@ -315,16 +324,12 @@ fn decide(
         }
         let this_wave = &candidates[next..(next + wave).min(candidates.len())];
         next += this_wave.len();
-        progress.set_message(format!(
-            "synthesizing {} at their weakest n",
-            this_wave
-                .iter()
-                .map(|c| c.kind.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
         // The first wave is synthesized whole at once: nothing yet to fall short of.
         if best > 0.0 {
+            progress.set_message(format!(
+                "synthesizing {} at their weakest n",
+                names(this_wave)
+            ));
             let weakest: Vec<(HwLobe, u32)> = this_wave.iter().map(Candidate::weakest).collect();
             tools.run(&weakest);
             if tools.missing() > 0 {
@@ -347,11 +352,7 @@ fn decide(
         }
         progress.set_message(format!(
             "synthesizing {} at every n",
-            whole
-                .iter()
-                .map(|c| c.kind.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
+            names(whole.iter().copied())
         ));
         let designs: Vec<(HwLobe, u32)> = whole
             .iter()

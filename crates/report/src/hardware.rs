@@ -48,7 +48,6 @@ fn synthesized(
         OnMiss::Skip
     };
     let claim = claim::evaluate(sweeps, Cache::default_location().as_ref(), on_miss, &|| {});
-    let tools = specula_synth::ToolVersions::find(claim::CLAIM_TARGET).is_ok();
     let estimate = |lobe: HwLobe, bits: Option<u32>| -> String {
         let resources = bits.and_then(|bits| {
             sweeps
@@ -77,7 +76,11 @@ fn synthesized(
                 "the designs could not be synthesized here (see the notes on this machine)"
                     .to_owned()
             }
-            Ok(claim) if full && tools && !context.synthesize => {
+            Ok(claim)
+                if full
+                    && !context.synthesize
+                    && specula_synth::ToolVersions::find(claim::CLAIM_TARGET).is_ok() =>
+            {
                 // A full report's first pass: synthesized after the page is written.
                 let missing = claim
                     .designs

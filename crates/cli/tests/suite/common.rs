@@ -12,26 +12,35 @@ pub fn test_cache() -> std::path::PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join("specula-cache")
 }
 
+/// `specula` to run in `directory` with the suite's cache folder ([`test_cache`]); arguments
+/// and more of the environment are added before it runs.
+pub fn command(directory: &Path) -> Command {
+    let mut command = Command::cargo_bin("specula").expect("binary built");
+    command
+        .env("SPECULA_CACHE_DIR", test_cache())
+        .current_dir(directory);
+    command
+}
+
+/// Runs `command` and requires success, showing its stderr where it fails.
+pub fn succeeds(command: &mut Command) -> std::process::Output {
+    let output = command.output().expect("runs");
+    assert!(
+        output.status.success(),
+        "{command:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output
+}
+
 /// Runs `specula args` in `directory`.
 pub fn specula(directory: &Path, args: &[&str]) -> std::process::Output {
-    Command::cargo_bin("specula")
-        .expect("binary built")
-        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
-        .current_dir(directory)
-        .args(args)
-        .output()
-        .expect("runs")
+    command(directory).args(args).output().expect("runs")
 }
 
 /// Runs `specula args` in `directory` and requires success.
 pub fn ok(directory: &Path, args: &[&str]) -> std::process::Output {
-    let output = specula(directory, args);
-    assert!(
-        output.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    output
+    succeeds(command(directory).args(args))
 }
 
 /// Whether `tool` runs (`tool version_flag` succeeds). When it does not, a run with `CI=true`

@@ -6,7 +6,8 @@ use specula::LobeKind;
 
 use super::{verdict, verification_exponents, Design, DesignRequest, DesignedLobe};
 use crate::percent::flag_percent_above;
-use crate::recommend::{pareto_front, recommend, Candidate, Request, Standing};
+use crate::ranking::{pareto_front, Standing};
+use crate::recommend::{recommend, Candidate, Request};
 use crate::{sample_exponents, Zone};
 
 /// Ranks the searched lobes with the built-ins (and the request's other lobes) on the
@@ -102,7 +103,7 @@ pub(super) fn rank(
 /// Where the fastest designs' measured rates overlap, the most accurate of them first (as
 /// `recommend` breaks its ties), the tie recorded in that lobe's [`DesignedLobe::tied`].
 pub(super) fn break_tie(sorted: &mut [DesignedLobe]) {
-    let tie = crate::recommend::break_tie(sorted, |d| Standing {
+    let tie = crate::ranking::break_tie(sorted, |d| Standing {
         meets: d.meets,
         rate: d.rate,
         spread: d.spread,

@@ -3,7 +3,7 @@
 //! bound removed and the flag that admits it.
 
 use super::{percent, Design, DesignRequest};
-use crate::recommend::{rates_overlap, versus_pow};
+use crate::ranking::{rates_overlap, versus_pow};
 
 /// The answer in one line.
 pub(super) fn verdict(design: &Design, request: &DesignRequest) -> String {

@@ -24,19 +24,11 @@ fn the_quick_report_is_complete_and_well_formed() {
     let directory = tempfile::tempdir().unwrap();
     let d = directory.path();
     // The Python with the `vtk` wheel runs VTK for the medical section's comparison.
-    let output = assert_cmd::Command::cargo_bin("specula")
-        .expect("binary built")
-        .env("SPECULA_CACHE_DIR", crate::common::test_cache())
-        .current_dir(d)
-        .env("SPECULA_PYTHON", python())
-        .args(["report", "--quick", "--out", "out", "--materials"])
-        .arg(rgl())
-        .output()
-        .expect("runs");
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
+    common::succeeds(
+        common::command(d)
+            .env("SPECULA_PYTHON", python())
+            .args(["report", "--quick", "--out", "out", "--materials"])
+            .arg(rgl()),
     );
     let out = d.join("out");
     let page = std::fs::read_to_string(out.join("index.html")).unwrap();
@@ -458,18 +450,10 @@ fn installing_sollya_after_a_report_brings_the_limit_table() {
     std::fs::set_permissions(&script, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
     let path = std::env::var("PATH").unwrap_or_default();
     let report = |out: &str, path: String| {
-        let output = assert_cmd::Command::cargo_bin("specula")
-            .expect("binary built")
-            .env("SPECULA_CACHE_DIR", crate::common::test_cache())
-            .env("PATH", path)
-            .current_dir(d)
-            .args(["report", "--quick", "--out", out])
-            .output()
-            .expect("runs");
-        assert!(
-            output.status.success(),
-            "{}",
-            String::from_utf8_lossy(&output.stderr)
+        common::succeeds(
+            common::command(d)
+                .env("PATH", path)
+                .args(["report", "--quick", "--out", out]),
         );
         std::fs::read_to_string(d.join(out).join("index.html")).unwrap()
     };
