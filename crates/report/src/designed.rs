@@ -7,10 +7,9 @@
 //! `specula design --target cpu` on a quiet machine.
 
 use indicatif::ProgressBar;
-use rayon::prelude::*;
 use specula::{Exponent, LobeKind};
 use specula_decide::design::{
-    default_whole_error, design, percent, removed, Bounds, Design, DesignRequest,
+    default_whole_error, design_each, percent, removed, Bounds, Design, DesignRequest,
     DEFAULT_WHOLE_ERROR,
 };
 use specula_decide::{versus_pow, Target};
@@ -78,10 +77,11 @@ fn designed_now(context: &mut Context) -> Result<String, String> {
         .iter()
         .flat_map(|&(target, name)| bounds.iter().map(move |&b| (target, name, b)))
         .collect();
-    let answers: Vec<Design> = jobs
-        .par_iter()
-        .map(|&(target, _, bound)| design(&request(target, bound, &yours), &ProgressBar::hidden()))
-        .collect::<Result<_, _>>()?;
+    let requests: Vec<DesignRequest> = jobs
+        .iter()
+        .map(|&(target, _, bound)| request(target, bound, &yours))
+        .collect();
+    let answers: Vec<Design> = design_each(&requests, &ProgressBar::hidden())?;
     let verified = answers.first().map_or(0, |a| a.exponents_verified);
     let mut html = paragraph(&prose::fill(
         prose::DESIGNED,

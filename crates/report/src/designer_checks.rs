@@ -6,11 +6,10 @@
 //! prints).
 
 use indicatif::ProgressBar;
-use rayon::prelude::*;
 use specula::Exponent;
 use specula_decide::design::grammar::{self, Fate};
 use specula_decide::design::limit::limit_table;
-use specula_decide::design::thesis::{against_thesis, ThesisRow};
+use specula_decide::design::thesis::{against_thesis_each, ThesisRow};
 use specula_decide::design::{percent, Design};
 use specula_decide::Target;
 
@@ -67,10 +66,10 @@ pub(crate) fn thesis_table(
     (low, high): (f64, f64),
 ) -> Result<String, String> {
     let range = (Exponent::new(low), Exponent::new(high));
-    let answers: Vec<Vec<ThesisRow>> = families
-        .par_iter()
-        .map(|&(target, _)| against_thesis(target, None, range, &ProgressBar::hidden()))
-        .collect::<Result<_, _>>()?;
+    let targets: Vec<(Target, Option<specula::gpus::Gpu>)> =
+        families.iter().map(|&(target, _)| (target, None)).collect();
+    let answers: Vec<Vec<ThesisRow>> =
+        against_thesis_each(&targets, range, &ProgressBar::hidden())?;
     let mut html = paragraph(&format!(
         "Against the thesis: each of its lobes asks for the accuracy it reaches itself over n = \
          {low}..{high} (its largest epicentre error, and its largest whole-lobe error as the whole \

@@ -249,13 +249,72 @@ pub fn verification_exponents(low: Exponent, high: Exponent) -> Vec<Exponent> {
 /// ([`Cache::default_for`]`("design")`) where this build made it before.
 pub fn design(request: &DesignRequest, progress: &ProgressBar) -> Result<Design, String> {
     check(request)?;
-    // On the FPGA a lobe is a datapath compiled from its formula, which takes no
-    // transcendental (those are the built-in table units' work).
-    let request = &DesignRequest {
+    let request = &searched_as(request);
+    let searched = search(request, Cache::default_for("design").as_ref(), progress);
+    answer(request, searched, progress)
+}
+
+/// [`design`] for several requests at once, the answers in the requests' order: requests
+/// alike but for the target (the search does not see it) share one search, made once, so a
+/// page that asks every GPU for the same bound pays for one search, not one per vendor.
+/// `progress` counts the searches, then the answers.
+pub fn design_each(
+    requests: &[DesignRequest],
+    progress: &ProgressBar,
+) -> Result<Vec<Design>, String> {
+    for request in requests {
+        check(request)?;
+    }
+    let requests: Vec<DesignRequest> = requests.iter().map(searched_as).collect();
+    let keys: Vec<String> = requests.iter().map(cache::key).collect();
+    let mut distinct: Vec<usize> = Vec::new();
+    for (k, key) in keys.iter().enumerate() {
+        if !distinct.iter().any(|&d| keys[d] == *key) {
+            distinct.push(k);
+        }
+    }
+    let cache = Cache::default_for("design");
+    let hidden = ProgressBar::hidden();
+    progress.set_length((distinct.len() + requests.len()) as u64);
+    let searches: Vec<Vec<DesignedLobe>> = distinct
+        .par_iter()
+        .map(|&k| {
+            let searched = search(&requests[k], cache.as_ref(), &hidden);
+            progress.inc(1);
+            searched
+        })
+        .collect();
+    requests
+        .par_iter()
+        .zip(&keys)
+        .map(|(request, key)| {
+            let shared = distinct
+                .iter()
+                .position(|&d| keys[d] == *key)
+                .map(|position| searches[position].clone())
+                .unwrap_or_default();
+            let answered = answer(request, shared, &hidden);
+            progress.inc(1);
+            answered
+        })
+        .collect()
+}
+
+/// `request` as the search sees it: on the FPGA a lobe is a datapath compiled from its
+/// formula, which takes no transcendental (those are the built-in table units' work).
+fn searched_as(request: &DesignRequest) -> DesignRequest {
+    DesignRequest {
         no_transcendentals: request.no_transcendentals || request.target == Target::Fpga,
         ..request.clone()
-    };
-    let searched = search(request, Cache::default_for("design").as_ref(), progress);
+    }
+}
+
+/// The answer to `request` from its search: the families ranked on its target.
+fn answer(
+    request: &DesignRequest,
+    searched: Vec<DesignedLobe>,
+    progress: &ProgressBar,
+) -> Result<Design, String> {
     let enumerated = enumeration(request, &searched);
     let mut answer = rank(request, searched, progress)?;
     answer.enumerated = enumerated;

@@ -385,3 +385,24 @@ fn the_hinge_is_a_two_piece_select() {
         }
     }
 }
+
+/// Requests asked together answer as each asked alone: those alike but for the target share
+/// one search, and each is ranked on its own target.
+#[test]
+fn requests_asked_together_answer_as_each_asked_alone() {
+    let requests = [
+        request(Target::GpuAmd, 16.0, 128.0, 0.005, 0.01),
+        request(Target::GpuNvidia, 16.0, 128.0, 0.005, 0.01),
+        request(Target::GpuAmd, 16.0, 128.0, 0.005, 0.02),
+    ];
+    let together = design_each(&requests, &ProgressBar::hidden()).unwrap();
+    assert_eq!(together.len(), requests.len());
+    for (request, answer) in requests.iter().zip(&together) {
+        let alone = design(request, &ProgressBar::hidden()).unwrap();
+        assert_eq!(figures(&answer.designed), figures(&alone.designed));
+        let best = |d: &Design| d.best().map(|b| (b.name.clone(), b.rate.to_bits()));
+        assert_eq!(best(answer), best(&alone), "{}", request.target.id());
+        assert!(best(answer).is_some(), "a design meets 0.5 %");
+        assert_eq!(answer.pow_rate.to_bits(), alone.pow_rate.to_bits());
+    }
+}

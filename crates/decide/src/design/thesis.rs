@@ -12,7 +12,7 @@ use indicatif::ProgressBar;
 use serde::Serialize;
 use specula::{Exponent, Lobe, LobeKind};
 
-use super::{design, verification_exponents, Bounds, DesignRequest};
+use super::{design_each, verification_exponents, Bounds, DesignRequest};
 use crate::Target;
 
 /// The thesis's lobes: modified Schlick, its quadratic Chebyshev, log/exp and `K_4`.
@@ -62,66 +62,108 @@ fn errors(kind: LobeKind, exponents: &[Exponent]) -> Result<(f64, f64), String> 
     Ok((epicentre, whole))
 }
 
-/// Every thesis lobe on `target` over `range`, against the design at its accuracy.
+/// Every thesis lobe on `target` over `range`, against the design at its accuracy;
+/// `progress` counts the searches, then the answers.
 pub fn against_thesis(
     target: Target,
     gpu: Option<specula::gpus::Gpu>,
     range: (Exponent, Exponent),
     progress: &ProgressBar,
 ) -> Result<Vec<ThesisRow>, String> {
+    let mut rows = against_thesis_each(&[(target, gpu)], range, progress)?;
+    Ok(rows.pop().unwrap_or_default())
+}
+
+/// [`against_thesis`] on several targets at once, in their order: each thesis lobe's
+/// accuracy is one search whatever the target, made once ([`design_each`]).
+pub fn against_thesis_each(
+    targets: &[(Target, Option<specula::gpus::Gpu>)],
+    range: (Exponent, Exponent),
+    progress: &ProgressBar,
+) -> Result<Vec<Vec<ThesisRow>>, String> {
     let exponents = verification_exponents(range.0, range.1);
-    let mut rows = Vec::new();
-    for kind in thesis_lobes() {
-        let (epicentre, whole) = errors(kind, &exponents)?;
-        // Its own errors must meet the bounds they set: a hair above, against rounding.
-        let bound = (epicentre * (1.0 + 1e-9)).min(1.0);
-        let request = DesignRequest {
-            target,
-            gpu,
-            range,
-            bounds: Bounds {
-                epicentre: bound,
-                whole: (whole * (1.0 + 1e-9)).max(bound).min(1.0),
-                energy: None,
-            },
-            no_transcendentals: false,
-            also: vec![kind],
-            max_operations: crate::design::grammar::default_max_operations(target),
-        };
-        let answer = design(&request, progress)?;
-        let thesis = answer
-            .compared
-            .iter()
-            .find(|c| c.lobe == kind.to_string())
-            .ok_or_else(|| format!("{kind} was not ranked on {}", target.id()))?;
-        let designed = answer.best();
-        let built_in = answer.best_compared();
-        let row = match (designed, built_in) {
-            (Some(d), Some(c)) if d.rate <= c.rate => {
-                (c.lobe.clone(), formula_of(&c.lobe), c.rate, false)
-            }
-            (Some(d), _) => (d.name.clone(), d.formula.clone(), d.rate, true),
-            (None, Some(c)) => (c.lobe.clone(), formula_of(&c.lobe), c.rate, false),
-            (None, None) => (
-                kind.to_string(),
-                formula_of(&kind.to_string()),
-                thesis.rate,
-                false,
-            ),
-        };
-        rows.push(ThesisRow {
-            thesis: kind.to_string(),
-            thesis_formula: kind.info().formula.to_owned(),
-            epicentre_error: epicentre,
-            whole_error: whole,
-            thesis_rate: thesis.rate,
-            answer: row.0,
-            answer_formula: row.1,
-            answer_rate: row.2,
-            designed: row.3,
-        });
-    }
-    Ok(rows)
+    let accuracies = thesis_lobes()
+        .into_iter()
+        .map(|kind| Ok((kind, errors(kind, &exponents)?)))
+        .collect::<Result<Vec<_>, String>>()?;
+    let requests: Vec<DesignRequest> = targets
+        .iter()
+        .flat_map(|&(target, gpu)| {
+            accuracies.iter().map(move |&(kind, (epicentre, whole))| {
+                // Its own errors must meet the bounds they set: a hair above, against
+                // rounding.
+                let bound = (epicentre * (1.0 + 1e-9)).min(1.0);
+                DesignRequest {
+                    target,
+                    gpu,
+                    range,
+                    bounds: Bounds {
+                        epicentre: bound,
+                        whole: (whole * (1.0 + 1e-9)).max(bound).min(1.0),
+                        energy: None,
+                    },
+                    no_transcendentals: false,
+                    also: vec![kind],
+                    max_operations: crate::design::grammar::default_max_operations(target),
+                }
+            })
+        })
+        .collect();
+    let answers = design_each(&requests, progress)?;
+    answers
+        .chunks(accuracies.len().max(1))
+        .zip(targets)
+        .map(|(answers, &(target, _))| {
+            answers
+                .iter()
+                .zip(&accuracies)
+                .map(|(answer, &(kind, (epicentre, whole)))| {
+                    row(answer, kind, epicentre, whole, target)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// One thesis lobe's row from the answer at its accuracy.
+fn row(
+    answer: &super::Design,
+    kind: LobeKind,
+    epicentre: f64,
+    whole: f64,
+    target: Target,
+) -> Result<ThesisRow, String> {
+    let thesis = answer
+        .compared
+        .iter()
+        .find(|c| c.lobe == kind.to_string())
+        .ok_or_else(|| format!("{kind} was not ranked on {}", target.id()))?;
+    let designed = answer.best();
+    let built_in = answer.best_compared();
+    let row = match (designed, built_in) {
+        (Some(d), Some(c)) if d.rate <= c.rate => {
+            (c.lobe.clone(), formula_of(&c.lobe), c.rate, false)
+        }
+        (Some(d), _) => (d.name.clone(), d.formula.clone(), d.rate, true),
+        (None, Some(c)) => (c.lobe.clone(), formula_of(&c.lobe), c.rate, false),
+        (None, None) => (
+            kind.to_string(),
+            formula_of(&kind.to_string()),
+            thesis.rate,
+            false,
+        ),
+    };
+    Ok(ThesisRow {
+        thesis: kind.to_string(),
+        thesis_formula: kind.info().formula.to_owned(),
+        epicentre_error: epicentre,
+        whole_error: whole,
+        thesis_rate: thesis.rate,
+        answer: row.0,
+        answer_formula: row.1,
+        answer_rate: row.2,
+        designed: row.3,
+    })
 }
 
 /// A built-in's formula from its id (the id itself for a lobe not in the registry).

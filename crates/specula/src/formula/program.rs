@@ -196,13 +196,15 @@ pub(crate) struct Leaves<'a, R> {
 /// Runs `tape`; its result.
 ///
 /// A lobe's scalar path runs this per evaluation (per sample of a volume, per path of an
-/// environment render), so tapes of the usual size keep their values on the stack.
+/// environment render, per point of an accuracy check), so tapes of the usual size keep
+/// their values on the stack, in the smallest of a few sizes: the buffer is filled before
+/// the run, and filling 64 entries for a tape of 10 took longer than the tape.
 pub(crate) fn run<R: Real>(tape: &[Op], leaves: &Leaves<'_, R>) -> R {
-    const ON_STACK: usize = 64;
-    if tape.len() <= ON_STACK {
-        run_in(tape, leaves, &mut [leaves.t; ON_STACK])
-    } else {
-        run_in(tape, leaves, &mut vec![leaves.t; tape.len()])
+    match tape.len() {
+        0..=16 => run_in(tape, leaves, &mut [leaves.t; 16]),
+        17..=32 => run_in(tape, leaves, &mut [leaves.t; 32]),
+        33..=64 => run_in(tape, leaves, &mut [leaves.t; 64]),
+        _ => run_in(tape, leaves, &mut vec![leaves.t; tape.len()]),
     }
 }
 
