@@ -56,8 +56,19 @@ impl Distribution {
     /// `kind` at `n` as a normal distribution.
     #[must_use]
     pub fn lobe(kind: LobeKind, n: Exponent) -> Self {
+        Self::lobe_within(kind, n, tabulated::TOLERANCE)
+    }
+
+    /// [`Distribution::lobe`] with its normalisation and `Lambda` integrated to within
+    /// `tolerance` ([`Tabulated::with_tolerance`]).
+    #[must_use]
+    pub fn lobe_within(kind: LobeKind, n: Exponent, tolerance: f64) -> Self {
         let lobe = Lobe::new(kind, n);
-        let table = Tabulated::new(move |c| lobe.eval(c), tabulated::lobe_width(n.get()));
+        let table = Tabulated::with_tolerance(
+            move |c| lobe.eval(c),
+            tabulated::lobe_width(n.get()),
+            tolerance,
+        );
         Self::Lobe {
             lobe,
             table: Arc::new(table),

@@ -24,8 +24,10 @@ use crate::quadrature::integrate_pieces;
 /// Angles `theta_o` in `[0, pi/2]` at which `Lambda` is tabulated.
 pub const ANGLES: usize = 257;
 
-/// The `theta_m` integrals' absolute tolerance (adaptive Gauss-Kronrod).
-const TOLERANCE: f64 = 1e-8;
+/// The `theta_m` integrals' absolute tolerance (adaptive Gauss-Kronrod): `Lambda` to a few
+/// parts in a million at 88 degrees, where it is largest and Smith's slope-space integral
+/// is held against it.
+pub const TOLERANCE: f64 = 1e-8;
 
 /// Points of the sampling table over `theta_h`.
 const SAMPLING_POINTS: usize = 4096;
@@ -66,6 +68,18 @@ impl Tabulated {
     /// the angle its peak spans (radians).
     #[must_use]
     pub fn new(shape: impl Fn(f64) -> f64 + Send + Sync + 'static, width: f64) -> Self {
+        Self::with_tolerance(shape, width, TOLERANCE)
+    }
+
+    /// [`Tabulated::new`] with its integrals to within `tolerance` rather than
+    /// [`TOLERANCE`]: a search that only compares distributions near each other (a fit's)
+    /// takes them looser and faster.
+    #[must_use]
+    pub fn with_tolerance(
+        shape: impl Fn(f64) -> f64 + Send + Sync + 'static,
+        width: f64,
+        tolerance: f64,
+    ) -> Self {
         let points = breakpoints(width);
         // The projected area splits at `theta_m = pi / 2 - theta_o`: below it every microfacet
         // faces `wo` (`b >= a`), and the azimuthal integral is `2 pi cos theta_o cos theta_m`,
@@ -85,7 +99,7 @@ impl Tabulated {
         let mut below = Vec::with_capacity(cuts.len());
         let mut running = 0.0;
         below.push(0.0);
-        let piece_tolerance = TOLERANCE / cuts.len() as f64;
+        let piece_tolerance = tolerance / cuts.len() as f64;
         for pair in cuts.windows(2) {
             running += integrate_pieces(area_density, pair, piece_tolerance);
             below.push(running);
@@ -111,7 +125,7 @@ impl Tabulated {
                         shape(c) * s * azimuthal(sin_o * s, cos_o * c)
                     },
                     &beyond,
-                    TOLERANCE,
+                    tolerance,
                 );
                 normaliser * (facing + seen_edge_on)
             })

@@ -4,6 +4,7 @@
 //! Gauss-Newton steps on the cube-root error (see the module page of `fit`).
 
 use core::f64::consts::FRAC_1_PI;
+use core::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
 
@@ -29,6 +30,9 @@ pub(super) struct Prepared<'a> {
     pub(super) target: [Vec<f64>; 3],
     /// Per channel, the weight that linearises the cube root at the data.
     pub(super) linearised: [Vec<f64>; 3],
+    /// Observations evaluated so far (each pass of [`Prepared::cost`] or [`Prepared::step`]
+    /// counts them all): the work a fit did, which its time is judged by.
+    pub(super) evaluations: AtomicU64,
 }
 
 /// A direction pair as every microfacet term sees it.
@@ -205,6 +209,7 @@ impl<'a> Prepared<'a> {
             weight: &observations.weight,
             target: [channel(0), channel(1), channel(2)],
             linearised: [linearised(0), linearised(1), linearised(2)],
+            evaluations: AtomicU64::new(0),
         }
     }
 
@@ -236,7 +241,14 @@ impl<'a> Prepared<'a> {
     /// [`Prepared::step`], so both run on the widest vectors the CPU has (`pulp` picks AVX-512
     /// or AVX2 and compiles the loop for it): eight lanes of running sums and a cube root
     /// without branches.
-    fn cost(&self, c: usize, rows: &Rows, x: &[f64; MAX_COEFFICIENTS], roots: &mut [f64]) -> f64 {
+    pub(super) fn cost(
+        &self,
+        c: usize,
+        rows: &Rows,
+        x: &[f64; MAX_COEFFICIENTS],
+        roots: &mut [f64],
+    ) -> f64 {
+        self.count_pass();
         struct Cost<'a> {
             columns: &'a [Vec<f64>; MAX_COEFFICIENTS],
             target: &'a [f64],
@@ -264,6 +276,7 @@ impl<'a> Prepared<'a> {
     /// the root's slope (bounded where the model vanishes), weighted, against the residual.
     /// Run as [`Prepared::cost`] is.
     fn step(&self, c: usize, rows: &Rows, roots: &[f64]) -> Quadratic {
+        self.count_pass();
         struct Step<'a> {
             columns: &'a [Vec<f64>; MAX_COEFFICIENTS],
             target: &'a [f64],
@@ -288,6 +301,16 @@ impl<'a> Prepared<'a> {
         step.normal = [[n00, n01, n02], [0.0, n11, n12], [0.0, 0.0, n22]];
         step.rhs = [r0, r1, r2];
         step
+    }
+
+    fn count_pass(&self) {
+        self.evaluations
+            .fetch_add(self.cosine.len() as u64, Ordering::Relaxed);
+    }
+
+    /// [`Prepared::step`] alone, for the peak rate (its system is not needed).
+    pub(super) fn step_sums(&self, c: usize, rows: &Rows, roots: &[f64]) {
+        let _ = self.step(c, rows, roots);
     }
 
     /// The best coefficients `>= 0` of channel `c` for the specular columns of `rows`:

@@ -164,6 +164,11 @@ impl Specular {
     /// distribution of normals.
     #[must_use]
     pub fn shape(self, parameter: f64) -> Shape {
+        self.shape_for(parameter, Stage::Answer)
+    }
+
+    /// [`Specular::shape`], its lobe distributions' tables made as `stage` needs them.
+    fn shape_for(self, parameter: f64, stage: Stage) -> Shape {
         let exponent = Exponent::clamped(parameter);
         match self {
             Specular::Lobe { kind, geometry } => Shape::Lobe {
@@ -179,7 +184,7 @@ impl Specular {
             } => Shape::Microfacet(Distribution::Beckmann { alpha: parameter }),
             Specular::Microfacet {
                 normals: Normals::Lobe(kind),
-            } => Shape::Microfacet(Distribution::lobe(kind, exponent)),
+            } => Shape::Microfacet(Distribution::lobe_within(kind, exponent, stage.tolerance())),
         }
     }
 
@@ -195,8 +200,8 @@ impl Specular {
     /// The specular term's columns per unit coefficient at every observation (without the
     /// cosine): the lobe, or `D G2 / (4 cos_o cos_i)`; with Fresnel, that term and the same
     /// times Schlick's `(1 - wo.h)^5`, the model being `K F0 M + K (1 - F0) M S`.
-    fn columns(self, parameter: f64, observations: &Prepared) -> Vec<Vec<f64>> {
-        let distribution = match self.shape(parameter) {
+    fn columns(self, parameter: f64, observations: &Prepared, stage: Stage) -> Vec<Vec<f64>> {
+        let distribution = match self.shape_for(parameter, stage) {
             Shape::Lobe { lobe, geometry } => {
                 let t = match geometry {
                     Geometry::Phong => &observations.t_phong,
@@ -229,6 +234,28 @@ impl Specular {
             .map(|(pair, m)| m * pair.schlick)
             .collect();
         vec![term, schlick]
+    }
+}
+
+/// What a fit evaluates a family for: comparing parameters in its search, or the answer at
+/// the parameter found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stage {
+    /// The lobe distributions' `Lambda` tables to `1e-6`, where [`Distribution::lobe`]'s
+    /// are to `1e-8`: near one another the profile over `ln n` is the same to about `1e-7`
+    /// of the error (every bundled material's fits agree with the exact tables' to 4e-7), and
+    /// the tables take a third less time, most of a microfacet fit's.
+    Search,
+    /// The exact tables: the reported error and coefficients are the answer's own.
+    Answer,
+}
+
+impl Stage {
+    fn tolerance(self) -> f64 {
+        match self {
+            Stage::Search => 1e-6,
+            Stage::Answer => crate::microfacet::tabulated::TOLERANCE,
+        }
     }
 }
 
@@ -456,9 +483,42 @@ pub fn fit_all(observations: &Observations, kinds: &[LobeKind]) -> Vec<Fit> {
 /// Each of `families`, shared and per channel, fitted in parallel, in that order.
 #[must_use]
 pub fn fit_families(observations: &Observations, families: &[Specular]) -> Vec<Fit> {
+    fit_families_counted(observations, families).0
+}
+
+/// [`fit_families`] and the observation evaluations it made: every pass of the solver over
+/// the observations counts them all, which the benches divide by the time taken and hold
+/// against [`evaluation_peak`].
+#[must_use]
+pub fn fit_families_counted(observations: &Observations, families: &[Specular]) -> (Vec<Fit>, u64) {
     let prepared = Prepared::new(observations);
-    families
+    let fits = families
         .par_iter()
         .flat_map_iter(|&specular| fit_family(&prepared, specular))
-        .collect()
+        .collect();
+    (fits, prepared.evaluations.into_inner())
+}
+
+/// The observation evaluations per second one thread reaches in the solver's two passes
+/// when it does nothing else (the cost with its cube roots, then the Gauss-Newton sums, over
+/// every observation at `pow`'s Phong rows for `n = 64`), for about `seconds`: the most a fit
+/// could make of this machine's vector units, against which its own rate is read.
+#[must_use]
+pub fn evaluation_peak(observations: &Observations, seconds: f64) -> f64 {
+    let prepared = Prepared::new(observations);
+    let specular = Specular::Lobe {
+        kind: LobeKind::Pow,
+        geometry: Geometry::Phong,
+    };
+    let rows = prepared.rows(&specular.columns(64.0, &prepared, Stage::Answer));
+    let mut roots = vec![0.0; observations.weight.len()];
+    let x = [0.05, 0.5, 0.0];
+    let start = std::time::Instant::now();
+    while start.elapsed().as_secs_f64() < seconds {
+        for _ in 0..16 {
+            core::hint::black_box(prepared.cost(0, &rows, core::hint::black_box(&x), &mut roots));
+            prepared.step_sums(0, &rows, &roots);
+        }
+    }
+    prepared.evaluations.into_inner() as f64 / start.elapsed().as_secs_f64()
 }

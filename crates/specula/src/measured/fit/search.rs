@@ -6,7 +6,7 @@ use argmin::core::{CostFunction, Executor};
 use argmin::solver::brent::BrentOpt;
 
 use super::channel::{Prepared, MAX_COEFFICIENTS};
-use super::{Fit, Observations, Sharing, Specular, GRID_POINTS};
+use super::{Fit, Observations, Sharing, Specular, Stage, GRID_POINTS};
 
 /// A channel's coefficients (`kd`, then the specular columns') and its error sum.
 type Solution = ([f64; MAX_COEFFICIENTS], f64);
@@ -23,8 +23,10 @@ struct Profile<'p, 'a> {
 }
 
 impl Profile<'_, '_> {
-    fn solve(&self, log_parameter: f64) -> (Vec<Solution>, f64) {
-        let columns = self.specular.columns(log_parameter.exp(), self.prepared);
+    fn solve(&self, log_parameter: f64, stage: Stage) -> (Vec<Solution>, f64) {
+        let columns = self
+            .specular
+            .columns(log_parameter.exp(), self.prepared, stage);
         let rows = self.prepared.rows(&columns);
         let last = self.last.borrow().clone();
         let solutions: Vec<Solution> = self
@@ -47,7 +49,7 @@ impl CostFunction for Profile<'_, '_> {
     type Output = f64;
 
     fn cost(&self, log_parameter: &f64) -> Result<f64, argmin::core::Error> {
-        Ok(self.solve(*log_parameter).1)
+        Ok(self.solve(*log_parameter, Stage::Search).1)
     }
 }
 
@@ -63,7 +65,7 @@ fn scan(prepared: &Prepared, specular: Specular) -> (Vec<f64>, Vec<[f64; 3]>) {
     let costs = grid
         .iter()
         .map(|&p| {
-            let rows = prepared.rows(&specular.columns(p.exp(), prepared));
+            let rows = prepared.rows(&specular.columns(p.exp(), prepared, Stage::Search));
             let solved: [Solution; 3] = core::array::from_fn(|c| {
                 prepared.solve_channel(c, &rows, last.as_ref().map(|last| &last[c].0))
             });
@@ -170,7 +172,7 @@ pub(super) fn fit_family(prepared: &Prepared, specular: Specular) -> [Fit; 2] {
     };
     let all = profile(&[0, 1, 2]);
     let shared = minimise(&all, &grid, &costs);
-    let at_shared = all.solve(shared).0;
+    let at_shared = all.solve(shared, Stage::Answer).0;
     let shared_solutions = [at_shared[0], at_shared[1], at_shared[2]];
     // Each channel from its own scan, or from the shared optimum where that is better (a
     // second start: a channel's scan can bracket another basin than the sum's).
@@ -179,7 +181,7 @@ pub(super) fn fit_family(prepared: &Prepared, specular: Specular) -> [Fit; 2] {
     for (c, channel) in [[0], [1], [2]].iter().enumerate() {
         let own = profile(channel);
         let best = minimise(&own, &grid, &costs);
-        let (solved, cost) = own.solve(best);
+        let (solved, cost) = own.solve(best, Stage::Answer);
         if cost < solutions[c].1 {
             (parameter[c], solutions[c]) = (best, solved[0]);
         }
