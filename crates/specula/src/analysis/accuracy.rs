@@ -63,7 +63,7 @@ impl Evaluator for Precision {
 
     fn evaluate(&mut self, lobe: &Lobe, cosines: &[f64]) -> Vec<f64> {
         match self {
-            Precision::F64 => cosines.iter().map(|&t| lobe.eval(t)).collect(),
+            Precision::F64 => lobe.eval_each(cosines),
             Precision::F32 => cosines
                 .iter()
                 .map(|&t| f64::from(lobe.eval(t as f32)))

@@ -342,6 +342,12 @@ impl Formula {
         self.run_tape(&self.body, t, slots)
     }
 
+    /// [`Formula::raw`] in `f64` at each of `ts`, into `out` (as long).
+    pub(crate) fn raw_each(&self, ts: &[f64], slots: &[f64; MAX_SLOTS], out: &mut [f64]) {
+        let slot = |s: usize| <f64 as crate::Real>::parameter(self.slot_names[s], slots[s]);
+        program::run_each(&self.body, ts, &slot, out);
+    }
+
     /// The tail as written, at `t`.
     pub(crate) fn tail<R: crate::Real>(&self, t: R, slots: &[f64; MAX_SLOTS]) -> Option<R> {
         Some(self.run_tape(self.tail.as_ref()?, t, slots))

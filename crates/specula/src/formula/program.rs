@@ -223,6 +223,66 @@ fn run_in<R: Real>(tape: &[Op], leaves: &Leaves<'_, R>, values: &mut [R]) -> R {
     values[tape.len() - 1]
 }
 
+/// [`run`] in `f64` over many `ts` at once (`out` as long), `slot(s)` each slot's value:
+/// each operation over a chunk of lanes before the next, so the tape is walked once a chunk
+/// rather than once a value, and the arithmetic runs as vector loops. Every lane computes
+/// what [`run`] computes for its `t`, operation for operation (the same [`Real`] methods), so
+/// the values agree to the bit. An analysis that scans a lobe over thousands of cosines (a
+/// design's verification) takes this path.
+pub(crate) fn run_each(tape: &[Op], ts: &[f64], slot: &dyn Fn(usize) -> f64, out: &mut [f64]) {
+    const LANES: usize = 64;
+    let Some(last) = tape.len().checked_sub(1) else {
+        return;
+    };
+    let mut values = vec![[0.0_f64; LANES]; tape.len()];
+    for (ts, out) in ts.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        let count = ts.len();
+        for (index, &op) in tape.iter().enumerate() {
+            let (before, rest) = values.split_at_mut(index);
+            let value = &mut rest[0];
+            let lanes = |operand: usize| &before[operand];
+            // Lanes past `count` hold what earlier chunks left: computed and never read.
+            match op {
+                Op::T | Op::N => value[..count].copy_from_slice(ts),
+                Op::Param(_) => unreachable!("parameters reach a formula as slots"),
+                Op::Slot(s) => value.fill(slot(s)),
+                Op::Const(c) => value.fill(c),
+                Op::Add(a, b) => lanewise(value, lanes(a), lanes(b), |x, y| x + y),
+                Op::Sub(a, b) => lanewise(value, lanes(a), lanes(b), |x, y| x - y),
+                Op::Mul(a, b) => lanewise(value, lanes(a), lanes(b), |x, y| x * y),
+                Op::Div(a, b) => lanewise(value, lanes(a), lanes(b), |x, y| x / y),
+                Op::Min(a, b) => lanewise(value, lanes(a), lanes(b), Real::min),
+                Op::Max(a, b) => lanewise(value, lanes(a), lanes(b), Real::max),
+                Op::Powi(a, k) => {
+                    let x = lanes(a);
+                    for lane in 0..LANES {
+                        value[lane] = powi(x[lane], k);
+                    }
+                }
+                op => {
+                    for lane in 0..count {
+                        value[lane] = apply(op, |operand| before[operand][lane]);
+                    }
+                }
+            }
+        }
+        out.copy_from_slice(&values[last][..count]);
+    }
+}
+
+/// `value[k] = f(a[k], b[k])` for every lane.
+#[inline(always)]
+fn lanewise<const L: usize>(
+    value: &mut [f64; L],
+    a: &[f64; L],
+    b: &[f64; L],
+    f: impl Fn(f64, f64) -> f64,
+) {
+    for lane in 0..L {
+        value[lane] = f(a[lane], b[lane]);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -410,3 +410,43 @@ fn operations_count_what_an_evaluation_multiplies() {
     assert_eq!(count("let s = n / 16;\nmax(0, 1 - s * (1 - t)) ^ 16"), 8);
     assert_eq!(count("pow(t, n)"), 3);
 }
+
+/// A formula lobe evaluated over many cosines at once (the tape walked per chunk of lanes)
+/// gives what it gives one cosine at a time, to the bit: formulas using every operation, with
+/// slots, selects and integer powers, over cosines inside `(0, 1]` and the shared rules'
+/// edges (0, negatives, NaN, above 1), more of them than one chunk holds.
+#[test]
+fn a_lobe_over_many_cosines_is_the_lobe_at_each() {
+    let formulas = [
+        ("each-k4", K4),
+        (
+            "each-ops",
+            "let a = sqrt(t) * log2(t + 1) + exp2(t) - exp(-t) + log(t + 2);\n\
+             let b = acos(t) + cos(t) * sin(t) + abs(t - 0.5) + floor(4 * t) / 4 + ceil(t);\n\
+             min(1, max(0, (a * b) / (n + 3) + t ^ 2.5 + t ^ 7 - t ^ (n / 9)))",
+        ),
+        (
+            "each-select",
+            "let s = 1 - 2 * (1 - t) * (n + 2) / 8;\nselect(s < 0.25, mix(0, clamp(s, 0, 1), 0.5), clamp(s, 0, 1) ^ 8)",
+        ),
+    ];
+    let mut ts: Vec<f64> = (0..=1500)
+        .map(|i| 1.0 - (f64::from(i) / 1500.0).powi(3))
+        .collect();
+    ts.extend([0.0, -0.0, -1.0, f64::NAN, 1.5, f64::INFINITY, 1e-300, 0.5]);
+    for (name, text) in formulas {
+        let kind = kind_of(definition(name, text));
+        for n in [1.0, 7.5, 64.0, 1000.0] {
+            let lobe = Lobe::checked(kind, Exponent::new(n)).unwrap();
+            let each = lobe.eval_each(&ts);
+            assert_eq!(each.len(), ts.len());
+            for (&t, value) in ts.iter().zip(&each) {
+                assert_eq!(
+                    value.to_bits(),
+                    lobe.eval(t).to_bits(),
+                    "{name} n = {n} t = {t}"
+                );
+            }
+        }
+    }
+}

@@ -55,6 +55,14 @@ impl FormulaLobe {
         value.max(R::from_f64(0.0)).min(R::from_f64(1.0))
     }
 
+    /// [`FormulaLobe::eval`] at each of `ts` (each in `(0, 1]`), into `out` (as long).
+    pub(crate) fn eval_each(&self, ts: &[f64], out: &mut [f64]) {
+        self.instance.formula().raw_each(ts, &self.slots, out);
+        for value in out.iter_mut() {
+            *value = Real::min(Real::max(*value, 0.0), 1.0);
+        }
+    }
+
     /// `int_t^1 lobe`, from the formula's tail.
     pub(crate) fn tail<R: Real>(&self, t: R) -> Option<R> {
         self.instance.formula().tail(t, &self.slots)

@@ -250,6 +250,30 @@ impl Lobe {
         with_shared_rules(t, |unit| self.eval_unit(unit))
     }
 
+    /// [`Lobe::eval`] in `f64` at each of `ts`, the same values to the bit: a formula lobe
+    /// runs its tape over all of them at once ([`crate::formula`]), which an analysis that
+    /// scans a lobe over thousands of cosines needs; the others evaluate one by one.
+    #[must_use]
+    pub fn eval_each(&self, ts: &[f64]) -> Vec<f64> {
+        let Model::Formula(formula) = &self.model else {
+            return ts.iter().map(|&t| self.eval(t)).collect();
+        };
+        // The shared rules around the batch: the formula sees `t` in (0, 1] only (1 where
+        // the rules answer 0 without it), and `t <= 0` or NaN is 0.
+        let units: Vec<f64> = ts
+            .iter()
+            .map(|&t| if t > 0.0 { t.min(1.0) } else { 1.0 })
+            .collect();
+        let mut values = vec![0.0; ts.len()];
+        formula.eval_each(&units, &mut values);
+        for (value, &t) in values.iter_mut().zip(ts) {
+            if t.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+                *value = 0.0;
+            }
+        }
+        values
+    }
+
     /// The model's own formula, for `t` in `(0, 1]` (what [`Lobe::expression`] records).
     #[inline]
     pub(crate) fn eval_unit<R: Real>(&self, t: R) -> R {
