@@ -276,6 +276,11 @@ pub fn design_each(
     let cache = Cache::default_for("design");
     let hidden = ProgressBar::hidden();
     progress.set_length((distinct.len() + requests.len()) as u64);
+    progress.set_message(format!(
+        "fitting and verifying the families for {} distinct request{}",
+        distinct.len(),
+        if distinct.len() == 1 { "" } else { "s" }
+    ));
     let searches: Vec<Vec<DesignedLobe>> = distinct
         .par_iter()
         .map(|&k| {
@@ -284,6 +289,7 @@ pub fn design_each(
             searched
         })
         .collect();
+    progress.set_message("costing the lobes on each target");
     requests
         .par_iter()
         .zip(&keys)

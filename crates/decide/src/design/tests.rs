@@ -395,8 +395,12 @@ fn requests_asked_together_answer_as_each_asked_alone() {
         request(Target::GpuNvidia, 16.0, 128.0, 0.005, 0.01),
         request(Target::GpuAmd, 16.0, 128.0, 0.005, 0.02),
     ];
-    let together = design_each(&requests, &ProgressBar::hidden()).unwrap();
+    let progress = ProgressBar::hidden();
+    let together = design_each(&requests, &progress).unwrap();
     assert_eq!(together.len(), requests.len());
+    // Two searches (the first two requests differ only in the target), three answers.
+    assert_eq!(progress.length(), Some(5));
+    assert_eq!(progress.position(), 5);
     for (request, answer) in requests.iter().zip(&together) {
         let alone = design(request, &ProgressBar::hidden()).unwrap();
         assert_eq!(figures(&answer.designed), figures(&alone.designed));

@@ -231,6 +231,7 @@ fn run_in<R: Real>(tape: &[Op], leaves: &Leaves<'_, R>, values: &mut [R]) -> R {
 /// design's verification) takes this path.
 pub(crate) fn run_each(tape: &[Op], ts: &[f64], slot: &dyn Fn(usize) -> f64, out: &mut [f64]) {
     const LANES: usize = 64;
+    assert_eq!(ts.len(), out.len(), "one output per cosine");
     let Some(last) = tape.len().checked_sub(1) else {
         return;
     };
@@ -243,6 +244,8 @@ pub(crate) fn run_each(tape: &[Op], ts: &[f64], slot: &dyn Fn(usize) -> f64, out
             let lanes = |operand: usize| &before[operand];
             // Lanes past `count` hold what earlier chunks left: computed and never read.
             match op {
+                // `n` reaches a formula's body as a slot; the leaf stands for `t` as in
+                // `Formula::run_tape`'s scalar leaves.
                 Op::T | Op::N => value[..count].copy_from_slice(ts),
                 Op::Param(_) => unreachable!("parameters reach a formula as slots"),
                 Op::Slot(s) => value.fill(slot(s)),

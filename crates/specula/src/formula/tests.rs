@@ -427,7 +427,8 @@ fn a_lobe_over_many_cosines_is_the_lobe_at_each() {
         ),
         (
             "each-select",
-            "let s = 1 - 2 * (1 - t) * (n + 2) / 8;\nselect(s < 0.25, mix(0, clamp(s, 0, 1), 0.5), clamp(s, 0, 1) ^ 8)",
+            "let s = 1 - 2 * (1 - t) * (n + 2) / 8;\n\
+             select(s < 0.25, mix(0, clamp(s, 0, 1), 0.5), clamp(s, 0, 1) ^ 8)",
         ),
     ];
     let mut ts: Vec<f64> = (0..=1500)

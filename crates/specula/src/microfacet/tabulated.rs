@@ -71,7 +71,8 @@ impl Tabulated {
         Self::with_tolerance(shape, width, TOLERANCE)
     }
 
-    /// [`Tabulated::new`] with its integrals to within `tolerance` rather than
+    /// [`Tabulated::new`] with its integrals to within `tolerance` (positive; 0 refines
+    /// until [`crate::quadrature::MAX_PANELS`]) rather than
     /// [`TOLERANCE`]: a search that only compares distributions near each other (a fit's)
     /// takes them looser and faster.
     #[must_use]

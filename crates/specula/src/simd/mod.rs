@@ -9,9 +9,9 @@
 //!
 //! Levels ([`Level`]), chosen at run time:
 //! - [`Level::Avx2`]: 8 lanes, AVX2 + FMA, through `pulp`'s safe intrinsics. CPUs with
-//!   AVX-512 run these kernels too: no AVX-512 machine was available to test 16-lane kernels
-//!   on, and `pulp` 0.22's `truncate_f32x16` rounds as `f64` lanes, so its V4 wrappers were
-//!   not trusted untested.
+//!   AVX-512 run these kernels too: `pulp` 0.22's `truncate_f32x16` rounds as `f64` lanes,
+//!   so its V4 wrappers are not trusted for the lobes' `f32` kernels (the material fit's
+//!   `f64` sums, auto-vectorised, take AVX-512 through `pulp::Arch`).
 //! - [`Level::Baseline`]: the same kernels over one-lane [`Scalar`](scalar::Scalar) values
 //!   with unfused multiply-adds, compiled for the target's baseline (SSE2 on x86-64, NEON on
 //!   AArch64), where the auto-vectoriser does what it can.

@@ -59,7 +59,7 @@ pub(super) struct Rows {
 /// A symmetric system of up to [`MAX_COEFFICIENTS`] unknowns, of which the first `size` are
 /// used: `minimise x' N x - 2 x' r`.
 #[derive(Clone, Copy)]
-struct Quadratic {
+pub(super) struct Quadratic {
     normal: [[f64; MAX_COEFFICIENTS]; MAX_COEFFICIENTS],
     rhs: [f64; MAX_COEFFICIENTS],
     size: usize,
@@ -275,7 +275,7 @@ impl<'a> Prepared<'a> {
     /// The Gauss-Newton step's system at the model's cube roots `roots`: each row scaled by
     /// the root's slope (bounded where the model vanishes), weighted, against the residual.
     /// Run as [`Prepared::cost`] is.
-    fn step(&self, c: usize, rows: &Rows, roots: &[f64]) -> Quadratic {
+    pub(super) fn step(&self, c: usize, rows: &Rows, roots: &[f64]) -> Quadratic {
         self.count_pass();
         struct Step<'a> {
             columns: &'a [Vec<f64>; MAX_COEFFICIENTS],
@@ -303,14 +303,10 @@ impl<'a> Prepared<'a> {
         step
     }
 
+    /// One pass over every observation, counted in [`Prepared::evaluations`].
     fn count_pass(&self) {
         self.evaluations
             .fetch_add(self.cosine.len() as u64, Ordering::Relaxed);
-    }
-
-    /// [`Prepared::step`] alone, for the peak rate (its system is not needed).
-    pub(super) fn step_sums(&self, c: usize, rows: &Rows, roots: &[f64]) {
-        let _ = self.step(c, rows, roots);
     }
 
     /// The best coefficients `>= 0` of channel `c` for the specular columns of `rows`:
@@ -432,7 +428,7 @@ fn step_sums(
     let lanes = |values: &[f64], start: usize| -> [f64; LANES] {
         values[start..start + LANES]
             .try_into()
-            .unwrap_or([0.0; LANES])
+            .expect("a whole chunk of lanes")
     };
     for start in (0..whole).step_by(LANES) {
         let rows = [lanes(a0, start), lanes(a1, start), lanes(a2, start)];
@@ -539,6 +535,65 @@ mod tests {
     /// (is non-negative) in every unknown at it, on random positive definite systems with
     /// random bounds, the unknowns' scales apart by up to eight orders (as a dark channel's
     /// cube-root weights make them).
+    /// The vector passes agree with plain loops (within rounding of the sums' order) at
+    /// every remainder of the lanes, and at counts below one chunk: the padded lanes add
+    /// nothing, and the cube roots left behind are the model's.
+    #[test]
+    fn the_vector_sums_are_the_plain_sums_at_every_remainder() {
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for count in (0..20).chain([8 * 7 + 3, 8 * 40, 8 * 40 + 7]) {
+            let columns: [Vec<f64>; MAX_COEFFICIENTS] =
+                core::array::from_fn(|_| (0..count).map(|_| uniform()).collect());
+            let target: Vec<f64> = (0..count).map(|_| uniform()).collect();
+            let weight: Vec<f64> = (0..count).map(|_| uniform() / 50.0).collect();
+            let x = [0.3, 1.7, 0.02];
+            let mut roots = vec![f64::NAN; count];
+            let cost = super::cost_sum(&columns, &target, &weight, x, &mut roots);
+            let row = |j: usize| [columns[0][j], columns[1][j], columns[2][j]];
+            let model = |j: usize| row(j).iter().zip(x).map(|(a, x)| a * x).sum::<f64>();
+            let mut plain = 0.0;
+            for j in 0..count {
+                let root = model(j).cbrt();
+                assert!((roots[j] - root).abs() <= 1e-13 * root, "{count}: root {j}");
+                plain += weight[j] * (target[j] - root).powi(2);
+            }
+            assert!(
+                (cost - plain).abs() <= 1e-12 * plain,
+                "{count}: {cost} {plain}"
+            );
+            let sums = super::step_sums(&columns, &target, &weight, &roots);
+            let (mut expected, mut magnitude) = ([0.0; 9], [0.0_f64; 9]);
+            for j in 0..count {
+                let slope = 1.0 / (3.0 * roots[j].max(1e-4).powi(2));
+                let a = row(j).map(|a| slope * a);
+                let residual = target[j] - roots[j];
+                let pairs = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+                let terms = pairs
+                    .map(|(p, q)| weight[j] * a[p] * a[q])
+                    .into_iter()
+                    .chain((0..3).map(|p| weight[j] * a[p] * residual));
+                for (k, term) in terms.enumerate() {
+                    expected[k] += term;
+                    magnitude[k] += term.abs();
+                }
+            }
+            for k in 0..9 {
+                assert!(
+                    (sums[k] - expected[k]).abs() <= 1e-12 * magnitude[k],
+                    "{count}: sum {k}: {} {}",
+                    sums[k],
+                    expected[k]
+                );
+            }
+        }
+    }
+
     #[test]
     fn the_bounded_minimiser_meets_the_optimality_conditions() {
         let mut state = 0x9E37_79B9_7F4A_7C15_u64;
