@@ -24,6 +24,7 @@ mod pinned;
 mod ranking;
 pub mod rates;
 mod recommend;
+mod recommendation;
 mod synthesis_plan;
 
 pub use choice::{Target, Zone};

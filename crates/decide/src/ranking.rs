@@ -4,7 +4,7 @@
 
 use specula::LobeKind;
 
-use crate::recommend::{Candidate, Recommendation};
+use crate::recommendation::{Candidate, Recommendation};
 use crate::Target;
 
 /// Which of `points` (error, rate) no other point dominates (at least as accurate and at

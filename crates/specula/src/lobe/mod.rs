@@ -251,7 +251,7 @@ impl Lobe {
     }
 
     /// [`Lobe::eval`] in `f64` at each of `ts`, the same values to the bit: a formula lobe
-    /// runs its tape over all of them at once ([`crate::formula`]), which an analysis that
+    /// runs its tape over all of them at once (`formula`'s `run_each`), which an analysis that
     /// scans a lobe over thousands of cosines needs; the others evaluate one by one.
     #[must_use]
     pub fn eval_each(&self, ts: &[f64]) -> Vec<f64> {
