@@ -38,6 +38,7 @@
 mod channel;
 mod observations;
 mod search;
+mod sums;
 pub mod verdict;
 
 use channel::Prepared;
