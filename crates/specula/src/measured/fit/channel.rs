@@ -12,10 +12,7 @@ use super::Observations;
 use crate::microfacet::{fresnel_schlick, TableIndex};
 use crate::Geometry;
 
-use super::sums::{cost_sum, step_sums};
-
-/// The most coefficients a channel has: `kd` and two specular columns.
-pub(super) const MAX_COEFFICIENTS: usize = 3;
+use super::sums::{cost_sum, step_sums, MAX_COEFFICIENTS};
 
 /// Observations with what every fit needs computed once.
 pub(super) struct Prepared<'a> {

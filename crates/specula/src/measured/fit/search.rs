@@ -5,7 +5,8 @@
 use argmin::core::{CostFunction, Executor};
 use argmin::solver::brent::BrentOpt;
 
-use super::channel::{Prepared, MAX_COEFFICIENTS};
+use super::channel::Prepared;
+use super::sums::MAX_COEFFICIENTS;
 use super::{Fit, Observations, Sharing, Specular, Stage, GRID_POINTS};
 
 /// A channel's coefficients (`kd`, then the specular columns') and its error sum.

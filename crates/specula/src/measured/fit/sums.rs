@@ -2,7 +2,8 @@
 //! error with the model's cube roots ([`cost_sum`]) and the Gauss-Newton step's sums
 //! ([`step_sums`]), the rows stored by column so that every loop loads whole vectors.
 
-use super::channel::MAX_COEFFICIENTS;
+/// The most coefficients a channel has: `kd` and two specular columns.
+pub(super) const MAX_COEFFICIENTS: usize = 3;
 
 /// Lanes of the sums over the observations: a whole AVX-512 register of `f64`, two of AVX2's.
 const LANES: usize = 8;
