@@ -142,50 +142,37 @@ impl Family {
     /// The lobe at `u = 1 - t` for `n`, with the formula's operations in its order.
     #[must_use]
     pub fn eval(self, beta: &[f64], n: f64, u: f64) -> f64 {
-        match self {
+        self.at(beta, n).eval(u)
+    }
+
+    /// The family's constants at `n`, as the formula's `let`s compute them: what a fit
+    /// evaluating many `u` at one `n` computes once rather than per point.
+    #[must_use]
+    pub fn at(self, beta: &[f64], n: f64) -> AtN {
+        let constants = match self {
             Family::Exp2Poly { degree } => {
                 let [a1, a2, a3] = exp2_coefficients(degree, beta, n);
-                match degree {
-                    1 => (a1 * u).exp2(),
-                    2 => (u * (a1 + u * a2)).exp2(),
-                    _ => (u * (a1 + u * (a2 + u * a3))).exp2(),
-                }
+                [a1, a2, a3, 0.0]
             }
-            Family::PolyPow { degree, squarings } => {
-                let base = match degree {
-                    1 => {
-                        let s = beta[0] * n + beta[1];
-                        (1.0 - s * u).max(0.0)
-                    }
-                    2 => {
-                        let (s, c, stop) = quadratic_constants(beta, n);
-                        let v = u.min(stop);
-                        1.0 - v * (s - c * v)
-                    }
-                    _ => {
-                        let (s, c, d, stop) = cubic_constants(beta, n);
-                        let v = u.min(stop);
-                        (1.0 - v * (s - v * (c + v * d))).max(0.0)
-                    }
-                };
-                (0..squarings).fold(base, |x, _| x * x)
+            Family::PolyPow { degree: 1, .. } => [beta[0] * n + beta[1], 0.0, 0.0, 0.0],
+            Family::PolyPow { degree: 2, .. } => {
+                let (s, c, stop) = quadratic_constants(beta, n);
+                [s, c, 0.0, stop]
             }
-            Family::HingePow { squarings } => {
+            Family::PolyPow { .. } => {
+                let (s, c, d, stop) = cubic_constants(beta, n);
+                [s, c, d, stop]
+            }
+            Family::HingePow { .. } => {
                 let s = beta[0] * n + beta[1];
-                let (k, d) = (beta[2] / s, beta[3] * s);
-                let base = (1.0 - s * u + d * (u - k).max(0.0)).max(0.0);
-                (0..squarings).fold(base, |x, _| x * x)
+                [s, beta[2] / s, beta[3] * s, 0.0]
             }
-            Family::RationalPow { squarings } => {
-                let (a, b) = (beta[0] * n + beta[1], beta[2] * n + beta[3]);
-                let base = (1.0 - a * u).max(0.0) / (1.0 + b * u);
-                (0..squarings).fold(base, |x, _| x * x)
-            }
-            Family::Exp2Rational => {
-                let a1 = -LOG2_E * (n + beta[0] / n);
-                let b = 0.5 + beta[1];
-                (a1 * u / (1.0 - b * u)).exp2()
-            }
+            Family::RationalPow { .. } => [beta[0] * n + beta[1], beta[2] * n + beta[3], 0.0, 0.0],
+            Family::Exp2Rational => [-LOG2_E * (n + beta[0] / n), 0.5 + beta[1], 0.0, 0.0],
+        };
+        AtN {
+            family: self,
+            constants,
         }
     }
 
@@ -353,6 +340,58 @@ fn signed(x: f64) -> String {
     } else {
         format!("+ {x}")
     }
+}
+
+
+/// A family at one `n`: its constants computed, the lobe evaluated per `u`.
+#[derive(Clone, Copy, Debug)]
+pub struct AtN {
+    family: Family,
+    /// The `let`s' values, in the order [`Family::at`] lists them.
+    constants: [f64; 4],
+}
+
+impl AtN {
+    /// The lobe at `u = 1 - t`, with the formula's operations in its order.
+    #[must_use]
+    #[inline]
+    pub fn eval(self, u: f64) -> f64 {
+        let [k0, k1, k2, k3] = self.constants;
+        match self.family {
+            Family::Exp2Poly { degree } => match degree {
+                1 => (k0 * u).exp2(),
+                2 => (u * (k0 + u * k1)).exp2(),
+                _ => (u * (k0 + u * (k1 + u * k2))).exp2(),
+            },
+            Family::PolyPow { degree, squarings } => {
+                let base = match degree {
+                    1 => (1.0 - k0 * u).max(0.0),
+                    2 => {
+                        let v = u.min(k3);
+                        1.0 - v * (k0 - k1 * v)
+                    }
+                    _ => {
+                        let v = u.min(k3);
+                        (1.0 - v * (k0 - v * (k1 + v * k2))).max(0.0)
+                    }
+                };
+                squared(base, squarings)
+            }
+            Family::HingePow { squarings } => {
+                squared((1.0 - k0 * u + k2 * (u - k1).max(0.0)).max(0.0), squarings)
+            }
+            Family::RationalPow { squarings } => {
+                squared((1.0 - k0 * u).max(0.0) / (1.0 + k1 * u), squarings)
+            }
+            Family::Exp2Rational => (k0 * u / (1.0 - k1 * u)).exp2(),
+        }
+    }
+}
+
+/// `x` squared `squarings` times.
+#[inline]
+fn squared(x: f64, squarings: u8) -> f64 {
+    (0..squarings).fold(x, |x, _| x * x)
 }
 
 /// `a1, a2, a3` of an `exp2` family at `n` (log2 units), as the formula's `let`s compute them.

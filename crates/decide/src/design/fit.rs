@@ -110,13 +110,14 @@ impl Grid {
 /// The family's figures on `grid`.
 fn figures_at(family: Family, beta: &[f64], grid: &Grid, energy: bool) -> Figures {
     let n = grid.n;
+    let lobe = family.at(beta, n);
     let mut epicentre = 0.0_f64;
     for &(u, exact) in &grid.epicentre {
-        epicentre = epicentre.max((family.eval(beta, n, u) / exact - 1.0).abs());
+        epicentre = epicentre.max((lobe.eval(u) / exact - 1.0).abs());
     }
     let mut whole = 0.0_f64;
     for &(u, exact) in &grid.whole {
-        let value = family.eval(beta, n, u);
+        let value = lobe.eval(u);
         if !(0.0..=1.0).contains(&value) {
             return Figures {
                 epicentre: f64::INFINITY,
@@ -139,7 +140,7 @@ fn figures_at(family: Family, beta: &[f64], grid: &Grid, energy: bool) -> Figure
                     k if k % 2 == 1 => 4.0,
                     _ => 2.0,
                 };
-                weight * family.eval(beta, n, h * k as f64)
+                weight * lobe.eval(h * k as f64)
             })
             .sum();
         (sum * h / 3.0 * (n + 1.0) - 1.0).abs()

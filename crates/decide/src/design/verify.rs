@@ -183,7 +183,7 @@ fn decreasing_at(lobe: &Lobe) -> Option<f64> {
         .chain((0..=1000).map(|k| f64::from(k) / 1000.0))
         .collect();
     ts.sort_by(f64::total_cmp);
-    let values: Vec<f64> = ts.iter().map(|&t| lobe.eval(t)).collect();
+    let values = lobe.eval_each(&ts);
     values
         .windows(2)
         .zip(&ts)

@@ -389,8 +389,11 @@ impl Lobe {
                 return Err(refuse(format!("the constant '{slot}' is {value}")));
             }
         }
-        for t in check_points() {
-            let value: f64 = formula.raw(t, &slots);
+        // The whole grid at once: the batch interpreter is the scalar one lane by lane.
+        let points: Vec<f64> = check_points().collect();
+        let mut values = vec![0.0; points.len()];
+        formula.raw_each(&points, &slots, &mut values);
+        for (&t, &value) in points.iter().zip(&values) {
             let problem = if !value.is_finite() {
                 Some("not finite")
             } else if value < -1e-12 {
