@@ -112,7 +112,9 @@ enum Command {
                             specula shader --lobe cosquad --n 64 --lang mtlx -o \
                             specula_cosquad.mtlx\n  \
                             specula shader --lobe cosquad --n 64 --normalisation lobe --lang \
-                            mitsuba -o specula_cosquad.py"
+                            mitsuba -o specula_cosquad.py\n  \
+                            specula shader --lobe cosquad --n 32 --lang vtk -o \
+                            specula_cosquad_vtk.py"
     )]
     Shader(commands::shader::Args),
     /// Measure throughput (printed figures and ratios, not pass/fail).

@@ -146,7 +146,7 @@ pub enum ExportFormat {
 
 impl ExportFormat {
     /// Every format, in the order `--help` lists them.
-    pub const ALL: [ExportFormat; 10] = [
+    pub const ALL: [ExportFormat; 11] = [
         ExportFormat::Naga(Language::Wgsl),
         ExportFormat::Naga(Language::Glsl),
         ExportFormat::Naga(Language::Hlsl),
@@ -157,6 +157,7 @@ impl ExportFormat {
         ExportFormat::Renderer(specula_targets::RendererFormat::Mitsuba),
         ExportFormat::Engine(Engine::ThreeJs),
         ExportFormat::Engine(Engine::Babylon),
+        ExportFormat::Engine(Engine::Vtk),
     ];
 
     /// The name on the command line.

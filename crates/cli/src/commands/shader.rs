@@ -31,8 +31,9 @@ pub struct Args {
     /// The shading language: wgsl, glsl, hlsl, msl, spirv (a function for one's own
     /// shader), osl (a Blender Cycles script node), mtlx (a MaterialX
     /// document), mitsuba (a Mitsuba 3 BSDF plugin in Python), threejs (an ES module patching
-    /// a MeshPhongMaterial or MeshPhongNodeMaterial) or babylon (an ES module with a
-    /// MaterialPluginBase for StandardMaterial).
+    /// a MeshPhongMaterial or MeshPhongNodeMaterial), babylon (an ES module with a
+    /// MaterialPluginBase for StandardMaterial) or vtk (a Python module putting the lobe in
+    /// VTK's GPU ray caster and surface shading).
     #[arg(long, value_parser = choice(&ExportFormat::ALL, ExportFormat::id))]
     lang: ExportFormat,
     /// The GLSL dialect (with --lang glsl): 450 (Vulkan, OpenGL 4.5), 300es (OpenGL ES 3,

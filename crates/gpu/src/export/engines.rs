@@ -1,5 +1,5 @@
-//! The real-time engines' specular, replaced: an ES module per engine that patches the
-//! engine's own Phong material so that its specular is the lobe (`threejs.js`, `babylon.js`,
+//! The real-time engines' specular, replaced: a module per engine that patches the engine's
+//! own Phong shading so that its specular is the lobe (`threejs.js`, `babylon.js`, `vtk.py`,
 //! their manual pages). The lobe's functions in them are the GLSL ES 3.00 export (and, for
 //! three.js's node materials, the WGSL export) of the lobe's one recorded expression, with `n`
 //! as an argument where the lobe's constants and the normalisation are closed forms of it.
@@ -15,11 +15,14 @@ pub enum Engine {
     ThreeJs,
     /// Babylon.js: a `MaterialPluginBase` for `StandardMaterial`.
     Babylon,
+    /// VTK: `vtkShaderProperty` replacements of the power in its GPU ray caster's and its
+    /// polydata mapper's Phong specular (3D Slicer's, ParaView's).
+    Vtk,
 }
 
 impl Engine {
     /// Every engine.
-    pub const ALL: [Engine; 2] = [Engine::ThreeJs, Engine::Babylon];
+    pub const ALL: [Engine; 3] = [Engine::ThreeJs, Engine::Babylon, Engine::Vtk];
 
     /// The name on the command line.
     #[must_use]
@@ -27,6 +30,7 @@ impl Engine {
         match self {
             Engine::ThreeJs => "threejs",
             Engine::Babylon => "babylon",
+            Engine::Vtk => "vtk",
         }
     }
 
@@ -37,6 +41,15 @@ impl Engine {
         geometry: Geometry,
         normalisation: Normalisation,
     ) -> Result<String, ExportError> {
+        if self == Engine::Vtk && geometry != Geometry::Phong {
+            return Err(ExportError {
+                language: "vtk",
+                message: "VTK forms the specular cosine itself (Phong's reflection vector; the \
+                          surface headlight's N.V); the module replaces only the power: leave \
+                          --geometry at phong"
+                    .to_owned(),
+            });
+        }
         let functions =
             |language| functions_taking_n_where_possible(lobe, geometry, normalisation, language);
         let glsl = functions(Language::Glsl)?;
@@ -68,6 +81,7 @@ impl Engine {
                 .replace("{tsl_call}", &call("")("normal", "wo", "wi")),
             Engine::Babylon => include_str!("babylon.js")
                 .replace("{glsl_call}", &call("specula_")("normal", "wo", "wi")),
+            Engine::Vtk => vtk_module(&glsl, taking_n)?,
         };
         let (n_note, n_range) = match range {
             Some(range) => (
@@ -76,11 +90,18 @@ impl Engine {
                     specula_targets::code::describe_range(range),
                     lobe.exponent()
                 ),
-                format!("[{}, {}]", range[0], range[1]),
+                match self {
+                    Engine::Vtk => format!("({:?}, {:?})", range[0], range[1]),
+                    _ => format!("[{}, {}]", range[0], range[1]),
+                },
             ),
             None => (
                 format!("n = {} baked in", lobe.exponent()),
-                "null".to_owned(),
+                match self {
+                    Engine::Vtk => "None",
+                    _ => "null",
+                }
+                .to_owned(),
             ),
         };
         let mut module = template
@@ -97,9 +118,39 @@ impl Engine {
         if self == Engine::ThreeJs {
             module = module.replace("{wgsl}", &escaped(&functions(Language::Wgsl)?.text));
         }
-        let module = module.replace("{glsl}", &escaped(&glsl));
-        Ok(module)
+        let glsl = match self {
+            Engine::Vtk => glsl,
+            _ => escaped(&glsl),
+        };
+        Ok(module.replace("{glsl}", &glsl))
     }
+}
+
+/// The VTK module's template with its call of the lobe in pow's place (`specula_vtk(t, n)`)
+/// and what the exponent does; the GLSL goes in a raw Python string.
+fn vtk_module(glsl: &str, taking_n: bool) -> Result<String, ExportError> {
+    if glsl.contains("'''") {
+        return Err(ExportError {
+            language: "vtk",
+            message: "the GLSL holds ''' and cannot sit in the module's raw string".to_owned(),
+        });
+    }
+    let (call, follows) = if taking_n {
+        (
+            "specula_normalisation(n) * specula_lobe(n, t)",
+            "changing it (SetSpecularPower) changes the lobe's n at run time, within N_RANGE \
+             (the shader clamps to it).",
+        )
+    } else {
+        (
+            "SPECULA_NORMALISATION * specula_lobe(t)",
+            "it must stay at the exported n, for which the lobe's constants are fitted \
+             (apply_to_* sets it; the shader ignores another).",
+        )
+    };
+    Ok(include_str!("vtk.py")
+        .replace("{vtk_call}", call)
+        .replace("{n_follows}", follows))
 }
 
 /// `text` inside a JavaScript template literal.
