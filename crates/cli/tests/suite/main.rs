@@ -33,3 +33,4 @@ mod sky;
 mod structure;
 mod user_lobe;
 mod volume;
+mod vtk;

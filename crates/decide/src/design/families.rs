@@ -342,7 +342,6 @@ fn signed(x: f64) -> String {
     }
 }
 
-
 /// A family at one `n`: its constants computed, the lobe evaluated per `u`.
 #[derive(Clone, Copy, Debug)]
 pub struct AtN {
