@@ -101,7 +101,7 @@ enum Command {
                             specula diff a.exr b.exr --heatmap flip.png --format json")]
     Diff(commands::diff::Args),
     /// Export one lobe: a shader function (WGSL, GLSL, HLSL, MSL, SPIR-V), a Blender (OSL),
-    /// MaterialX or Mitsuba 3 file, or a three.js or Babylon.js module.
+    /// MaterialX or Mitsuba 3 file, or a three.js, Babylon.js or VTK module.
     #[command(
         after_help = "Examples:\n  specula shader --lobe schlick-mod --n 64 --lang glsl\n  \
                             specula shader --lobe cosquad --n 100 --geometry blinn --normalisation \

@@ -393,3 +393,48 @@ else:
         String::from_utf8_lossy(&output.stderr)
     );
 }
+
+/// The README's VTK example runs as printed, after the export above it, against the wheel.
+#[test]
+fn the_readme_vtk_example_runs_as_written() {
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md"))
+            .unwrap();
+    let section = readme
+        .split("### Use a lobe in VTK, 3D Slicer and ParaView")
+        .nth(1)
+        .expect("the README's VTK section");
+    let block = |fence: &str| {
+        section
+            .split(fence)
+            .nth(1)
+            .and_then(|rest| rest.split("```").next())
+            .expect("a code block")
+            .trim()
+            .to_owned()
+    };
+    let (export, example) = (block("```sh\n"), block("```python\n"));
+    let directory = tempfile::tempdir().unwrap();
+    let d = directory.path();
+    let args: Vec<&str> = export.split_whitespace().skip(1).collect();
+    ok(d, &args);
+    if !have_python_module("vtk", "vtk==9.7.2") {
+        return;
+    }
+    std::fs::write(
+        d.join("example.py"),
+        format!("{example}\nassert lobe.uncovered(volume) == []\n"),
+    )
+    .unwrap();
+    let output = std::process::Command::new(python())
+        .current_dir(d)
+        .env("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+        .arg("example.py")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        output.status.success() && !stderr.contains("ERR|"),
+        "{stderr}"
+    );
+}
