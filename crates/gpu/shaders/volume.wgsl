@@ -20,7 +20,8 @@ struct Params {
     to_index_z: vec4<f32>,
     // xyz = the world position of voxel (0, 0, 0); w = the gradient of full shading.
     origin: vec4<f32>,
-    // xyz = towards the light.
+    // xyz = towards the light; w = what a sample with no gradient keeps of its colour (1, or
+    // the ambient weight as VTK's GPU caster).
     light: vec4<f32>,
     // ka, kd, ks, and 1 when samples are shaded.
     weights: vec4<f32>,
@@ -136,7 +137,7 @@ struct Shaded {
 fn shade(g: vec3<f32>, base: vec3<f32>, wo: vec3<f32>) -> Shaded {
     let strength = length(g);
     if !(strength > 0.0) {
-        return Shaded(base, 0.0, 0.0);
+        return Shaded(base * params.light.w, 0.0, 0.0);
     }
     var normal = -g / strength;
     if dot(normal, wo) < 0.0 {

@@ -395,14 +395,20 @@ fn params(
     let (light, weights, gradient_reference, geometry) = match &plan.lighting {
         Some(lighting) => {
             let shading = &lighting.shading;
+            // w: what a sample with no gradient keeps of its colour.
+            let flat = if shading.ambient_where_flat {
+                shading.ka
+            } else {
+                1.0
+            };
             (
-                lighting.light,
+                with_w(lighting.light, flat),
                 [shading.ka, shading.kd, shading.ks, 1.0],
                 lighting.gradient_reference,
                 geometry_id(shading.geometry),
             )
         }
-        None => (glam::Vec3::Z, [0.0; 4], 1.0, 0),
+        None => (with_w(glam::Vec3::Z, 1.0), [0.0; 4], 1.0, 0),
     };
     Params {
         eye: with_w(camera.eye, camera.half_height),
@@ -415,7 +421,7 @@ fn params(
             with_w(to_index.z_axis, 0.0),
         ],
         origin: with_w(volume.origin(), gradient_reference),
-        light: with_w(light, 0.0),
+        light,
         weights,
         background: with_w(settings.background, 0.0),
         size: [

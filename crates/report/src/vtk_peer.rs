@@ -53,6 +53,8 @@ pub fn python() -> PathBuf {
 pub struct VtkTimes {
     /// The median of the timed frames' ray casts (the mapper's own time to draw), seconds.
     pub median_draw: f64,
+    /// Each timed frame's, seconds (on the GPU caster, `Render()` and `glFinish`).
+    pub draw_seconds: Vec<f64>,
     /// VTK's version.
     pub version: String,
     /// Seconds from starting its process to its first frame drawn (Python, the imports, the
@@ -72,6 +74,15 @@ fn times(report: &serde_json::Value, spawned_unix: Option<f64>) -> Result<VtkTim
         median_draw: report["median_draw"]
             .as_f64()
             .ok_or("vtk_volume.py reported no median_draw")?,
+        draw_seconds: report["draw_seconds"]
+            .as_array()
+            .map(|frames| {
+                frames
+                    .iter()
+                    .filter_map(serde_json::Value::as_f64)
+                    .collect()
+            })
+            .unwrap_or_default(),
         version: report["vtk"].as_str().unwrap_or("?").to_owned(),
         first_image: report["first_image_unix"]
             .as_f64()
@@ -220,6 +231,21 @@ impl Running {
             })
             .collect())
     }
+}
+
+/// VTK's PNG as it wrote it (8-bit linear values, no gamma: its framebuffer): `read_image`
+/// decodes sRGB, which encoding again undoes exactly for every byte (the real-scan tests
+/// check every byte).
+pub fn read_png(path: &Path) -> Result<Vec<[f32; 3]>, String> {
+    let image = specula_render::read_image(path).map_err(|e| e.to_string())?;
+    Ok(image
+        .pixels()
+        .iter()
+        .map(|p| {
+            p.to_array()
+                .map(|c| (specula_render::srgb_encode(c) * 255.0).round() / 255.0)
+        })
+        .collect())
 }
 
 /// The volume as a NIfTI file VTK can read: `input` itself, or a copy in `scratch`.

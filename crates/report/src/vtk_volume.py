@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Render a NIfTI volume with VTK's CPU ray caster (vtkFixedPointVolumeRayCastMapper), the
-yardstick specula's volume renderer is compared and timed against.
+yardstick specula's volume renderer is compared and timed against, or with its GPU ray caster
+(vtkGPUVolumeRayCastMapper, what 3D Slicer and ParaView draw with), optionally shaded by a lobe
+module of `specula shader --lang vtk`.
 
     python vtk_volume.py JOB.json
 
@@ -18,7 +20,9 @@ JOB.json (world = RAS millimetres, as nibabel's affine gives them):
      "threads": 2, "warmup": 1, "frames": 5,
      "output": "/abs/out.png"}
 
-Optional keys: "background" [r, g, b] (default black); "opacity_points_per_segment" (64);
+Optional keys: "mapper": "cpu" (default) or "gpu"; "lobe_module": "/abs/lobe_vtk.py" (GPU
+only: its apply_to_volume puts the lobe in place of the specular pow, at the shading's power);
+"background" [r, g, b] (default black); "opacity_points_per_segment" (64);
 "headlight_ambient_color" [r, g, b] (default: leave the automatic headlight as VTK makes it,
 whose ambient colour is black, so that VTK's ambient coefficient has no effect; see
 VTK_NOTES.md); "clipping_range" [near, far] in mm from the camera (default:
@@ -39,6 +43,11 @@ How the job becomes a VTK scene:
   VTK's interpolation linear in alpha follows specula's linear in sigma. VTK then corrects
   alpha per sample as 1 - (1 - alpha)^(sample_distance / 1 mm) = 1 - exp(-sigma d).
 - Colour: a vtkColorTransferFunction in RGB space with the control points' colours.
+- The GPU caster (mapper "gpu"): vtkGPUVolumeRayCastMapper with AutoAdjustSampleDistances and
+  LockSampleDistanceToInputSpacing off, SampleDistance = sample_distance, ImageSampleDistance
+  1, jittering off; it shades Phong's R.V (not the CPU caster's Blinn-Phong) and stops a ray at
+  1 - 1/255 opacity. Frame times are the wall time of window.Render() and glFinish
+  (WaitForCompletion; the mapper's own GetTimeToDraw does not wait for the GPU).
 - vtkFixedPointVolumeRayCastMapper: AutoAdjustSampleDistances off,
   LockSampleDistanceToInputSpacing off, SampleDistance = InteractiveSampleDistance =
   sample_distance, ImageSampleDistance 1 (one ray per pixel), `threads` threads (also
@@ -136,6 +145,12 @@ def read_job(path):
     job["background"] = vector(job.get("background", [0, 0, 0]), "background")
     if job.get("headlight_ambient_color") is not None:
         job["headlight_ambient_color"] = vector(job["headlight_ambient_color"], "headlight_ambient_color")
+    job.setdefault("mapper", "cpu")
+    if job["mapper"] not in ("cpu", "gpu"):
+        raise Failure("mapper must be 'cpu' or 'gpu'")
+    module = job.get("lobe_module")
+    if module is not None and not (job["mapper"] == "gpu" and isinstance(module, str) and os.path.isfile(module)):
+        raise Failure("lobe_module must name an existing file of `specula shader --lang vtk`, with mapper 'gpu'")
     if job.get("clipping_range") is not None:
         near, far = vector(job["clipping_range"], "clipping_range", 2)
         if not 0 < near < far:
@@ -255,22 +270,34 @@ def render(job):
         prop.SetSpecularPower(float(shading["power"]))
 
     vtk.vtkMultiThreader.SetGlobalMaximumNumberOfThreads(threads)
-    mapper = vtk.vtkFixedPointVolumeRayCastMapper()
+    gpu = job["mapper"] == "gpu"
+    if gpu:
+        mapper = vtk.vtkGPUVolumeRayCastMapper()
+        mapper.SetUseJittering(0)
+    else:
+        mapper = vtk.vtkFixedPointVolumeRayCastMapper()
+        mapper.SetInteractiveSampleDistance(float(job["sample_distance"]))
+        mapper.SetMinimumImageSampleDistance(1.0)
+        mapper.SetMaximumImageSampleDistance(1.0)
+        mapper.SetNumberOfThreads(threads)
     mapper.SetInputData(image)
     mapper.SetBlendModeToComposite()
     mapper.SetAutoAdjustSampleDistances(0)
     mapper.SetLockSampleDistanceToInputSpacing(0)
     mapper.SetSampleDistance(float(job["sample_distance"]))
-    mapper.SetInteractiveSampleDistance(float(job["sample_distance"]))
     mapper.SetImageSampleDistance(1.0)
-    mapper.SetMinimumImageSampleDistance(1.0)
-    mapper.SetMaximumImageSampleDistance(1.0)
-    mapper.SetNumberOfThreads(threads)
 
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
     volume.SetProperty(prop)
     volume.SetUserMatrix(user)
+    if job.get("lobe_module") is not None:
+        import importlib.util
+
+        spec = importlib.util.spec_from_file_location("specula_lobe_vtk", job["lobe_module"])
+        lobe = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(lobe)
+        lobe.apply_to_volume(volume, n=float(shading["power"]) if shading else None)
 
     renderer = vtk.vtkRenderer()
     renderer.SetBackground(*job["background"])
@@ -319,8 +346,10 @@ def render(job):
         volume.Modified()
         start = time.perf_counter()
         window.Render()
+        if gpu:
+            window.WaitForCompletion()  # glFinish: the GPU's work, not its queueing
         render_seconds.append(time.perf_counter() - start)
-        draw_seconds.append(mapper.GetTimeToDraw())
+        draw_seconds.append(render_seconds[-1] if gpu else mapper.GetTimeToDraw())
     if min(draw_seconds) <= 0:
         raise Failure(f"the mapper did not ray cast every frame (draw times {draw_seconds})")
 
@@ -359,7 +388,7 @@ def render(job):
         },
         "two_sided_lighting": bool(renderer.GetTwoSidedLighting()),
         "clipping_range": list(camera.GetClippingRange()),
-        "threads": mapper.GetNumberOfThreads(),
+        "threads": threads if gpu else mapper.GetNumberOfThreads(),
         "first_image_unix": first_image_unix,
         "peak_bytes": peak_bytes(),
     }

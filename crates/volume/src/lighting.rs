@@ -28,6 +28,10 @@ pub struct Shading {
     /// value range per voxel), since a normal means little inside uniform tissue; without it
     /// every sample with a gradient is fully shaded, as VTK's ray casters shade.
     pub fade_weak_gradients: bool,
+    /// Whether a sample with no gradient keeps its ambient term alone (VTK's GPU ray caster,
+    /// whose normal there is 0, so that only `ambient * colour` is left) rather than its full
+    /// colour, unlit, as specula and VTK's CPU caster keep it.
+    pub ambient_where_flat: bool,
 }
 
 /// Where a volume's light is.
@@ -69,6 +73,7 @@ impl Shading {
             ks: 0.5,
             light: Light::Key,
             fade_weak_gradients: true,
+            ambient_where_flat: false,
         }
     }
 }
@@ -145,8 +150,13 @@ impl Lighting {
         // base.lerp(lit, weight), the highlight's share kept apart.
         let weight = (squared * inverse * gx.splat(self.per_gradient_reference)).min(one);
         let lit = one + weight * (gx.splat(shading.ka) + gx.splat(shading.kd) * diffuse - one);
+        let flat = if shading.ambient_where_flat {
+            gx.splat(shading.ka)
+        } else {
+            one
+        };
         LitLanes {
-            colour_scale: lit.select(shaded, one),
+            colour_scale: lit.select(shaded, flat),
             fade: weight.keep(shaded),
             t: t.keep(shaded),
         }

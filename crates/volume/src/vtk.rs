@@ -27,6 +27,9 @@ use crate::volume::{Volume, VolumeError};
 /// Where VTK stops a ray: its remaining opacity (15-bit) below 255 of 32767.
 pub const VTK_OPACITY_CUTOFF: f32 = 1.0 - 255.0 / 32767.0;
 
+/// Where VTK's GPU ray caster stops a ray (`g_opacityThreshold`, 1 - 1/255).
+pub const VTK_GPU_OPACITY_CUTOFF: f32 = 1.0 - 1.0 / 255.0;
+
 /// The weights both renderers use in a comparison (specula's defaults).
 pub const AMBIENT: f32 = 0.25;
 /// See [`AMBIENT`].
@@ -45,18 +48,54 @@ pub fn alike_settings(
     power: Exponent,
     sample_distance: f32,
 ) -> Result<DvrSettings, VolumeError> {
-    let shading = Shading {
+    let pow = Lobe::new(LobeKind::Pow, power);
+    let shading = alike_shading(pow, Geometry::Blinn, false);
+    let mut settings = alike(volume, width, height, view, shading, sample_distance)?;
+    settings.opacity_cutoff = VTK_OPACITY_CUTOFF;
+    Ok(settings)
+}
+
+/// specula's settings for a render VTK's GPU ray caster can match, `lobe` in place of its
+/// `pow` (the module of `specula shader --lang vtk`): as [`alike_settings`], but Phong's `R.V`
+/// (that caster's cosine, where the CPU caster's is Blinn's), its early termination, and a
+/// sample with no gradient lit by the ambient term alone (its normal there is 0).
+pub fn alike_gpu_settings(
+    volume: &Volume,
+    width: u32,
+    height: u32,
+    view: View,
+    lobe: Lobe,
+    sample_distance: f32,
+) -> Result<DvrSettings, VolumeError> {
+    let shading = alike_shading(lobe, Geometry::Phong, true);
+    let mut settings = alike(volume, width, height, view, shading, sample_distance)?;
+    settings.opacity_cutoff = VTK_GPU_OPACITY_CUTOFF;
+    Ok(settings)
+}
+
+/// The headlight with both renderers' weights, every sample fully shaded; a sample with no
+/// gradient left unlit, or with its ambient term alone (`ambient_where_flat`).
+fn alike_shading(lobe: Lobe, geometry: Geometry, ambient_where_flat: bool) -> Shading {
+    Shading {
         ka: AMBIENT,
         kd: DIFFUSE,
         ks: SPECULAR,
         light: Light::Headlight,
         fade_weak_gradients: false,
-        ..Shading::new(
-            Lobe::new(LobeKind::Pow, power),
-            Geometry::Blinn,
-            Normalisation::None,
-        )
-    };
+        ambient_where_flat,
+        ..Shading::new(lobe, geometry, Normalisation::None)
+    }
+}
+
+/// The settings both casters share: the view, the sample distance (at most 4 voxels).
+fn alike(
+    volume: &Volume,
+    width: u32,
+    height: u32,
+    view: View,
+    shading: Shading,
+    sample_distance: f32,
+) -> Result<DvrSettings, VolumeError> {
     let voxel = volume.spacing().min_element();
     if !(sample_distance > 0.0 && sample_distance <= 4.0 * voxel) {
         return Err(VolumeError(format!(
@@ -67,7 +106,6 @@ pub fn alike_settings(
     }
     let mut settings = DvrSettings::new(width, height, view, Some(shading));
     settings.step_fraction = sample_distance / voxel;
-    settings.opacity_cutoff = VTK_OPACITY_CUTOFF;
     Ok(settings)
 }
 
@@ -129,6 +167,24 @@ pub struct VtkJob {
     pub headlight_ambient_color: [f32; 3],
     /// The background.
     pub background: [f32; 3],
+    /// `cpu` (`vtkFixedPointVolumeRayCastMapper`) or `gpu` (`vtkGPUVolumeRayCastMapper`).
+    pub mapper: &'static str,
+    /// The module of `specula shader --lang vtk` whose lobe replaces the GPU caster's `pow`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lobe_module: Option<PathBuf>,
+}
+
+impl VtkJob {
+    /// The job on VTK's GPU ray caster, shaded by `lobe_module`'s lobe (VTK's own `pow`
+    /// without one); its settings should be [`alike_gpu_settings`]'.
+    #[must_use]
+    pub fn on_gpu(self, lobe_module: Option<PathBuf>) -> Self {
+        Self {
+            mapper: "gpu",
+            lobe_module,
+            ..self
+        }
+    }
 }
 
 /// The VTK job that renders `volume` (read from `volume_file`, a NIfTI file of the same
@@ -181,5 +237,7 @@ pub fn job(
         output: output.to_owned(),
         headlight_ambient_color: [1.0; 3],
         background: array(settings.background),
+        mapper: "cpu",
+        lobe_module: None,
     })
 }

@@ -15,6 +15,7 @@ mod first_run;
 pub mod lobes;
 mod mitsuba_peer;
 pub mod volume;
+mod vtk_lobes;
 
 /// What to measure.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -41,6 +42,10 @@ pub enum Target {
     /// `--width`/`--height` say otherwise), beside VTK's CPU ray caster when the `vtk` wheel
     /// is present.
     Volume,
+    /// Every lobe inside VTK's GPU ray caster (`specula shader --lang vtk`) on `--input`
+    /// (256 x 256 unless `--width`/`--height` say otherwise): frame time against VTK's own pow
+    /// in the same process, and the image against specula's marcher set up alike.
+    VtkLobes,
 }
 
 /// Arguments of `specula bench`.
@@ -116,6 +121,7 @@ pub fn run(args: &Args) -> CommandResult {
         Target::Gpu => bench_gpu(args),
         Target::GpuLobes => bench_gpu_lobes(args),
         Target::Volume => volume::run(args),
+        Target::VtkLobes => vtk_lobes::run(args),
         Target::Environment => environment::run(args),
         Target::FirstRun => first_run::run(),
     }
@@ -126,6 +132,7 @@ impl Args {
     fn size(&self) -> (u32, u32) {
         let (width, height) = match self.target {
             Target::Volume => (512, 512),
+            Target::VtkLobes => (256, 256),
             _ => (1920, 1080),
         };
         (self.width.unwrap_or(width), self.height.unwrap_or(height))

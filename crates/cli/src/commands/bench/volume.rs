@@ -10,23 +10,29 @@ use specula_report::vtk_peer;
 use specula_volume::dvr::render_dvr_prepared;
 use specula_volume::march::PreparedVolume;
 use specula_volume::transfer::TransferFunction;
-use specula_volume::vtk;
+use specula_volume::{vtk, Volume};
 
 use super::Args;
 use crate::commands::volume::{load, Source};
 use crate::commands::CommandResult;
 use crate::output::Table;
 
-/// Measures and prints.
-pub fn run(args: &Args) -> CommandResult {
-    let source = Source::new(&args.input);
-    let loading = Instant::now();
-    let volume = load(&source)?;
+/// `--input` and its transfer function (`--transfer`, else the volume's own), as both volume
+/// benchmarks read them.
+pub(super) fn volume_and_transfer(args: &Args) -> Result<(Volume, TransferFunction), String> {
+    let volume = load(&Source::new(&args.input))?;
     let transfer = match &args.transfer {
         Some(name) => TransferFunction::preset(name).map_err(|e| e.to_string())?,
         None => TransferFunction::default_for(&volume),
     }
     .for_volume(&volume);
+    Ok((volume, transfer))
+}
+
+/// Measures and prints.
+pub fn run(args: &Args) -> CommandResult {
+    let loading = Instant::now();
+    let (volume, transfer) = volume_and_transfer(args)?;
     let (width, height) = args.size();
     let view = args.view;
     let settings = vtk::alike_settings(&volume, width, height, view, args.n, args.sample_distance)

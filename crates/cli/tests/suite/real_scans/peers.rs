@@ -15,15 +15,7 @@ fn png_bytes(path: &Path) -> Pixels {
         let back = (srgb_encode(srgb_decode(f32::from(byte) / 255.0)) * 255.0).round();
         assert_eq!(back, f32::from(byte), "sRGB does not round-trip {byte}");
     }
-    let image = read_image(path).expect("vtk.png reads");
-    image
-        .pixels()
-        .iter()
-        .map(|p| {
-            p.to_array()
-                .map(|c| (srgb_encode(c) * 255.0).round() / 255.0)
-        })
-        .collect()
+    specula_report::vtk_peer::read_png(path).expect("vtk.png reads")
 }
 
 /// `specula bench volume` on `input` with `transfer`, 256 x 256, one frame: specula's image
