@@ -32,6 +32,7 @@ mod sections;
 mod stored;
 mod verdict;
 mod volumes;
+mod vtk_gpu;
 pub mod vtk_peer;
 mod write;
 mod yours;

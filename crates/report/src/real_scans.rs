@@ -190,8 +190,17 @@ pub fn real_scans(context: &mut Context) -> Result<String, String> {
         .map(|loaded| alike_setup(loaded, side, frames, scratch.path()))
         .collect::<Result<Vec<_>, _>>()?;
     let jobs: Vec<vtk::VtkJob> = setups.iter().map(|(_, job)| job.clone()).collect();
+    // The first scan also on VTK's GPU ray caster, with the lobe's module.
+    let gpu = crate::vtk_gpu::setup(
+        &compared[0].volume,
+        &jobs[0].volume,
+        &compared[0].transfer,
+        side,
+        SAMPLE_DISTANCE,
+        &scratch.path().join(compared[0].scan.key),
+    )?;
     let running = running.and_then(|mut running| {
-        running.submit(&jobs)?;
+        running.submit(&[&jobs[..], std::slice::from_ref(&gpu.1)].concat())?;
         Ok(running)
     });
     let prepared: Vec<PreparedVolume> = scans
@@ -202,7 +211,13 @@ pub fn real_scans(context: &mut Context) -> Result<String, String> {
         html += &lobe_table(context, loaded, prepared, &lobes, side)?;
     }
     // specula's frames are timed once VTK is done, so that neither times the other's work.
-    let theirs = running.and_then(vtk_peer::Running::finish);
+    let (theirs, gpu_run) = match running.and_then(vtk_peer::Running::finish) {
+        Ok(mut runs) => {
+            let gpu_run = runs.pop().unwrap_or_else(|| Err("no answer".to_owned()));
+            (Ok(runs), gpu_run)
+        }
+        Err(why) => (Err(why.clone()), Err(why)),
+    };
     let ours = compared
         .iter()
         .zip(&prepared)
@@ -223,6 +238,14 @@ pub fn real_scans(context: &mut Context) -> Result<String, String> {
         &jobs,
         theirs,
         (side, frames, quick),
+    )?;
+    let first = &compared[0];
+    html += &crate::vtk_gpu::section(
+        context,
+        (first.scan.name, first.scan.key),
+        (&first.volume, &prepared[0], &first.transfer),
+        &gpu,
+        gpu_run,
     )?;
     Ok(html)
 }
