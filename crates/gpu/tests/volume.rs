@@ -63,6 +63,40 @@ fn gpu_ray_marching_matches_the_cpu_for_every_lobe() {
     assert!(apart > 10.0 * agreement.max(1e-5), "{apart} vs {agreement}");
 }
 
+/// A sample with no gradient keeps its ambient term alone on the GPU as on the CPU
+/// (`Shading::ambient_where_flat`, VTK's GPU caster's rule), and the rule changes the image.
+#[test]
+fn gpu_flat_samples_keep_their_ambient_term_as_the_cpu_does() {
+    let Some(gpu) = common::gpu() else { return };
+    let renderer = GpuVolumeRenderer::new(&gpu);
+    let volume = phantom::shepp_logan(48).unwrap();
+    let transfer = TransferFunction::default_for(&volume).for_volume(&volume);
+    let shading = |flat: bool| Shading {
+        fade_weak_gradients: false,
+        ambient_where_flat: flat,
+        ..shading(LobeKind::Pow)
+    };
+    let settings = DvrSettings::new(96, 80, View::Anterior, Some(shading(true)));
+    let cpu = render_dvr(&volume, &transfer, &settings, &|| {}).unwrap();
+    let gpu_image = renderer.render(&volume, &transfer, &settings).unwrap();
+    let mut parity = Parity::new(MAX_MEAN_FLIP, MIN_PSNR_DB);
+    parity.check(
+        "pow, ambient where flat",
+        &gpu,
+        &cpu,
+        &gpu_image,
+        Display::default(),
+    );
+    parity.report();
+    let unlit = DvrSettings::new(96, 80, View::Anterior, Some(shading(false)));
+    let other = render_dvr(&volume, &transfer, &unlit, &|| {}).unwrap();
+    let apart = compare(&cpu, &other, Display::default()).unwrap().mean_flip;
+    let agreement = compare(&cpu, &gpu_image, Display::default())
+        .unwrap()
+        .mean_flip;
+    assert!(apart > 10.0 * agreement.max(1e-5), "{apart} vs {agreement}");
+}
+
 /// Every lobe's image from one march is the one its lobe alone draws, bit for bit, past
 /// the 16 images one march holds (20 lobes: two marches); an unshaded march has no lobe to
 /// vary and is refused.

@@ -82,10 +82,26 @@ pub(crate) fn section(
             return Ok(html);
         }
     };
+    let side = settings.width;
+    let theirs = match vtk_peer::read_png(&job.output) {
+        Ok(pixels) if pixels.len() == (side * settings.height) as usize => pixels,
+        Ok(pixels) => {
+            html += &paragraph(&format!(
+                "VTK's GPU ray caster drew {} pixels, not {side} x {}.",
+                pixels.len(),
+                settings.height
+            ));
+            return Ok(html);
+        }
+        Err(why) => {
+            html += &paragraph(&format!(
+                "VTK's GPU ray caster's image is unreadable: {why}"
+            ));
+            return Ok(html);
+        }
+    };
     let ours = render_dvr_prepared(volume, prepared, transfer, settings, &|| {})
         .map_err(|e| e.to_string())?;
-    let theirs = vtk_peer::read_png(&job.output)?;
-    let side = settings.width;
     let (mut total, mut off) = (0.0_f64, 0_usize);
     for (a, b) in ours.pixels().iter().zip(&theirs) {
         let d = (a.clamp(Vec3::ZERO, Vec3::ONE) - Vec3::from_array(*b)).abs();

@@ -291,13 +291,17 @@ def render(job):
     volume.SetMapper(mapper)
     volume.SetProperty(prop)
     volume.SetUserMatrix(user)
+    lobe = None
     if job.get("lobe_module") is not None:
         import importlib.util
 
-        spec = importlib.util.spec_from_file_location("specula_lobe_vtk", job["lobe_module"])
-        lobe = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(lobe)
-        lobe.apply_to_volume(volume, n=float(shading["power"]) if shading else None)
+        try:
+            spec = importlib.util.spec_from_file_location("specula_lobe_vtk", job["lobe_module"])
+            lobe = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(lobe)
+            lobe.apply_to_volume(volume, n=float(shading["power"]) if shading else None)
+        except Exception as e:  # the module's refusal, or a module that is not one
+            raise Failure(f"{job['lobe_module']}: {e}")
 
     renderer = vtk.vtkRenderer()
     renderer.SetBackground(*job["background"])
@@ -350,6 +354,10 @@ def render(job):
             window.WaitForCompletion()  # glFinish: the GPU's work, not its queueing
         render_seconds.append(time.perf_counter() - start)
         draw_seconds.append(render_seconds[-1] if gpu else mapper.GetTimeToDraw())
+    # The module's watch has seen the shader VTK compiled (from the second frame), with no
+    # specular pow left: a shader that failed to compile draws black and is never announced.
+    if lobe is not None and lobe.uncovered(volume) != []:
+        raise Failure(f"the lobe's shader did not compile or kept a pow: {lobe.uncovered(volume)}")
     if min(draw_seconds) <= 0:
         raise Failure(f"the mapper did not ray cast every frame (draw times {draw_seconds})")
 

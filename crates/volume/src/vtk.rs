@@ -131,7 +131,7 @@ pub struct VtkShading {
     pub diffuse: f32,
     /// Specular weight.
     pub specular: f32,
-    /// Blinn-Phong's exponent.
+    /// The specular power (Blinn-Phong's on the CPU caster, Phong's on the GPU caster).
     pub power: f32,
 }
 
@@ -176,7 +176,7 @@ pub struct VtkJob {
 
 impl VtkJob {
     /// The job on VTK's GPU ray caster, shaded by `lobe_module`'s lobe (VTK's own `pow`
-    /// without one); its settings should be [`alike_gpu_settings`]'.
+    /// without one); its settings should be [`alike_gpu_settings`].
     #[must_use]
     pub fn on_gpu(self, lobe_module: Option<PathBuf>) -> Self {
         Self {

@@ -17,8 +17,9 @@ Each JOB.json (VTK imported once for them all): {"module": "/abs/lobe_vtk.py" or
 
 The camera looks down -z at the origin, parallel projection, parallel scale 1 (the sphere
 fills the height). Writes the framebuffer's RGB bytes, bottom row first (VTK's order), to
-`output`, and prints one JSON line per job: {"vtk": version, "uncovered": [...], "mapper":
-class}.
+`output`, and prints one JSON line per job: {"vtk": version, "uncovered": [...] or null
+(no shader seen), "mapper": class}. A job with "control": true drops the module's
+replacements, so that its watch must report the pows left.
 """
 
 import importlib.util
@@ -127,6 +128,9 @@ def render(path):
     n, side = float(job["n"]), int(job["side"])
     prop, mapper = surface(n) if job["kind"] == "surface" else volume(n)
     module = load(job["module"]) if job.get("module") else None
+    if module is not None and job.get("control"):
+        # The watch's own test: without the replacements every specular pow is left.
+        module.VOLUME_SITES, module.SURFACE_SITES = (), ()
     if module is not None:
         if job["kind"] == "surface":
             module.apply_to_actor(prop, n=n)

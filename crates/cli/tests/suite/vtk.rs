@@ -11,8 +11,9 @@
 //!   read off VTK's own `pow` render of the same scene (`t = pow_pixel^(1/n)`, where that pixel
 //!   is neither black nor saturated) and the lobe's render must be `lobe(t)` there, within
 //!   2/255;
-//! - each lobe's render differs from `pow`'s wherever the lobe differs from `t^n` by more than
-//!   the tolerance, and no specular `pow` is left in any shader VTK wrote (the module's watch).
+//! - each lobe's render moves from `pow`'s by more than 2 tolerances wherever the lobe is more
+//!   than 3 tolerances from `t^n`, and no specular `pow` is left in any shader VTK wrote (the
+//!   module's watch, which reports what it finds left when the replacements are dropped).
 
 use std::path::Path;
 
@@ -33,11 +34,13 @@ struct Job {
     n: f64,
     kind: &'static str,
     lights: &'static str,
+    /// The module without its replacements: its watch must report every `pow` left.
+    control: bool,
 }
 
 /// Renders every job in one Python process; each image's red channel in [0, 1], bottom row
-/// first, and what the module's watch found left.
-fn render(directory: &Path, jobs: &[Job]) -> Vec<(Vec<f64>, Vec<String>)> {
+/// first, and what the module's watch found left (`None`: it saw no shader).
+fn render(directory: &Path, jobs: &[Job]) -> Vec<(Vec<f64>, Option<Vec<String>>)> {
     let mut paths = Vec::new();
     for (k, job) in jobs.iter().enumerate() {
         let path = directory.join(format!("job-{k}.json"));
@@ -47,6 +50,7 @@ fn render(directory: &Path, jobs: &[Job]) -> Vec<(Vec<f64>, Vec<String>)> {
             "side": SIDE,
             "kind": job.kind,
             "lights": job.lights,
+            "control": job.control,
             "output": directory.join(format!("image-{k}.rgb")),
         });
         std::fs::write(&path, spec.to_string()).unwrap();
@@ -91,12 +95,11 @@ fn render(directory: &Path, jobs: &[Job]) -> Vec<(Vec<f64>, Vec<String>)> {
             let bytes = std::fs::read(directory.join(format!("image-{k}.rgb"))).unwrap();
             assert_eq!(bytes.len(), SIDE * SIDE * 3);
             let red = bytes.chunks(3).map(|p| f64::from(p[0]) / 255.0).collect();
-            let left = line["uncovered"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|v| v.as_str().unwrap().to_owned())
-                .collect();
+            let left = line["uncovered"].as_array().map(|left| {
+                left.iter()
+                    .map(|v| v.as_str().unwrap().to_owned())
+                    .collect()
+            });
             (red, left)
         })
         .collect()
@@ -211,6 +214,7 @@ fn vtk_shades_with_each_lobe_in_place_of_pow() {
                 n,
                 kind,
                 lights,
+                control: false,
             });
         }
         for (k, (_, n, _)) in lobes.iter().enumerate() {
@@ -219,6 +223,7 @@ fn vtk_shades_with_each_lobe_in_place_of_pow() {
                 n: *n,
                 kind,
                 lights,
+                control: false,
             });
         }
     }
@@ -231,12 +236,25 @@ fn vtk_shades_with_each_lobe_in_place_of_pow() {
             n: N,
             kind,
             lights: "kit",
+            control: false,
         });
         jobs.push(Job {
             module: Some("lobe1.py".to_owned()),
             n: N,
             kind,
             lights: "kit",
+            control: false,
+        });
+    }
+    // The watch can fail: each path's module without its replacements reports what it left.
+    let controls_from = jobs.len();
+    for &(kind, lights) in &paths {
+        jobs.push(Job {
+            module: Some("lobe1.py".to_owned()),
+            n: N,
+            kind,
+            lights,
+            control: true,
         });
     }
     let images = render(d, &jobs);
@@ -256,7 +274,7 @@ fn vtk_shades_with_each_lobe_in_place_of_pow() {
             let (image, left) = &images[base + 2 + k];
             let label = format!("{lobe} at n = {n}, {kind} under the {lights}");
             check(
-                left.is_empty(),
+                left.as_deref() == Some(&[]),
                 format!("{label}: VTK's shader kept {left:?}"),
             );
             let (cosines, tolerance) = if (kind, lights) == ("surface", "headlight") {
@@ -284,10 +302,16 @@ fn vtk_shades_with_each_lobe_in_place_of_pow() {
             }
         }
     }
-    for pair in images[kit_from..].chunks(2) {
+    for (&(kind, lights), (_, left)) in paths.iter().zip(&images[controls_from..]) {
+        check(
+            left.as_ref().is_some_and(|left| !left.is_empty()),
+            format!("{kind} under the {lights}, replacements dropped: the watch saw {left:?}"),
+        );
+    }
+    for pair in images[kit_from..controls_from].chunks(2) {
         let ((pow_image, _), (image, left)) = (&pair[0], &pair[1]);
         check(
-            left.is_empty(),
+            left.as_deref() == Some(&[]),
             format!("{}: the light kit kept {left:?}", lobes[1].0),
         );
         let moved = image
@@ -423,7 +447,10 @@ fn the_readme_vtk_example_runs_as_written() {
     }
     std::fs::write(
         d.join("example.py"),
-        format!("{example}\nassert lobe.uncovered(volume) == []\n"),
+        format!(
+            "{example}\n# A second frame: the ray caster announces the shader it reuses.\n\
+             volume.Modified(); window.Render()\nassert lobe.uncovered(volume) == []\n"
+        ),
     )
     .unwrap();
     let output = std::process::Command::new(python())
@@ -454,9 +481,10 @@ fn the_gpu_caster_with_each_lobe_agrees_with_specula() {
 
 /// `specula bench vtk-lobes ARGS` at 96 x 96: `pow`'s images within `pow_bounds` (the mean
 /// absolute difference, the fraction of pixels off by more than 0.1), every lobe's within
-/// 0.001 and 0.5 points of `pow`'s, and each lobe's change from `pow` alike in both
-/// renderers (within a factor of 5: `fasterpow`'s is 0.22x on the CT, 0.34x on the phantom,
-/// every other lobe's 0.8-1.3x).
+/// 0.001 and 1 point of `pow`'s, and each lobe's change from `pow` alike in both renderers:
+/// VTK's 0.5-2x specula's (measured 0.8-1.3x), but `fasterpow`'s 0.15-2x (measured 0.22x on
+/// the CT and 0.34x on the phantom, not yet explained), and under 2e-4 where specula's is
+/// under 1e-4.
 pub(crate) fn lobes_agree_in_the_gpu_caster(args: &[&str], pow_bounds: (f64, f64)) {
     use specula_render::read_image;
     let directory = tempfile::tempdir().unwrap();
@@ -519,9 +547,15 @@ pub(crate) fn lobes_agree_in_the_gpu_caster(args: &[&str], pow_bounds: (f64, f64
             off * 100.0
         );
         eprintln!("{line}");
-        // The lobe changes VTK's image as it changes specula's, within a factor of 5.
-        let alike = moved_specula < 1e-4 || (moved_vtk / moved_specula).ln().abs() < 5f64.ln();
-        if agree > pow_agree + 0.001 || off > pow_off + 0.005 || !alike {
+        // The lobe changes VTK's image as it changes specula's: within 0.5-2x (fasterpow's,
+        // unexplained, within 0.15-2x), and hardly where specula's hardly changes.
+        let low = if kind.id() == "fasterpow" { 0.15 } else { 0.5 };
+        let alike = if moved_specula < 1e-4 {
+            moved_vtk < 2e-4
+        } else {
+            (low..=2.0).contains(&(moved_vtk / moved_specula))
+        };
+        if agree > pow_agree + 0.001 || off > pow_off + 0.01 || !alike {
             failures.push(line);
         }
     }

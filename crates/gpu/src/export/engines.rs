@@ -41,6 +41,14 @@ impl Engine {
         geometry: Geometry,
         normalisation: Normalisation,
     ) -> Result<String, ExportError> {
+        if self == Engine::Vtk && normalisation != Normalisation::None {
+            return Err(ExportError {
+                language: "vtk",
+                message: "VTK's Phong specular has no normalisation (ks pow(t, n)), and the \
+                          module replaces only the power: leave --normalisation at none"
+                    .to_owned(),
+            });
+        }
         if self == Engine::Vtk && geometry != Geometry::Phong {
             return Err(ExportError {
                 language: "vtk",

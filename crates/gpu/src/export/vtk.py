@@ -29,6 +29,7 @@ watches the mapper's shaders (vtkCommand.UpdateShaderEvent) and `uncovered(prop)
 specular `pow` that a VTK version wrote differently and the replacements missed.
 """
 
+import numbers
 import re
 import sys
 
@@ -63,7 +64,7 @@ SURFACE_TAG = "//VTK::Light::Dec"
 SYSTEM_TAG = "//VTK::System::Dec"
 BIT_ENCODING = "#extension GL_ARB_shader_bit_encoding : require"
 # A specular power still raised by pow once the replacements ran: a light path missed.
-LEFTOVER = re.compile(r"pow\([^;]*?(in_shininess|specularPower)[^;]*")
+LEFTOVER = re.compile(r"pow\([^;]*?(in_shininess|specularPower|power_specular)[^;]*")
 
 # The CPU ray casters shade without shaders: the lobe cannot reach them.
 CPU_MAPPERS = ("vtkFixedPointVolumeRayCastMapper", "vtkVolumeRayCastMapper", "vtkUnstructuredGridVolumeRayCastMapper")
@@ -79,7 +80,7 @@ def checked_n(value):
     """The exponent this module serves: within N_RANGE, or the exported n where baked in."""
     if value is None:
         return float(EXPORTED_N)
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise SpeculaVtkError(f"specula {LOBE}: n must be a number, not {value!r}")
     fits = value == EXPORTED_N if N_RANGE is None else N_RANGE[0] <= value <= N_RANGE[1]
     if not fits:
@@ -98,7 +99,7 @@ def _watch(mapper, key, what):
         if program is None:
             return
         left = [m.group(0).strip() for m in LEFTOVER.finditer(program.GetFragmentShader().GetSource())]
-        if left and not _uncovered.get(key):
+        if left and not _uncovered.get(key):  # the first miss, once
             print(f"specula {LOBE}: {what}: VTK wrote a specular power this module does not replace: {left[0]}", file=sys.stderr)
         _uncovered[key] = left
 
@@ -123,7 +124,10 @@ def apply_to_volume(volume, n=None):
     if not (hasattr(volume, "IsA") and volume.IsA("vtkVolume")):
         raise SpeculaVtkError(f"specula {LOBE}: apply_to_volume takes a vtkVolume, not {type(volume).__name__}")
     mapper = volume.GetMapper()
-    if mapper is not None and mapper.GetClassName() in CPU_MAPPERS:
+    ray_cast_only = mapper is not None and mapper.IsA("vtkSmartVolumeMapper") and (
+        mapper.GetRequestedRenderMode() == mapper.RayCastRenderMode
+    )
+    if mapper is not None and (mapper.GetClassName() in CPU_MAPPERS or ray_cast_only):
         raise SpeculaVtkError(
             f"specula {LOBE}: the volume's mapper is {mapper.GetClassName()}, which shades on the CPU; the lobe goes into "
             "VTK's GPU ray caster: vtkGPUVolumeRayCastMapper, vtkOpenGLGPUVolumeRayCastMapper or vtkSmartVolumeMapper"
@@ -137,7 +141,7 @@ def apply_to_volume(volume, n=None):
         checked_n(prop.GetSpecularPower(0))
     _replace(volume.GetShaderProperty(), VOLUME_TAG, VOLUME_SITES)
     if mapper is not None:
-        _watch(mapper, id(volume), "the volume's ray caster")
+        _watch(mapper, _key(volume), "the volume's ray caster")
     return volume
 
 
@@ -159,13 +163,19 @@ def apply_to_actor(actor, n=None):
         checked_n(prop.GetSpecularPower())
     _replace(actor.GetShaderProperty(), SURFACE_TAG, SURFACE_SITES)
     if actor.GetMapper() is not None:
-        _watch(actor.GetMapper(), id(actor), "the actor's surface shading")
+        _watch(actor.GetMapper(), _key(actor), "the actor's surface shading")
     return actor
+
+
+def _key(prop):
+    """The VTK object itself (a Python wrapper fetched again is another Python object)."""
+    return prop.GetAddressAsString("vtkObjectBase")
 
 
 def uncovered(prop):
     """The specular pows VTK wrote for `prop` (a volume or actor given to apply_to_*) that the
-    replacements missed, as of its last shader readied: empty where the lobe is in every light
-    path. A volume's ray caster reports from its second frame (VTK announces a shader it
-    reuses, not one it has just built)."""
-    return list(_uncovered.get(id(prop), []))
+    replacements missed, as of its last shader readied: [] where the lobe is in every light
+    path, None until a shader was seen (a volume's ray caster reports from its second frame:
+    VTK announces a shader it reuses, not one it has just built)."""
+    left = _uncovered.get(_key(prop))
+    return None if left is None else list(left)

@@ -113,7 +113,8 @@ pub fn run(args: &Args) -> CommandResult {
     );
     println!(
         "against specula: its marcher set up for this caster (Phong's R.V, rays stopped at \
-         1 - 1/255), mean absolute difference over pixels and channels (of 1) and the \
+         1 - 1/255, a sample with no gradient lit by its ambient term alone), mean absolute \
+         difference over pixels and channels (of 1) and the \
          pixels whose largest channel differs by more than 0.1; against pow: VTK's image with \
          the lobe against its own pow's"
     );

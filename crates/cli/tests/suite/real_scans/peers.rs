@@ -305,13 +305,16 @@ fn the_gpu_renders_the_real_scans_as_the_cpu_does() {
 }
 
 /// Every lobe in VTK's GPU ray caster on the real CT (`ct-bone`) against specula's marcher set
-/// up for that caster (`crate::vtk`'s check). Measured at 128 x 128: `pow`'s images differ by
-/// 0.022 on average and at 7.0 % of the pixels by more than 0.1 (the GPU caster's gradients of
-/// the CT's noise, taken on the fly, against specula's), every lobe's within 0.0007 and 0.5
+/// up for that caster (`crate::vtk`'s check). Measured at 96 x 96: `pow`'s images differ by
+/// 0.0226 on average and at 7.2 % of the pixels by more than 0.1 (the GPU caster's gradients
+/// of the CT's noise, taken on the fly, against specula's), every lobe's within 0.0006 and 0.4
 /// points of that.
 #[test]
 fn the_gpu_caster_with_each_lobe_agrees_with_specula_on_the_ct() {
     let Some(scans) = scans() else { return };
+    if !have_python_module("vtk", "vtk==9.7.2") {
+        return;
+    }
     let input = text(&scans.ct_nifti);
     crate::vtk::lobes_agree_in_the_gpu_caster(
         &["--input", input, "--transfer", "ct-bone"],
