@@ -7,8 +7,9 @@ import specula
 
 @pytest.mark.parametrize("language", specula.languages())
 def test_every_language_is_written(language):
-    # OSL takes no normalisation (its closure is GGX, normalised by construction).
-    normalisation = "none" if language == "osl" else "lobe"
+    # OSL takes no normalisation (its closure is GGX, normalised by construction), nor does
+    # VTK's module (it replaces only the power of VTK's own Phong specular).
+    normalisation = "none" if language in ("osl", "vtk") else "lobe"
     code = specula.Lobe("cosquad", 64, normalisation=normalisation).shader(language)
     if language == "spirv":
         assert isinstance(code, bytes) and code[:4] == b"\x03\x02\x23\x07"
@@ -33,9 +34,10 @@ def test_bad_languages_are_refused():
         lobe.shader("glsl", glsl_version="330")
 
 
-def test_osl_refuses_a_normalisation_as_the_cli_does(cli):
+@pytest.mark.parametrize("language", ["osl", "vtk"])
+def test_a_normalisation_is_refused_as_the_cli_does(cli, language):
     with pytest.raises(ValueError) as raised:
-        specula.Lobe("pow", 8, normalisation="lobe").shader("osl")
+        specula.Lobe("pow", 8, normalisation="lobe").shader(language)
     code, _, err = cli("shader", "--lobe", "pow", "--n", "8", "--normalisation", "lobe",
-                       "--lang", "osl")
+                       "--lang", language)
     assert code != 0 and str(raised.value) in err
