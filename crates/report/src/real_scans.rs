@@ -9,7 +9,7 @@ use std::time::Instant;
 use glam::Vec3;
 use specula::{Exponent, LobeKind};
 use specula_render::metrics::compare;
-use specula_render::{read_image, srgb_encode, Display, Image};
+use specula_render::{Display, Image};
 use specula_volume::dvr::{render_dvr_lobes, render_dvr_prepared, DvrSettings, View};
 use specula_volume::march::PreparedVolume;
 use specula_volume::transfer::TransferFunction;
@@ -343,20 +343,6 @@ fn lobe_table(
     Ok(html)
 }
 
-/// VTK's PNG (8-bit linear values, as VTK composites them) as a linear image.
-fn read_vtk_png(path: &Path) -> Result<Image, String> {
-    let decoded = read_image(path).map_err(|e| e.to_string())?;
-    // `read_image` decodes sRGB; VTK wrote linear values, so encode them back.
-    let pixels = decoded
-        .pixels()
-        .iter()
-        .map(|p| Vec3::new(srgb_encode(p.x), srgb_encode(p.y), srgb_encode(p.z)))
-        .map(|p| (p * 255.0).round() / 255.0)
-        .collect();
-    Image::from_pixels(decoded.width(), decoded.height(), pixels)
-        .ok_or_else(|| "VTK's image has an inconsistent size".to_owned())
-}
-
 /// specula's settings for a render VTK can match, and VTK's job for it.
 fn alike_setup(
     loaded: &Loaded,
@@ -458,7 +444,7 @@ fn against_vtk(
             }
         };
         version = times.version.clone();
-        let theirs = read_vtk_png(&job.output)?;
+        let theirs = vtk_peer::read_png_image(&job.output)?;
         if (theirs.width(), theirs.height()) != (ours.width(), ours.height()) {
             return Err(format!(
                 "VTK drew {}x{} pixels, specula {side}x{side}",

@@ -5,10 +5,9 @@
 
 use std::path::Path;
 
-use glam::Vec3;
 use specula::{Exponent, Geometry, Lobe, LobeKind, Normalisation};
 use specula_gpu::export::Engine;
-use specula_render::{Display, Image};
+use specula_render::Display;
 use specula_volume::dvr::{render_dvr_prepared, DvrSettings, View};
 use specula_volume::march::PreparedVolume;
 use specula_volume::transfer::TransferFunction;
@@ -83,12 +82,13 @@ pub(crate) fn section(
         }
     };
     let side = settings.width;
-    let theirs = match vtk_peer::read_png(&job.output) {
-        Ok(pixels) if pixels.len() == (side * settings.height) as usize => pixels,
-        Ok(pixels) => {
+    let vtk_image = match vtk_peer::read_png_image(&job.output) {
+        Ok(image) if (image.width(), image.height()) == (side, settings.height) => image,
+        Ok(image) => {
             html += &paragraph(&format!(
-                "VTK's GPU ray caster drew {} pixels, not {side} x {}.",
-                pixels.len(),
+                "VTK's GPU ray caster drew {} x {} pixels, not {side} x {}.",
+                image.width(),
+                image.height(),
                 settings.height
             ));
             return Ok(html);
@@ -102,28 +102,17 @@ pub(crate) fn section(
     };
     let ours = render_dvr_prepared(volume, prepared, transfer, settings, &|| {})
         .map_err(|e| e.to_string())?;
-    let (mut total, mut off) = (0.0_f64, 0_usize);
-    for (a, b) in ours.pixels().iter().zip(&theirs) {
-        let d = (a.clamp(Vec3::ZERO, Vec3::ONE) - Vec3::from_array(*b)).abs();
-        total += f64::from(d.x + d.y + d.z);
-        off += usize::from(d.max_element() > 0.1);
-    }
-    let count = theirs.len().max(1);
+    let theirs: Vec<[f32; 3]> = vtk_image.pixels().iter().map(|p| p.to_array()).collect();
+    let (mean, off) = vtk_peer::agreement(&ours, &theirs);
     html += &paragraph(&format!(
         "Mean |specula - VTK| {:.4} (linear, of 1), {:.2} % of the pixels off by more than 0.1; \
          VTK {} on this machine's OpenGL (llvmpipe where there is no GPU), {:.0} ms for the \
          frame. specula bench vtk-lobes times every lobe there against VTK's own pow.",
-        total / (3 * count) as f64,
-        100.0 * off as f64 / count as f64,
+        mean,
+        100.0 * off,
         times.version,
         times.median_draw * 1e3,
     ));
-    let vtk_image = Image::from_pixels(
-        side,
-        side,
-        theirs.iter().map(|p| Vec3::from_array(*p)).collect(),
-    )
-    .ok_or("VTK's image has an inconsistent size")?;
     html += &context.png_srgb8(
         &format!("real-{key}-gpu-specula.png"),
         side,

@@ -237,15 +237,54 @@ impl Running {
 /// decodes sRGB, which encoding again undoes exactly for every byte (the real-scan tests
 /// check every byte).
 pub fn read_png(path: &Path) -> Result<Vec<[f32; 3]>, String> {
-    let image = specula_render::read_image(path).map_err(|e| e.to_string())?;
-    Ok(image
+    Ok(read_png_image(path)?
+        .pixels()
+        .iter()
+        .map(|p| p.to_array())
+        .collect())
+}
+
+/// [`read_png`] as an image.
+pub fn read_png_image(path: &Path) -> Result<Image, String> {
+    let decoded = specula_render::read_image(path).map_err(|e| e.to_string())?;
+    let pixels = decoded
         .pixels()
         .iter()
         .map(|p| {
             p.to_array()
                 .map(|c| (specula_render::srgb_encode(c) * 255.0).round() / 255.0)
         })
-        .collect())
+        .map(glam::Vec3::from_array)
+        .collect();
+    Image::from_pixels(decoded.width(), decoded.height(), pixels)
+        .ok_or_else(|| "VTK's image has an inconsistent size".to_owned())
+}
+
+/// specula's linear image (clamped to [0, 1], as a framebuffer holds it) against VTK's
+/// pixels: the mean absolute difference over pixels and channels, and the fraction of pixels
+/// whose largest channel difference exceeds 0.1.
+#[must_use]
+pub fn agreement(specula: &Image, vtk: &[[f32; 3]]) -> (f64, f64) {
+    let ours: Vec<[f32; 3]> = specula
+        .pixels()
+        .iter()
+        .map(|p| p.to_array().map(|c| c.clamp(0.0, 1.0)))
+        .collect();
+    agreement_of_pixels(&ours, vtk)
+}
+
+/// [`agreement`] between two sets of pixels already in [0, 1].
+#[must_use]
+pub fn agreement_of_pixels(a: &[[f32; 3]], b: &[[f32; 3]]) -> (f64, f64) {
+    let mut sum = 0.0;
+    let mut far = 0usize;
+    for (p, q) in a.iter().zip(b) {
+        let largest = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max);
+        sum += (0..3).map(|c| f64::from((p[c] - q[c]).abs())).sum::<f64>();
+        far += usize::from(largest > 0.1);
+    }
+    let pixels = a.len().max(1) as f64;
+    (sum / (3.0 * pixels), far as f64 / pixels)
 }
 
 /// The volume as a NIfTI file VTK can read: `input` itself, or a copy in `scratch`.

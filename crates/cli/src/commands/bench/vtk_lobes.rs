@@ -7,7 +7,7 @@ use std::path::Path;
 
 use specula::{Geometry, Lobe, LobeKind, Normalisation};
 use specula_gpu::export::Engine;
-use specula_render::{write_image, Display, Image};
+use specula_render::{write_image, Display};
 use specula_report::vtk_peer;
 use specula_volume::dvr::render_dvr_prepared;
 use specula_volume::march::PreparedVolume;
@@ -139,8 +139,8 @@ pub fn run(args: &Args) -> CommandResult {
         let frames = &frames[k];
         let (low, high) = bounds(frames);
         let name = lobe.map_or("pow (VTK's own)".to_owned(), |kind| kind.id().to_owned());
-        let (mean, far) = agreement(&images[k], &vtk_images[k]);
-        let (against_pow, _) = agreement_8bit(&vtk_images[k], &vtk_images[0]);
+        let (mean, far) = vtk_peer::agreement(&images[k], &vtk_images[k]);
+        let (against_pow, _) = vtk_peer::agreement_of_pixels(&vtk_images[k], &vtk_images[0]);
         let (ratio_low, ratio_high) = (low / pow_high, high / pow_low);
         let tie = if ratio_low <= 1.0 && ratio_high >= 1.0 {
             " (tie)"
@@ -182,28 +182,4 @@ pub fn run(args: &Args) -> CommandResult {
         );
     }
     Ok(())
-}
-
-/// specula's linear image (clamped to [0, 1], as a framebuffer holds it) against VTK's.
-fn agreement(specula: &Image, vtk: &[[f32; 3]]) -> (f64, f64) {
-    let ours: Vec<[f32; 3]> = specula
-        .pixels()
-        .iter()
-        .map(|p| p.to_array().map(|c| c.clamp(0.0, 1.0)))
-        .collect();
-    agreement_8bit(&ours, vtk)
-}
-
-/// The mean absolute difference over pixels and channels, and the fraction of pixels whose
-/// largest channel difference exceeds 0.1.
-fn agreement_8bit(a: &[[f32; 3]], b: &[[f32; 3]]) -> (f64, f64) {
-    let mut sum = 0.0;
-    let mut far = 0usize;
-    for (p, q) in a.iter().zip(b) {
-        let largest = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max);
-        sum += (0..3).map(|c| f64::from((p[c] - q[c]).abs())).sum::<f64>();
-        far += usize::from(largest > 0.1);
-    }
-    let pixels = a.len().max(1) as f64;
-    (sum / (3.0 * pixels), far as f64 / pixels)
 }
